@@ -1,0 +1,1 @@
+//! Host-side driver for the hydrorattle kernel.

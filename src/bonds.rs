@@ -1,0 +1,179 @@
+//! Fixed-capacity bond lists: chains, rings, trees and arbitrary topologies.
+//!
+//! Bond `k` joins particles `(i, j)` with length `d_k`; its constraint is
+//! `sigma_k = |r_i - r_j|^2 - d_k^2 = 0`.
+
+use crate::error::BondError;
+use crate::real::Real;
+use heapless::Vec;
+
+/// One holonomic distance constraint.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bond<T: Real> {
+    /// First particle.
+    pub i: usize,
+    /// Second particle.
+    pub j: usize,
+    /// Centre-to-centre length.
+    pub length: T,
+}
+
+/// Up to `B` bonds (heapless storage).
+#[derive(Clone, Debug, Default)]
+pub struct BondSet<T: Real, const B: usize> {
+    bonds: Vec<Bond<T>, B>,
+}
+
+impl<T: Real, const B: usize> BondSet<T, B> {
+    /// No bonds.
+    pub const fn new() -> Self {
+        Self { bonds: Vec::new() }
+    }
+
+    /// The bonds, in insertion order (which is the SHAKE sweep order).
+    pub fn as_slice(&self) -> &[Bond<T>] {
+        &self.bonds
+    }
+
+    /// Number of bonds.
+    pub fn len(&self) -> usize {
+        self.bonds.len()
+    }
+
+    /// `true` when there are no bonds.
+    pub fn is_empty(&self) -> bool {
+        self.bonds.is_empty()
+    }
+
+    /// Adds a bond after checking it against the `n` particles and the bonds already
+    /// present. Hands the bond back with the reason when it is rejected.
+    pub fn push(&mut self, b: Bond<T>, n: usize) -> Result<usize, (Bond<T>, BondError)> {
+        let k = self.bonds.len();
+        if let Err(e) = check_bond(k, &b, n, &self.bonds) {
+            return Err((b, e));
+        }
+        self.bonds.push(b).map_err(|b| (b, BondError::Full))?;
+        Ok(k)
+    }
+
+    /// Adds a bond whose length is the current distance between its particles.
+    pub fn push_current(
+        &mut self,
+        i: usize,
+        j: usize,
+        pos: &[T::V3],
+    ) -> Result<usize, (Bond<T>, BondError)> {
+        let length = match (pos.get(i), pos.get(j)) {
+            (Some(&a), Some(&b)) => T::norm(a - b),
+            _ => T::ZERO,
+        };
+        self.push(Bond { i, j, length }, pos.len())
+    }
+
+    /// A chain `0-1-...-(n-1)` with lengths taken from `pos` (`n = pos.len()`).
+    pub fn chain(pos: &[T::V3]) -> Result<Self, BondError> {
+        let mut s = Self::new();
+        for i in 1..pos.len() {
+            s.push_current(i - 1, i, pos).map_err(|(_, e)| e)?;
+        }
+        Ok(s)
+    }
+
+    /// A ring: the chain plus the bond closing it (needs at least 3 particles).
+    pub fn ring(pos: &[T::V3]) -> Result<Self, BondError> {
+        let mut s = Self::chain(pos)?;
+        // n < 3 fails naturally: a self-bond (n = 1), a duplicate (n = 2), out of range (n = 0).
+        let last = pos.len().saturating_sub(1);
+        s.push_current(last, 0, pos).map_err(|(_, e)| e)?;
+        Ok(s)
+    }
+
+    /// A tree from a parent list: `parents[c] = Some(p)` bonds `c` to `p < c`;
+    /// `None` marks a root. Lengths are taken from `pos`.
+    pub fn tree(pos: &[T::V3], parents: &[Option<usize>]) -> Result<Self, BondError> {
+        if parents.len() != pos.len() {
+            return Err(BondError::BadTree {
+                particle: parents.len().min(pos.len()),
+            });
+        }
+        let mut s = Self::new();
+        for (c, p) in parents.iter().enumerate() {
+            if let Some(p) = *p {
+                if p >= c {
+                    return Err(BondError::BadTree { particle: c });
+                }
+                s.push_current(p, c, pos).map_err(|(_, e)| e)?;
+            }
+        }
+        Ok(s)
+    }
+
+    /// Checks every bond against `n` particles and against each other.
+    pub fn validate(&self, n: usize) -> Result<(), BondError> {
+        for (k, b) in self.bonds.iter().enumerate() {
+            check_bond(k, b, n, &self.bonds[..k])?;
+        }
+        Ok(())
+    }
+
+    /// Largest relative length error `| |r_ij| - d | / d` and its bond (0 if none).
+    pub fn max_residual(&self, pos: &[T::V3]) -> (usize, T) {
+        max_residual(&self.bonds, pos)
+    }
+
+    /// Validates, then checks that `pos` satisfies every bond to relative `tolerance`.
+    pub fn check_satisfied(&self, pos: &[T::V3], tolerance: T) -> Result<(), BondError> {
+        self.validate(pos.len())?;
+        let (bond, r) = self.max_residual(pos);
+        if r.is_finite() && r <= tolerance {
+            Ok(())
+        } else {
+            Err(BondError::Violated {
+                bond,
+                residual: r.to_f64(),
+            })
+        }
+    }
+}
+
+/// Largest relative length error over `bonds` and the bond where it occurs.
+pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
+    let mut worst = (0, T::ZERO);
+    for (k, b) in bonds.iter().enumerate() {
+        let r = ((T::norm(pos[b.i] - pos[b.j]) - b.length) / b.length).abs();
+        if !(r <= worst.1) {
+            worst = (k, r);
+        }
+    }
+    worst
+}
+
+fn check_bond<T: Real>(
+    k: usize,
+    b: &Bond<T>,
+    n: usize,
+    earlier: &[Bond<T>],
+) -> Result<(), BondError> {
+    for p in [b.i, b.j] {
+        if p >= n {
+            return Err(BondError::OutOfRange {
+                bond: k,
+                particle: p,
+            });
+        }
+    }
+    if b.i == b.j {
+        return Err(BondError::SelfBond {
+            bond: k,
+            particle: b.i,
+        });
+    }
+    if !(b.length.is_finite() && b.length > T::ZERO) {
+        return Err(BondError::BadLength { bond: k });
+    }
+    let same = |o: &Bond<T>| (o.i == b.i && o.j == b.j) || (o.i == b.j && o.j == b.i);
+    if let Some(other) = earlier.iter().position(same) {
+        return Err(BondError::Duplicate { bond: k, other });
+    }
+    Ok(())
+}

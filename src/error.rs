@@ -1,0 +1,266 @@
+//! Typed errors: one small `Copy` enum per operation, each with `Display`.
+//!
+//! Payloads name the particle, bond or matrix row at fault; residuals are carried as
+//! `f64` so the enums stay independent of the precision.
+
+use core::fmt;
+
+/// A particle set rejected an input.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParticleError {
+    /// The set is full (capacity `N`).
+    Full,
+    /// A position, velocity, radius or density is NaN or infinite.
+    NonFinite {
+        /// Index of the particle.
+        particle: usize,
+    },
+    /// Radius is zero or negative.
+    BadRadius {
+        /// Index of the particle.
+        particle: usize,
+    },
+    /// Density is negative.
+    BadDensity {
+        /// Index of the particle.
+        particle: usize,
+    },
+    /// One sphere lies inside the other (`|r_i - r_j| <= |a_i - a_j|`).
+    Nested {
+        /// First particle.
+        i: usize,
+        /// Second particle.
+        j: usize,
+    },
+    /// Two spheres overlap (`|r_i - r_j| < a_i + a_j`) and the policy rejects it.
+    Overlap {
+        /// First particle.
+        i: usize,
+        /// Second particle.
+        j: usize,
+    },
+    /// An inertial method needs every particle to have positive mass.
+    Massless {
+        /// Index of the particle.
+        particle: usize,
+    },
+}
+
+/// A bond set rejected an input.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BondError {
+    /// The bond list is full (capacity `B`).
+    Full,
+    /// A bond joins a particle to itself.
+    SelfBond {
+        /// Index of the bond.
+        bond: usize,
+        /// The particle.
+        particle: usize,
+    },
+    /// A bond names a particle that does not exist.
+    OutOfRange {
+        /// Index of the bond.
+        bond: usize,
+        /// The index given.
+        particle: usize,
+    },
+    /// The same pair is bonded twice.
+    Duplicate {
+        /// Index of the later bond.
+        bond: usize,
+        /// Index of the earlier bond.
+        other: usize,
+    },
+    /// Length is zero, negative or not finite.
+    BadLength {
+        /// Index of the bond.
+        bond: usize,
+    },
+    /// The configuration is off the constraint by more than the tolerance.
+    Violated {
+        /// Index of the bond.
+        bond: usize,
+        /// Relative length error `| |r_ij| - d | / d`.
+        residual: f64,
+    },
+    /// A tree needs `parents.len() == particles` and each parent index below its child.
+    BadTree {
+        /// The child whose parent is invalid.
+        particle: usize,
+    },
+}
+
+/// A factorisation or solve failed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LinalgError {
+    /// The matrix is not (numerically) positive definite; the pivot at `row` was not positive.
+    NotPositiveDefinite {
+        /// Scalar row where the pivot failed.
+        row: usize,
+    },
+    /// The matrix is (numerically) singular at `row`.
+    Singular {
+        /// Scalar row where the pivot vanished.
+        row: usize,
+    },
+}
+
+/// Where in a step a linear-algebra failure happened.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Factorising the mobility (resistance through Cholesky).
+    Mobility,
+    /// Factorising the implicit drag operator.
+    Drag,
+    /// Solving for position multipliers.
+    Positions,
+    /// Solving for velocity multipliers.
+    Velocities,
+    /// Estimating the explicit-drag stability limit.
+    Stability,
+}
+
+/// A step failed; the caller's state is exactly as it was before the call.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StepError {
+    /// `dt` is zero, negative or not finite.
+    BadTimeStep,
+    /// A parameter other than `dt` is invalid (named).
+    BadParameter(&'static str),
+    /// The particle set is invalid (checked at the start of the step).
+    Particle(ParticleError),
+    /// The bond set is invalid for these particles.
+    Bond(BondError),
+    /// A factorisation failed.
+    Linalg {
+        /// The stage.
+        stage: Stage,
+        /// The failure.
+        error: LinalgError,
+    },
+    /// A constraint solve hit its iteration cap.
+    NoConvergence {
+        /// Which solve.
+        stage: Stage,
+        /// Iterations done.
+        iterations: u32,
+        /// Largest residual left.
+        residual: f64,
+    },
+    /// A bond turned so far in one step that the linearised update has no root
+    /// (the SHAKE denominator vanished or changed sign).
+    Degenerate {
+        /// The bond.
+        bond: usize,
+    },
+    /// A force, velocity or position became NaN or infinite.
+    NonFinite {
+        /// The particle.
+        particle: usize,
+    },
+    /// Two spheres overlap or nest after the step, and the policy rejects it.
+    Overlap {
+        /// First particle.
+        i: usize,
+        /// Second particle.
+        j: usize,
+    },
+    /// The explicit-drag step is beyond its linear stability limit.
+    Unstable {
+        /// The step asked for.
+        dt: f64,
+        /// The largest stable step for this configuration.
+        limit: f64,
+    },
+}
+
+impl fmt::Display for ParticleError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::Full => write!(f, "particle set is full"),
+            Self::NonFinite { particle } => write!(f, "particle {particle}: non-finite value"),
+            Self::BadRadius { particle } => write!(f, "particle {particle}: radius must be > 0"),
+            Self::BadDensity { particle } => write!(f, "particle {particle}: density must be >= 0"),
+            Self::Nested { i, j } => write!(f, "particles {i} and {j}: one sphere inside the other"),
+            Self::Overlap { i, j } => write!(f, "particles {i} and {j} overlap"),
+            Self::Massless { particle } => {
+                write!(f, "particle {particle}: inertial method needs mass > 0")
+            }
+        }
+    }
+}
+
+impl fmt::Display for BondError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::Full => write!(f, "bond list is full"),
+            Self::SelfBond { bond, particle } => {
+                write!(f, "bond {bond}: particle {particle} bonded to itself")
+            }
+            Self::OutOfRange { bond, particle } => {
+                write!(f, "bond {bond}: particle index {particle} out of range")
+            }
+            Self::Duplicate { bond, other } => write!(f, "bond {bond} duplicates bond {other}"),
+            Self::BadLength { bond } => write!(f, "bond {bond}: length must be finite and > 0"),
+            Self::Violated { bond, residual } => {
+                write!(f, "bond {bond}: configuration off by relative {residual:e}")
+            }
+            Self::BadTree { particle } => {
+                write!(f, "tree: particle {particle} needs a parent with a smaller index")
+            }
+        }
+    }
+}
+
+impl fmt::Display for LinalgError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::NotPositiveDefinite { row } => {
+                write!(f, "matrix not positive definite (pivot at row {row})")
+            }
+            Self::Singular { row } => write!(f, "matrix singular (pivot at row {row})"),
+        }
+    }
+}
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::BadTimeStep => write!(f, "time step must be finite and > 0"),
+            Self::BadParameter(name) => write!(f, "invalid parameter: {name}"),
+            Self::Particle(e) => write!(f, "{e}"),
+            Self::Bond(e) => write!(f, "{e}"),
+            Self::Linalg { stage, error } => write!(f, "{stage:?}: {error}"),
+            Self::NoConvergence {
+                stage,
+                iterations,
+                residual,
+            } => write!(
+                f,
+                "{stage:?} constraint solve did not converge in {iterations} iterations (residual {residual:e})"
+            ),
+            Self::Degenerate { bond } => {
+                write!(f, "bond {bond} turned too far in one step (degenerate SHAKE update)")
+            }
+            Self::NonFinite { particle } => write!(f, "particle {particle}: state became non-finite"),
+            Self::Overlap { i, j } => write!(f, "particles {i} and {j} overlap after the step"),
+            Self::Unstable { dt, limit } => write!(
+                f,
+                "explicit drag unstable: dt = {dt:e} exceeds the stability limit {limit:e}"
+            ),
+        }
+    }
+}
+
+impl From<ParticleError> for StepError {
+    fn from(e: ParticleError) -> Self {
+        Self::Particle(e)
+    }
+}
+
+impl From<BondError> for StepError {
+    fn from(e: BondError) -> Self {
+        Self::Bond(e)
+    }
+}

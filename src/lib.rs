@@ -1,0 +1,30 @@
+//! # hydrorattle
+//!
+//! A `#![no_std]`, allocation-free kernel for HydroRATTLE (A. S. Kim, 2012):
+//! RATTLE/SHAKE constraint dynamics of bonded rigid spheres in Stokesian dynamics with
+//! the far-field Rotne-Prager-Yamakawa grand mobility.
+//!
+//! Everything is generic over the precision ([`Real`]: `f32`, `f64`) and over the
+//! particle capacity `N` (and bond capacity `B`); all storage is caller-owned.
+//!
+//! Where to look:
+//! * RPY formulas: [`mobility`];
+//! * Cholesky and solves: [`linalg`];
+//! * the SHAKE sweep, Newton solve and RATTLE velocity sweep: [`constraints`];
+//! * the integrators and [`step`]: [`integrate`].
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod bonds;
+pub mod error;
+pub mod linalg;
+pub mod mobility;
+pub mod particles;
+pub mod real;
+
+pub use bonds::{Bond, BondSet};
+pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
+pub use mobility::Hydro;
+pub use particles::{Particle, ParticleSet};
+pub use real::Real;

@@ -1,0 +1,213 @@
+//! Far-field hydrodynamics: the polydisperse Rotne-Prager-Yamakawa grand mobility
+//! (Zuk, Wajnryb, Mizerski & Szymczak, J. Fluid Mech. 741 R5, 2014) and two cheaper
+//! levels (Oseen, free-draining).
+//!
+//! Blocks follow `U_i = sum_j (tt_ij F_j + tr_ij T_j)`, `W_i = sum_j (rt_ij F_j + rr_ij T_j)`
+//! with `r = r_i - r_j`, `s = |r|`, `e = r / s`. Storage is caller-owned: a row-major
+//! array of 3x3 blocks, `n x n` for `tt` alone or `2n x 2n` for the grand mobility
+//! (block rows `0..n` translations, `n..2n` rotations, matching the ordering of the
+//! reference data).
+
+use crate::error::ParticleError;
+use crate::real::Real;
+
+/// How much hydrodynamics to model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Hydro {
+    /// Self terms only (Stokes drag on each sphere, no interactions).
+    FreeDraining,
+    /// Point-force (Oseen) interactions: `(I + e e) / (8 pi eta s)`. Not positive
+    /// definite when spheres come close: a documented failure case.
+    Oseen,
+    /// Rotne-Prager-Yamakawa, far and overlapping branches (default).
+    #[default]
+    Rpy,
+}
+
+/// The 3x3 blocks of one pair's mobility.
+#[derive(Clone, Copy, Debug)]
+pub struct PairBlocks<T: Real> {
+    /// Translation of `i` from force on `j` (`tt_ij = tt_ji`).
+    pub tt: T::M3,
+    /// Rotation of `i` from force on `j`.
+    pub rt_ij: T::M3,
+    /// Rotation of `j` from force on `i` (differs from `-rt_ij` for unequal
+    /// overlapping spheres).
+    pub rt_ji: T::M3,
+    /// Rotation from torque (`rr_ij = rr_ji`).
+    pub rr: T::M3,
+}
+
+/// `1/(6 pi eta a)`: Stokes' translational mobility of a lone sphere.
+pub fn self_tt<T: Real>(eta: T, a: T) -> T {
+    T::ONE / (T::from_f64(6.0) * T::PI * eta * a)
+}
+
+/// `1/(8 pi eta a^3)`: rotational mobility of a lone sphere.
+pub fn self_rr<T: Real>(eta: T, a: T) -> T {
+    T::ONE / (T::from_f64(8.0) * T::PI * eta * a * a * a)
+}
+
+/// Translation-translation block for the pair `(i, j)`, `i != j`.
+///
+/// `Err(())` when one sphere lies inside the other (no valid RPY form there).
+#[inline]
+pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Result<T::M3, ()> {
+    let s2 = T::norm2(r);
+    let s = s2.sqrt();
+    if level == Hydro::FreeDraining {
+        return Ok(T::M3_ZERO);
+    }
+    let e = r / s;
+    let ee = T::outer(e, e);
+    let pi8 = T::from_f64(8.0) * T::PI * eta;
+    if level == Hydro::Oseen {
+        return Ok((T::M3_IDENTITY + ee) * (T::ONE / (pi8 * s)));
+    }
+    let sum = ai + aj;
+    let dif = ai - aj;
+    if s > sum {
+        let q = (ai * ai + aj * aj) / s2;
+        let third = T::ONE / T::from_f64(3.0);
+        let c = T::ONE / (pi8 * s);
+        Ok(T::m3_diag(c * (T::ONE + q * third)) + ee * (c * (T::ONE - q)))
+    } else if s > dif.abs() {
+        // Overlapping branch (Zuk et al. 2014, eq. 2.7): stays positive definite.
+        let s3 = s2 * s;
+        let k = T::ONE / (T::from_f64(6.0) * T::PI * eta * ai * aj * T::from_f64(32.0) * s3);
+        let p = dif * dif + T::from_f64(3.0) * s2;
+        let iso = T::from_f64(16.0) * s3 * sum - p * p;
+        let q = dif * dif - s2;
+        let aniso = T::from_f64(3.0) * q * q;
+        Ok(T::m3_diag(k * iso) + ee * (k * aniso))
+    } else {
+        Err(())
+    }
+}
+
+/// All blocks for the pair `(i, j)`, `i != j` (rotation couplings included).
+pub fn pair_blocks<T: Real>(
+    level: Hydro,
+    eta: T,
+    ai: T,
+    aj: T,
+    r: T::V3,
+) -> Result<PairBlocks<T>, ()> {
+    let tt = pair_tt(level, eta, ai, aj, r)?;
+    if level == Hydro::FreeDraining {
+        return Ok(PairBlocks {
+            tt,
+            rt_ij: T::M3_ZERO,
+            rt_ji: T::M3_ZERO,
+            rr: T::M3_ZERO,
+        });
+    }
+    let s2 = T::norm2(r);
+    let s = s2.sqrt();
+    let e = r / s;
+    let ee = T::outer(e, e);
+    let three = T::from_f64(3.0);
+    let pi8 = T::from_f64(8.0) * T::PI * eta;
+    // rt_ij F = c_ij (F x e) = -c_ij [e]x F; rt_ji uses -e and the swapped radii.
+    let cross = T::m3_cross(e);
+    let far = level == Hydro::Oseen || s > ai + aj;
+    let rt_ij = cross * (-rt_coefficient(far, eta, ai, aj, s));
+    let rt_ji = cross * rt_coefficient(far, eta, aj, ai, s);
+    if far {
+        let rr = (ee * three - T::M3_IDENTITY) * (T::ONE / (T::TWO * pi8 * s2 * s));
+        return Ok(PairBlocks {
+            tt,
+            rt_ij,
+            rt_ji,
+            rr,
+        });
+    }
+    // Overlapping branch (Zuk et al. 2014).
+    let s3 = s2 * s;
+    let (ai2, aj2) = (ai * ai, aj * aj);
+    let dif = ai - aj;
+    let dif2 = dif * dif;
+    let w = ai2 + T::from_f64(4.0) * ai * aj + aj2;
+    let iso = T::from_f64(5.0) * s3 * s3 - T::from_f64(27.0) * s2 * s2 * (ai2 + aj2)
+        + T::from_f64(32.0) * s3 * (ai2 * ai + aj2 * aj)
+        - T::from_f64(9.0) * s2 * (ai2 - aj2) * (ai2 - aj2)
+        - dif2 * dif2 * w;
+    let q = dif2 - s2;
+    let aniso = three * q * q * (w - s2);
+    let krr = T::ONE / (pi8 * ai2 * ai * aj2 * aj * T::from_f64(64.0) * s3);
+    let rr = T::m3_diag(krr * iso) + ee * (krr * aniso);
+    Ok(PairBlocks {
+        tt,
+        rt_ij,
+        rt_ji,
+        rr,
+    })
+}
+
+/// Scalar `c` in `rt_ij F = c (F x e_ij)`, `e_ij = (r_i - r_j)/s`.
+fn rt_coefficient<T: Real>(far: bool, eta: T, ai: T, aj: T, s: T) -> T {
+    let pi16 = T::from_f64(16.0) * T::PI * eta;
+    if far {
+        return T::TWO / (pi16 * s * s);
+    }
+    // Continuous with the far form at s = a_i + a_j (both give 1 / (8 pi eta s^2)).
+    let g = ai - aj + s;
+    let h = ai - s;
+    let poly = g * g * (aj * aj + T::TWO * aj * (ai + s) - T::from_f64(3.0) * h * h);
+    poly / (pi16 * ai * ai * ai * aj * T::from_f64(8.0) * s * s)
+}
+
+/// Assembles the `n x n` translational mobility `mu_tt` into `out[..n*n]`, both
+/// triangles (symmetric by construction: each pair is evaluated once).
+pub fn assemble_tt<T: Real>(
+    level: Hydro,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    out: &mut [T::M3],
+) -> Result<(), ParticleError> {
+    let n = pos.len();
+    for i in 0..n {
+        out[i * n + i] = T::m3_diag(self_tt(eta, radius[i]));
+        for j in 0..i {
+            let b = pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
+                .map_err(|()| ParticleError::Nested { i: j, j: i })?;
+            out[i * n + j] = b;
+            out[j * n + i] = b;
+        }
+    }
+    Ok(())
+}
+
+/// Assembles the `2n x 2n` grand mobility `[[tt, tr], [rt, rr]]` into `out[..4n^2]`.
+pub fn assemble_grand<T: Real>(
+    level: Hydro,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    out: &mut [T::M3],
+) -> Result<(), ParticleError> {
+    let n = pos.len();
+    let m = 2 * n;
+    for i in 0..n {
+        let a = radius[i];
+        out[i * m + i] = T::m3_diag(self_tt(eta, a));
+        out[(n + i) * m + n + i] = T::m3_diag(self_rr(eta, a));
+        out[i * m + n + i] = T::M3_ZERO;
+        out[(n + i) * m + i] = T::M3_ZERO;
+        for j in 0..i {
+            let b = pair_blocks(level, eta, a, radius[j], pos[i] - pos[j])
+                .map_err(|()| ParticleError::Nested { i: j, j: i })?;
+            // The grand mobility is symmetric: tr_ij = rt_ji^T.
+            out[i * m + j] = b.tt;
+            out[j * m + i] = b.tt;
+            out[(n + i) * m + n + j] = b.rr;
+            out[(n + j) * m + n + i] = b.rr;
+            out[(n + i) * m + j] = b.rt_ij;
+            out[(n + j) * m + i] = b.rt_ji;
+            out[i * m + n + j] = T::transpose(b.rt_ji);
+            out[j * m + n + i] = T::transpose(b.rt_ij);
+        }
+    }
+    Ok(())
+}

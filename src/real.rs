@@ -1,0 +1,290 @@
+//! One precision trait, implemented for `f32` and `f64`.
+//!
+//! Every algorithm in the kernel is written once against [`Real`]. The vector and
+//! 3x3 matrix types are glam's (`Vec3`/`Mat3` or `DVec3`/`DMat3`); transcendental
+//! functions go through `libm`, so results do not depend on the platform's maths
+//! library.
+
+use core::fmt::{Debug, Display};
+use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
+
+/// A floating-point precision the kernel runs in.
+pub trait Real:
+    Copy
+    + Debug
+    + Display
+    + Default
+    + PartialEq
+    + PartialOrd
+    + Send
+    + Sync
+    + 'static
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+    + DivAssign
+{
+    /// 3-vector of this precision (glam).
+    type V3: Copy
+        + Debug
+        + PartialEq
+        + Send
+        + Sync
+        + Add<Output = Self::V3>
+        + Sub<Output = Self::V3>
+        + Mul<Self, Output = Self::V3>
+        + Div<Self, Output = Self::V3>
+        + Neg<Output = Self::V3>
+        + AddAssign
+        + SubAssign
+        + MulAssign<Self>;
+    /// 3x3 matrix of this precision (glam, column-major).
+    type M3: Copy
+        + Debug
+        + PartialEq
+        + Send
+        + Sync
+        + Add<Output = Self::M3>
+        + Sub<Output = Self::M3>
+        + Mul<Output = Self::M3>
+        + Mul<Self::V3, Output = Self::V3>
+        + Mul<Self, Output = Self::M3>
+        + AddAssign
+        + SubAssign;
+
+    /// 0.
+    const ZERO: Self;
+    /// 1.
+    const ONE: Self;
+    /// 2.
+    const TWO: Self;
+    /// 1/2.
+    const HALF: Self;
+    /// pi.
+    const PI: Self;
+    /// Machine epsilon.
+    const EPSILON: Self;
+    /// The zero vector.
+    const V3_ZERO: Self::V3;
+    /// The zero matrix.
+    const M3_ZERO: Self::M3;
+    /// The identity matrix.
+    const M3_IDENTITY: Self::M3;
+
+    /// Converts from `f64` (rounding for `f32`).
+    fn from_f64(x: f64) -> Self;
+    /// Converts to `f64` (exact).
+    fn to_f64(self) -> f64;
+    /// Square root (libm).
+    fn sqrt(self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// Sine (libm).
+    fn sin(self) -> Self;
+    /// Cosine (libm).
+    fn cos(self) -> Self;
+    /// Four-quadrant arctangent of `self / x` (libm).
+    fn atan2(self, x: Self) -> Self;
+    /// Arccosine (libm).
+    fn acos(self) -> Self;
+    /// Exponential (libm).
+    fn exp(self) -> Self;
+    /// `true` unless NaN or infinite.
+    fn is_finite(self) -> bool;
+    /// The larger of two values (NaN-ignoring as `f64::max`).
+    fn max(self, other: Self) -> Self;
+    /// The smaller of two values.
+    fn min(self, other: Self) -> Self;
+
+    /// Builds a vector.
+    fn v3(x: Self, y: Self, z: Self) -> Self::V3;
+    /// The components of a vector.
+    fn xyz(v: Self::V3) -> [Self; 3];
+    /// Dot product.
+    fn dot(a: Self::V3, b: Self::V3) -> Self;
+    /// Cross product.
+    fn cross(a: Self::V3, b: Self::V3) -> Self::V3;
+    /// Builds a matrix from its columns.
+    fn m3_cols(c0: Self::V3, c1: Self::V3, c2: Self::V3) -> Self::M3;
+    /// Column `i` of a matrix.
+    fn m3_col(m: Self::M3, i: usize) -> Self::V3;
+    /// Transpose.
+    fn transpose(m: Self::M3) -> Self::M3;
+
+    /// Converts from an `f64` triple.
+    fn v3_from(a: [f64; 3]) -> Self::V3 {
+        Self::v3(Self::from_f64(a[0]), Self::from_f64(a[1]), Self::from_f64(a[2]))
+    }
+    /// Converts to an `f64` triple.
+    fn v3_to_f64(v: Self::V3) -> [f64; 3] {
+        let [x, y, z] = Self::xyz(v);
+        [x.to_f64(), y.to_f64(), z.to_f64()]
+    }
+    /// Squared length (plain multiply-add, no fma: same bits everywhere).
+    fn norm2(v: Self::V3) -> Self {
+        Self::dot(v, v)
+    }
+    /// Length, through libm's square root.
+    fn norm(v: Self::V3) -> Self {
+        Self::dot(v, v).sqrt()
+    }
+    /// `true` when all three components are finite.
+    fn v3_is_finite(v: Self::V3) -> bool {
+        let [x, y, z] = Self::xyz(v);
+        x.is_finite() && y.is_finite() && z.is_finite()
+    }
+    /// Outer product `a b^T`.
+    fn outer(a: Self::V3, b: Self::V3) -> Self::M3 {
+        let [x, y, z] = Self::xyz(b);
+        Self::m3_cols(a * x, a * y, a * z)
+    }
+    /// `m^T v` without forming the transpose.
+    fn m3_tmul(m: Self::M3, v: Self::V3) -> Self::V3 {
+        Self::v3(
+            Self::dot(Self::m3_col(m, 0), v),
+            Self::dot(Self::m3_col(m, 1), v),
+            Self::dot(Self::m3_col(m, 2), v),
+        )
+    }
+    /// `s I`.
+    fn m3_diag(s: Self) -> Self::M3 {
+        Self::M3_IDENTITY * s
+    }
+    /// Element at row `r`, column `c`.
+    fn m3_get(m: Self::M3, r: usize, c: usize) -> Self {
+        Self::xyz(Self::m3_col(m, c))[r]
+    }
+    /// The matrix of `x -> v x x` (cross-product matrix `[v]x`).
+    fn m3_cross(v: Self::V3) -> Self::M3 {
+        let [x, y, z] = Self::xyz(v);
+        let o = Self::ZERO;
+        Self::m3_cols(Self::v3(o, z, -y), Self::v3(-z, o, x), Self::v3(y, -x, o))
+    }
+}
+
+macro_rules! impl_real {
+    ($t:ty, $v:ty, $m:ty, $sqrt:path, $sin:path, $cos:path, $atan2:path, $acos:path, $exp:path) => {
+        impl Real for $t {
+            type V3 = $v;
+            type M3 = $m;
+            const ZERO: Self = 0.0;
+            const ONE: Self = 1.0;
+            const TWO: Self = 2.0;
+            const HALF: Self = 0.5;
+            const PI: Self = core::f64::consts::PI as $t;
+            const EPSILON: Self = <$t>::EPSILON;
+            const V3_ZERO: $v = <$v>::ZERO;
+            const M3_ZERO: $m = <$m>::ZERO;
+            const M3_IDENTITY: $m = <$m>::IDENTITY;
+
+            #[inline]
+            fn from_f64(x: f64) -> Self {
+                x as $t
+            }
+            #[inline]
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            #[inline]
+            fn sqrt(self) -> Self {
+                $sqrt(self)
+            }
+            #[inline]
+            fn abs(self) -> Self {
+                if self < 0.0 { -self } else { self }
+            }
+            #[inline]
+            fn sin(self) -> Self {
+                $sin(self)
+            }
+            #[inline]
+            fn cos(self) -> Self {
+                $cos(self)
+            }
+            #[inline]
+            fn atan2(self, x: Self) -> Self {
+                $atan2(self, x)
+            }
+            #[inline]
+            fn acos(self) -> Self {
+                $acos(self)
+            }
+            #[inline]
+            fn exp(self) -> Self {
+                $exp(self)
+            }
+            #[inline]
+            fn is_finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
+            #[inline]
+            fn max(self, other: Self) -> Self {
+                <$t>::max(self, other)
+            }
+            #[inline]
+            fn min(self, other: Self) -> Self {
+                <$t>::min(self, other)
+            }
+            #[inline]
+            fn v3(x: Self, y: Self, z: Self) -> $v {
+                <$v>::new(x, y, z)
+            }
+            #[inline]
+            fn xyz(v: $v) -> [Self; 3] {
+                v.to_array()
+            }
+            #[inline]
+            fn dot(a: $v, b: $v) -> Self {
+                a.x * b.x + a.y * b.y + a.z * b.z
+            }
+            #[inline]
+            fn cross(a: $v, b: $v) -> $v {
+                <$v>::new(
+                    a.y * b.z - a.z * b.y,
+                    a.z * b.x - a.x * b.z,
+                    a.x * b.y - a.y * b.x,
+                )
+            }
+            #[inline]
+            fn m3_cols(c0: $v, c1: $v, c2: $v) -> $m {
+                <$m>::from_cols(c0, c1, c2)
+            }
+            #[inline]
+            fn m3_col(m: $m, i: usize) -> $v {
+                m.col(i)
+            }
+            #[inline]
+            fn transpose(m: $m) -> $m {
+                m.transpose()
+            }
+        }
+    };
+}
+
+impl_real!(
+    f32,
+    glam::Vec3,
+    glam::Mat3,
+    libm::sqrtf,
+    libm::sinf,
+    libm::cosf,
+    libm::atan2f,
+    libm::acosf,
+    libm::expf
+);
+impl_real!(
+    f64,
+    glam::DVec3,
+    glam::DMat3,
+    libm::sqrt,
+    libm::sin,
+    libm::cos,
+    libm::atan2,
+    libm::acos,
+    libm::exp
+);
