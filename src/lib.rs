@@ -17,13 +17,24 @@
 #![deny(missing_docs)]
 
 pub mod bonds;
+pub mod constraints;
 pub mod error;
+pub mod forces;
+pub mod integrate;
 pub mod linalg;
 pub mod mobility;
+pub mod observables;
+pub mod params;
 pub mod particles;
 pub mod real;
+pub mod workspace;
 
 pub use bonds::{Bond, BondSet};
+pub use constraints::{Solver, SolverKind};
+pub use forces::{ExternalForce, NoForce};
+pub use integrate::{StepReport, step};
+pub use params::{Method, Params};
+pub use workspace::Workspace;
 pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
 pub use mobility::Hydro;
 pub use particles::{Particle, ParticleSet};

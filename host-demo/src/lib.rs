@@ -1,1 +1,13 @@
-//! Host-side driver for the hydrorattle kernel.
+//! Host-side driver for the hydrorattle kernel: scene files, output writers, pictures
+//! and charts, and progress reporting.
+//!
+//! * [`scene`]: TOML scene files parsed and validated into a plain [`scene::Scene`];
+//! * [`output`]: atomic file writes, extended XYZ trajectories (writer and reader),
+//!   CSV and JSON;
+//! * [`render`]: sphere pictures (side and top views, the Figure 1 layout) and charts;
+//! * [`progress`]: a progress bar that stays out of the way of short or piped runs.
+
+pub mod output;
+pub mod progress;
+pub mod render;
+pub mod scene;

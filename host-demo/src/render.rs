@@ -1,0 +1,697 @@
+//! Pictures: sphere configurations drawn to scale (side and top views, the paper's
+//! Figure 1 layout) and two generic charts (line chart, categorical map), as PNG.
+//!
+//! Views: the side view looks along `+y` (the viewer stands at `y = -inf`), screen
+//! right is `+x` and screen up is `+z`; the top view looks down from `z = +inf`, screen
+//! right is `+x` and screen up is `+y`. Spheres are drawn as filled discs of their
+//! true radius with a thin dark outline, farthest first, so nearer spheres cover
+//! farther ones. Colours follow the paper: the head (particle 0) red, tails blue, the
+//! last particle green.
+
+use anyhow::{Result, anyhow};
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Head colour (particle 0).
+pub const HEAD_COLOR: RGBColor = RGBColor(214, 39, 40);
+/// Tail colour.
+pub const TAIL_COLOR: RGBColor = RGBColor(52, 101, 164);
+/// Colour of the last particle.
+pub const LAST_COLOR: RGBColor = RGBColor(44, 160, 44);
+/// Outline of every sphere.
+pub const OUTLINE_COLOR: RGBColor = RGBColor(30, 30, 30);
+
+/// Series colours of the line chart, in order.
+pub const SERIES_COLORS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+];
+
+const FONT: &str = "sans-serif";
+
+fn drawing<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow!("drawing failed: {e}")
+}
+
+/// Colours of an `n`-particle chain: head red, tails blue, last particle green.
+pub fn chain_colors(n: usize) -> Vec<RGBColor> {
+    (0..n)
+        .map(|i| match i {
+            0 => HEAD_COLOR,
+            i if i + 1 == n => LAST_COLOR,
+            _ => TAIL_COLOR,
+        })
+        .collect()
+}
+
+/// A projection of 3-D space onto a picture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum View {
+    /// Looking along `+y`: screen `(x, z)`.
+    Side,
+    /// Looking down `-z`: screen `(x, y)`.
+    Top,
+}
+
+impl View {
+    /// Screen coordinates `(right, up)` of a point and its nearness to the viewer
+    /// (larger is nearer).
+    pub fn project(self, p: [f64; 3]) -> (f64, f64, f64) {
+        match self {
+            View::Side => (p[0], p[2], -p[1]),
+            View::Top => (p[0], p[1], p[2]),
+        }
+    }
+
+    /// Short name for panel titles.
+    pub fn name(self) -> &'static str {
+        match self {
+            View::Side => "side (x-z)",
+            View::Top => "top (x-y)",
+        }
+    }
+}
+
+/// Sphere centres and radii at one moment.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Snapshot {
+    /// Simulated time.
+    pub time: f64,
+    /// Centres.
+    pub positions: Vec<[f64; 3]>,
+    /// Radii.
+    pub radii: Vec<f64>,
+}
+
+/// Screen-space bounding box `(min_right, min_up, max_right, max_up)` of the spheres
+/// in a view, radii included.
+pub fn extent(snapshot: &Snapshot, view: View) -> (f64, f64, f64, f64) {
+    let mut b = (f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY);
+    for (p, &r) in snapshot.positions.iter().zip(&snapshot.radii) {
+        let (u, v, _) = view.project(*p);
+        b = (b.0.min(u - r), b.1.min(v - r), b.2.max(u + r), b.3.max(v + r));
+    }
+    if b.0 > b.2 { (0.0, 0.0, 0.0, 0.0) } else { b }
+}
+
+/// Height in pixels kept at the top of a sphere panel for its title.
+const PANEL_TITLE: u32 = 22;
+/// Free margin around the spheres, in pixels.
+const PANEL_PAD: u32 = 8;
+
+/// Pixels per length unit that fit each `(snapshot, view)` into a panel of `size`.
+pub fn fit_scale(items: &[(&Snapshot, View)], size: (u32, u32)) -> f64 {
+    let w = f64::from(size.0.saturating_sub(2 * PANEL_PAD).max(1));
+    let h = f64::from(size.1.saturating_sub(PANEL_TITLE + 2 * PANEL_PAD).max(1));
+    items
+        .iter()
+        .map(|(s, v)| {
+            let b = extent(s, *v);
+            let (dw, dh) = ((b.2 - b.0).max(1e-9), (b.3 - b.1).max(1e-9));
+            (w / dw).min(h / dh)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// A "nice" length (1, 2 or 5 times a power of ten) at most `max`.
+fn nice_length(max: f64) -> f64 {
+    if max <= 0.0 || !max.is_finite() {
+        return 1.0;
+    }
+    let p = 10f64.powf(max.log10().floor());
+    [5.0, 2.0, 1.0]
+        .into_iter()
+        .map(|m| m * p)
+        .find(|&l| l <= max)
+        .unwrap_or(p)
+}
+
+/// Draws one panel: the spheres of `snapshot` in `view` at `scale` pixels per unit,
+/// centred on their bounding box, under `title`, with a scale bar (lengths in tail
+/// radii) and, in side views, an arrow showing gravity (`-z`).
+pub fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    snapshot: &Snapshot,
+    colors: &[RGBColor],
+    view: View,
+    scale: f64,
+    title: &str,
+) -> Result<()> {
+    let (w, h) = area.dim_in_pixel();
+    let frame = RGBColor(190, 190, 190);
+    area.draw(&Rectangle::new(
+        [(0, 0), (w as i32 - 1, h as i32 - 1)],
+        frame.stroke_width(1),
+    ))
+    .map_err(drawing)?;
+    area.draw(&Text::new(
+        title.to_string(),
+        (6, 4),
+        (FONT, 15).into_font().color(&BLACK),
+    ))
+    .map_err(drawing)?;
+
+    let b = extent(snapshot, view);
+    let (uc, vc) = (0.5 * (b.0 + b.2), 0.5 * (b.1 + b.3));
+    let (xc, yc) = (
+        0.5 * f64::from(w),
+        f64::from(PANEL_TITLE) + 0.5 * f64::from(h.saturating_sub(PANEL_TITLE)),
+    );
+    let mut order: Vec<usize> = (0..snapshot.positions.len()).collect();
+    let nearness = |i: usize| view.project(snapshot.positions[i]).2;
+    order.sort_by(|&i, &j| nearness(i).total_cmp(&nearness(j)).then(i.cmp(&j)));
+    for i in order {
+        let (u, v, _) = view.project(snapshot.positions[i]);
+        let centre = (
+            (xc + (u - uc) * scale).round() as i32,
+            (yc - (v - vc) * scale).round() as i32,
+        );
+        let r = (snapshot.radii[i] * scale).max(1.5);
+        let color = colors.get(i).copied().unwrap_or(TAIL_COLOR);
+        area.draw(&Circle::new(centre, r, color.filled()))
+            .map_err(drawing)?;
+        area.draw(&Circle::new(centre, r, OUTLINE_COLOR.stroke_width(1)))
+            .map_err(drawing)?;
+    }
+
+    // Scale bar, bottom left.
+    let bar = nice_length(0.3 * f64::from(w) / scale);
+    let bar_px = (bar * scale).round() as i32;
+    let y = h as i32 - 10;
+    let style = BLACK.stroke_width(2);
+    area.draw(&PathElement::new(vec![(8, y), (8 + bar_px, y)], style))
+        .map_err(drawing)?;
+    for x in [8, 8 + bar_px] {
+        area.draw(&PathElement::new(vec![(x, y - 4), (x, y + 4)], style))
+            .map_err(drawing)?;
+    }
+    area.draw(&Text::new(
+        format!("{} a", crate::output::format_f64(bar)),
+        (12 + bar_px, y - 8),
+        (FONT, 13).into_font().color(&BLACK),
+    ))
+    .map_err(drawing)?;
+
+    if view == View::Side {
+        let x = w as i32 - 16;
+        let (y0, y1) = (PANEL_TITLE as i32 + 6, PANEL_TITLE as i32 + 34);
+        area.draw(&PathElement::new(vec![(x, y0), (x, y1)], style))
+            .map_err(drawing)?;
+        area.draw(&Polygon::new(
+            vec![(x - 5, y1 - 7), (x + 5, y1 - 7), (x, y1 + 1)],
+            BLACK.filled(),
+        ))
+        .map_err(drawing)?;
+        area.draw(&Text::new(
+            "g",
+            (x - 14, y0),
+            (FONT, 14).into_font().color(&BLACK),
+        ))
+        .map_err(drawing)?;
+    }
+    Ok(())
+}
+
+/// Draws the side and top views of one configuration side by side, at one scale,
+/// into a PNG of `size` pixels.
+pub fn draw_configuration(
+    path: &Path,
+    snapshot: &Snapshot,
+    colors: &[RGBColor],
+    title: &str,
+    size: (u32, u32),
+) -> Result<()> {
+    let root = BitMapBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE).map_err(drawing)?;
+    let root = root
+        .titled(title, (FONT, 20).into_font())
+        .map_err(drawing)?;
+    let panels = root.split_evenly((1, 2));
+    let views = [View::Side, View::Top];
+    let items: Vec<(&Snapshot, View)> = views.iter().map(|&v| (snapshot, v)).collect();
+    let scale = fit_scale(&items, panels[0].dim_in_pixel());
+    for (panel, view) in panels.iter().zip(views) {
+        let t = format!("{}, t = {}", view.name(), short(snapshot.time));
+        draw_panel(&panel.margin(4, 4, 4, 4), snapshot, colors, view, scale, &t)?;
+    }
+    root.present().map_err(drawing)?;
+    Ok(())
+}
+
+/// A number for a label: at most four significant digits, no trailing zeros.
+fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// One case of the Figure 1 layout.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure1Case {
+    /// Case title, e.g. `(a) D=1.50, head 2^(1/3)`.
+    pub title: String,
+    /// Initial configuration.
+    pub initial: Snapshot,
+    /// Final (late) configuration.
+    pub last: Snapshot,
+}
+
+/// Panel width of the Figure 1 layout, pixels.
+const FIG1_PANEL_W: u32 = 270;
+/// Side-view panel height of the Figure 1 layout, pixels.
+const FIG1_SIDE_H: u32 = 620;
+/// Top-view panel height of the Figure 1 layout, pixels.
+const FIG1_TOP_H: u32 = 270;
+/// Height of a case title, pixels.
+const FIG1_CASE_TITLE: u32 = 34;
+/// Gap between case blocks, pixels.
+const FIG1_GAP: u32 = 24;
+
+/// Draws the paper's Figure 1 layout to a PNG: the cases side by side, each a 2x2
+/// block (top row: side view, initial | final; bottom row: top view, initial | final),
+/// all four panels of a case at one scale, chosen so that the largest of them fits.
+pub fn draw_figure1(path: &Path, cases: &[Figure1Case]) -> Result<()> {
+    if cases.is_empty() {
+        return Err(anyhow!("figure 1 needs at least one case"));
+    }
+    let n = cases.len() as u32;
+    let block_w = 2 * FIG1_PANEL_W;
+    let width = n * block_w + (n + 1) * FIG1_GAP;
+    let height = 50 + FIG1_CASE_TITLE + FIG1_SIDE_H + FIG1_TOP_H + FIG1_GAP;
+    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
+    root.fill(&WHITE).map_err(drawing)?;
+    root.draw(&Text::new(
+        "Settling helical chains: side view (upper row) and top view (lower row), initial (left) and final (right) state",
+        (FIG1_GAP as i32, 14),
+        (FONT, 19).into_font().color(&BLACK),
+    ))
+    .map_err(drawing)?;
+    for (k, case) in cases.iter().enumerate() {
+        let x0 = FIG1_GAP + k as u32 * (block_w + FIG1_GAP);
+        let y0 = 50;
+        root.draw(&Text::new(
+            case.title.clone(),
+            (x0 as i32, y0 as i32 + 4),
+            (FONT, 21).into_font().style(FontStyle::Bold).color(&BLACK),
+        ))
+        .map_err(drawing)?;
+        let panel = |col: u32, row: u32| {
+            let (top, h) = if row == 0 {
+                (y0 + FIG1_CASE_TITLE, FIG1_SIDE_H)
+            } else {
+                (y0 + FIG1_CASE_TITLE + FIG1_SIDE_H, FIG1_TOP_H)
+            };
+            let left = x0 + col * FIG1_PANEL_W;
+            root.clone().shrink(
+                (left as i32 + 2, top as i32 + 2),
+                (FIG1_PANEL_W - 4, h - 4),
+            )
+        };
+        let side_size = (FIG1_PANEL_W - 4, FIG1_SIDE_H - 4);
+        let top_size = (FIG1_PANEL_W - 4, FIG1_TOP_H - 4);
+        let scale = fit_scale(&[(&case.initial, View::Side), (&case.last, View::Side)], side_size)
+            .min(fit_scale(
+                &[(&case.initial, View::Top), (&case.last, View::Top)],
+                top_size,
+            ));
+        let colors = chain_colors(case.initial.positions.len());
+        for (col, (snap, when)) in [(&case.initial, "initial"), (&case.last, "final")]
+            .into_iter()
+            .enumerate()
+        {
+            for (row, view) in [View::Side, View::Top].into_iter().enumerate() {
+                let name = if view == View::Side { "side" } else { "top" };
+                let title = format!("{name}, {when}, t = {}", short(snap.time));
+                draw_panel(
+                    &panel(col as u32, row as u32),
+                    snap,
+                    &colors,
+                    view,
+                    scale,
+                    &title,
+                )?;
+            }
+        }
+    }
+    root.present().map_err(drawing)?;
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------
+// Charts
+// ---------------------------------------------------------------------------------------
+
+/// A named series of `(x, y)` points.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Series {
+    /// Legend entry.
+    pub name: String,
+    /// Points, drawn joined in the given order, each with a small marker.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A line chart.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LineChart {
+    /// Title above the chart.
+    pub title: String,
+    /// Horizontal axis label.
+    pub x_label: String,
+    /// Vertical axis label.
+    pub y_label: String,
+    /// Logarithmic horizontal axis (points with `x <= 0` are left out).
+    pub log_x: bool,
+    /// Logarithmic vertical axis (points with `y <= 0` are left out).
+    pub log_y: bool,
+    /// The series.
+    pub series: Vec<Series>,
+}
+
+fn padded_range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
+    if log {
+        let (a, b) = (lo.log10(), hi.log10());
+        let pad = ((b - a) * 0.05).max(0.05);
+        (10f64.powf(a - pad), 10f64.powf(b + pad))
+    } else {
+        let pad = ((hi - lo) * 0.05).max(1e-12 * lo.abs().max(hi.abs()).max(1e-300));
+        (lo - pad, hi + pad)
+    }
+}
+
+/// Draws a line chart to a PNG of `size` pixels.
+pub fn line_chart(path: &Path, chart: &LineChart, size: (u32, u32)) -> Result<()> {
+    let keep = |&(x, y): &(f64, f64)| {
+        x.is_finite() && y.is_finite() && (!chart.log_x || x > 0.0) && (!chart.log_y || y > 0.0)
+    };
+    let series: Vec<(&str, Vec<(f64, f64)>)> = chart
+        .series
+        .iter()
+        .map(|s| (s.name.as_str(), s.points.iter().copied().filter(keep).collect()))
+        .collect();
+    let all = series.iter().flat_map(|(_, p)| p.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        -f64::INFINITY,
+        f64::INFINITY,
+        -f64::INFINITY,
+    );
+    for &(x, y) in all {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    if x0 > x1 {
+        return Err(anyhow!("line chart {:?} has no drawable point", chart.title));
+    }
+    let (x0, x1) = padded_range(x0, x1, chart.log_x);
+    let (y0, y1) = padded_range(y0, y1, chart.log_y);
+    let root = BitMapBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE).map_err(drawing)?;
+    match (chart.log_x, chart.log_y) {
+        (false, false) => plot_lines(&root, chart, &series, x0..x1, y0..y1),
+        (true, false) => plot_lines(&root, chart, &series, (x0..x1).log_scale(), y0..y1),
+        (false, true) => plot_lines(&root, chart, &series, x0..x1, (y0..y1).log_scale()),
+        (true, true) => plot_lines(
+            &root,
+            chart,
+            &series,
+            (x0..x1).log_scale(),
+            (y0..y1).log_scale(),
+        ),
+    }?;
+    root.present().map_err(drawing)?;
+    Ok(())
+}
+
+fn plot_lines<DB, X, Y>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &LineChart,
+    series: &[(&str, Vec<(f64, f64)>)],
+    x: X,
+    y: Y,
+) -> Result<()>
+where
+    DB: DrawingBackend,
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let mut ctx = ChartBuilder::on(root)
+        .caption(&chart.title, (FONT, 22))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(x, y)
+        .map_err(drawing)?;
+    ctx.configure_mesh()
+        .x_desc(&chart.x_label)
+        .y_desc(&chart.y_label)
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 16))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(drawing)?;
+    for (k, (name, points)) in series.iter().enumerate() {
+        let color = SERIES_COLORS[k % SERIES_COLORS.len()];
+        ctx.draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
+            .map_err(drawing)?
+            .label(*name)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(2))
+            });
+        ctx.draw_series(
+            points
+                .iter()
+                .map(|&p| Circle::new(p, 3, color.filled())),
+        )
+        .map_err(drawing)?;
+    }
+    if series.iter().any(|(name, _)| !name.is_empty()) {
+        ctx.configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(150, 150, 150))
+            .label_font((FONT, 14))
+            .draw()
+            .map_err(drawing)?;
+    }
+    Ok(())
+}
+
+/// A marked point on a [`CategoryMap`].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Mark {
+    /// Horizontal position, in axis units.
+    pub x: f64,
+    /// Vertical position, in axis units.
+    pub y: f64,
+    /// Label written next to the marker.
+    pub label: String,
+}
+
+/// A map of categories over a grid of `(x, y)` cells, e.g. the outcome phase diagram.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CategoryMap {
+    /// Title above the map.
+    pub title: String,
+    /// Horizontal axis label.
+    pub x_label: String,
+    /// Vertical axis label.
+    pub y_label: String,
+    /// Cell centres along `x`, increasing.
+    pub x: Vec<f64>,
+    /// Cell centres along `y`, increasing.
+    pub y: Vec<f64>,
+    /// Category index of each cell, row by row: `cells[iy * x.len() + ix]`; `None`
+    /// for a cell without a result (drawn grey and crossed).
+    pub cells: Vec<Option<usize>>,
+    /// Category names and colours.
+    pub categories: Vec<(String, RGBColor)>,
+    /// Points to mark.
+    pub marks: Vec<Mark>,
+}
+
+/// Cell edges around increasing centres: midpoints inside, half a spacing outside.
+fn edges(centres: &[f64]) -> Vec<f64> {
+    let n = centres.len();
+    if n == 1 {
+        return vec![centres[0] - 0.5, centres[0] + 0.5];
+    }
+    let mut e = Vec::with_capacity(n + 1);
+    e.push(centres[0] - 0.5 * (centres[1] - centres[0]));
+    for k in 0..n - 1 {
+        e.push(0.5 * (centres[k] + centres[k + 1]));
+    }
+    e.push(centres[n - 1] + 0.5 * (centres[n - 1] - centres[n - 2]));
+    e
+}
+
+/// Draws a category map to a PNG of `size` pixels, with a legend on the right.
+pub fn category_map(path: &Path, map: &CategoryMap, size: (u32, u32)) -> Result<()> {
+    let (nx, ny) = (map.x.len(), map.y.len());
+    if nx == 0 || ny == 0 || map.cells.len() != nx * ny {
+        return Err(anyhow!(
+            "category map needs {nx} x {ny} = {} cells, got {}",
+            nx * ny,
+            map.cells.len()
+        ));
+    }
+    let increasing = |v: &[f64]| v.windows(2).all(|w| w[0] < w[1]);
+    if !increasing(&map.x) || !increasing(&map.y) {
+        return Err(anyhow!("category map cell centres must increase"));
+    }
+    if let Some(bad) = map.cells.iter().flatten().find(|&&c| c >= map.categories.len()) {
+        return Err(anyhow!("category {bad} has no name and colour"));
+    }
+    let (ex, ey) = (edges(&map.x), edges(&map.y));
+    let root = BitMapBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE).map_err(drawing)?;
+    let legend_w = 190.min(size.0 / 3);
+    let (plot, legend) = root.split_horizontally(size.0 - legend_w);
+    let mut ctx = ChartBuilder::on(&plot)
+        .caption(&map.title, (FONT, 22))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(64)
+        .build_cartesian_2d(ex[0]..ex[nx], ey[0]..ey[ny])
+        .map_err(drawing)?;
+    ctx.configure_mesh()
+        .disable_mesh()
+        .x_desc(&map.x_label)
+        .y_desc(&map.y_label)
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 16))
+        .draw()
+        .map_err(drawing)?;
+    let missing = RGBColor(200, 200, 200);
+    for iy in 0..ny {
+        for ix in 0..nx {
+            let corners = [(ex[ix], ey[iy]), (ex[ix + 1], ey[iy + 1])];
+            let (color, cross) = match map.cells[iy * nx + ix] {
+                Some(c) => (map.categories[c].1, false),
+                None => (missing, true),
+            };
+            ctx.draw_series([
+                Rectangle::new(corners, color.filled()),
+                Rectangle::new(corners, WHITE.stroke_width(1)),
+            ])
+            .map_err(drawing)?;
+            if cross {
+                let [(a, b), (c, d)] = corners;
+                ctx.draw_series([
+                    PathElement::new(vec![(a, b), (c, d)], RGBColor(120, 120, 120)),
+                    PathElement::new(vec![(a, d), (c, b)], RGBColor(120, 120, 120)),
+                ])
+                .map_err(drawing)?;
+            }
+        }
+    }
+    for m in &map.marks {
+        let p = (m.x, m.y);
+        ctx.draw_series([
+            Circle::new(p, 7, WHITE.filled()),
+            Circle::new(p, 7, BLACK.stroke_width(2)),
+            Circle::new(p, 2, BLACK.filled()),
+        ])
+        .map_err(drawing)?;
+        ctx.draw_series([EmptyElement::at(p)
+            + Text::new(
+                m.label.clone(),
+                (10, -18),
+                (FONT, 16).into_font().style(FontStyle::Bold).color(&BLACK),
+            )])
+            .map_err(drawing)?;
+    }
+
+    // Legend.
+    let mut y = 60;
+    for (name, color) in &map.categories {
+        legend
+            .draw(&Rectangle::new([(10, y), (30, y + 20)], color.filled()))
+            .map_err(drawing)?;
+        legend
+            .draw(&Rectangle::new([(10, y), (30, y + 20)], BLACK.stroke_width(1)))
+            .map_err(drawing)?;
+        legend
+            .draw(&Text::new(
+                name.clone(),
+                (38, y + 2),
+                (FONT, 16).into_font().color(&BLACK),
+            ))
+            .map_err(drawing)?;
+        y += 30;
+    }
+    if map.cells.iter().any(Option::is_none) {
+        legend
+            .draw(&Rectangle::new([(10, y), (30, y + 20)], missing.filled()))
+            .map_err(drawing)?;
+        legend
+            .draw(&Text::new(
+                "no result",
+                (38, y + 2),
+                (FONT, 16).into_font().color(&BLACK),
+            ))
+            .map_err(drawing)?;
+    }
+    root.present().map_err(drawing)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chain_colours_mark_head_and_last() {
+        let c = chain_colors(4);
+        assert_eq!(c, vec![HEAD_COLOR, TAIL_COLOR, TAIL_COLOR, LAST_COLOR]);
+        assert_eq!(chain_colors(1), vec![HEAD_COLOR]);
+    }
+
+    #[test]
+    fn views_project_and_order_by_nearness() {
+        let p = [1.0, 2.0, 3.0];
+        assert_eq!(View::Side.project(p), (1.0, 3.0, -2.0));
+        assert_eq!(View::Top.project(p), (1.0, 2.0, 3.0));
+    }
+
+    #[test]
+    fn extent_includes_radii() {
+        let s = Snapshot {
+            time: 0.0,
+            positions: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 1.0]],
+            radii: vec![1.0, 2.0],
+        };
+        assert_eq!(extent(&s, View::Side), (-1.0, -1.0, 6.0, 3.0));
+        let scale = fit_scale(&[(&s, View::Side)], (100 + 2 * PANEL_PAD, 200));
+        assert!((scale - 100.0 / 7.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn nice_lengths() {
+        assert_eq!(nice_length(7.3), 5.0);
+        assert_eq!(nice_length(23.0), 20.0);
+        assert_eq!(nice_length(0.15), 0.1);
+        assert_eq!(short(400.0), "400");
+        assert_eq!(short(0.012345), "0.01235");
+    }
+
+    #[test]
+    fn cell_edges_are_midpoints() {
+        assert_eq!(edges(&[1.0, 2.0, 4.0]), vec![0.5, 1.5, 3.0, 5.0]);
+    }
+}

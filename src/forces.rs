@@ -1,0 +1,64 @@
+//! External forces: buoyant weight, and a hook for anything else (DLVO, walls, traps)
+//! that needs no allocation.
+
+use crate::error::StepError;
+use crate::params::Params;
+use crate::particles::sphere_volume;
+use crate::real::Real;
+
+/// Adds user forces on top of gravity. Called with candidate positions (possibly
+/// more than once per step, e.g. at a predictor), so it must not keep state that
+/// assumes one call per step.
+pub trait ExternalForce<T: Real> {
+    /// Adds forces into `force` (which already holds the buoyant weight).
+    fn add(&mut self, pos: &[T::V3], radius: &[T], force: &mut [T::V3]);
+}
+
+/// No forces besides gravity.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoForce;
+
+impl<T: Real> ExternalForce<T> for NoForce {
+    fn add(&mut self, _: &[T::V3], _: &[T], _: &mut [T::V3]) {}
+}
+
+impl<T: Real, F: FnMut(&[T::V3], &[T], &mut [T::V3])> ExternalForce<T> for F {
+    fn add(&mut self, pos: &[T::V3], radius: &[T], force: &mut [T::V3]) {
+        self(pos, radius, force)
+    }
+}
+
+/// Buoyant weight `(rho_p - rho_f) V g` plus the hook, into `out`; NaN is reported.
+pub fn external<T: Real, E: ExternalForce<T>>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    density: &[T],
+    ext: &mut E,
+    out: &mut [T::V3],
+) -> Result<(), StepError> {
+    for ((f, &a), &rho) in out.iter_mut().zip(radius).zip(density) {
+        *f = p.gravity * ((rho - p.fluid_density) * sphere_volume(a));
+    }
+    ext.add(pos, radius, out);
+    match out.iter().position(|&f| !T::v3_is_finite(f)) {
+        Some(particle) => Err(StepError::NonFinite { particle }),
+        None => Ok(()),
+    }
+}
+
+/// Hookean bond forces `-k (|b| - d) b / |b|`, added into `out`.
+pub fn springs<T: Real>(
+    bonds: &[crate::bonds::Bond<T>],
+    stiffness: T,
+    pos: &[T::V3],
+    out: &mut [T::V3],
+) {
+    for b in bonds {
+        let r = pos[b.i] - pos[b.j];
+        let s = T::norm(r);
+        let f = r * (-stiffness * (s - b.length) / s);
+        out[b.i] += f;
+        out[b.j] -= f;
+    }
+}
