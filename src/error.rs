@@ -182,7 +182,9 @@ impl fmt::Display for ParticleError {
             Self::NonFinite { particle } => write!(f, "particle {particle}: non-finite value"),
             Self::BadRadius { particle } => write!(f, "particle {particle}: radius must be > 0"),
             Self::BadDensity { particle } => write!(f, "particle {particle}: density must be >= 0"),
-            Self::Nested { i, j } => write!(f, "particles {i} and {j}: one sphere inside the other"),
+            Self::Nested { i, j } => {
+                write!(f, "particles {i} and {j}: one sphere inside the other")
+            }
             Self::Overlap { i, j } => write!(f, "particles {i} and {j} overlap"),
             Self::Massless { particle } => {
                 write!(f, "particle {particle}: inertial method needs mass > 0")
@@ -207,7 +209,10 @@ impl fmt::Display for BondError {
                 write!(f, "bond {bond}: configuration off by relative {residual:e}")
             }
             Self::BadTree { particle } => {
-                write!(f, "tree: particle {particle} needs a parent with a smaller index")
+                write!(
+                    f,
+                    "tree: particle {particle} needs a parent with a smaller index"
+                )
             }
         }
     }
@@ -241,9 +246,14 @@ impl fmt::Display for StepError {
                 "{stage:?} constraint solve did not converge in {iterations} iterations (residual {residual:e})"
             ),
             Self::Degenerate { bond } => {
-                write!(f, "bond {bond} turned too far in one step (degenerate SHAKE update)")
+                write!(
+                    f,
+                    "bond {bond} turned too far in one step (degenerate SHAKE update)"
+                )
             }
-            Self::NonFinite { particle } => write!(f, "particle {particle}: state became non-finite"),
+            Self::NonFinite { particle } => {
+                write!(f, "particle {particle}: state became non-finite")
+            }
             Self::Overlap { i, j } => write!(f, "particles {i} and {j} overlap after the step"),
             Self::Unstable { dt, limit } => write!(
                 f,

@@ -91,16 +91,31 @@ fn check_inputs<T: Real, const N: usize>(
     if !(p.dt > T::ZERO && p.dt.is_finite()) {
         return Err(StepError::BadTimeStep);
     }
-    let bad = |ok: bool, name| if ok { Ok(()) } else { Err(StepError::BadParameter(name)) };
-    bad(p.viscosity > T::ZERO && p.viscosity.is_finite(), "viscosity")?;
+    let bad = |ok: bool, name| {
+        if ok {
+            Ok(())
+        } else {
+            Err(StepError::BadParameter(name))
+        }
+    };
+    bad(
+        p.viscosity > T::ZERO && p.viscosity.is_finite(),
+        "viscosity",
+    )?;
     bad(p.fluid_density.is_finite(), "fluid_density")?;
     bad(T::v3_is_finite(p.gravity), "gravity")?;
     bad(T::v3_is_finite(p.flow_velocity), "flow_velocity")?;
     bad(T::v3_is_finite(p.vorticity), "vorticity")?;
-    bad(p.solver.tolerance > T::ZERO && p.solver.tolerance.is_finite(), "tolerance")?;
+    bad(
+        p.solver.tolerance > T::ZERO && p.solver.tolerance.is_finite(),
+        "tolerance",
+    )?;
     bad(p.solver.max_iterations > 0, "max_iterations")?;
     if p.method == Method::Springs {
-        bad(p.spring_stiffness > T::ZERO && p.spring_stiffness.is_finite(), "spring_stiffness")?;
+        bad(
+            p.spring_stiffness > T::ZERO && p.spring_stiffness.is_finite(),
+            "spring_stiffness",
+        )?;
     }
     let n = ps.len();
     for i in 0..n {
@@ -168,7 +183,12 @@ fn gvec<T: Real, const N: usize>(v: &mut [[T::V3; N]; 2], len: usize) -> &mut [T
     &mut v.as_flattened_mut()[..len]
 }
 
-fn assemble_tt<T: Real>(p: &Params<T>, pos: &[T::V3], radius: &[T], mu: &mut [T::M3]) -> Result<(), StepError> {
+fn assemble_tt<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    mu: &mut [T::M3],
+) -> Result<(), StepError> {
     mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
 }
 
@@ -212,7 +232,12 @@ fn max_tension<T: Real>(bonds: &[Bond<T>], lambda: &[T]) -> T {
 }
 
 /// `f_i += sum_l lambda_l (+-g_l)`: the constraint forces.
-fn add_constraint_forces<T: Real>(bonds: &[Bond<T>], grad: &[T::V3], lambda: &[T], f: &mut [T::V3]) {
+fn add_constraint_forces<T: Real>(
+    bonds: &[Bond<T>],
+    grad: &[T::V3],
+    lambda: &[T],
+    f: &mut [T::V3],
+) {
     for (l, b) in bonds.iter().enumerate() {
         f[b.i] += grad[l] * lambda[l];
         f[b.j] -= grad[l] * lambda[l];
@@ -234,8 +259,9 @@ fn spin<T: Real>(
     }
     for i in 0..pos.len() {
         for j in 0..i {
-            let b = mobility::pair_blocks(p.hydro, p.viscosity, radius[i], radius[j], pos[i] - pos[j])
-                .map_err(|()| StepError::Particle(ParticleError::Nested { i: j, j: i }))?;
+            let b =
+                mobility::pair_blocks(p.hydro, p.viscosity, radius[i], radius[j], pos[i] - pos[j])
+                    .ok_or(StepError::Particle(ParticleError::Nested { i: j, j: i }))?;
             out[i] += b.rt_ij * f[j];
             out[j] += b.rt_ji * f[i];
         }
@@ -256,7 +282,11 @@ fn overdamped<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     let force = gvec::<T, N>(&mut ws.force, n);
     let u = gvec::<T, N>(&mut ws.work_a, n);
     let new_pos = &mut ws.new_pos[..n];
-    let (grad, disp, lambda) = (&mut ws.grad[..nb], &mut ws.disp.as_flattened_mut()[..nb * n], &mut ws.lambda[..nb]);
+    let (grad, disp, lambda) = (
+        &mut ws.grad[..nb],
+        &mut ws.disp.as_flattened_mut()[..nb * n],
+        &mut ws.lambda[..nb],
+    );
     // Mobility and forces at the start; unconstrained move r* = r + dt (U_inf + mu F).
     assemble_tt(p, s.pos, s.radius, mu)?;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
@@ -276,7 +306,11 @@ fn overdamped<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
         &p.solver,
         new_pos,
         lambda,
-        &mut Scratch { jac: ws.jac.as_flattened_mut(), rhs: &mut ws.rhs, piv: &mut ws.piv },
+        &mut Scratch {
+            jac: ws.jac.as_flattened_mut(),
+            rhs: &mut ws.rhs,
+            piv: &mut ws.piv,
+        },
     )?;
     for i in 0..n {
         ws.new_vel[i] = (new_pos[i] - s.pos[i]) / dt;
@@ -286,7 +320,12 @@ fn overdamped<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     Ok(report(stats, 0, bonds, lambda))
 }
 
-fn report<T: Real>(stats: SolveStats<T>, velocity_iterations: u32, bonds: &[Bond<T>], lambda: &[T]) -> StepReport<T> {
+fn report<T: Real>(
+    stats: SolveStats<T>,
+    velocity_iterations: u32,
+    bonds: &[Bond<T>],
+    lambda: &[T],
+) -> StepReport<T> {
     StepReport {
         iterations: stats.iterations,
         velocity_iterations,
@@ -317,8 +356,19 @@ fn projected_velocity<T: Real>(
     bond_vectors(bonds, pos, grad);
     mobility_disp(mu, n, bonds, grad, T::ONE, disp);
     kappa.fill(T::ZERO);
-    let problem = Problem::Velocities { bond: grad, dt: p.dt };
-    constraints::solve(problem, &Metric::Dense { disp, n }, bonds, &p.solver, u, kappa, scratch)
+    let problem = Problem::Velocities {
+        bond: grad,
+        dt: p.dt,
+    };
+    constraints::solve(
+        problem,
+        &Metric::Dense { disp, n },
+        bonds,
+        &p.solver,
+        u,
+        kappa,
+        scratch,
+    )
 }
 
 /// Overdamped second order: Heun predictor-corrector on the projected velocity, then
@@ -339,8 +389,16 @@ fn overdamped2<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     let x_p = gvec::<T, N>(&mut ws.work_c, n);
     let new_pos = &mut ws.new_pos[..n];
     let (grad, grad_new) = (&mut ws.grad[..nb], &mut ws.grad_new[..nb]);
-    let (disp, lambda, kappa) = (&mut ws.disp.as_flattened_mut()[..nb * n], &mut ws.lambda[..nb], &mut ws.kappa[..nb]);
-    let mut sc = Scratch { jac: ws.jac.as_flattened_mut(), rhs: &mut ws.rhs[..], piv: &mut ws.piv[..] };
+    let (disp, lambda, kappa) = (
+        &mut ws.disp.as_flattened_mut()[..nb * n],
+        &mut ws.lambda[..nb],
+        &mut ws.kappa[..nb],
+    );
+    let mut sc = Scratch {
+        jac: ws.jac.as_flattened_mut(),
+        rhs: &mut ws.rhs[..],
+        piv: &mut ws.piv[..],
+    };
     // Predictor: projected velocity at r, one projected Euler step.
     assemble_tt(p, s.pos, s.radius, mu0)?;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
@@ -353,11 +411,21 @@ fn overdamped2<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     mobility_disp(mu0, n, bonds, grad, dt, disp);
     lambda.fill(T::ZERO);
     let metric = Metric::Dense { disp, n };
-    constraints::solve(Problem::Positions, &metric, bonds, &p.solver, x_p, lambda, &mut sc)?;
+    constraints::solve(
+        Problem::Positions,
+        &metric,
+        bonds,
+        &p.solver,
+        x_p,
+        lambda,
+        &mut sc,
+    )?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
     assemble_tt(p, x_p, s.radius, mu1)?;
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
-    projected_velocity(p, x_p, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1)?;
+    projected_velocity(
+        p, x_p, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1,
+    )?;
     for i in 0..n {
         new_pos[i] = s.pos[i] + (f0[i] + f1[i]) * (dt * T::HALF);
     }
@@ -365,7 +433,15 @@ fn overdamped2<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     mobility_disp(mu0, n, bonds, grad, dt, disp);
     lambda.fill(T::ZERO);
     let metric = Metric::Dense { disp, n };
-    let stats = constraints::solve(Problem::Positions, &metric, bonds, &p.solver, new_pos, lambda, &mut sc)?;
+    let stats = constraints::solve(
+        Problem::Positions,
+        &metric,
+        bonds,
+        &p.solver,
+        new_pos,
+        lambda,
+        &mut sc,
+    )?;
     for i in 0..n {
         ws.new_vel[i] = (new_pos[i] - s.pos[i]) / dt;
     }
@@ -373,7 +449,10 @@ fn overdamped2<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     add_constraint_forces(bonds, grad, lambda, force);
     spin(p, s.pos, s.radius, force, &mut ws.new_omega[..n])?;
-    Ok(StepReport { max_tension: tension, ..report(stats, 0, bonds, lambda) })
+    Ok(StepReport {
+        max_tension: tension,
+        ..report(stats, 0, bonds, lambda)
+    })
 }
 
 /// `1/m` per particle into `inv_mass`.
@@ -402,16 +481,26 @@ fn rattle_explicit<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>
     let (new_pos, new_vel) = (&mut ws.new_pos[..n], &mut ws.new_vel[..n]);
     let (grad, grad_new) = (&mut ws.grad[..nb], &mut ws.grad_new[..nb]);
     let (lambda, kappa) = (&mut ws.lambda[..nb], &mut ws.kappa[..nb]);
-    let mut sc = Scratch { jac: ws.jac.as_flattened_mut(), rhs: &mut ws.rhs[..], piv: &mut ws.piv[..] };
+    let mut sc = Scratch {
+        jac: ws.jac.as_flattened_mut(),
+        rhs: &mut ws.rhs[..],
+        piv: &mut ws.piv[..],
+    };
     inverse_masses(s.radius, s.density, inv_mass);
     // Resistance through the Cholesky factor of mu_tt: R dv = mu^-1 (v - U_inf).
     assemble_tt(p, s.pos, s.radius, mu)?;
     fac.copy_from_slice(mu);
-    linalg::cholesky::<T>(fac, n).map_err(|error| StepError::Linalg { stage: Stage::Mobility, error })?;
+    linalg::cholesky::<T>(fac, n).map_err(|error| StepError::Linalg {
+        stage: Stage::Mobility,
+        error,
+    })?;
     if p.stability_guard {
         let limit = explicit_drag_limit(fac, n, inv_mass, r_star, acc);
         if p.dt > limit {
-            return Err(StepError::Unstable { dt: dt.to_f64(), limit: limit.to_f64() });
+            return Err(StepError::Unstable {
+                dt: dt.to_f64(),
+                limit: limit.to_f64(),
+            });
         }
     }
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
@@ -429,15 +518,31 @@ fn rattle_explicit<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>
     // SHAKE with the mass metric (eq. 3).
     bond_vectors(bonds, s.pos, grad);
     lambda.fill(T::ZERO);
-    let metric = Metric::Mass { inv_mass, grad, scale: half_dt2 };
-    let stats = constraints::solve(Problem::Positions, &metric, bonds, &p.solver, new_pos, lambda, &mut sc)?;
+    let metric = Metric::Mass {
+        inv_mass,
+        grad,
+        scale: half_dt2,
+    };
+    let stats = constraints::solve(
+        Problem::Positions,
+        &metric,
+        bonds,
+        &p.solver,
+        new_pos,
+        lambda,
+        &mut sc,
+    )?;
     // v* = v + a dt + a_C dt / 2, then RATTLE (eq. 4) for the velocity multipliers.
     for i in 0..n {
         new_vel[i] = s.vel[i] + acc[i] * dt + (new_pos[i] - r_star[i]) / dt;
     }
     bond_vectors(bonds, new_pos, grad_new);
     kappa.fill(T::ZERO);
-    let metric = Metric::Mass { inv_mass, grad: grad_new, scale: T::HALF * dt };
+    let metric = Metric::Mass {
+        inv_mass,
+        grad: grad_new,
+        scale: T::HALF * dt,
+    };
     let problem = Problem::Velocities { bond: grad_new, dt };
     let vstats = constraints::solve(problem, &metric, bonds, &p.solver, new_vel, kappa, &mut sc)?;
     // Each sphere pushes on the fluid with R (v - U_inf).
@@ -447,7 +552,13 @@ fn rattle_explicit<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>
 
 /// Linear stability limit of the explicit drag, `2 lambda_min(M^1/2 mu M^1/2)`, by
 /// inverse iteration through the Cholesky factor of `mu` (40 iterations, fixed start).
-fn explicit_drag_limit<T: Real>(fac: &[T::M3], n: usize, inv_mass: &[T], z: &mut [T::V3], y: &mut [T::V3]) -> T {
+fn explicit_drag_limit<T: Real>(
+    fac: &[T::M3],
+    n: usize,
+    inv_mass: &[T],
+    z: &mut [T::V3],
+    y: &mut [T::V3],
+) -> T {
     for (i, zi) in z.iter_mut().enumerate() {
         let t = T::ONE + T::from_f64(0.01 * i as f64);
         *zi = T::v3(t, T::HALF * t, T::ONE);
@@ -462,7 +573,7 @@ fn explicit_drag_limit<T: Real>(fac: &[T::M3], n: usize, inv_mass: &[T], z: &mut
         linalg::cholesky_solve::<T>(fac, n, y);
         rq = T::ZERO;
         for i in 0..n {
-            y[i] = y[i] * inv_mass[i].sqrt();
+            y[i] *= inv_mass[i].sqrt();
             rq += T::dot(z[i], y[i]);
         }
         z.copy_from_slice(y);
@@ -473,11 +584,11 @@ fn explicit_drag_limit<T: Real>(fac: &[T::M3], n: usize, inv_mass: &[T], z: &mut
 /// `y <- S^-1 dt K^-1 S y` with `K = dt I + S mu S` factorised in `fac`.
 fn apply_drag<T: Real>(fac: &[T::M3], sq: &[T], dt: T, y: &mut [T::V3]) {
     for (v, &q) in y.iter_mut().zip(sq) {
-        *v = *v * q;
+        *v *= q;
     }
     linalg::cholesky_solve::<T>(fac, sq.len(), y);
     for (v, &q) in y.iter_mut().zip(sq) {
-        *v = *v * (dt / q);
+        *v *= dt / q;
     }
 }
 
@@ -501,8 +612,16 @@ fn rattle_stable<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     let sq = &mut ws.sqrt_m.as_flattened_mut()[..m];
     let (new_pos, new_vel) = (&mut ws.new_pos[..n], &mut ws.new_vel[..n]);
     let (grad, grad_new) = (&mut ws.grad[..nb], &mut ws.grad_new[..nb]);
-    let (disp, lambda, kappa) = (&mut ws.disp.as_flattened_mut()[..nb * n], &mut ws.lambda[..nb], &mut ws.kappa[..nb]);
-    let mut sc = Scratch { jac: ws.jac.as_flattened_mut(), rhs: &mut ws.rhs[..], piv: &mut ws.piv[..] };
+    let (disp, lambda, kappa) = (
+        &mut ws.disp.as_flattened_mut()[..nb * n],
+        &mut ws.lambda[..nb],
+        &mut ws.kappa[..nb],
+    );
+    let mut sc = Scratch {
+        jac: ws.jac.as_flattened_mut(),
+        rhs: &mut ws.rhs[..],
+        piv: &mut ws.piv[..],
+    };
     // Mobility (translation or grand) and the drag operator K = dt I + S mu S.
     if p.rotation {
         mobility::assemble_grand(p.hydro, p.viscosity, s.pos, s.radius, mu)?;
@@ -522,7 +641,10 @@ fn rattle_stable<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
         }
         fac[i * m + i] += T::m3_diag(dt);
     }
-    linalg::cholesky::<T>(fac, m).map_err(|error| StepError::Linalg { stage: Stage::Drag, error })?;
+    linalg::cholesky::<T>(fac, m).map_err(|error| StepError::Linalg {
+        stage: Stage::Drag,
+        error,
+    })?;
     // Unconstrained generalised velocity from F + M v / dt.
     forces::external(p, s.pos, s.radius, s.density, ext, &mut rhs6[..n])?;
     rhs6[n..].fill(T::V3_ZERO);
@@ -547,7 +669,15 @@ fn rattle_stable<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     }
     lambda.fill(T::ZERO);
     let metric = Metric::Dense { disp, n };
-    let stats = constraints::solve(Problem::Positions, &metric, bonds, &p.solver, new_pos, lambda, &mut sc)?;
+    let stats = constraints::solve(
+        Problem::Positions,
+        &metric,
+        bonds,
+        &p.solver,
+        new_pos,
+        lambda,
+        &mut sc,
+    )?;
     for i in 0..n {
         new_vel[i] = (new_pos[i] - s.pos[i]) / dt;
     }

@@ -15,6 +15,10 @@
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
+// `!(x <= tol)` is deliberate throughout: NaN must fail the test, not pass it.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Index loops over several parallel arrays read like the paper's formulas.
+#![allow(clippy::needless_range_loop)]
 
 pub mod bonds;
 pub mod constraints;
@@ -31,11 +35,11 @@ pub mod workspace;
 
 pub use bonds::{Bond, BondSet};
 pub use constraints::{Solver, SolverKind};
+pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
 pub use forces::{ExternalForce, NoForce};
 pub use integrate::{StepReport, step};
-pub use params::{Method, Params};
-pub use workspace::Workspace;
-pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
 pub use mobility::Hydro;
+pub use params::{Method, Params};
 pub use particles::{Particle, ParticleSet};
 pub use real::Real;
+pub use workspace::Workspace;

@@ -50,19 +50,19 @@ pub fn self_rr<T: Real>(eta: T, a: T) -> T {
 
 /// Translation-translation block for the pair `(i, j)`, `i != j`.
 ///
-/// `Err(())` when one sphere lies inside the other (no valid RPY form there).
+/// `None` when one sphere lies inside the other (no valid RPY form there).
 #[inline]
-pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Result<T::M3, ()> {
+pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<T::M3> {
     let s2 = T::norm2(r);
     let s = s2.sqrt();
     if level == Hydro::FreeDraining {
-        return Ok(T::M3_ZERO);
+        return Some(T::M3_ZERO);
     }
     let e = r / s;
     let ee = T::outer(e, e);
     let pi8 = T::from_f64(8.0) * T::PI * eta;
     if level == Hydro::Oseen {
-        return Ok((T::M3_IDENTITY + ee) * (T::ONE / (pi8 * s)));
+        return Some((T::M3_IDENTITY + ee) * (T::ONE / (pi8 * s)));
     }
     let sum = ai + aj;
     let dif = ai - aj;
@@ -70,7 +70,7 @@ pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Result<
         let q = (ai * ai + aj * aj) / s2;
         let third = T::ONE / T::from_f64(3.0);
         let c = T::ONE / (pi8 * s);
-        Ok(T::m3_diag(c * (T::ONE + q * third)) + ee * (c * (T::ONE - q)))
+        Some(T::m3_diag(c * (T::ONE + q * third)) + ee * (c * (T::ONE - q)))
     } else if s > dif.abs() {
         // Overlapping branch (Zuk et al. 2014, eq. 2.7): stays positive definite.
         let s3 = s2 * s;
@@ -79,23 +79,17 @@ pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Result<
         let iso = T::from_f64(16.0) * s3 * sum - p * p;
         let q = dif * dif - s2;
         let aniso = T::from_f64(3.0) * q * q;
-        Ok(T::m3_diag(k * iso) + ee * (k * aniso))
+        Some(T::m3_diag(k * iso) + ee * (k * aniso))
     } else {
-        Err(())
+        None
     }
 }
 
 /// All blocks for the pair `(i, j)`, `i != j` (rotation couplings included).
-pub fn pair_blocks<T: Real>(
-    level: Hydro,
-    eta: T,
-    ai: T,
-    aj: T,
-    r: T::V3,
-) -> Result<PairBlocks<T>, ()> {
+pub fn pair_blocks<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<PairBlocks<T>> {
     let tt = pair_tt(level, eta, ai, aj, r)?;
     if level == Hydro::FreeDraining {
-        return Ok(PairBlocks {
+        return Some(PairBlocks {
             tt,
             rt_ij: T::M3_ZERO,
             rt_ji: T::M3_ZERO,
@@ -115,7 +109,7 @@ pub fn pair_blocks<T: Real>(
     let rt_ji = cross * rt_coefficient(far, eta, aj, ai, s);
     if far {
         let rr = (ee * three - T::M3_IDENTITY) * (T::ONE / (T::TWO * pi8 * s2 * s));
-        return Ok(PairBlocks {
+        return Some(PairBlocks {
             tt,
             rt_ij,
             rt_ji,
@@ -136,7 +130,7 @@ pub fn pair_blocks<T: Real>(
     let aniso = three * q * q * (w - s2);
     let krr = T::ONE / (pi8 * ai2 * ai * aj2 * aj * T::from_f64(64.0) * s3);
     let rr = T::m3_diag(krr * iso) + ee * (krr * aniso);
-    Ok(PairBlocks {
+    Some(PairBlocks {
         tt,
         rt_ij,
         rt_ji,
@@ -171,7 +165,7 @@ pub fn assemble_tt<T: Real>(
         out[i * n + i] = T::m3_diag(self_tt(eta, radius[i]));
         for j in 0..i {
             let b = pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
-                .map_err(|()| ParticleError::Nested { i: j, j: i })?;
+                .ok_or(ParticleError::Nested { i: j, j: i })?;
             out[i * n + j] = b;
             out[j * n + i] = b;
         }
@@ -197,7 +191,7 @@ pub fn assemble_grand<T: Real>(
         out[(n + i) * m + i] = T::M3_ZERO;
         for j in 0..i {
             let b = pair_blocks(level, eta, a, radius[j], pos[i] - pos[j])
-                .map_err(|()| ParticleError::Nested { i: j, j: i })?;
+                .ok_or(ParticleError::Nested { i: j, j: i })?;
             // The grand mobility is symmetric: tr_ij = rt_ji^T.
             out[i * m + j] = b.tt;
             out[j * m + i] = b.tt;

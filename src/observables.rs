@@ -1,1 +1,194 @@
-//! Observables (filled in below).
+//! Outcome metrics of a settling chain, defined once here, and the classifier that turns
+//! them into the paper's words.
+//!
+//! Conventions: particle 0 is the head, the last particle the chain's end; "down" is
+//! the direction of gravity.
+
+use crate::bonds::Bond;
+use crate::real::Real;
+
+/// End-to-end distance (head to last particle) over the contour length (sum of bond
+/// lengths): 1 for a straight chain.
+pub fn extension<T: Real>(pos: &[T::V3], bonds: &[Bond<T>]) -> T {
+    let contour = bonds.iter().fold(T::ZERO, |a, b| a + b.length);
+    match (pos.first(), pos.last()) {
+        (Some(&h), Some(&e)) if contour > T::ZERO => T::norm(e - h) / contour,
+        _ => T::ZERO,
+    }
+}
+
+/// `|cos|` of the angle between the head-to-end vector and gravity: 1 when the chain
+/// hangs vertically ("like a chopstick"), 0 when it lies horizontally.
+pub fn verticality<T: Real>(pos: &[T::V3], gravity: T::V3) -> T {
+    let (g, len) = (T::norm(gravity), pos.len());
+    if len < 2 || g == T::ZERO {
+        return T::ZERO;
+    }
+    let d = pos[len - 1] - pos[0];
+    let l = T::norm(d);
+    if l == T::ZERO {
+        T::ZERO
+    } else {
+        (T::dot(d, gravity) / (l * g)).abs()
+    }
+}
+
+/// Mass-weighted centre.
+pub fn centre_of_mass<T: Real>(pos: &[T::V3], mass: impl Fn(usize) -> T) -> T::V3 {
+    let mut c = T::V3_ZERO;
+    let mut m = T::ZERO;
+    for (i, &r) in pos.iter().enumerate() {
+        c += r * mass(i);
+        m += mass(i);
+    }
+    if m > T::ZERO { c / m } else { c }
+}
+
+/// Settling speed of particle `i` along gravity (positive when moving down).
+pub fn settling_speed<T: Real>(vel: &[T::V3], i: usize, gravity: T::V3) -> T {
+    let g = T::norm(gravity);
+    match vel.get(i) {
+        Some(&v) if g > T::ZERO => T::dot(v, gravity) / g,
+        _ => T::ZERO,
+    }
+}
+
+/// Accumulated azimuth of the chain about the vertical through the head.
+///
+/// Each update measures every other particle's azimuth about the axis through the head
+/// along gravity, unwraps its change since the last update, and adds the mean change
+/// weighted by the squared distance from the axis (so particles on the axis, whose
+/// azimuth is meaningless, do not count). Call it often enough that no particle turns
+/// by more than half a turn between calls.
+#[derive(Clone, Debug)]
+pub struct Twist<T: Real, const N: usize> {
+    prev: [T; N],
+    started: bool,
+    /// Accumulated twist angle (radians, right-handed about "up").
+    pub total: T,
+}
+
+impl<T: Real, const N: usize> Default for Twist<T, N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<T: Real, const N: usize> Twist<T, N> {
+    /// No twist accumulated yet.
+    pub const fn new() -> Self {
+        Self {
+            prev: [T::ZERO; N],
+            started: false,
+            total: T::ZERO,
+        }
+    }
+
+    /// Adds the twist since the last call and returns the accumulated total.
+    pub fn update(&mut self, pos: &[T::V3], gravity: T::V3) -> T {
+        let g = T::norm(gravity);
+        if pos.is_empty() || pos.len() > N || g == T::ZERO {
+            return self.total;
+        }
+        let up = -gravity / g;
+        // An orthonormal frame (ex, ey) of the horizontal plane.
+        let seed = if T::xyz(up)[0].abs() < T::HALF {
+            T::v3(T::ONE, T::ZERO, T::ZERO)
+        } else {
+            T::v3(T::ZERO, T::ONE, T::ZERO)
+        };
+        let ex = {
+            let v = seed - up * T::dot(seed, up);
+            v / T::norm(v)
+        };
+        let ey = T::cross(up, ex);
+        let (mut num, mut den) = (T::ZERO, T::ZERO);
+        let two_pi = T::TWO * T::PI;
+        for k in 1..pos.len() {
+            let d = pos[k] - pos[0];
+            let (x, y) = (T::dot(d, ex), T::dot(d, ey));
+            let phi = y.atan2(x);
+            if self.started {
+                let mut dphi = phi - self.prev[k];
+                while dphi > T::PI {
+                    dphi -= two_pi;
+                }
+                while dphi < -T::PI {
+                    dphi += two_pi;
+                }
+                let w = x * x + y * y;
+                num += w * dphi;
+                den += w;
+            }
+            self.prev[k] = phi;
+        }
+        if self.started && den > T::ZERO {
+            self.total += num / den;
+        }
+        self.started = true;
+        self.total
+    }
+}
+
+/// The paper's words for a chain's late state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Hangs straight and vertical ("stretched like a chopstick").
+    Stretched,
+    /// Keeps turning about the vertical ("everlasting twisting").
+    Twisting,
+    /// Neither: folded, tilted or tumbling.
+    Other,
+}
+
+impl Outcome {
+    /// Lower-case name, as written to summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Stretched => "stretched",
+            Outcome::Twisting => "twisting",
+            Outcome::Other => "other",
+        }
+    }
+}
+
+/// Classifier thresholds.
+///
+/// Defaults: stretched when verticality is at least 0.95 and extension at least 0.85;
+/// otherwise twisting when the late twist rate is at least 0.002 rad per time unit
+/// (about one turn per 3000 time units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Thresholds<T> {
+    /// Minimum verticality of a stretched chain.
+    pub verticality: T,
+    /// Minimum extension of a stretched chain.
+    pub extension: T,
+    /// Minimum `|twist rate|` of a twisting chain.
+    pub twist_rate: T,
+}
+
+impl<T: Real> Default for Thresholds<T> {
+    fn default() -> Self {
+        Self {
+            verticality: T::from_f64(0.95),
+            extension: T::from_f64(0.85),
+            twist_rate: T::from_f64(0.002),
+        }
+    }
+}
+
+/// Classifies a late state from its verticality, extension and twist rate.
+pub fn classify<T: Real>(
+    verticality: T,
+    extension: T,
+    twist_rate: T,
+    th: &Thresholds<T>,
+) -> Outcome {
+    if verticality >= th.verticality && extension >= th.extension {
+        Outcome::Stretched
+    } else if twist_rate.abs() >= th.twist_rate {
+        Outcome::Twisting
+    } else {
+        Outcome::Other
+    }
+}

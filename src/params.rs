@@ -63,7 +63,11 @@ pub struct Params<T: Real> {
 impl<T: Real> Params<T> {
     /// Defaults as documented on each field, with time step `dt`.
     pub fn new(dt: T) -> Self {
-        let tolerance = if T::EPSILON.to_f64() < 1e-10 { 1e-10 } else { 1e-5 };
+        let tolerance = if T::EPSILON.to_f64() < 1e-10 {
+            1e-10
+        } else {
+            1e-5
+        };
         Self {
             dt,
             viscosity: T::ONE,

@@ -118,7 +118,11 @@ pub trait Real:
 
     /// Converts from an `f64` triple.
     fn v3_from(a: [f64; 3]) -> Self::V3 {
-        Self::v3(Self::from_f64(a[0]), Self::from_f64(a[1]), Self::from_f64(a[2]))
+        Self::v3(
+            Self::from_f64(a[0]),
+            Self::from_f64(a[1]),
+            Self::from_f64(a[2]),
+        )
     }
     /// Converts to an `f64` triple.
     fn v3_to_f64(v: Self::V3) -> [f64; 3] {

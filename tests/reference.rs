@@ -14,11 +14,19 @@ struct Case {
 }
 
 fn load() -> Vec<Case> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/reference/rpy_grand_mobility.json");
-    let text = std::fs::read_to_string(path).expect("reference file ../shared/reference is required");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/reference/rpy_grand_mobility.json"
+    );
+    let text =
+        std::fs::read_to_string(path).expect("reference file ../shared/reference is required");
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let arr = |x: &serde_json::Value| -> Vec<f64> {
-        x.as_array().unwrap().iter().map(|y| y.as_f64().unwrap()).collect()
+        x.as_array()
+            .unwrap()
+            .iter()
+            .map(|y| y.as_f64().unwrap())
+            .collect()
     };
     v["cases"]
         .as_array()
@@ -37,7 +45,12 @@ fn load() -> Vec<Case> {
                     [a[0], a[1], a[2]]
                 })
                 .collect(),
-            mu: c["grand_mobility"].as_array().unwrap().iter().map(arr).collect(),
+            mu: c["grand_mobility"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(arr)
+                .collect(),
         })
         .collect()
 }
@@ -86,5 +99,8 @@ fn reference_covers_the_overlapping_branch() {
         let pos: Vec<_> = c.centres.iter().map(|p| f64::v3_from(*p)).collect();
         check_pairs::<f64>(&pos, &c.radii, false).is_err()
     });
-    assert!(overlapping, "the reference must exercise the overlapping RPY branch");
+    assert!(
+        overlapping,
+        "the reference must exercise the overlapping RPY branch"
+    );
 }

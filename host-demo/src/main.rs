@@ -75,10 +75,7 @@ fn run(cli: Cli) -> Result<()> {
                 scene.integrator.method,
                 scene.integrator.steps()
             );
-            println!(
-                "run: not wired yet (would write to {})",
-                out.display()
-            );
+            println!("run: not wired yet (would write to {})", out.display());
         }
         Command::Figure1 { out } => {
             let cases = Scene::figure1()?;

@@ -58,7 +58,10 @@ impl AtomicFile {
     /// Flushes, syncs the data to disk and renames the file to its final name (then
     /// syncs the directory, where the platform allows it).
     pub fn commit(mut self) -> io::Result<()> {
-        let writer = self.writer.take().expect("an uncommitted file has a writer");
+        let writer = self
+            .writer
+            .take()
+            .expect("an uncommitted file has a writer");
         let file = writer.into_inner().map_err(|e| e.into_error())?;
         file.sync_all()?;
         drop(file);
@@ -68,7 +71,9 @@ impl AtomicFile {
     }
 
     fn writer(&mut self) -> &mut BufWriter<File> {
-        self.writer.as_mut().expect("an uncommitted file has a writer")
+        self.writer
+            .as_mut()
+            .expect("an uncommitted file has a writer")
     }
 }
 
@@ -324,7 +329,9 @@ struct Columns {
 fn columns(properties: &str) -> Result<Columns, String> {
     let parts: Vec<&str> = properties.split(':').collect();
     if parts.len() % 3 != 0 {
-        return Err(format!("Properties={properties} is not name:type:count triples"));
+        return Err(format!(
+            "Properties={properties} is not name:type:count triples"
+        ));
     }
     let (mut species, mut pos, mut radius, mut velocity) = (None, None, None, None);
     let mut at = 0;
@@ -500,10 +507,8 @@ mod tests {
     use super::*;
 
     fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!(
-            "host-demo-output-{}-{name}",
-            std::process::id()
-        ));
+        let dir =
+            std::env::temp_dir().join(format!("host-demo-output-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir
@@ -593,7 +598,10 @@ mod tests {
             .write_frame(0.0, &["H"], &[[0.0; 3]; 2], &[1.0; 2], &[[0.0; 3]; 2])
             .unwrap_err();
         assert_eq!(e.kind(), io::ErrorKind::InvalidInput);
-        assert!(w.write_frame(0.0, &["a b"], &[[0.0; 3]], &[1.0], &[[0.0; 3]]).is_err());
+        assert!(
+            w.write_frame(0.0, &["a b"], &[[0.0; 3]], &[1.0], &[[0.0; 3]])
+                .is_err()
+        );
     }
 
     #[test]

@@ -97,20 +97,37 @@ pub fn extent(snapshot: &Snapshot, view: View) -> (f64, f64, f64, f64) {
     let mut b = (f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY);
     for (p, &r) in snapshot.positions.iter().zip(&snapshot.radii) {
         let (u, v, _) = view.project(*p);
-        b = (b.0.min(u - r), b.1.min(v - r), b.2.max(u + r), b.3.max(v + r));
+        b = (
+            b.0.min(u - r),
+            b.1.min(v - r),
+            b.2.max(u + r),
+            b.3.max(v + r),
+        );
     }
     if b.0 > b.2 { (0.0, 0.0, 0.0, 0.0) } else { b }
 }
 
-/// Height in pixels kept at the top of a sphere panel for its title.
-const PANEL_TITLE: u32 = 22;
-/// Free margin around the spheres, in pixels.
-const PANEL_PAD: u32 = 8;
+/// Height kept at the top of a sphere panel for its title (output pixels).
+const PANEL_TITLE: f64 = 22.0;
+/// Height kept at the bottom of a sphere panel for the scale bar (output pixels).
+const PANEL_FOOT: f64 = 22.0;
+/// Free margin around the spheres (output pixels).
+const PANEL_PAD: f64 = 8.0;
 
-/// Pixels per length unit that fit each `(snapshot, view)` into a panel of `size`.
+/// Pictures are drawn this many times larger and averaged down to their final size,
+/// which smooths the edges of discs, lines and text.
+pub const SUPERSAMPLE: u32 = 3;
+
+/// Rounds `v` output pixels, at `k` drawing pixels per output pixel, to drawing pixels.
+fn px(k: f64, v: f64) -> i32 {
+    (v * k).round() as i32
+}
+
+/// Pixels per length unit that fit each `(snapshot, view)` into a sphere panel of
+/// `size` pixels (title, scale bar and margins left free).
 pub fn fit_scale(items: &[(&Snapshot, View)], size: (u32, u32)) -> f64 {
-    let w = f64::from(size.0.saturating_sub(2 * PANEL_PAD).max(1));
-    let h = f64::from(size.1.saturating_sub(PANEL_TITLE + 2 * PANEL_PAD).max(1));
+    let w = (f64::from(size.0) - 2.0 * PANEL_PAD).max(1.0);
+    let h = (f64::from(size.1) - PANEL_TITLE - PANEL_FOOT - 2.0 * PANEL_PAD).max(1.0);
     items
         .iter()
         .map(|(s, v)| {
@@ -134,9 +151,49 @@ fn nice_length(max: f64) -> f64 {
         .unwrap_or(p)
 }
 
-/// Draws one panel: the spheres of `snapshot` in `view` at `scale` pixels per unit,
-/// centred on their bounding box, under `title`, with a scale bar (lengths in tail
-/// radii) and, in side views, an arrow showing gravity (`-z`).
+/// Draws at [`SUPERSAMPLE`] times `size` into memory, averages the result down to
+/// `size` and saves it as a PNG. `draw` gets the large drawing area and the factor.
+fn save_png<F>(path: &Path, size: (u32, u32), draw: F) -> Result<()>
+where
+    F: FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>, f64) -> Result<()>,
+{
+    let k = SUPERSAMPLE;
+    let (w, h) = size;
+    let (bw, bh) = (w * k, h * k);
+    let mut big = vec![255u8; bw as usize * bh as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut big, (bw, bh)).into_drawing_area();
+        root.fill(&WHITE).map_err(drawing)?;
+        draw(&root, f64::from(k))?;
+        root.present().map_err(drawing)?;
+    }
+    let (k, bw) = (k as usize, bw as usize);
+    let mut small = vec![0u8; w as usize * h as usize * 3];
+    for y in 0..h as usize {
+        for x in 0..w as usize {
+            for c in 0..3 {
+                let mut sum = 0usize;
+                for dy in 0..k {
+                    let row = ((y * k + dy) * bw + x * k) * 3 + c;
+                    for dx in 0..k {
+                        sum += usize::from(big[row + dx * 3]);
+                    }
+                }
+                small[(y * w as usize + x) * 3 + c] = ((sum + k * k / 2) / (k * k)) as u8;
+            }
+        }
+    }
+    let mut backend = BitMapBackend::new(path, size);
+    backend.blit_bitmap((0, 0), size, &small).map_err(drawing)?;
+    backend.present().map_err(drawing)?;
+    Ok(())
+}
+
+/// Draws one sphere panel: the spheres of `snapshot` in `view` at `scale` output
+/// pixels per length unit, centred on their bounding box, under `title`, with a scale
+/// bar (lengths in tail radii `a`) and, in side views, an arrow for gravity (`-z`).
+/// `k` is the number of drawing pixels per output pixel of `area` (1 when drawing
+/// straight to the final picture).
 pub fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     snapshot: &Snapshot,
@@ -144,84 +201,91 @@ pub fn draw_panel<DB: DrawingBackend>(
     view: View,
     scale: f64,
     title: &str,
+    k: f64,
 ) -> Result<()> {
     let (w, h) = area.dim_in_pixel();
-    let frame = RGBColor(190, 190, 190);
+    let (w, h) = (f64::from(w) / k, f64::from(h) / k);
+    let thin = |c: RGBColor| c.stroke_width(px(k, 1.0).max(1) as u32);
+    let thick = BLACK.stroke_width(px(k, 2.0).max(1) as u32);
+    let font = |size: f64| (FONT, size * k).into_font().color(&BLACK);
     area.draw(&Rectangle::new(
-        [(0, 0), (w as i32 - 1, h as i32 - 1)],
-        frame.stroke_width(1),
+        [(0, 0), (px(k, w) - 1, px(k, h) - 1)],
+        thin(RGBColor(190, 190, 190)),
     ))
     .map_err(drawing)?;
     area.draw(&Text::new(
         title.to_string(),
-        (6, 4),
-        (FONT, 15).into_font().color(&BLACK),
+        (px(k, 6.0), px(k, 4.0)),
+        font(15.0),
     ))
     .map_err(drawing)?;
 
     let b = extent(snapshot, view);
     let (uc, vc) = (0.5 * (b.0 + b.2), 0.5 * (b.1 + b.3));
-    let (xc, yc) = (
-        0.5 * f64::from(w),
-        f64::from(PANEL_TITLE) + 0.5 * f64::from(h.saturating_sub(PANEL_TITLE)),
-    );
+    let (xc, yc) = (0.5 * w, PANEL_TITLE + 0.5 * (h - PANEL_TITLE - PANEL_FOOT));
     let mut order: Vec<usize> = (0..snapshot.positions.len()).collect();
     let nearness = |i: usize| view.project(snapshot.positions[i]).2;
     order.sort_by(|&i, &j| nearness(i).total_cmp(&nearness(j)).then(i.cmp(&j)));
     for i in order {
         let (u, v, _) = view.project(snapshot.positions[i]);
-        let centre = (
-            (xc + (u - uc) * scale).round() as i32,
-            (yc - (v - vc) * scale).round() as i32,
-        );
-        let r = (snapshot.radii[i] * scale).max(1.5);
+        let centre = (px(k, xc + (u - uc) * scale), px(k, yc - (v - vc) * scale));
+        // A dark disc with the coloured disc one output pixel smaller on top: the
+        // outline, with no gap between fill and outline.
+        let r = (snapshot.radii[i] * scale).max(1.5) * k;
         let color = colors.get(i).copied().unwrap_or(TAIL_COLOR);
-        area.draw(&Circle::new(centre, r, color.filled()))
+        area.draw(&Circle::new(centre, r, OUTLINE_COLOR.filled()))
             .map_err(drawing)?;
-        area.draw(&Circle::new(centre, r, OUTLINE_COLOR.stroke_width(1)))
+        area.draw(&Circle::new(centre, (r - k).max(0.5 * r), color.filled()))
             .map_err(drawing)?;
     }
 
     // Scale bar, bottom left.
-    let bar = nice_length(0.3 * f64::from(w) / scale);
-    let bar_px = (bar * scale).round() as i32;
-    let y = h as i32 - 10;
-    let style = BLACK.stroke_width(2);
-    area.draw(&PathElement::new(vec![(8, y), (8 + bar_px, y)], style))
+    let bar = nice_length(0.3 * w / scale);
+    let (x0, x1, y) = (8.0, 8.0 + bar * scale, h - 10.0);
+    area.draw(&PathElement::new(
+        vec![(px(k, x0), px(k, y)), (px(k, x1), px(k, y))],
+        thick,
+    ))
+    .map_err(drawing)?;
+    for x in [x0, x1] {
+        area.draw(&PathElement::new(
+            vec![(px(k, x), px(k, y - 4.0)), (px(k, x), px(k, y + 4.0))],
+            thick,
+        ))
         .map_err(drawing)?;
-    for x in [8, 8 + bar_px] {
-        area.draw(&PathElement::new(vec![(x, y - 4), (x, y + 4)], style))
-            .map_err(drawing)?;
     }
     area.draw(&Text::new(
         format!("{} a", crate::output::format_f64(bar)),
-        (12 + bar_px, y - 8),
-        (FONT, 13).into_font().color(&BLACK),
+        (px(k, x1 + 5.0), px(k, y - 8.0)),
+        font(13.0),
     ))
     .map_err(drawing)?;
 
     if view == View::Side {
-        let x = w as i32 - 16;
-        let (y0, y1) = (PANEL_TITLE as i32 + 6, PANEL_TITLE as i32 + 34);
-        area.draw(&PathElement::new(vec![(x, y0), (x, y1)], style))
-            .map_err(drawing)?;
+        let x = w - 16.0;
+        let (y0, y1) = (PANEL_TITLE + 6.0, PANEL_TITLE + 34.0);
+        area.draw(&PathElement::new(
+            vec![(px(k, x), px(k, y0)), (px(k, x), px(k, y1 - 4.0))],
+            thick,
+        ))
+        .map_err(drawing)?;
         area.draw(&Polygon::new(
-            vec![(x - 5, y1 - 7), (x + 5, y1 - 7), (x, y1 + 1)],
+            vec![
+                (px(k, x - 5.0), px(k, y1 - 8.0)),
+                (px(k, x + 5.0), px(k, y1 - 8.0)),
+                (px(k, x), px(k, y1 + 1.0)),
+            ],
             BLACK.filled(),
         ))
         .map_err(drawing)?;
-        area.draw(&Text::new(
-            "g",
-            (x - 14, y0),
-            (FONT, 14).into_font().color(&BLACK),
-        ))
-        .map_err(drawing)?;
+        area.draw(&Text::new("g", (px(k, x - 14.0), px(k, y0)), font(14.0)))
+            .map_err(drawing)?;
     }
     Ok(())
 }
 
-/// Draws the side and top views of one configuration side by side, at one scale,
-/// into a PNG of `size` pixels.
+/// Draws the side and top views of one configuration next to each other, at one
+/// scale, into a PNG of `size` pixels.
 pub fn draw_configuration(
     path: &Path,
     snapshot: &Snapshot,
@@ -229,21 +293,32 @@ pub fn draw_configuration(
     title: &str,
     size: (u32, u32),
 ) -> Result<()> {
-    let root = BitMapBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE).map_err(drawing)?;
-    let root = root
-        .titled(title, (FONT, 20).into_font())
-        .map_err(drawing)?;
-    let panels = root.split_evenly((1, 2));
+    let title_h = 36.0;
+    let panel = (
+        (f64::from(size.0) / 2.0 - 8.0).max(1.0),
+        (f64::from(size.1) - title_h - 8.0).max(1.0),
+    );
     let views = [View::Side, View::Top];
     let items: Vec<(&Snapshot, View)> = views.iter().map(|&v| (snapshot, v)).collect();
-    let scale = fit_scale(&items, panels[0].dim_in_pixel());
-    for (panel, view) in panels.iter().zip(views) {
-        let t = format!("{}, t = {}", view.name(), short(snapshot.time));
-        draw_panel(&panel.margin(4, 4, 4, 4), snapshot, colors, view, scale, &t)?;
-    }
-    root.present().map_err(drawing)?;
-    Ok(())
+    let scale = fit_scale(&items, (panel.0 as u32, panel.1 as u32));
+    save_png(path, size, |root, k| {
+        root.draw(&Text::new(
+            title.to_string(),
+            (px(k, 8.0), px(k, 8.0)),
+            (FONT, 20.0 * k).into_font().color(&BLACK),
+        ))
+        .map_err(drawing)?;
+        for (col, view) in views.into_iter().enumerate() {
+            let left = 4.0 + col as f64 * (panel.0 + 8.0);
+            let area = root.clone().shrink(
+                (px(k, left), px(k, title_h)),
+                (px(k, panel.0) as u32, px(k, panel.1) as u32),
+            );
+            let t = format!("{}, t = {}", view.name(), short(snapshot.time));
+            draw_panel(&area, snapshot, colors, view, scale, &t, k)?;
+        }
+        Ok(())
+    })
 }
 
 /// A number for a label: at most four significant digits, no trailing zeros.
@@ -272,84 +347,82 @@ pub struct Figure1Case {
 }
 
 /// Panel width of the Figure 1 layout, pixels.
-const FIG1_PANEL_W: u32 = 270;
+const FIG1_PANEL_W: f64 = 270.0;
 /// Side-view panel height of the Figure 1 layout, pixels.
-const FIG1_SIDE_H: u32 = 620;
+const FIG1_SIDE_H: f64 = 620.0;
 /// Top-view panel height of the Figure 1 layout, pixels.
-const FIG1_TOP_H: u32 = 270;
+const FIG1_TOP_H: f64 = 270.0;
+/// Height of the figure's heading, pixels.
+const FIG1_HEADING: f64 = 50.0;
 /// Height of a case title, pixels.
-const FIG1_CASE_TITLE: u32 = 34;
-/// Gap between case blocks, pixels.
-const FIG1_GAP: u32 = 24;
+const FIG1_CASE_TITLE: f64 = 34.0;
+/// Gap between case blocks and around the figure, pixels.
+const FIG1_GAP: f64 = 24.0;
 
-/// Draws the paper's Figure 1 layout to a PNG: the cases side by side, each a 2x2
-/// block (top row: side view, initial | final; bottom row: top view, initial | final),
-/// all four panels of a case at one scale, chosen so that the largest of them fits.
+/// Draws the paper's Figure 1 layout to a PNG: the cases next to each other, each a
+/// 2x2 block (upper row: side view, initial | final; lower row: top view, initial |
+/// final), the four panels of a case at one scale, the largest that fits all four.
 pub fn draw_figure1(path: &Path, cases: &[Figure1Case]) -> Result<()> {
     if cases.is_empty() {
         return Err(anyhow!("figure 1 needs at least one case"));
     }
-    let n = cases.len() as u32;
-    let block_w = 2 * FIG1_PANEL_W;
-    let width = n * block_w + (n + 1) * FIG1_GAP;
-    let height = 50 + FIG1_CASE_TITLE + FIG1_SIDE_H + FIG1_TOP_H + FIG1_GAP;
-    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
-    root.fill(&WHITE).map_err(drawing)?;
-    root.draw(&Text::new(
-        "Settling helical chains: side view (upper row) and top view (lower row), initial (left) and final (right) state",
-        (FIG1_GAP as i32, 14),
-        (FONT, 19).into_font().color(&BLACK),
-    ))
-    .map_err(drawing)?;
-    for (k, case) in cases.iter().enumerate() {
-        let x0 = FIG1_GAP + k as u32 * (block_w + FIG1_GAP);
-        let y0 = 50;
+    let n = cases.len() as f64;
+    let block_w = 2.0 * FIG1_PANEL_W;
+    let width = n * block_w + (n + 1.0) * FIG1_GAP;
+    let height = FIG1_HEADING + FIG1_CASE_TITLE + FIG1_SIDE_H + FIG1_TOP_H + FIG1_GAP;
+    let inset = 2.0;
+    let side_size = (FIG1_PANEL_W - 2.0 * inset, FIG1_SIDE_H - 2.0 * inset);
+    let top_size = (FIG1_PANEL_W - 2.0 * inset, FIG1_TOP_H - 2.0 * inset);
+    let as_u32 = |s: (f64, f64)| (s.0 as u32, s.1 as u32);
+    save_png(path, (width as u32, height as u32), |root, k| {
         root.draw(&Text::new(
-            case.title.clone(),
-            (x0 as i32, y0 as i32 + 4),
-            (FONT, 21).into_font().style(FontStyle::Bold).color(&BLACK),
+            "Settling helical chains: side view (upper row) and top view (lower row), \
+             initial (left) and final (right) state; head red, tails blue, last tail green",
+            (px(k, FIG1_GAP), px(k, 14.0)),
+            (FONT, 19.0 * k).into_font().color(&BLACK),
         ))
         .map_err(drawing)?;
-        let panel = |col: u32, row: u32| {
-            let (top, h) = if row == 0 {
-                (y0 + FIG1_CASE_TITLE, FIG1_SIDE_H)
-            } else {
-                (y0 + FIG1_CASE_TITLE + FIG1_SIDE_H, FIG1_TOP_H)
-            };
-            let left = x0 + col * FIG1_PANEL_W;
-            root.clone().shrink(
-                (left as i32 + 2, top as i32 + 2),
-                (FIG1_PANEL_W - 4, h - 4),
+        for (c, case) in cases.iter().enumerate() {
+            let x0 = FIG1_GAP + c as f64 * (block_w + FIG1_GAP);
+            root.draw(&Text::new(
+                case.title.clone(),
+                (px(k, x0), px(k, FIG1_HEADING + 4.0)),
+                (FONT, 21.0 * k)
+                    .into_font()
+                    .style(FontStyle::Bold)
+                    .color(&BLACK),
+            ))
+            .map_err(drawing)?;
+            let scale = fit_scale(
+                &[(&case.initial, View::Side), (&case.last, View::Side)],
+                as_u32(side_size),
             )
-        };
-        let side_size = (FIG1_PANEL_W - 4, FIG1_SIDE_H - 4);
-        let top_size = (FIG1_PANEL_W - 4, FIG1_TOP_H - 4);
-        let scale = fit_scale(&[(&case.initial, View::Side), (&case.last, View::Side)], side_size)
             .min(fit_scale(
                 &[(&case.initial, View::Top), (&case.last, View::Top)],
-                top_size,
+                as_u32(top_size),
             ));
-        let colors = chain_colors(case.initial.positions.len());
-        for (col, (snap, when)) in [(&case.initial, "initial"), (&case.last, "final")]
-            .into_iter()
-            .enumerate()
-        {
-            for (row, view) in [View::Side, View::Top].into_iter().enumerate() {
-                let name = if view == View::Side { "side" } else { "top" };
-                let title = format!("{name}, {when}, t = {}", short(snap.time));
-                draw_panel(
-                    &panel(col as u32, row as u32),
-                    snap,
-                    &colors,
-                    view,
-                    scale,
-                    &title,
-                )?;
+            let colors = chain_colors(case.initial.positions.len());
+            let states = [(&case.initial, "initial"), (&case.last, "final")];
+            for (col, (snap, when)) in states.into_iter().enumerate() {
+                for (row, view) in [View::Side, View::Top].into_iter().enumerate() {
+                    let (top, size) = if row == 0 {
+                        (FIG1_HEADING + FIG1_CASE_TITLE, side_size)
+                    } else {
+                        (FIG1_HEADING + FIG1_CASE_TITLE + FIG1_SIDE_H, top_size)
+                    };
+                    let left = x0 + col as f64 * FIG1_PANEL_W;
+                    let area = root.clone().shrink(
+                        (px(k, left + inset), px(k, top + inset)),
+                        (px(k, size.0) as u32, px(k, size.1) as u32),
+                    );
+                    let name = if view == View::Side { "side" } else { "top" };
+                    let title = format!("{name}, {when}, t = {}", short(snap.time));
+                    draw_panel(&area, snap, &colors, view, scale, &title, k)?;
+                }
             }
         }
-    }
-    root.present().map_err(drawing)?;
-    Ok(())
+        Ok(())
+    })
 }
 
 // ---------------------------------------------------------------------------------------
@@ -401,20 +474,24 @@ pub fn line_chart(path: &Path, chart: &LineChart, size: (u32, u32)) -> Result<()
     let series: Vec<(&str, Vec<(f64, f64)>)> = chart
         .series
         .iter()
-        .map(|s| (s.name.as_str(), s.points.iter().copied().filter(keep).collect()))
+        .map(|s| {
+            (
+                s.name.as_str(),
+                s.points.iter().copied().filter(keep).collect(),
+            )
+        })
         .collect();
     let all = series.iter().flat_map(|(_, p)| p.iter());
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        -f64::INFINITY,
-        f64::INFINITY,
-        -f64::INFINITY,
-    );
+    let (mut x0, mut x1, mut y0, mut y1) =
+        (f64::INFINITY, -f64::INFINITY, f64::INFINITY, -f64::INFINITY);
     for &(x, y) in all {
         (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
     }
     if x0 > x1 {
-        return Err(anyhow!("line chart {:?} has no drawable point", chart.title));
+        return Err(anyhow!(
+            "line chart {:?} has no drawable point",
+            chart.title
+        ));
     }
     let (x0, x1) = padded_range(x0, x1, chart.log_x);
     let (y0, y1) = padded_range(y0, y1, chart.log_y);
@@ -467,18 +544,15 @@ where
         .map_err(drawing)?;
     for (k, (name, points)) in series.iter().enumerate() {
         let color = SERIES_COLORS[k % SERIES_COLORS.len()];
-        ctx.draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
-            .map_err(drawing)?
-            .label(*name)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(2))
-            });
-        ctx.draw_series(
-            points
-                .iter()
-                .map(|&p| Circle::new(p, 3, color.filled())),
-        )
-        .map_err(drawing)?;
+        ctx.draw_series(LineSeries::new(
+            points.iter().copied(),
+            color.stroke_width(2),
+        ))
+        .map_err(drawing)?
+        .label(*name)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(2)));
+        ctx.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
+            .map_err(drawing)?;
     }
     if series.iter().any(|(name, _)| !name.is_empty()) {
         ctx.configure_series_labels()
@@ -554,7 +628,12 @@ pub fn category_map(path: &Path, map: &CategoryMap, size: (u32, u32)) -> Result<
     if !increasing(&map.x) || !increasing(&map.y) {
         return Err(anyhow!("category map cell centres must increase"));
     }
-    if let Some(bad) = map.cells.iter().flatten().find(|&&c| c >= map.categories.len()) {
+    if let Some(bad) = map
+        .cells
+        .iter()
+        .flatten()
+        .find(|&&c| c >= map.categories.len())
+    {
         return Err(anyhow!("category {bad} has no name and colour"));
     }
     let (ex, ey) = (edges(&map.x), edges(&map.y));
@@ -614,7 +693,7 @@ pub fn category_map(path: &Path, map: &CategoryMap, size: (u32, u32)) -> Result<
                 (10, -18),
                 (FONT, 16).into_font().style(FontStyle::Bold).color(&BLACK),
             )])
-            .map_err(drawing)?;
+        .map_err(drawing)?;
     }
 
     // Legend.
@@ -624,7 +703,10 @@ pub fn category_map(path: &Path, map: &CategoryMap, size: (u32, u32)) -> Result<
             .draw(&Rectangle::new([(10, y), (30, y + 20)], color.filled()))
             .map_err(drawing)?;
         legend
-            .draw(&Rectangle::new([(10, y), (30, y + 20)], BLACK.stroke_width(1)))
+            .draw(&Rectangle::new(
+                [(10, y), (30, y + 20)],
+                BLACK.stroke_width(1),
+            ))
             .map_err(drawing)?;
         legend
             .draw(&Text::new(

@@ -52,10 +52,13 @@ pub const DEFAULT_HEAD_RATIO: f64 = 1.259_921_049_894_873_2;
 /// `head_ratio >= 1`, so all the paper's cases and the whole phase-diagram grid
 /// (`dhat >= 1.05`, `head_ratio >= 1`) use one common helix.
 pub const DEFAULT_HELIX_RADIUS: f64 = 2.0;
-/// Default helix pitch (rise per turn), in tail radii: two tail diameters, so that
-/// beads one turn apart leave a gap of one diameter between them and the coils never
-/// touch.
-pub const DEFAULT_HELIX_PITCH: f64 = 4.0;
+/// Default helix pitch (rise per turn), in tail radii. With 7, coils one turn apart
+/// are 3.5 tail diameters apart (fluid passes between them, they never touch), and
+/// for the paper's bond gaps the number of tails per turn is not a whole number (4.5
+/// for `dhat = 1.50`, 6.7 for `dhat = 1.05`), so the 24 tails spread round a full ring
+/// about the head in top view instead of stacking in a few columns, as in the
+/// paper's Figure 1.
+pub const DEFAULT_HELIX_PITCH: f64 = 7.0;
 /// Number of trajectory frames aimed at when `[output] every` is not given.
 pub const TARGET_FRAMES: usize = 200;
 
@@ -561,7 +564,10 @@ impl Scene {
             let start = e.span().map_or(0, |s| s.start);
             let mut message = e.message().trim_end().replace('\n', " ");
             // A missing key is reported at its table's header: name the table.
-            let header = text.get(start..).and_then(|t| t.lines().next()).unwrap_or("");
+            let header = text
+                .get(start..)
+                .and_then(|t| t.lines().next())
+                .unwrap_or("");
             if message.starts_with("missing field") && header.starts_with('[') {
                 message = format!("{message} in {}", header.trim());
             }
@@ -799,8 +805,7 @@ impl RawScene {
         let Some(raw_int) = &self.integrator else {
             return Err(Issue {
                 span: None,
-                message: "missing table [integrator] (method, dt and duration are required)"
-                    .into(),
+                message: "missing table [integrator] (method, dt and duration are required)".into(),
             });
         };
         let integrator = resolve_integrator(raw_int.get_ref())?;
@@ -850,8 +855,9 @@ impl RawScene {
             (None, None) => {
                 return Err(Issue {
                     span: None,
-                    message: "the scene has no particles: give [[particle]] tables or a [helix] table"
-                        .into(),
+                    message:
+                        "the scene has no particles: give [[particle]] tables or a [helix] table"
+                            .into(),
                 });
             }
         };
@@ -1025,7 +1031,11 @@ fn resolve_bonds(
     Ok(out)
 }
 
-fn check_geometry(particles: &[Particle], overlap: Overlap, spans: &BodySpans) -> Result<(), Issue> {
+fn check_geometry(
+    particles: &[Particle],
+    overlap: Overlap,
+    spans: &BodySpans,
+) -> Result<(), Issue> {
     for j in 0..particles.len() {
         for i in 0..j {
             let (p, q) = (&particles[i], &particles[j]);

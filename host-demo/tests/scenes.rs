@@ -1,7 +1,7 @@
 //! Scene files: every shipped scene parses; the helix generator is exact; every bad
 //! file under `tests/data/bad/` is refused with the line its `# expect-line:` names.
 
-use host_demo::scene::{HeadEnd, Helix, Scene, FIGURE1_SCENES};
+use host_demo::scene::{FIGURE1_SCENES, HeadEnd, Helix, Scene};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -93,7 +93,11 @@ fn small_scenes_have_the_described_shapes() {
 #[test]
 fn figure1_scenes_are_the_papers_cases() {
     let cases = Scene::figure1().unwrap();
-    let expected = [("a", 1.50, 2f64.cbrt()), ("b", 1.05, 2f64.cbrt()), ("c", 1.05, 2.0)];
+    let expected = [
+        ("a", 1.50, 2f64.cbrt()),
+        ("b", 1.05, 2f64.cbrt()),
+        ("c", 1.05, 2.0),
+    ];
     for ((case, scene), (want_case, dhat, ratio)) in cases.iter().zip(expected) {
         assert_eq!(*case, want_case);
         let h = scene.helix.expect("figure 1 scenes use the helix");
@@ -211,7 +215,10 @@ fn bad_scenes_report_file_line_and_reason() {
 fn unreadable_file_is_an_error_without_a_line() {
     let err = Scene::from_path(Path::new("no/such/scene.toml")).unwrap_err();
     assert_eq!(err.line(), None);
-    assert!(err.to_string().starts_with("no/such/scene.toml: cannot read"));
+    assert!(
+        err.to_string()
+            .starts_with("no/such/scene.toml: cannot read")
+    );
 }
 
 #[test]
