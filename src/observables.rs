@@ -59,27 +59,25 @@ pub fn settling_speed<T: Real>(vel: &[T::V3], i: usize, gravity: T::V3) -> T {
 /// along gravity, unwraps its change since the last update, and adds the mean change
 /// weighted by the squared distance from the axis (so particles on the axis, whose
 /// azimuth is meaningless, do not count). Call it often enough that no particle turns
-/// by more than half a turn between calls.
+/// by more than half a turn between calls. A chain whose root-mean-square distance from
+/// the axis is below `min_radius` (a straight vertical chain) has no meaningful azimuth:
+/// such updates add nothing.
 #[derive(Clone, Debug)]
 pub struct Twist<T: Real, const N: usize> {
     prev: [T; N],
     started: bool,
+    min_radius: T,
     /// Accumulated twist angle (radians, right-handed about "up").
     pub total: T,
 }
 
-impl<T: Real, const N: usize> Default for Twist<T, N> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
 impl<T: Real, const N: usize> Twist<T, N> {
-    /// No twist accumulated yet.
-    pub const fn new() -> Self {
+    /// No twist accumulated yet; `min_radius` as described on the type.
+    pub const fn new(min_radius: T) -> Self {
         Self {
             prev: [T::ZERO; N],
             started: false,
+            min_radius,
             total: T::ZERO,
         }
     }
@@ -122,7 +120,8 @@ impl<T: Real, const N: usize> Twist<T, N> {
             }
             self.prev[k] = phi;
         }
-        if self.started && den > T::ZERO {
+        let count = T::from_f64((pos.len() - 1) as f64);
+        if self.started && den > self.min_radius * self.min_radius * count {
             self.total += num / den;
         }
         self.started = true;

@@ -335,6 +335,26 @@ fn short(x: f64) -> String {
     }
 }
 
+/// A tick label: at most three significant digits, scientific notation (`1e-5`,
+/// `2.5e6`) outside `[1e-3, 1e5)`.
+fn tick(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || !x.is_finite() || (1e-3..1e5).contains(&a) {
+        let s = short(x);
+        // Within 1e-12 of zero on a linear axis is zero.
+        if a < 1e-12 { "0".into() } else { s }
+    } else {
+        let s = format!("{x:.2e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = if mantissa.contains('.') {
+            mantissa.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            mantissa
+        };
+        format!("{mantissa}e{exponent}")
+    }
+}
+
 /// One case of the Figure 1 layout.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure1Case {
@@ -495,22 +515,19 @@ pub fn line_chart(path: &Path, chart: &LineChart, size: (u32, u32)) -> Result<()
     }
     let (x0, x1) = padded_range(x0, x1, chart.log_x);
     let (y0, y1) = padded_range(y0, y1, chart.log_y);
-    let root = BitMapBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE).map_err(drawing)?;
-    match (chart.log_x, chart.log_y) {
-        (false, false) => plot_lines(&root, chart, &series, x0..x1, y0..y1),
-        (true, false) => plot_lines(&root, chart, &series, (x0..x1).log_scale(), y0..y1),
-        (false, true) => plot_lines(&root, chart, &series, x0..x1, (y0..y1).log_scale()),
+    save_png(path, size, |root, k| match (chart.log_x, chart.log_y) {
+        (false, false) => plot_lines(root, chart, &series, x0..x1, y0..y1, k),
+        (true, false) => plot_lines(root, chart, &series, (x0..x1).log_scale(), y0..y1, k),
+        (false, true) => plot_lines(root, chart, &series, x0..x1, (y0..y1).log_scale(), k),
         (true, true) => plot_lines(
-            &root,
+            root,
             chart,
             &series,
             (x0..x1).log_scale(),
             (y0..y1).log_scale(),
+            k,
         ),
-    }?;
-    root.present().map_err(drawing)?;
-    Ok(())
+    })
 }
 
 fn plot_lines<DB, X, Y>(
@@ -519,6 +536,7 @@ fn plot_lines<DB, X, Y>(
     series: &[(&str, Vec<(f64, f64)>)],
     x: X,
     y: Y,
+    k: f64,
 ) -> Result<()>
 where
     DB: DrawingBackend,
@@ -527,39 +545,55 @@ where
     X::CoordDescType: ValueFormatter<f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
+    let w = |v: f64| px(k, v).max(1) as u32;
     let mut ctx = ChartBuilder::on(root)
-        .caption(&chart.title, (FONT, 22))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(72)
+        .caption(&chart.title, (FONT, 22.0 * k))
+        .margin(w(14.0))
+        .x_label_area_size(w(48.0))
+        .y_label_area_size(w(76.0))
         .build_cartesian_2d(x, y)
         .map_err(drawing)?;
+    let format = |v: &f64| tick(*v);
     ctx.configure_mesh()
         .x_desc(&chart.x_label)
         .y_desc(&chart.y_label)
-        .label_style((FONT, 14))
-        .axis_desc_style((FONT, 16))
-        .light_line_style(RGBColor(235, 235, 235))
+        .x_label_formatter(&format)
+        .y_label_formatter(&format)
+        .label_style((FONT, 14.0 * k))
+        .axis_desc_style((FONT, 16.0 * k))
+        .axis_style(BLACK.stroke_width(w(1.0)))
+        .bold_line_style(RGBColor(215, 215, 215).stroke_width(w(1.0)))
+        .light_line_style(RGBColor(240, 240, 240).stroke_width(w(1.0)))
+        .set_all_tick_mark_size(w(5.0))
         .draw()
         .map_err(drawing)?;
-    for (k, (name, points)) in series.iter().enumerate() {
-        let color = SERIES_COLORS[k % SERIES_COLORS.len()];
-        ctx.draw_series(LineSeries::new(
-            points.iter().copied(),
-            color.stroke_width(2),
-        ))
-        .map_err(drawing)?
-        .label(*name)
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(2)));
-        ctx.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))
-            .map_err(drawing)?;
+    for (n, (name, points)) in series.iter().enumerate() {
+        let color = SERIES_COLORS[n % SERIES_COLORS.len()];
+        let line = color.stroke_width(w(2.0));
+        let (len, marker) = (px(k, 22.0), px(k, 3.0));
+        ctx.draw_series(LineSeries::new(points.iter().copied(), line))
+            .map_err(drawing)?
+            .label(*name)
+            .legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (len, 0)], line)
+                    + Circle::new((len / 2, 0), marker, color.filled())
+            });
+        ctx.draw_series(
+            points
+                .iter()
+                .map(|&p| Circle::new(p, marker, color.filled())),
+        )
+        .map_err(drawing)?;
     }
     if series.iter().any(|(name, _)| !name.is_empty()) {
         ctx.configure_series_labels()
             .position(SeriesLabelPosition::UpperLeft)
+            .margin(w(12.0))
+            .legend_area_size(w(30.0))
             .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(150, 150, 150))
-            .label_font((FONT, 14))
+            .border_style(RGBColor(150, 150, 150).stroke_width(w(1.0)))
+            .label_font((FONT, 14.0 * k))
             .draw()
             .map_err(drawing)?;
     }
@@ -637,26 +671,43 @@ pub fn category_map(path: &Path, map: &CategoryMap, size: (u32, u32)) -> Result<
         return Err(anyhow!("category {bad} has no name and colour"));
     }
     let (ex, ey) = (edges(&map.x), edges(&map.y));
-    let root = BitMapBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE).map_err(drawing)?;
-    let legend_w = 190.min(size.0 / 3);
-    let (plot, legend) = root.split_horizontally(size.0 - legend_w);
+    save_png(path, size, |root, k| draw_category_map(root, map, &ex, &ey, k))
+}
+
+fn draw_category_map<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    map: &CategoryMap,
+    ex: &[f64],
+    ey: &[f64],
+    k: f64,
+) -> Result<()> {
+    let (nx, ny) = (map.x.len(), map.y.len());
+    let w = |v: f64| px(k, v).max(1) as u32;
+    let font = |size: f64| (FONT, size * k).into_font().color(&BLACK);
+    let legend_w = px(k, 190.0).min(root.dim_in_pixel().0 as i32 / 3);
+    let (plot, legend) = root.split_horizontally(root.dim_in_pixel().0 as i32 - legend_w);
     let mut ctx = ChartBuilder::on(&plot)
-        .caption(&map.title, (FONT, 22))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(64)
+        .caption(&map.title, (FONT, 22.0 * k))
+        .margin(w(14.0))
+        .x_label_area_size(w(48.0))
+        .y_label_area_size(w(64.0))
         .build_cartesian_2d(ex[0]..ex[nx], ey[0]..ey[ny])
         .map_err(drawing)?;
+    let format = |v: &f64| tick(*v);
     ctx.configure_mesh()
         .disable_mesh()
         .x_desc(&map.x_label)
         .y_desc(&map.y_label)
-        .label_style((FONT, 14))
-        .axis_desc_style((FONT, 16))
+        .x_label_formatter(&format)
+        .y_label_formatter(&format)
+        .label_style((FONT, 14.0 * k))
+        .axis_desc_style((FONT, 16.0 * k))
+        .axis_style(BLACK.stroke_width(w(1.0)))
+        .set_all_tick_mark_size(w(5.0))
         .draw()
         .map_err(drawing)?;
     let missing = RGBColor(200, 200, 200);
+    let grey = RGBColor(120, 120, 120).stroke_width(w(1.0));
     for iy in 0..ny {
         for ix in 0..nx {
             let corners = [(ex[ix], ey[iy]), (ex[ix + 1], ey[iy + 1])];
@@ -666,14 +717,14 @@ pub fn category_map(path: &Path, map: &CategoryMap, size: (u32, u32)) -> Result<
             };
             ctx.draw_series([
                 Rectangle::new(corners, color.filled()),
-                Rectangle::new(corners, WHITE.stroke_width(1)),
+                Rectangle::new(corners, WHITE.stroke_width(w(1.0))),
             ])
             .map_err(drawing)?;
             if cross {
                 let [(a, b), (c, d)] = corners;
                 ctx.draw_series([
-                    PathElement::new(vec![(a, b), (c, d)], RGBColor(120, 120, 120)),
-                    PathElement::new(vec![(a, d), (c, b)], RGBColor(120, 120, 120)),
+                    PathElement::new(vec![(a, b), (c, d)], grey),
+                    PathElement::new(vec![(a, d), (c, b)], grey),
                 ])
                 .map_err(drawing)?;
             }
@@ -682,54 +733,49 @@ pub fn category_map(path: &Path, map: &CategoryMap, size: (u32, u32)) -> Result<
     for m in &map.marks {
         let p = (m.x, m.y);
         ctx.draw_series([
-            Circle::new(p, 7, WHITE.filled()),
-            Circle::new(p, 7, BLACK.stroke_width(2)),
-            Circle::new(p, 2, BLACK.filled()),
+            Circle::new(p, px(k, 7.0), WHITE.filled()),
+            Circle::new(p, px(k, 7.0), BLACK.stroke_width(w(2.0))),
+            Circle::new(p, px(k, 2.0), BLACK.filled()),
         ])
         .map_err(drawing)?;
         ctx.draw_series([EmptyElement::at(p)
             + Text::new(
                 m.label.clone(),
-                (10, -18),
-                (FONT, 16).into_font().style(FontStyle::Bold).color(&BLACK),
+                (px(k, 10.0), px(k, -20.0)),
+                (FONT, 17.0 * k)
+                    .into_font()
+                    .style(FontStyle::Bold)
+                    .color(&BLACK),
             )])
         .map_err(drawing)?;
     }
 
-    // Legend.
-    let mut y = 60;
-    for (name, color) in &map.categories {
-        legend
-            .draw(&Rectangle::new([(10, y), (30, y + 20)], color.filled()))
-            .map_err(drawing)?;
-        legend
-            .draw(&Rectangle::new(
-                [(10, y), (30, y + 20)],
-                BLACK.stroke_width(1),
-            ))
-            .map_err(drawing)?;
-        legend
-            .draw(&Text::new(
-                name.clone(),
-                (38, y + 2),
-                (FONT, 16).into_font().color(&BLACK),
-            ))
-            .map_err(drawing)?;
-        y += 30;
-    }
+    // Legend: one swatch per category, then the "no result" swatch if needed.
+    let mut entries: Vec<(&str, RGBColor)> = map
+        .categories
+        .iter()
+        .map(|(name, color)| (name.as_str(), *color))
+        .collect();
     if map.cells.iter().any(Option::is_none) {
+        entries.push(("no result", missing));
+    }
+    for (n, (name, color)) in entries.into_iter().enumerate() {
+        let y = 60.0 + 30.0 * n as f64;
+        let swatch = [(px(k, 10.0), px(k, y)), (px(k, 30.0), px(k, y + 20.0))];
         legend
-            .draw(&Rectangle::new([(10, y), (30, y + 20)], missing.filled()))
+            .draw(&Rectangle::new(swatch, color.filled()))
+            .map_err(drawing)?;
+        legend
+            .draw(&Rectangle::new(swatch, BLACK.stroke_width(w(1.0))))
             .map_err(drawing)?;
         legend
             .draw(&Text::new(
-                "no result",
-                (38, y + 2),
-                (FONT, 16).into_font().color(&BLACK),
+                name.to_string(),
+                (px(k, 38.0), px(k, y + 2.0)),
+                font(16.0),
             ))
             .map_err(drawing)?;
     }
-    root.present().map_err(drawing)?;
     Ok(())
 }
 
@@ -759,7 +805,7 @@ mod tests {
             radii: vec![1.0, 2.0],
         };
         assert_eq!(extent(&s, View::Side), (-1.0, -1.0, 6.0, 3.0));
-        let scale = fit_scale(&[(&s, View::Side)], (100 + 2 * PANEL_PAD, 200));
+        let scale = fit_scale(&[(&s, View::Side)], (116, 200));
         assert!((scale - 100.0 / 7.0).abs() < 1e-12);
     }
 
@@ -770,6 +816,10 @@ mod tests {
         assert_eq!(nice_length(0.15), 0.1);
         assert_eq!(short(400.0), "400");
         assert_eq!(short(0.012345), "0.01235");
+        assert_eq!(tick(9.999999999e-5), "1e-4");
+        assert_eq!(tick(2.5e6), "2.5e6");
+        assert_eq!(tick(0.30000000000000004), "0.3");
+        assert_eq!(tick(1e-17), "0");
     }
 
     #[test]
