@@ -16,7 +16,8 @@ use crate::real::Real;
 pub enum SolverKind {
     /// Cyclic sweeps, one constraint at a time in bond order (the paper's SHAKE/RATTLE).
     Sweep,
-    /// Newton iterations on the dense `bonds x bonds` Jacobian (LU), the default.
+    /// Newton iterations on the dense `bonds x bonds` Jacobian (LU, reused while it
+    /// keeps converging fast), the default.
     #[default]
     Newton,
 }
@@ -251,7 +252,9 @@ pub fn sweep<T: Real>(
 }
 
 /// Newton iterations on the dense Jacobian `J_kl = dir_k . (D_l(i_k) - D_l(j_k))`,
-/// solved by LU. Quadratic convergence for positions, one step for velocities.
+/// solved by LU. The factorisation is reused while the residual falls at least
+/// tenfold per iteration (a chord / quasi-Newton step: the Jacobian barely changes
+/// within one time step) and refreshed otherwise. Velocities are linear: one step.
 pub fn newton<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,
@@ -267,10 +270,15 @@ pub fn newton<T: Real>(
         &mut scratch.rhs[..nb],
         &mut scratch.piv[..nb],
     );
+    let mut previous: Option<T> = None;
     for it in 0..=solver.max_iterations {
         let residual = worst(&problem, bonds, x);
         if !residual.is_finite() {
-            break;
+            return Err(StepError::NoConvergence {
+                stage: problem.stage(),
+                iterations: it,
+                residual: residual.to_f64(),
+            });
         }
         if residual <= solver.tolerance {
             return Ok(SolveStats {
@@ -285,23 +293,33 @@ pub fn newton<T: Real>(
                 residual: residual.to_f64(),
             });
         }
+        let refresh = match previous {
+            None => true,
+            Some(p) => !(residual <= p * T::from_f64(0.1)),
+        };
+        previous = Some(residual);
         for (k, b) in bonds.iter().enumerate() {
             let (value, dir, _) = problem.eval(b, k, x);
             rhs[k] = -value;
-            for l in 0..nb {
-                jac[k * nb + l] = T::dot(dir, metric.relative(bonds, k, l));
+            if refresh {
+                for l in 0..nb {
+                    jac[k * nb + l] = T::dot(dir, metric.relative(bonds, k, l));
+                }
             }
         }
-        linalg::lu(jac, nb, piv).map_err(|error| StepError::Linalg {
-            stage: problem.stage(),
-            error,
-        })?;
+        if refresh {
+            linalg::lu(jac, nb, piv).map_err(|error| StepError::Linalg {
+                stage: problem.stage(),
+                error,
+            })?;
+        }
         linalg::lu_solve(jac, nb, piv, rhs);
         for l in 0..nb {
             mult[l] += rhs[l];
             metric.apply(bonds, l, rhs[l], x);
         }
     }
+    // The loop returns on its last pass (it == max_iterations).
     Err(StepError::NoConvergence {
         stage: problem.stage(),
         iterations: solver.max_iterations,

@@ -115,6 +115,7 @@ pub fn cholesky_solve<T: Real>(l: &[T::M3], n: usize, x: &mut [T::V3]) {
 /// `piv[k]` records the row swapped into row `k`. A zero or non-finite pivot is
 /// [`LinalgError::Singular`].
 pub fn lu<T: Real>(a: &mut [T], n: usize, piv: &mut [usize]) -> Result<(), LinalgError> {
+    let a = &mut a[..n * n];
     for k in 0..n {
         let mut p = k;
         let mut best = a[k * n + k].abs();
@@ -130,17 +131,18 @@ pub fn lu<T: Real>(a: &mut [T], n: usize, piv: &mut [usize]) -> Result<(), Linal
         }
         piv[k] = p;
         if p != k {
-            for c in 0..n {
-                a.swap(k * n + c, p * n + c);
-            }
+            let (top, bottom) = a.split_at_mut(p * n);
+            top[k * n..k * n + n].swap_with_slice(&mut bottom[..n]);
         }
-        let inv = T::ONE / a[k * n + k];
-        for r in k + 1..n {
-            let f = a[r * n + k] * inv;
-            a[r * n + k] = f;
-            for c in k + 1..n {
-                let u = a[k * n + c];
-                a[r * n + c] -= f * u;
+        // Eliminate below the pivot row, one row slice at a time (no bounds checks inside).
+        let (upper, lower) = a.split_at_mut((k + 1) * n);
+        let pivot_row = &upper[k * n + k..k * n + n];
+        let inv = T::ONE / pivot_row[0];
+        for row in lower.chunks_exact_mut(n) {
+            let f = row[k] * inv;
+            row[k] = f;
+            for (x, &u) in row[k + 1..].iter_mut().zip(&pivot_row[1..]) {
+                *x -= f * u;
             }
         }
     }
@@ -149,21 +151,24 @@ pub fn lu<T: Real>(a: &mut [T], n: usize, piv: &mut [usize]) -> Result<(), Linal
 
 /// Solves `A x = b` in place with the factors from [`lu`].
 pub fn lu_solve<T: Real>(a: &[T], n: usize, piv: &[usize], x: &mut [T]) {
+    let x = &mut x[..n];
     for k in 0..n {
         x.swap(k, piv[k]);
     }
     for r in 0..n {
-        let mut acc = x[r];
-        for c in 0..r {
-            acc -= a[r * n + c] * x[c];
-        }
+        let row = &a[r * n..r * n + r];
+        let acc = row
+            .iter()
+            .zip(&x[..r])
+            .fold(x[r], |acc, (&l, &y)| acc - l * y);
         x[r] = acc;
     }
     for r in (0..n).rev() {
-        let mut acc = x[r];
-        for c in r + 1..n {
-            acc -= a[r * n + c] * x[c];
-        }
+        let row = &a[r * n + r + 1..r * n + n];
+        let acc = row
+            .iter()
+            .zip(&x[r + 1..])
+            .fold(x[r], |acc, (&u, &y)| acc - u * y);
         x[r] = acc / a[r * n + r];
     }
 }

@@ -51,26 +51,26 @@ pub fn self_rr<T: Real>(eta: T, a: T) -> T {
 /// Translation-translation block for the pair `(i, j)`, `i != j`.
 ///
 /// `None` when one sphere lies inside the other (no valid RPY form there).
-#[inline]
+#[inline(always)]
 pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<T::M3> {
-    let s2 = T::norm2(r);
-    let s = s2.sqrt();
     if level == Hydro::FreeDraining {
         return Some(T::M3_ZERO);
     }
-    let e = r / s;
-    let ee = T::outer(e, e);
-    let pi8 = T::from_f64(8.0) * T::PI * eta;
+    let s2 = T::norm2(r);
+    let s = s2.sqrt();
+    let inv_s = T::ONE / s;
+    let e = r * inv_s;
+    // 1 / (8 pi eta s): the constant folds out of the assembly loop once inlined.
+    let c = inv_s * (T::ONE / (T::from_f64(8.0) * T::PI * eta));
     if level == Hydro::Oseen {
-        return Some((T::M3_IDENTITY + ee) * (T::ONE / (pi8 * s)));
+        return Some(T::m3_diag(c) + T::outer(e, e * c));
     }
     let sum = ai + aj;
     let dif = ai - aj;
     if s > sum {
-        let q = (ai * ai + aj * aj) / s2;
+        let q = (ai * ai + aj * aj) * (inv_s * inv_s);
         let third = T::ONE / T::from_f64(3.0);
-        let c = T::ONE / (pi8 * s);
-        Some(T::m3_diag(c * (T::ONE + q * third)) + ee * (c * (T::ONE - q)))
+        Some(T::m3_diag(c * (T::ONE + q * third)) + T::outer(e, e * (c * (T::ONE - q))))
     } else if s > dif.abs() {
         // Overlapping branch (Zuk et al. 2014, eq. 2.7): stays positive definite.
         let s3 = s2 * s;
@@ -79,7 +79,7 @@ pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<
         let iso = T::from_f64(16.0) * s3 * sum - p * p;
         let q = dif * dif - s2;
         let aniso = T::from_f64(3.0) * q * q;
-        Some(T::m3_diag(k * iso) + ee * (k * aniso))
+        Some(T::m3_diag(k * iso) + T::outer(e, e * (k * aniso)))
     } else {
         None
     }

@@ -16,8 +16,16 @@ fn dimer_theta<T: Real>(method: Method, dt: f64, t_end: f64, st: f64) -> f64 {
     let (th0, phi) = (2.5f64, 0.7f64);
     let e0 = [th0.sin() * phi.cos(), th0.sin() * phi.sin(), -th0.cos()];
     let spheres = [
-        Sphere { pos: [0.0; 3], radius: a1, density: RHO * st },
-        Sphere { pos: scale(e0, d), radius: a2, density: RHO * st },
+        Sphere {
+            pos: [0.0; 3],
+            radius: a1,
+            density: RHO * st,
+        },
+        Sphere {
+            pos: scale(e0, d),
+            radius: a2,
+            density: RHO * st,
+        },
     ];
     let mut ps: ParticleSet<T, 2> = particles(&spheres);
     let bonds: BondSet<T, 1> = BondSet::chain(&ps.pos[..2]).unwrap();
@@ -45,9 +53,19 @@ fn explore<T: Real>() {
         for dt in [0.01] {
             let th = dimer_theta::<T>(Method::RattleStable, dt, t_end, st);
             let tho = dimer_theta::<T>(Method::Overdamped, dt, t_end, st);
-            eprintln!("St {st} dt {dt} err vs exact {:e} vs OD {:e}", (th - exact).abs(), (th-tho).abs());
+            eprintln!(
+                "St {st} dt {dt} err vs exact {:e} vs OD {:e}",
+                (th - exact).abs(),
+                (th - tho).abs()
+            );
         }
     }
 }
-#[test] fn ex64() { explore::<f64>() }
-#[test] fn ex32() { explore::<f32>() }
+#[test]
+fn ex64() {
+    explore::<f64>()
+}
+#[test]
+fn ex32() {
+    explore::<f32>()
+}

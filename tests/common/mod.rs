@@ -217,7 +217,11 @@ pub fn assert_failed_unchanged<T: Real, const N: usize>(
         Ok(r) => panic!("{what}: expected an error, the step succeeded ({r:?})"),
         Err(e) => assert!(pred(e), "{what}: unexpected error {e:?}"),
     }
-    assert_eq!(before, snapshot(ps).as_slice(), "{what}: state changed on error");
+    assert_eq!(
+        before,
+        snapshot(ps).as_slice(),
+        "{what}: state changed on error"
+    );
 }
 
 /// Instantiates a generic test body `$body::<T>()` for f32 and f64 as two tests.

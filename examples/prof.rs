@@ -1,0 +1,46 @@
+use glam::DVec3;
+use hydrorattle::*;
+fn main() {
+    let n = 25;
+    let mut ps: ParticleSet<f64, 32> = ParticleSet::new();
+    for k in 0..n {
+        let ph = k as f64;
+        ps.push(Particle::new(
+            DVec3::new(3.0 * ph.cos(), 3.0 * ph.sin(), 0.5 * ph * 3.0 / 6.0 * 2.0),
+            1.0,
+            4.5,
+        ))
+        .unwrap();
+    }
+    let bonds: BondSet<f64, 32> = BondSet::chain(&ps.pos[..n]).unwrap();
+    let mut p = Params::new(0.001);
+    p.allow_overlap = true;
+    let method = std::env::args().nth(1).unwrap_or("o".into());
+    p.method = match method.as_str() {
+        "o" => Method::Overdamped,
+        "o2" => Method::Overdamped2,
+        "r" => Method::Rattle,
+        "s" => Method::RattleStable,
+        _ => Method::Springs,
+    };
+    if std::env::args().nth(2).as_deref() == Some("sweep") {
+        p.solver.kind = SolverKind::Sweep;
+    }
+    let mut ws: Box<Workspace<f64, 32, 32>> = Box::new(Workspace::new());
+    let steps: usize = std::env::var("STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20000);
+    let t0 = std::time::Instant::now();
+    let mut its = 0;
+    for _ in 0..steps {
+        its += step(&mut ps, &bonds, &p, &mut ws, &mut NoForce)
+            .unwrap()
+            .iterations;
+    }
+    println!(
+        "{method}: {:.2} us/step its {:.2}",
+        t0.elapsed().as_secs_f64() * 1e6 / steps as f64,
+        its as f64 / steps as f64
+    );
+}
