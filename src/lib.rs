@@ -36,7 +36,7 @@ pub mod workspace;
 pub use bonds::{Bond, BondSet};
 pub use constraints::{Solver, SolverKind};
 pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
-pub use forces::{ExternalForce, NoForce};
+pub use forces::{ExternalForce, NoForce, SoftContact};
 pub use integrate::{StepReport, step};
 pub use mobility::Hydro;
 pub use params::{Method, Params};

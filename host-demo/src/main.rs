@@ -3,6 +3,7 @@
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use host_demo::scene::Scene;
+use host_demo::sim::RunOptions;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -34,6 +35,9 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "out/figure1")]
         out: PathBuf,
+        /// Smoke run: at most 2000 steps per case.
+        #[arg(long)]
+        quick: bool,
     },
     /// Outcome phase diagram over the bond gap D and the head ratio.
     Phase {
@@ -66,8 +70,11 @@ fn init_logging(verbose: u8) {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Run { scene, out } => {
-            let scene = Scene::from_path(&scene)?;
+        Command::Run {
+            scene: scene_path,
+            out,
+        } => {
+            let scene = Scene::from_path(&scene_path)?;
             log::info!(
                 "scene: {} particles, {} bonds, {:?}, {} steps",
                 scene.particles.len(),
@@ -75,12 +82,59 @@ fn run(cli: Cli) -> Result<()> {
                 scene.integrator.method,
                 scene.integrator.steps()
             );
-            println!("run: not wired yet (would write to {})", out.display());
+            let name = scene_name(&scene_path);
+            let r = host_demo::sim::run(
+                &scene,
+                &name,
+                Some(&out),
+                RunOptions {
+                    progress: true,
+                    max_steps: None,
+                },
+            )?;
+            let s = &r.summary;
+            println!(
+                "{name}: {} of {} steps in {:.2} s ({:.0} steps/s); outcome {}; extension {:.3}, verticality {:.3}, twist rate {:.4}; wrote {}",
+                s.steps_done,
+                s.steps,
+                s.wall_time_s,
+                s.steps_per_second,
+                s.outcome,
+                s.final_observables.extension,
+                s.final_observables.verticality,
+                s.twist_rate,
+                out.display()
+            );
+            if let Some(f) = &s.failure {
+                anyhow::bail!("{name}: the run stopped early: {f}");
+            }
         }
-        Command::Figure1 { out } => {
-            let cases = Scene::figure1()?;
-            log::info!("figure 1: {} cases", cases.len());
-            println!("figure1: not wired yet (would write to {})", out.display());
+        Command::Figure1 { out, quick } => {
+            let s = host_demo::figure1::figure1(&out, quick.then_some(2000))?;
+            println!(
+                "case  D     head   extension verticality twist_rate head_speed outcome    t(ext>=0.95) wall_s"
+            );
+            for c in &s.cases {
+                println!(
+                    "{:<5} {:<5.2} {:<6.3} {:<9.3} {:<11.3} {:<10.4} {:<10.3} {:<10} {:<12} {:.2}",
+                    c.case,
+                    c.dhat,
+                    c.head_ratio,
+                    c.extension,
+                    c.verticality,
+                    c.twist_rate,
+                    c.head_speed,
+                    c.outcome,
+                    c.time_to_stretch
+                        .map_or("never".to_string(), |t| format!("{t:.1}")),
+                    c.wall_time_s
+                );
+            }
+            println!(
+                "three cases in {:.2} s (parallel); wrote {}/figure1.png and figure1.json",
+                s.wall_time_s,
+                out.display()
+            );
         }
         Command::Phase { out } => {
             println!("phase: not wired yet (would write to {})", out.display());
@@ -90,6 +144,11 @@ fn run(cli: Cli) -> Result<()> {
         }
     }
     Ok(())
+}
+
+fn scene_name(path: &std::path::Path) -> String {
+    path.file_stem()
+        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned())
 }
 
 fn main() -> ExitCode {

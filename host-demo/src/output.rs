@@ -165,7 +165,7 @@ pub struct Frame {
 /// 2
 /// Properties=species:S:1:pos:R:3:radius:R:1:velocity:R:3 Time=0.5 pbc="F F F"
 /// H 0 0 0 1.2599210498948732 0 0 -1
-/// T 2 0 1.7 1 0 0 -1
+/// Ta 2 0 1.7 1 0 0 -1
 /// ```
 pub struct XyzWriter<W: Write> {
     inner: W,
@@ -211,10 +211,15 @@ impl<W: Write> XyzWriter<W> {
         }
         let w = &mut self.inner;
         writeln!(w, "{n}")?;
+        // Time always reads as a real number (`0.0`, not `0`), so that readers that
+        // guess types from the text (ASE) type it the same in every frame.
+        let mut time_text = format_f64(time);
+        if !time_text.contains(['.', 'e', 'N', 'n']) {
+            time_text.push_str(".0");
+        }
         writeln!(
             w,
-            "Properties={XYZ_PROPERTIES} Time={} pbc=\"F F F\"",
-            format_f64(time)
+            "Properties={XYZ_PROPERTIES} Time={time_text} pbc=\"F F F\""
         )?;
         for k in 0..n {
             let (p, v) = (positions[k], velocities[k]);

@@ -116,7 +116,7 @@ const PANEL_PAD: f64 = 8.0;
 
 /// Pictures are drawn this many times larger and averaged down to their final size,
 /// which smooths the edges of discs, lines and text.
-pub const SUPERSAMPLE: u32 = 3;
+pub const SUPERSAMPLE: u32 = 2;
 
 /// Rounds `v` output pixels, at `k` drawing pixels per output pixel, to drawing pixels.
 fn px(k: f64, v: f64) -> i32 {

@@ -544,6 +544,9 @@ pub struct Scene {
     pub integrator: Integrator,
     /// Output settings.
     pub output: Output,
+    /// Soft excluded-volume stiffness (`[contact] stiffness`); `None`: spheres may
+    /// pass through each other, as in the paper.
+    pub contact: Option<f64>,
 }
 
 impl Scene {
@@ -607,12 +610,14 @@ impl Scene {
         self.particles.iter().map(|p| p.density).collect()
     }
 
-    /// Species names for trajectory files: `H` for the head and `T` for tails of a
-    /// helix, `P` for every particle of an explicit scene.
+    /// Species names for trajectory files: `H` for the head and `Ta` for tails of a
+    /// helix, `P` for every particle of an explicit scene. They are chemical element
+    /// symbols because ASE accepts nothing else in the species column (a bare `T`
+    /// makes `ase.io.read` fail); OVITO takes any name.
     pub fn species(&self) -> Vec<&'static str> {
         match self.helix {
             Some(_) => (0..self.particles.len())
-                .map(|i| if i == 0 { "H" } else { "T" })
+                .map(|i| if i == 0 { "H" } else { "Ta" })
                 .collect(),
             None => vec!["P"; self.particles.len()],
         }
@@ -639,6 +644,13 @@ struct RawScene {
     model: Option<RawModel>,
     integrator: S<RawIntegrator>,
     output: Option<RawOutput>,
+    contact: Option<RawContact>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawContact {
+    stiffness: S<f64>,
 }
 
 #[derive(Deserialize)]
@@ -802,6 +814,15 @@ impl RawScene {
                 overlap: m.overlap.unwrap_or_default(),
             },
         };
+        let contact = match &self.contact {
+            None => None,
+            Some(c) => Some(number(
+                &c.stiffness,
+                0.0,
+                "contact stiffness",
+                Bound::Positive,
+            )?),
+        };
         let Some(raw_int) = &self.integrator else {
             return Err(Issue {
                 span: None,
@@ -885,6 +906,7 @@ impl RawScene {
             model,
             integrator,
             output: Output { every },
+            contact,
         })
     }
 }

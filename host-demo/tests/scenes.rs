@@ -106,7 +106,7 @@ fn figure1_scenes_are_the_papers_cases() {
         assert!((h.head_ratio - ratio).abs() < 1e-15);
         assert_eq!(scene.particles.len(), 25);
         assert_eq!(scene.species()[0], "H");
-        assert!(scene.species()[1..].iter().all(|s| *s == "T"));
+        assert!(scene.species()[1..].iter().all(|s| *s == "Ta"));
         assert_eq!(scene.integrator.dt, 0.01);
         assert_eq!(scene.integrator.duration, 400.0);
     }

@@ -71,7 +71,7 @@ fn trajectory_round_trip_is_bit_exact() {
     assert_eq!(lines.next(), Some("25"));
     assert_eq!(
         lines.next(),
-        Some(format!("Properties={XYZ_PROPERTIES} Time=0 pbc=\"F F F\"").as_str())
+        Some(format!("Properties={XYZ_PROPERTIES} Time=0.0 pbc=\"F F F\"").as_str())
     );
     assert!(
         lines
@@ -79,7 +79,7 @@ fn trajectory_round_trip_is_bit_exact() {
             .unwrap()
             .starts_with("H 0 0 0 1.2599210498948732 ")
     );
-    assert!(lines.next().unwrap().starts_with("T "));
+    assert!(lines.next().unwrap().starts_with("Ta "));
 
     let back = read_xyz_file(&path).unwrap();
     assert_eq!(back.len(), frames.len());

@@ -256,3 +256,165 @@ pub fn pick<T: Real>(single: f64, double: f64) -> f64 {
 pub fn is_single<T: Real>() -> bool {
     T::EPSILON.to_f64() > 1e-10
 }
+
+/// Bond topology of a test scene.
+#[derive(Clone, Debug)]
+pub enum Topology {
+    Chain,
+    Ring,
+    Tree(Vec<Option<usize>>),
+}
+
+/// A named scene: spheres and how they are bonded (lengths from the positions).
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: &'static str,
+    pub spheres: Vec<Sphere>,
+    pub topology: Topology,
+}
+
+impl Scene {
+    /// Particle set and bonds in precision `T`.
+    pub fn build<T: Real, const N: usize, const B: usize>(
+        &self,
+    ) -> (ParticleSet<T, N>, BondSet<T, B>) {
+        let ps: ParticleSet<T, N> = particles(&self.spheres);
+        let pos = &ps.pos[..ps.len()];
+        let bonds = match &self.topology {
+            Topology::Chain => BondSet::chain(pos),
+            Topology::Ring => BondSet::ring(pos),
+            Topology::Tree(parents) => BondSet::tree(pos, parents),
+        }
+        .expect("valid bonds");
+        (ps, bonds)
+    }
+}
+
+/// An 8-bead polydisperse chain, bent in 3D.
+pub fn chain_scene() -> Scene {
+    let radii = [1.0, 0.7, 1.3, 1.0, 0.8, 1.2, 1.0, 0.9];
+    let dirs = [
+        [1.0, 0.2, 0.1],
+        [0.6, 0.8, -0.3],
+        [0.9, -0.1, 0.5],
+        [0.2, -0.9, 0.1],
+        [0.8, 0.1, -0.6],
+        [0.3, 0.7, 0.6],
+        [1.0, -0.3, 0.2],
+    ];
+    Scene {
+        name: "chain",
+        spheres: path(&radii, &dirs, 1.2, RHO),
+        topology: Topology::Chain,
+    }
+}
+
+/// A 6-bead polydisperse ring on a tilted circle at irregular angles.
+pub fn ring_scene() -> Scene {
+    let angles = [0.0f64, 50.0, 115.0, 170.0, 235.0, 300.0];
+    let radii = [1.0, 1.2, 0.8, 1.1, 0.9, 1.0];
+    let axis = scale([1.0, 1.0, 0.0], 1.0 / 2f64.sqrt());
+    let spheres = angles
+        .iter()
+        .zip(radii)
+        .map(|(deg, radius)| {
+            let t = deg.to_radians();
+            Sphere {
+                pos: rotate([3.5 * t.cos(), 3.5 * t.sin(), 0.0], axis, 0.6),
+                radius,
+                density: RHO,
+            }
+        })
+        .collect();
+    Scene {
+        name: "ring",
+        spheres,
+        topology: Topology::Ring,
+    }
+}
+
+/// An 8-bead branched aggregate: a root with three branches, two of them forked.
+pub fn tree_scene() -> Scene {
+    let parents = vec![
+        None,
+        Some(0),
+        Some(0),
+        Some(0),
+        Some(1),
+        Some(1),
+        Some(2),
+        Some(3),
+    ];
+    let radii = [1.3, 1.0, 1.0, 0.8, 0.9, 1.0, 0.7, 1.1];
+    let dirs: [[f64; 3]; 8] = [
+        [0.0; 3],
+        [1.0, 0.0, 0.0],
+        [-0.5, 0.87, 0.0],
+        [-0.5, -0.87, 0.2],
+        [1.0, 1.0, 0.3],
+        [1.0, -1.0, -0.3],
+        [-0.3, 1.0, 0.5],
+        [0.0, -1.0, -0.5],
+    ];
+    let mut spheres: Vec<Sphere> = Vec::new();
+    for (c, parent) in parents.iter().enumerate() {
+        let pos = match *parent {
+            None => [0.0; 3],
+            Some(p) => {
+                let u = scale(dirs[c], 1.0 / norm(dirs[c]));
+                add(spheres[p].pos, scale(u, 1.3 * (radii[p] + radii[c])))
+            }
+        };
+        spheres.push(Sphere {
+            pos,
+            radius: radii[c],
+            density: RHO,
+        });
+    }
+    Scene {
+        name: "tree",
+        spheres,
+        topology: Topology::Tree(parents),
+    }
+}
+
+/// Largest relative bond-length error of the current positions, evaluated in `f64`.
+pub fn bond_error<T: Real, const N: usize, const B: usize>(
+    ps: &ParticleSet<T, N>,
+    bonds: &BondSet<T, B>,
+) -> f64 {
+    bonds
+        .as_slice()
+        .iter()
+        .map(|b| {
+            let r = norm(sub(f64s::<T>(ps.pos[b.i]), f64s::<T>(ps.pos[b.j])));
+            let d = b.length.to_f64();
+            ((r - d) / d).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Largest normalised bond-rate error `dt |(r_i - r_j).(v_i - v_j)| / d^2` (the
+/// quantity the RATTLE velocity solve drives below its tolerance), in `f64`.
+pub fn bond_rate_error<T: Real, const N: usize, const B: usize>(
+    ps: &ParticleSet<T, N>,
+    bonds: &BondSet<T, B>,
+    dt: f64,
+) -> f64 {
+    bonds
+        .as_slice()
+        .iter()
+        .map(|b| {
+            let r = sub(f64s::<T>(ps.pos[b.i]), f64s::<T>(ps.pos[b.j]));
+            let v = sub(f64s::<T>(ps.vel[b.i]), f64s::<T>(ps.vel[b.j]));
+            let d = b.length.to_f64();
+            (dot(r, v) * dt).abs() / (d * d)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// `[1.234e-3, ...]` for messages.
+pub fn sci(v: &[f64]) -> String {
+    let items: Vec<String> = v.iter().map(|x| format!("{x:.3e}")).collect();
+    format!("[{}]", items.join(", "))
+}
