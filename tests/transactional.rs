@@ -247,6 +247,7 @@ fn chain_of(c: &Case) -> Option<Vec<Sphere>> {
 
 fn random_chain_property<T: Real>(c: &Case) -> Result<(), TestCaseError> {
     let Some(spheres) = chain_of(c) else {
+        eprintln!("REJECT");
         return Err(TestCaseError::reject("overlapping random walk"));
     };
     let mut ps: ParticleSet<T, 12> = particles(&spheres);
@@ -261,6 +262,7 @@ fn random_chain_property<T: Real>(c: &Case) -> Result<(), TestCaseError> {
         let before = snapshot(&ps);
         match step(&mut ps, &bonds, &p, &mut ws, &mut NoForce) {
             Ok(r) => {
+                eprintln!("OK {:?} dt {:.3} n {n} it {}", method, c.dt, r.iterations);
                 let err = bond_error(&ps, &bonds);
                 prop_assert!(err <= tol, "step {k}: bond error {err:e} (report {:e})", r.residual.to_f64());
                 if matches!(method, Method::Rattle | Method::RattleStable) {
@@ -269,6 +271,7 @@ fn random_chain_property<T: Real>(c: &Case) -> Result<(), TestCaseError> {
                 }
             }
             Err(e) => {
+                eprintln!("ERR {:?} dt {:.3} n {n} {e}", method, c.dt);
                 prop_assert_eq!(before, snapshot(&ps), "step {} failed ({}) and changed the state", k, e);
                 break;
             }
