@@ -42,4 +42,6 @@ pub use mobility::Hydro;
 pub use params::{Method, Params};
 pub use particles::{Particle, ParticleSet};
 pub use real::Real;
+/// The vector crate the kernel is written against (re-exported so callers match versions).
+pub use glam;
 pub use workspace::Workspace;

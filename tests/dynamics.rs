@@ -124,7 +124,9 @@ fn dimer_initial_rate<T: Real>() {
     let measured = (theta - DIMER.theta0) / dt;
     let want = -c * DIMER.theta0.sin();
     let rel = (measured / want - 1.0).abs();
-    eprintln!("dimer C = {c:.12}; first-step rate {measured:.9} vs -C sin(theta0) {want:.9} (rel {rel:.1e})");
+    eprintln!(
+        "dimer C = {c:.12}; first-step rate {measured:.9} vs -C sin(theta0) {want:.9} (rel {rel:.1e})"
+    );
     assert!(rel < pick::<T>(1e-2, 1e-4), "rate {measured} vs {want}");
 }
 
@@ -142,7 +144,10 @@ fn dimer_convergence<T: Real>() {
             errors.push((theta - exact).abs());
             // The bond stays in its initial vertical plane.
             let plane = pick::<T>(1e-5, 1e-12);
-            assert!((phi - DIMER.phi).abs() < plane, "{method:?} dt {dt}: phi {phi}");
+            assert!(
+                (phi - DIMER.phi).abs() < plane,
+                "{method:?} dt {dt}: phi {phi}"
+            );
         }
         let order = loglog_slope(&dts, &errors);
         eprintln!(
@@ -151,7 +156,10 @@ fn dimer_convergence<T: Real>() {
         );
         assert!((lo..=hi).contains(&order), "{method:?} order {order}");
         assert!(errors[3] < finest, "{method:?} error {:e}", errors[3]);
-        assert!(errors.windows(2).all(|w| w[1] < w[0]), "{method:?} {errors:?}");
+        assert!(
+            errors.windows(2).all(|w| w[1] < w[0]),
+            "{method:?} {errors:?}"
+        );
     }
 }
 
@@ -173,7 +181,10 @@ fn dimer_stokes_limit<T: Real>() {
     }
     for w in gaps.windows(2) {
         let ratio = w[0] / w[1];
-        assert!((5.0..20.0).contains(&ratio), "gap not ~linear in St: {gaps:?}");
+        assert!(
+            (5.0..20.0).contains(&ratio),
+            "gap not ~linear in St: {gaps:?}"
+        );
     }
     // Vanishing mass: the implicit-drag step is the overdamped step.
     let st = pick::<T>(1e-6, 1e-10);
@@ -185,7 +196,144 @@ fn dimer_stokes_limit<T: Real>() {
     assert!(gap < pick::<T>(2e-4, 1e-8), "gap {gap:e}");
 }
 
+/// An independent reference for the inertial dimer (St = 1, no closed form): the
+/// constrained equations of motion written out and integrated by classical RK4 at a
+/// small step, in `f64`, with the two-sphere RPY mobility assembled here.
+///
+/// `m_k a_k = F_k - (R (v - 0))_k + F^C_k`, `R = mu^-1` (6x6), `F^C_1 = lambda g`,
+/// `F^C_2 = -lambda g`, `g = r_1 - r_2`; `lambda` from the second derivative of the
+/// constraint, `g.(a_1 - a_2) + |v_1 - v_2|^2 = 0`.
+mod inertial_reference {
+    use super::common::*;
+    use std::f64::consts::PI;
+
+    type State = [[f64; 3]; 4]; // r1, r2, v1, v2
+
+    /// Inverse of a 6x6 matrix by Gauss-Jordan with partial pivoting.
+    fn invert(mut a: [[f64; 6]; 6]) -> [[f64; 6]; 6] {
+        let mut inv = [[0.0; 6]; 6];
+        for (i, row) in inv.iter_mut().enumerate() {
+            row[i] = 1.0;
+        }
+        for c in 0..6 {
+            let p = (c..6)
+                .max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))
+                .unwrap();
+            a.swap(c, p);
+            inv.swap(c, p);
+            let d = a[c][c];
+            for k in 0..6 {
+                a[c][k] /= d;
+                inv[c][k] /= d;
+            }
+            for r in 0..6 {
+                if r != c {
+                    let f = a[r][c];
+                    for k in 0..6 {
+                        a[r][k] -= f * a[c][k];
+                        inv[r][k] -= f * inv[c][k];
+                    }
+                }
+            }
+        }
+        inv
+    }
+
+    fn mobility(r1: [f64; 3], r2: [f64; 3], a1: f64, a2: f64) -> [[f64; 6]; 6] {
+        let g = sub(r1, r2);
+        let s = norm(g);
+        let e = scale(g, 1.0 / s);
+        let q = (a1 * a1 + a2 * a2) / (s * s);
+        let (ca, cb) = ((1.0 + q / 3.0) / (8.0 * PI * s), (1.0 - q) / (8.0 * PI * s));
+        let mut m = [[0.0; 6]; 6];
+        for i in 0..3 {
+            m[i][i] = 1.0 / (6.0 * PI * a1);
+            m[3 + i][3 + i] = 1.0 / (6.0 * PI * a2);
+            for j in 0..3 {
+                let pair = if i == j { ca } else { 0.0 } + cb * e[i] * e[j];
+                m[i][3 + j] = pair;
+                m[3 + i][j] = pair;
+            }
+        }
+        m
+    }
+
+    fn rate(x: &State, radii: [f64; 2], masses: [f64; 2], weights: [f64; 2]) -> State {
+        let [r1, r2, v1, v2] = *x;
+        let res = invert(mobility(r1, r2, radii[0], radii[1]));
+        let v = [v1[0], v1[1], v1[2], v2[0], v2[1], v2[2]];
+        let mut acc = [[0.0; 3]; 2];
+        for k in 0..2 {
+            for c in 0..3 {
+                let drag: f64 = (0..6).map(|j| res[3 * k + c][j] * v[j]).sum();
+                let weight = if c == 2 { -weights[k] } else { 0.0 };
+                acc[k][c] = (weight - drag) / masses[k];
+            }
+        }
+        let g = sub(r1, r2);
+        let v12 = sub(v1, v2);
+        let lambda = -(dot(g, sub(acc[0], acc[1])) + dot(v12, v12))
+            / (dot(g, g) * (1.0 / masses[0] + 1.0 / masses[1]));
+        let a1 = add(acc[0], scale(g, lambda / masses[0]));
+        let a2 = sub(acc[1], scale(g, lambda / masses[1]));
+        [v1, v2, a1, a2]
+    }
+
+    /// `(theta, phi)` of the bond at `t_end` from rest at `(theta0, phi)`.
+    pub fn theta(theta0: f64, phi: f64, t_end: f64, dt: f64) -> f64 {
+        let (a1, a2, d) = (1.0, 2.0, 4.5);
+        let vol = |a: f64| 4.0 / 3.0 * PI * a.powi(3);
+        let masses = [vol(a1) * RHO, vol(a2) * RHO];
+        let e0 = [
+            theta0.sin() * phi.cos(),
+            theta0.sin() * phi.sin(),
+            -theta0.cos(),
+        ];
+        let mut x: State = [[0.0; 3], scale(e0, d), [0.0; 3], [0.0; 3]];
+        let f = |x: &State| rate(x, [a1, a2], masses, masses);
+        let axpy = |x: &State, k: &State, h: f64| -> State {
+            core::array::from_fn(|i| add(x[i], scale(k[i], h)))
+        };
+        for _ in 0..(t_end / dt).round() as usize {
+            let k1 = f(&x);
+            let k2 = f(&axpy(&x, &k1, dt / 2.0));
+            let k3 = f(&axpy(&x, &k2, dt / 2.0));
+            let k4 = f(&axpy(&x, &k3, dt));
+            x = core::array::from_fn(|i| {
+                let s = add(add(k1[i], scale(k2[i], 2.0)), add(scale(k3[i], 2.0), k4[i]));
+                add(x[i], scale(s, dt / 6.0))
+            });
+        }
+        let e = sub(x[1], x[0]);
+        e[0].hypot(e[1]).atan2(-e[2])
+    }
+}
+
+/// The inertial schemes (St = 1) converge to the independent RK4 reference, at first
+/// order: the paper's velocity update `v* = v + a(t) dt + a_C dt / 2` uses the
+/// acceleration at `t` only, and the stable scheme is backward Euler in the velocity.
+fn dimer_inertial<T: Real>() {
+    let reference = inertial_reference::theta(DIMER.theta0, DIMER.phi, T_END, 1e-3);
+    let check = inertial_reference::theta(DIMER.theta0, DIMER.phi, T_END, 5e-4);
+    assert!((reference - check).abs() < 1e-10, "reference not converged");
+    let dts = [0.1, 0.05, 0.025, 0.0125];
+    for method in [Method::Rattle, Method::RattleStable] {
+        let errors: Vec<f64> = dts
+            .iter()
+            .map(|&dt| (DIMER.run::<T>(method, dt, T_END).0 - reference).abs())
+            .collect();
+        let order = loglog_slope(&dts, &errors);
+        eprintln!(
+            "inertial dimer St 1 {method:?}: theta({T_END}) reference {reference:.9}; errors {} at dt {dts:?}; order {order:.2}",
+            sci(&errors)
+        );
+        assert!((0.8..=1.3).contains(&order), "{method:?} order {order}");
+        assert!(errors[3] < 0.01, "{method:?} errors {errors:?}");
+    }
+}
+
 both_precisions! {
+    dimer_inertial_schemes_converge => dimer_inertial;
     dimer_initial_rate_matches_closed_form => dimer_initial_rate;
     dimer_overdamped_orders => dimer_convergence;
     dimer_rattle_stable_stokes_limit => dimer_stokes_limit;
@@ -198,7 +346,11 @@ both_precisions! {
 /// Every constrained method, both solvers, three topologies: the bond residual is
 /// within tolerance after every step, and RATTLE leaves velocities tangent to bonds.
 fn bonds_hold<T: Real>() {
-    let tol = Real::to_f64(params::<T>(0.05, Method::Overdamped, SolverKind::Newton).solver.tolerance);
+    let tol = Real::to_f64(
+        params::<T>(0.05, Method::Overdamped, SolverKind::Newton)
+            .solver
+            .tolerance,
+    );
     let slack = tol + 16.0 * T::EPSILON.to_f64();
     for scene in [chain_scene(), ring_scene(), tree_scene()] {
         for method in CONSTRAINED {
@@ -270,15 +422,15 @@ fn constraint_forces_internal<T: Real>() {
                 step(&mut ps, &bonds, &p, &mut ws, &mut hook)
                     .unwrap_or_else(|e| panic!("{} {method:?} step {k}: {e}", scene.name));
                 let mut balance = [0.0; 3];
-                for i in 0..n {
+                for (i, &old) in old_vel.iter().enumerate() {
                     let a = ps.radius[i].to_f64();
                     let zeta = 6.0 * PI * a;
                     let mass = 4.0 / 3.0 * PI * a.powi(3) * ps.density[i].to_f64();
                     let v = f64s::<T>(ps.vel[i]);
                     let term = match method {
                         Method::Overdamped | Method::Overdamped2 => scale(v, zeta),
-                        Method::RattleStable => add(scale(sub(v, old_vel[i]), mass / dt), scale(v, zeta)),
-                        _ => add(scale(sub(v, old_vel[i]), mass / dt), scale(old_vel[i], zeta)),
+                        Method::RattleStable => add(scale(sub(v, old), mass / dt), scale(v, zeta)),
+                        _ => add(scale(sub(v, old), mass / dt), scale(old, zeta)),
                     };
                     balance = add(balance, term);
                 }
@@ -308,7 +460,7 @@ fn constraint_work_vanishes<T: Real>() {
         let p = params::<T>(dt, Method::Overdamped, SolverKind::Newton);
         let mut ws: Workspace<T, 8, 8> = Workspace::new();
         let (mut w_c, mut w_g) = (0.0f64, 0.0f64);
-        for _ in 0..(t_end / dt as f64).round() as usize {
+        for _ in 0..(t_end / dt).round() as usize {
             let old: Vec<[f64; 3]> = ps.pos[..n].iter().map(|&v| f64s::<T>(v)).collect();
             step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
             let lambda = ws.multipliers();
@@ -320,16 +472,19 @@ fn constraint_work_vanishes<T: Real>() {
                 );
                 w_c += lambda[l].to_f64() * dot(g, dr);
             }
-            for i in 0..n {
+            for (i, r0) in old.iter().enumerate() {
                 let a = ps.radius[i].to_f64();
                 let weight = 4.0 / 3.0 * PI * a.powi(3) * ps.density[i].to_f64();
-                w_g += -weight * (f64s::<T>(ps.pos[i])[2] - old[i][2]);
+                w_g += -weight * (f64s::<T>(ps.pos[i])[2] - r0[2]);
             }
         }
         ratios.push((w_c / w_g).abs());
     }
     let order = loglog_slope(&dts, &ratios);
-    eprintln!("constraint work / gravity work: {} at dt {dts:?} (order {order:.2})", sci(&ratios));
+    eprintln!(
+        "constraint work / gravity work: {} at dt {dts:?} (order {order:.2})",
+        sci(&ratios)
+    );
     assert!(ratios[2] < 0.05, "{ratios:?}");
     assert!((0.8..1.3).contains(&order), "order {order}");
 }
@@ -365,8 +520,8 @@ fn uniform_flow<T: Real>() {
             let mut ws: Workspace<T, 8, 8> = Workspace::new();
             run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, steps);
             let tol = pick::<T>(2e-5, 1e-12);
-            for i in 0..n {
-                let want = add(start[i], scale(flow, t));
+            for (i, &r0) in start.iter().enumerate() {
+                let want = add(r0, scale(flow, t));
                 let got = f64s::<T>(ps.pos[i]);
                 let dv = norm(sub(f64s::<T>(ps.vel[i]), flow));
                 assert!(
@@ -403,7 +558,10 @@ fn rigid_rotation<T: Real>() {
     let omega = [0.2, -0.1, 0.4];
     let t_end = 2.0;
     let dts = [0.1, 0.05, 0.025];
-    for (method, lo, hi) in [(Method::Overdamped, 0.8, 1.3), (Method::Overdamped2, 1.7, 2.4)] {
+    for (method, lo, hi) in [
+        (Method::Overdamped, 0.8, 1.3),
+        (Method::Overdamped2, 1.7, 2.4),
+    ] {
         let mut errors = Vec::new();
         for &dt in &dts {
             let (mut ps, bonds) = chain_scene().build::<T, 8, 8>();
@@ -421,7 +579,10 @@ fn rigid_rotation<T: Real>() {
                 for j in 0..i {
                     let d0 = norm(sub(start[i], start[j]));
                     let d1 = norm(sub(f64s::<T>(ps.pos[i]), f64s::<T>(ps.pos[j])));
-                    assert!((d1 - d0).abs() < 0.05 * d0 * dt / 0.1, "{method:?} dt {dt}: pair {i}-{j} {d0} -> {d1}");
+                    assert!(
+                        (d1 - d0).abs() < 0.05 * d0 * dt / 0.1,
+                        "{method:?} dt {dt}: pair {i}-{j} {d0} -> {d1}"
+                    );
                 }
             }
         }
@@ -477,11 +638,17 @@ fn spin_up<T: Real>() {
         );
         // The continuous solution, to O(dt / tau_r).
         let cont = scale(omega, 1.0 - (-(k as f64) * dt / tau_r).exp());
-        assert!(norm(sub(got, cont)) < 0.1 * norm(omega), "step {k}: far from exp relaxation");
+        assert!(
+            norm(sub(got, cont)) < 0.1 * norm(omega),
+            "step {k}: far from exp relaxation"
+        );
         assert!(norm(f64s::<T>(ps.pos[0])) < tol && norm(f64s::<T>(ps.vel[0])) < tol);
     }
     let end = norm(sub(f64s::<T>(ps.omega[0]), omega)) / norm(omega);
-    eprintln!("spin-up: tau_r = {tau_r}, |W - Omega| / |Omega| after {:.1} tau_r = {end:.1e}", 200.0 * dt / tau_r);
+    eprintln!(
+        "spin-up: tau_r = {tau_r}, |W - Omega| / |Omega| after {:.1} tau_r = {end:.1e}",
+        200.0 * dt / tau_r
+    );
     assert!(end < pick::<T>(1e-5, 1e-9));
 }
 
@@ -533,7 +700,11 @@ fn side_by_side<T: Real>() {
                     "{name} {method:?} sphere {i}: W = {got:?}, want {want:?}"
                 );
             }
-            eprintln!("side by side ({name}, {method:?}): W0 = {:?}, W1 = {:?}", f64s::<T>(ps.omega[0]), f64s::<T>(ps.omega[1]));
+            eprintln!(
+                "side by side ({name}, {method:?}): W0 = {:?}, W1 = {:?}",
+                f64s::<T>(ps.omega[0]),
+                f64s::<T>(ps.omega[1])
+            );
         }
     }
     // Equal free spheres keep falling side by side, so W is steady; with rotational
@@ -560,11 +731,64 @@ fn side_by_side<T: Real>() {
     let got1 = f64s::<T>(ps.omega[1]);
     eprintln!("side by side (RattleStable, t = 30): W0 = {got0:?}, W1 = {got1:?}, want -/+ {want}");
     let tol = pick::<T>(1e-4, 1e-8);
-    assert!(norm(sub(got0, [0.0, -want, 0.0])) < tol * want, "W0 {got0:?}");
-    assert!(norm(sub(got1, [0.0, want, 0.0])) < tol * want, "W1 {got1:?}");
+    assert!(
+        norm(sub(got0, [0.0, -want, 0.0])) < tol * want,
+        "W0 {got0:?}"
+    );
+    assert!(
+        norm(sub(got1, [0.0, want, 0.0])) < tol * want,
+        "W1 {got1:?}"
+    );
+}
+
+/// With rotation resolved, the implicit-drag step on the grand mobility reduces to the
+/// overdamped one as masses and moments of inertia vanish: same positions, and the
+/// angular velocities `W = mu_rt (F + F_C)` the overdamped step reports.
+fn rotation_massless_limit<T: Real>() {
+    let st = pick::<T>(1e-6, 1e-10);
+    let spheres = [
+        Sphere {
+            pos: [0.0; 3],
+            radius: 1.0,
+            density: RHO * st,
+        },
+        Sphere {
+            pos: [3.0, 0.5, 2.5],
+            radius: 2.0,
+            density: RHO * st,
+        },
+    ];
+    let mut inertial: ParticleSet<T, 2> = particles(&spheres);
+    let mut overdamped = inertial.clone();
+    let bonds: BondSet<T, 1> = BondSet::chain(&inertial.pos[..2]).unwrap();
+    let mut p = params::<T>(0.05, Method::RattleStable, SolverKind::Newton);
+    p.rotation = true;
+    p.gravity = v3::<T>(0.0, 0.0, -1.0 / st);
+    p.vorticity = v3::<T>(0.0, 0.1, 0.0);
+    let mut ws: Workspace<T, 2, 1> = Workspace::new();
+    run(&mut inertial, &bonds, &p, &mut ws, &mut NoForce, 20);
+    p.method = Method::Overdamped;
+    run(&mut overdamped, &bonds, &p, &mut ws, &mut NoForce, 20);
+    for i in 0..2 {
+        let dr = norm(sub(
+            f64s::<T>(inertial.pos[i]),
+            f64s::<T>(overdamped.pos[i]),
+        ));
+        let w = f64s::<T>(overdamped.omega[i]);
+        let dw = norm(sub(f64s::<T>(inertial.omega[i]), w)) / norm(w);
+        assert!(
+            dr < pick::<T>(1e-3, 1e-6),
+            "sphere {i}: positions differ by {dr:e}"
+        );
+        assert!(
+            dw < pick::<T>(1e-3, 1e-6),
+            "sphere {i}: W {w:?} differs by relative {dw:e}"
+        );
+    }
 }
 
 both_precisions! {
+    rotation_rattle_stable_massless_limit => rotation_massless_limit;
     lone_sphere_spins_up_to_vorticity => spin_up;
     side_by_side_spheres_counter_rotate => side_by_side;
 }
@@ -593,14 +817,29 @@ fn sweep_vs_newton<T: Real>() {
                 if is_single::<T>() { "f32" } else { "f64" },
                 mean[slot]
             );
-            assert!(its.iter().all(|&i| i >= 1), "{kind:?}: the unconstrained move must need correcting");
+            assert!(
+                its.iter().all(|&i| i >= 1),
+                "{kind:?}: the unconstrained move must need correcting"
+            );
             ends.push(ps.pos[..25].iter().map(|&v| f64s::<T>(v)).collect());
         }
         // Both solve the same equations to the same tolerance.
-        let gap = ends[0].iter().zip(&ends[1]).map(|(a, b)| norm(sub(*a, *b))).fold(0.0, f64::max);
-        assert!(gap < pick::<T>(1e-3, 1e-7), "dt {dt}: sweep and Newton differ by {gap:e}");
+        let gap = ends[0]
+            .iter()
+            .zip(&ends[1])
+            .map(|(a, b)| norm(sub(*a, *b)))
+            .fold(0.0, f64::max);
+        assert!(
+            gap < pick::<T>(1e-3, 1e-7),
+            "dt {dt}: sweep and Newton differ by {gap:e}"
+        );
         if dt == 0.1 {
-            assert!(mean[1] <= mean[0], "Newton {} vs sweeps {}", mean[1], mean[0]);
+            assert!(
+                mean[1] <= mean[0],
+                "Newton {} vs sweeps {}",
+                mean[1],
+                mean[0]
+            );
         }
     }
 }

@@ -60,8 +60,14 @@ fn diverges<T: Real, const N: usize>(spheres: &[Sphere], dt: f64, steps: usize) 
 fn empirical_limit<T: Real, const N: usize>(spheres: &[Sphere], lo: f64, hi: f64) -> f64 {
     let steps = 400;
     let (mut lo, mut hi) = (lo, hi);
-    assert!(!diverges::<T, N>(spheres, lo, steps), "dt {lo} should be stable");
-    assert!(diverges::<T, N>(spheres, hi, steps), "dt {hi} should be unstable");
+    assert!(
+        !diverges::<T, N>(spheres, lo, steps),
+        "dt {lo} should be stable"
+    );
+    assert!(
+        diverges::<T, N>(spheres, hi, steps),
+        "dt {hi} should be unstable"
+    );
     while hi / lo > 1.001 {
         let mid = (lo * hi).sqrt();
         if diverges::<T, N>(spheres, mid, steps) {
@@ -83,7 +89,13 @@ fn guard_limit<T: Real, const N: usize>(spheres: &[Sphere]) -> f64 {
     let mut ws: Box<Workspace<T, N, N>> = Box::new(Workspace::new());
     let before = snapshot(&ps);
     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
-    assert_failed_unchanged(&before, &ps, &r, |e| matches!(e, StepError::Unstable { .. }), "guard");
+    assert_failed_unchanged(
+        &before,
+        &ps,
+        &r,
+        |e| matches!(e, StepError::Unstable { .. }),
+        "guard",
+    );
     match r {
         Err(StepError::Unstable { limit, dt }) => {
             assert_eq!(dt, 1e6);
@@ -107,8 +119,14 @@ fn lone_sphere_limit<T: Real>() {
         "lone sphere: empirical explicit-drag limit {found:.5} = {:.4} x 2m/zeta ({two_tau:.5}); guard {guard:.6}",
         found / two_tau
     );
-    assert!((found / two_tau - 1.0).abs() < 0.02, "limit {found} vs 2m/zeta {two_tau}");
-    assert!((guard / two_tau - 1.0).abs() < pick::<T>(1e-5, 1e-10), "guard {guard}");
+    assert!(
+        (found / two_tau - 1.0).abs() < 0.02,
+        "limit {found} vs 2m/zeta {two_tau}"
+    );
+    assert!(
+        (guard / two_tau - 1.0).abs() < pick::<T>(1e-5, 1e-10),
+        "guard {guard}"
+    );
 }
 
 /// The paper's 25-bead helix (head 2^(1/3), tails 1, D = 1.5) and a dimer (radii 1, 2):
@@ -123,7 +141,10 @@ fn chain_limits<T: Real>() {
         "dimer 1+2: empirical limit {found:.4} = {:.3} x 2m/zeta(small sphere); guard {guard:.4}",
         found / two_tau_tail
     );
-    assert!(guard <= found * 1.002, "guard {guard} above empirical {found}");
+    assert!(
+        guard <= found * 1.002,
+        "guard {guard} above empirical {found}"
+    );
     let helix = helix(25, 2f64.powf(1.0 / 3.0), 3.0, 0.5, 1.5);
     let found = empirical_limit::<T, 25>(&helix, 0.05, 10.0);
     let guard = guard_limit::<T, 25>(&helix);
@@ -132,7 +153,10 @@ fn chain_limits<T: Real>() {
         found / two_tau_tail,
         guard / two_tau_tail
     );
-    assert!(guard <= found * 1.002, "guard {guard} above empirical {found}");
+    assert!(
+        guard <= found * 1.002,
+        "guard {guard} above empirical {found}"
+    );
     assert!(found < 2.0 * two_tau_tail, "limit {found}");
 }
 
@@ -161,16 +185,25 @@ fn blow_up_is_an_error<T: Real>() {
             let before = snapshot(&ps);
             let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
             if let Err(e) = r {
-                assert_eq!(before, snapshot(&ps), "{name}: state changed by the failing step");
+                assert_eq!(
+                    before,
+                    snapshot(&ps),
+                    "{name}: state changed by the failing step"
+                );
                 failed = Some((k, e));
                 break;
             }
             for i in 0..n {
-                assert!(T::v3_is_finite(ps.pos[i]) && T::v3_is_finite(ps.vel[i]), "{name}: non-finite state committed");
+                assert!(
+                    T::v3_is_finite(ps.pos[i]) && T::v3_is_finite(ps.vel[i]),
+                    "{name}: non-finite state committed"
+                );
             }
         }
         let (k, e) = failed.unwrap_or_else(|| panic!("{name}: never failed"));
-        let vmax = (0..n).map(|i| norm(f64s::<T>(ps.vel[i]))).fold(0.0, f64::max);
+        let vmax = (0..n)
+            .map(|i| norm(f64s::<T>(ps.vel[i])))
+            .fold(0.0, f64::max);
         eprintln!("{name} at dt = 10 m/zeta: step {k} failed with {e}; last |v| = {vmax:.3e}");
         if name == "lone" {
             // A lone sphere has no constraint solve that could fail first.
@@ -194,7 +227,13 @@ fn guard_refuses<T: Real>() {
     let mut ws: Workspace<T, 1, 1> = Workspace::new();
     let before = snapshot(&ps);
     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
-    assert_failed_unchanged(&before, &ps, &r, |e| matches!(e, StepError::Unstable { .. }), "guard");
+    assert_failed_unchanged(
+        &before,
+        &ps,
+        &r,
+        |e| matches!(e, StepError::Unstable { .. }),
+        "guard",
+    );
     p.dt = T::from_f64(0.95 * two_tau);
     step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).expect("below the limit");
 }
@@ -218,7 +257,10 @@ fn implicit_bounded<T: Real>() {
         step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
         v = (v + dt * 1.0) / (1.0 + dt);
         let got = f64s::<T>(ps.vel[0]);
-        assert!(norm(sub(got, [0.0, 0.0, -v])) < pick::<T>(1e-5, 1e-12), "v = {got:?}, want {v}");
+        assert!(
+            norm(sub(got, [0.0, 0.0, -v])) < pick::<T>(1e-5, 1e-12),
+            "v = {got:?}, want {v}"
+        );
     }
     let mut ps: ParticleSet<T, 8> = particles(&chain_scene().spheres);
     let n = ps.len();
@@ -235,7 +277,10 @@ fn implicit_bounded<T: Real>() {
     for k in 0..50 {
         step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
         let e1 = kinetic(&ps);
-        assert!(e1 <= e * (1.0 + 1e-6) + 1e-30, "step {k}: kinetic energy {e} -> {e1}");
+        assert!(
+            e1 <= e * (1.0 + 1e-6) + 1e-30,
+            "step {k}: kinetic energy {e} -> {e1}"
+        );
         e = e1;
     }
     assert!(bond_error(&ps, &bonds) < pick::<T>(2e-5, 2e-10));
@@ -249,7 +294,10 @@ fn implicit_bounded<T: Real>() {
 fn silent_regime_needs_guard<T: Real>() {
     let spheres = helix(25, 2f64.powf(1.0 / 3.0), 3.0, 0.5, 1.5);
     let dt = 0.8;
-    assert!(diverges::<T, 25>(&spheres, dt, 400), "dt {dt} should be beyond the limit");
+    assert!(
+        diverges::<T, 25>(&spheres, dt, 400),
+        "dt {dt} should be beyond the limit"
+    );
     let mut ps: ParticleSet<T, 25> = particles(&spheres);
     let bonds: BondSet<T, 24> = BondSet::chain(&ps.pos[..25]).unwrap();
     let mut p = params::<T>(dt, Method::Rattle, SolverKind::Newton);
@@ -258,7 +306,13 @@ fn silent_regime_needs_guard<T: Real>() {
     let mut ws: Box<Workspace<T, 25, 24>> = Box::new(Workspace::new());
     let before = snapshot(&ps);
     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
-    assert_failed_unchanged(&before, &ps, &r, |e| matches!(e, StepError::Unstable { .. }), "guard on the helix");
+    assert_failed_unchanged(
+        &before,
+        &ps,
+        &r,
+        |e| matches!(e, StepError::Unstable { .. }),
+        "guard on the helix",
+    );
     eprintln!("helix at dt {dt}: guard says {}", r.unwrap_err());
 }
 

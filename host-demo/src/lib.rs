@@ -7,8 +7,10 @@
 //! * [`render`]: sphere pictures (side and top views, the Figure 1 layout) and charts;
 //! * [`progress`]: a progress bar that stays out of the way of short or piped runs.
 
+pub mod charts;
 pub mod figure1;
 pub mod output;
+pub mod phase;
 pub mod progress;
 pub mod render;
 pub mod scene;

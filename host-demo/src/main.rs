@@ -44,12 +44,24 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "out/phase")]
         out: PathBuf,
+        /// Grid points per axis (at least 2).
+        #[arg(long, default_value_t = 6)]
+        grid: usize,
+        /// Smoke run: at most 500 steps per cell.
+        #[arg(long)]
+        quick: bool,
+        /// Skip the sensitivity table.
+        #[arg(long)]
+        no_sensitivity: bool,
     },
     /// Accuracy and speed charts of the integrators and solvers.
     Chart {
         /// Output directory.
         #[arg(long, default_value = "out/charts")]
         out: PathBuf,
+        /// Smoke run: fewer and shorter runs.
+        #[arg(long)]
+        quick: bool,
     },
 }
 
@@ -136,11 +148,41 @@ fn run(cli: Cli) -> Result<()> {
                 out.display()
             );
         }
-        Command::Phase { out } => {
-            println!("phase: not wired yet (would write to {})", out.display());
+        Command::Phase {
+            out,
+            grid,
+            quick,
+            no_sensitivity,
+        } => {
+            anyhow::ensure!(grid >= 2, "--grid must be at least 2");
+            let cap = quick.then_some(500);
+            let t = std::time::Instant::now();
+            host_demo::phase::phase(&out, grid, cap)?;
+            println!(
+                "phase map ({grid} x {grid}) in {:.1} s: wrote {}/phase.png and phase.csv",
+                t.elapsed().as_secs_f64(),
+                out.display()
+            );
+            if !no_sensitivity {
+                let t = std::time::Instant::now();
+                host_demo::phase::sensitivity(&out, cap)?;
+                println!(
+                    "sensitivity table in {:.1} s: wrote {}/sensitivity.csv",
+                    t.elapsed().as_secs_f64(),
+                    out.display()
+                );
+            }
         }
-        Command::Chart { out } => {
-            println!("chart: not wired yet (would write to {})", out.display());
+        Command::Chart { out, quick } => {
+            let t = std::time::Instant::now();
+            for note in host_demo::charts::charts(&out, quick)? {
+                println!("{note}");
+            }
+            println!(
+                "charts in {:.1} s: wrote {}",
+                t.elapsed().as_secs_f64(),
+                out.display()
+            );
         }
     }
     Ok(())
