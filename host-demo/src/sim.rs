@@ -205,6 +205,9 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     };
     p.allow_overlap = scene.model.overlap == crate::scene::Overlap::Allow;
     p.spring_stiffness = T::from_f64(i.stiffness);
+    // The paper's explicit drag can shiver silently (bounded, wrong) beyond its limit:
+    // the demo refuses such steps up front.
+    p.stability_guard = true;
     p
 }
 
