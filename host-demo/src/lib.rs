@@ -7,6 +7,7 @@
 //! * [`render`]: sphere pictures (side and top views, the Figure 1 layout) and charts;
 //! * [`progress`]: a progress bar that stays out of the way of short or piped runs.
 
+pub mod auto;
 pub mod charts;
 pub mod figure1;
 pub mod output;

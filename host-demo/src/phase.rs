@@ -79,6 +79,7 @@ fn failed_summary(scene: &Scene, name: &str, why: &str) -> Summary {
         twist_rate: 0.0,
         outcome: "failed".to_string(),
         failure: Some(why.to_string()),
+        level_choice: None,
     }
 }
 

@@ -113,6 +113,8 @@ pub struct Summary {
     pub outcome: String,
     /// Why the run stopped early, if it did.
     pub failure: Option<String>,
+    /// What `level = "auto"` chose and why (None for a manual level).
+    pub level_choice: Option<crate::auto::Choice>,
 }
 
 /// A finished run: summary, first and last configurations, the observables series.
@@ -143,7 +145,15 @@ pub fn run(scene: &Scene, name: &str, out: Option<&Path>, opts: RunOptions) -> R
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     let need = scene.particles.len().max(scene.bonds.len());
-    let scene = scene.clone();
+    let choice =
+        (scene.model.level == crate::scene::Level::Auto).then(|| crate::auto::choose(scene));
+    let scene = match &choice {
+        Some(c) => {
+            log::info!("{name}: level auto: {}", c.reason);
+            crate::auto::apply(scene, c)
+        }
+        None => scene.clone(),
+    };
     let name = name.to_string();
     let out = out.map(Path::to_path_buf);
     macro_rules! go {
@@ -152,7 +162,7 @@ pub fn run(scene: &Scene, name: &str, out: Option<&Path>, opts: RunOptions) -> R
             let stack = 2 * std::mem::size_of::<Workspace<$t, $n, $n>>() + (64 << 20);
             std::thread::Builder::new()
                 .stack_size(stack)
-                .spawn(move || run_t::<$t, $n>(&scene, &name, out.as_deref(), opts))
+                .spawn(move || run_t::<$t, $n>(&scene, &name, out.as_deref(), opts, choice))
                 .context("spawning the run thread")?
                 .join()
                 .map_err(|_| anyhow!("the run thread panicked"))?
@@ -240,6 +250,7 @@ fn run_t<T: Real, const N: usize>(
     name: &str,
     out: Option<&Path>,
     opts: RunOptions,
+    level_choice: Option<crate::auto::Choice>,
 ) -> Result<RunResult> {
     let p = params::<T>(scene);
     let n = scene.particles.len();
@@ -390,6 +401,7 @@ fn run_t<T: Real, const N: usize>(
         twist_rate,
         outcome,
         failure,
+        level_choice,
     };
     if let Some(dir) = out {
         if let Some(w) = xyz {
