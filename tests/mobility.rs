@@ -337,6 +337,7 @@ fn far_blocks(eta: f64, ai: f64, aj: f64, r: [f64; 3]) -> (M, M, M) {
 /// A lone sphere: `U = F / (6 pi eta a)` through assembly and the symmetric product,
 /// and the resistance `6 pi eta a` through the Cholesky solve.
 fn lone_sphere_stokes<T: Real>(tol: &Tol) {
+    let mut worst = 0.0f64;
     for &(eta, a) in &[(1.0, 1.0), (0.37, 2.5), (3.0, 0.125)] {
         let force = [0.7, -1.9, 3.25];
         let (pos, rad) = conv::<T>(&[[1.0, -2.0, 0.5]], &[a]);
@@ -349,6 +350,7 @@ fn lone_sphere_stokes<T: Real>(tol: &Tol) {
         let got = T::v3_to_f64(u[0]);
         for c in 0..3 {
             let err = (got[c] - want[c]).abs() / want[c].abs();
+            worst = worst.max(err);
             assert!(
                 err <= tol.exact,
                 "Stokes' law, component {c}: rel error {err:e}"
@@ -364,6 +366,7 @@ fn lone_sphere_stokes<T: Real>(tol: &Tol) {
         let got = T::v3_to_f64(x[0]);
         for c in 0..3 {
             let err = (got[c] - want[c]).abs() / want[c].abs();
+            worst = worst.max(err);
             assert!(
                 err <= tol.exact * 4.0,
                 "resistance, component {c}: rel error {err:e}"
@@ -376,6 +379,7 @@ fn lone_sphere_stokes<T: Real>(tol: &Tol) {
             assert_eq!(m2[0], mu[0]);
         }
     }
+    eprintln!("Stokes' law: worst relative error {worst:.2e}");
 }
 
 /// Two equal spheres, equal forces: settling speed along and across the line of
@@ -428,6 +432,7 @@ fn two_equal_spheres_settling<T: Real>(tol: &Tol) {
 /// Polydisperse pair: every block of the 12 x 12 grand mobility against the far-field
 /// formulas of DESIGN.md, both orderings of big and small.
 fn polydisperse_pair_far<T: Real>(tol: &Tol) {
+    let mut worst = 0.0f64;
     let mut rng = Rng(11);
     let eta = 1.7;
     for &(a0, a1, gap) in &[
@@ -469,6 +474,7 @@ fn polydisperse_pair_far<T: Real>(tol: &Tol) {
             for (bj, &w) in row.iter().enumerate() {
                 let got = blk::<T>(&g, 4, bi, bj);
                 let err = max_diff(got, w) / max_abs(w).max(1e-3 * scale_all);
+                worst = worst.max(err);
                 assert!(
                     err <= tol.exact * 16.0,
                     "radii ({a0}, {a1}), gap {gap}: block ({bi},{bj}) rel error {err:e}\n got {got:?}\nwant {w:?}"
@@ -484,6 +490,7 @@ fn polydisperse_pair_far<T: Real>(tol: &Tol) {
             }
         }
     }
+    eprintln!("polydisperse far blocks: worst relative error {worst:.2e}");
 }
 
 /// Equal overlapping spheres: the classical Rotne-Prager regularised blocks
@@ -491,6 +498,7 @@ fn polydisperse_pair_far<T: Real>(tol: &Tol) {
 /// `rr = [(1 - 27r/32a + 5r^3/64a^3) I + (9r/32a - 3r^3/64a^3) ee] / (8 pi eta a^3)`,
 /// `rt F = (r/a)(1 - 3r/8a) (F x e) / (16 pi eta a^2)`.
 fn equal_overlapping_blocks<T: Real>(tol: &Tol) {
+    let mut worst = 0.0f64;
     let mut rng = Rng(3);
     let (eta, a) = (1.2, 0.9);
     for &x in &[0.2, 0.7, 1.0, 1.6, 1.99] {
@@ -531,12 +539,14 @@ fn equal_overlapping_blocks<T: Real>(tol: &Tol) {
             ("rt_10", blk::<T>(&g, 4, 3, 0), mscale(rt, -1.0)),
         ] {
             let err = max_diff(got, want) / max_abs(want);
+            worst = worst.max(err);
             assert!(
                 err <= tol.exact * 64.0,
                 "r/a = {x}: {name} rel error {err:e}"
             );
         }
     }
+    eprintln!("equal overlapping blocks: worst relative error {worst:.2e}");
 }
 
 /// Polydisperse overlapping branch at its two ends: continuous with the far form at
@@ -545,6 +555,7 @@ fn equal_overlapping_blocks<T: Real>(tol: &Tol) {
 /// rotation of the big sphere from a force on the small one `= (r_small - r_big) x F /
 /// (8 pi eta A^3)`, rotation of the small one from a force on the big one `-> 0`.
 fn polydisperse_overlap_limits<T: Real>(tol: &Tol) {
+    let mut worst = 0.0f64;
     let mut rng = Rng(5);
     let eta = 0.9;
     for &(big_first, ab, asm) in &[(true, 2.0, 0.5), (false, 1.7, 1.1), (true, 1.26, 1.0)] {
@@ -576,6 +587,7 @@ fn polydisperse_overlap_limits<T: Real>(tol: &Tol) {
             ("rt_10", blk::<T>(&g, 4, 3, 0), rt10),
         ] {
             let err = max_diff(got, want) / max_abs(want);
+            worst = worst.max(err);
             assert!(
                 err <= tol.limit,
                 "contact ({ab}, {asm}): {name} rel error {err:e}"
@@ -605,12 +617,14 @@ fn polydisperse_overlap_limits<T: Real>(tol: &Tol) {
             ),
         ] {
             let err = max_diff(got, want) / scale_ref;
+            worst = worst.max(err);
             assert!(
                 err <= tol.limit,
                 "nesting limit ({ab}, {asm}): {name} rel error {err:e}"
             );
         }
     }
+    eprintln!("overlap branch limits: worst relative error {worst:.2e}");
 }
 
 /// Oseen and free-draining off-diagonal blocks against their closed forms.

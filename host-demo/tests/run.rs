@@ -1,0 +1,138 @@
+//! End-to-end runs: every shipped scene runs, the files of a run are whole and
+//! consistent, and a bad scene stops the CLI with file and line before any output.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use host_demo::output::read_xyz_file;
+use host_demo::scene::Scene;
+use host_demo::sim::{COLUMNS, RunOptions, run};
+
+fn manifest() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("host-demo-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+#[test]
+fn every_shipped_scene_runs_and_writes_whole_files() {
+    for entry in std::fs::read_dir(manifest().join("scenes")).unwrap() {
+        let path = entry.unwrap().path();
+        let scene = Scene::from_path(&path).unwrap();
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let out = scratch(&name);
+        let opts = RunOptions {
+            progress: false,
+            max_steps: Some(300),
+        };
+        let r = run(&scene, &name, Some(&out), opts).unwrap();
+        assert_eq!(r.summary.failure, None, "{name}");
+        assert_eq!(
+            r.summary.steps_done,
+            300.min(scene.integrator.steps()),
+            "{name}"
+        );
+        let frames = read_xyz_file(&out.join("trajectory.xyz")).unwrap();
+        assert_eq!(
+            frames.len(),
+            r.series.len(),
+            "{name}: one frame per observables row"
+        );
+        assert_eq!(frames[0].positions.len(), scene.particles.len());
+        // The last frame is the final state, bit for bit.
+        assert_eq!(frames.last().unwrap().positions, r.last.positions, "{name}");
+        let csv = std::fs::read_to_string(out.join("observables.csv")).unwrap();
+        assert_eq!(csv.lines().next().unwrap(), COLUMNS.join(","));
+        assert_eq!(csv.lines().count(), r.series.len() + 1);
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["steps_done"], r.summary.steps_done);
+        // No temporary file is left behind.
+        for f in std::fs::read_dir(&out).unwrap() {
+            assert!(!f.unwrap().path().to_string_lossy().ends_with(".tmp"));
+        }
+        // Bonds held to the tolerance the run used.
+        let worst = r.series.iter().map(|o| o.bond_residual).fold(0.0, f64::max);
+        if scene.integrator.method != host_demo::scene::Method::Springs {
+            assert!(
+                worst <= 10.0 * r.summary.tolerance_used,
+                "{name}: {worst:e}"
+            );
+        }
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+}
+
+fn cli(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_host-demo"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn a_bad_scene_stops_the_cli_with_file_and_line_before_any_output() {
+    let bad = manifest().join("tests/data/bad");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&bad).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let out = scratch(&format!("bad-{checked}"));
+        let o = cli(&[
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!o.status.success(), "{}", path.display());
+        let err = String::from_utf8_lossy(&o.stderr);
+        let shown = format!("{}:", path.display());
+        assert!(err.contains(&shown), "{err}");
+        assert!(
+            !Path::new(&out).exists(),
+            "{}: output written for a bad scene",
+            path.display()
+        );
+        checked += 1;
+    }
+    assert!(checked >= 10);
+}
+
+#[test]
+fn figure1_quick_writes_its_picture_and_table() {
+    let out = scratch("figure1");
+    let o = cli(&["figure1", "--quick", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("figure1.png").metadata().unwrap().len() > 10_000);
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("figure1.json")).unwrap()).unwrap();
+    let cases = j["cases"].as_array().unwrap();
+    let names: Vec<&str> = cases.iter().map(|c| c["case"].as_str().unwrap()).collect();
+    assert_eq!(names, ["a", "b", "c"]);
+    for c in cases {
+        for key in [
+            "dhat",
+            "head_ratio",
+            "extension",
+            "verticality",
+            "twist_rate",
+            "head_speed",
+        ] {
+            assert!(c[key].is_number(), "{key}");
+        }
+        assert!(c["outcome"].is_string());
+        assert!(
+            out.join(c["case"].as_str().unwrap())
+                .join("summary.json")
+                .exists()
+        );
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
