@@ -200,6 +200,9 @@ fn bond_vectors<T: Real>(bonds: &[Bond<T>], pos: &[T::V3], out: &mut [T::V3]) {
 }
 
 /// Hydrodynamic metric `D_l(p) = scale (mu_pi - mu_pj) g_l`, bond-major with stride `n`.
+///
+/// `mu_tt` is symmetric with symmetric blocks, so `mu_pi = mu_ip`: rows `i` and `j` are
+/// read contiguously instead of two strided columns.
 fn mobility_disp<T: Real>(
     mu: &[T::M3],
     n: usize,
@@ -210,8 +213,9 @@ fn mobility_disp<T: Real>(
 ) {
     for (l, b) in bonds.iter().enumerate() {
         let g = grad[l] * scale;
-        for q in 0..n {
-            disp[l * n + q] = (mu[q * n + b.i] - mu[q * n + b.j]) * g;
+        let (row_i, row_j) = (&mu[b.i * n..b.i * n + n], &mu[b.j * n..b.j * n + n]);
+        for ((d, &mi), &mj) in disp[l * n..l * n + n].iter_mut().zip(row_i).zip(row_j) {
+            *d = mi * g - mj * g;
         }
     }
 }

@@ -37,11 +37,11 @@ pub use bonds::{Bond, BondSet};
 pub use constraints::{Solver, SolverKind};
 pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
 pub use forces::{ExternalForce, NoForce, SoftContact};
+/// The vector crate the kernel is written against (re-exported so callers match versions).
+pub use glam;
 pub use integrate::{StepReport, step};
 pub use mobility::Hydro;
 pub use params::{Method, Params};
 pub use particles::{Particle, ParticleSet};
 pub use real::Real;
-/// The vector crate the kernel is written against (re-exported so callers match versions).
-pub use glam;
 pub use workspace::Workspace;
