@@ -50,28 +50,33 @@ pub fn self_rr<T: Real>(eta: T, a: T) -> T {
 
 /// Translation-translation block for the pair `(i, j)`, `i != j`.
 ///
-/// `None` when one sphere lies inside the other (no valid RPY form there).
+/// `None` when one sphere lies inside the other, at every level (no valid
+/// configuration). Blocks are exactly symmetric: `e e^T` is formed before scaling.
 #[inline(always)]
 pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<T::M3> {
+    let s2 = T::norm2(r);
+    let dif = ai - aj;
+    if s2 <= dif * dif {
+        return None;
+    }
     if level == Hydro::FreeDraining {
         return Some(T::M3_ZERO);
     }
-    let s2 = T::norm2(r);
     let s = s2.sqrt();
     let inv_s = T::ONE / s;
     let e = r * inv_s;
+    let ee = T::outer(e, e);
     // 1 / (8 pi eta s): the constant folds out of the assembly loop once inlined.
     let c = inv_s * (T::ONE / (T::from_f64(8.0) * T::PI * eta));
     if level == Hydro::Oseen {
-        return Some(T::m3_diag(c) + T::outer(e, e * c));
+        return Some(T::m3_diag(c) + ee * c);
     }
     let sum = ai + aj;
-    let dif = ai - aj;
     if s > sum {
         let q = (ai * ai + aj * aj) * (inv_s * inv_s);
         let third = T::ONE / T::from_f64(3.0);
-        Some(T::m3_diag(c * (T::ONE + q * third)) + T::outer(e, e * (c * (T::ONE - q))))
-    } else if s > dif.abs() {
+        Some(T::m3_diag(c * (T::ONE + q * third)) + ee * (c * (T::ONE - q)))
+    } else {
         // Overlapping branch (Zuk et al. 2014, eq. 2.7): stays positive definite.
         let s3 = s2 * s;
         let k = T::ONE / (T::from_f64(6.0) * T::PI * eta * ai * aj * T::from_f64(32.0) * s3);
@@ -79,9 +84,7 @@ pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<
         let iso = T::from_f64(16.0) * s3 * sum - p * p;
         let q = dif * dif - s2;
         let aniso = T::from_f64(3.0) * q * q;
-        Some(T::m3_diag(k * iso) + T::outer(e, e * (k * aniso)))
-    } else {
-        None
+        Some(T::m3_diag(k * iso) + ee * (k * aniso))
     }
 }
 

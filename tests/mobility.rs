@@ -1220,7 +1220,6 @@ macro_rules! precision_tests {
                 symmetry::<$t>(&TOL);
             }
             #[test]
-            #[ignore = "kernel bug: pair_tt builds outer(e, e * k), so each off-diagonal tt block is asymmetric in the last bit"]
             fn assembled_matrices_are_exactly_symmetric() {
                 exact_symmetry::<$t>(&TOL);
             }
@@ -1237,7 +1236,6 @@ macro_rules! precision_tests {
                 nested_assembly_error::<$t>(&TOL);
             }
             #[test]
-            #[ignore = "kernel bug: Oseen/free-draining assembly does not report nested spheres"]
             fn nested_spheres_are_an_error_at_every_level() {
                 nested_assembly_error_cheaper_levels::<$t>(&TOL);
             }
