@@ -593,7 +593,7 @@ fn stability(out: &Path, quick: bool) -> Result<String> {
     let dts: Vec<f64> = if quick {
         vec![0.01, 0.1]
     } else {
-        vec![0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0]
+        vec![0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0]
     };
     let mut solver_pts = Vec::new();
     for kind in [SolverKind::Sweep, SolverKind::Newton] {
@@ -782,7 +782,8 @@ fn precision_drift(scene: &Scene, t_end: f64) -> Result<Vec<Point>> {
     let mut p64 = setup::<f64>(scene, Method::Overdamped, 0.005, 1.0);
     p64.p.solver.tolerance = 1e-12;
     let mut p32 = setup::<f32>(scene, Method::Overdamped, 0.005, 1.0);
-    p32.p.solver.tolerance = 1e-5;
+    // 1e-5 is at f32's floor: it stalls at 1.02e-5 near t = 44 on this scene.
+    p32.p.solver.tolerance = 1e-4;
     let (mut a, bonds_a) = build::<f64>(scene, 1.0)?;
     let (mut b, bonds_b) = build::<f32>(scene, 1.0)?;
     let mut wa: Box<Workspace<f64, N, N>> = Box::new(Workspace::new());
@@ -817,7 +818,8 @@ fn precision_drift(scene: &Scene, t_end: f64) -> Result<Vec<Point>> {
                 }
             },
         );
-        if ra.is_err() || rb.is_err() {
+        if let Err(e) = ra.and(rb.map(|_| ())).map(|_| ()) {
+            log::warn!("f32/f64 drift run stopped at t = {}: {e}", a.time);
             break;
         }
         if s % every == 0 {
