@@ -34,5 +34,7 @@ where
 fn main() {
     let f64_rate = rate::<f64, 24>(0.0, black_box(0.999_999), black_box(1e-9));
     let f32_rate = rate::<f32, 48>(0.0, black_box(0.999_9), black_box(1e-7));
-    println!("peak multiply-add rate, one core: f64 {f64_rate:.2} GFLOP/s, f32 {f32_rate:.2} GFLOP/s");
+    println!(
+        "peak multiply-add rate, one core: f64 {f64_rate:.2} GFLOP/s, f32 {f32_rate:.2} GFLOP/s"
+    );
 }

@@ -63,16 +63,24 @@ pub fn step<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
         radius: &ps.radius[..n],
         density: &ps.density[..n],
     };
-    let mut report = match p.method {
-        Method::Overdamped => overdamped(p, &s, bonds, ws, ext)?,
-        Method::Overdamped2 => overdamped2(p, &s, bonds, ws, ext)?,
-        Method::Rattle => rattle_explicit(p, &s, bonds, ws, ext)?,
-        Method::RattleStable => rattle_stable(p, &s, bonds, ws, ext)?,
-        Method::Springs => springs(p, &s, bonds, ws, ext)?,
+    let integrated = match p.method {
+        Method::Overdamped => overdamped(p, &s, bonds, ws, ext),
+        Method::Overdamped2 => overdamped2(p, &s, bonds, ws, ext),
+        Method::Rattle => rattle_explicit(p, &s, bonds, ws, ext),
+        Method::RattleStable => rattle_stable(p, &s, bonds, ws, ext),
+        Method::Springs => springs(p, &s, bonds, ws, ext),
     };
     // 3. Accept.
     let (new_pos, new_vel, new_omega) = (&ws.new_pos[..n], &ws.new_vel[..n], &ws.new_omega[..n]);
-    accept(new_pos, new_vel, new_omega, s.radius, p.allow_overlap)?;
+    let mut report = integrated
+        .and_then(|r| accept(new_pos, new_vel, new_omega, s.radius, p.allow_overlap).map(|()| r))
+        .inspect_err(|e| log::debug!("step at t = {} refused, state kept: {e}", ps.time))?;
+    log::trace!(
+        "t = {}: {} position / {} velocity iterations",
+        ps.time,
+        report.iterations,
+        report.velocity_iterations
+    );
     report.residual = max_residual(bonds, new_pos).1;
     // 4. Commit.
     ps.pos[..n].copy_from_slice(new_pos);
