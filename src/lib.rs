@@ -11,7 +11,8 @@
 //! * RPY formulas: [`mobility`];
 //! * Cholesky and solves: [`linalg`];
 //! * the SHAKE sweep, Newton solve and RATTLE velocity sweep: [`constraints`];
-//! * the integrators and [`step`]: [`integrate`].
+//! * [`step`] and its stages: [`integrate`] (one file per integrator; the paper's
+//!   velocity-Verlet HydroRATTLE step is `src/integrate/rattle.rs`).
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

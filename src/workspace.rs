@@ -1,6 +1,7 @@
 //! Caller-owned scratch storage for [`step`](crate::integrate::step): every array a step
 //! touches lives here, sized at compile time, so the kernel never allocates.
 
+use crate::constraints::Scratch;
 use crate::real::Real;
 
 /// Scratch for up to `N` particles and `B` bonds. Large (`8 N^2` 3x3 blocks); keep one
@@ -82,5 +83,57 @@ impl<T: Real, const N: usize, const B: usize> Workspace<T, N, B> {
     /// blocks, row-major), when the method assembled one.
     pub fn mobility(&self, n: usize) -> &[T::M3] {
         &self.mu.as_flattened().as_flattened()[..n * n]
+    }
+}
+
+/// The workspace split into named slices sized for one step: `n` particles, `nb`
+/// bonds, `m` block rows (`n`, or `2n` when rotation is resolved). Integrators work on
+/// these slices only; `N` and `B` stop at [`step`](crate::integrate::step).
+pub(crate) struct Views<'a, T: Real> {
+    pub mu: &'a mut [T::M3],
+    pub fac: &'a mut [T::M3],
+    pub disp: &'a mut [T::V3],
+    pub force: &'a mut [T::V3],
+    pub work_a: &'a mut [T::V3],
+    pub work_b: &'a mut [T::V3],
+    pub work_c: &'a mut [T::V3],
+    pub grad: &'a mut [T::V3],
+    pub grad_new: &'a mut [T::V3],
+    pub lambda: &'a mut [T],
+    pub kappa: &'a mut [T],
+    pub inv_mass: &'a mut [T],
+    pub sqrt_m: &'a mut [T],
+    pub new_pos: &'a mut [T::V3],
+    pub new_vel: &'a mut [T::V3],
+    pub new_omega: &'a mut [T::V3],
+    pub scratch: Scratch<'a, T>,
+}
+
+impl<T: Real, const N: usize, const B: usize> Workspace<T, N, B> {
+    /// Splits the storage for a step (`n <= N`, `nb <= B`, `m <= 2N` checked by the caller).
+    pub(crate) fn views(&mut self, n: usize, nb: usize, m: usize) -> Views<'_, T> {
+        Views {
+            mu: &mut self.mu.as_flattened_mut().as_flattened_mut()[..m * m],
+            fac: &mut self.fac.as_flattened_mut().as_flattened_mut()[..m * m],
+            disp: &mut self.disp.as_flattened_mut()[..nb * n],
+            force: &mut self.force.as_flattened_mut()[..m],
+            work_a: &mut self.work_a.as_flattened_mut()[..m],
+            work_b: &mut self.work_b.as_flattened_mut()[..m],
+            work_c: &mut self.work_c.as_flattened_mut()[..m],
+            grad: &mut self.grad[..nb],
+            grad_new: &mut self.grad_new[..nb],
+            lambda: &mut self.lambda[..nb],
+            kappa: &mut self.kappa[..nb],
+            inv_mass: &mut self.inv_mass[..n],
+            sqrt_m: &mut self.sqrt_m.as_flattened_mut()[..m],
+            new_pos: &mut self.new_pos[..n],
+            new_vel: &mut self.new_vel[..n],
+            new_omega: &mut self.new_omega[..n],
+            scratch: Scratch {
+                jac: &mut self.jac.as_flattened_mut()[..nb * nb],
+                rhs: &mut self.rhs[..nb],
+                piv: &mut self.piv[..nb],
+            },
+        }
     }
 }

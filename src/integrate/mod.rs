@@ -1,0 +1,306 @@
+//! The integrators and [`step`].
+//!
+//! `step` is a short list of stages: check the inputs, integrate into the workspace,
+//! accept the candidate state, commit it. A failure at any stage returns the error
+//! with the caller's state untouched.
+//!
+//! One file per integrator: `integrate/overdamped.rs` (HydroSHAKE, first and second
+//! order), `integrate/rattle.rs` (the paper's velocity-Verlet HydroRATTLE),
+//! `integrate/stable.rs` (implicit drag, optional rotation), `integrate/springs.rs`.
+//! This file holds `step` and the stages they share.
+
+mod overdamped;
+mod rattle;
+mod springs;
+mod stable;
+
+use overdamped::{overdamped, overdamped2};
+use rattle::rattle_explicit;
+use springs::springs;
+use stable::rattle_stable;
+
+use crate::bonds::{Bond, BondSet, max_residual};
+use crate::constraints::SolveStats;
+use crate::error::{ParticleError, StepError};
+use crate::forces::ExternalForce;
+use crate::mobility::{self, Hydro};
+use crate::params::{Method, Params};
+use crate::particles::ParticleSet;
+use crate::real::Real;
+use crate::workspace::Workspace;
+
+/// What a successful step measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepReport<T> {
+    /// Position-constraint iterations (sweeps or Newton steps) of the final solve.
+    pub iterations: u32,
+    /// Velocity-constraint iterations (RATTLE stage), 0 where there is none.
+    pub velocity_iterations: u32,
+    /// Largest relative bond-length error `| |r_ij| - d | / d` after the step.
+    pub residual: T,
+    /// Largest bond tension magnitude `|lambda_k| d_k` (force units); for springs
+    /// `k | |r_ij| - d |`.
+    pub max_tension: T,
+}
+
+/// Read-only view of the state at the start of a step.
+pub(super) struct Start<'a, T: Real> {
+    pub(super) pos: &'a [T::V3],
+    pub(super) vel: &'a [T::V3],
+    pub(super) omega: &'a [T::V3],
+    pub(super) radius: &'a [T],
+    pub(super) density: &'a [T],
+}
+
+/// Advances the particles by one step of `p.method`.
+///
+/// Stages: (1) check parameters, particles and bonds; (2) integrate into `ws` (forces,
+/// mobility, unconstrained move, constraint solves); (3) accept the candidate (finite,
+/// no nesting, no overlap unless allowed); (4) commit it into `ps`. On error `ps` is
+/// exactly as it was.
+pub fn step<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
+    ps: &mut ParticleSet<T, N>,
+    bonds: &BondSet<T, B>,
+    p: &Params<T>,
+    ws: &mut Workspace<T, N, B>,
+    ext: &mut E,
+) -> Result<StepReport<T>, StepError> {
+    let n = ps.len();
+    let bonds = bonds.as_slice();
+    // 1. Inputs.
+    check_inputs(ps, bonds, p)?;
+    // 2. Integrate into the workspace.
+    let s = Start {
+        pos: &ps.pos[..n],
+        vel: &ps.vel[..n],
+        omega: &ps.omega[..n],
+        radius: &ps.radius[..n],
+        density: &ps.density[..n],
+    };
+    let m = if p.rotation && p.method == Method::RattleStable {
+        2 * n
+    } else {
+        n
+    };
+    let v = ws.views(n, bonds.len(), m);
+    let integrated = match p.method {
+        Method::Overdamped => overdamped(p, &s, bonds, v, ext),
+        Method::Overdamped2 => overdamped2(p, &s, bonds, v, ext),
+        Method::Rattle => rattle_explicit(p, &s, bonds, v, ext),
+        Method::RattleStable => rattle_stable(p, &s, bonds, v, ext),
+        Method::Springs => springs(p, &s, bonds, v, ext),
+    };
+    // 3. Accept.
+    let (new_pos, new_vel, new_omega) = (&ws.new_pos[..n], &ws.new_vel[..n], &ws.new_omega[..n]);
+    let mut report = integrated
+        .and_then(|r| accept(new_pos, new_vel, new_omega, s.radius, p.allow_overlap).map(|()| r))
+        .inspect_err(|e| log::debug!("step at t = {} refused, state kept: {e}", ps.time))?;
+    log::trace!(
+        "t = {}: {} position / {} velocity iterations",
+        ps.time,
+        report.iterations,
+        report.velocity_iterations
+    );
+    report.residual = max_residual(bonds, new_pos).1;
+    // 4. Commit.
+    ps.pos[..n].copy_from_slice(new_pos);
+    ps.vel[..n].copy_from_slice(new_vel);
+    ps.omega[..n].copy_from_slice(new_omega);
+    ps.time += p.dt;
+    Ok(report)
+}
+
+/// Cheap checks (O(N + B)); pair checks happen in assembly and in [`accept`].
+fn check_inputs<T: Real, const N: usize>(
+    ps: &ParticleSet<T, N>,
+    bonds: &[Bond<T>],
+    p: &Params<T>,
+) -> Result<(), StepError> {
+    if !(p.dt > T::ZERO && p.dt.is_finite()) {
+        return Err(StepError::BadTimeStep);
+    }
+    let bad = |ok: bool, name| {
+        if ok {
+            Ok(())
+        } else {
+            Err(StepError::BadParameter(name))
+        }
+    };
+    bad(
+        p.viscosity > T::ZERO && p.viscosity.is_finite(),
+        "viscosity",
+    )?;
+    bad(p.fluid_density.is_finite(), "fluid_density")?;
+    bad(T::v3_is_finite(p.gravity), "gravity")?;
+    bad(T::v3_is_finite(p.flow_velocity), "flow_velocity")?;
+    bad(T::v3_is_finite(p.vorticity), "vorticity")?;
+    bad(
+        p.solver.tolerance > T::ZERO && p.solver.tolerance.is_finite(),
+        "tolerance",
+    )?;
+    bad(p.solver.max_iterations > 0, "max_iterations")?;
+    if p.method == Method::Springs {
+        bad(
+            p.spring_stiffness > T::ZERO && p.spring_stiffness.is_finite(),
+            "spring_stiffness",
+        )?;
+    }
+    let n = ps.len();
+    for i in 0..n {
+        let finite = T::v3_is_finite(ps.pos[i])
+            && T::v3_is_finite(ps.vel[i])
+            && T::v3_is_finite(ps.omega[i])
+            && ps.radius[i].is_finite()
+            && ps.density[i].is_finite();
+        if !finite {
+            return Err(ParticleError::NonFinite { particle: i }.into());
+        }
+        if ps.radius[i] <= T::ZERO {
+            return Err(ParticleError::BadRadius { particle: i }.into());
+        }
+        if ps.density[i] < T::ZERO {
+            return Err(ParticleError::BadDensity { particle: i }.into());
+        }
+        let inertial = matches!(p.method, Method::Rattle | Method::RattleStable);
+        if inertial && ps.mass(i) <= T::ZERO {
+            return Err(ParticleError::Massless { particle: i }.into());
+        }
+    }
+    // Bonds were validated on insertion; only the particle count can disagree.
+    for (bond, b) in bonds.iter().enumerate() {
+        if b.i.max(b.j) >= n {
+            let particle = b.i.max(b.j);
+            return Err(crate::error::BondError::OutOfRange { bond, particle }.into());
+        }
+    }
+    Ok(())
+}
+
+/// Finite, no nested spheres, no overlap unless allowed (squared distances: no sqrt).
+fn accept<T: Real>(
+    pos: &[T::V3],
+    vel: &[T::V3],
+    omega: &[T::V3],
+    radius: &[T],
+    allow_overlap: bool,
+) -> Result<(), StepError> {
+    for i in 0..pos.len() {
+        if !(T::v3_is_finite(pos[i]) && T::v3_is_finite(vel[i]) && T::v3_is_finite(omega[i])) {
+            return Err(StepError::NonFinite { particle: i });
+        }
+    }
+    for i in 0..pos.len() {
+        for j in i + 1..pos.len() {
+            let s2 = T::norm2(pos[i] - pos[j]);
+            let (dif, sum) = (radius[i] - radius[j], radius[i] + radius[j]);
+            if s2 <= dif * dif || (!allow_overlap && s2 < sum * sum) {
+                return Err(StepError::Overlap { i, j });
+            }
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn assemble_tt<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    mu: &mut [T::M3],
+) -> Result<(), StepError> {
+    mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
+}
+
+/// `g_l = r_i - r_j` for every bond.
+pub(super) fn bond_vectors<T: Real>(bonds: &[Bond<T>], pos: &[T::V3], out: &mut [T::V3]) {
+    for (g, b) in out.iter_mut().zip(bonds) {
+        *g = pos[b.i] - pos[b.j];
+    }
+}
+
+/// Hydrodynamic metric `D_l(p) = scale (mu_pi - mu_pj) g_l`, bond-major with stride `n`.
+///
+/// `mu_tt` is symmetric with symmetric blocks, so `mu_pi = mu_ip`: rows `i` and `j` are
+/// read contiguously instead of two strided columns.
+pub(super) fn mobility_disp<T: Real>(
+    mu: &[T::M3],
+    n: usize,
+    bonds: &[Bond<T>],
+    grad: &[T::V3],
+    scale: T,
+    disp: &mut [T::V3],
+) {
+    for (l, b) in bonds.iter().enumerate() {
+        let g = grad[l] * scale;
+        let (row_i, row_j) = (&mu[b.i * n..b.i * n + n], &mu[b.j * n..b.j * n + n]);
+        for ((d, &mi), &mj) in disp[l * n..l * n + n].iter_mut().zip(row_i).zip(row_j) {
+            *d = mi * g - mj * g;
+        }
+    }
+}
+
+/// `u_i += U_inf(r_i)`.
+pub(super) fn add_flow<T: Real>(p: &Params<T>, pos: &[T::V3], u: &mut [T::V3]) {
+    for (ui, &r) in u.iter_mut().zip(pos) {
+        *ui += p.flow_at(r);
+    }
+}
+
+/// Largest `|lambda_k| d_k`.
+pub(super) fn max_tension<T: Real>(bonds: &[Bond<T>], lambda: &[T]) -> T {
+    bonds
+        .iter()
+        .zip(lambda)
+        .fold(T::ZERO, |m, (b, &l)| m.max((l * b.length).abs()))
+}
+
+/// `f_i += sum_l lambda_l (+-g_l)`: the constraint forces.
+pub(super) fn add_constraint_forces<T: Real>(
+    bonds: &[Bond<T>],
+    grad: &[T::V3],
+    lambda: &[T],
+    f: &mut [T::V3],
+) {
+    for (l, b) in bonds.iter().enumerate() {
+        f[b.i] += grad[l] * lambda[l];
+        f[b.j] -= grad[l] * lambda[l];
+    }
+}
+
+/// Angular velocities of torque-free spheres: `W_i = Omega_inf + sum_j rt_ij f_j`, with
+/// `f` the force each sphere exerts on the fluid; `Omega_inf` alone when not resolved.
+pub(super) fn spin<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    f: &[T::V3],
+    out: &mut [T::V3],
+) -> Result<(), StepError> {
+    out.fill(p.vorticity);
+    if !p.rotation || p.hydro == Hydro::FreeDraining {
+        return Ok(());
+    }
+    for i in 0..pos.len() {
+        for j in 0..i {
+            let b =
+                mobility::pair_blocks(p.hydro, p.viscosity, radius[i], radius[j], pos[i] - pos[j])
+                    .ok_or(StepError::Particle(ParticleError::Nested { i: j, j: i }))?;
+            out[i] += b.rt_ij * f[j];
+            out[j] += b.rt_ji * f[i];
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn report<T: Real>(
+    stats: SolveStats<T>,
+    velocity_iterations: u32,
+    bonds: &[Bond<T>],
+    lambda: &[T],
+) -> StepReport<T> {
+    StepReport {
+        iterations: stats.iterations,
+        velocity_iterations,
+        residual: stats.residual,
+        max_tension: max_tension(bonds, lambda),
+    }
+}

@@ -1,0 +1,188 @@
+//! Overdamped HydroSHAKE: inertia dropped; the constraint move goes through the full
+//! mobility, `r' = r* + dt mu G^T lambda`. First order, and a second-order
+//! predictor-corrector with the same projection.
+
+use super::{
+    Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors, max_tension,
+    mobility_disp, report, spin,
+};
+use crate::bonds::Bond;
+use crate::constraints::{self, Metric, Problem, Scratch, SolveStats};
+use crate::error::StepError;
+use crate::forces::{self, ExternalForce};
+use crate::linalg;
+use crate::params::Params;
+use crate::real::Real;
+use crate::workspace::Views;
+
+/// Overdamped HydroSHAKE, first order.
+pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
+    p: &Params<T>,
+    s: &Start<'_, T>,
+    bonds: &[Bond<T>],
+    v: Views<'_, T>,
+    ext: &mut E,
+) -> Result<StepReport<T>, StepError> {
+    let (n, dt) = (s.pos.len(), p.dt);
+    let Views {
+        mu,
+        force,
+        work_a: u,
+        new_pos,
+        new_vel,
+        new_omega,
+        grad,
+        disp,
+        lambda,
+        mut scratch,
+        ..
+    } = v;
+    // Mobility and forces at the start; unconstrained move r* = r + dt (U_inf + mu F).
+    assemble_tt(p, s.pos, s.radius, mu)?;
+    forces::external(p, s.pos, s.radius, s.density, ext, force)?;
+    linalg::sym_matvec::<T>(mu, n, force, u);
+    add_flow(p, s.pos, u);
+    for i in 0..n {
+        new_pos[i] = s.pos[i] + u[i] * dt;
+    }
+    // Constraint move through the full mobility: r' = r* + dt mu G^T lambda.
+    bond_vectors(bonds, s.pos, grad);
+    mobility_disp(mu, n, bonds, grad, dt, disp);
+    lambda.fill(T::ZERO);
+    let stats = constraints::solve(
+        Problem::Positions,
+        &Metric::Dense { disp, n },
+        bonds,
+        &p.solver,
+        new_pos,
+        lambda,
+        &mut scratch,
+    )?;
+    for i in 0..n {
+        new_vel[i] = (new_pos[i] - s.pos[i]) / dt;
+    }
+    add_constraint_forces(bonds, grad, lambda, force);
+    spin(p, s.pos, s.radius, force, new_omega)?;
+    Ok(report(stats, 0, bonds, lambda))
+}
+
+/// Projected overdamped velocity at `pos`: `U = U_inf + mu (F + G^T kappa)` with `kappa`
+/// such that every bond's length rate vanishes. `mu` and `force` must hold the mobility
+/// and external forces at `pos`; the result is left in `u`.
+#[allow(clippy::too_many_arguments)]
+fn projected_velocity<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    mu: &[T::M3],
+    force: &[T::V3],
+    bonds: &[Bond<T>],
+    grad: &mut [T::V3],
+    disp: &mut [T::V3],
+    kappa: &mut [T],
+    scratch: &mut Scratch<'_, T>,
+    u: &mut [T::V3],
+) -> Result<SolveStats<T>, StepError> {
+    let n = pos.len();
+    linalg::sym_matvec::<T>(mu, n, force, u);
+    add_flow(p, pos, u);
+    bond_vectors(bonds, pos, grad);
+    mobility_disp(mu, n, bonds, grad, T::ONE, disp);
+    kappa.fill(T::ZERO);
+    let problem = Problem::Velocities {
+        bond: grad,
+        dt: p.dt,
+    };
+    constraints::solve(
+        problem,
+        &Metric::Dense { disp, n },
+        bonds,
+        &p.solver,
+        u,
+        kappa,
+        scratch,
+    )
+}
+
+/// Overdamped second order: Heun predictor-corrector on the projected velocity, then
+/// the same position projection as the first-order scheme.
+pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
+    p: &Params<T>,
+    s: &Start<'_, T>,
+    bonds: &[Bond<T>],
+    v: Views<'_, T>,
+    ext: &mut E,
+) -> Result<StepReport<T>, StepError> {
+    let (n, dt) = (s.pos.len(), p.dt);
+    let Views {
+        mu: mu0,
+        fac: mu1,
+        force,
+        work_a: f0,
+        work_b: f1,
+        work_c: x_p,
+        new_pos,
+        new_vel,
+        new_omega,
+        grad,
+        grad_new,
+        disp,
+        lambda,
+        kappa,
+        scratch: mut sc,
+        ..
+    } = v;
+    // Predictor: projected velocity at r, one projected Euler step.
+    assemble_tt(p, s.pos, s.radius, mu0)?;
+    forces::external(p, s.pos, s.radius, s.density, ext, force)?;
+    projected_velocity(p, s.pos, mu0, force, bonds, grad, disp, kappa, &mut sc, f0)?;
+    // Tension at the start of the step: the velocity projection's multipliers are forces.
+    let tension = max_tension(bonds, kappa);
+    for i in 0..n {
+        x_p[i] = s.pos[i] + f0[i] * dt;
+    }
+    mobility_disp(mu0, n, bonds, grad, dt, disp);
+    lambda.fill(T::ZERO);
+    let metric = Metric::Dense { disp, n };
+    constraints::solve(
+        Problem::Positions,
+        &metric,
+        bonds,
+        &p.solver,
+        x_p,
+        lambda,
+        &mut sc,
+    )?;
+    // Corrector: projected velocity at the predicted point, trapezoidal average.
+    assemble_tt(p, x_p, s.radius, mu1)?;
+    forces::external(p, x_p, s.radius, s.density, ext, force)?;
+    projected_velocity(
+        p, x_p, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1,
+    )?;
+    for i in 0..n {
+        new_pos[i] = s.pos[i] + (f0[i] + f1[i]) * (dt * T::HALF);
+    }
+    // Projection as in the first-order scheme: r' = r* + dt mu(r) G(r)^T lambda.
+    mobility_disp(mu0, n, bonds, grad, dt, disp);
+    lambda.fill(T::ZERO);
+    let metric = Metric::Dense { disp, n };
+    let stats = constraints::solve(
+        Problem::Positions,
+        &metric,
+        bonds,
+        &p.solver,
+        new_pos,
+        lambda,
+        &mut sc,
+    )?;
+    for i in 0..n {
+        new_vel[i] = (new_pos[i] - s.pos[i]) / dt;
+    }
+    // Spin from the start-of-step forces (external plus the projection's).
+    forces::external(p, s.pos, s.radius, s.density, ext, force)?;
+    add_constraint_forces(bonds, grad, lambda, force);
+    spin(p, s.pos, s.radius, force, new_omega)?;
+    Ok(StepReport {
+        max_tension: tension,
+        ..report(stats, 0, bonds, lambda)
+    })
+}

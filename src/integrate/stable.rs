@@ -1,0 +1,152 @@
+//! Inertial RATTLE with the drag implicit (backward Euler in the velocity): stable at
+//! any `dt`, equal to the overdamped step as the masses go to zero; with rotation it
+//! runs on the 6N grand mobility.
+
+use super::{
+    Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors, report,
+};
+use crate::bonds::Bond;
+use crate::constraints::{self, Metric, Problem};
+use crate::error::{Stage, StepError};
+use crate::forces::{self, ExternalForce};
+use crate::linalg;
+use crate::mobility;
+use crate::params::Params;
+use crate::particles::sphere_volume;
+use crate::real::Real;
+use crate::workspace::Views;
+
+/// `y <- S^-1 dt K^-1 S y` with `K = dt I + S mu S` factorised in `fac`.
+fn apply_drag<T: Real>(fac: &[T::M3], sq: &[T], dt: T, y: &mut [T::V3]) {
+    for (v, &q) in y.iter_mut().zip(sq) {
+        *v *= q;
+    }
+    linalg::cholesky_solve::<T>(fac, sq.len(), y);
+    for (v, &q) in y.iter_mut().zip(sq) {
+        *v *= dt / q;
+    }
+}
+
+/// Inertial with implicit drag: `(R + M/dt) v' = F + F_C + M v/dt + R U_inf`, solved as
+/// `v' = S^-1 dt K^-1 S (mu (F + F_C + M v/dt) + U_inf)`, `S = M^1/2`, `K = dt I + S mu S`.
+/// With rotation the same on the 6N grand mobility (`M` holds masses and moments).
+pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
+    p: &Params<T>,
+    s: &Start<'_, T>,
+    bonds: &[Bond<T>],
+    v: Views<'_, T>,
+    ext: &mut E,
+) -> Result<StepReport<T>, StepError> {
+    let (n, dt) = (s.pos.len(), p.dt);
+    let m = if p.rotation { 2 * n } else { n };
+    let Views {
+        mu,
+        fac,
+        force: rhs6,
+        work_a: u,
+        work_b: t,
+        sqrt_m: sq,
+        new_pos,
+        new_vel,
+        new_omega,
+        grad,
+        grad_new,
+        disp,
+        lambda,
+        kappa,
+        scratch: mut sc,
+        ..
+    } = v;
+    // Mobility (translation or grand) and the drag operator K = dt I + S mu S.
+    if p.rotation {
+        mobility::assemble_grand(p.hydro, p.viscosity, s.pos, s.radius, mu)?;
+    } else {
+        assemble_tt(p, s.pos, s.radius, mu)?;
+    }
+    for i in 0..n {
+        let mass = sphere_volume(s.radius[i]) * s.density[i];
+        sq[i] = mass.sqrt();
+        if p.rotation {
+            sq[n + i] = (T::from_f64(0.4) * mass * s.radius[i] * s.radius[i]).sqrt();
+        }
+    }
+    for i in 0..m {
+        for j in 0..=i {
+            fac[i * m + j] = mu[i * m + j] * (sq[i] * sq[j]);
+        }
+        fac[i * m + i] += T::m3_diag(dt);
+    }
+    linalg::cholesky::<T>(fac, m).map_err(|error| StepError::Linalg {
+        stage: Stage::Drag,
+        error,
+    })?;
+    // Unconstrained generalised velocity from F + M v / dt.
+    forces::external(p, s.pos, s.radius, s.density, ext, &mut rhs6[..n])?;
+    rhs6[n..].fill(T::V3_ZERO);
+    for i in 0..m {
+        let w = if i < n { s.vel[i] } else { s.omega[i - n] };
+        rhs6[i] += w * (sq[i] * sq[i] / dt);
+    }
+    drag_velocity(p, s.pos, mu, fac, sq, rhs6, u);
+    for i in 0..n {
+        new_pos[i] = s.pos[i] + u[i] * dt;
+    }
+    // Constraint displacements D_l = dt S^-1 dt K^-1 S mu g_l (every bead moves).
+    bond_vectors(bonds, s.pos, grad);
+    for (l, b) in bonds.iter().enumerate() {
+        for q in 0..m {
+            t[q] = (mu[q * m + b.i] - mu[q * m + b.j]) * grad[l];
+        }
+        apply_drag(fac, sq, dt, t);
+        for q in 0..n {
+            disp[l * n + q] = t[q] * dt;
+        }
+    }
+    lambda.fill(T::ZERO);
+    let metric = Metric::Dense { disp, n };
+    let stats = constraints::solve(
+        Problem::Positions,
+        &metric,
+        bonds,
+        &p.solver,
+        new_pos,
+        lambda,
+        &mut sc,
+    )?;
+    for i in 0..n {
+        new_vel[i] = (new_pos[i] - s.pos[i]) / dt;
+    }
+    // Angular velocities: the same solve with the constraint forces included.
+    if p.rotation {
+        add_constraint_forces(bonds, grad, lambda, &mut rhs6[..n]);
+        drag_velocity(p, s.pos, mu, fac, sq, rhs6, u);
+        new_omega.copy_from_slice(&u[n..]);
+    } else {
+        new_omega.fill(p.vorticity);
+    }
+    // RATTLE: make the velocities tangent to the bonds at the new positions.
+    bond_vectors(bonds, new_pos, grad_new);
+    kappa.fill(T::ZERO);
+    let problem = Problem::Velocities { bond: grad_new, dt };
+    let vstats = constraints::solve(problem, &metric, bonds, &p.solver, new_vel, kappa, &mut sc)?;
+    Ok(report(stats, vstats.iterations, bonds, lambda))
+}
+
+/// `u = S^-1 dt K^-1 S (mu f + U_inf)` for a generalised force `f` (length `m`).
+fn drag_velocity<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    mu: &[T::M3],
+    fac: &[T::M3],
+    sq: &[T],
+    f: &[T::V3],
+    u: &mut [T::V3],
+) {
+    let (m, n) = (f.len(), pos.len());
+    linalg::sym_matvec::<T>(mu, m, f, u);
+    add_flow(p, pos, &mut u[..n]);
+    for w in &mut u[n..] {
+        *w += p.vorticity;
+    }
+    apply_drag(fac, sq, p.dt, u);
+}
