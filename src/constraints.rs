@@ -144,6 +144,14 @@ impl<T: Real> Problem<'_, T> {
             Problem::Velocities { .. } => Stage::Velocities,
         }
     }
+
+    fn no_convergence(&self, iterations: u32, residual: T) -> StepError {
+        StepError::NoConvergence {
+            stage: self.stage(),
+            iterations,
+            residual: residual.to_f64(),
+        }
+    }
 }
 
 /// Outcome of a converged solve.
@@ -227,11 +235,7 @@ pub fn sweep<T: Real>(
             moved = true;
         }
         if !residual.is_finite() {
-            return Err(StepError::NoConvergence {
-                stage: problem.stage(),
-                iterations: it,
-                residual: residual.to_f64(),
-            });
+            return Err(problem.no_convergence(it, residual));
         }
         if !moved && residual <= solver.tolerance {
             return Ok(SolveStats {
@@ -240,11 +244,7 @@ pub fn sweep<T: Real>(
             });
         }
         if it == solver.max_iterations {
-            return Err(StepError::NoConvergence {
-                stage: problem.stage(),
-                iterations: it,
-                residual: residual.to_f64(),
-            });
+            return Err(problem.no_convergence(it, residual));
         }
     }
     // The loop returns on its last pass; this is the empty-range case (cap 0 handled above).
@@ -274,11 +274,7 @@ pub fn newton<T: Real>(
     for it in 0..=solver.max_iterations {
         let residual = worst(&problem, bonds, x);
         if !residual.is_finite() {
-            return Err(StepError::NoConvergence {
-                stage: problem.stage(),
-                iterations: it,
-                residual: residual.to_f64(),
-            });
+            return Err(problem.no_convergence(it, residual));
         }
         if residual <= solver.tolerance {
             return Ok(SolveStats {
@@ -287,11 +283,7 @@ pub fn newton<T: Real>(
             });
         }
         if it == solver.max_iterations {
-            return Err(StepError::NoConvergence {
-                stage: problem.stage(),
-                iterations: it,
-                residual: residual.to_f64(),
-            });
+            return Err(problem.no_convergence(it, residual));
         }
         let refresh = match previous {
             None => true,

@@ -20,7 +20,7 @@ use springs::springs;
 use stable::rattle_stable;
 
 use crate::bonds::{Bond, BondSet, max_residual};
-use crate::constraints::SolveStats;
+use crate::constraints::{self, Metric, Problem, Scratch, SolveStats};
 use crate::error::{ParticleError, StepError};
 use crate::forces::ExternalForce;
 use crate::mobility::{self, Hydro};
@@ -289,6 +289,36 @@ pub(super) fn spin<T: Real>(
         }
     }
     Ok(())
+}
+
+/// Projects `x` onto the bonds along the dense displacements `disp` (bond-major,
+/// stride `n`); the multipliers start from zero and end in `lambda`.
+pub(super) fn project_positions<T: Real>(
+    p: &Params<T>,
+    bonds: &[Bond<T>],
+    disp: &[T::V3],
+    x: &mut [T::V3],
+    lambda: &mut [T],
+    scratch: &mut Scratch<'_, T>,
+) -> Result<SolveStats<T>, StepError> {
+    lambda.fill(T::ZERO);
+    let metric = Metric::Dense { disp, n: x.len() };
+    constraints::solve(
+        Problem::Positions,
+        &metric,
+        bonds,
+        &p.solver,
+        x,
+        lambda,
+        scratch,
+    )
+}
+
+/// `v = (x' - x) / dt`.
+pub(super) fn step_velocity<T: Real>(start: &[T::V3], end: &[T::V3], dt: T, v: &mut [T::V3]) {
+    for ((v, &a), &b) in v.iter_mut().zip(start).zip(end) {
+        *v = (b - a) / dt;
+    }
 }
 
 pub(super) fn report<T: Real>(

@@ -4,7 +4,7 @@
 
 use super::{
     Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors, max_tension,
-    mobility_disp, report, spin,
+    mobility_disp, project_positions, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats};
@@ -48,19 +48,8 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     // Constraint move through the full mobility: r' = r* + dt mu G^T lambda.
     bond_vectors(bonds, s.pos, grad);
     mobility_disp(mu, n, bonds, grad, dt, disp);
-    lambda.fill(T::ZERO);
-    let stats = constraints::solve(
-        Problem::Positions,
-        &Metric::Dense { disp, n },
-        bonds,
-        &p.solver,
-        new_pos,
-        lambda,
-        &mut scratch,
-    )?;
-    for i in 0..n {
-        new_vel[i] = (new_pos[i] - s.pos[i]) / dt;
-    }
+    let stats = project_positions(p, bonds, disp, new_pos, lambda, &mut scratch)?;
+    step_velocity(s.pos, new_pos, dt, new_vel);
     add_constraint_forces(bonds, grad, lambda, force);
     spin(p, s.pos, s.radius, force, new_omega)?;
     Ok(report(stats, 0, bonds, lambda))
@@ -141,17 +130,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         x_p[i] = s.pos[i] + f0[i] * dt;
     }
     mobility_disp(mu0, n, bonds, grad, dt, disp);
-    lambda.fill(T::ZERO);
-    let metric = Metric::Dense { disp, n };
-    constraints::solve(
-        Problem::Positions,
-        &metric,
-        bonds,
-        &p.solver,
-        x_p,
-        lambda,
-        &mut sc,
-    )?;
+    project_positions(p, bonds, disp, x_p, lambda, &mut sc)?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
     assemble_tt(p, x_p, s.radius, mu1)?;
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
@@ -163,20 +142,8 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     }
     // Projection as in the first-order scheme: r' = r* + dt mu(r) G(r)^T lambda.
     mobility_disp(mu0, n, bonds, grad, dt, disp);
-    lambda.fill(T::ZERO);
-    let metric = Metric::Dense { disp, n };
-    let stats = constraints::solve(
-        Problem::Positions,
-        &metric,
-        bonds,
-        &p.solver,
-        new_pos,
-        lambda,
-        &mut sc,
-    )?;
-    for i in 0..n {
-        new_vel[i] = (new_pos[i] - s.pos[i]) / dt;
-    }
+    let stats = project_positions(p, bonds, disp, new_pos, lambda, &mut sc)?;
+    step_velocity(s.pos, new_pos, dt, new_vel);
     // Spin from the start-of-step forces (external plus the projection's).
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     add_constraint_forces(bonds, grad, lambda, force);

@@ -3,7 +3,8 @@
 //! runs on the 6N grand mobility.
 
 use super::{
-    Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors, report,
+    Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors,
+    project_positions, report, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem};
@@ -102,20 +103,9 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
             disp[l * n + q] = t[q] * dt;
         }
     }
-    lambda.fill(T::ZERO);
+    let stats = project_positions(p, bonds, disp, new_pos, lambda, &mut sc)?;
+    step_velocity(s.pos, new_pos, dt, new_vel);
     let metric = Metric::Dense { disp, n };
-    let stats = constraints::solve(
-        Problem::Positions,
-        &metric,
-        bonds,
-        &p.solver,
-        new_pos,
-        lambda,
-        &mut sc,
-    )?;
-    for i in 0..n {
-        new_vel[i] = (new_pos[i] - s.pos[i]) / dt;
-    }
     // Angular velocities: the same solve with the constraint forces included.
     if p.rotation {
         add_constraint_forces(bonds, grad, lambda, &mut rhs6[..n]);
