@@ -83,9 +83,9 @@ impl Observables {
 pub struct Summary {
     /// Scene name (file stem or case).
     pub scene: String,
-    /// Particles and bonds.
+    /// Number of particles.
     pub particles: usize,
-    /// Bonds.
+    /// Number of bonds.
     pub bonds: usize,
     /// The model as run.
     pub model: crate::scene::Model,
@@ -95,7 +95,7 @@ pub struct Summary {
     pub tolerance_used: f64,
     /// Contact stiffness (0 when off).
     pub contact_stiffness: f64,
-    /// Steps asked for and done.
+    /// Steps asked for.
     pub steps: usize,
     /// Steps completed (fewer than `steps` when the run failed).
     pub steps_done: usize,
@@ -135,7 +135,7 @@ pub struct RunResult {
 pub struct RunOptions {
     /// Show a progress bar (on a terminal, after a second).
     pub progress: bool,
-    /// Contact stiffness override (None: the scene's).
+    /// Stop after at most this many steps (smoke runs); None: the whole duration.
     pub max_steps: Option<usize>,
 }
 
