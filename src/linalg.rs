@@ -8,6 +8,11 @@
 //!
 //! Loops run in a fixed order and use plain multiply-add (no `mul_add`), so results are
 //! bit-identical across runs and platforms.
+//!
+//! Slice lengths are the caller's contract (`n * n` blocks for a matrix, `n` for a
+//! vector); a shorter slice panics on indexing, like any slice API. `step()` always
+//! passes views sized from its own capacity, so no user input reaches these with a
+//! wrong length.
 
 use crate::error::LinalgError;
 use crate::real::Real;

@@ -6,7 +6,8 @@
 //! with `r = r_i - r_j`, `s = |r|`, `e = r / s`. Storage is caller-owned: a row-major
 //! array of 3x3 blocks, `n x n` for `tt` alone or `2n x 2n` for the grand mobility
 //! (block rows `0..n` translations, `n..2n` rotations, matching the ordering of the
-//! reference data).
+//! reference data). `out` must hold at least `n * n` (or `4 n^2`) blocks: its length is
+//! the caller's contract, as for any slice API.
 
 use crate::error::ParticleError;
 use crate::real::Real;
