@@ -136,12 +136,17 @@ impl<T: Real, const B: usize> BondSet<T, B> {
     }
 }
 
-/// Largest relative length error over `bonds` and the bond where it occurs.
+/// Largest relative length error over `bonds` and the bond where it occurs. NaN is
+/// sticky (a NaN residual is never hidden), and a bond naming a particle beyond `pos`
+/// counts as infinitely violated.
 pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
     let mut worst = (0, T::ZERO);
     for (k, b) in bonds.iter().enumerate() {
-        let r = ((T::norm(pos[b.i] - pos[b.j]) - b.length) / b.length).abs();
-        if !(r <= worst.1) {
+        let r = match (pos.get(b.i), pos.get(b.j)) {
+            (Some(&a), Some(&c)) => ((T::norm(a - c) - b.length) / b.length).abs(),
+            _ => T::ONE / T::ZERO,
+        };
+        if !worst.1.is_nan() && (r.is_nan() || r > worst.1) {
             worst = (k, r);
         }
     }
@@ -168,7 +173,8 @@ fn check_bond<T: Real>(
             particle: b.i,
         });
     }
-    if !(b.length.is_finite() && b.length > T::ZERO) {
+    // The constraint squares the length: d^2 must be finite too.
+    if !(b.length > T::ZERO && (b.length * b.length).is_finite()) {
         return Err(BondError::BadLength { bond: k });
     }
     let same = |o: &Bond<T>| (o.i == b.i && o.j == b.j) || (o.i == b.j && o.j == b.i);

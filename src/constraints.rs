@@ -177,10 +177,7 @@ pub struct Scratch<'a, T> {
 fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T {
     let mut w = T::ZERO;
     for (k, b) in bonds.iter().enumerate() {
-        let r = problem.eval(b, k, x).2;
-        if !(r <= w) {
-            w = r;
-        }
+        w = w.max_sticky(problem.eval(b, k, x).2);
     }
     w
 }
@@ -216,9 +213,7 @@ pub fn sweep<T: Real>(
         let mut moved = false;
         for (k, b) in bonds.iter().enumerate() {
             let (value, dir, r) = problem.eval(b, k, x);
-            if !(r <= residual) {
-                residual = r;
-            }
+            residual = residual.max_sticky(r);
             if r <= solver.tolerance || it == solver.max_iterations {
                 continue;
             }

@@ -72,7 +72,7 @@ pub enum BondError {
         /// Index of the earlier bond.
         other: usize,
     },
-    /// Length is zero, negative or not finite.
+    /// Length is zero, negative, not finite, or so large that its square overflows.
     BadLength {
         /// Index of the bond.
         bond: usize,

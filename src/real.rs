@@ -96,6 +96,8 @@ pub trait Real:
     fn exp(self) -> Self;
     /// `true` unless NaN or infinite.
     fn is_finite(self) -> bool;
+    /// `true` for NaN.
+    fn is_nan(self) -> bool;
     /// The larger of two values (NaN-ignoring as `f64::max`).
     fn max(self, other: Self) -> Self;
     /// The smaller of two values.
@@ -141,6 +143,17 @@ pub trait Real:
     fn v3_is_finite(v: Self::V3) -> bool {
         let [x, y, z] = Self::xyz(v);
         x.is_finite() && y.is_finite() && z.is_finite()
+    }
+    /// The larger of two residuals, NaN-sticky: once either is NaN the result is NaN,
+    /// so a bad bond can never be hidden by a later good one.
+    fn max_sticky(self, other: Self) -> Self {
+        if self.is_nan() {
+            self
+        } else if other.is_nan() || other > self {
+            other
+        } else {
+            self
+        }
     }
     /// Outer product `a b^T`.
     fn outer(a: Self::V3, b: Self::V3) -> Self::M3 {
@@ -225,6 +238,10 @@ macro_rules! impl_real {
             #[inline]
             fn is_finite(self) -> bool {
                 <$t>::is_finite(self)
+            }
+            #[inline]
+            fn is_nan(self) -> bool {
+                <$t>::is_nan(self)
             }
             #[inline]
             fn max(self, other: Self) -> Self {

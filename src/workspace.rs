@@ -74,15 +74,23 @@ impl<T: Real, const N: usize, const B: usize> Workspace<T, N, B> {
         }
     }
 
-    /// The multipliers of the last successful position solve (one per bond).
+    /// The multipliers of the last position solve (one per bond; force per unit length
+    /// along each bond). Meaningful after a successful constrained step; after `Springs`
+    /// or a failed step they are stale or partial, and after `Overdamped2` they hold only
+    /// the final projection's small correction.
     pub fn multipliers(&self) -> &[T; B] {
         &self.lambda
     }
 
     /// The translational mobility of the last step's start configuration (`n x n`
-    /// blocks, row-major), when the method assembled one.
+    /// blocks, row-major), after a step that assembled it without rotation (with
+    /// rotation the storage holds the `2n x 2n` grand mobility). Empty for `n > 2N`.
     pub fn mobility(&self, n: usize) -> &[T::M3] {
-        &self.mu.as_flattened().as_flattened()[..n * n]
+        self.mu
+            .as_flattened()
+            .as_flattened()
+            .get(..n * n)
+            .unwrap_or(&[])
     }
 }
 

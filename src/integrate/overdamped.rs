@@ -124,8 +124,11 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     assemble_tt(p, s.pos, s.radius, mu0)?;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     projected_velocity(p, s.pos, mu0, force, bonds, grad, disp, kappa, &mut sc, f0)?;
-    // Tension at the start of the step: the velocity projection's multipliers are forces.
+    // Tension and spin at the start of the step: the velocity projection's multipliers
+    // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
     let tension = max_tension(bonds, kappa);
+    add_constraint_forces(bonds, grad, kappa, force);
+    spin(p, s.pos, s.radius, force, new_omega)?;
     for i in 0..n {
         x_p[i] = s.pos[i] + f0[i] * dt;
     }
@@ -144,10 +147,6 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     mobility_disp(mu0, n, bonds, grad, dt, disp);
     let stats = project_positions(p, bonds, disp, new_pos, lambda, &mut sc)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
-    // Spin from the start-of-step forces (external plus the projection's).
-    forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    add_constraint_forces(bonds, grad, lambda, force);
-    spin(p, s.pos, s.radius, force, new_omega)?;
     Ok(StepReport {
         max_tension: tension,
         ..report(stats, 0, bonds, lambda)
