@@ -49,34 +49,66 @@ pub fn self_rr<T: Real>(eta: T, a: T) -> T {
     T::ONE / (T::from_f64(8.0) * T::PI * eta * a * a * a)
 }
 
+/// Geometry of a pair, computed once: `s^2`, `s`, `1/s`, `e = r/s` and `e e^T`
+/// (formed before any scaling, so the blocks built from it are exactly symmetric).
+struct Geometry<T: Real> {
+    s2: T,
+    s: T,
+    inv_s: T,
+    e: T::V3,
+    ee: T::M3,
+}
+
+impl<T: Real> Geometry<T> {
+    /// `None` when one sphere lies inside the other (`s <= |a_i - a_j|`).
+    #[inline(always)]
+    fn new(ai: T, aj: T, r: T::V3) -> Option<Self> {
+        let s2 = T::norm2(r);
+        let dif = ai - aj;
+        if s2 <= dif * dif {
+            return None;
+        }
+        let s = s2.sqrt();
+        let inv_s = T::ONE / s;
+        let e = r * inv_s;
+        Some(Self {
+            s2,
+            s,
+            inv_s,
+            e,
+            ee: T::outer(e, e),
+        })
+    }
+}
+
 /// Translation-translation block for the pair `(i, j)`, `i != j`.
 ///
 /// `None` when one sphere lies inside the other, at every level (no valid
-/// configuration). Blocks are exactly symmetric: `e e^T` is formed before scaling.
+/// configuration). Blocks are exactly symmetric.
 #[inline(always)]
 pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<T::M3> {
-    let s2 = T::norm2(r);
-    let dif = ai - aj;
-    if s2 <= dif * dif {
-        return None;
-    }
     if level == Hydro::FreeDraining {
-        return Some(T::M3_ZERO);
+        let dif = ai - aj;
+        return (T::norm2(r) > dif * dif).then_some(T::M3_ZERO);
     }
-    let s = s2.sqrt();
-    let inv_s = T::ONE / s;
-    let e = r * inv_s;
-    let ee = T::outer(e, e);
+    Geometry::new(ai, aj, r).map(|g| tt_block(level, eta, ai, aj, &g))
+}
+
+/// The `tt` block of an interacting level (Oseen or RPY) from the pair geometry.
+#[inline(always)]
+fn tt_block<T: Real>(level: Hydro, eta: T, ai: T, aj: T, g: &Geometry<T>) -> T::M3 {
+    let (s2, s, ee) = (g.s2, g.s, g.ee);
     // 1 / (8 pi eta s): the constant folds out of the assembly loop once inlined.
-    let c = inv_s * (T::ONE / (T::from_f64(8.0) * T::PI * eta));
+    let c = g.inv_s * (T::ONE / (T::from_f64(8.0) * T::PI * eta));
     if level == Hydro::Oseen {
-        return Some(T::m3_diag(c) + ee * c);
+        return T::m3_diag(c) + ee * c;
     }
     let sum = ai + aj;
+    let dif = ai - aj;
     if s > sum {
-        let q = (ai * ai + aj * aj) * (inv_s * inv_s);
+        let q = (ai * ai + aj * aj) * (g.inv_s * g.inv_s);
         let third = T::ONE / T::from_f64(3.0);
-        Some(T::m3_diag(c * (T::ONE + q * third)) + ee * (c * (T::ONE - q)))
+        T::m3_diag(c * (T::ONE + q * third)) + ee * (c * (T::ONE - q))
     } else {
         // Overlapping branch (Zuk et al. 2014, eq. 2.7): stays positive definite.
         let s3 = s2 * s;
@@ -85,29 +117,27 @@ pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<
         let iso = T::from_f64(16.0) * s3 * sum - p * p;
         let q = dif * dif - s2;
         let aniso = T::from_f64(3.0) * q * q;
-        Some(T::m3_diag(k * iso) + ee * (k * aniso))
+        T::m3_diag(k * iso) + ee * (k * aniso)
     }
 }
 
 /// All blocks for the pair `(i, j)`, `i != j` (rotation couplings included).
 pub fn pair_blocks<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<PairBlocks<T>> {
-    let tt = pair_tt(level, eta, ai, aj, r)?;
     if level == Hydro::FreeDraining {
-        return Some(PairBlocks {
+        return pair_tt(level, eta, ai, aj, r).map(|tt| PairBlocks {
             tt,
             rt_ij: T::M3_ZERO,
             rt_ji: T::M3_ZERO,
             rr: T::M3_ZERO,
         });
     }
-    let s2 = T::norm2(r);
-    let s = s2.sqrt();
-    let e = r / s;
-    let ee = T::outer(e, e);
+    let g = Geometry::new(ai, aj, r)?;
+    let tt = tt_block(level, eta, ai, aj, &g);
+    let (s2, s, ee) = (g.s2, g.s, g.ee);
     let three = T::from_f64(3.0);
     let pi8 = T::from_f64(8.0) * T::PI * eta;
     // rt_ij F = c_ij (F x e) = -c_ij [e]x F; rt_ji uses -e and the swapped radii.
-    let cross = T::m3_cross(e);
+    let cross = T::m3_cross(g.e);
     let far = level == Hydro::Oseen || s > ai + aj;
     let rt_ij = cross * (-rt_coefficient(far, eta, ai, aj, s));
     let rt_ji = cross * rt_coefficient(far, eta, aj, ai, s);
