@@ -18,7 +18,7 @@ use std::time::Duration;
 use criterion::{BatchSize, BenchmarkId, Criterion};
 use hydrorattle::linalg::{cholesky, cholesky_solve, sym_matvec};
 use hydrorattle::mobility::{Hydro, assemble_grand, assemble_tt};
-use hydrorattle::{BondSet, Method, NoForce, Params, Particle, ParticleSet, Real, Workspace, step};
+use hydrorattle::{BondSet, Method, NoForce, Params, Particle, ParticleSet, Real, step};
 
 /// Stage sizes.
 const STAGE_SIZES: [usize; 4] = [8, 25, 100, 256];
@@ -151,7 +151,8 @@ fn step_benches<T: Real, const N: usize, const B: usize>(
     }
     init.validate(false).unwrap();
     let bonds = BondSet::<T, B>::chain(&init.pos).unwrap();
-    let mut ws = Workspace::<T, N, B>::new();
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(N, B));
+    let mut ws = ws_store.workspace();
     for &method in methods {
         let mut params = Params::new(T::from_f64(0.01));
         params.method = method;

@@ -32,7 +32,9 @@ fn main() {
     if std::env::args().nth(2).as_deref() == Some("sweep") {
         p.solver.kind = SolverKind::Sweep;
     }
-    let mut ws: Box<Workspace<f64, 32, 32>> = Box::new(Workspace::new());
+    let mut ws_store =
+        hydrorattle::workspace::Buffers::<f64>::new(hydrorattle::Layout::all(32, 32));
+    let mut ws = ws_store.workspace();
     let steps: usize = std::env::var("STEPS")
         .ok()
         .and_then(|s| s.parse().ok())

@@ -159,6 +159,16 @@ fn check_bond<T: Real>(
     n: usize,
     earlier: &[Bond<T>],
 ) -> Result<(), BondError> {
+    check_one(k, b, n)?;
+    let same = |o: &Bond<T>| (o.i == b.i && o.j == b.j) || (o.i == b.j && o.j == b.i);
+    if let Some(other) = earlier.iter().position(same) {
+        return Err(BondError::Duplicate { bond: k, other });
+    }
+    Ok(())
+}
+
+/// Bond `k` on its own against `n` particles: range, self-bond, length (`O(1)`).
+pub(crate) fn check_one<T: Real>(k: usize, b: &Bond<T>, n: usize) -> Result<(), BondError> {
     for p in [b.i, b.j] {
         if p >= n {
             return Err(BondError::OutOfRange {
@@ -176,10 +186,6 @@ fn check_bond<T: Real>(
     // The constraint squares the length: d^2 must be finite too.
     if !(b.length > T::ZERO && (b.length * b.length).is_finite()) {
         return Err(BondError::BadLength { bond: k });
-    }
-    let same = |o: &Bond<T>| (o.i == b.i && o.j == b.j) || (o.i == b.j && o.j == b.i);
-    if let Some(other) = earlier.iter().position(same) {
-        return Err(BondError::Duplicate { bond: k, other });
     }
     Ok(())
 }

@@ -5,6 +5,8 @@
 
 use core::fmt;
 
+use crate::workspace::Layout;
+
 /// A particle set rejected an input.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ParticleError {
@@ -166,6 +168,15 @@ pub enum StepError {
         /// Second particle.
         j: usize,
     },
+    /// The workspace is smaller than this step's [`Layout`]; nothing was touched.
+    Storage {
+        /// What the step needs.
+        need: Layout,
+        /// What the workspace holds.
+        have: Layout,
+    },
+    /// The state's slices disagree in length.
+    StateLength,
     /// The explicit-drag step is beyond its linear stability limit.
     Unstable {
         /// The step asked for.
@@ -255,6 +266,19 @@ impl fmt::Display for StepError {
                 write!(f, "particle {particle}: state became non-finite")
             }
             Self::Overlap { i, j } => write!(f, "particles {i} and {j} overlap after the step"),
+            Self::Storage { need, have } => write!(
+                f,
+                "workspace too small: need {} blocks, {} vectors, {} scalars, {} indices; have {}, {}, {}, {}",
+                need.blocks,
+                need.vectors,
+                need.scalars,
+                need.indices,
+                have.blocks,
+                have.vectors,
+                have.scalars,
+                have.indices
+            ),
+            Self::StateLength => write!(f, "state slices differ in length"),
             Self::Unstable { dt, limit } => write!(
                 f,
                 "explicit drag unstable: dt = {dt:e} exceeds the stability limit {limit:e}"

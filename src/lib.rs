@@ -34,15 +34,20 @@ pub mod particles;
 pub mod real;
 pub mod workspace;
 
+#[cfg(feature = "alloc")]
+extern crate alloc;
+
 pub use bonds::{Bond, BondSet};
-pub use constraints::{Solver, SolverKind};
+pub use constraints::{DENSE_BONDS_MAX, Solver, SolverKind};
 pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
 pub use forces::{ExternalForce, NoForce, SoftContact};
 /// The vector crate the kernel is written against (re-exported so callers match versions).
 pub use glam;
-pub use integrate::{StepReport, step};
+pub use integrate::{StepReport, step, step_slices};
 pub use mobility::Hydro;
 pub use params::{Method, Params};
-pub use particles::{Particle, ParticleSet};
+pub use particles::{Particle, ParticleSet, State};
 pub use real::Real;
-pub use workspace::Workspace;
+#[cfg(feature = "alloc")]
+pub use workspace::Buffers;
+pub use workspace::{Layout, Storage, Workspace};

@@ -3,13 +3,14 @@
 //! levels (Oseen, free-draining).
 //!
 //! Blocks follow `U_i = sum_j (tt_ij F_j + tr_ij T_j)`, `W_i = sum_j (rt_ij F_j + rr_ij T_j)`
-//! with `r = r_i - r_j`, `s = |r|`, `e = r / s`. Storage is caller-owned: a row-major
-//! array of 3x3 blocks, `n x n` for `tt` alone or `2n x 2n` for the grand mobility
-//! (block rows `0..n` translations, `n..2n` rotations, matching the ordering of the
-//! reference data). `out` must hold at least `n * n` (or `4 n^2`) blocks: its length is
-//! the caller's contract, as for any slice API.
+//! with `r = r_i - r_j`, `s = |r|`, `e = r / s`. Storage is caller-owned: the packed
+//! lower triangle of 3x3 blocks ([`crate::linalg`]), `n x n` for `tt` alone or `2n x 2n`
+//! for the grand mobility (block rows `0..n` translations, `n..2n` rotations, matching
+//! the ordering of the reference data). `out` must hold at least `tri(n)` (or
+//! `tri(2n)`) blocks: its length is the caller's contract, as for any slice API.
 
 use crate::error::ParticleError;
+use crate::linalg::tri;
 use crate::real::Real;
 
 /// How much hydrodynamics to model.
@@ -185,8 +186,8 @@ fn rt_coefficient<T: Real>(far: bool, eta: T, ai: T, aj: T, s: T) -> T {
     poly / (pi16 * ai * ai * ai * aj * T::from_f64(8.0) * s * s)
 }
 
-/// Assembles the `n x n` translational mobility `mu_tt` into `out[..n*n]`, both
-/// triangles (symmetric by construction: each pair is evaluated once).
+/// Assembles the `n x n` translational mobility `mu_tt`, packed lower triangle
+/// ([`tri`]`(n)` blocks into `out`; symmetric by construction: each pair is evaluated once).
 pub fn assemble_tt<T: Real>(
     level: Hydro,
     eta: T,
@@ -194,20 +195,19 @@ pub fn assemble_tt<T: Real>(
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), ParticleError> {
-    let n = pos.len();
-    for i in 0..n {
-        out[i * n + i] = T::m3_diag(self_tt(eta, radius[i]));
+    for i in 0..pos.len() {
+        let row = tri(i);
         for j in 0..i {
-            let b = pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
+            out[row + j] = pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
                 .ok_or(ParticleError::Nested { i: j, j: i })?;
-            out[i * n + j] = b;
-            out[j * n + i] = b;
         }
+        out[row + i] = T::m3_diag(self_tt(eta, radius[i]));
     }
     Ok(())
 }
 
-/// Assembles the `2n x 2n` grand mobility `[[tt, tr], [rt, rr]]` into `out[..4n^2]`.
+/// Assembles the `2n x 2n` grand mobility `[[tt, tr], [rt, rr]]`, packed lower triangle
+/// (`tri(2n)` blocks; the upper blocks `tr_ij = rt_ji^T` follow by symmetry).
 pub fn assemble_grand<T: Real>(
     level: Hydro,
     eta: T,
@@ -216,25 +216,20 @@ pub fn assemble_grand<T: Real>(
     out: &mut [T::M3],
 ) -> Result<(), ParticleError> {
     let n = pos.len();
-    let m = 2 * n;
     for i in 0..n {
         let a = radius[i];
-        out[i * m + i] = T::m3_diag(self_tt(eta, a));
-        out[(n + i) * m + n + i] = T::m3_diag(self_rr(eta, a));
-        out[i * m + n + i] = T::M3_ZERO;
-        out[(n + i) * m + i] = T::M3_ZERO;
+        let (ti, ri) = (tri(i), tri(n + i));
+        out[ti + i] = T::m3_diag(self_tt(eta, a));
+        out[ri + n + i] = T::m3_diag(self_rr(eta, a));
+        out[ri + i] = T::M3_ZERO;
         for j in 0..i {
             let b = pair_blocks(level, eta, a, radius[j], pos[i] - pos[j])
                 .ok_or(ParticleError::Nested { i: j, j: i })?;
-            // The grand mobility is symmetric: tr_ij = rt_ji^T.
-            out[i * m + j] = b.tt;
-            out[j * m + i] = b.tt;
-            out[(n + i) * m + n + j] = b.rr;
-            out[(n + j) * m + n + i] = b.rr;
-            out[(n + i) * m + j] = b.rt_ij;
-            out[(n + j) * m + i] = b.rt_ji;
-            out[i * m + n + j] = T::transpose(b.rt_ji);
-            out[j * m + n + i] = T::transpose(b.rt_ij);
+            let rj = tri(n + j);
+            out[ti + j] = b.tt;
+            out[ri + n + j] = b.rr;
+            out[ri + j] = b.rt_ij;
+            out[rj + i] = b.rt_ji;
         }
     }
     Ok(())

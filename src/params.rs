@@ -48,7 +48,7 @@ pub struct Params<T: Real> {
     /// [`Method::RattleStable`] they are integrated with rotational inertia; otherwise
     /// reported as `Omega_inf + mu_rt F`). Default false.
     pub rotation: bool,
-    /// Constraint solver. Default Newton, tolerance 1e-10 (f64) / 1e-5 (f32), cap 100.
+    /// Constraint solver. Default [`SolverKind::Auto`], tolerance 1e-10 (f64) / 1e-5 (f32), cap 100.
     pub solver: Solver<T>,
     /// Accept overlapping (not nested) spheres. Default false.
     pub allow_overlap: bool,
@@ -81,7 +81,7 @@ impl<T: Real> Params<T> {
             method: Method::Overdamped,
             rotation: false,
             solver: Solver {
-                kind: SolverKind::Newton,
+                kind: SolverKind::Auto,
                 tolerance: T::from_f64(tolerance),
                 max_iterations: 100,
             },

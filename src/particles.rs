@@ -136,6 +136,52 @@ impl<T: Real, const N: usize> ParticleSet<T, N> {
     }
 }
 
+/// A mutable view of `n` particles' state in caller-owned slices (all of length `n`):
+/// what [`step_slices`](crate::integrate::step_slices) advances. Hosts keep the arrays
+/// anywhere (vectors of any length); [`ParticleSet::state`] gives this view of a set.
+#[derive(Debug)]
+pub struct State<'a, T: Real> {
+    /// Centres.
+    pub pos: &'a mut [T::V3],
+    /// Translational velocities.
+    pub vel: &'a mut [T::V3],
+    /// Angular velocities.
+    pub omega: &'a mut [T::V3],
+    /// Radii.
+    pub radius: &'a [T],
+    /// Material densities.
+    pub density: &'a [T],
+    /// Simulated time.
+    pub time: &'a mut T,
+}
+
+impl<T: Real> State<'_, T> {
+    /// Number of particles (the length of `pos`).
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+
+    /// `true` when there are no particles.
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+}
+
+impl<T: Real, const N: usize> ParticleSet<T, N> {
+    /// The state of the first [`len`](Self::len) particles as slices.
+    pub fn state(&mut self) -> State<'_, T> {
+        let n = self.len;
+        State {
+            pos: &mut self.pos[..n],
+            vel: &mut self.vel[..n],
+            omega: &mut self.omega[..n],
+            radius: &self.radius[..n],
+            density: &self.density[..n],
+            time: &mut self.time,
+        }
+    }
+}
+
 /// Volume of a sphere of radius `a`.
 pub fn sphere_volume<T: Real>(a: T) -> T {
     T::from_f64(4.0 / 3.0) * T::PI * a * a * a

@@ -13,8 +13,7 @@ use std::hint::black_box;
 use hydrorattle::linalg::{cholesky, cholesky_solve, lu, lu_solve, sym_matvec};
 use hydrorattle::mobility::{Hydro, assemble_grand, assemble_tt};
 use hydrorattle::{
-    BondSet, Method, NoForce, Params, Particle, ParticleSet, Real, SolverKind, StepError,
-    Workspace, step,
+    BondSet, Method, NoForce, Params, Particle, ParticleSet, Real, SolverKind, StepError, step,
 };
 
 struct Counting;
@@ -174,7 +173,8 @@ fn alloc_free_steps<T: Real>() {
     let init = chain::<T, N>();
     let bonds = BondSet::<T, B>::chain(&init.pos[..N]).unwrap();
     // The workspace is on the heap, allocated before counting starts.
-    let mut ws: Box<Workspace<T, N, B>> = Box::new(Workspace::new());
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(N, B));
+    let mut ws = ws_store.workspace();
     let methods = [
         Method::Overdamped,
         Method::Overdamped2,

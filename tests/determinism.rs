@@ -12,7 +12,7 @@
 mod common;
 
 use common::*;
-use hydrorattle::{BondSet, Method, NoForce, ParticleSet, Real, SolverKind, Workspace};
+use hydrorattle::{BondSet, Method, NoForce, ParticleSet, Real, SolverKind};
 
 const K: usize = 50;
 const DT: f64 = 0.02;
@@ -33,7 +33,8 @@ fn digest<T: Real>(method: Method, dirty: bool) -> u64 {
     let scene = helix(25, 2f64.powf(1.0 / 3.0), 3.0, 0.5, 1.5);
     let fresh: ParticleSet<T, 25> = particles(&scene);
     let bonds: BondSet<T, 24> = BondSet::chain(&fresh.pos[..25]).unwrap();
-    let mut ws: Box<Workspace<T, 25, 24>> = Box::new(Workspace::new());
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(25, 24));
+    let mut ws = ws_store.workspace();
     if dirty {
         let mut other = fresh.clone();
         let mut p = params::<T>(0.1, Method::RattleStable, SolverKind::Sweep);

@@ -8,9 +8,7 @@
 mod common;
 
 use common::*;
-use hydrorattle::{
-    BondSet, Hydro, Method, NoForce, ParticleSet, Real, SolverKind, Workspace, step,
-};
+use hydrorattle::{BondSet, Hydro, Method, NoForce, ParticleSet, Real, SolverKind, step};
 use std::f64::consts::PI;
 
 const CONSTRAINED: [Method; 4] = [
@@ -101,7 +99,9 @@ impl Dimer {
         let bonds: BondSet<T, 1> = BondSet::chain(&ps.pos[..2]).unwrap();
         let mut p = params::<T>(dt, method, SolverKind::Newton);
         p.gravity = v3::<T>(0.0, 0.0, -1.0 / self.st);
-        let mut ws: Workspace<T, 2, 1> = Workspace::new();
+        let mut ws_store =
+            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws = ws_store.workspace();
         let steps = (t_end / dt).round() as usize;
         run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, steps);
         let e = sub(f64s::<T>(ps.pos[1]), f64s::<T>(ps.pos[0]));
@@ -358,7 +358,9 @@ fn bonds_hold<T: Real>() {
                 let (mut ps, bonds) = scene.build::<T, 8, 8>();
                 let start = f64s::<T>(ps.pos[0]);
                 let p = params::<T>(0.05, method, kind);
-                let mut ws: Workspace<T, 8, 8> = Workspace::new();
+                let mut ws_store =
+                    hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+                let mut ws = ws_store.workspace();
                 let (mut worst, mut worst_rate) = (0.0f64, 0.0f64);
                 for k in 0..40 {
                     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap_or_else(|e| {
@@ -408,7 +410,9 @@ fn constraint_forces_internal<T: Real>() {
             let n = ps.len();
             let mut p = params::<T>(dt, method, SolverKind::Newton);
             p.hydro = Hydro::FreeDraining;
-            let mut ws: Workspace<T, 8, 8> = Workspace::new();
+            let mut ws_store =
+                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+            let mut ws = ws_store.workspace();
             // Gravity plus a pull on bead 0 through the force hook.
             let mut hook = |_: &[T::V3], _: &[T], f: &mut [T::V3]| {
                 f[0] += T::v3_from(pull);
@@ -458,12 +462,14 @@ fn constraint_work_vanishes<T: Real>() {
         let (mut ps, bonds) = tree_scene().build::<T, 8, 8>();
         let n = ps.len();
         let p = params::<T>(dt, Method::Overdamped, SolverKind::Newton);
-        let mut ws: Workspace<T, 8, 8> = Workspace::new();
+        let mut ws_store =
+            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+        let mut ws = ws_store.workspace();
         let (mut w_c, mut w_g) = (0.0f64, 0.0f64);
         for _ in 0..(t_end / dt).round() as usize {
             let old: Vec<[f64; 3]> = ps.pos[..n].iter().map(|&v| f64s::<T>(v)).collect();
             step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
-            let lambda = ws.multipliers();
+            let lambda = ws.multipliers(bonds.len());
             for (l, b) in bonds.as_slice().iter().enumerate() {
                 let g = sub(old[b.i], old[b.j]);
                 let dr = sub(
@@ -517,7 +523,9 @@ fn uniform_flow<T: Real>() {
             let mut p = params::<T>(dt, method, kind);
             p.gravity = T::V3_ZERO;
             p.flow_velocity = T::v3_from(flow);
-            let mut ws: Workspace<T, 8, 8> = Workspace::new();
+            let mut ws_store =
+                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+            let mut ws = ws_store.workspace();
             run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, steps);
             let tol = pick::<T>(2e-5, 1e-12);
             for (i, &r0) in start.iter().enumerate() {
@@ -570,7 +578,9 @@ fn rigid_rotation<T: Real>() {
             let mut p = params::<T>(dt, method, SolverKind::Newton);
             p.gravity = T::V3_ZERO;
             p.vorticity = T::v3_from(omega);
-            let mut ws: Workspace<T, 8, 8> = Workspace::new();
+            let mut ws_store =
+                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+            let mut ws = ws_store.workspace();
             let steps = (t_end / dt).round() as usize;
             run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, steps);
             errors.push(rotation_error(&ps, &start, omega, t_end));
@@ -623,7 +633,8 @@ fn spin_up<T: Real>() {
     p.rotation = true;
     p.gravity = T::V3_ZERO;
     p.vorticity = T::v3_from(omega);
-    let mut ws: Workspace<T, 1, 1> = Workspace::new();
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(1, 1));
+    let mut ws = ws_store.workspace();
     let mass = 4.0 / 3.0 * PI * a.powi(3) * RHO;
     let tau_r = 0.4 * mass * a * a / (8.0 * PI * a.powi(3));
     let q = tau_r / (tau_r + dt);
@@ -686,7 +697,9 @@ fn side_by_side<T: Real>() {
             };
             let mut p = params::<T>(0.1, method, SolverKind::Newton);
             p.rotation = true;
-            let mut ws: Workspace<T, 2, 1> = Workspace::new();
+            let mut ws_store =
+                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+            let mut ws = ws_store.workspace();
             step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
             let weight = |a: f64| 4.0 / 3.0 * PI * a.powi(3) * RHO;
             let c = 1.0 / (8.0 * PI * s * s);
@@ -726,7 +739,9 @@ fn side_by_side<T: Real>() {
         let bonds: BondSet<T, 1> = BondSet::new();
         let mut p = params::<T>(0.1, method, SolverKind::Newton);
         p.rotation = true;
-        let mut ws: Workspace<T, 2, 1> = Workspace::new();
+        let mut ws_store =
+            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws = ws_store.workspace();
         run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, 300);
         let want = 6.0 * PI / (8.0 * PI * 16.0);
         let got0 = f64s::<T>(ps.omega[0]);
@@ -770,7 +785,8 @@ fn rotation_massless_limit<T: Real>() {
     p.rotation = true;
     p.gravity = v3::<T>(0.0, 0.0, -1.0 / st);
     p.vorticity = v3::<T>(0.0, 0.1, 0.0);
-    let mut ws: Workspace<T, 2, 1> = Workspace::new();
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+    let mut ws = ws_store.workspace();
     run(&mut inertial, &bonds, &p, &mut ws, &mut NoForce, 20);
     p.method = Method::Overdamped;
     run(&mut overdamped, &bonds, &p, &mut ws, &mut NoForce, 20);
@@ -813,7 +829,9 @@ fn sweep_vs_newton<T: Real>() {
             let bonds: BondSet<T, 24> = BondSet::chain(&ps.pos[..25]).unwrap();
             let mut p = params::<T>(dt, Method::Overdamped, kind);
             p.solver.max_iterations = 1000;
-            let mut ws: Box<Workspace<T, 25, 24>> = Box::new(Workspace::new());
+            let mut ws_store =
+                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(25, 24));
+            let mut ws = ws_store.workspace();
             let reports = run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, steps);
             let its: Vec<u32> = reports.iter().map(|r| r.iterations).collect();
             mean[slot] = its.iter().map(|&i| f64::from(i)).sum::<f64>() / steps as f64;

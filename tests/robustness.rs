@@ -4,7 +4,7 @@
 
 use hydrorattle::glam::DVec3;
 use hydrorattle::{
-    Bond, BondError, BondSet, Method, NoForce, Params, Particle, ParticleSet, StepError, Workspace,
+    Bond, BondError, BondSet, Method, NoForce, Params, Particle, ParticleSet, StepError,
     bonds::max_residual, step,
 };
 
@@ -91,7 +91,9 @@ fn the_guard_sees_the_stiffest_mode_in_every_direction() {
         let mut p = Params::new(1e6);
         p.method = Method::Rattle;
         p.stability_guard = true;
-        let mut ws: Box<Workspace<f64, 2, 1>> = Box::new(Workspace::new());
+        let mut ws_store =
+            hydrorattle::workspace::Buffers::<f64>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws = ws_store.workspace();
         match step(&mut ps, &bonds, &p, &mut ws, &mut NoForce) {
             Err(StepError::Unstable { limit, .. }) => {
                 assert!(
@@ -119,7 +121,9 @@ fn overdamped2_spin_includes_the_constraint_forces() {
         p.method = method;
         p.rotation = true;
         p.gravity = DVec3::new(0.3, 0.0, -1.0);
-        let mut ws: Box<Workspace<f64, 3, 2>> = Box::new(Workspace::new());
+        let mut ws_store =
+            hydrorattle::workspace::Buffers::<f64>::new(hydrorattle::Layout::all(3, 2));
+        let mut ws = ws_store.workspace();
         step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
         ps.omega
     };

@@ -8,9 +8,7 @@
 mod common;
 
 use common::*;
-use hydrorattle::{
-    BondSet, Method, NoForce, ParticleSet, Real, SolverKind, StepError, Workspace, step,
-};
+use hydrorattle::{BondSet, Method, NoForce, ParticleSet, Real, SolverKind, StepError, step};
 use std::f64::consts::PI;
 
 /// Momentum relaxation time `m / (6 pi eta a)` (eta = 1).
@@ -46,7 +44,8 @@ fn diverges<T: Real, const N: usize>(spheres: &[Sphere], dt: f64, steps: usize) 
     let mut p = params::<T>(dt, Method::Rattle, SolverKind::Newton);
     p.gravity = T::V3_ZERO;
     p.allow_overlap = true;
-    let mut ws: Box<Workspace<T, N, N>> = Box::new(Workspace::new());
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(N, N));
+    let mut ws = ws_store.workspace();
     let e0 = kinetic(&ps);
     for _ in 0..steps {
         if step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).is_err() || kinetic(&ps) > 4.0 * e0 {
@@ -86,7 +85,8 @@ fn guard_limit<T: Real, const N: usize>(spheres: &[Sphere]) -> f64 {
     let bonds: BondSet<T, N> = BondSet::chain(&ps.pos[..n]).unwrap();
     let mut p = params::<T>(1e6, Method::Rattle, SolverKind::Newton);
     p.stability_guard = true;
-    let mut ws: Box<Workspace<T, N, N>> = Box::new(Workspace::new());
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(N, N));
+    let mut ws = ws_store.workspace();
     let before = snapshot(&ps);
     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
     assert_failed_unchanged(
@@ -179,7 +179,9 @@ fn blow_up_is_an_error<T: Real>() {
         let n = ps.len();
         let bonds: BondSet<T, 2> = BondSet::chain(&ps.pos[..n]).unwrap();
         let p = params::<T>(10.0 * tau(1.0, RHO), Method::Rattle, SolverKind::Newton);
-        let mut ws: Workspace<T, 2, 2> = Workspace::new();
+        let mut ws_store =
+            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 2));
+        let mut ws = ws_store.workspace();
         let mut failed = None;
         for k in 0..5000 {
             let before = snapshot(&ps);
@@ -224,7 +226,8 @@ fn guard_refuses<T: Real>() {
     let bonds: BondSet<T, 1> = BondSet::new();
     let mut p = params::<T>(1.05 * two_tau, Method::Rattle, SolverKind::Newton);
     p.stability_guard = true;
-    let mut ws: Workspace<T, 1, 1> = Workspace::new();
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(1, 1));
+    let mut ws = ws_store.workspace();
     let before = snapshot(&ps);
     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
     assert_failed_unchanged(
@@ -251,7 +254,8 @@ fn implicit_bounded<T: Real>() {
     let mut ps: ParticleSet<T, 1> = particles(&lone);
     let bonds: BondSet<T, 1> = BondSet::new();
     let p = params::<T>(dt, Method::RattleStable, SolverKind::Newton);
-    let mut ws: Workspace<T, 1, 1> = Workspace::new();
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(1, 1));
+    let mut ws = ws_store.workspace();
     let mut v = 0.0;
     for _ in 0..50 {
         step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
@@ -272,7 +276,8 @@ fn implicit_bounded<T: Real>() {
     let mut p = params::<T>(dt, Method::RattleStable, SolverKind::Newton);
     p.gravity = T::V3_ZERO;
     p.allow_overlap = true;
-    let mut ws: Workspace<T, 8, 8> = Workspace::new();
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+    let mut ws = ws_store.workspace();
     let mut e = kinetic(&ps);
     for k in 0..50 {
         step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
@@ -303,7 +308,8 @@ fn silent_regime_needs_guard<T: Real>() {
     let mut p = params::<T>(dt, Method::Rattle, SolverKind::Newton);
     p.gravity = T::V3_ZERO;
     p.stability_guard = true;
-    let mut ws: Box<Workspace<T, 25, 24>> = Box::new(Workspace::new());
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(25, 24));
+    let mut ws = ws_store.workspace();
     let before = snapshot(&ps);
     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
     assert_failed_unchanged(

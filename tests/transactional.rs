@@ -7,8 +7,7 @@ mod common;
 
 use common::*;
 use hydrorattle::{
-    BondSet, Method, NoForce, ParticleError, ParticleSet, Real, SolverKind, Stage, StepError,
-    Workspace, step,
+    BondSet, Method, NoForce, ParticleError, ParticleSet, Real, SolverKind, Stage, StepError, step,
 };
 use proptest::prelude::*;
 
@@ -31,7 +30,8 @@ fn warmed_chain<T: Real>(method: Method) -> (ParticleSet<T, 8>, BondSet<T, 8>) {
     let (mut ps, bonds) = chain_scene().build::<T, 8, 8>();
     let mut p = params::<T>(0.05, method, SolverKind::Newton);
     p.rotation = method == Method::RattleStable;
-    let mut ws: Workspace<T, 8, 8> = Workspace::new();
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+    let mut ws = ws_store.workspace();
     run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, 3);
     (ps, bonds)
 }
@@ -44,7 +44,9 @@ fn no_convergence<T: Real>() {
             let mut p = params::<T>(0.5, method, kind);
             p.solver.max_iterations = 1;
             p.solver.tolerance = T::from_f64(pick::<T>(1e-7, 1e-13));
-            let mut ws: Workspace<T, 8, 8> = Workspace::new();
+            let mut ws_store =
+                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+            let mut ws = ws_store.workspace();
             let before = snapshot(&ps);
             let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
             let what = format!("{method:?} {kind:?}");
@@ -74,7 +76,9 @@ fn nan_force<T: Real>() {
         let (mut ps, bonds) = warmed_chain::<T>(method);
         let mut p = params::<T>(0.01, method, SolverKind::Newton);
         p.rotation = method == Method::RattleStable;
-        let mut ws: Workspace<T, 8, 8> = Workspace::new();
+        let mut ws_store =
+            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+        let mut ws = ws_store.workspace();
         let mut at_once = |_: &[T::V3], _: &[T], f: &mut [T::V3]| {
             f[2] = T::v3_from([f64::NAN, 0.0, 0.0]);
         };
@@ -137,7 +141,9 @@ fn overlap<T: Real>() {
         let mut ps: ParticleSet<T, 2> = particles(&spheres);
         let bonds: BondSet<T, 1> = BondSet::new();
         let mut p = params::<T>(0.1, method, SolverKind::Newton);
-        let mut ws: Workspace<T, 2, 1> = Workspace::new();
+        let mut ws_store =
+            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws = ws_store.workspace();
         let mut push = |_: &[T::V3], _: &[T], f: &mut [T::V3]| {
             f[0] += T::v3_from([-154.0, 0.0, 0.0]);
             f[1] += T::v3_from([154.0, 0.0, 0.0]);
@@ -195,7 +201,9 @@ fn not_positive_definite<T: Real>() {
         let mut p = params::<T>(0.01, method, SolverKind::Newton);
         p.hydro = hydrorattle::Hydro::Oseen;
         p.allow_overlap = true;
-        let mut ws: Workspace<T, 2, 1> = Workspace::new();
+        let mut ws_store =
+            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws = ws_store.workspace();
         let before = snapshot(&ps);
         let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
         let what = format!("{method:?} Oseen");
@@ -215,7 +223,8 @@ fn not_positive_definite<T: Real>() {
 /// Bad time steps and viscosities, and massless particles with inertial methods.
 fn bad_inputs<T: Real>() {
     let (mut ps, bonds) = warmed_chain::<T>(Method::Overdamped);
-    let mut ws: Workspace<T, 8, 8> = Workspace::new();
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+    let mut ws = ws_store.workspace();
     let before = snapshot(&ps);
     for method in ALL {
         for dt in [0.0, -0.1, f64::NAN, f64::INFINITY] {
@@ -349,7 +358,8 @@ fn random_chain_property<T: Real>(c: &Case) -> Result<(), TestCaseError> {
     };
     let p = params::<T>(c.dt, method, kind);
     let tol = p.solver.tolerance.to_f64() + 16.0 * T::EPSILON.to_f64();
-    let mut ws: Box<Workspace<T, 12, 12>> = Box::new(Workspace::new());
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(12, 12));
+    let mut ws = ws_store.workspace();
     for k in 0..c.steps {
         let before = snapshot(&ps);
         match step(&mut ps, &bonds, &p, &mut ws, &mut NoForce) {

@@ -17,14 +17,17 @@
 use core::hint::black_box;
 use core::panic::PanicInfo;
 
-use hydrorattle::linalg::{cholesky, cholesky_solve, sym_matvec};
+use hydrorattle::linalg::{cholesky, cholesky_solve, sym_matvec, tri};
 use hydrorattle::mobility::{Hydro, assemble_grand, assemble_tt};
 use hydrorattle::{
-    BondSet, Method, NoForce, Params, Particle, ParticleSet, Real, SolverKind, Workspace, step,
+    BondSet, Layout, Method, NoForce, Params, Particle, ParticleSet, Real, SolverKind, Storage,
+    step,
 };
 
 const N: usize = 4;
 const B: usize = N - 1;
+/// Storage for every method at this size, counted at compile time.
+const L: Layout = Layout::all(N, B);
 
 /// An empty state in a `static`: everything in the kernel is `const`-constructible.
 static EMPTY_F32: ParticleSet<f32, N> = ParticleSet::new();
@@ -51,7 +54,7 @@ fn exercise<T: Real>(empty: &ParticleSet<T, N>) -> Result<(), ()> {
     let eta = black_box(T::ONE);
 
     // Translational mobility: assemble, product, factorise, solve.
-    let mut tt = [T::M3_ZERO; N * N];
+    let mut tt = [T::M3_ZERO; tri(N)];
     assemble_tt(Hydro::Rpy, eta, &ps.pos, &ps.radius, &mut tt).map_err(|_| ())?;
     let force = [T::v3(T::ZERO, T::ZERO, -T::ONE); N];
     let mut u = [T::V3_ZERO; N];
@@ -61,15 +64,16 @@ fn exercise<T: Real>(empty: &ParticleSet<T, N>) -> Result<(), ()> {
     black_box(&u);
 
     // Grand mobility (translations and rotations).
-    let mut grand = [T::M3_ZERO; 4 * N * N];
+    let mut grand = [T::M3_ZERO; tri(2 * N)];
     assemble_grand(Hydro::Rpy, eta, &ps.pos, &ps.radius, &mut grand).map_err(|_| ())?;
     cholesky::<T>(&mut grand, 2 * N).map_err(|_| ())?;
     let mut w = [T::v3(T::ONE, T::ZERO, T::ZERO); 2 * N];
     cholesky_solve::<T>(&grand, 2 * N, &mut w);
     black_box(&w);
 
-    // Full steps of every method, with a workspace on the stack.
-    let mut ws = Workspace::<T, N, B>::new();
+    // Full steps of every method, with storage on the stack sized by a const layout.
+    let mut store = Storage::<T, { L.blocks }, { L.vectors }, { L.scalars }, { L.indices }>::new();
+    let mut ws = store.workspace();
     let methods = [
         Method::Overdamped,
         Method::Overdamped2,

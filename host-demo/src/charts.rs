@@ -9,8 +9,8 @@ use hydrorattle::glam;
 use hydrorattle::linalg;
 use hydrorattle::mobility::{Hydro, assemble_tt};
 use hydrorattle::{
-    Bond, BondSet, ExternalForce, Method, Params, Particle, ParticleSet, Real, SoftContact,
-    SolverKind, StepError, Workspace, step,
+    Bond, BondSet, Buffers, ExternalForce, Layout, Method, Params, Particle, ParticleSet, Real,
+    SoftContact, SolverKind, StepError, step,
 };
 use rayon::prelude::*;
 
@@ -80,7 +80,8 @@ fn simulate<T: Real>(
     for _ in 0..repeats.max(1) {
         let (mut ps, bonds) =
             build::<T>(scene, s.st).map_err(|_| StepError::BadParameter("scene"))?;
-        let mut ws: Box<Workspace<T, N, N>> = Box::new(Workspace::new());
+        let mut ws_store = Buffers::<T>::new(Layout::all(N, N));
+        let mut ws = ws_store.workspace();
         let mut ext = |pos: &[T::V3], r: &[T], f: &mut [T::V3]| {
             if let Some(mut c) = contact {
                 c.add(pos, r, f);
@@ -424,7 +425,8 @@ fn stays_bounded<T: Real>(scene: &Scene, s: Setup<T>, steps: usize) -> bool {
     let mut p = s.p;
     p.stability_guard = false;
     p.gravity *= T::from_f64(1.0 / s.st);
-    let mut ws: Box<Workspace<T, N, N>> = Box::new(Workspace::new());
+    let mut ws_store = Buffers::<T>::new(Layout::all(N, N));
+    let mut ws = ws_store.workspace();
     let mut ext = hydrorattle::NoForce;
     let mut prev_v: Vec<T::V3> = ps.vel[..n].to_vec();
     let mut prev_dv: Vec<T::V3> = vec![T::V3_ZERO; n];
@@ -470,7 +472,8 @@ fn guard_limit(scene: &Scene, st: f64) -> f64 {
     let Ok((mut ps, bonds)) = build::<f64>(scene, st) else {
         return f64::NAN;
     };
-    let mut ws: Box<Workspace<f64, N, N>> = Box::new(Workspace::new());
+    let mut ws_store = Buffers::<f64>::new(Layout::all(N, N));
+    let mut ws = ws_store.workspace();
     match step(&mut ps, &bonds, &s.p, &mut ws, &mut hydrorattle::NoForce) {
         Err(StepError::Unstable { limit, .. }) => limit,
         _ => f64::NAN,
@@ -604,7 +607,8 @@ fn stability(out: &Path, quick: bool) -> Result<String> {
             let name = format!("{kind:?}");
             let (mut ps, bonds) = build::<f64>(&scene, 1.0)?;
             let before = ps.pos;
-            let mut ws: Box<Workspace<f64, N, N>> = Box::new(Workspace::new());
+            let mut ws_store = Buffers::<f64>::new(Layout::all(N, N));
+            let mut ws = ws_store.workspace();
             let res = step(&mut ps, &bonds, &s.p, &mut ws, &mut hydrorattle::NoForce);
             // Largest bond rotation in the step, degrees.
             let rot = bonds
@@ -786,8 +790,10 @@ fn precision_drift(scene: &Scene, t_end: f64) -> Result<Vec<Point>> {
     p32.p.solver.tolerance = 1e-4;
     let (mut a, bonds_a) = build::<f64>(scene, 1.0)?;
     let (mut b, bonds_b) = build::<f32>(scene, 1.0)?;
-    let mut wa: Box<Workspace<f64, N, N>> = Box::new(Workspace::new());
-    let mut wb: Box<Workspace<f32, N, N>> = Box::new(Workspace::new());
+    let mut wa_store = Buffers::<f64>::new(Layout::all(N, N));
+    let mut wa = wa_store.workspace();
+    let mut wb_store = Buffers::<f32>::new(Layout::all(N, N));
+    let mut wb = wb_store.workspace();
     let ka = scene.contact.map(|k| SoftContact { stiffness: k });
     let kb = scene.contact.map(|k| SoftContact {
         stiffness: k as f32,

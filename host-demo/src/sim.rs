@@ -8,8 +8,8 @@ use std::time::Instant;
 use anyhow::{Context, Result, anyhow};
 use hydrorattle::observables::{self, Thresholds, Twist};
 use hydrorattle::{
-    Bond, BondSet, Hydro, Method as KMethod, Params, Particle, ParticleSet, Real, SoftContact,
-    Solver as KSolver, SolverKind, Workspace, step,
+    Bond, BondSet, Buffers, Hydro, Layout, Method as KMethod, Params, Particle, ParticleSet, Real,
+    SoftContact, Solver as KSolver, SolverKind, step,
 };
 use serde::Serialize;
 
@@ -158,8 +158,8 @@ pub fn run(scene: &Scene, name: &str, out: Option<&Path>, opts: RunOptions) -> R
     let out = out.map(Path::to_path_buf);
     macro_rules! go {
         ($t:ty, $n:literal) => {{
-            // The workspace grows as N^2: run on a thread whose stack holds it.
-            let stack = 2 * std::mem::size_of::<Workspace<$t, $n, $n>>() + (64 << 20);
+            // The workspace is on the heap; the particle set is built on this stack.
+            let stack = 2 * std::mem::size_of::<ParticleSet<$t, $n>>() + (64 << 20);
             std::thread::Builder::new()
                 .stack_size(stack)
                 .spawn(move || run_t::<$t, $n>(&scene, &name, out.as_deref(), opts, choice))
@@ -274,7 +274,8 @@ fn run_t<T: Real, const N: usize>(
         };
         bonds.push(bond, n).map_err(|(_, e)| anyhow!("{e}"))?;
     }
-    let mut ws: Box<Workspace<T, N, N>> = Box::new(Workspace::new());
+    let mut ws_store = Buffers::<T>::new(Layout::all(N, N));
+    let mut ws = ws_store.workspace();
     let contact = scene.contact.map(|k| SoftContact {
         stiffness: T::from_f64(k),
     });

@@ -25,7 +25,7 @@ use crate::error::{ParticleError, StepError};
 use crate::forces::ExternalForce;
 use crate::mobility::{self, Hydro};
 use crate::params::{Method, Params};
-use crate::particles::ParticleSet;
+use crate::particles::{ParticleSet, State, sphere_volume};
 use crate::real::Real;
 use crate::workspace::Workspace;
 
@@ -52,70 +52,94 @@ pub(super) struct Start<'a, T: Real> {
     pub(super) density: &'a [T],
 }
 
-/// Advances the particles by one step of `p.method`.
-///
-/// Stages: (1) check parameters, particles and bonds; (2) integrate into `ws` (forces,
-/// mobility, unconstrained move, constraint solves); (3) accept the candidate (finite,
-/// no nesting, no overlap unless allowed); (4) commit it into `ps`. On error `ps` is
-/// exactly as it was.
+/// Advances the particles of a [`ParticleSet`] by one step of `p.method`: the
+/// fixed-capacity front door of [`step_slices`].
 pub fn step<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     ps: &mut ParticleSet<T, N>,
     bonds: &BondSet<T, B>,
     p: &Params<T>,
-    ws: &mut Workspace<T, N, B>,
+    ws: &mut Workspace<'_, T>,
     ext: &mut E,
 ) -> Result<StepReport<T>, StepError> {
-    let n = ps.len();
-    let bonds = bonds.as_slice();
-    // 1. Inputs.
-    check_inputs(ps, bonds, p)?;
-    // 2. Integrate into the workspace.
+    step_slices(ps.state(), bonds.as_slice(), p, ws, ext)
+}
+
+/// Advances `n` particles held in caller-owned slices by one step of `p.method`.
+///
+/// Stages: (1) check parameters, particles and bonds, and carve the workspace for this
+/// method (a too-small workspace is [`StepError::Storage`]); (2) integrate into the
+/// workspace (forces, mobility, unconstrained move, constraint solves); (3) accept the
+/// candidate (finite, no nesting, no overlap unless allowed); (4) commit it into
+/// `state`. On error `state` is exactly as it was.
+///
+/// Bonds are checked for range, self-bonds and lengths on every call; duplicates are
+/// the caller's to avoid ([`BondSet`] refuses them), and make the dense Jacobian singular.
+pub fn step_slices<T: Real, E: ExternalForce<T>>(
+    state: State<'_, T>,
+    bonds: &[Bond<T>],
+    p: &Params<T>,
+    ws: &mut Workspace<'_, T>,
+    ext: &mut E,
+) -> Result<StepReport<T>, StepError> {
+    let n = state.len();
+    // 1. Inputs and storage.
+    check_inputs(&state, bonds, p)?;
     let s = Start {
-        pos: &ps.pos[..n],
-        vel: &ps.vel[..n],
-        omega: &ps.omega[..n],
-        radius: &ps.radius[..n],
-        density: &ps.density[..n],
+        pos: state.pos,
+        vel: state.vel,
+        omega: state.omega,
+        radius: state.radius,
+        density: state.density,
     };
-    let m = if p.rotation && p.method == Method::RattleStable {
-        2 * n
-    } else {
-        n
+    // 2. Integrate into the workspace.
+    let integrated = {
+        let v = ws.views(p.method, p.rotation, p.solver.kind, n, bonds.len())?;
+        match p.method {
+            Method::Overdamped => overdamped(p, &s, bonds, v, ext),
+            Method::Overdamped2 => overdamped2(p, &s, bonds, v, ext),
+            Method::Rattle => rattle_explicit(p, &s, bonds, v, ext),
+            Method::RattleStable => rattle_stable(p, &s, bonds, v, ext),
+            Method::Springs => springs(p, &s, bonds, v, ext),
+        }
     };
-    let v = ws.views(n, bonds.len(), m);
-    let integrated = match p.method {
-        Method::Overdamped => overdamped(p, &s, bonds, v, ext),
-        Method::Overdamped2 => overdamped2(p, &s, bonds, v, ext),
-        Method::Rattle => rattle_explicit(p, &s, bonds, v, ext),
-        Method::RattleStable => rattle_stable(p, &s, bonds, v, ext),
-        Method::Springs => springs(p, &s, bonds, v, ext),
-    };
-    // 3. Accept.
-    let (new_pos, new_vel, new_omega) = (&ws.new_pos[..n], &ws.new_vel[..n], &ws.new_omega[..n]);
+    // 3. Accept. The candidate state heads the vector storage (see `Workspace::views`).
+    let (new_pos, rest) = ws.vectors.split_at(n);
+    let (new_vel, rest) = rest.split_at(n);
+    let new_omega = &rest[..n];
     let mut report = integrated
         .and_then(|r| accept(new_pos, new_vel, new_omega, s.radius, p.allow_overlap).map(|()| r))
-        .inspect_err(|e| log::debug!("step at t = {} refused, state kept: {e}", ps.time))?;
+        .inspect_err(|e| log::debug!("step at t = {} refused, state kept: {e}", *state.time))?;
     log::trace!(
         "t = {}: {} position / {} velocity iterations",
-        ps.time,
+        *state.time,
         report.iterations,
         report.velocity_iterations
     );
     report.residual = max_residual(bonds, new_pos).1;
     // 4. Commit.
-    ps.pos[..n].copy_from_slice(new_pos);
-    ps.vel[..n].copy_from_slice(new_vel);
-    ps.omega[..n].copy_from_slice(new_omega);
-    ps.time += p.dt;
+    state.pos.copy_from_slice(new_pos);
+    state.vel.copy_from_slice(new_vel);
+    state.omega.copy_from_slice(new_omega);
+    *state.time += p.dt;
     Ok(report)
 }
 
 /// Cheap checks (O(N + B)); pair checks happen in assembly and in [`accept`].
-fn check_inputs<T: Real, const N: usize>(
-    ps: &ParticleSet<T, N>,
+fn check_inputs<T: Real>(
+    state: &State<'_, T>,
     bonds: &[Bond<T>],
     p: &Params<T>,
 ) -> Result<(), StepError> {
+    let n = state.len();
+    let lengths = [
+        state.vel.len(),
+        state.omega.len(),
+        state.radius.len(),
+        state.density.len(),
+    ];
+    if lengths.iter().any(|&l| l != n) {
+        return Err(StepError::StateLength);
+    }
     if !(p.dt > T::ZERO && p.dt.is_finite()) {
         return Err(StepError::BadTimeStep);
     }
@@ -145,33 +169,28 @@ fn check_inputs<T: Real, const N: usize>(
             "spring_stiffness",
         )?;
     }
-    let n = ps.len();
+    let inertial = matches!(p.method, Method::Rattle | Method::RattleStable);
     for i in 0..n {
-        let finite = T::v3_is_finite(ps.pos[i])
-            && T::v3_is_finite(ps.vel[i])
-            && T::v3_is_finite(ps.omega[i])
-            && ps.radius[i].is_finite()
-            && ps.density[i].is_finite();
+        let finite = T::v3_is_finite(state.pos[i])
+            && T::v3_is_finite(state.vel[i])
+            && T::v3_is_finite(state.omega[i])
+            && state.radius[i].is_finite()
+            && state.density[i].is_finite();
         if !finite {
             return Err(ParticleError::NonFinite { particle: i }.into());
         }
-        if ps.radius[i] <= T::ZERO {
+        if state.radius[i] <= T::ZERO {
             return Err(ParticleError::BadRadius { particle: i }.into());
         }
-        if ps.density[i] < T::ZERO {
+        if state.density[i] < T::ZERO {
             return Err(ParticleError::BadDensity { particle: i }.into());
         }
-        let inertial = matches!(p.method, Method::Rattle | Method::RattleStable);
-        if inertial && ps.mass(i) <= T::ZERO {
+        if inertial && sphere_volume(state.radius[i]) * state.density[i] <= T::ZERO {
             return Err(ParticleError::Massless { particle: i }.into());
         }
     }
-    // Bonds were validated on insertion; only the particle count can disagree.
     for (bond, b) in bonds.iter().enumerate() {
-        if b.i.max(b.j) >= n {
-            let particle = b.i.max(b.j);
-            return Err(crate::error::BondError::OutOfRange { bond, particle }.into());
-        }
+        crate::bonds::check_one(bond, b, n)?;
     }
     Ok(())
 }
@@ -214,27 +233,6 @@ pub(super) fn assemble_tt<T: Real>(
 pub(super) fn bond_vectors<T: Real>(bonds: &[Bond<T>], pos: &[T::V3], out: &mut [T::V3]) {
     for (g, b) in out.iter_mut().zip(bonds) {
         *g = pos[b.i] - pos[b.j];
-    }
-}
-
-/// Hydrodynamic metric `D_l(p) = scale (mu_pi - mu_pj) g_l`, bond-major with stride `n`.
-///
-/// `mu_tt` is symmetric with symmetric blocks, so `mu_pi = mu_ip`: rows `i` and `j` are
-/// read contiguously instead of two strided columns.
-pub(super) fn mobility_disp<T: Real>(
-    mu: &[T::M3],
-    n: usize,
-    bonds: &[Bond<T>],
-    grad: &[T::V3],
-    scale: T,
-    disp: &mut [T::V3],
-) {
-    for (l, b) in bonds.iter().enumerate() {
-        let g = grad[l] * scale;
-        let (row_i, row_j) = (&mu[b.i * n..b.i * n + n], &mu[b.j * n..b.j * n + n]);
-        for ((d, &mi), &mj) in disp[l * n..l * n + n].iter_mut().zip(row_i).zip(row_j) {
-            *d = mi * g - mj * g;
-        }
     }
 }
 
@@ -291,21 +289,20 @@ pub(super) fn spin<T: Real>(
     Ok(())
 }
 
-/// Projects `x` onto the bonds along the dense displacements `disp` (bond-major,
-/// stride `n`); the multipliers start from zero and end in `lambda`.
+/// Projects `x` onto the bonds along `metric`; the multipliers start from zero and end
+/// in `lambda`.
 pub(super) fn project_positions<T: Real>(
     p: &Params<T>,
     bonds: &[Bond<T>],
-    disp: &[T::V3],
+    metric: &Metric<'_, T>,
     x: &mut [T::V3],
     lambda: &mut [T],
     scratch: &mut Scratch<'_, T>,
 ) -> Result<SolveStats<T>, StepError> {
     lambda.fill(T::ZERO);
-    let metric = Metric::Dense { disp, n: x.len() };
     constraints::solve(
         Problem::Positions,
-        &metric,
+        metric,
         bonds,
         &p.solver,
         x,

@@ -4,7 +4,7 @@
 
 use super::{
     Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors, max_tension,
-    mobility_disp, project_positions, report, spin, step_velocity,
+    project_positions, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats};
@@ -32,7 +32,6 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         new_vel,
         new_omega,
         grad,
-        disp,
         lambda,
         mut scratch,
         ..
@@ -47,8 +46,12 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     }
     // Constraint move through the full mobility: r' = r* + dt mu G^T lambda.
     bond_vectors(bonds, s.pos, grad);
-    mobility_disp(mu, n, bonds, grad, dt, disp);
-    let stats = project_positions(p, bonds, disp, new_pos, lambda, &mut scratch)?;
+    let metric = Metric::Mobility {
+        mu,
+        grad,
+        scale: dt,
+    };
+    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut scratch)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
     add_constraint_forces(bonds, grad, lambda, force);
     spin(p, s.pos, s.radius, force, new_omega)?;
@@ -66,7 +69,6 @@ fn projected_velocity<T: Real>(
     force: &[T::V3],
     bonds: &[Bond<T>],
     grad: &mut [T::V3],
-    disp: &mut [T::V3],
     kappa: &mut [T],
     scratch: &mut Scratch<'_, T>,
     u: &mut [T::V3],
@@ -75,7 +77,6 @@ fn projected_velocity<T: Real>(
     linalg::sym_matvec::<T>(mu, n, force, u);
     add_flow(p, pos, u);
     bond_vectors(bonds, pos, grad);
-    mobility_disp(mu, n, bonds, grad, T::ONE, disp);
     kappa.fill(T::ZERO);
     let problem = Problem::Velocities {
         bond: grad,
@@ -83,7 +84,11 @@ fn projected_velocity<T: Real>(
     };
     constraints::solve(
         problem,
-        &Metric::Dense { disp, n },
+        &Metric::Mobility {
+            mu,
+            grad,
+            scale: T::ONE,
+        },
         bonds,
         &p.solver,
         u,
@@ -114,7 +119,6 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         new_omega,
         grad,
         grad_new,
-        disp,
         lambda,
         kappa,
         scratch: mut sc,
@@ -123,7 +127,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     // Predictor: projected velocity at r, one projected Euler step.
     assemble_tt(p, s.pos, s.radius, mu0)?;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    projected_velocity(p, s.pos, mu0, force, bonds, grad, disp, kappa, &mut sc, f0)?;
+    projected_velocity(p, s.pos, mu0, force, bonds, grad, kappa, &mut sc, f0)?;
     // Tension and spin at the start of the step: the velocity projection's multipliers
     // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
     let tension = max_tension(bonds, kappa);
@@ -132,20 +136,21 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     for i in 0..n {
         x_p[i] = s.pos[i] + f0[i] * dt;
     }
-    mobility_disp(mu0, n, bonds, grad, dt, disp);
-    project_positions(p, bonds, disp, x_p, lambda, &mut sc)?;
+    let metric = Metric::Mobility {
+        mu: mu0,
+        grad,
+        scale: dt,
+    };
+    project_positions(p, bonds, &metric, x_p, lambda, &mut sc)?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
     assemble_tt(p, x_p, s.radius, mu1)?;
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
-    projected_velocity(
-        p, x_p, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1,
-    )?;
+    projected_velocity(p, x_p, mu1, force, bonds, grad_new, kappa, &mut sc, f1)?;
     for i in 0..n {
         new_pos[i] = s.pos[i] + (f0[i] + f1[i]) * (dt * T::HALF);
     }
     // Projection as in the first-order scheme: r' = r* + dt mu(r) G(r)^T lambda.
-    mobility_disp(mu0, n, bonds, grad, dt, disp);
-    let stats = project_positions(p, bonds, disp, new_pos, lambda, &mut sc)?;
+    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut sc)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
     Ok(StepReport {
         max_tension: tension,

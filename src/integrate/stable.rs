@@ -7,26 +7,15 @@ use super::{
     project_positions, report, step_velocity,
 };
 use crate::bonds::Bond;
-use crate::constraints::{self, Metric, Problem};
+use crate::constraints::{self, Metric, Problem, SolverKind, apply_drag};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
-use crate::linalg;
+use crate::linalg::{self, tri};
 use crate::mobility;
 use crate::params::Params;
 use crate::particles::sphere_volume;
 use crate::real::Real;
 use crate::workspace::Views;
-
-/// `y <- S^-1 dt K^-1 S y` with `K = dt I + S mu S` factorised in `fac`.
-fn apply_drag<T: Real>(fac: &[T::M3], sq: &[T], dt: T, y: &mut [T::V3]) {
-    for (v, &q) in y.iter_mut().zip(sq) {
-        *v *= q;
-    }
-    linalg::cholesky_solve::<T>(fac, sq.len(), y);
-    for (v, &q) in y.iter_mut().zip(sq) {
-        *v *= dt / q;
-    }
-}
 
 /// Inertial with implicit drag: `(R + M/dt) v' = F + F_C + M v/dt + R U_inf`, solved as
 /// `v' = S^-1 dt K^-1 S (mu (F + F_C + M v/dt) + U_inf)`, `S = M^1/2`, `K = dt I + S mu S`.
@@ -73,9 +62,9 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     }
     for i in 0..m {
         for j in 0..=i {
-            fac[i * m + j] = mu[i * m + j] * (sq[i] * sq[j]);
+            fac[tri(i) + j] = mu[tri(i) + j] * (sq[i] * sq[j]);
         }
-        fac[i * m + i] += T::m3_diag(dt);
+        fac[tri(i) + i] += T::m3_diag(dt);
     }
     linalg::cholesky::<T>(fac, m).map_err(|error| StepError::Linalg {
         stage: Stage::Drag,
@@ -92,20 +81,39 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     for i in 0..n {
         new_pos[i] = s.pos[i] + u[i] * dt;
     }
-    // Constraint displacements D_l = dt S^-1 dt K^-1 S mu g_l (every bead moves).
+    // Constraint displacements D_l = dt S^-1 dt K^-1 S mu g_l (every bead moves):
+    // for the dense solves one drag solve per bond, for Krylov one per iteration.
     bond_vectors(bonds, s.pos, grad);
-    for (l, b) in bonds.iter().enumerate() {
-        for q in 0..m {
-            t[q] = (mu[q * m + b.i] - mu[q * m + b.j]) * grad[l];
+    let metric = if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
+        Metric::Drag {
+            mu,
+            fac,
+            sq,
+            dt,
+            grad,
         }
-        apply_drag(fac, sq, dt, t);
-        for q in 0..n {
-            disp[l * n + q] = t[q] * dt;
+    } else {
+        for (l, b) in bonds.iter().enumerate() {
+            for q in 0..m {
+                // Block (q, i): the tt blocks are symmetric, rotation rows lie below.
+                let block = |i: usize| {
+                    if i <= q {
+                        mu[tri(q) + i]
+                    } else {
+                        mu[tri(i) + q]
+                    }
+                };
+                t[q] = (block(b.i) - block(b.j)) * grad[l];
+            }
+            apply_drag(fac, sq, dt, t);
+            for q in 0..n {
+                disp[l * n + q] = t[q] * dt;
+            }
         }
-    }
-    let stats = project_positions(p, bonds, disp, new_pos, lambda, &mut sc)?;
+        Metric::Dense { disp, n, grad }
+    };
+    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut sc)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
-    let metric = Metric::Dense { disp, n };
     // Angular velocities: the same solve with the constraint forces included.
     if p.rotation {
         add_constraint_forces(bonds, grad, lambda, &mut rhs6[..n]);

@@ -174,7 +174,7 @@ pub fn run<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     ps: &mut ParticleSet<T, N>,
     bonds: &BondSet<T, B>,
     p: &Params<T>,
-    ws: &mut Workspace<T, N, B>,
+    ws: &mut Workspace<'_, T>,
     ext: &mut E,
     steps: usize,
 ) -> Vec<StepReport<T>> {

@@ -1,0 +1,226 @@
+//! How a unit multiplier on bond `l` displaces the beads: `D_l(p)`.
+//!
+//! Every metric pushes along the bond vectors `g_l` of the step's start (the
+//! SHAKE/RATTLE convention). The mass metric moves only the bond's two beads; the
+//! hydrodynamic metrics move every bead, but none of them is ever stored as a dense
+//! `beads x bonds` array except [`Metric::Dense`], which the small dense solve of the
+//! implicit-drag integrator uses.
+
+use crate::bonds::Bond;
+use crate::linalg::{self, tri};
+use crate::real::Real;
+
+/// How a unit multiplier on bond `l` displaces bead `p`.
+#[derive(Clone, Copy, Debug)]
+pub enum Metric<'a, T: Real> {
+    /// Inverse-mass metric (the paper's eqs. 3-4): `+scale g_l / m_i` on `i`,
+    /// `-scale g_l / m_j` on `j`, zero elsewhere.
+    Mass {
+        /// `1 / m` per bead.
+        inv_mass: &'a [T],
+        /// Constraint gradients `g_l = r_i - r_j`, one per bond.
+        grad: &'a [T::V3],
+        /// Overall factor (`dt^2 / 2` for positions).
+        scale: T,
+    },
+    /// Hydrodynamic metric from the packed translational mobility:
+    /// `D_l(p) = scale (mu_pi - mu_pj) g_l`, read block by block where it is used.
+    Mobility {
+        /// Packed `mu_tt` (`tri(n)` blocks).
+        mu: &'a [T::M3],
+        /// Constraint gradients, one per bond.
+        grad: &'a [T::V3],
+        /// Overall factor (`dt` for positions).
+        scale: T,
+    },
+    /// Precomputed displacements `disp[l * n + p]` (`beads x bonds`).
+    Dense {
+        /// Displacements, bond-major.
+        disp: &'a [T::V3],
+        /// Beads.
+        n: usize,
+        /// Constraint gradients, one per bond.
+        grad: &'a [T::V3],
+    },
+    /// Implicit-drag metric `D_l = dt Q g_l`, `Q = (R + M/dt)^-1 = dt S^-1 K^-1 S mu`
+    /// with `K = dt I + S mu S` factorised (the stable inertial integrator). Only its
+    /// action on a whole multiplier vector is available: one mobility product and one
+    /// Cholesky solve. Solved by the Krylov solver only.
+    Drag {
+        /// Packed mobility (`tri(m)` blocks, `m = n` or `2n` with rotation).
+        mu: &'a [T::M3],
+        /// Cholesky factor of `K`, packed.
+        fac: &'a [T::M3],
+        /// `S`: `sqrt(m)` per bead, then `sqrt(I)` per bead with rotation (length `m`).
+        sq: &'a [T],
+        /// Time step.
+        dt: T,
+        /// Constraint gradients, one per bond.
+        grad: &'a [T::V3],
+    },
+}
+
+/// Block `(p, q)` of a packed symmetric matrix whose blocks are symmetric, so either
+/// triangle can be read without a transpose.
+#[inline(always)]
+fn sym_block<T: Real>(mu: &[T::M3], p: usize, q: usize) -> T::M3 {
+    if q <= p {
+        mu[tri(p) + q]
+    } else {
+        mu[tri(q) + p]
+    }
+}
+
+/// `y <- S^-1 dt K^-1 S y` with `K = dt I + S mu S` factorised in `fac`.
+pub(crate) fn apply_drag<T: Real>(fac: &[T::M3], sq: &[T], dt: T, y: &mut [T::V3]) {
+    for (v, &q) in y.iter_mut().zip(sq) {
+        *v *= q;
+    }
+    linalg::cholesky_solve::<T>(fac, sq.len(), y);
+    for (v, &q) in y.iter_mut().zip(sq) {
+        *v *= dt / q;
+    }
+}
+
+impl<T: Real> Metric<'_, T> {
+    /// The bond vector multiplier `l` pushes along.
+    #[inline]
+    pub fn grad(&self, l: usize) -> T::V3 {
+        match *self {
+            Metric::Mass { grad, .. }
+            | Metric::Mobility { grad, .. }
+            | Metric::Dense { grad, .. }
+            | Metric::Drag { grad, .. } => grad[l],
+        }
+    }
+
+    /// Displacement of bead `p` per unit multiplier on bond `l`. Exact for every metric
+    /// but [`Metric::Drag`], where it is the preconditioner's local model
+    /// `Q_pq ~ sqrt(c_p c_q) mu_pq`, `c_p = 1 / (1 + m_p mu_pp / dt)`: exact for a lone
+    /// bead, `mu` as the masses vanish and `dt / m` as they grow.
+    #[inline]
+    pub fn at(&self, bonds: &[Bond<T>], l: usize, p: usize) -> T::V3 {
+        let b = bonds[l];
+        match *self {
+            Metric::Mass {
+                inv_mass,
+                grad,
+                scale,
+            } => {
+                if p == b.i {
+                    grad[l] * (scale * inv_mass[p])
+                } else if p == b.j {
+                    grad[l] * (-scale * inv_mass[p])
+                } else {
+                    T::V3_ZERO
+                }
+            }
+            Metric::Mobility { mu, grad, scale } => {
+                let g = grad[l] * scale;
+                sym_block::<T>(mu, p, b.i) * g - sym_block::<T>(mu, p, b.j) * g
+            }
+            Metric::Dense { disp, n, .. } => disp[l * n + p],
+            Metric::Drag {
+                mu, sq, dt, grad, ..
+            } => {
+                let c = |q: usize| {
+                    let self_mu = T::m3_get(mu[tri(q) + q], 0, 0);
+                    T::ONE / (T::ONE + sq[q] * sq[q] * self_mu / dt)
+                };
+                let cp = c(p);
+                let g = grad[l] * dt;
+                let q_pi = sym_block::<T>(mu, p, b.i) * (cp * c(b.i)).sqrt();
+                let q_pj = sym_block::<T>(mu, p, b.j) * (cp * c(b.j)).sqrt();
+                q_pi * g - q_pj * g
+            }
+        }
+    }
+
+    /// Change of bond `k`'s vector per unit multiplier on bond `l`.
+    #[inline]
+    pub fn relative(&self, bonds: &[Bond<T>], k: usize, l: usize) -> T::V3 {
+        let b = bonds[k];
+        self.at(bonds, l, b.i) - self.at(bonds, l, b.j)
+    }
+
+    /// `x += c D_l` (one bond; the sweep and the dense Newton update).
+    pub fn apply_one(&self, bonds: &[Bond<T>], l: usize, c: T, x: &mut [T::V3]) {
+        match *self {
+            Metric::Mass { .. } => {
+                let b = bonds[l];
+                x[b.i] += self.at(bonds, l, b.i) * c;
+                x[b.j] += self.at(bonds, l, b.j) * c;
+            }
+            Metric::Dense { disp, .. } => {
+                let n = x.len();
+                for (xp, &d) in x.iter_mut().zip(&disp[l * n..l * n + n]) {
+                    *xp += d * c;
+                }
+            }
+            Metric::Mobility { .. } | Metric::Drag { .. } => {
+                for p in 0..x.len() {
+                    x[p] += self.at(bonds, l, p) * c;
+                }
+            }
+        }
+    }
+
+    /// `out = sum_l c_l D_l` over all bonds at once (the Krylov solver's product):
+    /// `G^T c`, then one mobility product (and one drag solve). `tmp` holds at least
+    /// `2m` vectors (`m` block rows of the mobility).
+    pub fn apply_all(&self, bonds: &[Bond<T>], c: &[T], out: &mut [T::V3], tmp: &mut [T::V3]) {
+        let n = out.len();
+        match *self {
+            Metric::Mass {
+                inv_mass,
+                grad,
+                scale,
+            } => {
+                out.fill(T::V3_ZERO);
+                for (l, b) in bonds.iter().enumerate() {
+                    let g = grad[l] * (c[l] * scale);
+                    out[b.i] += g * inv_mass[b.i];
+                    out[b.j] -= g * inv_mass[b.j];
+                }
+            }
+            Metric::Dense { .. } => {
+                out.fill(T::V3_ZERO);
+                for (l, &cl) in c.iter().enumerate() {
+                    self.apply_one(bonds, l, cl, out);
+                }
+            }
+            Metric::Mobility { mu, grad, scale } => {
+                let f = &mut tmp[..n];
+                spread(bonds, grad, c, scale, f);
+                linalg::sym_matvec::<T>(mu, n, f, out);
+            }
+            Metric::Drag {
+                mu,
+                fac,
+                sq,
+                dt,
+                grad,
+            } => {
+                let m = sq.len();
+                let (f, u) = tmp[..2 * m].split_at_mut(m);
+                f.fill(T::V3_ZERO);
+                spread(bonds, grad, c, T::ONE, &mut f[..n]);
+                linalg::sym_matvec::<T>(mu, m, f, u);
+                apply_drag(fac, sq, dt, u);
+                for (o, &v) in out.iter_mut().zip(u.iter()) {
+                    *o = v * dt;
+                }
+            }
+        }
+    }
+}
+
+/// `f = scale G^T c`: the forces a multiplier vector puts on the beads.
+fn spread<T: Real>(bonds: &[Bond<T>], grad: &[T::V3], c: &[T], scale: T, f: &mut [T::V3]) {
+    f.fill(T::V3_ZERO);
+    for (l, b) in bonds.iter().enumerate() {
+        let g = grad[l] * (c[l] * scale);
+        f[b.i] += g;
+        f[b.j] -= g;
+    }
+}

@@ -1,0 +1,207 @@
+//! Constraint solves on one generic problem: the SHAKE/RATTLE sweep of the paper
+//! (`sweep.rs`), Newton on the dense Jacobian (`newton.rs`) and chord Newton with
+//! preconditioned conjugate gradients for many bonds (`krylov.rs`).
+//!
+//! A unit multiplier on bond `l` moves bead `p` by `D_l(p)` ([`Metric`]). The position
+//! problem finds `lambda` with `|x_i - x_j|^2 = d^2` for `x = x* + sum_l lambda_l D_l`
+//! (paper eq. 3); the velocity problem finds `kappa` with `b_k . (v_i - v_j) = 0` for
+//! `v = v* + sum_l kappa_l D_l` (paper eq. 4), `b_k` the bond vectors at the new positions.
+
+mod krylov;
+mod metric;
+mod newton;
+mod sweep;
+
+pub use krylov::{BAND, krylov};
+
+/// Krylov scratch scalars per bond.
+pub(crate) const fn krylov_scratch_per_bond() -> usize {
+    krylov::SCALARS_PER_BOND
+}
+pub use metric::Metric;
+pub(crate) use metric::apply_drag;
+pub use newton::newton;
+pub use sweep::sweep;
+
+use crate::bonds::Bond;
+use crate::error::{Stage, StepError};
+use crate::real::Real;
+
+/// [`SolverKind::Auto`] picks the dense [`SolverKind::Newton`] solve up to this many
+/// bonds and [`SolverKind::Krylov`] above. Measured crossover (`cargo bench --bench
+/// kernel -- solver`): see `docs/BENCHMARKS.md`.
+pub const DENSE_BONDS_MAX: usize = 64;
+
+/// Which algorithm solves for the multipliers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SolverKind {
+    /// Cyclic sweeps, one constraint at a time in bond order (the paper's SHAKE/RATTLE).
+    Sweep,
+    /// Newton iterations on the dense `bonds x bonds` Jacobian (LU, reused while it
+    /// keeps converging fast): `O(B^2)` storage, `O(B^3)` per factorisation.
+    Newton,
+    /// Chord Newton with banded-preconditioned conjugate gradients: `O(B)` storage,
+    /// one mobility product per iteration.
+    Krylov,
+    /// [`SolverKind::Newton`] up to [`DENSE_BONDS_MAX`] bonds, [`SolverKind::Krylov`]
+    /// above (the default).
+    #[default]
+    Auto,
+}
+
+impl SolverKind {
+    /// The algorithm that runs for `bonds` bonds ([`SolverKind::Auto`] resolved).
+    pub const fn resolve(self, bonds: usize) -> Self {
+        match self {
+            Self::Auto if bonds <= DENSE_BONDS_MAX => Self::Newton,
+            Self::Auto => Self::Krylov,
+            kind => kind,
+        }
+    }
+}
+
+/// Tolerance and iteration cap for a constraint solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Solver<T> {
+    /// Algorithm.
+    pub kind: SolverKind,
+    /// Largest accepted relative bond-length error `| |r_ij| - d | / d` (positions), or
+    /// relative length change per step `dt |b.(v_i - v_j)| / d^2` (velocities).
+    pub tolerance: T,
+    /// Iteration cap (sweeps, Newton steps, or Krylov chord steps; Krylov also stops
+    /// after `10 x max_iterations` operator products); reaching it is an error.
+    pub max_iterations: u32,
+}
+
+/// Which condition to enforce.
+#[derive(Clone, Copy, Debug)]
+pub enum Problem<'a, T: Real> {
+    /// `|x_i - x_j|^2 - d^2 = 0` (SHAKE).
+    Positions,
+    /// `b_k . (x_i - x_j) = 0` with `b_k` the new bond vectors (RATTLE); `dt` scales the
+    /// residual to a relative length change per step.
+    Velocities {
+        /// Bond vectors at the new positions.
+        bond: &'a [T::V3],
+        /// Time step.
+        dt: T,
+    },
+}
+
+impl<T: Real> Problem<'_, T> {
+    /// Residual of bond `k`, its derivative direction (w.r.t. `x_i - x_j`), and the
+    /// normalised magnitude compared with the tolerance.
+    #[inline]
+    fn eval(&self, b: &Bond<T>, k: usize, x: &[T::V3]) -> (T, T::V3, T) {
+        let rel = x[b.i] - x[b.j];
+        let d2 = b.length * b.length;
+        match *self {
+            Problem::Positions => {
+                let s = T::norm2(rel) - d2;
+                (s, rel * T::TWO, s.abs() / (T::TWO * d2))
+            }
+            Problem::Velocities { bond, dt } => {
+                let c = T::dot(bond[k], rel);
+                (c, bond[k], (c * dt).abs() / d2)
+            }
+        }
+    }
+
+    /// `|value|` normalised as the tolerance is (a linear residual of bond `b`).
+    #[inline]
+    fn normalise(&self, b: &Bond<T>, value: T) -> T {
+        let d2 = b.length * b.length;
+        match *self {
+            Problem::Positions => value.abs() / (T::TWO * d2),
+            Problem::Velocities { dt, .. } => (value * dt).abs() / d2,
+        }
+    }
+
+    /// `c` in the chord matrix `A = c G D`: the derivative of the residual along `g`.
+    fn chord_factor(&self) -> T {
+        match self {
+            Problem::Positions => T::TWO,
+            Problem::Velocities { .. } => T::ONE,
+        }
+    }
+
+    fn stage(&self) -> Stage {
+        match self {
+            Problem::Positions => Stage::Positions,
+            Problem::Velocities { .. } => Stage::Velocities,
+        }
+    }
+
+    fn no_convergence(&self, iterations: u32, residual: T) -> StepError {
+        StepError::NoConvergence {
+            stage: self.stage(),
+            iterations,
+            residual: residual.to_f64(),
+        }
+    }
+}
+
+/// Outcome of a converged solve.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolveStats<T> {
+    /// Sweeps or Newton steps taken.
+    pub iterations: u32,
+    /// Largest normalised residual left.
+    pub residual: T,
+}
+
+/// Solver scratch, each part sized by [`Layout`](crate::workspace::Layout) for the
+/// solver that runs (empty otherwise).
+pub struct Scratch<'a, T: Real> {
+    /// Newton: the Jacobian (`bonds^2`, row-major).
+    pub jac: &'a mut [T],
+    /// Newton: right-hand side / update (`bonds`).
+    pub rhs: &'a mut [T],
+    /// Newton: LU pivots (`bonds`).
+    pub piv: &'a mut [usize],
+    /// Krylov: preconditioner band and CG vectors (`krylov::SCALARS_PER_BOND x bonds`).
+    pub krylov: &'a mut [T],
+    /// Krylov: bead-space vectors (`2n + 2m`).
+    pub beads: &'a mut [T::V3],
+}
+
+/// Scratch sizes `[scalars, vectors, indices]` of `kind` for `n` beads, `m` block rows
+/// of the mobility and `bonds` bonds.
+pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) -> [usize; 3] {
+    match kind.resolve(bonds) {
+        SolverKind::Newton => [bonds * bonds + bonds, 0, bonds],
+        SolverKind::Krylov => [krylov::SCALARS_PER_BOND * bonds, 2 * n + 2 * m, 0],
+        _ => [0, 0, 0],
+    }
+}
+
+/// Largest normalised residual over all bonds.
+fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T {
+    let mut w = T::ZERO;
+    for (k, b) in bonds.iter().enumerate() {
+        w = w.max_sticky(problem.eval(b, k, x).2);
+    }
+    w
+}
+
+/// Solves for the multipliers, accumulating them into `mult` and moving `x`. The
+/// implicit-drag metric has no cheap single-bond form and is always solved by Krylov.
+pub fn solve<T: Real>(
+    problem: Problem<'_, T>,
+    metric: &Metric<'_, T>,
+    bonds: &[Bond<T>],
+    solver: &Solver<T>,
+    x: &mut [T::V3],
+    mult: &mut [T],
+    scratch: &mut Scratch<'_, T>,
+) -> Result<SolveStats<T>, StepError> {
+    let kind = match metric {
+        Metric::Drag { .. } => SolverKind::Krylov,
+        _ => solver.kind.resolve(bonds.len()),
+    };
+    match kind {
+        SolverKind::Sweep => sweep(problem, metric, bonds, solver, x, mult),
+        SolverKind::Krylov => krylov(problem, metric, bonds, solver, x, mult, scratch),
+        _ => newton(problem, metric, bonds, solver, x, mult, scratch),
+    }
+}

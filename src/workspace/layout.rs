@@ -1,0 +1,158 @@
+//! How much storage a step needs: counted per method, rotation flag, solver, beads and
+//! bonds, in a `const fn`, so firmware sizes a [`Storage`](super::Storage) at compile
+//! time and a host sizes [`Buffers`](super::Buffers) at run time from the same numbers.
+
+use crate::constraints::{SolverKind, scratch_size};
+use crate::linalg::tri;
+use crate::params::Method;
+use crate::real::Real;
+
+/// Element counts of the four storage arrays one step uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Layout {
+    /// 3x3 blocks (packed mobilities and factors).
+    pub blocks: usize,
+    /// 3-vectors (forces, velocities, candidate state, bond vectors, solver vectors).
+    pub vectors: usize,
+    /// Scalars (multipliers, masses, solver matrices).
+    pub scalars: usize,
+    /// Indices (LU pivots).
+    pub indices: usize,
+}
+
+/// Block rows of the mobility: `2n` when rotation is resolved (only the stable inertial
+/// integrator integrates it), `n` otherwise.
+pub(crate) const fn block_rows(method: Method, rotation: bool, n: usize) -> usize {
+    if rotation && matches!(method, Method::RattleStable) {
+        2 * n
+    } else {
+        n
+    }
+}
+
+impl Layout {
+    /// Storage for `method` with the default solver ([`SolverKind::Auto`]), `n`
+    /// particles and `bonds` bonds.
+    pub const fn new(method: Method, rotation: bool, n: usize, bonds: usize) -> Self {
+        Self::with_solver(method, rotation, SolverKind::Auto, n, bonds)
+    }
+
+    /// Storage for `method` with the solver `kind`.
+    ///
+    /// Every method stores the candidate state (`3n` vectors), the forces (`m`), the bond
+    /// vectors and multipliers (`B` each), and:
+    /// * `Overdamped`, `Springs`: one packed mobility `tri(n)` blocks;
+    /// * `Overdamped2`: two (start and predicted point);
+    /// * `Rattle`: the mobility and its Cholesky factor;
+    /// * `RattleStable`: the mobility and the drag factor over `m` block rows (`2n` with
+    ///   rotation), plus the dense `n x B` constraint displacements unless the solver is
+    ///   Krylov.
+    ///
+    /// The dense Newton solve adds `B^2 + B` scalars and `B` indices; Krylov adds
+    /// `9 B` scalars and `2n + 2m` vectors; the sweep adds nothing.
+    pub const fn with_solver(
+        method: Method,
+        rotation: bool,
+        kind: SolverKind,
+        n: usize,
+        bonds: usize,
+    ) -> Self {
+        let m = block_rows(method, rotation, n);
+        let b = bonds;
+        let kind = kind.resolve(bonds);
+        // Candidate state, forces, bond vectors, multipliers.
+        let mut l = Layout {
+            blocks: 0,
+            vectors: 3 * n + m + b,
+            scalars: b,
+            indices: 0,
+        };
+        match method {
+            Method::Overdamped | Method::Springs => {
+                l.blocks = tri(n);
+                l.vectors += n;
+            }
+            Method::Overdamped2 => {
+                l.blocks = 2 * tri(n);
+                l.vectors += 3 * n + b;
+                l.scalars += b;
+            }
+            Method::Rattle => {
+                l.blocks = 2 * tri(n);
+                l.vectors += 3 * n + b;
+                l.scalars += n + b;
+            }
+            Method::RattleStable => {
+                l.blocks = 2 * tri(m);
+                l.vectors += 2 * m + b;
+                l.scalars += m + b;
+                if !matches!(kind, SolverKind::Krylov) {
+                    l.vectors += n * b;
+                }
+            }
+        }
+        if !matches!(method, Method::Springs) {
+            let [s, v, i] = scratch_size(kind, n, m, b);
+            l.scalars += s;
+            l.vectors += v;
+            l.indices += i;
+        }
+        l
+    }
+
+    /// Storage for every method, with and without rotation, with every solver: one
+    /// workspace a host can switch methods on.
+    pub const fn all(n: usize, bonds: usize) -> Self {
+        let methods = [
+            Method::Overdamped,
+            Method::Overdamped2,
+            Method::Rattle,
+            Method::RattleStable,
+            Method::Springs,
+        ];
+        let kinds = [SolverKind::Sweep, SolverKind::Newton, SolverKind::Krylov];
+        let mut l = Layout {
+            blocks: 0,
+            vectors: 0,
+            scalars: 0,
+            indices: 0,
+        };
+        let mut i = 0;
+        while i < methods.len() * kinds.len() * 2 {
+            let (method, kind) = (methods[i / 6], kinds[(i / 2) % 3]);
+            l = l.max(Self::with_solver(method, i % 2 == 1, kind, n, bonds));
+            i += 1;
+        }
+        l
+    }
+
+    /// Element-wise maximum: storage that serves both layouts (one workspace shared by
+    /// several methods).
+    pub const fn max(self, o: Self) -> Self {
+        const fn mx(a: usize, b: usize) -> usize {
+            if a > b { a } else { b }
+        }
+        Self {
+            blocks: mx(self.blocks, o.blocks),
+            vectors: mx(self.vectors, o.vectors),
+            scalars: mx(self.scalars, o.scalars),
+            indices: mx(self.indices, o.indices),
+        }
+    }
+
+    /// Bytes of this layout in precision `T`.
+    pub const fn bytes<T: Real>(&self) -> usize {
+        self.blocks * core::mem::size_of::<T::M3>()
+            + self.vectors * core::mem::size_of::<T::V3>()
+            + self.scalars * core::mem::size_of::<T>()
+            + self.indices * core::mem::size_of::<usize>()
+    }
+
+    /// `true` when every count of `need` fits in `self`.
+    pub const fn holds(&self, need: &Self) -> bool {
+        need.blocks <= self.blocks
+            && need.vectors <= self.vectors
+            && need.scalars <= self.scalars
+            && need.indices <= self.indices
+    }
+}

@@ -1,0 +1,149 @@
+//! Caller-owned scratch storage for [`step`](crate::integrate::step), sized to what the
+//! chosen method needs ([`Layout`]) and never allocated by the kernel.
+//!
+//! A [`Workspace`] borrows four slices (blocks, vectors, scalars, indices). Who owns
+//! them is the caller's choice:
+//! * firmware: a [`Storage`] sized at compile time from a `const` [`Layout`], which can
+//!   live in a `static` (its constructor is `const`);
+//! * a host: [`Buffers`] (feature `alloc`), built directly on the heap, never on the
+//!   stack, so thousands of beads fit;
+//! * anything else: four slices from wherever (an arena, a C caller).
+//!
+//! ```
+//! use hydrorattle::{Layout, Method, Storage};
+//! const L: Layout = Layout::new(Method::Overdamped, false, 25, 24);
+//! static STORE: Storage<f32, { L.blocks }, { L.vectors }, { L.scalars }, { L.indices }> =
+//!     Storage::new();
+//! # let _ = &STORE;
+//! ```
+
+mod layout;
+mod views;
+
+pub use layout::Layout;
+pub(crate) use layout::block_rows;
+pub(crate) use views::Views;
+
+use crate::real::Real;
+
+/// Scratch for one step, borrowed from caller-owned slices. Any sizes work; a step
+/// whose [`Layout`] does not fit returns [`StepError::Storage`](crate::StepError::Storage)
+/// before touching anything.
+#[derive(Debug)]
+pub struct Workspace<'a, T: Real> {
+    pub(crate) blocks: &'a mut [T::M3],
+    pub(crate) vectors: &'a mut [T::V3],
+    pub(crate) scalars: &'a mut [T],
+    pub(crate) indices: &'a mut [usize],
+}
+
+impl<'a, T: Real> Workspace<'a, T> {
+    /// A workspace over four caller-owned slices (contents are overwritten by steps).
+    pub fn new(
+        blocks: &'a mut [T::M3],
+        vectors: &'a mut [T::V3],
+        scalars: &'a mut [T],
+        indices: &'a mut [usize],
+    ) -> Self {
+        Self {
+            blocks,
+            vectors,
+            scalars,
+            indices,
+        }
+    }
+
+    /// The element counts this workspace holds.
+    pub fn capacity(&self) -> Layout {
+        Layout {
+            blocks: self.blocks.len(),
+            vectors: self.vectors.len(),
+            scalars: self.scalars.len(),
+            indices: self.indices.len(),
+        }
+    }
+
+    /// The position multipliers of the last constrained step with `bonds` bonds (force
+    /// per unit length along each bond). After `Springs` or a failed step they are
+    /// stale or partial; after `Overdamped2` they hold only the final projection's
+    /// small correction.
+    pub fn multipliers(&self, bonds: usize) -> &[T] {
+        &self.scalars[..bonds.min(self.scalars.len())]
+    }
+}
+
+/// Fixed-size storage: `BL` blocks, `VE` vectors, `SC` scalars, `IX` indices, sized
+/// from a `const` [`Layout`]. `const fn new`, so it can initialise a `static`.
+#[derive(Clone, Debug)]
+pub struct Storage<T: Real, const BL: usize, const VE: usize, const SC: usize, const IX: usize> {
+    blocks: [T::M3; BL],
+    vectors: [T::V3; VE],
+    scalars: [T; SC],
+    indices: [usize; IX],
+}
+
+impl<T: Real, const BL: usize, const VE: usize, const SC: usize, const IX: usize> Default
+    for Storage<T, BL, VE, SC, IX>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<T: Real, const BL: usize, const VE: usize, const SC: usize, const IX: usize>
+    Storage<T, BL, VE, SC, IX>
+{
+    /// Zeroed storage.
+    pub const fn new() -> Self {
+        Self {
+            blocks: [T::M3_ZERO; BL],
+            vectors: [T::V3_ZERO; VE],
+            scalars: [T::ZERO; SC],
+            indices: [0; IX],
+        }
+    }
+
+    /// A workspace over this storage.
+    pub fn workspace(&mut self) -> Workspace<'_, T> {
+        Workspace::new(
+            &mut self.blocks,
+            &mut self.vectors,
+            &mut self.scalars,
+            &mut self.indices,
+        )
+    }
+}
+
+/// Heap storage sized at run time (feature `alloc`): built element by element on the
+/// heap, so no size ever passes through the stack.
+#[cfg(feature = "alloc")]
+#[derive(Clone, Debug, Default)]
+pub struct Buffers<T: Real> {
+    blocks: alloc::vec::Vec<T::M3>,
+    vectors: alloc::vec::Vec<T::V3>,
+    scalars: alloc::vec::Vec<T>,
+    indices: alloc::vec::Vec<usize>,
+}
+
+#[cfg(feature = "alloc")]
+impl<T: Real> Buffers<T> {
+    /// Zeroed buffers holding `layout`.
+    pub fn new(layout: Layout) -> Self {
+        Self {
+            blocks: alloc::vec![T::M3_ZERO; layout.blocks],
+            vectors: alloc::vec![T::V3_ZERO; layout.vectors],
+            scalars: alloc::vec![T::ZERO; layout.scalars],
+            indices: alloc::vec![0; layout.indices],
+        }
+    }
+
+    /// A workspace over these buffers.
+    pub fn workspace(&mut self) -> Workspace<'_, T> {
+        Workspace::new(
+            &mut self.blocks,
+            &mut self.vectors,
+            &mut self.scalars,
+            &mut self.indices,
+        )
+    }
+}

@@ -1,0 +1,123 @@
+//! The workspace carved into the named slices one step uses. Each method takes only
+//! its own parts (the others are empty), in the order [`Layout`] counts them.
+
+use super::{Layout, Workspace};
+use crate::constraints::Scratch;
+use crate::constraints::{SolverKind, krylov_scratch_per_bond};
+use crate::error::StepError;
+use crate::linalg::tri;
+use crate::params::Method;
+use crate::real::Real;
+
+/// Named slices for one step of `n` particles, `nb` bonds, `m` block rows.
+pub(crate) struct Views<'a, T: Real> {
+    pub mu: &'a mut [T::M3],
+    pub fac: &'a mut [T::M3],
+    pub disp: &'a mut [T::V3],
+    pub force: &'a mut [T::V3],
+    pub work_a: &'a mut [T::V3],
+    pub work_b: &'a mut [T::V3],
+    pub work_c: &'a mut [T::V3],
+    pub grad: &'a mut [T::V3],
+    pub grad_new: &'a mut [T::V3],
+    pub lambda: &'a mut [T],
+    pub kappa: &'a mut [T],
+    pub inv_mass: &'a mut [T],
+    pub sqrt_m: &'a mut [T],
+    pub new_pos: &'a mut [T::V3],
+    pub new_vel: &'a mut [T::V3],
+    pub new_omega: &'a mut [T::V3],
+    pub scratch: Scratch<'a, T>,
+}
+
+/// Takes slices off the front of a slice.
+struct Carve<'a, X>(&'a mut [X]);
+
+impl<'a, X> Carve<'a, X> {
+    /// The next `k` elements (the layout check guarantees they exist).
+    fn take(&mut self, k: usize) -> &'a mut [X] {
+        let rest = core::mem::take(&mut self.0);
+        let (head, tail) = rest.split_at_mut(k.min(rest.len()));
+        self.0 = tail;
+        head
+    }
+}
+
+impl<T: Real> Workspace<'_, T> {
+    /// Checks that the layout of this step fits, then splits the storage.
+    pub(crate) fn views(
+        &mut self,
+        method: Method,
+        rotation: bool,
+        kind: SolverKind,
+        n: usize,
+        nb: usize,
+    ) -> Result<Views<'_, T>, StepError> {
+        let need = Layout::with_solver(method, rotation, kind, n, nb);
+        let have = self.capacity();
+        if !have.holds(&need) {
+            return Err(StepError::Storage { need, have });
+        }
+        let m = super::block_rows(method, rotation, n);
+        let kind = kind.resolve(nb);
+        let krylov = matches!(kind, SolverKind::Krylov);
+        let mut bl = Carve(&mut *self.blocks);
+        let mut ve = Carve(&mut *self.vectors);
+        let mut sc = Carve(&mut *self.scalars);
+        let mut ix = Carve(&mut *self.indices);
+        // Multipliers first: `Workspace::multipliers` reads them there.
+        let lambda = sc.take(nb);
+        let (new_pos, new_vel, new_omega) = (ve.take(n), ve.take(n), ve.take(n));
+        let (force, grad) = (ve.take(m), ve.take(nb));
+        let (mats, work, extra_bonds, inv_mass, sqrt_m, disp) = match method {
+            Method::Overdamped | Method::Springs => (1, [n, 0, 0], 0, 0, 0, 0),
+            Method::Overdamped2 => (2, [n, n, n], nb, 0, 0, 0),
+            Method::Rattle => (2, [n, n, n], nb, n, 0, 0),
+            Method::RattleStable => (2, [m, m, 0], nb, 0, m, if krylov { 0 } else { n * nb }),
+        };
+        let mu = bl.take(tri(m));
+        let fac = bl.take(if mats == 2 { tri(m) } else { 0 });
+        let (work_a, work_b, work_c) = (ve.take(work[0]), ve.take(work[1]), ve.take(work[2]));
+        let grad_new = ve.take(extra_bonds);
+        let kappa = sc.take(extra_bonds);
+        let inv_mass = sc.take(inv_mass);
+        let sqrt_m = sc.take(sqrt_m);
+        let disp = ve.take(disp);
+        let constrained = !matches!(method, Method::Springs);
+        let newton = constrained && matches!(kind, SolverKind::Newton);
+        let scratch = Scratch {
+            jac: sc.take(if newton { nb * nb } else { 0 }),
+            rhs: sc.take(if newton { nb } else { 0 }),
+            piv: ix.take(if newton { nb } else { 0 }),
+            krylov: sc.take(if constrained && krylov {
+                krylov_scratch_per_bond() * nb
+            } else {
+                0
+            }),
+            beads: ve.take(if constrained && krylov {
+                2 * n + 2 * m
+            } else {
+                0
+            }),
+        };
+        Ok(Views {
+            mu,
+            fac,
+            disp,
+            force,
+            work_a,
+            work_b,
+            work_c,
+            grad,
+            grad_new,
+            lambda,
+            kappa,
+            inv_mass,
+            sqrt_m,
+            new_pos,
+            new_vel,
+            new_omega,
+            scratch,
+        })
+    }
+}
