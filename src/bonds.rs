@@ -110,10 +110,7 @@ impl<T: Real, const B: usize> BondSet<T, B> {
 
     /// Checks every bond against `n` particles and against each other.
     pub fn validate(&self, n: usize) -> Result<(), BondError> {
-        for (k, b) in self.bonds.iter().enumerate() {
-            check_bond(k, b, n, &self.bonds[..k])?;
-        }
-        Ok(())
+        validate(&self.bonds, n)
     }
 
     /// Largest relative length error `| |r_ij| - d | / d` and its bond (0 if none).
@@ -134,6 +131,16 @@ impl<T: Real, const B: usize> BondSet<T, B> {
             })
         }
     }
+}
+
+/// Checks a bond list of any length against `n` particles: range, self-bonds, lengths
+/// and duplicates (the checks [`BondSet::push`] makes, for runtime-sized hosts; the
+/// duplicate check is `O(B^2)`, once per list, not per step).
+pub fn validate<T: Real>(bonds: &[Bond<T>], n: usize) -> Result<(), BondError> {
+    for (k, b) in bonds.iter().enumerate() {
+        check_bond(k, b, n, &bonds[..k])?;
+    }
+    Ok(())
 }
 
 /// Largest relative length error over `bonds` and the bond where it occurs. NaN is
