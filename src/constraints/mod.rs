@@ -30,7 +30,7 @@ use crate::real::Real;
 /// [`SolverKind::Auto`] picks the dense [`SolverKind::Newton`] solve up to this many
 /// bonds and [`SolverKind::Krylov`] above. Measured crossover (`cargo bench --bench
 /// kernel -- solver`): see `docs/BENCHMARKS.md`.
-pub const DENSE_BONDS_MAX: usize = 64;
+pub const DENSE_BONDS_MAX: usize = 32;
 
 /// Which algorithm solves for the multipliers.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
