@@ -5,6 +5,7 @@
 //! chain (radius 3, rise 0.5 per bead, tails of radius 1, head 2^(1/3), bonds 1.05 (a_i +
 //! a_j)) settles under gravity with dt = 0.01 for `STEPS` steps (default 5). Prints
 //! milliseconds per step and constraint iterations (PCG iterations for Krylov).
+//! `MF=1` runs matrix-free (Overdamped, Springs), `DT=x` sets the time step.
 
 use hydrorattle::*;
 
@@ -64,7 +65,8 @@ fn main() {
         p.method = method;
         p.solver.kind = kind;
         p.allow_overlap = true;
-        let layout = Layout::with_solver(method, false, kind, n, bonds.len());
+        p.matrix_free = std::env::var("MF").is_ok();
+        let layout = Layout::for_params(&p, n, bonds.len());
         let mut store = Buffers::<f64>::new(layout);
         let mut ws = store.workspace();
         let t0 = std::time::Instant::now();

@@ -186,6 +186,54 @@ fn rt_coefficient<T: Real>(far: bool, eta: T, ai: T, aj: T, s: T) -> T {
     poly / (pi16 * ai * ai * ai * aj * T::from_f64(8.0) * s * s)
 }
 
+/// `y = mu_tt x` without storing `mu_tt`: each pair block is evaluated where it is
+/// used, in the orientation and summation order of [`assemble_tt`] followed by
+/// [`sym_matvec`](crate::linalg::sym_matvec), so the result is bit-identical to the
+/// stored path at the cost of re-evaluating the pairs (storage `O(N)` instead of
+/// `O(N^2)`). Nested spheres are an error, as in assembly.
+pub fn tt_product<T: Real>(
+    level: Hydro,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    x: &[T::V3],
+    y: &mut [T::V3],
+) -> Result<(), ParticleError> {
+    let n = pos.len();
+    for i in 0..n {
+        y[i] = T::m3_diag(self_tt(eta, radius[i])) * x[i];
+    }
+    for i in 0..n {
+        let mut acc = T::V3_ZERO;
+        for j in 0..i {
+            let b = pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
+                .ok_or(ParticleError::Nested { i: j, j: i })?;
+            acc += b * x[j];
+            y[j] += T::m3_tmul(b, x[i]);
+        }
+        y[i] += acc;
+    }
+    Ok(())
+}
+
+/// Block `(p, q)` of `mu_tt` as [`assemble_tt`] stores it (the pair evaluated from the
+/// higher index), `None` for nested spheres.
+#[inline]
+pub fn tt_block_at<T: Real>(
+    level: Hydro,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    p: usize,
+    q: usize,
+) -> Option<T::M3> {
+    let (i, j) = if p >= q { (p, q) } else { (q, p) };
+    if i == j {
+        return Some(T::m3_diag(self_tt(eta, radius[i])));
+    }
+    pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
+}
+
 /// Assembles the `n x n` translational mobility `mu_tt`, packed lower triangle
 /// ([`tri`]`(n)` blocks into `out`; symmetric by construction: each pair is evaluated once).
 pub fn assemble_tt<T: Real>(

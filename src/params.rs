@@ -48,6 +48,13 @@ pub struct Params<T: Real> {
     /// [`Method::RattleStable`] they are integrated with rotational inertia; otherwise
     /// reported as `Omega_inf + mu_rt F`). Default false.
     pub rotation: bool,
+    /// Matrix-free mobility: never store `mu_tt`, evaluate each pair block where it is
+    /// used (storage `O(N + B)`; the same bits as the stored path, at the cost of one
+    /// pair evaluation per block per product). Honoured by [`Method::Overdamped`] and
+    /// [`Method::Springs`]; the other methods factorise or keep a second mobility and
+    /// refuse it ([`StepError::BadParameter`](crate::StepError::BadParameter)).
+    /// Default false.
+    pub matrix_free: bool,
     /// Constraint solver. Default [`SolverKind::Auto`], tolerance 1e-10 (f64) / 1e-5 (f32), cap 100.
     pub solver: Solver<T>,
     /// Accept overlapping (not nested) spheres. Default false.
@@ -80,6 +87,7 @@ impl<T: Real> Params<T> {
             hydro: Hydro::Rpy,
             method: Method::Overdamped,
             rotation: false,
+            matrix_free: false,
             solver: Solver {
                 kind: SolverKind::Auto,
                 tolerance: T::from_f64(tolerance),

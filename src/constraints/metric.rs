@@ -8,6 +8,7 @@
 
 use crate::bonds::Bond;
 use crate::linalg::{self, tri};
+use crate::mobility::{Hydro, tt_block_at, tt_product};
 use crate::real::Real;
 
 /// How a unit multiplier on bond `l` displaces bead `p`.
@@ -28,6 +29,24 @@ pub enum Metric<'a, T: Real> {
     Mobility {
         /// Packed `mu_tt` (`tri(n)` blocks).
         mu: &'a [T::M3],
+        /// Constraint gradients, one per bond.
+        grad: &'a [T::V3],
+        /// Overall factor (`dt` for positions).
+        scale: T,
+    },
+    /// The same hydrodynamic metric without a stored mobility: each pair block is
+    /// evaluated where it is used (matrix-free; bit-identical to [`Metric::Mobility`]).
+    /// The positions must have passed a product at these positions ([`tt_product`]),
+    /// which refuses nested spheres.
+    Free {
+        /// Hydrodynamic level.
+        level: Hydro,
+        /// Viscosity.
+        eta: T,
+        /// Bead centres.
+        pos: &'a [T::V3],
+        /// Bead radii.
+        radius: &'a [T],
         /// Constraint gradients, one per bond.
         grad: &'a [T::V3],
         /// Overall factor (`dt` for positions).
@@ -89,6 +108,7 @@ impl<T: Real> Metric<'_, T> {
         match *self {
             Metric::Mass { grad, .. }
             | Metric::Mobility { grad, .. }
+            | Metric::Free { grad, .. }
             | Metric::Dense { grad, .. }
             | Metric::Drag { grad, .. } => grad[l],
         }
@@ -118,6 +138,19 @@ impl<T: Real> Metric<'_, T> {
             Metric::Mobility { mu, grad, scale } => {
                 let g = grad[l] * scale;
                 sym_block::<T>(mu, p, b.i) * g - sym_block::<T>(mu, p, b.j) * g
+            }
+            Metric::Free {
+                level,
+                eta,
+                pos,
+                radius,
+                grad,
+                scale,
+            } => {
+                // Nested pairs were refused by the product at these positions.
+                let block = |q| tt_block_at(level, eta, pos, radius, p, q).unwrap_or(T::M3_ZERO);
+                let g = grad[l] * scale;
+                block(b.i) * g - block(b.j) * g
             }
             Metric::Dense { disp, n, .. } => disp[l * n + p],
             Metric::Drag {
@@ -157,7 +190,7 @@ impl<T: Real> Metric<'_, T> {
                     *xp += d * c;
                 }
             }
-            Metric::Mobility { .. } | Metric::Drag { .. } => {
+            Metric::Mobility { .. } | Metric::Free { .. } | Metric::Drag { .. } => {
                 for p in 0..x.len() {
                     x[p] += self.at(bonds, l, p) * c;
                 }
@@ -193,6 +226,21 @@ impl<T: Real> Metric<'_, T> {
                 let f = &mut tmp[..n];
                 spread(bonds, grad, c, scale, f);
                 linalg::sym_matvec::<T>(mu, n, f, out);
+            }
+            Metric::Free {
+                level,
+                eta,
+                pos,
+                radius,
+                grad,
+                scale,
+            } => {
+                let f = &mut tmp[..n];
+                spread(bonds, grad, c, scale, f);
+                // Nested pairs were refused by the product at these positions.
+                if tt_product(level, eta, pos, radius, f, out).is_err() {
+                    out.fill(T::V3_ZERO);
+                }
             }
             Metric::Drag {
                 mu,

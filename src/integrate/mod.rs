@@ -23,6 +23,7 @@ use crate::bonds::{Bond, BondSet, max_residual};
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats};
 use crate::error::{ParticleError, StepError};
 use crate::forces::ExternalForce;
+use crate::linalg;
 use crate::mobility::{self, Hydro};
 use crate::params::{Method, Params};
 use crate::particles::{ParticleSet, State, sphere_volume};
@@ -93,7 +94,7 @@ pub fn step_slices<T: Real, E: ExternalForce<T>>(
     };
     // 2. Integrate into the workspace.
     let integrated = {
-        let v = ws.views(p.method, p.rotation, p.solver.kind, n, bonds.len())?;
+        let v = ws.views(p, n, bonds.len())?;
         match p.method {
             Method::Overdamped => overdamped(p, &s, bonds, v, ext),
             Method::Overdamped2 => overdamped2(p, &s, bonds, v, ext),
@@ -163,6 +164,10 @@ fn check_inputs<T: Real>(
         "tolerance",
     )?;
     bad(p.solver.max_iterations > 0, "max_iterations")?;
+    bad(
+        !p.matrix_free || matches!(p.method, Method::Overdamped | Method::Springs),
+        "matrix_free (Overdamped and Springs only)",
+    )?;
     if p.method == Method::Springs {
         bad(
             p.spring_stiffness > T::ZERO && p.spring_stiffness.is_finite(),
@@ -218,6 +223,48 @@ fn accept<T: Real>(
         }
     }
     Ok(())
+}
+
+/// `u = mu_tt(pos) f`: from the assembled mobility in `mu`, or matrix-free (then `mu`
+/// is empty and nothing is stored).
+pub(super) fn mobility_product<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    mu: &mut [T::M3],
+    f: &[T::V3],
+    u: &mut [T::V3],
+) -> Result<(), StepError> {
+    if p.matrix_free {
+        return mobility::tt_product(p.hydro, p.viscosity, pos, radius, f, u)
+            .map_err(StepError::from);
+    }
+    assemble_tt(p, pos, radius, mu)?;
+    linalg::sym_matvec::<T>(mu, pos.len(), f, u);
+    Ok(())
+}
+
+/// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`, stored or matrix-free.
+pub(super) fn mobility_metric<'a, T: Real>(
+    p: &Params<T>,
+    pos: &'a [T::V3],
+    radius: &'a [T],
+    mu: &'a [T::M3],
+    grad: &'a [T::V3],
+    scale: T,
+) -> Metric<'a, T> {
+    if p.matrix_free {
+        Metric::Free {
+            level: p.hydro,
+            eta: p.viscosity,
+            pos,
+            radius,
+            grad,
+            scale,
+        }
+    } else {
+        Metric::Mobility { mu, grad, scale }
+    }
 }
 
 pub(super) fn assemble_tt<T: Real>(

@@ -4,7 +4,7 @@
 
 use super::{
     Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors, max_tension,
-    project_positions, report, spin, step_velocity,
+    mobility_metric, mobility_product, project_positions, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats};
@@ -36,21 +36,16 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         mut scratch,
         ..
     } = v;
-    // Mobility and forces at the start; unconstrained move r* = r + dt (U_inf + mu F).
-    assemble_tt(p, s.pos, s.radius, mu)?;
+    // Forces and mobility at the start; unconstrained move r* = r + dt (U_inf + mu F).
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    linalg::sym_matvec::<T>(mu, n, force, u);
+    mobility_product(p, s.pos, s.radius, mu, force, u)?;
     add_flow(p, s.pos, u);
     for i in 0..n {
         new_pos[i] = s.pos[i] + u[i] * dt;
     }
     // Constraint move through the full mobility: r' = r* + dt mu G^T lambda.
     bond_vectors(bonds, s.pos, grad);
-    let metric = Metric::Mobility {
-        mu,
-        grad,
-        scale: dt,
-    };
+    let metric = mobility_metric(p, s.pos, s.radius, mu, grad, dt);
     let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut scratch)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
     add_constraint_forces(bonds, grad, lambda, force);

@@ -1,11 +1,10 @@
 //! Hookean springs instead of constraints (the paper's costly alternative): overdamped
 //! explicit Euler, stable only for `dt` below about `1 / (k mu)`.
 
-use super::{Start, StepReport, add_flow, assemble_tt, spin};
+use super::{Start, StepReport, add_flow, mobility_product, spin};
 use crate::bonds::{Bond, max_residual};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
-use crate::linalg;
 use crate::params::Params;
 use crate::real::Real;
 use crate::workspace::Views;
@@ -28,10 +27,9 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         new_omega,
         ..
     } = v;
-    assemble_tt(p, s.pos, s.radius, mu)?;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     forces::springs(bonds, p.spring_stiffness, s.pos, force);
-    linalg::sym_matvec::<T>(mu, n, force, u);
+    mobility_product(p, s.pos, s.radius, mu, force, u)?;
     add_flow(p, s.pos, u);
     for i in 0..n {
         new_pos[i] = s.pos[i] + u[i] * dt;

@@ -4,7 +4,7 @@
 
 use crate::constraints::{SolverKind, scratch_size};
 use crate::linalg::tri;
-use crate::params::Method;
+use crate::params::{Method, Params};
 use crate::real::Real;
 
 /// Element counts of the four storage arrays one step uses.
@@ -98,6 +98,29 @@ impl Layout {
             l.indices += i;
         }
         l
+    }
+
+    /// Storage for one step with parameters `p` (method, rotation flag, solver and the
+    /// matrix-free flag), `n` particles and `bonds` bonds.
+    pub const fn for_params<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Self {
+        let l = Self::with_solver(p.method, p.rotation, p.solver.kind, n, bonds);
+        if p.matrix_free {
+            l.matrix_free(p.method, n)
+        } else {
+            l
+        }
+    }
+
+    /// This layout without the stored mobility, for the methods that run matrix-free
+    /// ([`Params::matrix_free`]: `Overdamped`, `Springs`); unchanged for the others.
+    pub const fn matrix_free(self, method: Method, n: usize) -> Self {
+        match method {
+            Method::Overdamped | Method::Springs => Self {
+                blocks: self.blocks - tri(n),
+                ..self
+            },
+            _ => self,
+        }
     }
 
     /// Storage for every method, with and without rotation, with every solver: one

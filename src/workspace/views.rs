@@ -6,7 +6,7 @@ use crate::constraints::Scratch;
 use crate::constraints::{SolverKind, krylov_scratch_per_bond};
 use crate::error::StepError;
 use crate::linalg::tri;
-use crate::params::Method;
+use crate::params::{Method, Params};
 use crate::real::Real;
 
 /// Named slices for one step of `n` particles, `nb` bonds, `m` block rows.
@@ -47,13 +47,12 @@ impl<T: Real> Workspace<'_, T> {
     /// Checks that the layout of this step fits, then splits the storage.
     pub(crate) fn views(
         &mut self,
-        method: Method,
-        rotation: bool,
-        kind: SolverKind,
+        p: &Params<T>,
         n: usize,
         nb: usize,
     ) -> Result<Views<'_, T>, StepError> {
-        let need = Layout::with_solver(method, rotation, kind, n, nb);
+        let (method, rotation, kind) = (p.method, p.rotation, p.solver.kind);
+        let need = Layout::for_params(p, n, nb);
         let have = self.capacity();
         if !have.holds(&need) {
             return Err(StepError::Storage { need, have });
@@ -75,7 +74,8 @@ impl<T: Real> Workspace<'_, T> {
             Method::Rattle => (2, [n, n, n], nb, n, 0, 0),
             Method::RattleStable => (2, [m, m, 0], nb, 0, m, if krylov { 0 } else { n * nb }),
         };
-        let mu = bl.take(tri(m));
+        let stored = !(p.matrix_free && matches!(method, Method::Overdamped | Method::Springs));
+        let mu = bl.take(if stored { tri(m) } else { 0 });
         let fac = bl.take(if mats == 2 { tri(m) } else { 0 });
         let (work_a, work_b, work_c) = (ve.take(work[0]), ve.take(work[1]), ve.take(work[2]));
         let grad_new = ve.take(extra_bonds);

@@ -1,0 +1,68 @@
+//! The matrix-free mobility (`Params::matrix_free`): no `mu_tt` stored, pair blocks
+//! evaluated where they are used. It must give the same bits as the stored path (same
+//! pair orientation, same summation order) for every method that offers it and every
+//! solver, keep no mobility in its layout, and be refused by the methods that need a
+//! stored mobility.
+
+mod common;
+
+use common::*;
+use hydrorattle::{
+    BondSet, Buffers, Layout, Method, NoForce, ParticleSet, Real, SolverKind, StepError, step,
+};
+
+const N: usize = 40;
+
+fn run_with<T: Real>(method: Method, kind: SolverKind, matrix_free: bool) -> Vec<u64> {
+    let scene = helix(N, 2f64.cbrt(), 3.0, 0.5, 1.5);
+    let mut ps: ParticleSet<T, N> = particles(&scene);
+    let bonds: BondSet<T, { N - 1 }> = BondSet::chain(&ps.pos[..N]).unwrap();
+    let mut p = params::<T>(0.02, method, kind);
+    p.matrix_free = matrix_free;
+    p.rotation = true; // the spin output is matrix-free in both paths
+    let layout = Layout::for_params(&p, N, N - 1);
+    if matrix_free {
+        assert_eq!(
+            layout.blocks, 0,
+            "{method:?}: a matrix-free layout stores no blocks"
+        );
+    }
+    let mut store = Buffers::<T>::new(layout);
+    let mut ws = store.workspace();
+    run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, 10);
+    snapshot(&ps)
+}
+
+fn same_bits<T: Real>() {
+    for method in [Method::Overdamped, Method::Springs] {
+        for kind in [SolverKind::Sweep, SolverKind::Newton, SolverKind::Krylov] {
+            let stored = run_with::<T>(method, kind, false);
+            let free = run_with::<T>(method, kind, true);
+            assert_eq!(stored, free, "{method:?} {kind:?}: matrix-free differs");
+        }
+    }
+}
+
+fn refused_where_unsupported<T: Real>() {
+    let scene = helix(8, 2f64.cbrt(), 3.0, 0.5, 1.5);
+    let mut ps: ParticleSet<T, 8> = particles(&scene);
+    let bonds: BondSet<T, 7> = BondSet::chain(&ps.pos[..8]).unwrap();
+    let mut store = Buffers::<T>::new(Layout::all(8, 7));
+    let mut ws = store.workspace();
+    for method in [Method::Overdamped2, Method::Rattle, Method::RattleStable] {
+        let mut p = params::<T>(0.02, method, SolverKind::Auto);
+        p.matrix_free = true;
+        let before = snapshot(&ps);
+        let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
+        assert!(
+            matches!(r, Err(StepError::BadParameter(_))),
+            "{method:?}: {r:?}"
+        );
+        assert_eq!(before, snapshot(&ps));
+    }
+}
+
+both_precisions! {
+    matrix_free_gives_the_stored_bits => same_bits;
+    matrix_free_refused_by_methods_that_store => refused_where_unsupported;
+}
