@@ -4,10 +4,13 @@
 //! * `assemble_tt`, `assemble_grand`, `cholesky` (of `mu_tt`), `cholesky_solve` and
 //!   `sym_matvec` at N = 8, 25, 100, 256 in f64 and f32;
 //! * `step()` per `Method` at N = 8, 16, 25, 64, 128, 256 (and 512 for the overdamped
-//!   methods and springs) in f64 and f32.
+//!   methods and springs) in f64 and f32;
+//! * `scaling/...`: `step_slices` on runtime-sized chains up to N = 2048 (Overdamped
+//!   stored and matrix-free, RattleStable), and `solver/...`: dense Newton against
+//!   Krylov at N = 16 ... 64 (the `Auto` switch), f64, with iteration counts printed.
 //!
-//! The workspace for N = 512 is ~150 MB (f64), so criterion runs on a thread with a
-//! 2 GiB stack and each size's workspace lives in that thread's stack frame.
+//! Particle sets up to N = 512 are built on the stack, so criterion runs on a thread
+//! with a large stack; workspaces are on the heap, sized per method.
 //!
 //! Run: `cargo bench --bench kernel` (add `-- --quick` for a faster pass, or a filter
 //! such as `-- step/Rattle`). Results land in `target/criterion/`.
@@ -18,7 +21,10 @@ use std::time::Duration;
 use criterion::{BatchSize, BenchmarkId, Criterion};
 use hydrorattle::linalg::{cholesky, cholesky_solve, sym_matvec};
 use hydrorattle::mobility::{Hydro, assemble_grand, assemble_tt};
-use hydrorattle::{BondSet, Method, NoForce, Params, Particle, ParticleSet, Real, step};
+use hydrorattle::{
+    Bond, BondSet, Buffers, Layout, Method, NoForce, Params, Particle, ParticleSet, Real,
+    SolverKind, State, step, step_slices,
+};
 
 /// Stage sizes.
 const STAGE_SIZES: [usize; 4] = [8, 25, 100, 256];
@@ -183,6 +189,82 @@ fn all_steps<T: Real>(c: &mut Criterion, prec: &str) {
     step_benches::<T, 512, 511>(c, prec, &overdamped);
 }
 
+/// `step_slices` on runtime-sized state (no compile-time capacity), f64: the scaling
+/// targets of issue 8. `group/label/N`. Prints the constraint iterations per step
+/// (operator products for Krylov) next to the times: counts, not only seconds.
+fn scaling_bench(
+    c: &mut Criterion,
+    group: &str,
+    label: &str,
+    sizes: &[usize],
+    setup: impl Fn(&mut Params<f64>),
+) {
+    let mut g = c.benchmark_group(format!("{group}/{label}"));
+    for &n in sizes {
+        let (p, r) = chain_geometry(n);
+        let pos0: Vec<glam::DVec3> = p.iter().map(|&x| f64::v3_from(x)).collect();
+        let bonds: Vec<Bond<f64>> = (1..n)
+            .map(|i| Bond {
+                i: i - 1,
+                j: i,
+                length: (pos0[i] - pos0[i - 1]).length(),
+            })
+            .collect();
+        let density = vec![4.5; n];
+        let mut params = Params::new(0.01);
+        setup(&mut params);
+        let mut store = Buffers::<f64>::new(Layout::for_params(&params, n, bonds.len()));
+        let mut ws = store.workspace();
+        let zero = vec![glam::DVec3::ZERO; n];
+        let go = |pos: &mut Vec<glam::DVec3>, ws: &mut hydrorattle::Workspace<'_, f64>| {
+            let (mut vel, mut omega, mut time) = (zero.clone(), zero.clone(), 0.0);
+            let state = State {
+                pos,
+                vel: &mut vel,
+                omega: &mut omega,
+                radius: &r,
+                density: &density,
+                time: &mut time,
+            };
+            step_slices(state, &bonds, &params, ws, &mut NoForce).unwrap()
+        };
+        let its = go(&mut pos0.clone(), &mut ws).iterations;
+        eprintln!("{group}/{label}/{n}: {its} constraint iterations per step");
+        g.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter_batched_ref(
+                || pos0.clone(),
+                |pos| go(pos, &mut ws),
+                BatchSize::LargeInput,
+            )
+        });
+    }
+    g.finish();
+}
+
+fn scaling(c: &mut Criterion) {
+    let big = [64, 128, 256, 512, 1024, 2048];
+    scaling_bench(c, "scaling", "Overdamped", &big, |_| {});
+    scaling_bench(c, "scaling", "Overdamped-matrix-free", &big[..5], |p| {
+        p.matrix_free = true
+    });
+    scaling_bench(c, "scaling", "RattleStable", &big[..4], |p| {
+        p.method = Method::RattleStable
+    });
+    let small = [16, 24, 32, 48, 64];
+    for (label, kind) in [
+        ("Newton", SolverKind::Newton),
+        ("Krylov", SolverKind::Krylov),
+    ] {
+        scaling_bench(c, "solver/Overdamped", label, &small, |p| {
+            p.solver.kind = kind
+        });
+        scaling_bench(c, "solver/RattleStable", label, &small, |p| {
+            p.method = Method::RattleStable;
+            p.solver.kind = kind;
+        });
+    }
+}
+
 fn run() {
     let mut c = Criterion::default()
         .sample_size(10)
@@ -190,6 +272,7 @@ fn run() {
         .measurement_time(Duration::from_millis(1500))
         .nresamples(10_000)
         .configure_from_args();
+    scaling(&mut c);
     stage_benches::<f64>(&mut c, "f64");
     stage_benches::<f32>(&mut c, "f32");
     all_steps::<f64>(&mut c, "f64");

@@ -83,9 +83,9 @@ fn main() {
             let r = step_slices(state, &bonds, &p, &mut ws, &mut NoForce).unwrap();
             its += r.iterations;
         }
-        let ms = t0.elapsed().as_secs_f64() * 1e3 / steps as f64;
+        let us = t0.elapsed().as_secs_f64() * 1e6 / steps as f64;
         println!(
-            "n {n:5}  {ms:9.2} ms/step  iterations {:6.1}  storage {:.1} MB",
+            "n {n:5}  {us:9.2} us/step  iterations {:6.1}  storage {:.1} MB",
             its as f64 / steps as f64,
             layout.bytes::<f64>() as f64 / 1e6
         );

@@ -50,6 +50,19 @@ fn paper_chain_fits_the_budgets() {
             over.push((method, rotation, single, budget));
         }
     }
+    let free = |bytes: usize| {
+        core::mem::size_of::<ParticleSet<f32, N>>()
+            + core::mem::size_of::<BondSet<f32, B>>()
+            + bytes
+    };
+    let mf = Layout::new(Method::Overdamped, false, N, B).matrix_free(Method::Overdamped, N);
+    let mf64 = core::mem::size_of::<ParticleSet<f64, N>>()
+        + core::mem::size_of::<BondSet<f64, B>>()
+        + mf.bytes::<f64>();
+    eprintln!(
+        "| Overdamped matrix-free | false | {} | {mf64} | - |",
+        free(mf.bytes::<f32>())
+    );
     assert!(over.is_empty(), "over budget: {over:?}");
 }
 
