@@ -55,7 +55,12 @@ fn paper_chain_fits_the_budgets() {
             + core::mem::size_of::<BondSet<f32, B>>()
             + bytes
     };
-    let mf = Layout::new(Method::Overdamped, false, N, B).matrix_free(Method::Overdamped, N);
+    let mf = Layout::new(Method::Overdamped, false, N, B).matrix_free(
+        Method::Overdamped,
+        SolverKind::Auto,
+        N,
+        B,
+    );
     let mf64 = core::mem::size_of::<ParticleSet<f64, N>>()
         + core::mem::size_of::<BondSet<f64, B>>()
         + mf.bytes::<f64>();

@@ -140,9 +140,9 @@ fn precondition<T: Real>(metric: &Metric<'_, T>, bonds: &[Bond<T>], c: T, pre: &
     let nb = bonds.len();
     let entry = |k: usize, l: usize| T::dot(metric.grad(k), metric.relative(bonds, k, l)) * c;
     for k in 0..nb {
-        for l in k.saturating_sub(BAND)..=k {
-            pre[band::at(BAND, k, l)] = entry(k, l);
-        }
+        let first = k.saturating_sub(BAND);
+        let row = &mut pre[band::at(BAND, k, first)..=band::at(BAND, k, k)];
+        metric.jacobian_row(bonds, k, metric.grad(k) * c, first, row);
     }
     if band::cholesky(pre, nb, BAND).is_ok() {
         return;

@@ -118,7 +118,7 @@ impl<T: Real> Metric<'_, T> {
     /// but [`Metric::Drag`], where it is the preconditioner's local model
     /// `Q_pq ~ sqrt(c_p c_q) mu_pq`, `c_p = 1 / (1 + m_p mu_pp / dt)`: exact for a lone
     /// bead, `mu` as the masses vanish and `dt / m` as they grow.
-    #[inline]
+    #[inline(always)]
     pub fn at(&self, bonds: &[Bond<T>], l: usize, p: usize) -> T::V3 {
         let b = bonds[l];
         match *self {
@@ -170,10 +170,36 @@ impl<T: Real> Metric<'_, T> {
     }
 
     /// Change of bond `k`'s vector per unit multiplier on bond `l`.
-    #[inline]
+    #[inline(always)]
     pub fn relative(&self, bonds: &[Bond<T>], k: usize, l: usize) -> T::V3 {
         let b = bonds[k];
         self.at(bonds, l, b.i) - self.at(bonds, l, b.j)
+    }
+
+    /// `row[l - first] = dir . (D_l(i_k) - D_l(j_k))` for `l` in `first..first + row.len()`:
+    /// a row of the constraint Jacobian. The metric is matched once per row, not per
+    /// entry (this is the dense solve's inner loop).
+    pub fn jacobian_row(
+        &self,
+        bonds: &[Bond<T>],
+        k: usize,
+        dir: T::V3,
+        first: usize,
+        row: &mut [T],
+    ) {
+        let b = bonds[k];
+        match *self {
+            Metric::Dense { disp, n, .. } => {
+                for (l, r) in (first..).zip(row.iter_mut()) {
+                    *r = T::dot(dir, disp[l * n + b.i] - disp[l * n + b.j]);
+                }
+            }
+            _ => {
+                for (l, r) in (first..).zip(row.iter_mut()) {
+                    *r = T::dot(dir, self.relative(bonds, k, l));
+                }
+            }
+        }
     }
 
     /// `x += c D_l` (one bond; the sweep and the dense Newton update).
@@ -259,6 +285,25 @@ impl<T: Real> Metric<'_, T> {
                     *o = v * dt;
                 }
             }
+        }
+    }
+}
+
+/// Tabulates `disp[l * n + q] = scale (mu_qi - mu_qj) g_l` from the packed mobility:
+/// the values [`Metric::Mobility`] gives, read row by row (the blocks `(q, i)` with
+/// `q <= i` are row `i`, contiguous; the rest are column `i` below it).
+pub(crate) fn tabulate<T: Real>(
+    mu: &[T::M3],
+    bonds: &[Bond<T>],
+    grad: &[T::V3],
+    scale: T,
+    n: usize,
+    disp: &mut [T::V3],
+) {
+    for (l, b) in bonds.iter().enumerate() {
+        let g = grad[l] * scale;
+        for (q, d) in disp[l * n..l * n + n].iter_mut().enumerate() {
+            *d = sym_block::<T>(mu, q, b.i) * g - sym_block::<T>(mu, q, b.j) * g;
         }
     }
 }

@@ -19,7 +19,7 @@ pub(crate) const fn krylov_scratch_per_bond() -> usize {
     krylov::SCALARS_PER_BOND
 }
 pub use metric::Metric;
-pub(crate) use metric::apply_drag;
+pub(crate) use metric::{apply_drag, tabulate};
 pub use newton::newton;
 pub use sweep::sweep;
 

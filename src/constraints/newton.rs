@@ -50,9 +50,7 @@ pub fn newton<T: Real>(
             let (value, dir, _) = problem.eval(b, k, x);
             rhs[k] = -value;
             if refresh {
-                for l in 0..nb {
-                    jac[k * nb + l] = T::dot(dir, metric.relative(bonds, k, l));
-                }
+                metric.jacobian_row(bonds, k, dir, 0, &mut jac[k * nb..k * nb + nb]);
             }
         }
         if refresh {

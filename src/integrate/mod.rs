@@ -20,7 +20,7 @@ use springs::springs;
 use stable::rattle_stable;
 
 use crate::bonds::{Bond, BondSet, max_residual};
-use crate::constraints::{self, Metric, Problem, Scratch, SolveStats};
+use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind};
 use crate::error::{ParticleError, StepError};
 use crate::forces::ExternalForce;
 use crate::linalg;
@@ -244,27 +244,37 @@ pub(super) fn mobility_product<T: Real>(
     Ok(())
 }
 
-/// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`, stored or matrix-free.
+/// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`: matrix-free when asked;
+/// read from the packed mobility where it is used for Krylov (one product per
+/// iteration, no table); tabulated once into `disp` (`n x B`) for the dense solvers,
+/// which read every `D_l(p)` at every iteration.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn mobility_metric<'a, T: Real>(
     p: &Params<T>,
+    bonds: &[Bond<T>],
     pos: &'a [T::V3],
     radius: &'a [T],
     mu: &'a [T::M3],
     grad: &'a [T::V3],
     scale: T,
+    disp: &'a mut [T::V3],
 ) -> Metric<'a, T> {
     if p.matrix_free {
-        Metric::Free {
+        return Metric::Free {
             level: p.hydro,
             eta: p.viscosity,
             pos,
             radius,
             grad,
             scale,
-        }
-    } else {
-        Metric::Mobility { mu, grad, scale }
+        };
     }
+    if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
+        return Metric::Mobility { mu, grad, scale };
+    }
+    let n = pos.len();
+    constraints::tabulate(mu, bonds, grad, scale, n, disp);
+    Metric::Dense { disp, n, grad }
 }
 
 pub(super) fn assemble_tt<T: Real>(

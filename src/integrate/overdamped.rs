@@ -7,7 +7,7 @@ use super::{
     mobility_metric, mobility_product, project_positions, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
-use crate::constraints::{self, Metric, Problem, Scratch, SolveStats};
+use crate::constraints::{self, Problem, Scratch, SolveStats};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
 use crate::linalg;
@@ -32,6 +32,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         new_vel,
         new_omega,
         grad,
+        disp,
         lambda,
         mut scratch,
         ..
@@ -45,7 +46,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     }
     // Constraint move through the full mobility: r' = r* + dt mu G^T lambda.
     bond_vectors(bonds, s.pos, grad);
-    let metric = mobility_metric(p, s.pos, s.radius, mu, grad, dt);
+    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu, grad, dt, disp);
     let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut scratch)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
     add_constraint_forces(bonds, grad, lambda, force);
@@ -60,10 +61,12 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
 fn projected_velocity<T: Real>(
     p: &Params<T>,
     pos: &[T::V3],
+    radius: &[T],
     mu: &[T::M3],
     force: &[T::V3],
     bonds: &[Bond<T>],
     grad: &mut [T::V3],
+    disp: &mut [T::V3],
     kappa: &mut [T],
     scratch: &mut Scratch<'_, T>,
     u: &mut [T::V3],
@@ -77,19 +80,8 @@ fn projected_velocity<T: Real>(
         bond: grad,
         dt: p.dt,
     };
-    constraints::solve(
-        problem,
-        &Metric::Mobility {
-            mu,
-            grad,
-            scale: T::ONE,
-        },
-        bonds,
-        &p.solver,
-        u,
-        kappa,
-        scratch,
-    )
+    let metric = mobility_metric(p, bonds, pos, radius, mu, grad, T::ONE, disp);
+    constraints::solve(problem, &metric, bonds, &p.solver, u, kappa, scratch)
 }
 
 /// Overdamped second order: Heun predictor-corrector on the projected velocity, then
@@ -114,6 +106,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         new_omega,
         grad,
         grad_new,
+        disp,
         lambda,
         kappa,
         scratch: mut sc,
@@ -122,7 +115,9 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     // Predictor: projected velocity at r, one projected Euler step.
     assemble_tt(p, s.pos, s.radius, mu0)?;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    projected_velocity(p, s.pos, mu0, force, bonds, grad, kappa, &mut sc, f0)?;
+    projected_velocity(
+        p, s.pos, s.radius, mu0, force, bonds, grad, disp, kappa, &mut sc, f0,
+    )?;
     // Tension and spin at the start of the step: the velocity projection's multipliers
     // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
     let tension = max_tension(bonds, kappa);
@@ -131,20 +126,19 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     for i in 0..n {
         x_p[i] = s.pos[i] + f0[i] * dt;
     }
-    let metric = Metric::Mobility {
-        mu: mu0,
-        grad,
-        scale: dt,
-    };
+    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu0, grad, dt, disp);
     project_positions(p, bonds, &metric, x_p, lambda, &mut sc)?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
     assemble_tt(p, x_p, s.radius, mu1)?;
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
-    projected_velocity(p, x_p, mu1, force, bonds, grad_new, kappa, &mut sc, f1)?;
+    projected_velocity(
+        p, x_p, s.radius, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1,
+    )?;
     for i in 0..n {
         new_pos[i] = s.pos[i] + (f0[i] + f1[i]) * (dt * T::HALF);
     }
     // Projection as in the first-order scheme: r' = r* + dt mu(r) G(r)^T lambda.
+    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu0, grad, dt, disp);
     let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut sc)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
     Ok(StepReport {

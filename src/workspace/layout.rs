@@ -43,6 +43,9 @@ impl Layout {
     /// vectors and multipliers (`B` each), and:
     /// * `Overdamped`, `Springs`: one packed mobility `tri(n)` blocks;
     /// * `Overdamped2`: two (start and predicted point);
+    /// * `Overdamped`, `Overdamped2` with a dense solver (sweep, Newton): the `n x B`
+    ///   table of constraint displacements, which those solvers read at every
+    ///   iteration (Krylov needs none);
     /// * `Rattle`: the mobility and its Cholesky factor;
     /// * `RattleStable`: the mobility and the drag factor over `m` block rows (`2n` with
     ///   rotation), plus the dense `n x B` constraint displacements unless the solver is
@@ -77,6 +80,13 @@ impl Layout {
                 l.vectors += 3 * n + b;
                 l.scalars += b;
             }
+            Method::Rattle | Method::RattleStable => {}
+        }
+        // The dense solvers read a table of the hydrodynamic displacements.
+        let table = !matches!(kind, SolverKind::Krylov);
+        match method {
+            Method::Overdamped | Method::Overdamped2 if table => l.vectors += n * b,
+            Method::Overdamped | Method::Overdamped2 | Method::Springs => {}
             Method::Rattle => {
                 l.blocks = 2 * tri(n);
                 l.vectors += 3 * n + b;
@@ -105,18 +115,30 @@ impl Layout {
     pub const fn for_params<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Self {
         let l = Self::with_solver(p.method, p.rotation, p.solver.kind, n, bonds);
         if p.matrix_free {
-            l.matrix_free(p.method, n)
+            l.matrix_free(p.method, p.solver.kind, n, bonds)
         } else {
             l
         }
     }
 
-    /// This layout without the stored mobility, for the methods that run matrix-free
+    /// This layout without the stored mobility (and without the displacement table of
+    /// the dense solvers), for the methods that run matrix-free
     /// ([`Params::matrix_free`]: `Overdamped`, `Springs`); unchanged for the others.
-    pub const fn matrix_free(self, method: Method, n: usize) -> Self {
+    pub const fn matrix_free(
+        self,
+        method: Method,
+        kind: SolverKind,
+        n: usize,
+        bonds: usize,
+    ) -> Self {
+        let table = match (method, kind.resolve(bonds)) {
+            (Method::Overdamped, SolverKind::Sweep | SolverKind::Newton) => n * bonds,
+            _ => 0,
+        };
         match method {
             Method::Overdamped | Method::Springs => Self {
                 blocks: self.blocks - tri(n),
+                vectors: self.vectors - table,
                 ..self
             },
             _ => self,

@@ -68,13 +68,16 @@ impl<T: Real> Workspace<'_, T> {
         let lambda = sc.take(nb);
         let (new_pos, new_vel, new_omega) = (ve.take(n), ve.take(n), ve.take(n));
         let (force, grad) = (ve.take(m), ve.take(nb));
-        let (mats, work, extra_bonds, inv_mass, sqrt_m, disp) = match method {
-            Method::Overdamped | Method::Springs => (1, [n, 0, 0], 0, 0, 0, 0),
-            Method::Overdamped2 => (2, [n, n, n], nb, 0, 0, 0),
-            Method::Rattle => (2, [n, n, n], nb, n, 0, 0),
-            Method::RattleStable => (2, [m, m, 0], nb, 0, m, if krylov { 0 } else { n * nb }),
-        };
         let stored = !(p.matrix_free && matches!(method, Method::Overdamped | Method::Springs));
+        // The dense solvers' table of displacements (see `Layout::with_solver`).
+        let table = if krylov || !stored { 0 } else { n * nb };
+        let (mats, work, extra_bonds, inv_mass, sqrt_m, disp) = match method {
+            Method::Overdamped => (1, [n, 0, 0], 0, 0, 0, table),
+            Method::Springs => (1, [n, 0, 0], 0, 0, 0, 0),
+            Method::Overdamped2 => (2, [n, n, n], nb, 0, 0, table),
+            Method::Rattle => (2, [n, n, n], nb, n, 0, 0),
+            Method::RattleStable => (2, [m, m, 0], nb, 0, m, table),
+        };
         let mu = bl.take(if stored { tri(m) } else { 0 });
         let fac = bl.take(if mats == 2 { tri(m) } else { 0 });
         let (work_a, work_b, work_c) = (ve.take(work[0]), ve.take(work[1]), ve.take(work[2]));
