@@ -185,7 +185,7 @@ fn alloc_free_steps<T: Real>() {
     let mut runs = 0;
     for method in methods {
         for rotation in [false, true] {
-            for kind in [SolverKind::Sweep, SolverKind::Newton] {
+            for kind in [SolverKind::Sweep, SolverKind::Newton, SolverKind::Krylov] {
                 let mut p = Params::new(T::from_f64(0.01));
                 p.method = method;
                 p.rotation = rotation;
@@ -206,7 +206,17 @@ fn alloc_free_steps<T: Real>() {
             }
         }
     }
-    assert_eq!(runs, 20);
+    assert_eq!(runs, 30);
+    // Matrix-free: no stored mobility, still no heap.
+    for method in [Method::Overdamped, Method::Springs] {
+        let mut p = Params::new(T::from_f64(0.01));
+        p.method = method;
+        p.matrix_free = true;
+        let mut ps = init.clone();
+        let (res, n) = count(|| step(&mut ps, &bonds, &p, &mut ws, &mut NoForce));
+        res.unwrap_or_else(|e| panic!("{method:?} matrix-free: {e}"));
+        assert_eq!(n, 0, "{method:?} matrix-free: {n} allocator calls");
+    }
     // A closure force and a failing step (returned error, state untouched) allocate nothing.
     let mut p = Params::new(T::from_f64(0.01));
     p.method = Method::Rattle;
