@@ -102,14 +102,14 @@ fn tt_block<T: Real>(level: Hydro, eta: T, ai: T, aj: T, g: &Geometry<T>) -> T::
     // 1 / (8 pi eta s): the constant folds out of the assembly loop once inlined.
     let c = g.inv_s * (T::ONE / (T::from_f64(8.0) * T::PI * eta));
     if level == Hydro::Oseen {
-        return T::m3_diag(c) + ee * c;
+        return T::m3_add_diag(ee * c, c);
     }
     let sum = ai + aj;
     let dif = ai - aj;
     if s > sum {
         let q = (ai * ai + aj * aj) * (g.inv_s * g.inv_s);
         let third = T::ONE / T::from_f64(3.0);
-        T::m3_diag(c * (T::ONE + q * third)) + ee * (c * (T::ONE - q))
+        T::m3_add_diag(ee * (c * (T::ONE - q)), c * (T::ONE + q * third))
     } else {
         // Overlapping branch (Zuk et al. 2014, eq. 2.7): stays positive definite.
         let s3 = s2 * s;
@@ -118,7 +118,7 @@ fn tt_block<T: Real>(level: Hydro, eta: T, ai: T, aj: T, g: &Geometry<T>) -> T::
         let iso = T::from_f64(16.0) * s3 * sum - p * p;
         let q = dif * dif - s2;
         let aniso = T::from_f64(3.0) * q * q;
-        T::m3_diag(k * iso) + ee * (k * aniso)
+        T::m3_add_diag(ee * (k * aniso), k * iso)
     }
 }
 

@@ -172,6 +172,9 @@ pub trait Real:
     fn m3_diag(s: Self) -> Self::M3 {
         Self::M3_IDENTITY * s
     }
+    /// `m + s I`, touching only the diagonal (the same values as `m + m3_diag(s)`
+    /// wherever an off-diagonal entry is nonzero, for 3 additions instead of 18 flops).
+    fn m3_add_diag(m: Self::M3, s: Self) -> Self::M3;
     /// Element at row `r`, column `c`.
     fn m3_get(m: Self::M3, r: usize, c: usize) -> Self {
         Self::xyz(Self::m3_col(m, c))[r]
@@ -282,6 +285,13 @@ macro_rules! impl_real {
             #[inline]
             fn transpose(m: $m) -> $m {
                 m.transpose()
+            }
+            #[inline]
+            fn m3_add_diag(mut m: $m, s: Self) -> $m {
+                m.x_axis.x += s;
+                m.y_axis.y += s;
+                m.z_axis.z += s;
+                m
             }
         }
     };
