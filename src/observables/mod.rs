@@ -1,8 +1,17 @@
 //! Outcome metrics of a settling chain, defined once here, and the classifier that turns
-//! them into the paper's words.
+//! them into the paper's words. Motion and shape measures over time (rotation about the
+//! vertical, poloidal circulation, vertical runs and fronts, extents, settling speed)
+//! are in `motion.rs`.
 //!
 //! Conventions: particle 0 is the head, the last particle the chain's end; "down" is
 //! the direction of gravity.
+
+mod motion;
+
+pub use motion::{
+    FrontOrder, Rotation, VerticalFront, bond_is_vertical, com_settling_speed, extents,
+    poloidal_circulation, spin_about_vertical, vertical_run,
+};
 
 use crate::bonds::Bond;
 use crate::real::Real;
