@@ -110,7 +110,7 @@ pub fn poloidal_circulation<T: Real>(pos: &[T::V3], vel: &[T::V3], mass: &[T]) -
     for (&p, &w) in pos.iter().zip(mass) {
         radius += w * T::norm(perp::<T>(p - c, n));
     }
-    radius = radius / m;
+    radius /= m;
     let (mut l, mut inertia, mut energy) = (T::ZERO, T::ZERO, T::ZERO);
     for ((&p, &u), &w) in pos.iter().zip(vel).zip(mass) {
         let v = u - vc;

@@ -1,6 +1,6 @@
 //! How much storage a step needs: counted per method, rotation flag, solver, beads and
 //! bonds, in a `const fn`, so firmware sizes a [`Storage`](super::Storage) at compile
-//! time and a host sizes [`Buffers`](super::Buffers) at run time from the same numbers.
+//! time and a host sizes `Buffers` at run time from the same numbers.
 
 use crate::constraints::{SolverKind, scratch_size};
 use crate::linalg::tri;

@@ -5,7 +5,7 @@
 //! them is the caller's choice:
 //! * firmware: a [`Storage`] sized at compile time from a `const` [`Layout`], which can
 //!   live in a `static` (its constructor is `const`);
-//! * a host: [`Buffers`] (feature `alloc`), built directly on the heap, never on the
+//! * a host: `Buffers` (feature `alloc`), built directly on the heap, never on the
 //!   stack, so thousands of beads fit;
 //! * anything else: four slices from wherever (an arena, a C caller).
 //!
