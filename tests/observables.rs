@@ -185,7 +185,7 @@ fn a_rolling_ring_circulates_poloidally_at_its_rate() {
     let ring = torus(DVec3::Z, DVec3::ZERO);
     let pos: Vec<DVec3> = ring.iter().map(|r| r.0).collect();
     let vel: Vec<DVec3> = pos.iter().map(|&x| DVec3::Z.cross(x) * w).collect();
-    let s = spin_about_vertical::<f64>(&pos, &vel, &vec![1.0; 24], DOWN);
+    let s = spin_about_vertical::<f64>(&pos, &vel, &[1.0; 24], DOWN);
     assert!((s.rate - w).abs() < 1e-12);
 }
 
