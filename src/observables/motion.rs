@@ -47,6 +47,27 @@ pub struct Rotation<T> {
     pub coherence: T,
 }
 
+impl<T: Real> Rotation<T> {
+    /// The least-squares rate `L / I` from an angular momentum `L` and moment `I`, and
+    /// its share `(L^2 / I) / E` of the relative kinetic energy `E`; zero without a
+    /// moment.
+    fn fit(l: T, inertia: T, energy: T) -> Self {
+        if !(inertia > T::ZERO) {
+            return Self {
+                rate: T::ZERO,
+                coherence: T::ZERO,
+            };
+        }
+        let rate = l / inertia;
+        let coherence = if energy > T::ZERO {
+            (rate * l / energy).min(T::ONE)
+        } else {
+            T::ZERO
+        };
+        Self { rate, coherence }
+    }
+}
+
 /// Rotation about the vertical through the centre of mass: the rate `L_up / I_up`
 /// (right-handed about "up") of the rigid rotation that best fits the horizontal
 /// velocities relative to the centre of mass, and the share of the horizontal relative
@@ -57,12 +78,8 @@ pub fn spin_about_vertical<T: Real>(
     mass: &[T],
     gravity: T::V3,
 ) -> Rotation<T> {
-    let none = Rotation {
-        rate: T::ZERO,
-        coherence: T::ZERO,
-    };
     let Some(n) = up::<T>(gravity) else {
-        return none;
+        return Rotation::fit(T::ZERO, T::ZERO, T::ZERO);
     };
     let (c, vc, _) = means::<T>(pos, vel, mass);
     let (mut l, mut inertia, mut energy) = (T::ZERO, T::ZERO, T::ZERO);
@@ -72,17 +89,7 @@ pub fn spin_about_vertical<T: Real>(
         inertia += w * T::norm2(r);
         energy += w * T::norm2(v);
     }
-    if !(inertia > T::ZERO) {
-        return none;
-    }
-    let rate = l / inertia;
-    // The rigid fit's share of the energy: (L^2 / I) / E.
-    let coherence = if energy > T::ZERO {
-        (rate * l / energy).min(T::ONE)
-    } else {
-        T::ZERO
-    };
-    Rotation { rate, coherence }
+    Rotation::fit(l, inertia, energy)
 }
 
 /// Poloidal circulation: beads turning about the chain's own centreline, a ring
@@ -97,13 +104,9 @@ pub fn spin_about_vertical<T: Real>(
 /// fit, positive right-handed about `t`. Applies to closed chains and to folded ones
 /// whose beads wind around a core.
 pub fn poloidal_circulation<T: Real>(pos: &[T::V3], vel: &[T::V3], mass: &[T]) -> Rotation<T> {
-    let none = Rotation {
-        rate: T::ZERO,
-        coherence: T::ZERO,
-    };
     let (c, vc, m) = means::<T>(pos, vel, mass);
     if !(m > T::ZERO) || pos.len() < 3 {
-        return none;
+        return Rotation::fit(T::ZERO, T::ZERO, T::ZERO);
     }
     let n = thinnest_axis::<T>(pos, mass, c);
     let mut radius = T::ZERO;
@@ -125,16 +128,7 @@ pub fn poloidal_circulation<T: Real>(pos: &[T::V3], vel: &[T::V3], mass: &[T]) -
         l += w * T::dot(T::cross(rho, v), t);
         inertia += w * T::norm2(rho);
     }
-    if !(inertia > T::ZERO) {
-        return none;
-    }
-    let rate = l / inertia;
-    let coherence = if energy > T::ZERO {
-        (rate * l / energy).min(T::ONE)
-    } else {
-        T::ZERO
-    };
-    Rotation { rate, coherence }
+    Rotation::fit(l, inertia, energy)
 }
 
 /// Unit eigenvector of the smallest eigenvalue of the gyration tensor
