@@ -41,9 +41,9 @@ fn no_convergence<T: Real>() {
     for method in CONSTRAINED {
         for kind in [SolverKind::Sweep, SolverKind::Newton] {
             let (mut ps, bonds) = warmed_chain::<T>(method);
-            let mut p = params::<T>(0.5, method, kind);
+            let mut p = params::<T>(1.0, method, kind);
             p.solver.max_iterations = 1;
-            p.solver.tolerance = T::from_f64(pick::<T>(1e-7, 1e-13));
+            p.solver.tolerance = T::from_f64(pick::<T>(2e-6, 1e-13));
             let mut ws_store =
                 hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
             let mut ws = ws_store.workspace();
@@ -261,7 +261,49 @@ fn bad_inputs<T: Real>() {
     step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).expect("massless bead, overdamped");
 }
 
+/// Issue 11: a tolerance below what the precision can reach is refused at once (not
+/// iterated to a huge cap), a non-finite or non-advancing time is refused, and the
+/// tolerance bounds the relative length error as documented, compressed bonds included.
+fn tolerance_and_time<T: Real>() {
+    let (mut ps, bonds) = warmed_chain::<T>(Method::Overdamped);
+    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+    let mut ws = ws_store.workspace();
+    let before = snapshot(&ps);
+    let mut p = params::<T>(0.05, Method::Overdamped, SolverKind::Newton);
+    p.solver.tolerance = T::from_f64(1e-310_f64.max(pick::<T>(1e-7, 1e-16)));
+    p.solver.max_iterations = u32::MAX;
+    let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
+    assert!(matches!(r, Err(StepError::BadParameter(_))), "{r:?}");
+    assert_eq!(before, snapshot(&ps));
+    let p = params::<T>(0.05, Method::Overdamped, SolverKind::Newton);
+    for time in [f64::NAN, f64::INFINITY, pick::<T>(1e9, 1e18)] {
+        let mut bad = ps.clone();
+        bad.time = T::from_f64(time);
+        let r = step(&mut bad, &bonds, &p, &mut ws, &mut NoForce);
+        assert!(
+            matches!(r, Err(StepError::BadParameter(_))),
+            "time {time}: {r:?}"
+        );
+    }
+    // Every bond within the tolerance of its length, measured as documented.
+    for kind in [SolverKind::Sweep, SolverKind::Newton, SolverKind::Krylov] {
+        let mut p = params::<T>(0.2, Method::Overdamped, kind);
+        p.solver.tolerance = T::from_f64(pick::<T>(1e-3, 1e-6));
+        let mut ps = ps.clone();
+        for _ in 0..5 {
+            step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
+            let (_, worst) = bonds.max_residual(&ps.pos[..ps.len()]);
+            assert!(
+                worst <= p.solver.tolerance,
+                "{kind:?}: {worst} > {}",
+                p.solver.tolerance
+            );
+        }
+    }
+}
+
 both_precisions! {
+    tolerance_and_time_are_checked => tolerance_and_time;
     no_convergence_leaves_state => no_convergence;
     nan_force_leaves_state => nan_force;
     overlap_leaves_state => overlap;

@@ -66,11 +66,22 @@ pub struct Solver<T> {
     /// Algorithm.
     pub kind: SolverKind,
     /// Largest accepted relative bond-length error `| |r_ij| - d | / d` (positions), or
-    /// relative length change per step `dt |b.(v_i - v_j)| / d^2` (velocities).
+    /// relative length change per step `dt |b.(v_i - v_j)| / d^2` (velocities). At
+    /// least [`Solver::min_tolerance`]: rounding alone makes smaller values unreachable,
+    /// and a step refuses them (`StepError::BadParameter`) instead of iterating to the cap.
     pub tolerance: T,
     /// Iteration cap (sweeps, Newton steps, or Krylov chord steps; Krylov also stops
     /// after `10 x max_iterations` operator products); reaching it is an error.
     pub max_iterations: u32,
+}
+
+impl<T: Real> Solver<T> {
+    /// The smallest tolerance a step accepts: 16 machine epsilons (1.9e-6 in f32,
+    /// 3.6e-15 in f64). A bond's length is computed from two rounded positions, so its
+    /// relative error cannot be driven much below a few epsilons.
+    pub fn min_tolerance() -> T {
+        T::EPSILON * T::from_f64(16.0)
+    }
 }
 
 /// Which condition to enforce.
@@ -97,8 +108,14 @@ impl<T: Real> Problem<'_, T> {
         let d2 = b.length * b.length;
         match *self {
             Problem::Positions => {
-                let s = T::norm2(rel) - d2;
-                (s, rel * T::TWO, s.abs() / (T::TWO * d2))
+                let r2 = T::norm2(rel);
+                // The relative length error `| |r| - d | / d` the tolerance is stated in
+                // (`|r^2 - d^2| / (2 d^2)` would understate a compressed bond's error).
+                (
+                    r2 - d2,
+                    rel * T::TWO,
+                    (r2.sqrt() - b.length).abs() / b.length,
+                )
             }
             Problem::Velocities { bond, dt } => {
                 let c = T::dot(bond[k], rel);

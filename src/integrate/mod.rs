@@ -20,7 +20,7 @@ use springs::springs;
 use stable::rattle_stable;
 
 use crate::bonds::{Bond, BondSet, max_residual};
-use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind};
+use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, Solver, SolverKind};
 use crate::error::{ParticleError, StepError};
 use crate::forces::ExternalForce;
 use crate::linalg;
@@ -160,8 +160,15 @@ fn check_inputs<T: Real>(
     bad(T::v3_is_finite(p.flow_velocity), "flow_velocity")?;
     bad(T::v3_is_finite(p.vorticity), "vorticity")?;
     bad(
-        p.solver.tolerance > T::ZERO && p.solver.tolerance.is_finite(),
-        "tolerance",
+        p.solver.tolerance >= Solver::min_tolerance() && p.solver.tolerance.is_finite(),
+        "tolerance (at least 16 machine epsilons, finite)",
+    )?;
+    // Time must stay finite and advance (a huge time would swallow dt).
+    bad(
+        state.time.is_finite()
+            && *state.time + p.dt > *state.time
+            && (*state.time + p.dt).is_finite(),
+        "time (finite, and advanced by dt)",
     )?;
     bad(p.solver.max_iterations > 0, "max_iterations")?;
     bad(
