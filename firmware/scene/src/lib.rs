@@ -1,0 +1,285 @@
+//! The paper's Figure 1 case (c) chain and a digest of its positions' bits, written
+//! once and used by the Cortex-M firmware, the host check and the C interface, so that
+//! "host and target give the same bits" compares like with like.
+//!
+//! The chain follows `host-demo/scenes/figure1c.toml`: a head of radius 2 (bead 0) and
+//! 24 tails of radius 1, density 4.5, bonds of length `1.05 (a_i + a_j)`, the tails on
+//! a right-handed helix of radius 2 and pitch 7 about the vertical axis, the head on the
+//! axis below the first tail. The geometry is computed in `f64` with `libm` (the same
+//! code on every target) and rounded once to the run's precision.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+use core::fmt::{self, Write};
+
+use hydrorattle::{
+    Bond, BondSet, Method, Params, Particle, ParticleSet, Real, SoftContact, SolverKind, StepError,
+    StepReport, Workspace, step,
+};
+
+/// Beads: one head and 24 tails.
+pub const N: usize = 25;
+/// Bonds of the chain.
+pub const B: usize = N - 1;
+/// Steps the firmware and the host check run.
+pub const STEPS: u32 = 200;
+/// Head radius over tail radius (case c: "big head").
+pub const HEAD_RADIUS: f64 = 2.0;
+/// Bond length over the sum of the two radii.
+pub const DHAT: f64 = 1.05;
+/// Tail centres' distance from the vertical axis.
+pub const HELIX_RADIUS: f64 = 2.0;
+/// Rise per turn of the helix.
+pub const HELIX_PITCH: f64 = 7.0;
+/// Density of every bead.
+pub const DENSITY: f64 = 4.5;
+/// Time step of the scene.
+pub const DT: f64 = 0.005;
+/// Soft-contact stiffness of the scene (`[contact] stiffness`).
+pub const CONTACT_STIFFNESS: f64 = 1000.0;
+
+/// The runs the firmware has a binary for: name, method, rotation resolved.
+pub const RUNS: [(&str, Method, bool); 6] = [
+    ("overdamped", Method::Overdamped, false),
+    ("overdamped2", Method::Overdamped2, false),
+    ("rattle", Method::Rattle, false),
+    ("stable", Method::RattleStable, false),
+    ("stable_rotation", Method::RattleStable, true),
+    ("springs", Method::Springs, false),
+];
+
+/// Bead centres (`f64`), radii and bond lengths of the chain with `tails` tails.
+/// `None` when the helix cannot be built (fewer than one tail, or more than `N - 1`).
+pub fn helix(tails: usize) -> Option<([[f64; 3]; N], [f64; N], [f64; B])> {
+    if tails == 0 || tails > B {
+        return None;
+    }
+    let tail_bond = DHAT * 2.0;
+    let head_bond = DHAT * (HEAD_RADIUS + 1.0);
+    let dphi = angular_step(HELIX_RADIUS, HELIX_PITCH, tail_bond);
+    // The head sits on the axis, one head bond from the first tail.
+    let lift = libm::sqrt(head_bond * head_bond - HELIX_RADIUS * HELIX_RADIUS);
+    let mut pos = [[0.0; 3]; N];
+    let mut radius = [0.0; N];
+    let mut length = [0.0; B];
+    radius[0] = HEAD_RADIUS;
+    for k in 0..tails {
+        let phi = k as f64 * dphi;
+        let z = lift + HELIX_PITCH * phi / (2.0 * core::f64::consts::PI);
+        pos[k + 1] = [
+            HELIX_RADIUS * libm::cos(phi),
+            HELIX_RADIUS * libm::sin(phi),
+            z,
+        ];
+        radius[k + 1] = 1.0;
+        length[k] = DHAT * (radius[k] + radius[k + 1]);
+    }
+    Some((pos, radius, length))
+}
+
+/// The angle between consecutive tails, in `(0, pi]`: the root of
+/// `(2 R sin(x / 2))^2 + (p x / 2 pi)^2 = d^2` by bisection down to adjacent doubles
+/// (the chord grows with `x` there, and the scene's numbers keep the root inside).
+fn angular_step(r: f64, pitch: f64, d: f64) -> f64 {
+    let chord2 = |x: f64| {
+        let across = 2.0 * r * libm::sin(0.5 * x);
+        let up = pitch * x / (2.0 * core::f64::consts::PI);
+        across * across + up * up
+    };
+    let (mut lo, mut hi) = (0.0_f64, core::f64::consts::PI);
+    loop {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            return mid;
+        }
+        if chord2(mid) < d * d {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+}
+
+/// Fills `ps` (which must be empty) with the chain and returns its bonds.
+pub fn chain<T: Real>(ps: &mut ParticleSet<T, N>) -> Result<BondSet<T, B>, StepError> {
+    let (pos, radius, length) = helix(B).ok_or(StepError::StateLength)?;
+    for (c, &a) in pos.iter().zip(&radius) {
+        let p = Particle::new(T::v3_from(*c), T::from_f64(a), T::from_f64(DENSITY));
+        ps.push(p).map_err(|(_, e)| e)?;
+    }
+    let mut bonds = BondSet::new();
+    for (k, &d) in length.iter().enumerate() {
+        let b = Bond {
+            i: k,
+            j: k + 1,
+            length: T::from_f64(d),
+        };
+        bonds.push(b, N).map_err(|(_, e)| e)?;
+    }
+    Ok(bonds)
+}
+
+/// The scene's parameters for `method` (rotation resolved or not): `dt` 0.005, RPY,
+/// gravity `(0, 0, -1)`, Newton with the precision's default tolerance and a cap of
+/// 500, overlapping spheres allowed (the scene's soft contact keeps them apart).
+pub fn params<T: Real>(method: Method, rotation: bool) -> Params<T> {
+    let mut p = Params::new(T::from_f64(DT));
+    p.method = method;
+    p.rotation = rotation;
+    p.solver.kind = SolverKind::Newton;
+    p.solver.max_iterations = 500;
+    p.allow_overlap = true;
+    p
+}
+
+/// The scene's soft contact.
+pub fn contact<T: Real>() -> SoftContact<T> {
+    SoftContact {
+        stiffness: T::from_f64(CONTACT_STIFFNESS),
+    }
+}
+
+/// The bits of a float, for the digest.
+pub trait Bits: Real {
+    /// Little-endian bytes of `to_bits()` fed to `f`.
+    fn feed(self, f: &mut impl FnMut(u8));
+}
+
+impl Bits for f32 {
+    fn feed(self, f: &mut impl FnMut(u8)) {
+        self.to_bits().to_le_bytes().into_iter().for_each(f);
+    }
+}
+
+impl Bits for f64 {
+    fn feed(self, f: &mut impl FnMut(u8)) {
+        self.to_bits().to_le_bytes().into_iter().for_each(f);
+    }
+}
+
+/// FNV-1a (64 bit) over the little-endian bytes of `to_bits()` of every position
+/// component, bead by bead, x, y, z.
+pub fn digest<T: Bits>(pos: &[T::V3]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |b: u8| {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    };
+    for &v in pos {
+        for c in T::xyz(v) {
+            c.feed(&mut eat);
+        }
+    }
+    h
+}
+
+/// What a run produced.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outcome<T> {
+    /// Steps done.
+    pub steps: u32,
+    /// [`digest`] of the final positions.
+    pub digest: u64,
+    /// The last step's report.
+    pub report: StepReport<T>,
+}
+
+/// A failed run: the step that failed (0-based) and its error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Failure {
+    /// The step.
+    pub step: u32,
+    /// The error.
+    pub error: StepError,
+}
+
+/// Runs `steps` steps of the scene from the chain in `ps`; `each` is called around
+/// every step (`true` before, `false` after), for timing.
+pub fn run<T: Bits>(
+    ps: &mut ParticleSet<T, N>,
+    bonds: &BondSet<T, B>,
+    p: &Params<T>,
+    ws: &mut Workspace<'_, T>,
+    steps: u32,
+    mut each: impl FnMut(bool),
+) -> Result<Outcome<T>, Failure> {
+    let mut contact = contact::<T>();
+    let mut report = StepReport::default();
+    for s in 0..steps {
+        each(true);
+        let r = step(ps, bonds, p, ws, &mut contact);
+        each(false);
+        report = r.map_err(|error| Failure { step: s, error })?;
+    }
+    Ok(Outcome {
+        steps,
+        digest: digest::<T>(&ps.pos[..ps.len()]),
+        report,
+    })
+}
+
+/// A float as its bits in hex (no float formatting: it would cost firmware flash).
+pub struct Hex<T>(pub T);
+
+impl fmt::Display for Hex<f32> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:#010x}", self.0.to_bits())
+    }
+}
+
+impl fmt::Display for Hex<f64> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:#018x}", self.0.to_bits())
+    }
+}
+
+/// The line both the firmware and the host check print for a run; CI compares them.
+pub fn summary<T: Bits>(
+    w: &mut impl Write,
+    method: Method,
+    rotation: bool,
+    outcome: &Result<Outcome<T>, Failure>,
+) -> fmt::Result
+where
+    Hex<T>: fmt::Display,
+{
+    let bits = core::mem::size_of::<T>() * 8;
+    write!(
+        w,
+        "figure1c f{bits} {method:?} rotation={} ",
+        rotation as u8
+    )?;
+    match outcome {
+        Ok(o) => writeln!(
+            w,
+            "steps={} digest={:016x} iterations={} velocity_iterations={} residual={} max_tension={}",
+            o.steps,
+            o.digest,
+            o.report.iterations,
+            o.report.velocity_iterations,
+            Hex(o.report.residual),
+            Hex(o.report.max_tension)
+        ),
+        Err(e) => writeln!(w, "failed at step {}: {}", e.step, error_name(&e.error)),
+    }
+}
+
+/// The variant of a step error, without its payload (whose floats would need float
+/// formatting).
+pub fn error_name(e: &StepError) -> &'static str {
+    match e {
+        StepError::BadTimeStep => "BadTimeStep",
+        StepError::BadParameter(name) => name,
+        StepError::Particle(_) => "Particle",
+        StepError::Bond(_) => "Bond",
+        StepError::Linalg { .. } => "Linalg",
+        StepError::NoConvergence { .. } => "NoConvergence",
+        StepError::Degenerate { .. } => "Degenerate",
+        StepError::NonFinite { .. } => "NonFinite",
+        StepError::Overlap { .. } => "Overlap",
+        StepError::Storage { .. } => "Storage",
+        StepError::StateLength => "StateLength",
+        StepError::Unstable { .. } => "Unstable",
+    }
+}
