@@ -19,7 +19,7 @@ use core::panic::PanicInfo;
 
 use cortex_m::peripheral::{MPU, SCB, SYST, syst::SystClkSource};
 use cortex_m_semihosting::{debug, hio};
-use hydrorattle::{Method, ParticleSet, Workspace};
+use hydrorattle::{Params, ParticleSet, Workspace};
 use hydrorattle_scene::{self as scene, N};
 
 pub use cortex_m_rt::entry;
@@ -60,16 +60,21 @@ macro_rules! firmware {
             static mut STORE: Store = Store::new();
             static mut CHAIN: hydrorattle::ParticleSet<f32, { hydrorattle_scene::N }> =
                 hydrorattle::ParticleSet::new();
-            $crate::run($name, $method, $rotation, &mut STORE.workspace(), CHAIN)
+            // A constant the compiler can see through: only this method is linked.
+            static PARAMS: hydrorattle::Params<f32> =
+                hydrorattle_scene::params_f32($method, $rotation);
+            $crate::run($name, &PARAMS, &mut STORE.workspace(), CHAIN)
         }
     };
 }
 
-/// Runs the scene with `method`, prints the summary and cost lines, exits QEMU.
+/// Runs the scene with `p`, prints the summary and cost lines, exits QEMU. Inlined
+/// into `main`, where `p` is a constant `static`: the compiler folds the method and
+/// solver choices and links only the integrator this binary runs.
+#[inline(always)]
 pub fn run(
     name: &str,
-    method: Method,
-    rotation: bool,
+    p: &Params<f32>,
     ws: &mut Workspace<'_, f32>,
     ps: &mut ParticleSet<f32, N>,
 ) -> ! {
@@ -78,10 +83,9 @@ pub fn run(
     start_clock(&mut cp.SYST);
     let calibration = time(|| spin(CALIBRATION / 2));
     let bonds = scene::chain(ps).unwrap_or_else(|_| fail("scene"));
-    let p = scene::params::<f32>(method, rotation);
     let mut ticks = 0u64;
     let mut t0 = 0;
-    let outcome = scene::run(ps, &bonds, &p, ws, scene::STEPS, |before| {
+    let outcome = scene::run(ps, &bonds, p, ws, scene::STEPS, |before| {
         let now = SYST::get_current();
         if before {
             t0 = now;
@@ -90,7 +94,7 @@ pub fn run(
         }
     });
     let mut out = Host;
-    let _ = scene::summary(&mut out, method, rotation, &outcome);
+    let _ = scene::summary(&mut out, p.method, p.rotation, &outcome);
     let steps = u64::from(scene::STEPS);
     let per_step = ticks * u64::from(CALIBRATION) / (u64::from(calibration.max(1)) * steps);
     let (bss, data, stack) = (

@@ -11,11 +11,15 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+#[cfg(feature = "alloc")]
+extern crate alloc;
+
 use core::fmt::{self, Write};
 
+use hydrorattle::glam::Vec3;
 use hydrorattle::{
-    Bond, BondSet, Method, Params, Particle, ParticleSet, Real, SoftContact, SolverKind, StepError,
-    StepReport, Workspace, step,
+    Bond, BondSet, Hydro, Method, Params, Particle, ParticleSet, Real, SoftContact, Solver,
+    SolverKind, StepError, StepReport, Workspace, step,
 };
 
 /// Beads: one head and 24 tails.
@@ -131,6 +135,32 @@ pub fn params<T: Real>(method: Method, rotation: bool) -> Params<T> {
     p.solver.max_iterations = 500;
     p.allow_overlap = true;
     p
+}
+
+/// [`params`] in `f32` as a constant (a test checks that the two agree). Firmware keeps
+/// it in a `static`: the compiler then sees the method, drops the other integrators
+/// and inlines the step (38 KB of flash instead of 87 KB for Overdamped).
+pub const fn params_f32(method: Method, rotation: bool) -> Params<f32> {
+    Params {
+        dt: DT as f32,
+        viscosity: 1.0,
+        fluid_density: 0.0,
+        gravity: Vec3::new(0.0, 0.0, -1.0),
+        flow_velocity: Vec3::ZERO,
+        vorticity: Vec3::ZERO,
+        hydro: Hydro::Rpy,
+        method,
+        rotation,
+        matrix_free: false,
+        solver: Solver {
+            kind: SolverKind::Newton,
+            tolerance: 1e-5,
+            max_iterations: 500,
+        },
+        allow_overlap: true,
+        spring_stiffness: 1e3,
+        stability_guard: false,
+    }
 }
 
 /// The scene's soft contact.
@@ -263,6 +293,30 @@ where
         ),
         Err(e) => writeln!(w, "failed at step {}: {}", e.step, error_name(&e.error)),
     }
+}
+
+/// The summary lines of the [`RUNS`] named in `only` (all when empty), computed on
+/// this machine: what the firmware must print.
+#[cfg(feature = "alloc")]
+pub fn host_summaries(only: &[&str]) -> alloc::string::String {
+    use hydrorattle::{Buffers, Layout};
+    let mut out = alloc::string::String::new();
+    for (name, method, rotation) in RUNS {
+        if !only.is_empty() && !only.contains(&name) {
+            continue;
+        }
+        let mut ps = ParticleSet::<f32, N>::new();
+        let outcome = chain(&mut ps)
+            .map_err(|error| Failure { step: 0, error })
+            .and_then(|bonds| {
+                let p = params::<f32>(method, rotation);
+                let mut store = Buffers::<f32>::new(Layout::for_params(&p, N, bonds.len()));
+                run(&mut ps, &bonds, &p, &mut store.workspace(), STEPS, |_| {})
+            });
+        // Writing to a String cannot fail.
+        let _ = summary(&mut out, method, rotation, &outcome);
+    }
+    out
 }
 
 /// The variant of a step error, without its payload (whose floats would need float

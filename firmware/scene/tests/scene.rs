@@ -1,0 +1,64 @@
+//! The scene as the firmware runs it: constant parameters equal to the kernel's
+//! defaults with the scene's changes, a chain that satisfies its bonds, and a run that
+//! gives the same bits twice.
+
+use hydrorattle::{Buffers, Layout, ParticleSet};
+use hydrorattle_scene::{B, N, RUNS, chain, digest, params, params_f32, run};
+
+#[test]
+fn constant_parameters_match_the_kernel_defaults() {
+    for (name, method, rotation) in RUNS {
+        assert_eq!(
+            params_f32(method, rotation),
+            params::<f32>(method, rotation),
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn chain_holds_its_bonds() {
+    let mut ps = ParticleSet::<f64, N>::new();
+    let bonds = chain(&mut ps).unwrap();
+    assert_eq!((ps.len(), bonds.len()), (N, B));
+    bonds.check_satisfied(&ps.pos[..N], 1e-12).unwrap();
+    ps.validate(false).unwrap();
+}
+
+#[test]
+fn runs_are_deterministic() {
+    let once = || {
+        let mut ps = ParticleSet::<f32, N>::new();
+        let bonds = chain(&mut ps).unwrap();
+        let p = params::<f32>(hydrorattle::Method::Overdamped, false);
+        let mut store = Buffers::<f32>::new(Layout::for_params(&p, N, B));
+        run(&mut ps, &bonds, &p, &mut store.workspace(), 20, |_| {}).unwrap()
+    };
+    let (a, b) = (once(), once());
+    assert_eq!(a, b);
+    assert_ne!(a.digest, digest::<f32>(&[]));
+}
+
+/// With `HYDRORATTLE_FIRMWARE_OUTPUT` naming a file of firmware output (QEMU's
+/// semihosting stdout, as `ci.sh` saves it), every summary line in it must equal the
+/// line computed here: the same bits on x86_64 and on the Cortex-M4.
+#[test]
+fn firmware_output_matches_the_host() {
+    let Ok(path) = std::env::var("HYDRORATTLE_FIRMWARE_OUTPUT") else {
+        eprintln!("HYDRORATTLE_FIRMWARE_OUTPUT not set: nothing to compare");
+        return;
+    };
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("figure1c "))
+        .collect();
+    assert!(!lines.is_empty(), "{path} holds no summary line");
+    let host = hydrorattle_scene::host_summaries(&[]);
+    for line in lines {
+        assert!(
+            host.lines().any(|h| h == line),
+            "firmware: {line}\nhost:\n{host}"
+        );
+    }
+}
