@@ -94,6 +94,16 @@ pub fn interaction(scene: &Scene) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The (method, rotation) pairs the rules can pick, without and with inertia, for an
+/// ambient vorticity: what an auto-level scene is sized for before it is resolved.
+pub fn possible_methods(vorticity: [f64; 3]) -> [(Method, bool); 2] {
+    let spinning = vorticity.iter().any(|&w| w != 0.0);
+    [
+        (Method::Overdamped, false),
+        (Method::RattleStable, spinning),
+    ]
+}
+
 /// Applies the rules to `scene`.
 pub fn choose(scene: &Scene) -> Choice {
     let st = stokes_number(scene);
@@ -104,13 +114,7 @@ pub fn choose(scene: &Scene) -> Choice {
     } else {
         Hydrodynamics::Rpy
     };
-    let spinning = scene.flow.vorticity.iter().any(|&w| w != 0.0);
-    let rotation = inertia && spinning;
-    let method = if inertia {
-        Method::RattleStable
-    } else {
-        Method::Overdamped
-    };
+    let (method, rotation) = possible_methods(scene.flow.vorticity)[usize::from(inertia)];
     let reason = format!(
         "St = {st:.3e}: dropping inertia errs ~{:.2e} radii (tolerance {TOLERANCE}) -> {}; \
          interaction {inter:.3} {} {FREE_DRAINING_MAX} -> {}; rotation {}",

@@ -95,6 +95,7 @@ pub fn figure1(out: &Path, max_steps: Option<usize>) -> Result<Figure1Summary> {
     let opts = RunOptions {
         progress: true,
         max_steps,
+        ..RunOptions::default()
     };
     let results: Vec<Result<RunResult>> = scenes
         .par_iter()

@@ -16,3 +16,4 @@ pub mod progress;
 pub mod render;
 pub mod scene;
 pub mod sim;
+pub mod sizing;

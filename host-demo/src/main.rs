@@ -4,6 +4,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 use host_demo::scene::Scene;
 use host_demo::sim::RunOptions;
+use host_demo::sizing::{DEFAULT_LIMIT, limit_from_gib};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -29,6 +30,10 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        /// Largest step storage allowed, GiB: a scene needing more is refused before
+        /// anything is built (storage grows as the square of the bead count).
+        #[arg(long, default_value_t = (DEFAULT_LIMIT >> 30) as f64, value_name = "GIB", value_parser = gib)]
+        max_storage: f64,
     },
     /// Reproduce the paper's Figure 1: three helical chains settling.
     Figure1 {
@@ -85,8 +90,10 @@ fn run(cli: Cli) -> Result<()> {
         Command::Run {
             scene: scene_path,
             out,
+            max_storage,
         } => {
-            let scene = Scene::from_path(&scene_path)?;
+            let limit = limit_from_gib(max_storage).unwrap_or(DEFAULT_LIMIT);
+            let scene = Scene::from_path_within(&scene_path, limit)?;
             log::info!(
                 "scene: {} particles, {} bonds, {:?}, {} steps",
                 scene.particles.len(),
@@ -102,6 +109,7 @@ fn run(cli: Cli) -> Result<()> {
                 RunOptions {
                     progress: true,
                     max_steps: None,
+                    max_storage: limit,
                 },
             )?;
             let s = &r.summary;
@@ -186,6 +194,14 @@ fn run(cli: Cli) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A positive number of GiB.
+fn gib(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if limit_from_gib(x).is_some() => Ok(x),
+        _ => Err(format!("expected a positive number of GiB, not {s:?}")),
+    }
 }
 
 fn scene_name(path: &std::path::Path) -> String {

@@ -51,6 +51,7 @@ fn run_quiet(scene: &Scene, name: &str, max_steps: Option<usize>) -> Summary {
     let opts = RunOptions {
         progress: false,
         max_steps,
+        ..RunOptions::default()
     };
     match run(scene, name, None, opts) {
         Ok(r) => r.summary,

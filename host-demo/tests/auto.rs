@@ -79,6 +79,7 @@ fn the_run_records_the_choice() {
     let opts = host_demo::sim::RunOptions {
         progress: false,
         max_steps: Some(5),
+        ..Default::default()
     };
     let r = host_demo::sim::run(&scene, "auto", None, opts).unwrap();
     let c = r

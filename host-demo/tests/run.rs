@@ -28,6 +28,7 @@ fn every_shipped_scene_runs_and_writes_whole_files() {
         let opts = RunOptions {
             progress: false,
             max_steps: Some(300),
+            ..Default::default()
         };
         let r = run(&scene, &name, Some(&out), opts).unwrap();
         assert_eq!(r.summary.failure, None, "{name}");

@@ -1,0 +1,111 @@
+//! Unit tests of scene parsing and the helix generator.
+
+use super::raw::distance;
+use super::*;
+
+const MINIMAL: &str = "[[particle]]\nposition = [0, 0, 0]\nradius = 1\n\n[integrator]\nmethod = \"overdamped\"\ndt = 0.01\nduration = 1\n";
+
+#[test]
+fn line_col_counts_lines_and_characters() {
+    let t = "ab\nçd\nx";
+    assert_eq!(line_col(t, 0), (1, 1));
+    assert_eq!(line_col(t, 3), (2, 1));
+    assert_eq!(line_col(t, 5), (2, 2)); // after the two-byte 'ç'
+    assert_eq!(line_col(t, 100), (3, 2));
+}
+
+#[test]
+fn minimal_scene_gets_defaults() {
+    let s = Scene::parse(MINIMAL, "m.toml").unwrap();
+    assert_eq!(s.fluid.viscosity, 1.0);
+    assert_eq!(s.fluid.density, 0.0);
+    assert_eq!(s.gravity, [0.0, 0.0, -1.0]);
+    assert_eq!(s.particles[0].density, DEFAULT_DENSITY);
+    assert_eq!(s.model, Model::default());
+    assert_eq!(s.integrator.solver, Solver::Auto);
+    assert_eq!(s.integrator.tolerance, 1e-10);
+    assert_eq!(s.integrator.max_iterations, 500);
+    assert_eq!(s.integrator.precision, Precision::F64);
+    assert_eq!(s.integrator.stiffness, 1e4);
+    assert_eq!(s.integrator.steps(), 100);
+    assert_eq!(s.output.every, 1);
+    assert_eq!(s.species(), vec!["P"]);
+}
+
+#[test]
+fn default_density_settles_a_lone_tail_at_unit_speed() {
+    let weight = 4.0 / 3.0 * std::f64::consts::PI * DEFAULT_DENSITY;
+    assert!((weight - 6.0 * std::f64::consts::PI).abs() < 1e-12);
+}
+
+#[test]
+fn default_every_aims_at_200_frames() {
+    let text = MINIMAL.replace("duration = 1", "duration = 400");
+    let s = Scene::parse(&text, "m.toml").unwrap();
+    assert_eq!(s.integrator.steps(), 40_000);
+    assert_eq!(s.output.every, 200);
+}
+
+#[test]
+fn semantic_error_points_at_the_key() {
+    let text = MINIMAL.replace("radius = 1", "radius = -1");
+    let e = Scene::parse(&text, "m.toml").unwrap_err();
+    assert_eq!(e.location, Some((3, 10)));
+    assert!(e.to_string().starts_with("m.toml:3:10: radius must be > 0"));
+}
+
+#[test]
+fn unknown_key_is_an_error_with_its_line() {
+    let text = MINIMAL.replace("radius = 1", "radius = 1\ncolour = 2");
+    let e = Scene::parse(&text, "m.toml").unwrap_err();
+    assert_eq!(e.line(), Some(4), "{e}");
+    assert!(e.message.contains("colour"), "{e}");
+}
+
+#[test]
+fn helix_default_geometry_is_exact() {
+    let h = Helix::default();
+    let c = h.generate().unwrap();
+    assert_eq!(c.positions.len(), 25);
+    for &(i, j, d) in &c.bonds {
+        let s = distance(c.positions[i], c.positions[j]);
+        assert!((s - d).abs() < 1e-12, "bond {i}-{j}: {s} vs {d}");
+    }
+    // Head at the bottom, on the axis.
+    assert_eq!(c.positions[0], [0.0, 0.0, 0.0]);
+    assert!(c.positions[1..].iter().all(|p| p[2] > 0.0));
+}
+
+#[test]
+fn helix_head_at_top_is_above_every_tail() {
+    let h = Helix {
+        head_end: HeadEnd::Top,
+        ..Helix::default()
+    };
+    let c = h.generate().unwrap();
+    assert!(c.positions[1..].iter().all(|p| p[2] < 0.0));
+    let s = distance(c.positions[0], c.positions[1]);
+    assert!((s - h.head_bond()).abs() < 1e-12);
+}
+
+#[test]
+fn helix_too_wide_for_the_head_bond_is_refused() {
+    let h = Helix {
+        radius: 3.0,
+        dhat: 1.05,
+        ..Helix::default()
+    };
+    assert!(h.generate().unwrap_err().contains("head bond"));
+}
+
+#[test]
+fn helix_too_tight_is_refused() {
+    let h = Helix {
+        radius: 1.0,
+        pitch: 0.5,
+        dhat: 1.5,
+        head_ratio: 2.0,
+        ..Helix::default()
+    };
+    assert!(h.generate().unwrap_err().contains("too tight"));
+}

@@ -1,0 +1,154 @@
+//! Runtime-sized particle state and bonds: what the kernel's `step_slices` advances,
+//! for any number of beads.
+
+use std::fmt;
+
+use hydrorattle::particles::{check_pairs, sphere_volume};
+use hydrorattle::{Bond, BondError, ParticleError, Real, State};
+
+use crate::scene;
+use crate::sizing::TooLarge;
+
+/// Particle state in vectors of any length (all of the same length).
+#[derive(Clone, Debug)]
+pub struct Beads<T: Real> {
+    /// Centres.
+    pub pos: Vec<T::V3>,
+    /// Translational velocities.
+    pub vel: Vec<T::V3>,
+    /// Angular velocities.
+    pub omega: Vec<T::V3>,
+    /// Radii.
+    pub radius: Vec<T>,
+    /// Material densities.
+    pub density: Vec<T>,
+    /// Simulated time.
+    pub time: T,
+}
+
+impl<T: Real> Beads<T> {
+    /// The particles at rest, densities scaled by `density_scale`, each checked on its
+    /// own in precision `T` (finite, radius > 0, density >= 0; pairs are
+    /// [`check_pairs`](Self::check_pairs)' job).
+    pub fn new(particles: &[scene::Particle], density_scale: f64) -> Result<Self, ParticleError> {
+        let n = particles.len();
+        let mut beads = Beads {
+            pos: Vec::with_capacity(n),
+            vel: vec![T::V3_ZERO; n],
+            omega: vec![T::V3_ZERO; n],
+            radius: Vec::with_capacity(n),
+            density: Vec::with_capacity(n),
+            time: T::ZERO,
+        };
+        for (k, q) in particles.iter().enumerate() {
+            let (r, d) = (
+                T::from_f64(q.radius),
+                T::from_f64(q.density * density_scale),
+            );
+            let pos = T::v3_from(q.position);
+            // Values valid in f64 may not be in f32 (an overflow, a radius that rounds to 0).
+            if !(T::v3_is_finite(pos) && r.is_finite() && d.is_finite()) {
+                return Err(ParticleError::NonFinite { particle: k });
+            }
+            if r <= T::ZERO {
+                return Err(ParticleError::BadRadius { particle: k });
+            }
+            if d < T::ZERO {
+                return Err(ParticleError::BadDensity { particle: k });
+            }
+            beads.pos.push(pos);
+            beads.radius.push(r);
+            beads.density.push(d);
+        }
+        Ok(beads)
+    }
+
+    /// Nested spheres are refused; overlapping ones unless `allow_overlap`.
+    pub fn check_pairs(&self, allow_overlap: bool) -> Result<(), ParticleError> {
+        check_pairs(&self.pos, &self.radius, allow_overlap)
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+
+    /// `true` when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+
+    /// The kernel's view of this state, for `step_slices`.
+    pub fn state(&mut self) -> State<'_, T> {
+        State {
+            pos: &mut self.pos,
+            vel: &mut self.vel,
+            omega: &mut self.omega,
+            radius: &self.radius,
+            density: &self.density,
+            time: &mut self.time,
+        }
+    }
+
+    /// Mass of particle `i`.
+    pub fn mass(&self, i: usize) -> T {
+        sphere_volume(self.radius[i]) * self.density[i]
+    }
+}
+
+/// A scene's bonds in precision `T`, validated against `n` particles (range,
+/// self-bonds, lengths, duplicates).
+pub fn bonds<T: Real>(bonds: &[scene::Bond], n: usize) -> Result<Vec<Bond<T>>, BondError> {
+    let out: Vec<Bond<T>> = bonds
+        .iter()
+        .map(|b| Bond {
+            i: b.i,
+            j: b.j,
+            length: T::from_f64(b.length),
+        })
+        .collect();
+    hydrorattle::bonds::validate(&out, n)?;
+    Ok(out)
+}
+
+/// Why a run cannot start: the kernel refuses a particle or a bond, or the storage
+/// would exceed the limit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BuildError {
+    /// A particle, on its own or in a pair.
+    Particle(ParticleError),
+    /// A bond.
+    Bond(BondError),
+    /// The step storage.
+    TooLarge(TooLarge),
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BuildError::Particle(e) => write!(f, "{e}"),
+            BuildError::Bond(e) => write!(f, "{e}"),
+            BuildError::TooLarge(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for BuildError {}
+
+impl From<ParticleError> for BuildError {
+    fn from(e: ParticleError) -> Self {
+        BuildError::Particle(e)
+    }
+}
+
+impl From<BondError> for BuildError {
+    fn from(e: BondError) -> Self {
+        BuildError::Bond(e)
+    }
+}
+
+impl From<TooLarge> for BuildError {
+    fn from(e: TooLarge) -> Self {
+        BuildError::TooLarge(e)
+    }
+}

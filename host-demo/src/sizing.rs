@@ -1,0 +1,180 @@
+//! How much kernel storage a run needs, and the limit a run must stay under.
+//!
+//! Every method stores the `N x N` mobility (packed 3x3 blocks), so storage grows as
+//! `N^2`: 604 MB for 4096 beads overdamped in f64, 4.8 GB for the stable inertial method
+//! with rotation. A scene file is checked against the limit from its counts alone,
+//! while it is read and before any bead is generated or any pair checked, so an
+//! oversized scene is refused at once, at the line that set its size.
+
+use std::fmt;
+
+use hydrorattle::Layout;
+
+use crate::scene::{Method, Precision, Scene, Solver};
+
+/// Default limit on one run's step storage (`run --max-storage`): 8 GiB holds every
+/// method at 4096 beads in f64.
+pub const DEFAULT_LIMIT: usize = 8 << 30;
+
+/// Largest particle or bond count the storage arithmetic takes. Far beyond any limit
+/// (storage there is about 1e17 bytes), and small enough that no count of the kernel's
+/// [`Layout`] nor its byte total overflows.
+const COUNT_MAX: usize = (usize::MAX >> 10).isqrt();
+
+/// A run whose step storage would exceed the limit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TooLarge {
+    /// Particles.
+    pub particles: usize,
+    /// Bonds.
+    pub bonds: usize,
+    /// Bytes one step needs; `None` when a count is past counting.
+    pub bytes: Option<usize>,
+    /// The limit, bytes.
+    pub limit: usize,
+}
+
+const GIB: f64 = (1u64 << 30) as f64;
+
+impl fmt::Display for TooLarge {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (n, b, limit) = (self.particles, self.bonds, self.limit as f64 / GIB);
+        match self.bytes {
+            Some(bytes) => write!(
+                f,
+                "{n} particles and {b} bonds need {:.3} GiB of step storage, over the limit of {limit:.3} GiB",
+                bytes as f64 / GIB
+            )?,
+            None => write!(
+                f,
+                "{n} particles and {b} bonds are too many to size (the limit is {limit:.3} GiB)"
+            )?,
+        }
+        write!(
+            f,
+            "; use fewer beads, precision \"f32\" (half the storage) or `run --max-storage`"
+        )
+    }
+}
+
+impl std::error::Error for TooLarge {}
+
+/// What sizes a run's storage: method, rotation flag, solver and precision.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Integrator.
+    pub method: Method,
+    /// Whether rotation is resolved.
+    pub rotation: bool,
+    /// Constraint solver.
+    pub solver: Solver,
+    /// Precision.
+    pub precision: Precision,
+}
+
+impl Plan {
+    /// The plan of `scene` as it will run (its level already applied).
+    pub fn of(scene: &Scene) -> Plan {
+        Plan {
+            method: scene.integrator.method,
+            rotation: scene.model.rotation,
+            solver: scene.integrator.solver,
+            precision: scene.integrator.precision,
+        }
+    }
+
+    /// The kernel's storage for `n` particles and `b` bonds; `None` past counting.
+    pub fn layout(&self, n: usize, b: usize) -> Option<Layout> {
+        let kernel = (self.method.kernel(), self.solver.kind());
+        (n <= COUNT_MAX && b <= COUNT_MAX)
+            .then(|| Layout::with_solver(kernel.0, self.rotation, kernel.1, n, b))
+    }
+
+    /// Bytes of [`layout`](Self::layout) in this plan's precision.
+    pub fn bytes(&self, n: usize, b: usize) -> Option<usize> {
+        self.layout(n, b).map(|l| match self.precision {
+            Precision::F32 => l.bytes::<f32>(),
+            Precision::F64 => l.bytes::<f64>(),
+        })
+    }
+
+    /// The storage for `n` particles and `b` bonds, if it fits in `limit` bytes.
+    pub fn check(&self, n: usize, b: usize, limit: usize) -> Result<Layout, TooLarge> {
+        match (self.layout(n, b), self.bytes(n, b)) {
+            (Some(layout), Some(bytes)) if bytes <= limit => Ok(layout),
+            (_, bytes) => Err(TooLarge {
+                particles: n,
+                bonds: b,
+                bytes,
+                limit,
+            }),
+        }
+    }
+}
+
+/// A limit given in GiB (`run --max-storage`) in bytes; `None` unless positive.
+pub fn limit_from_gib(gib: f64) -> Option<usize> {
+    // `as` saturates: a huge limit is just "no limit" up to the address space.
+    (gib > 0.0).then_some((gib * GIB) as usize)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(method: Method, rotation: bool, precision: Precision) -> Plan {
+        Plan {
+            method,
+            rotation,
+            solver: Solver::Auto,
+            precision,
+        }
+    }
+
+    #[test]
+    fn every_method_fits_4096_beads_in_f64_under_the_default_limit() {
+        for method in [
+            Method::Overdamped,
+            Method::Overdamped2,
+            Method::Rattle,
+            Method::RattleStable,
+            Method::Springs,
+        ] {
+            let p = plan(method, true, Precision::F64);
+            assert!(p.check(4096, 4095, DEFAULT_LIMIT).is_ok(), "{method:?}");
+        }
+        // The mobility alone: tri(4096) blocks of 72 bytes.
+        let od = plan(Method::Overdamped, false, Precision::F64);
+        assert!(od.bytes(4096, 4095).unwrap() > 4096 * 4097 / 2 * 72);
+    }
+
+    #[test]
+    fn counts_past_counting_are_refused_without_overflow() {
+        let p = plan(Method::RattleStable, true, Precision::F64);
+        let e = p.check(usize::MAX, usize::MAX - 1, usize::MAX).unwrap_err();
+        assert_eq!(e.bytes, None);
+        let sized = p.check(COUNT_MAX, COUNT_MAX, usize::MAX);
+        assert!(
+            sized.is_ok_and(|l| l.blocks > 0),
+            "the largest count is sized"
+        );
+    }
+
+    #[test]
+    fn f32_needs_about_half_of_f64() {
+        let (a, b) = (
+            plan(Method::Overdamped, false, Precision::F32).bytes(1000, 999),
+            plan(Method::Overdamped, false, Precision::F64).bytes(1000, 999),
+        );
+        let (a, b) = (a.unwrap() as f64, b.unwrap() as f64);
+        assert!((a / b - 0.5).abs() < 0.01, "{a} / {b}");
+    }
+
+    #[test]
+    fn limits_in_gib() {
+        assert_eq!(limit_from_gib(8.0), Some(DEFAULT_LIMIT));
+        assert_eq!(limit_from_gib(0.0), None);
+        assert_eq!(limit_from_gib(f64::NAN), None);
+        assert_eq!(limit_from_gib(1e30), Some(usize::MAX));
+    }
+}
