@@ -38,16 +38,16 @@ const GIB: f64 = (1u64 << 30) as f64;
 
 impl fmt::Display for TooLarge {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (n, b, limit) = (self.particles, self.bonds, self.limit as f64 / GIB);
+        let (n, b, limit) = (self.particles, self.bonds, human(self.limit));
         match self.bytes {
             Some(bytes) => write!(
                 f,
-                "{n} particles and {b} bonds need {:.3} GiB of step storage, over the limit of {limit:.3} GiB",
-                bytes as f64 / GIB
+                "{n} particles and {b} bonds need {} of step storage, over the limit of {limit}",
+                human(bytes)
             )?,
             None => write!(
                 f,
-                "{n} particles and {b} bonds are too many to size (the limit is {limit:.3} GiB)"
+                "{n} particles and {b} bonds are too many to size (the limit is {limit})"
             )?,
         }
         write!(
@@ -55,6 +55,17 @@ impl fmt::Display for TooLarge {
             "; use fewer beads, precision \"f32\" (half the storage) or `run --max-storage`"
         )
     }
+}
+
+/// `bytes` in the largest binary unit that leaves at least 1.
+fn human(bytes: usize) -> String {
+    const UNITS: [&str; 7] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
+    let (mut x, mut u) = (bytes as f64, 0);
+    while x >= 1024.0 && u + 1 < UNITS.len() {
+        x /= 1024.0;
+        u += 1;
+    }
+    format!("{x:.1} {}", UNITS[u])
 }
 
 impl std::error::Error for TooLarge {}
@@ -168,6 +179,14 @@ mod tests {
         );
         let (a, b) = (a.unwrap() as f64, b.unwrap() as f64);
         assert!((a / b - 0.5).abs() < 0.01, "{a} / {b}");
+    }
+
+    #[test]
+    fn sizes_read_in_binary_units() {
+        assert_eq!(human(DEFAULT_LIMIT), "8.0 GiB");
+        assert_eq!(human(1536), "1.5 KiB");
+        assert_eq!(human(12), "12.0 B");
+        assert_eq!(human(usize::MAX), "16.0 EiB");
     }
 
     #[test]

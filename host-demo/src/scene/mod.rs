@@ -18,13 +18,17 @@
 //! | `[[bond]]` | `between = [i, j]` (required, 0-based), `length` (> 0) | initial distance |
 //! | `[helix]` | `tails`, `head_ratio`, `dhat`, `head_end`, `radius`, `pitch`, `density` | see [`Helix`] |
 //! | `[model]` | `hydrodynamics = "rpy"\|"oseen"\|"free-draining"`, `inertia`, `rotation`, `level = "auto"\|"manual"`, `overlap = "reject"\|"allow"` | rpy, false, false, manual, allow |
-//! | `[integrator]` | `method` (required), `dt` (required), `duration` (required), `solver = "sweep"\|"newton"`, `tolerance`, `max_iterations`, `precision = "f32"\|"f64"`, `stiffness` | newton, 1e-10, 500, f64, 1e4 |
+//! | `[integrator]` | `method` (required), `dt` (required), `duration` (required), `solver = "auto"\|"sweep"\|"newton"\|"krylov"`, `tolerance`, `max_iterations`, `precision = "f32"\|"f64"`, `stiffness` | auto, 1e-10, 500, f64, 1e4 |
 //! | `[output]` | `every` (steps between trajectory frames, >= 1) | about [`TARGET_FRAMES`] frames |
 //!
 //! A scene gives either a `[helix]` table or explicit `[[particle]]` (and optionally
 //! `[[bond]]`) tables, never both. Units are those of `DESIGN.md` section 4: tail radius
 //! 1, viscosity 1, and the default density 4.5 with gravity `[0, 0, -1]` and fluid
 //! density 0 gives a lone tail a buoyant weight of `6 pi`, so it settles at speed 1.
+//!
+//! A scene whose step storage would exceed a limit ([`crate::sizing`]) is refused from
+//! its counts, before the helix is generated or any pair checked, at the value that set
+//! the count.
 //!
 //! `overlap` defaults to `"allow"` because the paper's chains have no excluded volume:
 //! only the bonds keep beads apart, and non-bonded beads may touch or overlap (the RPY

@@ -2,6 +2,7 @@
 
 use super::raw::distance;
 use super::*;
+use crate::sizing::Plan;
 
 const MINIMAL: &str = "[[particle]]\nposition = [0, 0, 0]\nradius = 1\n\n[integrator]\nmethod = \"overdamped\"\ndt = 0.01\nduration = 1\n";
 
@@ -108,4 +109,88 @@ fn helix_too_tight_is_refused() {
         ..Helix::default()
     };
     assert!(h.generate().unwrap_err().contains("too tight"));
+}
+
+/// `n` unit spheres in a row, 3 apart, and a chain of `b` bonds along them.
+fn row(n: usize, b: usize, level: &str) -> String {
+    let mut t = format!(
+        "[model]\nlevel = \"{level}\"\n\n[integrator]\nmethod = \"overdamped\"\ndt = 0.01\nduration = 1\n"
+    );
+    for k in 0..n {
+        t += &format!("\n[[particle]]\nposition = [{}, 0, 0]\nradius = 1\n", 3 * k);
+    }
+    for k in 0..b {
+        t += &format!("\n[[bond]]\nbetween = [{k}, {}]\n", k + 1);
+    }
+    t
+}
+
+fn line_of(text: &str, needle: &str) -> usize {
+    1 + text.lines().position(|l| l == needle).unwrap()
+}
+
+fn overdamped() -> Plan {
+    Plan {
+        method: Method::Overdamped,
+        rotation: false,
+        solver: Solver::Auto,
+        precision: Precision::F64,
+    }
+}
+
+#[test]
+fn too_many_particles_are_refused_at_the_first_that_does_not_fit() {
+    let text = row(12, 0, "manual");
+    let limit = overdamped().bytes(9, 0).unwrap();
+    let e = Scene::parse_within(&text, "row.toml", limit).unwrap_err();
+    // Nine particles fit; the tenth (index 9) does not.
+    assert_eq!(
+        e.line(),
+        Some(line_of(&text, "position = [27, 0, 0]")),
+        "{e}"
+    );
+    let big = e.too_large.expect("a storage refusal");
+    assert_eq!((big.particles, big.bonds, big.limit), (12, 0, limit));
+    assert_eq!(big.bytes, overdamped().bytes(12, 0));
+    assert!(e.message.contains("over the limit"), "{e}");
+    assert!(Scene::parse_within(&text, "row.toml", big.bytes.unwrap()).is_ok());
+}
+
+#[test]
+fn too_many_bonds_are_refused_at_the_first_that_does_not_fit() {
+    let text = row(8, 7, "manual");
+    let limit = overdamped().bytes(8, 4).unwrap();
+    let e = Scene::parse_within(&text, "row.toml", limit).unwrap_err();
+    assert_eq!(e.line(), Some(line_of(&text, "between = [4, 5]")), "{e}");
+    assert_eq!(e.too_large.map(|t| t.bonds), Some(7));
+}
+
+#[test]
+fn an_auto_level_scene_is_sized_for_every_method_it_may_get() {
+    // The stable inertial method stores two mobilities: twice the overdamped's.
+    let text = row(20, 19, "auto");
+    let limit = overdamped().bytes(20, 19).unwrap();
+    let e = Scene::parse_within(&text, "row.toml", limit).unwrap_err();
+    assert!(e.too_large.is_some(), "{e}");
+    let manual = row(20, 19, "manual");
+    assert!(Scene::parse_within(&manual, "row.toml", limit).is_ok());
+}
+
+#[test]
+fn solvers_are_named_as_in_the_kernel() {
+    for (name, solver) in [
+        ("auto", Solver::Auto),
+        ("sweep", Solver::Sweep),
+        ("newton", Solver::Newton),
+        ("krylov", Solver::Krylov),
+    ] {
+        let text = MINIMAL.replace(
+            "duration = 1",
+            &format!("duration = 1\nsolver = \"{name}\""),
+        );
+        assert_eq!(
+            Scene::parse(&text, "m.toml").unwrap().integrator.solver,
+            solver
+        );
+    }
 }

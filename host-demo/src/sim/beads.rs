@@ -152,3 +152,42 @@ impl From<TooLarge> for BuildError {
         BuildError::TooLarge(e)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sphere(radius: f64) -> scene::Particle {
+        scene::Particle {
+            position: [0.0; 3],
+            radius,
+            density: 1.0,
+        }
+    }
+
+    #[test]
+    fn values_valid_in_f64_are_checked_again_in_f32() {
+        let ps = [sphere(1.0), sphere(1e-50)];
+        assert!(Beads::<f64>::new(&ps, 1.0).is_ok());
+        let e = Beads::<f32>::new(&ps, 1.0).unwrap_err();
+        assert_eq!(e, ParticleError::BadRadius { particle: 1 });
+        let e = Beads::<f32>::new(&[sphere(1e300)], 1.0).unwrap_err();
+        assert_eq!(e, ParticleError::NonFinite { particle: 0 });
+    }
+
+    #[test]
+    fn bonds_are_validated_against_the_particle_count() {
+        let b = |i, j| scene::Bond { i, j, length: 1.0 };
+        assert_eq!(bonds::<f64>(&[b(0, 1)], 2).unwrap().len(), 1);
+        let e = bonds::<f64>(&[b(0, 1), b(1, 0)], 2).unwrap_err();
+        assert_eq!(e, BondError::Duplicate { bond: 1, other: 0 });
+        let e = bonds::<f64>(&[b(0, 2)], 2).unwrap_err();
+        assert_eq!(
+            e,
+            BondError::OutOfRange {
+                bond: 0,
+                particle: 2
+            }
+        );
+    }
+}

@@ -1,0 +1,114 @@
+//! Thousands of beads through the real `host-demo run`: a 4096-bead helix steps with
+//! its bonds held, and a scene too large for the storage limit is refused at once, at
+//! its line, before anything is written.
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use host_demo::output::read_xyz_file;
+use host_demo::scene::Scene;
+use host_demo::sim::{BuildError, RunOptions, run};
+
+fn manifest() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("host-demo-large-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn cli_run(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_host-demo"))
+        .arg("run")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn a_4096_bead_helix_steps_with_its_bonds_held() {
+    let scene = manifest().join("tests/data/helix4096.toml");
+    let out = scratch("helix4096");
+    let o = cli_run(&[scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["particles"], 4096);
+    assert_eq!(summary["bonds"], 4095);
+    assert_eq!(summary["steps"], 3);
+    assert_eq!(summary["steps_done"], 3);
+    assert!(summary["failure"].is_null(), "{}", summary["failure"]);
+    // Every recorded frame holds every bond to the tolerance (f64, 1e-10).
+    let tolerance = summary["tolerance_used"].as_f64().unwrap();
+    let csv = std::fs::read_to_string(out.join("observables.csv")).unwrap();
+    let residuals: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(9).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(residuals.len(), 4, "the initial frame and one per step");
+    for r in &residuals {
+        assert!(*r <= 10.0 * tolerance, "bond residual {r:e}");
+    }
+    // The whole chain is in the trajectory, and it moved: it settles along gravity.
+    let frames = read_xyz_file(&out.join("trajectory.xyz")).unwrap();
+    let (first, last) = (&frames[0], frames.last().unwrap());
+    assert_eq!(last.positions.len(), 4096);
+    let drop = first.positions[0][2] - last.positions[0][2];
+    assert!(drop > 0.0, "the head moved down by {drop}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn ten_million_tails_are_refused_at_once_at_their_line() {
+    let scene = manifest().join("tests/data/bad/helix_too_large.toml");
+    let out = scratch("too-large");
+    let start = Instant::now();
+    let o = cli_run(&[scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let took = start.elapsed();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains(&format!("{}:7:", scene.display())), "{err}");
+    assert!(err.contains("over the limit of 8.0 GiB"), "{err}");
+    assert!(!out.exists(), "nothing may be written");
+    assert!(took < Duration::from_secs(1), "refused after {took:?}");
+}
+
+#[test]
+fn the_limit_can_be_raised_or_lowered() {
+    let scene = manifest().join("scenes/figure1a.toml");
+    let out = scratch("limit");
+    // The 25-bead chain needs tens of kB: 1 kB is too little.
+    let o = cli_run(&[
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--max-storage",
+        "0.000001",
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("scenes/figure1a.toml:"), "{err}");
+    assert!(err.contains("step storage"), "{err}");
+    assert!(!out.exists());
+    let o = cli_run(&[scene.to_str().unwrap(), "--out", "x", "--max-storage", "0"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("positive number of GiB"));
+}
+
+#[test]
+fn the_library_refuses_an_oversized_run_with_a_typed_error() {
+    let scene = Scene::figure1().unwrap().remove(0).1;
+    let opts = RunOptions {
+        max_storage: 1024,
+        ..Default::default()
+    };
+    let e = run(&scene, "a", None, opts).unwrap_err();
+    let Some(BuildError::TooLarge(t)) = e.downcast_ref::<BuildError>() else {
+        panic!("{e:#}");
+    };
+    assert_eq!((t.particles, t.bonds, t.limit), (25, 24, 1024));
+}
