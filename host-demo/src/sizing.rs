@@ -144,13 +144,7 @@ mod tests {
 
     #[test]
     fn every_method_fits_4096_beads_in_f64_under_the_default_limit() {
-        for method in [
-            Method::Overdamped,
-            Method::Overdamped2,
-            Method::Rattle,
-            Method::RattleStable,
-            Method::Springs,
-        ] {
+        for method in Method::ALL {
             let p = plan(method, true, Precision::F64);
             assert!(p.check(4096, 4095, DEFAULT_LIMIT).is_ok(), "{method:?}");
         }

@@ -115,6 +115,15 @@ pub enum Method {
 }
 
 impl Method {
+    /// Every method, in declaration order.
+    pub const ALL: [Method; 5] = [
+        Method::Overdamped,
+        Method::Overdamped2,
+        Method::Rattle,
+        Method::RattleStable,
+        Method::Springs,
+    ];
+
     /// Whether the method carries particle momenta (and so needs positive masses).
     pub fn is_inertial(self) -> bool {
         matches!(self, Method::Rattle | Method::RattleStable)

@@ -315,3 +315,27 @@ fn run_t<T: Real>(
         series,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Method, Solver};
+    use hydrorattle::Layout;
+
+    #[test]
+    fn the_storage_checked_is_the_storage_the_kernel_asks_for() {
+        let mut scene = Scene::figure1().unwrap().remove(0).1;
+        for method in Method::ALL {
+            for solver in [Solver::Auto, Solver::Sweep, Solver::Newton, Solver::Krylov] {
+                for rotation in [false, true] {
+                    scene.integrator.method = method;
+                    scene.integrator.solver = solver;
+                    scene.model.rotation = rotation;
+                    let (n, b) = (scene.particles.len(), scene.bonds.len());
+                    let want = Layout::for_params(&params::<f64>(&scene), n, b);
+                    assert_eq!(Plan::of(&scene).layout(n, b), Some(want));
+                }
+            }
+        }
+    }
+}
