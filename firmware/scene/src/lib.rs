@@ -191,15 +191,22 @@ impl Bits for f64 {
 /// FNV-1a (64 bit) over the little-endian bytes of `to_bits()` of every position
 /// component, bead by bead, x, y, z.
 pub fn digest<T: Bits>(pos: &[T::V3]) -> u64 {
+    fnv(pos.iter().flat_map(|&v| T::xyz(v)))
+}
+
+/// [`digest`] of positions held as `[x, y, z]` triples (as C callers hold them).
+pub fn digest_triples<T: Bits>(pos: &[[T; 3]]) -> u64 {
+    fnv(pos.iter().flatten().copied())
+}
+
+fn fnv<T: Bits>(components: impl Iterator<Item = T>) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     let mut eat = |b: u8| {
         h ^= u64::from(b);
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     };
-    for &v in pos {
-        for c in T::xyz(v) {
-            c.feed(&mut eat);
-        }
+    for c in components {
+        c.feed(&mut eat);
     }
     h
 }
