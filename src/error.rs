@@ -287,6 +287,11 @@ impl fmt::Display for StepError {
     }
 }
 
+impl core::error::Error for ParticleError {}
+impl core::error::Error for BondError {}
+impl core::error::Error for LinalgError {}
+impl core::error::Error for StepError {}
+
 impl From<ParticleError> for StepError {
     fn from(e: ParticleError) -> Self {
         Self::Particle(e)

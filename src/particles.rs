@@ -187,7 +187,9 @@ pub fn sphere_volume<T: Real>(a: T) -> T {
     T::from_f64(4.0 / 3.0) * T::PI * a * a * a
 }
 
-fn check_one<T: Real>(i: usize, p: &Particle<T>) -> Result<(), ParticleError> {
+/// Checks particle `i` on its own: finite values, radius > 0, density >= 0 (the checks
+/// [`ParticleSet::push`] makes; pair checks are [`check_pairs`]).
+pub fn check_one<T: Real>(i: usize, p: &Particle<T>) -> Result<(), ParticleError> {
     let finite = T::v3_is_finite(p.position)
         && T::v3_is_finite(p.velocity)
         && p.radius.is_finite()

@@ -57,7 +57,8 @@ fn a_rigidly_rotating_helix_twists_at_its_angular_speed() {
         }));
         v
     };
-    let mut tw: Twist<f64, 16> = Twist::new(0.1);
+    let mut prev = [0.0; 16];
+    let mut tw = Twist::new(&mut prev, 0.1);
     let dt = 0.5;
     for s in 0..=200 {
         tw.update(&shape(s as f64 * dt), DOWN);
@@ -71,7 +72,8 @@ fn a_rigidly_rotating_helix_twists_at_its_angular_speed() {
 
 #[test]
 fn a_chain_on_the_axis_accumulates_no_twist() {
-    let mut tw: Twist<f64, 8> = Twist::new(0.1);
+    let mut prev = [0.0; 8];
+    let mut tw = Twist::new(&mut prev, 0.1);
     for s in 0..50 {
         // Straight down the axis, with sub-threshold jitter that has no meaningful azimuth.
         let jitter = 1e-3 * ((s % 7) as f64 - 3.0);

@@ -71,20 +71,23 @@ pub fn settling_speed<T: Real>(vel: &[T::V3], i: usize, gravity: T::V3) -> T {
 /// by more than half a turn between calls. A chain whose root-mean-square distance from
 /// the axis is below `min_radius` (a straight vertical chain) has no meaningful azimuth:
 /// such updates add nothing.
-#[derive(Clone, Debug)]
-pub struct Twist<T: Real, const N: usize> {
-    prev: [T; N],
+/// `prev` is caller storage, one entry per particle (any length: a fixed array in
+/// firmware, a `Vec` on a host); more particles than that are ignored by `update`.
+#[derive(Debug)]
+pub struct Twist<'a, T: Real> {
+    prev: &'a mut [T],
     started: bool,
     min_radius: T,
     /// Accumulated twist angle (radians, right-handed about "up").
     pub total: T,
 }
 
-impl<T: Real, const N: usize> Twist<T, N> {
-    /// No twist accumulated yet; `min_radius` as described on the type.
-    pub const fn new(min_radius: T) -> Self {
+impl<'a, T: Real> Twist<'a, T> {
+    /// No twist accumulated yet, over caller storage `prev`; `min_radius` as described
+    /// on the type.
+    pub fn new(prev: &'a mut [T], min_radius: T) -> Self {
         Self {
-            prev: [T::ZERO; N],
+            prev,
             started: false,
             min_radius,
             total: T::ZERO,
@@ -94,7 +97,7 @@ impl<T: Real, const N: usize> Twist<T, N> {
     /// Adds the twist since the last call and returns the accumulated total.
     pub fn update(&mut self, pos: &[T::V3], gravity: T::V3) -> T {
         let g = T::norm(gravity);
-        if pos.is_empty() || pos.len() > N || g == T::ZERO {
+        if pos.is_empty() || pos.len() > self.prev.len() || g == T::ZERO {
             return self.total;
         }
         let up = -gravity / g;

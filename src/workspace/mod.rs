@@ -137,6 +137,26 @@ impl<T: Real> Buffers<T> {
         }
     }
 
+    /// Like [`Buffers::new`], but an allocation the system refuses is an error instead
+    /// of an abort (hosts sizing storage from user input).
+    pub fn try_new(layout: Layout) -> Result<Self, alloc::collections::TryReserveError> {
+        fn zeroed<X: Clone>(
+            len: usize,
+            x: X,
+        ) -> Result<alloc::vec::Vec<X>, alloc::collections::TryReserveError> {
+            let mut v = alloc::vec::Vec::new();
+            v.try_reserve_exact(len)?;
+            v.resize(len, x);
+            Ok(v)
+        }
+        Ok(Self {
+            blocks: zeroed(layout.blocks, T::M3_ZERO)?,
+            vectors: zeroed(layout.vectors, T::V3_ZERO)?,
+            scalars: zeroed(layout.scalars, T::ZERO)?,
+            indices: zeroed(layout.indices, 0)?,
+        })
+    }
+
     /// A workspace over these buffers.
     pub fn workspace(&mut self) -> Workspace<'_, T> {
         Workspace::new(

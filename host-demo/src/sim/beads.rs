@@ -47,15 +47,7 @@ impl<T: Real> Beads<T> {
             );
             let pos = T::v3_from(q.position);
             // Values valid in f64 may not be in f32 (an overflow, a radius that rounds to 0).
-            if !(T::v3_is_finite(pos) && r.is_finite() && d.is_finite()) {
-                return Err(ParticleError::NonFinite { particle: k });
-            }
-            if r <= T::ZERO {
-                return Err(ParticleError::BadRadius { particle: k });
-            }
-            if d < T::ZERO {
-                return Err(ParticleError::BadDensity { particle: k });
-            }
+            hydrorattle::particles::check_one(k, &hydrorattle::Particle::new(pos, r, d))?;
             beads.pos.push(pos);
             beads.radius.push(r);
             beads.density.push(d);
@@ -121,6 +113,8 @@ pub enum BuildError {
     Bond(BondError),
     /// The step storage.
     TooLarge(TooLarge),
+    /// The system refused the step storage's memory (bytes asked for).
+    OutOfMemory(usize),
 }
 
 impl fmt::Display for BuildError {
@@ -129,6 +123,9 @@ impl fmt::Display for BuildError {
             BuildError::Particle(e) => write!(f, "{e}"),
             BuildError::Bond(e) => write!(f, "{e}"),
             BuildError::TooLarge(e) => write!(f, "{e}"),
+            BuildError::OutOfMemory(bytes) => {
+                write!(f, "the system refused {bytes} bytes for the step storage")
+            }
         }
     }
 }

@@ -8,17 +8,15 @@
 
 mod beads;
 mod record;
-mod twist;
 
 pub use beads::{Beads, BuildError, bonds};
 pub use record::{COLUMNS, Observables};
-pub use twist::Twist;
 
 use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use hydrorattle::observables::{self, Thresholds};
+use hydrorattle::observables::{self, Thresholds, Twist};
 use hydrorattle::{Buffers, Hydro, Params, Real, SoftContact, Solver as KSolver, step_slices};
 use serde::Serialize;
 
@@ -192,7 +190,8 @@ fn prepare<T: Real>(scene: &Scene, p: &Params<T>, limit: usize) -> Result<Prepar
     Ok(Prepared {
         bonds: bonds::<T>(&scene.bonds, n)?,
         beads,
-        store: Buffers::new(layout),
+        store: Buffers::try_new(layout)
+            .map_err(|_| BuildError::OutOfMemory(layout.bytes::<T>()))?,
     })
 }
 
@@ -226,7 +225,8 @@ fn run_t<T: Real>(
     });
     let every = scene.output.every.max(1);
     let mut rec = Recorder::new(out, scene.species())?;
-    let mut twist = Twist::<T>::new(T::from_f64(0.25));
+    let mut twist_prev = vec![T::ZERO; beads.len()];
+    let mut twist = Twist::new(&mut twist_prev, T::from_f64(0.25));
     let mut series = Vec::with_capacity(steps / every + 2);
     let observe = |beads: &Beads<T>, twist: T, iterations: u32, tension: T| {
         Observables::of(beads, &bonds, p.gravity, twist, iterations, tension)
