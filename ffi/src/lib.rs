@@ -55,7 +55,7 @@ pub extern "C" fn hr_params_default_f64(dt: f64) -> HrParamsF64 {
 }
 
 fn bytes<T: Precision>(params: *const HrParams<T>, n: usize, bonds: usize) -> usize {
-    if params.is_null() || params as usize % core::mem::align_of::<HrParams<T>>() != 0 {
+    if params.is_null() || !(params as usize).is_multiple_of(core::mem::align_of::<HrParams<T>>()) {
         return 0;
     }
     // SAFETY: non-null and aligned, read by value.
@@ -124,7 +124,7 @@ unsafe fn step_any<T: Precision>(
         Ok(()) => HrStatus::Ok,
         Err(s) => s,
     };
-    if !report.is_null() && report as usize % core::mem::align_of::<HrReport<T>>() == 0 {
+    if !report.is_null() && (report as usize).is_multiple_of(core::mem::align_of::<HrReport<T>>()) {
         // SAFETY: non-null, aligned; written by value.
         unsafe { report.write(r) };
     }
@@ -248,7 +248,12 @@ pub unsafe extern "C" fn hr_figure1c_f32(
     if pos.is_null() || radius.is_null() || density.is_null() || bonds.is_null() {
         return HrStatus::NullPointer;
     }
-    let Some((p, a, d)) = scene::helix(scene::B) else {
+    let Some(scene::Helix {
+        pos: p,
+        radius: a,
+        length: d,
+    }) = scene::helix(scene::B)
+    else {
         return HrStatus::Size;
     };
     for k in 0..scene::N {

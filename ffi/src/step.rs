@@ -180,8 +180,8 @@ pub unsafe fn step<T: Precision>(
     if state.is_null() || params.is_null() || storage.is_null() {
         return Err(HrStatus::NullPointer);
     }
-    if state as usize % align_of::<HrState<T>>() != 0
-        || params as usize % align_of::<HrParams<T>>() != 0
+    if !(state as usize).is_multiple_of(align_of::<HrState<T>>())
+        || !(params as usize).is_multiple_of(align_of::<HrParams<T>>())
     {
         return Err(HrStatus::Alignment);
     }
@@ -209,7 +209,7 @@ pub unsafe fn step<T: Precision>(
         (span(st.density, n, false), t),
         (span(storage as *const u8, storage_bytes, true), 1),
         (span(state as *const HrState<T>, 1, true), 1),
-        (span(params as *const HrParams<T>, 1, false), 1),
+        (span(params, 1, false), 1),
         bond_span,
     ])?;
     let end = storage as usize + storage_bytes;

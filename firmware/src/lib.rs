@@ -130,9 +130,7 @@ impl Write for Host {
 fn fail(why: &str) -> ! {
     let _ = writeln!(Host, "firmware error: {why}");
     debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::udf();
-    }
+    cortex_m::asm::udf()
 }
 
 /// Starts SysTick as a free-running 24-bit down-counter on the core clock.
@@ -212,6 +210,9 @@ fn guard_below_stack() {
 
 /// The HardFault vector: a stack overflow leaves the stack pointer outside RAM, so move
 /// it back to the top of the stack before running any Rust.
+///
+/// # Safety
+/// Only the processor calls it, as an exception handler; it never returns.
 #[unsafe(naked)]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn HardFault() -> ! {
@@ -238,16 +239,12 @@ extern "C" fn fault_report() -> ! {
         "HardFault: {what}; CFSR={cfsr:#010x} MMFAR={mmfar:#010x}"
     );
     debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::udf();
-    }
+    cortex_m::asm::udf()
 }
 
 #[panic_handler]
 fn panic(info: &PanicInfo) -> ! {
     let _ = writeln!(Host, "panic: {info}");
     debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::udf();
-    }
+    cortex_m::asm::udf()
 }

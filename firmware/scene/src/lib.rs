@@ -53,9 +53,20 @@ pub const RUNS: [(&str, Method, bool); 6] = [
     ("springs", Method::Springs, false),
 ];
 
-/// Bead centres (`f64`), radii and bond lengths of the chain with `tails` tails.
-/// `None` when the helix cannot be built (fewer than one tail, or more than `N - 1`).
-pub fn helix(tails: usize) -> Option<([[f64; 3]; N], [f64; N], [f64; B])> {
+/// The chain's geometry in `f64`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Helix {
+    /// Bead centres.
+    pub pos: [[f64; 3]; N],
+    /// Bead radii.
+    pub radius: [f64; N],
+    /// Bond lengths (bond `k` joins beads `k` and `k + 1`).
+    pub length: [f64; B],
+}
+
+/// The chain with `tails` tails (the unused entries are zero). `None` when the helix
+/// cannot be built (fewer than one tail, or more than `N - 1`).
+pub fn helix(tails: usize) -> Option<Helix> {
     if tails == 0 || tails > B {
         return None;
     }
@@ -79,7 +90,11 @@ pub fn helix(tails: usize) -> Option<([[f64; 3]; N], [f64; N], [f64; B])> {
         radius[k + 1] = 1.0;
         length[k] = DHAT * (radius[k] + radius[k + 1]);
     }
-    Some((pos, radius, length))
+    Some(Helix {
+        pos,
+        radius,
+        length,
+    })
 }
 
 /// The angle between consecutive tails, in `(0, pi]`: the root of
@@ -107,7 +122,11 @@ fn angular_step(r: f64, pitch: f64, d: f64) -> f64 {
 
 /// Fills `ps` (which must be empty) with the chain and returns its bonds.
 pub fn chain<T: Real>(ps: &mut ParticleSet<T, N>) -> Result<BondSet<T, B>, StepError> {
-    let (pos, radius, length) = helix(B).ok_or(StepError::StateLength)?;
+    let Helix {
+        pos,
+        radius,
+        length,
+    } = helix(B).ok_or(StepError::StateLength)?;
     for (c, &a) in pos.iter().zip(&radius) {
         let p = Particle::new(T::v3_from(*c), T::from_f64(a), T::from_f64(DENSITY));
         ps.push(p).map_err(|(_, e)| e)?;
