@@ -34,19 +34,23 @@ if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
 
 # --- Tools ----------------------------------------------------------------------------
 
+# HYDRORATTLE_FW_HOST_ONLY=1 runs the host part alone (as when the target is missing).
 target_ok=1
-if ! command -v rustup >/dev/null 2>&1; then
+if [ "${HYDRORATTLE_FW_HOST_ONLY:-0}" = 1 ]; then
+    target_ok=0
+elif ! command -v rustup >/dev/null 2>&1; then
     target_ok=0
 elif ! rustup target list --installed 2>/dev/null | grep -qx "$thumb"; then
     rustup target add "$thumb" || target_ok=0
 fi
-if ! command -v qemu-system-arm >/dev/null 2>&1 || ! command -v arm-none-eabi-gcc >/dev/null 2>&1 ||
-    [ ! -d /usr/lib/arm-none-eabi/newlib ]; then
+if [ "$target_ok" -eq 1 ] && { ! command -v qemu-system-arm >/dev/null 2>&1 ||
+    ! command -v arm-none-eabi-gcc >/dev/null 2>&1 || [ ! -d /usr/lib/arm-none-eabi/newlib ]; }; then
     { $sudo apt-get update -qq &&
         $sudo apt-get install -y -qq qemu-system-arm gcc-arm-none-eabi libnewlib-arm-none-eabi; } ||
         target_ok=0
 fi
 for tool in cbindgen flip-link; do
+    if [ "$tool" = flip-link ] && [ "$target_ok" -eq 0 ]; then continue; fi
     if ! command -v "$tool" >/dev/null 2>&1; then
         run cargo install "$tool" --locked || { [ "$tool" = flip-link ] && target_ok=0; }
     fi
