@@ -122,12 +122,21 @@ fn angular_step(r: f64, pitch: f64, d: f64) -> f64 {
 
 /// Fills `ps` (which must be empty) with the chain and returns its bonds.
 pub fn chain<T: Real>(ps: &mut ParticleSet<T, N>) -> Result<BondSet<T, B>, StepError> {
+    chain_from(&helix(B).ok_or(StepError::StateLength)?, ps)
+}
+
+/// [`chain`] from a geometry computed beforehand (the firmware's comes from its build
+/// script, so that no `f64` trigonometry is linked into it).
+pub fn chain_from<T: Real>(
+    h: &Helix,
+    ps: &mut ParticleSet<T, N>,
+) -> Result<BondSet<T, B>, StepError> {
     let Helix {
         pos,
         radius,
         length,
-    } = helix(B).ok_or(StepError::StateLength)?;
-    for (c, &a) in pos.iter().zip(&radius) {
+    } = h;
+    for (c, &a) in pos.iter().zip(radius) {
         let p = Particle::new(T::v3_from(*c), T::from_f64(a), T::from_f64(DENSITY));
         ps.push(p).map_err(|(_, e)| e)?;
     }
@@ -317,7 +326,12 @@ where
             Hex(o.report.residual),
             Hex(o.report.max_tension)
         ),
-        Err(e) => writeln!(w, "failed at step {}: {}", e.step, error_name(&e.error)),
+        Err(e) => {
+            // `write_str`, not `{}`: a `&str` through `{}` links core's padding code.
+            write!(w, "failed at step {}: ", e.step)?;
+            w.write_str(error_name(&e.error))?;
+            w.write_str("\n")
+        }
     }
 }
 
