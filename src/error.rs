@@ -184,6 +184,9 @@ pub enum StepError {
         /// The largest stable step for this configuration.
         limit: f64,
     },
+    /// The combination asked for is not implemented (named): for example thermal noise
+    /// with a method other than `Overdamped`, or without a stored mobility.
+    Unsupported(&'static str),
 }
 
 impl fmt::Display for ParticleError {
@@ -283,6 +286,7 @@ impl fmt::Display for StepError {
                 f,
                 "explicit drag unstable: dt = {dt:e} exceeds the stability limit {limit:e}"
             ),
+            Self::Unsupported(what) => write!(f, "not supported: {what}"),
         }
     }
 }

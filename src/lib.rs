@@ -28,6 +28,7 @@ pub mod forces;
 pub mod integrate;
 pub mod linalg;
 pub mod mobility;
+pub mod noise;
 pub mod observables;
 pub mod params;
 pub mod particles;
@@ -43,9 +44,10 @@ pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
 pub use forces::{ExternalForce, NoForce, SoftContact};
 /// The vector crate the kernel is written against (re-exported so callers match versions).
 pub use glam;
-pub use integrate::{StepReport, step, step_slices};
+pub use integrate::{StepReport, step, step_slices, step_slices_thermal, step_thermal};
 pub use mobility::Hydro;
-pub use params::{Method, Params};
+pub use noise::Noise;
+pub use params::{Brownian, Drift, Method, Params};
 pub use particles::{Particle, ParticleSet, State};
 pub use real::Real;
 #[cfg(feature = "alloc")]

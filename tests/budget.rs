@@ -68,6 +68,15 @@ fn paper_chain_fits_the_budgets() {
         "| Overdamped matrix-free | false | {} | {mf64} | - |",
         free(mf.bytes::<f32>())
     );
+    // Thermal noise (issue 12): the Cholesky factor and the midpoint's vectors on top.
+    let th = Layout::new(Method::Overdamped, false, N, B).thermal(Method::Overdamped, N, B);
+    let th64 = core::mem::size_of::<ParticleSet<f64, N>>()
+        + core::mem::size_of::<BondSet<f64, B>>()
+        + th.bytes::<f64>();
+    eprintln!(
+        "| Overdamped thermal | false | {} | {th64} | - |",
+        free(th.bytes::<f32>())
+    );
     assert!(over.is_empty(), "over budget: {over:?}");
 }
 

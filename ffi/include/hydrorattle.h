@@ -52,6 +52,8 @@ enum HrStatus
   HR_STATUS_STATE_LENGTH = 11,
   // `StepError::Unstable`.
   HR_STATUS_UNSTABLE = 12,
+  // `StepError::Unsupported`: the combination of parameters is not implemented.
+  HR_STATUS_UNSUPPORTED = 13,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L

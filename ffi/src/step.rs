@@ -332,5 +332,6 @@ fn describe<T>(e: StepError, r: &mut HrReport<T>) -> HrStatus {
             (r.error_value, r.error_limit) = (dt, limit);
             HrStatus::Unstable
         }
+        StepError::Unsupported(_) => HrStatus::Unsupported,
     }
 }

@@ -47,6 +47,8 @@ pub enum HrStatus {
     StateLength = 11,
     /// `StepError::Unstable`.
     Unstable = 12,
+    /// `StepError::Unsupported`: the combination of parameters is not implemented.
+    Unsupported = 13,
 }
 
 /// Values of [`HrParams::method`] (the kernel's `Method`).

@@ -9,11 +9,13 @@
 //! `integrate/stable.rs` (implicit drag, optional rotation), `integrate/springs.rs`.
 //! This file holds `step` and the stages they share.
 
+mod brownian;
 mod overdamped;
 mod rattle;
 mod springs;
 mod stable;
 
+use brownian::overdamped_thermal;
 use overdamped::{overdamped, overdamped2};
 use rattle::rattle_explicit;
 use springs::springs;
@@ -25,6 +27,7 @@ use crate::error::{ParticleError, StepError};
 use crate::forces::ExternalForce;
 use crate::linalg;
 use crate::mobility::{self, Hydro};
+use crate::noise::Noise;
 use crate::params::{Method, Params};
 use crate::particles::{ParticleSet, State, sphere_volume};
 use crate::real::Real;
@@ -82,9 +85,50 @@ pub fn step_slices<T: Real, E: ExternalForce<T>>(
     ws: &mut Workspace<'_, T>,
     ext: &mut E,
 ) -> Result<StepReport<T>, StepError> {
+    advance(state, bonds, p, ws, ext, None)
+}
+
+/// [`step`] with thermal noise ([`Params::brownian`]) drawn from the caller's generator.
+pub fn step_thermal<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
+    ps: &mut ParticleSet<T, N>,
+    bonds: &BondSet<T, B>,
+    p: &Params<T>,
+    ws: &mut Workspace<'_, T>,
+    ext: &mut E,
+    noise: &mut Noise,
+) -> Result<StepReport<T>, StepError> {
+    advance(ps.state(), bonds.as_slice(), p, ws, ext, Some(noise))
+}
+
+/// [`step_slices`] with thermal noise ([`Params::brownian`]) drawn from the caller's
+/// generator. The step draws from a copy of `noise` and stores the copy only when it
+/// succeeds: a refused step leaves the state and the generator as they were. With no
+/// [`Params::brownian`], or a zero temperature, this is [`step_slices`] bit for bit and
+/// draws nothing.
+pub fn step_slices_thermal<T: Real, E: ExternalForce<T>>(
+    state: State<'_, T>,
+    bonds: &[Bond<T>],
+    p: &Params<T>,
+    ws: &mut Workspace<'_, T>,
+    ext: &mut E,
+    noise: &mut Noise,
+) -> Result<StepReport<T>, StepError> {
+    advance(state, bonds, p, ws, ext, Some(noise))
+}
+
+/// The stages of every step; `noise` is the generator of a thermal step.
+fn advance<T: Real, E: ExternalForce<T>>(
+    state: State<'_, T>,
+    bonds: &[Bond<T>],
+    p: &Params<T>,
+    ws: &mut Workspace<'_, T>,
+    ext: &mut E,
+    noise: Option<&mut Noise>,
+) -> Result<StepReport<T>, StepError> {
     let n = state.len();
     // 1. Inputs and storage.
     check_inputs(&state, bonds, p)?;
+    let thermal = check_thermal(p, noise.is_some())?;
     let s = Start {
         pos: state.pos,
         vel: state.vel,
@@ -92,15 +136,19 @@ pub fn step_slices<T: Real, E: ExternalForce<T>>(
         radius: state.radius,
         density: state.density,
     };
-    // 2. Integrate into the workspace.
+    // 2. Integrate into the workspace (a thermal step draws from a copy of the generator).
+    let mut drawn = noise.as_deref().cloned();
     let integrated = {
         let v = ws.views(p, n, bonds.len())?;
-        match p.method {
-            Method::Overdamped => overdamped(p, &s, bonds, v, ext),
-            Method::Overdamped2 => overdamped2(p, &s, bonds, v, ext),
-            Method::Rattle => rattle_explicit(p, &s, bonds, v, ext),
-            Method::RattleStable => rattle_stable(p, &s, bonds, v, ext),
-            Method::Springs => springs(p, &s, bonds, v, ext),
+        match (p.method, thermal, drawn.as_mut()) {
+            (Method::Overdamped, Some(b), Some(g)) => {
+                overdamped_thermal(p, b, &s, bonds, v, ext, g)
+            }
+            (Method::Overdamped, ..) => overdamped(p, &s, bonds, v, ext),
+            (Method::Overdamped2, ..) => overdamped2(p, &s, bonds, v, ext),
+            (Method::Rattle, ..) => rattle_explicit(p, &s, bonds, v, ext),
+            (Method::RattleStable, ..) => rattle_stable(p, &s, bonds, v, ext),
+            (Method::Springs, ..) => springs(p, &s, bonds, v, ext),
         }
     };
     // 3. Accept. The candidate state heads the vector storage (see `Workspace::views`).
@@ -117,12 +165,52 @@ pub fn step_slices<T: Real, E: ExternalForce<T>>(
         report.velocity_iterations
     );
     report.residual = max_residual(bonds, new_pos).1;
-    // 4. Commit.
+    // 4. Commit (the generator too, if it was drawn from).
     state.pos.copy_from_slice(new_pos);
     state.vel.copy_from_slice(new_vel);
     state.omega.copy_from_slice(new_omega);
     *state.time += p.dt;
+    if let (Some(g), Some(d)) = (noise, drawn) {
+        if thermal.is_some() {
+            *g = d;
+        }
+    }
     Ok(report)
+}
+
+/// The thermal settings when this step has noise (`brownian` with `kT > 0`), after
+/// checking that the temperature is valid and the combination is implemented.
+fn check_thermal<T: Real>(
+    p: &Params<T>,
+    has_generator: bool,
+) -> Result<Option<crate::params::Brownian<T>>, StepError> {
+    let Some(b) = p.brownian else {
+        return Ok(None);
+    };
+    if !(b.temperature >= T::ZERO && b.temperature.is_finite()) {
+        return Err(StepError::BadParameter(
+            "brownian.temperature (finite, >= 0)",
+        ));
+    }
+    if b.temperature == T::ZERO {
+        return Ok(None);
+    }
+    if p.method != Method::Overdamped {
+        return Err(StepError::Unsupported(
+            "thermal noise with a method other than Overdamped",
+        ));
+    }
+    if p.matrix_free {
+        return Err(StepError::Unsupported(
+            "thermal noise without a stored mobility (matrix_free: no Lanczos square root)",
+        ));
+    }
+    if !has_generator {
+        return Err(StepError::Unsupported(
+            "thermal noise without a generator (call step_thermal / step_slices_thermal)",
+        ));
+    }
+    Ok(Some(b))
 }
 
 /// Cheap checks (O(N + B)); pair checks happen in assembly and in [`accept`].

@@ -124,6 +124,12 @@ pub fn cholesky<T: Real>(a: &mut [T::M3], n: usize) -> Result<(), LinalgError> {
 
 /// Solves `L L^T x = b` in place with a factor from [`cholesky`].
 pub fn cholesky_solve<T: Real>(l: &[T::M3], n: usize, x: &mut [T::V3]) {
+    solve_lower::<T>(l, n, x);
+    solve_upper::<T>(l, n, x);
+}
+
+/// Solves `L y = b` in place with a factor from [`cholesky`] (forward substitution).
+pub fn solve_lower<T: Real>(l: &[T::M3], n: usize, x: &mut [T::V3]) {
     for i in 0..n {
         let ri = tri(i);
         let mut acc = x[i];
@@ -132,11 +138,29 @@ pub fn cholesky_solve<T: Real>(l: &[T::M3], n: usize, x: &mut [T::V3]) {
         }
         x[i] = l[ri + i] * acc;
     }
+}
+
+/// Solves `L^T x = y` in place with a factor from [`cholesky`] (back substitution):
+/// with `y` standard normal, `x = L^-T y` has covariance `A^-1`.
+pub fn solve_upper<T: Real>(l: &[T::M3], n: usize, x: &mut [T::V3]) {
     for i in (0..n).rev() {
         let mut acc = x[i];
         for k in i + 1..n {
             acc -= T::m3_tmul(l[tri(k) + i], x[k]);
         }
         x[i] = T::m3_tmul(l[tri(i) + i], acc);
+    }
+}
+
+/// `y = L x` with a factor from [`cholesky`] (whose diagonal blocks hold `L_ii^-1`):
+/// with `x` standard normal, `y` has covariance `A = L L^T`.
+pub fn lower_mul<T: Real>(l: &[T::M3], n: usize, x: &[T::V3], y: &mut [T::V3]) {
+    for i in 0..n {
+        let ri = tri(i);
+        let mut acc = inv_lower3::<T>(l[ri + i]) * x[i];
+        for k in 0..i {
+            acc += l[ri + k] * x[k];
+        }
+        y[i] = acc;
     }
 }

@@ -114,10 +114,33 @@ impl Layout {
     /// matrix-free flag), `n` particles and `bonds` bonds.
     pub const fn for_params<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Self {
         let l = Self::with_solver(p.method, p.rotation, p.solver.kind, n, bonds);
+        let l = if p.brownian.is_some() {
+            l.thermal(p.method, n, bonds)
+        } else {
+            l
+        };
         if p.matrix_free {
             l.matrix_free(p.method, p.solver.kind, n, bonds)
         } else {
             l
+        }
+    }
+
+    /// This layout with room for thermal noise ([`Params::brownian`]), for the method
+    /// that takes it (`Overdamped`; unchanged for the others): the mobility's Cholesky
+    /// factor, later the mobility at the midpoint (`tri(n)` blocks), the noise
+    /// displacement (`n` vectors), the bond vectors at the midpoint (`B` vectors) and
+    /// the midpoint projection's multipliers (`B` scalars). The normal deviates and the
+    /// midpoint itself live in the candidate velocities and spins until those are written.
+    pub const fn thermal(self, method: Method, n: usize, bonds: usize) -> Self {
+        match method {
+            Method::Overdamped => Self {
+                blocks: self.blocks + tri(n),
+                vectors: self.vectors + n + bonds,
+                scalars: self.scalars + bonds,
+                ..self
+            },
+            _ => self,
         }
     }
 

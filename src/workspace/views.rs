@@ -71,7 +71,11 @@ impl<T: Real> Workspace<'_, T> {
         let stored = !(p.matrix_free && matches!(method, Method::Overdamped | Method::Springs));
         // The dense solvers' table of displacements (see `Layout::with_solver`).
         let table = if krylov || !stored { 0 } else { n * nb };
+        // Thermal noise (`Layout::thermal`): the factor, one vector array, the midpoint's
+        // bond vectors and multipliers.
+        let thermal = p.brownian.is_some();
         let (mats, work, extra_bonds, inv_mass, sqrt_m, disp) = match method {
+            Method::Overdamped if thermal => (2, [n, n, 0], nb, 0, 0, table),
             Method::Overdamped => (1, [n, 0, 0], 0, 0, 0, table),
             Method::Springs => (1, [n, 0, 0], 0, 0, 0, 0),
             Method::Overdamped2 => (2, [n, n, n], nb, 0, 0, table),

@@ -188,6 +188,7 @@ pub const fn params_f32(method: Method, rotation: bool) -> Params<f32> {
         allow_overlap: true,
         spring_stiffness: 1e3,
         stability_guard: false,
+        brownian: None,
     }
 }
 
@@ -375,5 +376,6 @@ pub fn error_name(e: &StepError) -> &'static str {
         StepError::Storage { .. } => "Storage",
         StepError::StateLength => "StateLength",
         StepError::Unstable { .. } => "Unstable",
+        StepError::Unsupported(what) => what,
     }
 }

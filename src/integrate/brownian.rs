@@ -1,0 +1,119 @@
+//! Overdamped HydroSHAKE with thermal noise (constrained Brownian dynamics).
+//!
+//! The unconstrained move gets a displacement with covariance `2 kT dt mu`, drawn as
+//! `L xi` with `L L^T = mu` (block Cholesky of the packed mobility) and `xi` standard
+//! normal; the constraint projection then runs as in the deterministic step. What the
+//! constrained motion also needs is the Ito drift `kT div(P mu)`, `P mu` the mobility
+//! projected onto the constraints (`P = I - mu G^T (G mu G^T)^-1 G`):
+//!
+//! * [`Drift::Midpoint`] gets it from a Fixman-type midpoint. With
+//!   `x~ = x + sqrt(kT dt / 2) L xi`, the noise `sqrt(2 kT dt) P(x~) mu(x~) L^-T xi` has
+//!   covariance `2 kT dt P mu` to leading order (`L^-T L^-1 = mu^-1`) and mean
+//!   `kT dt d_k (P mu)_ik` (`E[(L xi)_k (L^-T xi)_j] = delta_kj`). `P(x~) mu(x~) v` is a
+//!   linear constraint solve at `x~`: `v` through `mu(x~)`, minus the part that changes
+//!   a bond length at `x~`.
+//! * [`Drift::Uncorrected`] adds `sqrt(2 kT dt) L xi` and nothing else.
+//!
+//! The RPY mobility (and Oseen's, and free draining) has zero divergence in free space,
+//! so the unconstrained drift `kT div mu` vanishes: no term for it here. The midpoint
+//! would supply it anyway (it differentiates `P mu` as a whole).
+
+use super::{
+    Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors, mobility_metric,
+    mobility_product, project_positions, report, spin, step_velocity,
+};
+use crate::bonds::Bond;
+use crate::constraints::{self, Problem};
+use crate::error::{Stage, StepError};
+use crate::forces::{self, ExternalForce};
+use crate::linalg;
+use crate::noise::Noise;
+use crate::params::{Brownian, Drift, Params};
+use crate::real::Real;
+use crate::workspace::Views;
+
+/// One overdamped step with thermal noise at `b.temperature > 0` (stored mobility).
+pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
+    p: &Params<T>,
+    b: Brownian<T>,
+    s: &Start<'_, T>,
+    bonds: &[Bond<T>],
+    v: Views<'_, T>,
+    ext: &mut E,
+    noise: &mut Noise,
+) -> Result<StepReport<T>, StepError> {
+    let (n, dt, kt) = (s.pos.len(), p.dt, b.temperature);
+    // The normal deviates and the midpoint borrow the candidate velocities and spins,
+    // which are written only at the end.
+    let Views {
+        mu,
+        fac,
+        force,
+        work_a: u,
+        work_b: dx,
+        new_pos,
+        new_vel: xi,
+        new_omega: mid,
+        grad,
+        grad_new: grad_mid,
+        disp,
+        lambda,
+        kappa,
+        mut scratch,
+        ..
+    } = v;
+    // Deterministic velocity at the start: U_inf + mu F.
+    forces::external(p, s.pos, s.radius, s.density, ext, force)?;
+    mobility_product(p, s.pos, s.radius, mu, force, u)?;
+    add_flow(p, s.pos, u);
+    // L L^T = mu.
+    fac.copy_from_slice(mu);
+    linalg::cholesky::<T>(fac, n).map_err(|error| StepError::Linalg {
+        stage: Stage::Mobility,
+        error,
+    })?;
+    noise.fill::<T>(xi);
+    let amplitude = (T::TWO * kt * dt).sqrt();
+    match b.drift {
+        Drift::Uncorrected => {
+            linalg::lower_mul::<T>(fac, n, xi, dx);
+            for d in dx.iter_mut() {
+                *d *= amplitude;
+            }
+        }
+        Drift::Midpoint => {
+            // x~ = x + sqrt(kT dt / 2) L xi; then xi <- sqrt(2 kT dt) L^-T xi.
+            linalg::lower_mul::<T>(fac, n, xi, mid);
+            let half = (kt * dt * T::HALF).sqrt();
+            for (m, &r) in mid.iter_mut().zip(s.pos) {
+                *m = r + *m * half;
+            }
+            linalg::solve_upper::<T>(fac, n, xi);
+            for z in xi.iter_mut() {
+                *z *= amplitude;
+            }
+            // dx = P(x~) mu(x~) xi: the factor's storage takes mu(x~).
+            assemble_tt(p, mid, s.radius, fac)?;
+            linalg::sym_matvec::<T>(fac, n, xi, dx);
+            bond_vectors(bonds, mid, grad_mid);
+            kappa.fill(T::ZERO);
+            let metric = mobility_metric(p, bonds, mid, s.radius, fac, grad_mid, T::ONE, disp);
+            let problem = Problem::Velocities {
+                bond: grad_mid,
+                dt: T::ONE,
+            };
+            constraints::solve(problem, &metric, bonds, &p.solver, dx, kappa, &mut scratch)?;
+        }
+    }
+    // r* = r + dt (U_inf + mu F) + noise, projected as in the deterministic step.
+    for i in 0..n {
+        new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
+    }
+    bond_vectors(bonds, s.pos, grad);
+    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu, grad, dt, disp);
+    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut scratch)?;
+    step_velocity(s.pos, new_pos, dt, xi);
+    add_constraint_forces(bonds, grad, lambda, force);
+    spin(p, s.pos, s.radius, force, mid)?;
+    Ok(report(stats, 0, bonds, lambda))
+}
