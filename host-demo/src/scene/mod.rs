@@ -20,6 +20,7 @@
 //! | `[model]` | `hydrodynamics = "rpy"\|"oseen"\|"free-draining"`, `inertia`, `rotation`, `level = "auto"\|"manual"`, `overlap = "reject"\|"allow"` | rpy, false, false, manual, allow |
 //! | `[integrator]` | `method` (required), `dt` (required), `duration` (required), `solver = "auto"\|"sweep"\|"newton"\|"krylov"`, `tolerance`, `max_iterations`, `precision = "f32"\|"f64"`, `stiffness` | auto, 1e-10, 500, f64, 1e4 |
 //! | `[output]` | `every` (steps between trajectory frames, >= 1) | about [`TARGET_FRAMES`] frames |
+//! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
 //!
 //! A scene gives either a `[helix]` table or explicit `[[particle]]` (and optionally
 //! `[[bond]]`) tables, never both. Units are those of `DESIGN.md` section 4: tail radius
@@ -43,6 +44,7 @@ mod raw;
 mod resolve;
 #[cfg(test)]
 mod tests;
+mod thermal;
 
 pub use error::{SceneError, line_col};
 pub use helix::{Chain, HeadEnd, Helix};
@@ -50,6 +52,7 @@ pub use model::{
     Bond, Flow, Fluid, Hydrodynamics, Integrator, Level, Method, Model, Output, Overlap, Particle,
     Precision, Solver,
 };
+pub use thermal::{DEFAULT_SEED, Drift, Thermal};
 
 use serde::Serialize;
 use std::path::Path;
@@ -125,6 +128,8 @@ pub struct Scene {
     /// Soft excluded-volume stiffness (`[contact] stiffness`); `None`: spheres may
     /// pass through each other, as in the paper.
     pub contact: Option<f64>,
+    /// Thermal noise (`[brownian]`); `None`: deterministic.
+    pub brownian: Option<Thermal>,
 }
 
 impl Scene {

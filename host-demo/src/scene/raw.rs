@@ -24,6 +24,7 @@ pub(super) struct RawScene {
     pub(super) integrator: S<RawIntegrator>,
     pub(super) output: Option<RawOutput>,
     pub(super) contact: Option<RawContact>,
+    pub(super) brownian: Option<super::thermal::RawBrownian>,
 }
 
 #[derive(Deserialize)]

@@ -69,6 +69,10 @@ impl RawScene {
             ));
         };
         let integrator = resolve_integrator(raw_int.get_ref())?;
+        let brownian = match &self.brownian {
+            None => None,
+            Some(b) => Some(b.resolve(&model, &integrator)?),
+        };
         let every = match self.output.as_ref().and_then(|o| o.every.as_ref()) {
             None => integrator.steps().div_ceil(TARGET_FRAMES).max(1),
             Some(e) if *e.get_ref() == 0 => {
@@ -150,6 +154,7 @@ impl RawScene {
             integrator,
             output: Output { every },
             contact,
+            brownian,
         })
     }
 }

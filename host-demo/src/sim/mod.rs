@@ -17,14 +17,16 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use hydrorattle::observables::{self, Thresholds, Twist};
-use hydrorattle::{Buffers, Hydro, Params, Real, SoftContact, Solver as KSolver, step_slices};
+use hydrorattle::{
+    Buffers, Hydro, Noise, Params, Real, SoftContact, Solver as KSolver, step_slices_thermal,
+};
 use serde::Serialize;
 
 use crate::output::write_json;
 use crate::progress::Progress;
 use crate::render::Snapshot;
-use crate::scene::{Hydrodynamics, Precision, Scene};
-use crate::sizing::{DEFAULT_LIMIT, Plan};
+use crate::scene::{DEFAULT_SEED, Hydrodynamics, Precision, Scene};
+use crate::sizing::{DEFAULT_LIMIT, Plan, TooLarge};
 use record::Recorder;
 
 /// What `summary.json` holds.
@@ -146,6 +148,10 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     // The paper's explicit drag can shiver silently (bounded, wrong) beyond its limit:
     // the demo refuses such steps up front.
     p.stability_guard = true;
+    p.brownian = scene.brownian.map(|b| hydrorattle::Brownian {
+        temperature: T::from_f64(b.temperature),
+        drift: b.drift.kernel(),
+    });
     p
 }
 
@@ -185,6 +191,24 @@ fn prepare<T: Real>(scene: &Scene, p: &Params<T>, limit: usize) -> Result<Prepar
     let (n, b) = (scene.particles.len(), scene.bonds.len());
     // Sized first: an oversized scene is refused before any O(N^2) work.
     let layout = Plan::of(scene).check(n, b, limit)?;
+    // Thermal noise needs the mobility's factor on top (`Layout::thermal`).
+    let layout = match scene.brownian {
+        Some(_) => {
+            let l = layout.thermal(p.method, n, b);
+            let bytes = l.bytes::<T>();
+            if bytes > limit {
+                return Err(TooLarge {
+                    particles: n,
+                    bonds: b,
+                    bytes: Some(bytes),
+                    limit,
+                }
+                .into());
+            }
+            l
+        }
+        None => layout,
+    };
     let beads = Beads::<T>::new(&scene.particles, 1.0)?;
     beads.check_pairs(p.allow_overlap)?;
     Ok(Prepared {
@@ -212,6 +236,7 @@ fn run_t<T: Real>(
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     let mut ws = store.workspace();
+    let mut noise = Noise::new(scene.brownian.map_or(DEFAULT_SEED, |b| b.seed));
     let contact = scene.contact.map(|k| SoftContact {
         stiffness: T::from_f64(k),
     });
@@ -244,7 +269,7 @@ fn run_t<T: Real>(
     let start = Instant::now();
     let (mut done, mut failure, mut total_iterations) = (0usize, None, 0u64);
     for s in 1..=steps {
-        match step_slices(beads.state(), &bonds, &p, &mut ws, &mut ext) {
+        match step_slices_thermal(beads.state(), &bonds, &p, &mut ws, &mut ext, &mut noise) {
             Ok(rep) => {
                 done = s;
                 total_iterations += u64::from(rep.iterations);

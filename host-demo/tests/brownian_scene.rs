@@ -1,0 +1,73 @@
+//! `[brownian]` scene keys (issue 12): parsed with their defaults, and a run is fixed by
+//! its seed (same seed same bits in f32 and f64; another seed another run; `kT = 0` the
+//! deterministic run).
+
+use host_demo::scene::{Drift, Precision, Scene, Thermal};
+use host_demo::sim::{RunOptions, run};
+
+const SHIPPED: &str = include_str!("../scenes/brownian_chain.toml");
+
+/// The shipped Brownian scene with its `[brownian]` table replaced by `table` (none
+/// when empty) and the given precision.
+fn scene(table: &str, precision: &str) -> Scene {
+    let body = SHIPPED.split("[brownian]").next().unwrap();
+    let body = body.replace(
+        "precision = \"f64\"",
+        &format!("precision = \"{precision}\""),
+    );
+    Scene::parse(&format!("{body}{table}"), "test").unwrap()
+}
+
+fn last(scene: &Scene) -> Vec<[f64; 3]> {
+    let opts = RunOptions {
+        max_steps: Some(40),
+        ..Default::default()
+    };
+    let r = run(scene, "test", None, opts).unwrap();
+    assert_eq!(r.summary.failure, None);
+    r.last.positions
+}
+
+#[test]
+fn keys_and_defaults() {
+    let s = Scene::parse(SHIPPED, "shipped").unwrap();
+    assert_eq!(
+        s.brownian,
+        Some(Thermal {
+            temperature: 0.5,
+            seed: 7,
+            drift: Drift::Midpoint
+        })
+    );
+    let s = scene("[brownian]\ntemperature = 2.0\n", "f64");
+    assert_eq!(
+        s.brownian.map(|b| (b.seed, b.drift)),
+        Some((1, Drift::Midpoint))
+    );
+    assert_eq!(scene("", "f64").brownian, None);
+    assert_eq!(s.integrator.precision, Precision::F64);
+}
+
+#[test]
+fn the_seed_fixes_the_run() {
+    for precision in ["f32", "f64"] {
+        let with = |seed: u64| {
+            scene(
+                &format!("[brownian]\ntemperature = 0.5\nseed = {seed}\n"),
+                precision,
+            )
+        };
+        let a = last(&with(7));
+        assert_eq!(a, last(&with(7)), "{precision}: same seed, different runs");
+        assert_ne!(a, last(&with(8)), "{precision}: another seed, same run");
+        let cold = last(&scene(
+            "[brownian]\ntemperature = 0.0\nseed = 7\n",
+            precision,
+        ));
+        assert_eq!(
+            cold,
+            last(&scene("", precision)),
+            "{precision}: kT = 0 is not deterministic"
+        );
+    }
+}
