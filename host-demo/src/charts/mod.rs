@@ -4,10 +4,14 @@
 //! * `accuracy`: work-precision and model levels;
 //! * `stability`: where each method fails (explicit drag, springs, solvers), with
 //!   `cube` (Oseen's lost positive definiteness) and `precision` (f32 against f64);
-//! * `springs`: the paper's claim, springs against constraints at equal bond error.
+//! * `springs`: the paper's claim, springs against constraints at equal bond error;
+//! * `brownian`, `peclet`: thermal noise checked against exact results, and what it
+//!   does to Figure 1 (c).
 
 mod accuracy;
+mod brownian;
 mod cube;
+mod peclet;
 mod precision;
 mod springs;
 mod stability;
@@ -240,5 +244,9 @@ pub fn charts(out: &Path, quick: bool) -> Result<Vec<String>> {
     log::info!("models done in {:.1} s", t.elapsed().as_secs_f64());
     notes.push(stability::stability(out, quick)?);
     notes.push(springs::springs_vs_constraints(out, quick)?);
+    notes.push(brownian::trimer(out, quick)?);
+    notes.push(brownian::dimer(out, quick)?);
+    notes.push(peclet::peclet(out, quick)?);
+    log::info!("Brownian charts done in {:.1} s", t.elapsed().as_secs_f64());
     Ok(notes)
 }
