@@ -13,6 +13,7 @@ pub mod figure1;
 pub mod output;
 pub mod phase;
 pub mod progress;
+pub mod provenance;
 pub mod render;
 pub mod scene;
 pub mod sim;

@@ -3,8 +3,8 @@
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use host_demo::scene::Scene;
-use host_demo::sim::RunOptions;
-use host_demo::sizing::{DEFAULT_LIMIT, limit_from_gib};
+use host_demo::sim::{RunOptions, Start, Summary};
+use host_demo::sizing::{DEFAULT_LIMIT, DEFAULT_OUTPUT_LIMIT, Limits, limit_from_gib};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -34,6 +34,32 @@ enum Command {
         /// anything is built (storage grows as the square of the bead count).
         #[arg(long, default_value_t = (DEFAULT_LIMIT >> 30) as f64, value_name = "GIB", value_parser = gib)]
         max_storage: f64,
+        /// Largest trajectory output allowed, GiB: a scene whose frames would need more
+        /// is refused while it is read (at its `every` or `duration` line).
+        #[arg(long, default_value_t = (DEFAULT_OUTPUT_LIMIT >> 30) as f64, value_name = "GIB", value_parser = gib)]
+        max_output: f64,
+        /// Write DIR/checkpoint.json every T of simulated time (rounded to whole steps),
+        /// for `host-demo resume`.
+        #[arg(long, value_name = "T", value_parser = positive)]
+        checkpoint_every: Option<f64>,
+    },
+    /// Continue a run from its checkpoint (DIR/checkpoint.json, DIR/scene.toml) to a
+    /// later time: the same bytes as one run to that time.
+    Resume {
+        /// The output directory of the run.
+        dir: PathBuf,
+        /// Simulated time to run to.
+        #[arg(long, value_name = "T", value_parser = positive)]
+        until: f64,
+        /// Keep writing checkpoints every T of simulated time.
+        #[arg(long, value_name = "T", value_parser = positive)]
+        checkpoint_every: Option<f64>,
+        /// As for `run`.
+        #[arg(long, default_value_t = (DEFAULT_LIMIT >> 30) as f64, value_name = "GIB", value_parser = gib)]
+        max_storage: f64,
+        /// As for `run`.
+        #[arg(long, default_value_t = (DEFAULT_OUTPUT_LIMIT >> 30) as f64, value_name = "GIB", value_parser = gib)]
+        max_output: f64,
     },
     /// Reproduce the paper's Figure 1: three helical chains settling.
     Figure1 {
@@ -91,9 +117,11 @@ fn run(cli: Cli) -> Result<()> {
             scene: scene_path,
             out,
             max_storage,
+            max_output,
+            checkpoint_every,
         } => {
-            let limit = limit_from_gib(max_storage).unwrap_or(DEFAULT_LIMIT);
-            let scene = Scene::from_path_within(&scene_path, limit)?;
+            let limits = limits(max_storage, max_output);
+            let scene = Scene::from_path_limited(&scene_path, limits)?;
             log::info!(
                 "scene: {} particles, {} bonds, {:?}, {} steps",
                 scene.particles.len(),
@@ -102,32 +130,25 @@ fn run(cli: Cli) -> Result<()> {
                 scene.integrator.steps()
             );
             let name = scene_name(&scene_path);
-            let r = host_demo::sim::run(
-                &scene,
-                &name,
-                Some(&out),
-                RunOptions {
-                    progress: true,
-                    max_steps: None,
-                    max_storage: limit,
-                },
-            )?;
-            let s = &r.summary;
-            println!(
-                "{name}: {} of {} steps in {:.2} s ({:.0} steps/s); outcome {}; extension {:.3}, verticality {:.3}, twist rate {:.4}; wrote {}",
-                s.steps_done,
-                s.steps,
-                s.wall_time_s,
-                s.steps_per_second,
-                s.outcome,
-                s.final_observables.extension,
-                s.final_observables.verticality,
-                s.twist_rate,
-                out.display()
-            );
-            if let Some(f) = &s.failure {
-                anyhow::bail!("{name}: the run stopped early: {f}");
-            }
+            let opts = file_run(limits, checkpoint_every);
+            let start = Start {
+                scene_path: Some(scene_path),
+                checkpoint: None,
+            };
+            let r = host_demo::sim::run_from(&scene, &name, Some(&out), opts, start)?;
+            report(&name, &r.summary, &out)?;
+        }
+        Command::Resume {
+            dir,
+            until,
+            checkpoint_every,
+            max_storage,
+            max_output,
+        } => {
+            let limits = limits(max_storage, max_output);
+            let opts = file_run(limits, checkpoint_every);
+            let r = host_demo::sim::resume(&dir, until, limits, opts)?;
+            report(&r.summary.scene.clone(), &r.summary, &dir)?;
         }
         Command::Figure1 { out, quick } => {
             let s = host_demo::figure1::figure1(&out, quick.then_some(2000))?;
@@ -194,6 +215,53 @@ fn run(cli: Cli) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The limits a scene is read under.
+fn limits(max_storage: f64, max_output: f64) -> Limits {
+    Limits {
+        storage: limit_from_gib(max_storage).unwrap_or(DEFAULT_LIMIT),
+        output: limit_from_gib(max_output).map_or(DEFAULT_OUTPUT_LIMIT, |b| b as u64),
+    }
+}
+
+/// The options of a run from the command line: progress shown, nothing kept in memory.
+fn file_run(limits: Limits, checkpoint_every: Option<f64>) -> RunOptions {
+    RunOptions {
+        progress: true,
+        max_storage: limits.storage,
+        keep_series: false,
+        checkpoint_every,
+        ..RunOptions::default()
+    }
+}
+
+/// Prints a run's one-line report; a run that stopped early is an error.
+fn report(name: &str, s: &Summary, out: &std::path::Path) -> Result<()> {
+    println!(
+        "{name}: {} of {} steps in {:.2} s ({:.0} steps/s); outcome {}; extension {:.3}, verticality {:.3}, twist rate {:.4}; wrote {}",
+        s.steps_done,
+        s.steps,
+        s.wall_time_s,
+        s.steps_per_second,
+        s.outcome,
+        s.final_observables.extension,
+        s.final_observables.verticality,
+        s.twist_rate,
+        out.display()
+    );
+    if let Some(f) = &s.failure {
+        anyhow::bail!("{name}: the run stopped early: {f}");
+    }
+    Ok(())
+}
+
+/// A positive, finite number.
+fn positive(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("expected a positive number, not {s:?}")),
+    }
 }
 
 /// A positive number of GiB.

@@ -30,6 +30,7 @@ pub fn with_helix(template: &Scene, helix: Helix) -> Result<Scene> {
             position: chain.positions[k],
             radius: chain.radii[k],
             density: chain.densities[k],
+            ..Particle::default()
         })
         .collect();
     s.bonds = chain
@@ -64,23 +65,9 @@ fn run_quiet(scene: &Scene, name: &str, max_steps: Option<usize>) -> Summary {
 
 fn failed_summary(scene: &Scene, name: &str, why: &str) -> Summary {
     Summary {
-        scene: name.to_string(),
-        particles: scene.particles.len(),
-        bonds: scene.bonds.len(),
-        model: scene.model,
-        integrator: scene.integrator,
-        tolerance_used: scene.integrator.tolerance,
-        contact_stiffness: scene.contact.unwrap_or(0.0),
-        steps: scene.integrator.steps(),
-        steps_done: 0,
-        wall_time_s: 0.0,
-        steps_per_second: 0.0,
-        mean_iterations: 0.0,
-        final_observables: Default::default(),
-        twist_rate: 0.0,
         outcome: "failed".to_string(),
         failure: Some(why.to_string()),
-        level_choice: None,
+        ..Summary::for_scene(scene, name)
     }
 }
 

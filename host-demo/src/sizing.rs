@@ -16,6 +16,34 @@ use crate::scene::{Method, Precision, Scene, Solver};
 /// method at 4096 beads in f64.
 pub const DEFAULT_LIMIT: usize = 8 << 30;
 
+/// Default limit on a run's trajectory files (`run --max-output`), bytes: 64 GiB.
+pub const DEFAULT_OUTPUT_LIMIT: u64 = 64 << 30;
+
+/// What a scene may ask for, checked while it is read: step storage and output size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// Step storage, bytes.
+    pub storage: usize,
+    /// Trajectory files (extended XYZ, GSD, observables), bytes.
+    pub output: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            storage: DEFAULT_LIMIT,
+            output: DEFAULT_OUTPUT_LIMIT,
+        }
+    }
+}
+
+/// Bytes one trajectory frame of `n` particles takes at most, in every file of a run:
+/// an extended XYZ line of 15 numbers of up to 24 characters per particle, 24 bytes
+/// per particle in GSD, and a row of observables.
+pub fn frame_bytes(n: usize) -> f64 {
+    n as f64 * (15.0 * 24.0 + 24.0) + 600.0
+}
+
 /// Largest particle or bond count the storage arithmetic takes. Far beyond any limit
 /// (storage there is about 1e17 bytes), and small enough that no count of the kernel's
 /// [`Layout`] nor its byte total overflows.
@@ -38,12 +66,12 @@ const GIB: f64 = (1u64 << 30) as f64;
 
 impl fmt::Display for TooLarge {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (n, b, limit) = (self.particles, self.bonds, human(self.limit));
+        let (n, b, limit) = (self.particles, self.bonds, human(self.limit as u64));
         match self.bytes {
             Some(bytes) => write!(
                 f,
                 "{n} particles and {b} bonds need {} of step storage, over the limit of {limit}",
-                human(bytes)
+                human(bytes as u64)
             )?,
             None => write!(
                 f,
@@ -58,7 +86,7 @@ impl fmt::Display for TooLarge {
 }
 
 /// `bytes` in the largest binary unit that leaves at least 1.
-fn human(bytes: usize) -> String {
+pub fn human(bytes: u64) -> String {
     const UNITS: [&str; 7] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
     let (mut x, mut u) = (bytes as f64, 0);
     while x >= 1024.0 && u + 1 < UNITS.len() {
@@ -177,10 +205,10 @@ mod tests {
 
     #[test]
     fn sizes_read_in_binary_units() {
-        assert_eq!(human(DEFAULT_LIMIT), "8.0 GiB");
+        assert_eq!(human(DEFAULT_LIMIT as u64), "8.0 GiB");
         assert_eq!(human(1536), "1.5 KiB");
         assert_eq!(human(12), "12.0 B");
-        assert_eq!(human(usize::MAX), "16.0 EiB");
+        assert_eq!(human(u64::MAX), "16.0 EiB");
     }
 
     #[test]

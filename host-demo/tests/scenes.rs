@@ -105,8 +105,8 @@ fn figure1_scenes_are_the_papers_cases() {
         assert_eq!(h.dhat, dhat);
         assert!((h.head_ratio - ratio).abs() < 1e-15);
         assert_eq!(scene.particles.len(), 25);
-        assert_eq!(scene.species()[0], "H");
-        assert!(scene.species()[1..].iter().all(|s| *s == "Ta"));
+        assert_eq!(scene.species()[0], "head");
+        assert!(scene.species()[1..].iter().all(|s| *s == "tail"));
         // Soft contact is on, and the explicit step is stable with it:
         // dt k / (3 pi eta a_tail) < 1 (relative mobility of two tails ~ 2/(6 pi eta a)).
         let k = scene.contact.expect("figure 1 scenes use soft contact");

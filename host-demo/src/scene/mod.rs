@@ -14,10 +14,10 @@
 //! | `[fluid]` | `viscosity` (> 0), `density` (>= 0) | 1, 0 |
 //! | `[gravity]` | `acceleration = [x, y, z]` | `[0, 0, -1]` |
 //! | `[flow]` | `velocity = [..]`, `vorticity = [..]` (uniform flow plus rigid rotation) | zeros |
-//! | `[[particle]]` | `position = [..]` (required), `radius` (required, > 0), `density` (>= 0) | density 4.5 |
+//! | `[[particle]]` | `position = [..]` (required), `radius` (required, > 0), `density` (>= 0), `velocity = [..]`, `angular_velocity = [..]`, `species` (a type name) | density 4.5, at rest, one species per radius and density |
 //! | `[[bond]]` | `between = [i, j]` (required, 0-based), `length` (> 0) | initial distance |
 //! | `[helix]` | `tails`, `head_ratio`, `dhat`, `head_end`, `radius`, `pitch`, `density` | see [`Helix`] |
-//! | `[model]` | `hydrodynamics = "rpy"\|"oseen"\|"free-draining"`, `inertia`, `rotation`, `level = "auto"\|"manual"`, `overlap = "reject"\|"allow"` | rpy, false, false, manual, allow |
+//! | `[model]` | `hydrodynamics = "rpy"\|"oseen"\|"free-draining"`, `inertia`, `rotation`, `level = "auto"\|"manual"`, `overlap = "reject"\|"allow"` | rpy, false, false, manual, reject |
 //! | `[integrator]` | `method` (required), `dt` (required), `duration` (required), `solver = "auto"\|"sweep"\|"newton"\|"krylov"`, `tolerance`, `max_iterations`, `precision = "f32"\|"f64"`, `stiffness` | auto, 1e-10, 500, f64, 1e4 |
 //! | `[output]` | `every` (steps between trajectory frames, >= 1) | about [`TARGET_FRAMES`] frames |
 //! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
@@ -31,20 +31,24 @@
 //! its counts, before the helix is generated or any pair checked, at the value that set
 //! the count.
 //!
-//! `overlap` defaults to `"allow"` because the paper's chains have no excluded volume:
-//! only the bonds keep beads apart, and non-bonded beads may touch or overlap (the RPY
-//! tensors have a regularised form for that). `"reject"` refuses a scene whose initial
-//! spheres overlap. A sphere lying wholly inside another is refused either way (the
-//! mobility is not defined for it).
+//! `overlap` is about t = 0 and defaults to `"reject"`: spheres that overlap at the
+//! start are almost always a typing error, so such a scene is refused at the line of
+//! the later sphere unless it says `overlap = "allow"`. During the run spheres may come
+//! to overlap whatever the setting (the paper's chains have no excluded volume; the RPY
+//! tensors have a regularised form for it; `[contact]` adds a soft repulsion). A sphere
+//! lying wholly inside another is refused either way (the mobility is not defined for
+//! it).
 
 mod error;
 mod helix;
 mod model;
+mod precision;
 mod raw;
 mod resolve;
 #[cfg(test)]
 mod tests;
 mod thermal;
+mod write;
 
 pub use error::{SceneError, line_col};
 pub use helix::{Chain, HeadEnd, Helix};
@@ -57,7 +61,8 @@ pub use thermal::{DEFAULT_SEED, Drift, Thermal};
 use serde::Serialize;
 use std::path::Path;
 
-use crate::sizing::DEFAULT_LIMIT;
+use crate::output::Topology;
+use crate::sizing::{DEFAULT_LIMIT, Limits};
 use raw::RawScene;
 
 /// Radius of a tail bead of the helix generator: the length unit of the demo scenes.
@@ -130,6 +135,10 @@ pub struct Scene {
     pub contact: Option<f64>,
     /// Thermal noise (`[brownian]`); `None`: deterministic.
     pub brownian: Option<Thermal>,
+    /// Species (type name) of each particle: `head` and `tail` for a helix; the
+    /// `species` key, or one name per distinct radius and density, for explicit
+    /// particles.
+    pub species: Vec<String>,
 }
 
 impl Scene {
@@ -141,14 +150,35 @@ impl Scene {
 
     /// [`from_path`](Self::from_path) with a storage limit of `limit` bytes.
     pub fn from_path_within(path: &Path, limit: usize) -> Result<Scene, SceneError> {
+        Scene::from_path_limited(
+            path,
+            Limits {
+                storage: limit,
+                ..Limits::default()
+            },
+        )
+    }
+
+    /// [`from_path`](Self::from_path) under `limits` (step storage and output size).
+    pub fn from_path_limited(path: &Path, limits: Limits) -> Result<Scene, SceneError> {
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        let error = |location, message| SceneError {
             origin: origin.clone(),
-            location: None,
-            message: format!("cannot read scene file: {e}"),
+            location,
+            message,
             too_large: None,
+        };
+        let bytes =
+            std::fs::read(path).map_err(|e| error(None, format!("cannot read scene file: {e}")))?;
+        let text = std::str::from_utf8(&bytes).map_err(|e| {
+            let valid = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
+            let at = line_col(valid, valid.len());
+            error(
+                Some(at),
+                "the file is not valid UTF-8 here (TOML files are UTF-8, comments too)".into(),
+            )
         })?;
-        Scene::parse_within(&text, &origin, limit)
+        Scene::parse_limited(text, &origin, limits)
     }
 
     /// Parses scene text; `origin` names it in error messages (usually its path).
@@ -160,6 +190,16 @@ impl Scene {
     /// [`parse`](Self::parse) with a storage limit of `limit` bytes, checked before any
     /// bead is generated or any pair is checked.
     pub fn parse_within(text: &str, origin: &str, limit: usize) -> Result<Scene, SceneError> {
+        let limits = Limits {
+            storage: limit,
+            ..Limits::default()
+        };
+        Scene::parse_limited(text, origin, limits)
+    }
+
+    /// [`parse`](Self::parse) under `limits`, checked from the counts before any bead is
+    /// generated or any pair is checked.
+    pub fn parse_limited(text: &str, origin: &str, limits: Limits) -> Result<Scene, SceneError> {
         let raw: RawScene = toml::from_str(text).map_err(|e| {
             let start = e.span().map_or(0, |s| s.start);
             let mut message = e.message().trim_end().replace('\n', " ");
@@ -178,7 +218,7 @@ impl Scene {
                 too_large: None,
             }
         })?;
-        raw.resolve(limit).map_err(|i| SceneError {
+        raw.resolve(limits).map_err(|i| SceneError {
             origin: origin.to_string(),
             location: Some(i.span.map_or((1, 1), |s| line_col(text, s.start))),
             message: i.message,
@@ -209,16 +249,35 @@ impl Scene {
         self.particles.iter().map(|p| p.density).collect()
     }
 
-    /// Species names for trajectory files: `H` for the head and `Ta` for tails of a
-    /// helix, `P` for every particle of an explicit scene. They are chemical element
-    /// symbols because ASE accepts nothing else in the species column (a bare `T`
-    /// makes `ase.io.read` fail); OVITO takes any name.
-    pub fn species(&self) -> Vec<&'static str> {
-        match self.helix {
-            Some(_) => (0..self.particles.len())
-                .map(|i| if i == 0 { "H" } else { "Ta" })
+    /// Species (type name) of each particle.
+    pub fn species(&self) -> Vec<&str> {
+        self.species.iter().map(String::as_str).collect()
+    }
+
+    /// Types, radii, masses and bonds, for the trajectory files. Types are numbered
+    /// in order of first appearance.
+    pub fn topology(&self) -> Topology {
+        let mut types: Vec<String> = Vec::new();
+        // A scene edited in code may have fewer names than particles: the rest are "P".
+        let typeid = (0..self.particles.len())
+            .map(|k| {
+                let s = self.species.get(k).map_or("P", String::as_str);
+                types.iter().position(|t| t == s).unwrap_or_else(|| {
+                    types.push(s.to_string());
+                    types.len() - 1
+                })
+            })
+            .collect();
+        Topology {
+            types,
+            typeid,
+            radius: self.radii(),
+            mass: self
+                .particles
+                .iter()
+                .map(|p| hydrorattle::particles::sphere_volume(p.radius) * p.density)
                 .collect(),
-            None => vec!["P"; self.particles.len()],
+            bonds: self.bonds.iter().map(|b| [b.i, b.j]).collect(),
         }
     }
 }

@@ -21,7 +21,7 @@ pub struct Flow {
 }
 
 /// One rigid sphere.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
 pub struct Particle {
     /// Centre.
     pub position: [f64; 3],
@@ -29,6 +29,11 @@ pub struct Particle {
     pub radius: f64,
     /// Material density (>= 0; > 0 for the inertial methods).
     pub density: f64,
+    /// Initial velocity (the inertial methods start from it; the overdamped ones
+    /// compute velocities from the forces).
+    pub velocity: [f64; 3],
+    /// Initial angular velocity (used with `rotation = true` and inertia).
+    pub angular_velocity: [f64; 3],
 }
 
 /// A rigid bond (holonomic distance constraint) between two particles.
@@ -68,14 +73,17 @@ pub enum Level {
     Manual,
 }
 
-/// What to do with initially overlapping (non-nested) spheres.
+/// What to do with spheres that overlap (without nesting) at t = 0. Overlap at the
+/// start is almost always a typing error, so it is refused unless the scene asks for
+/// it; during the run spheres may come to overlap (the paper's chains have no excluded
+/// volume; `[contact]` adds a soft repulsion).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Overlap {
     /// Refuse the scene.
-    Reject,
-    /// Accept it (the paper has no excluded volume).
     #[default]
+    Reject,
+    /// Accept it.
     Allow,
 }
 

@@ -59,6 +59,9 @@ pub(super) struct RawParticle {
     pub(super) position: Spanned<[f64; 3]>,
     pub(super) radius: Spanned<f64>,
     pub(super) density: S<f64>,
+    pub(super) velocity: S<[f64; 3]>,
+    pub(super) angular_velocity: S<[f64; 3]>,
+    pub(super) species: S<String>,
 }
 
 #[derive(Deserialize)]

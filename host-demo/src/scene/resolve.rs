@@ -15,11 +15,12 @@ use super::{
     Bond, DEFAULT_DENSITY, Flow, Fluid, Helix, Integrator, Level, Model, Output, Overlap, Particle,
     Scene, TARGET_FRAMES,
 };
-use crate::sizing::{Plan, TooLarge};
+use crate::sizing::{Limits, Plan, TooLarge};
 
 impl RawScene {
-    /// The scene, refused when its step storage would exceed `limit` bytes.
-    pub(super) fn resolve(self, limit: usize) -> Result<Scene, Issue> {
+    /// The scene, refused when its step storage or its output would exceed `limits`.
+    pub(super) fn resolve(self, limits: Limits) -> Result<Scene, Issue> {
+        let limit = limits.storage;
         let fluid = match &self.fluid {
             None => Fluid {
                 viscosity: 1.0,
@@ -81,8 +82,14 @@ impl RawScene {
             Some(e) => *e.get_ref(),
         };
         let plans = plans(&model, &integrator, &flow);
+        let every_span = self
+            .output
+            .as_ref()
+            .and_then(|o| o.every.as_ref())
+            .map(|e| e.span());
+        let output_span = every_span.unwrap_or_else(|| raw_int.get_ref().duration.span());
 
-        let (particles, bonds, helix, body_span) = match (&self.helix, &self.particles) {
+        let (particles, bonds, helix, body_span, species) = match (&self.helix, &self.particles) {
             (Some(h), Some(_)) => {
                 return Err(issue(
                     h.span(),
@@ -101,12 +108,15 @@ impl RawScene {
                 let at = h.get_ref().tails.as_ref().map_or(h.span(), |t| t.span());
                 fits(&plans, helix.tails.saturating_add(1), helix.tails, limit)
                     .map_err(|e| too_large(at, e))?;
+                check_output(&integrator, every, helix.tails + 1, limits.output)
+                    .map_err(|m| issue(output_span.clone(), m))?;
                 let chain = helix.generate().map_err(|m| issue(h.span(), m))?;
                 let particles = (0..chain.positions.len())
                     .map(|k| Particle {
                         position: chain.positions[k],
                         radius: chain.radii[k],
                         density: chain.densities[k],
+                        ..Particle::default()
                     })
                     .collect();
                 let bonds = chain
@@ -114,14 +124,21 @@ impl RawScene {
                     .iter()
                     .map(|&(i, j, length)| Bond { i, j, length })
                     .collect();
-                (particles, bonds, Some(helix), BodySpans::Helix(h.span()))
+                let species = (0..=helix.tails)
+                    .map(|k| if k == 0 { "head" } else { "tail" }.to_string())
+                    .collect();
+                let spans = BodySpans::Helix(h.span());
+                (particles, bonds, Some(helix), spans, species)
             }
             (None, Some(ps)) => {
-                let (particles, spans) = resolve_particles(ps)?;
                 let raw_bonds = self.bonds.as_ref().map_or(&[][..], |b| b.get_ref());
                 check_counts(&plans, ps.get_ref(), raw_bonds, limit)?;
-                let bonds = resolve_bonds(self.bonds.as_ref(), &particles)?;
-                (particles, bonds, None, BodySpans::Particles(spans))
+                check_output(&integrator, every, ps.get_ref().len(), limits.output)
+                    .map_err(|m| issue(output_span.clone(), m))?;
+                let (particles, spans, species) = resolve_particles(ps)?;
+                let (bonds, bond_spans) = resolve_bonds(self.bonds.as_ref(), &particles)?;
+                let spans = BodySpans::Particles(spans, bond_spans);
+                (particles, bonds, None, spans, species)
             }
             (None, None) => {
                 return Err(Issue::unplaced(
@@ -131,6 +148,7 @@ impl RawScene {
         };
 
         check_geometry(&particles, model.overlap, &body_span)?;
+        super::precision::check(&particles, &bonds, integrator.precision, &body_span)?;
         if integrator.method.is_inertial() {
             if let Some(k) = particles.iter().position(|p| p.density <= 0.0) {
                 return Err(issue(
@@ -155,31 +173,55 @@ impl RawScene {
             output: Output { every },
             contact,
             brownian,
+            species,
         })
     }
 }
 
 /// Spans of the body's values, to place geometric errors.
-enum BodySpans {
+pub(super) enum BodySpans {
     Helix(Range<usize>),
-    /// Per particle: span of its position, span of its density (or of its position).
-    Particles(Vec<(Range<usize>, Range<usize>)>),
+    /// Per particle: span of its position, span of its density (or of its position);
+    /// per bond: span of its length (or of its `between`).
+    Particles(ParticleSpans, Vec<Range<usize>>),
 }
 
 impl BodySpans {
-    fn position(&self, k: usize) -> Range<usize> {
+    pub(super) fn position(&self, k: usize) -> Range<usize> {
         match self {
             BodySpans::Helix(s) => s.clone(),
-            BodySpans::Particles(v) => v[k].0.clone(),
+            BodySpans::Particles(v, _) => v[k].0.clone(),
         }
     }
 
-    fn density(&self, k: usize) -> Range<usize> {
+    pub(super) fn density(&self, k: usize) -> Range<usize> {
         match self {
             BodySpans::Helix(s) => s.clone(),
-            BodySpans::Particles(v) => v[k].1.clone(),
+            BodySpans::Particles(v, _) => v[k].1.clone(),
         }
     }
+
+    pub(super) fn bond(&self, l: usize) -> Range<usize> {
+        match self {
+            BodySpans::Helix(s) => s.clone(),
+            BodySpans::Particles(_, b) => b[l].clone(),
+        }
+    }
+}
+
+/// Refuses a run whose trajectory files would exceed `limit` bytes (estimated from the
+/// frame count and the particle count, before anything is generated).
+fn check_output(integrator: &Integrator, every: usize, n: usize, limit: u64) -> Result<(), String> {
+    let frames = (integrator.steps() / every.max(1)) as f64 + 2.0;
+    let bytes = frames * crate::sizing::frame_bytes(n);
+    if bytes > limit as f64 {
+        return Err(format!(
+            "{frames:.0} frames of {n} particles make about {} of trajectory files, over the limit of {}; raise [output] every, shorten the duration or use `run --max-output`",
+            crate::sizing::human(bytes.min(u64::MAX as f64) as u64),
+            crate::sizing::human(limit)
+        ));
+    }
+    Ok(())
 }
 
 /// What sizes the scene's storage: its own method, or with `level = "auto"` each method
@@ -281,40 +323,95 @@ fn resolve_helix(r: &RawHelix) -> Result<Helix, Issue> {
     })
 }
 
-type ParticleSpans = Vec<(Range<usize>, Range<usize>)>;
+pub(super) type ParticleSpans = Vec<(Range<usize>, Range<usize>)>;
 
 fn resolve_particles(
     ps: &Spanned<Vec<RawParticle>>,
-) -> Result<(Vec<Particle>, ParticleSpans), Issue> {
+) -> Result<(Vec<Particle>, ParticleSpans, Vec<String>), Issue> {
     if ps.get_ref().is_empty() {
         return Err(issue(ps.span(), "the scene has no particles"));
     }
     let mut particles = Vec::with_capacity(ps.get_ref().len());
     let mut spans = Vec::with_capacity(ps.get_ref().len());
+    let mut given = Vec::with_capacity(ps.get_ref().len());
     for p in ps.get_ref() {
         let position = finite_vector(&p.position, "position")?;
         let radius = number(&Some(p.radius.clone()), 0.0, "radius", Bound::Positive)?;
         let density = number(&p.density, DEFAULT_DENSITY, "density", Bound::NonNegative)?;
+        let velocity = vector(&p.velocity, [0.0; 3], "velocity")?;
+        let angular_velocity = vector(&p.angular_velocity, [0.0; 3], "angular_velocity")?;
         particles.push(Particle {
             position,
             radius,
             density,
+            velocity,
+            angular_velocity,
         });
         let dspan = p.density.as_ref().map_or(p.position.span(), |d| d.span());
         spans.push((p.position.span(), dspan));
+        given.push(match &p.species {
+            Some(name) => Some(species_name(name)?),
+            None => None,
+        });
     }
-    Ok((particles, spans))
+    let species = default_species(&particles, given);
+    Ok((particles, spans, species))
+}
+
+/// A `species` name: 1 to 32 characters, letters, digits, `_`, `-`, `+` or `.`, so that
+/// every trajectory format and viewer takes it as it is.
+fn species_name(name: &Spanned<String>) -> Result<String, Issue> {
+    let s = name.get_ref();
+    let ok = (1..=32).contains(&s.len())
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-+.".contains(c));
+    if ok {
+        Ok(s.clone())
+    } else {
+        Err(issue(
+            name.span(),
+            format!("species {s:?} must be 1 to 32 letters, digits, '_', '-', '+' or '.'"),
+        ))
+    }
+}
+
+/// Species of explicit particles: the name given, or one name per distinct (radius,
+/// density), `A`, `B`, ... in order of first appearance.
+fn default_species(particles: &[Particle], given: Vec<Option<String>>) -> Vec<String> {
+    let mut classes: Vec<(u64, u64)> = Vec::new();
+    particles
+        .iter()
+        .zip(given)
+        .map(|(p, name)| {
+            name.unwrap_or_else(|| {
+                let key = (p.radius.to_bits(), p.density.to_bits());
+                let k = classes.iter().position(|c| *c == key).unwrap_or_else(|| {
+                    classes.push(key);
+                    classes.len() - 1
+                });
+                class_name(k)
+            })
+        })
+        .collect()
+}
+
+fn class_name(k: usize) -> String {
+    match u8::try_from(k) {
+        Ok(k) if k < 26 => char::from(b'A' + k).to_string(),
+        _ => format!("T{k}"),
+    }
 }
 
 fn resolve_bonds(
     bonds: Option<&Spanned<Vec<RawBond>>>,
     particles: &[Particle],
-) -> Result<Vec<Bond>, Issue> {
+) -> Result<(Vec<Bond>, Vec<Range<usize>>), Issue> {
     let Some(bonds) = bonds else {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), Vec::new()));
     };
     let n = particles.len();
     let mut out: Vec<Bond> = Vec::with_capacity(bonds.get_ref().len());
+    let mut spans = Vec::with_capacity(bonds.get_ref().len());
     for b in bonds.get_ref() {
         let [i, j] = *b.between.get_ref();
         if i >= n || j >= n {
@@ -344,8 +441,9 @@ fn resolve_bonds(
         let initial = distance(particles[i].position, particles[j].position);
         let length = number(&b.length, initial, "bond length", Bound::Positive)?;
         out.push(Bond { i, j, length });
+        spans.push(b.length.as_ref().map_or(b.between.span(), |l| l.span()));
     }
-    Ok(out)
+    Ok((out, spans))
 }
 
 fn check_geometry(
@@ -370,7 +468,7 @@ fn check_geometry(
                 return Err(issue(
                     spans.position(j),
                     format!(
-                        "particle {j} overlaps particle {i} (centre distance {s} < {}), and [model] overlap = \"reject\"",
+                        "particle {j} overlaps particle {i} at t = 0 (centre distance {s} < {}); if that is meant, say so with [model] overlap = \"allow\"",
                         p.radius + q.radius
                     ),
                 ));

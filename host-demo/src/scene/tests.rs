@@ -30,7 +30,7 @@ fn minimal_scene_gets_defaults() {
     assert_eq!(s.integrator.stiffness, 1e4);
     assert_eq!(s.integrator.steps(), 100);
     assert_eq!(s.output.every, 1);
-    assert_eq!(s.species(), vec!["P"]);
+    assert_eq!(s.species(), vec!["A"]);
 }
 
 #[test]

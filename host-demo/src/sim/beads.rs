@@ -27,7 +27,7 @@ pub struct Beads<T: Real> {
 }
 
 impl<T: Real> Beads<T> {
-    /// The particles at rest, densities scaled by `density_scale`, each checked on its
+    /// The particles with their initial velocities, densities scaled by `density_scale`, each checked on its
     /// own in precision `T` (finite, radius > 0, density >= 0; pairs are
     /// [`check_pairs`](Self::check_pairs)' job).
     pub fn new(particles: &[scene::Particle], density_scale: f64) -> Result<Self, ParticleError> {
@@ -46,8 +46,12 @@ impl<T: Real> Beads<T> {
                 T::from_f64(q.density * density_scale),
             );
             let pos = T::v3_from(q.position);
+            let mut kp = hydrorattle::Particle::new(pos, r, d);
+            kp.velocity = T::v3_from(q.velocity);
             // Values valid in f64 may not be in f32 (an overflow, a radius that rounds to 0).
-            hydrorattle::particles::check_one(k, &hydrorattle::Particle::new(pos, r, d))?;
+            hydrorattle::particles::check_one(k, &kp)?;
+            beads.vel[k] = kp.velocity;
+            beads.omega[k] = T::v3_from(q.angular_velocity);
             beads.pos.push(pos);
             beads.radius.push(r);
             beads.density.push(d);
@@ -156,9 +160,9 @@ mod tests {
 
     fn sphere(radius: f64) -> scene::Particle {
         scene::Particle {
-            position: [0.0; 3],
             radius,
             density: 1.0,
+            ..scene::Particle::default()
         }
     }
 

@@ -1,39 +1,66 @@
 //! Runs a scene on the kernel: the precision dispatch, the time loop, observables,
-//! outcome, and the files of a run (`trajectory.xyz`, `observables.csv`,
-//! `summary.json`), each written to a temporary name and renamed.
+//! outcome, checkpoints, and the files of a run, each written to a temporary name and
+//! renamed:
 //!
-//! The state lives in vectors of any length ([`Beads`]), stepped by the kernel's
-//! `step_slices` in storage sized for the scene's method, rotation flag, solver and
-//! bead count ([`Plan`]), under a storage limit checked before anything is built.
+//! * `trajectory.xyz` (extended XYZ, exact) and `trajectory.gsd` (GSD, HOOMD's format,
+//!   with types and bonds), one frame every `output.every` steps;
+//! * `observables.csv`, one row per frame; its last row is `summary.json`'s
+//!   `final_observables`;
+//! * `summary.json`: the run's record (resolved scene, code version, machine, results);
+//! * `scene.toml`: the resolved scene, which re-runs to the same result;
+//! * `checkpoint.json` with `--checkpoint-every` ([`Checkpoint`]).
+//!
+//! Everything is streamed: memory does not grow with the duration. The state lives in
+//! vectors of any length ([`Beads`]), stepped by the kernel's `step_slices` in storage
+//! sized for the scene's method, rotation flag, solver and bead count ([`Plan`](crate::sizing::Plan)), under
+//! a storage limit checked before anything is built.
 
 mod beads;
+mod checkpoint;
 mod record;
+mod run_loop;
+mod tail;
 
 pub use beads::{Beads, BuildError, bonds};
-pub use record::{COLUMNS, Observables};
+pub use checkpoint::{CHECKPOINT, Checkpoint};
+pub use record::{COLUMNS, Marks, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD, TRAJECTORY_XYZ};
 
-use std::path::Path;
-use std::time::Instant;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
-use hydrorattle::observables::{self, Thresholds, Twist};
-use hydrorattle::{
-    Buffers, Hydro, Noise, Params, Real, SoftContact, Solver as KSolver, step_slices_thermal,
-};
+use anyhow::{Context, Result, bail};
+use hydrorattle::{Hydro, Params, Real, Solver as KSolver};
 use serde::Serialize;
 
-use crate::output::write_json;
-use crate::progress::Progress;
+use crate::output::{write_atomic, write_json};
+use crate::provenance::{CODE_VERSION, Machine};
 use crate::render::Snapshot;
-use crate::scene::{DEFAULT_SEED, Hydrodynamics, Precision, Scene};
-use crate::sizing::{DEFAULT_LIMIT, Plan, TooLarge};
-use record::Recorder;
+use crate::scene::{Flow, Fluid, Hydrodynamics, Precision, Scene};
+use crate::sizing::{DEFAULT_LIMIT, Limits};
 
-/// What `summary.json` holds.
+/// The resolved scene's copy in the output folder.
+pub const SCENE_TOML: &str = "scene.toml";
+/// The run's record in the output folder.
+pub const SUMMARY_JSON: &str = "summary.json";
+
+/// What `summary.json` holds: everything needed to rerun, and the results.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
     /// Scene name (file stem or case).
     pub scene: String,
+    /// The scene file's path as given, when the run came from a file.
+    pub scene_path: Option<String>,
+    /// The code version (`git describe` at build time).
+    pub code_version: String,
+    /// The machine the run ran on.
+    pub machine: Machine,
+    /// Kernel precision.
+    pub precision: Precision,
+    /// The fluid.
+    pub fluid: Fluid,
+    /// Gravitational acceleration.
+    pub gravity: [f64; 3],
+    /// The ambient flow.
+    pub flow: Flow,
     /// Number of particles.
     pub particles: usize,
     /// Number of bonds.
@@ -50,15 +77,18 @@ pub struct Summary {
     pub steps: usize,
     /// Steps completed (fewer than `steps` when the run failed).
     pub steps_done: usize,
+    /// The simulated time the run was resumed from, if it was.
+    pub resumed_from: Option<f64>,
     /// Wall time of the time loop, seconds.
     pub wall_time_s: f64,
-    /// Steps per second.
+    /// Steps per second (of the steps this invocation made).
     pub steps_per_second: f64,
     /// Mean constraint iterations per step.
     pub mean_iterations: f64,
-    /// Observables at the end.
+    /// Observables at the end: the last row of `observables.csv`.
     pub final_observables: Observables,
-    /// Late-time twist rate (slope over the last quarter of the run), rad per time unit.
+    /// Late-time twist rate (slope over the last quarter of the run's time), rad per
+    /// time unit.
     pub twist_rate: f64,
     /// Classified outcome: stretched, twisting, other (or failed).
     pub outcome: String,
@@ -66,6 +96,43 @@ pub struct Summary {
     pub failure: Option<String>,
     /// What `level = "auto"` chose and why (None for a manual level).
     pub level_choice: Option<crate::auto::Choice>,
+    /// The scene as run: every default filled in and the `auto` choice applied
+    /// (`scene.toml` holds the same as a scene file).
+    pub resolved_scene: Scene,
+}
+
+impl Summary {
+    /// The record of `scene` before any step: results empty.
+    pub fn for_scene(scene: &Scene, name: &str) -> Summary {
+        Summary {
+            scene: name.to_string(),
+            scene_path: None,
+            code_version: CODE_VERSION.to_string(),
+            machine: Machine::this(),
+            precision: scene.integrator.precision,
+            fluid: scene.fluid,
+            gravity: scene.gravity,
+            flow: scene.flow,
+            particles: scene.particles.len(),
+            bonds: scene.bonds.len(),
+            model: scene.model,
+            integrator: scene.integrator,
+            tolerance_used: scene.integrator.tolerance,
+            contact_stiffness: scene.contact.unwrap_or(0.0),
+            steps: scene.integrator.steps(),
+            steps_done: 0,
+            resumed_from: None,
+            wall_time_s: 0.0,
+            steps_per_second: 0.0,
+            mean_iterations: 0.0,
+            final_observables: Observables::default(),
+            twist_rate: 0.0,
+            outcome: String::new(),
+            failure: None,
+            level_choice: None,
+            resolved_scene: scene.clone(),
+        }
+    }
 }
 
 /// A finished run: summary, first and last configurations, the observables series.
@@ -73,11 +140,12 @@ pub struct Summary {
 pub struct RunResult {
     /// Summary.
     pub summary: Summary,
-    /// Initial configuration.
+    /// Initial configuration (of this invocation: the checkpoint's for a resumed run).
     pub initial: Snapshot,
     /// Final configuration.
     pub last: Snapshot,
-    /// Observables every `output.every` steps.
+    /// Observables every `output.every` steps (empty unless
+    /// [`RunOptions::keep_series`]).
     pub series: Vec<Observables>,
 }
 
@@ -90,6 +158,12 @@ pub struct RunOptions {
     pub max_steps: Option<usize>,
     /// Largest step storage allowed, bytes.
     pub max_storage: usize,
+    /// Keep the observables series in memory ([`RunResult::series`]); off, memory does
+    /// not grow with the duration (the files have every row).
+    pub keep_series: bool,
+    /// Write a checkpoint every this much simulated time (rounded to whole steps), when
+    /// the run writes files.
+    pub checkpoint_every: Option<f64>,
 }
 
 impl Default for RunOptions {
@@ -98,6 +172,8 @@ impl Default for RunOptions {
             progress: false,
             max_steps: None,
             max_storage: DEFAULT_LIMIT,
+            keep_series: true,
+            checkpoint_every: None,
         }
     }
 }
@@ -105,6 +181,27 @@ impl Default for RunOptions {
 /// Runs `scene`, writing the run's files into `out` when given. Refuses (before
 /// writing anything) a scene whose step storage would exceed `opts.max_storage`.
 pub fn run(scene: &Scene, name: &str, out: Option<&Path>, opts: RunOptions) -> Result<RunResult> {
+    run_from(scene, name, out, opts, Start::default())
+}
+
+/// Where a run comes from, for its record, and where it starts.
+#[derive(Debug, Clone, Default)]
+pub struct Start {
+    /// The scene file, when the run came from one.
+    pub scene_path: Option<PathBuf>,
+    /// The checkpoint to continue from.
+    pub checkpoint: Option<Checkpoint>,
+}
+
+/// [`run`] from `start`. A run that fails before its files are complete removes the
+/// output folder if it created it (and leaves no `*.tmp` in any case).
+pub fn run_from(
+    scene: &Scene,
+    name: &str,
+    out: Option<&Path>,
+    opts: RunOptions,
+    start: Start,
+) -> Result<RunResult> {
     let choice =
         (scene.model.level == crate::scene::Level::Auto).then(|| crate::auto::choose(scene));
     let scene = match &choice {
@@ -114,10 +211,63 @@ pub fn run(scene: &Scene, name: &str, out: Option<&Path>, opts: RunOptions) -> R
         }
         None => scene.clone(),
     };
-    match scene.integrator.precision {
-        Precision::F64 => run_t::<f64>(&scene, name, out, opts, choice),
-        Precision::F32 => run_t::<f32>(&scene, name, out, opts, choice),
+    let fresh = out.filter(|d| !d.exists());
+    let checkpoint = start.checkpoint.as_ref();
+    let result = match scene.integrator.precision {
+        Precision::F64 => run_loop::run_t::<f64>(&scene, name, out, opts, checkpoint),
+        Precision::F32 => run_loop::run_t::<f32>(&scene, name, out, opts, checkpoint),
     }
+    .and_then(|mut r| {
+        r.summary.scene_path = start.scene_path.map(|p| p.display().to_string());
+        r.summary.level_choice = choice;
+        r.summary.resumed_from = checkpoint.map(Checkpoint::time);
+        r.summary.resolved_scene.model.level = crate::scene::Level::Manual;
+        if let Some(dir) = out {
+            let resolved = &r.summary.resolved_scene;
+            write_atomic(&dir.join(SCENE_TOML), resolved.to_toml().as_bytes())?;
+            write_json(&dir.join(SUMMARY_JSON), &r.summary)?;
+        }
+        Ok(r)
+    });
+    if result.is_err() {
+        if let Some(dir) = fresh.filter(|d| d.exists()) {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+    result
+}
+
+/// Continues the run whose files are in `dir` from its checkpoint to simulated time
+/// `until`, under `limits`: the files are cut back to the checkpoint and continued, the
+/// summary and `scene.toml` rewritten (with the new duration).
+pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Result<RunResult> {
+    let checkpoint = Checkpoint::load(dir)?;
+    let scene_path = dir.join(SCENE_TOML);
+    let mut scene = Scene::from_path_limited(&scene_path, limits)?;
+    let at = checkpoint.time();
+    let dt = scene.integrator.dt;
+    if !(until.is_finite() && until > at) {
+        bail!("--until {until} must be a time after the checkpoint's t = {at}");
+    }
+    if checkpoint.precision != scene.integrator.precision {
+        bail!(
+            "{}: the checkpoint's precision differs from {}",
+            dir.join(CHECKPOINT).display(),
+            scene_path.display()
+        );
+    }
+    scene.integrator.duration = until;
+    if scene.integrator.steps() as u64 <= checkpoint.step {
+        bail!("--until {until} is not a whole step (dt = {dt}) after the checkpoint's t = {at}");
+    }
+    let name = dir
+        .file_name()
+        .map_or_else(|| "run".to_string(), |s| s.to_string_lossy().into_owned());
+    let start = Start {
+        scene_path: Some(scene_path),
+        checkpoint: Some(checkpoint),
+    };
+    run_from(&scene, &name, Some(dir), opts, start).context("resuming")
 }
 
 /// Kernel parameters for a scene in precision `T`.
@@ -143,7 +293,9 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
         tolerance: T::from_f64(i.tolerance.max(floor)),
         max_iterations: u32::try_from(i.max_iterations).unwrap_or(u32::MAX),
     };
-    p.allow_overlap = scene.model.overlap == crate::scene::Overlap::Allow;
+    // `overlap` is about t = 0 (checked when the scene is read and when the run is
+    // prepared); during the run spheres may come to overlap, as in the paper.
+    p.allow_overlap = true;
     p.spring_stiffness = T::from_f64(i.stiffness);
     // The paper's explicit drag can shiver silently (bounded, wrong) beyond its limit:
     // the demo refuses such steps up front.
@@ -179,172 +331,11 @@ pub fn slope(points: &[(f64, f64)]) -> f64 {
     if den > 0.0 { num / den } else { 0.0 }
 }
 
-/// What a run steps: its particles, bonds and storage.
-struct Prepared<T: Real> {
-    beads: Beads<T>,
-    bonds: Vec<hydrorattle::Bond<T>>,
-    store: Buffers<T>,
-}
-
-/// The particles, bonds and storage of a run, checked before anything is written.
-fn prepare<T: Real>(scene: &Scene, p: &Params<T>, limit: usize) -> Result<Prepared<T>, BuildError> {
-    let (n, b) = (scene.particles.len(), scene.bonds.len());
-    // Sized first: an oversized scene is refused before any O(N^2) work.
-    let layout = Plan::of(scene).check(n, b, limit)?;
-    // Thermal noise needs the mobility's factor on top (`Layout::thermal`).
-    let layout = match scene.brownian {
-        Some(_) => {
-            let l = layout.thermal(p.method, n, b);
-            let bytes = l.bytes::<T>();
-            if bytes > limit {
-                return Err(TooLarge {
-                    particles: n,
-                    bonds: b,
-                    bytes: Some(bytes),
-                    limit,
-                }
-                .into());
-            }
-            l
-        }
-        None => layout,
-    };
-    let beads = Beads::<T>::new(&scene.particles, 1.0)?;
-    beads.check_pairs(p.allow_overlap)?;
-    Ok(Prepared {
-        bonds: bonds::<T>(&scene.bonds, n)?,
-        beads,
-        store: Buffers::try_new(layout)
-            .map_err(|_| BuildError::OutOfMemory(layout.bytes::<T>()))?,
-    })
-}
-
-fn run_t<T: Real>(
-    scene: &Scene,
-    name: &str,
-    out: Option<&Path>,
-    opts: RunOptions,
-    level_choice: Option<crate::auto::Choice>,
-) -> Result<RunResult> {
-    let p = params::<T>(scene);
-    let Prepared {
-        mut beads,
-        bonds,
-        mut store,
-    } = prepare::<T>(scene, &p, opts.max_storage)?;
-    if let Some(dir) = out {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let mut ws = store.workspace();
-    let mut noise = Noise::new(scene.brownian.map_or(DEFAULT_SEED, |b| b.seed));
-    let contact = scene.contact.map(|k| SoftContact {
-        stiffness: T::from_f64(k),
-    });
-    let mut ext = |pos: &[T::V3], radius: &[T], force: &mut [T::V3]| {
-        if let Some(mut c) = contact {
-            hydrorattle::ExternalForce::add(&mut c, pos, radius, force);
-        }
-    };
-    let steps = opts.max_steps.map_or(scene.integrator.steps(), |m| {
-        m.min(scene.integrator.steps())
-    });
-    let every = scene.output.every.max(1);
-    let mut rec = Recorder::new(out, scene.species())?;
-    let mut twist_prev = vec![T::ZERO; beads.len()];
-    let mut twist = Twist::new(&mut twist_prev, T::from_f64(0.25));
-    let mut series = Vec::with_capacity(steps / every + 2);
-    let observe = |beads: &Beads<T>, twist: T, iterations: u32, tension: T| {
-        Observables::of(beads, &bonds, p.gravity, twist, iterations, tension)
-    };
-    let initial = snapshot::<T>(&beads.pos, &beads.radius, beads.time);
-    twist.update(&beads.pos, p.gravity);
-    let first = observe(&beads, T::ZERO, 0, T::ZERO);
-    rec.record(&beads, &first)?;
-    series.push(first);
-    let bar = if opts.progress {
-        Progress::new(steps as u64, name)
-    } else {
-        Progress::hidden(steps as u64)
-    };
-    let start = Instant::now();
-    let (mut done, mut failure, mut total_iterations) = (0usize, None, 0u64);
-    for s in 1..=steps {
-        match step_slices_thermal(beads.state(), &bonds, &p, &mut ws, &mut ext, &mut noise) {
-            Ok(rep) => {
-                done = s;
-                total_iterations += u64::from(rep.iterations);
-                let tw = twist.update(&beads.pos, p.gravity);
-                if s % every == 0 || s == steps {
-                    let o = observe(&beads, tw, rep.iterations, rep.max_tension);
-                    rec.record(&beads, &o)?;
-                    series.push(o);
-                }
-            }
-            Err(e) => {
-                log::warn!("{name}: step {s} failed at t = {}: {e}", beads.time);
-                failure = Some(format!("step {s} (t = {}): {e}", beads.time.to_f64()));
-                break;
-            }
-        }
-        if s % 256 == 0 {
-            bar.set_position(s as u64);
-        }
-    }
-    bar.finish();
-    let wall = start.elapsed().as_secs_f64();
-    // Close the state: a final row when the run stopped between frames.
-    let last_obs = observe(&beads, twist.total, 0, T::ZERO);
-    if series.last().map(|o| o.time) != Some(last_obs.time) {
-        rec.record(&beads, &last_obs)?;
-        series.push(last_obs);
-    }
-    let tail: Vec<(f64, f64)> = series[series.len() * 3 / 4..]
-        .iter()
-        .map(|o| (o.time, o.twist))
-        .collect();
-    let twist_rate = slope(&tail);
-    let th = Thresholds::<f64>::default();
-    let outcome = match failure {
-        Some(_) => "failed".to_string(),
-        None => observables::classify(last_obs.verticality, last_obs.extension, twist_rate, &th)
-            .name()
-            .to_string(),
-    };
-    let summary = Summary {
-        scene: name.to_string(),
-        particles: beads.len(),
-        bonds: bonds.len(),
-        model: scene.model,
-        integrator: scene.integrator,
-        tolerance_used: p.solver.tolerance.to_f64(),
-        contact_stiffness: scene.contact.unwrap_or(0.0),
-        steps,
-        steps_done: done,
-        wall_time_s: wall,
-        steps_per_second: done as f64 / wall.max(1e-12),
-        mean_iterations: total_iterations as f64 / (done.max(1) as f64),
-        final_observables: last_obs,
-        twist_rate,
-        outcome,
-        failure,
-        level_choice,
-    };
-    rec.commit()?;
-    if let Some(dir) = out {
-        write_json(&dir.join("summary.json"), &summary)?;
-    }
-    Ok(RunResult {
-        summary,
-        initial,
-        last: snapshot::<T>(&beads.pos, &beads.radius, beads.time),
-        series,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::{Method, Solver};
+    use crate::sizing::Plan;
     use hydrorattle::Layout;
 
     #[test]

@@ -1,15 +1,17 @@
 //! What a run records: a row of observables per frame, written to `observables.csv`
-//! and, with the configuration, to `trajectory.xyz`.
+//! and, with the configuration, to `trajectory.xyz` and `trajectory.gsd`. Everything is
+//! streamed: memory does not grow with the number of frames.
 
+use std::io::Seek;
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use hydrorattle::observables;
 use hydrorattle::{Bond, Real};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::beads::Beads;
-use crate::output::{AtomicFile, CsvWriter, XyzWriter};
+use crate::output::{AtomicFile, CsvWriter, Topology, XyzWriter, gsd::GsdWriter};
 
 /// Columns of `observables.csv`, in order.
 pub const COLUMNS: [&str; 12] = [
@@ -27,8 +29,15 @@ pub const COLUMNS: [&str; 12] = [
     "max_tension",
 ];
 
+/// The files of a run, in the output folder.
+pub const TRAJECTORY_XYZ: &str = "trajectory.xyz";
+/// GSD trajectory.
+pub const TRAJECTORY_GSD: &str = "trajectory.gsd";
+/// Observables, one row per frame.
+pub const OBSERVABLES_CSV: &str = "observables.csv";
+
 /// One row of observables.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub struct Observables {
     /// Simulated time.
     pub time: f64,
@@ -46,9 +55,10 @@ pub struct Observables {
     pub com: [f64; 3],
     /// Largest relative bond-length error.
     pub bond_residual: f64,
-    /// Constraint iterations of the last step.
+    /// Constraint iterations of the step that led to this row (0 for the initial
+    /// state and for a row closing a failed run).
     pub iterations: u32,
-    /// Largest bond tension of the last step.
+    /// Largest bond tension of the step that led to this row (0 likewise).
     pub max_tension: f64,
 }
 
@@ -95,61 +105,154 @@ impl Observables {
             self.max_tension,
         ]
     }
+
+    /// Reads a row written by a run (bit-exact: numbers round-trip).
+    pub fn from_row(line: &str) -> Option<Observables> {
+        let x: Vec<f64> = line
+            .split(',')
+            .map(|f| f.parse().ok())
+            .collect::<Option<_>>()?;
+        (x.len() == COLUMNS.len()).then(|| Observables {
+            time: x[0],
+            extension: x[1],
+            verticality: x[2],
+            twist: x[3],
+            head_z: x[4],
+            head_speed: x[5],
+            com: [x[6], x[7], x[8]],
+            bond_residual: x[9],
+            iterations: x[10] as u32,
+            max_tension: x[11],
+        })
+    }
+}
+
+/// Where the files of a run stand: enough to cut them back to this point and continue.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub struct Marks {
+    /// Frames written.
+    pub frames: u64,
+    /// Bytes of `trajectory.xyz`.
+    pub xyz_bytes: u64,
+    /// Bytes of `observables.csv`.
+    pub csv_bytes: u64,
 }
 
 /// The trajectory and observables files of a run (nothing when it writes no files).
 pub(super) struct Recorder {
-    xyz: Option<XyzWriter<AtomicFile>>,
-    csv: Option<CsvWriter<AtomicFile>>,
-    species: Vec<&'static str>,
+    files: Option<Files>,
+    topology: Topology,
+    frames: u64,
+}
+
+struct Files {
+    xyz: XyzWriter<AtomicFile>,
+    gsd: GsdWriter<AtomicFile>,
+    csv: CsvWriter<AtomicFile>,
 }
 
 impl Recorder {
-    /// Opens `trajectory.xyz` and `observables.csv` under `out`, if given.
-    pub(super) fn new(out: Option<&Path>, species: Vec<&'static str>) -> Result<Self> {
-        let (xyz, csv) = match out {
-            Some(dir) => (
-                Some(XyzWriter::new(AtomicFile::create(
-                    &dir.join("trajectory.xyz"),
-                )?)),
-                Some(CsvWriter::new(
-                    AtomicFile::create(&dir.join("observables.csv"))?,
-                    &COLUMNS,
-                )?),
-            ),
-            None => (None, None),
+    /// Opens the files under `out`, if given: new ones, or (with `from`) the existing
+    /// ones cut back to the marks of a checkpoint.
+    pub(super) fn new(out: Option<&Path>, topology: Topology, from: Option<Marks>) -> Result<Self> {
+        let Some(dir) = out else {
+            return Ok(Recorder {
+                files: None,
+                topology,
+                frames: 0,
+            });
         };
-        Ok(Recorder { xyz, csv, species })
+        let (xyz, gsd, csv) = (
+            dir.join(TRAJECTORY_XYZ),
+            dir.join(TRAJECTORY_GSD),
+            dir.join(OBSERVABLES_CSV),
+        );
+        let files = match from {
+            None => Files {
+                xyz: XyzWriter::new(AtomicFile::create(&xyz)?),
+                gsd: GsdWriter::new(AtomicFile::create(&gsd)?, &topology)?,
+                csv: CsvWriter::new(AtomicFile::create(&csv)?, &COLUMNS)?,
+            },
+            Some(m) => {
+                let gsd_bytes = crate::output::gsd::data_end(&topology, m.frames);
+                Files {
+                    xyz: XyzWriter::new(AtomicFile::continue_from(&xyz, m.xyz_bytes)?),
+                    gsd: GsdWriter::resume(
+                        AtomicFile::continue_from(&gsd, gsd_bytes)?,
+                        &topology,
+                        m.frames,
+                    ),
+                    csv: CsvWriter::resume(
+                        AtomicFile::continue_from(&csv, m.csv_bytes)?,
+                        COLUMNS.len(),
+                    ),
+                }
+            }
+        };
+        Ok(Recorder {
+            files: Some(files),
+            topology,
+            frames: from.map_or(0, |m| m.frames),
+        })
     }
 
-    /// Writes one frame and its row.
-    pub(super) fn record<T: Real>(&mut self, beads: &Beads<T>, o: &Observables) -> Result<()> {
-        if let Some(w) = self.xyz.as_mut() {
-            let f64s =
-                |v: &[T::V3]| -> Vec<[f64; 3]> { v.iter().map(|&v| T::v3_to_f64(v)).collect() };
-            let rad: Vec<f64> = beads.radius.iter().map(|r| r.to_f64()).collect();
-            w.write_frame(
-                o.time,
-                &self.species,
-                &f64s(&beads.pos),
-                &rad,
-                &f64s(&beads.vel),
-            )?;
-        }
-        if let Some(c) = self.csv.as_mut() {
-            c.write_row(&o.row())?;
-        }
+    /// Writes one frame (reached at time step `step`) and its row.
+    pub(super) fn record<T: Real>(
+        &mut self,
+        step: u64,
+        beads: &Beads<T>,
+        o: &Observables,
+    ) -> Result<()> {
+        self.frames += 1;
+        let Some(f) = self.files.as_mut() else {
+            return Ok(());
+        };
+        let f64s = |v: &[T::V3]| -> Vec<[f64; 3]> { v.iter().map(|&v| T::v3_to_f64(v)).collect() };
+        let (pos, vel) = (f64s(&beads.pos), f64s(&beads.vel));
+        f.xyz.write_frame(&self.topology, o.time, &pos, &vel)?;
+        f.gsd.write_frame(step, o.time, &pos, &vel)?;
+        f.csv.write_row(&o.row())?;
         Ok(())
     }
 
-    /// Renames both files to their final names.
+    /// Where the files stand now (flushed, so that a checkpoint can name the bytes).
+    pub(super) fn marks(&mut self) -> Result<Marks> {
+        let frames = self.frames;
+        let Some(f) = self.files.as_mut() else {
+            return Ok(Marks {
+                frames,
+                ..Marks::default()
+            });
+        };
+        Ok(Marks {
+            frames,
+            xyz_bytes: f.xyz.get_mut().stream_position()?,
+            csv_bytes: f.csv.get_mut().stream_position()?,
+        })
+    }
+
+    /// Completes the GSD index and renames every file to its final name.
     pub(super) fn commit(self) -> Result<()> {
-        if let Some(w) = self.xyz {
-            w.into_inner().commit()?;
-        }
-        if let Some(c) = self.csv {
-            c.into_inner().commit()?;
+        if let Some(f) = self.files {
+            f.xyz.into_inner().commit()?;
+            f.gsd.finish()?.commit()?;
+            f.csv.into_inner().commit()?;
         }
         Ok(())
     }
+}
+
+/// Calls `each` with every row of an `observables.csv` up to `bytes` (a checkpoint's
+/// mark), in order, for a resumed run.
+pub(super) fn each_row(path: &Path, bytes: u64, mut each: impl FnMut(Observables)) -> Result<()> {
+    use std::io::{BufRead, Read};
+    let file = std::fs::File::open(path).with_context(|| format!("reading {}", path.display()))?;
+    let reader = std::io::BufReader::new(file.take(bytes));
+    for (k, line) in reader.lines().enumerate().skip(1) {
+        let line = line.with_context(|| format!("reading {}", path.display()))?;
+        let o = Observables::from_row(&line)
+            .with_context(|| format!("{}:{}: unreadable row", path.display(), k + 1))?;
+        each(o);
+    }
+    Ok(())
 }

@@ -1,0 +1,135 @@
+//! Checkpoints: the exact state of a run at a time step, written atomically to
+//! `checkpoint.json` in the output folder, and what `host-demo resume` continues from.
+//!
+//! Every number of the state is stored as the bits of its `f64` value (the kernel's
+//! `f32` values widen exactly), so a resumed run continues bit for bit. The files of
+//! the run are cut back to the marks the checkpoint names and continued: a run to `T`
+//! resumed to `2 T` writes the same bytes as one run to `2 T`.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use hydrorattle::Real;
+use serde::{Deserialize, Serialize};
+
+use super::beads::Beads;
+use super::record::{Marks, Observables};
+use crate::output::write_json;
+use crate::scene::Precision;
+
+/// The checkpoint file's name in the output folder.
+pub const CHECKPOINT: &str = "checkpoint.json";
+
+/// Format version of the checkpoint file.
+const VERSION: u32 = 1;
+
+/// The state of a run after time step `step`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Checkpoint {
+    /// Format version.
+    pub version: u32,
+    /// Time steps done.
+    pub step: u64,
+    /// Precision of the state.
+    pub precision: Precision,
+    /// Simulated time, `f64` bits.
+    pub time: u64,
+    /// Centres, `f64` bits, x y z per particle.
+    pub pos: Vec<u64>,
+    /// Velocities, likewise.
+    pub vel: Vec<u64>,
+    /// Angular velocities, likewise.
+    pub omega: Vec<u64>,
+    /// Twist accumulated so far, `f64` bits.
+    pub twist: u64,
+    /// Constraint iterations summed over the steps done.
+    pub total_iterations: u64,
+    /// Where the run's files stand.
+    pub marks: Marks,
+    /// The last row written.
+    pub last: Observables,
+}
+
+fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
+    v.iter()
+        .flat_map(|&x| T::v3_to_f64(x))
+        .map(f64::to_bits)
+        .collect()
+}
+
+fn restore<T: Real>(bits: &[u64], out: &mut [T::V3], what: &str) -> Result<()> {
+    if bits.len() != 3 * out.len() {
+        bail!(
+            "the checkpoint has {} {what} values for {} particles",
+            bits.len(),
+            out.len()
+        );
+    }
+    for (o, b) in out.iter_mut().zip(bits.chunks(3)) {
+        *o = T::v3_from([b[0], b[1], b[2]].map(f64::from_bits));
+    }
+    Ok(())
+}
+
+impl Checkpoint {
+    /// The state of `beads` after `step` steps.
+    pub(super) fn of<T: Real>(
+        step: u64,
+        precision: Precision,
+        beads: &Beads<T>,
+        twist: T,
+        total_iterations: u64,
+        marks: Marks,
+        last: Observables,
+    ) -> Self {
+        Checkpoint {
+            version: VERSION,
+            step,
+            precision,
+            time: beads.time.to_f64().to_bits(),
+            pos: bits::<T>(&beads.pos),
+            vel: bits::<T>(&beads.vel),
+            omega: bits::<T>(&beads.omega),
+            twist: twist.to_f64().to_bits(),
+            total_iterations,
+            marks,
+            last,
+        }
+    }
+
+    /// Puts the state back into `beads` (built from the same scene).
+    pub(super) fn restore<T: Real>(&self, beads: &mut Beads<T>) -> Result<()> {
+        restore::<T>(&self.pos, &mut beads.pos, "position")?;
+        restore::<T>(&self.vel, &mut beads.vel, "velocity")?;
+        restore::<T>(&self.omega, &mut beads.omega, "angular velocity")?;
+        beads.time = T::from_f64(f64::from_bits(self.time));
+        Ok(())
+    }
+
+    /// Simulated time.
+    pub fn time(&self) -> f64 {
+        f64::from_bits(self.time)
+    }
+
+    /// Writes `DIR/checkpoint.json` atomically.
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        Ok(write_json(&dir.join(CHECKPOINT), self)?)
+    }
+
+    /// Reads `DIR/checkpoint.json`.
+    pub fn load(dir: &Path) -> Result<Self> {
+        let path = dir.join(CHECKPOINT);
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
+        let c: Checkpoint = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not a checkpoint", path.display()))?;
+        if c.version != VERSION {
+            bail!(
+                "{}: checkpoint format {} (this program reads {VERSION})",
+                path.display(),
+                c.version
+            );
+        }
+        Ok(c)
+    }
+}

@@ -1,0 +1,178 @@
+//! The record of a run: `summary.json` holds what is needed to rerun it, `scene.toml`
+//! re-runs to the same bytes, `observables.csv` ends where the summary ends, and a run
+//! to `T` resumed to `2 T` writes the same bytes as one run to `2 T`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn manifest() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("record-{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn cli(args: &[&str]) {
+    let o = Command::new(env!("CARGO_BIN_EXE_host-demo"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn run(scene: &Path, out: &Path, extra: &[&str]) {
+    let mut args = vec![
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    cli(&args);
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn bytes(dir: &Path, name: &str) -> Vec<u8> {
+    std::fs::read(dir.join(name)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(name).display()))
+}
+
+const TRAJECTORY_FILES: [&str; 3] = ["trajectory.xyz", "trajectory.gsd", "observables.csv"];
+
+#[test]
+fn the_summary_records_what_a_rerun_needs() {
+    let scene = manifest().join("scenes/dimer.toml");
+    let out = scratch("summary");
+    run(&scene, &out, &[]);
+    let s = json(&out.join("summary.json"));
+    for key in [
+        "fluid",
+        "gravity",
+        "flow",
+        "precision",
+        "machine",
+        "resolved_scene",
+    ] {
+        assert!(!s[key].is_null(), "summary.json lacks {key}");
+    }
+    assert_eq!(s["scene_path"], scene.display().to_string());
+    let version = s["code_version"].as_str().unwrap();
+    assert!(version.starts_with(env!("CARGO_PKG_VERSION")), "{version}");
+    assert!(s["machine"]["cpus"].as_u64().unwrap() >= 1);
+    assert_eq!(s["resolved_scene"]["model"]["level"], "manual");
+    assert_eq!(
+        s["resolved_scene"]["output"]["every"],
+        s["integrator"]["duration"].as_f64().unwrap()
+            / s["integrator"]["dt"].as_f64().unwrap()
+            / 200.0
+    );
+}
+
+#[test]
+fn the_last_row_of_the_observables_is_the_summary_s_final_observables() {
+    // A step count that is not a multiple of `every`: the last frame is off schedule.
+    let dir = scratch("last-row");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("odd.toml");
+    let text = std::fs::read_to_string(manifest().join("scenes/dimer.toml")).unwrap();
+    assert!(text.contains("every = 10"));
+    let text = text.replace("every = 10", "every = 7");
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.join("out");
+    run(&scene, &out, &[]);
+    let s = json(&out.join("summary.json"));
+    let csv = String::from_utf8(bytes(&out, "observables.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let last: Vec<f64> = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let f = &s["final_observables"];
+    for (name, value) in header.iter().zip(&last) {
+        let want = match *name {
+            "com_x" => &f["com"][0],
+            "com_y" => &f["com"][1],
+            "com_z" => &f["com"][2],
+            n => &f[n],
+        };
+        assert_eq!(want.as_f64().unwrap(), *value, "{name}");
+    }
+    assert!(
+        f["iterations"].as_u64().unwrap() > 0,
+        "the last step's iterations"
+    );
+}
+
+#[test]
+fn the_resolved_scene_reruns_to_the_same_bytes() {
+    for (name, scene) in [
+        ("helix", "scenes/figure1c.toml"),
+        ("explicit", "scenes/tree.toml"),
+    ] {
+        let first = scratch(&format!("first-{name}"));
+        run(&manifest().join(scene), &first, &[]);
+        let again = scratch(&format!("again-{name}"));
+        run(&first.join("scene.toml"), &again, &[]);
+        for f in TRAJECTORY_FILES.iter().chain(&["scene.toml"]) {
+            assert!(bytes(&first, f) == bytes(&again, f), "{name}: {f} differs");
+        }
+    }
+}
+
+#[test]
+fn a_run_resumed_from_its_checkpoint_writes_the_same_bytes_as_one_run() {
+    // An inertial scene with initial velocities, ending off the frame schedule at T.
+    let dir = scratch("restart");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("spin.toml");
+    std::fs::write(
+        &scene,
+        "[[particle]]\nposition = [0, 0, 0]\nradius = 1.5\nvelocity = [0.3, 0, 0]\n\n\
+         [[particle]]\nposition = [3, 0, 1]\nradius = 1\nvelocity = [0, 0.2, -0.1]\nspecies = \"small\"\n\n\
+         [[particle]]\nposition = [6, 0, 2]\nradius = 1\n\n\
+         [[bond]]\nbetween = [0, 1]\n\n[[bond]]\nbetween = [1, 2]\n\n\
+         [integrator]\nmethod = \"rattle-stable\"\ndt = 0.01\nduration = 4.0\n\n\
+         [output]\nevery = 7\n",
+    )
+    .unwrap();
+    let one = dir.join("one");
+    let mut long = std::fs::read_to_string(&scene).unwrap();
+    long = long.replace("duration = 4.0", "duration = 8.0");
+    let long_scene = dir.join("long.toml");
+    std::fs::write(&long_scene, long).unwrap();
+    run(&long_scene, &one, &[]);
+
+    let two = dir.join("two");
+    run(&scene, &two, &["--checkpoint-every", "4"]);
+    let c = json(&two.join("checkpoint.json"));
+    assert_eq!(c["step"], 400);
+    cli(&["resume", two.to_str().unwrap(), "--until", "8"]);
+    for f in TRAJECTORY_FILES {
+        assert!(bytes(&one, f) == bytes(&two, f), "{f} differs after resume");
+    }
+    let (s1, s2) = (
+        json(&one.join("summary.json")),
+        json(&two.join("summary.json")),
+    );
+    assert!((s2["resumed_from"].as_f64().unwrap() - 4.0).abs() < 1e-9);
+    for key in [
+        "final_observables",
+        "twist_rate",
+        "steps_done",
+        "mean_iterations",
+    ] {
+        assert_eq!(s1[key], s2[key], "{key}");
+    }
+}

@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""Reads the trajectory files of `host-demo run` output folders back with the real
+tools (ASE, the `gsd` package and OVITO's Python module) and checks them against the
+run's own record (`summary.json`): species, masses, velocities, positions, bonds,
+frame count. Exits non-zero on the first disagreement.
+
+    python host-demo/tools/readback.py OUT_DIR [OUT_DIR ...]
+
+OVITO is optional (`--no-ovito`) for machines where its wheel does not install.
+"""
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+
+def fail(msg):
+    print(f"readback: FAIL: {msg}", file=sys.stderr)
+    sys.exit(1)
+
+
+def check(cond, msg):
+    if not cond:
+        fail(msg)
+
+
+def expected(out):
+    s = json.loads((out / "summary.json").read_text())
+    scene = s["resolved_scene"]
+    parts = scene["particles"]
+    mass = np.array([4.0 / 3.0 * math.pi * p["radius"] ** 3 * p["density"] for p in parts])
+    radius = np.array([p["radius"] for p in parts])
+    bonds = np.array([[b["i"], b["j"]] for b in scene["bonds"]], dtype=np.uint32).reshape(-1, 2)
+    return s, scene["species"], mass, radius, bonds
+
+
+def read_csv_times(out):
+    lines = (out / "observables.csv").read_text().splitlines()[1:]
+    return np.array([float(l.split(",")[0]) for l in lines])
+
+
+def check_ase(out, species, mass, radius, times):
+    import ase.io
+
+    frames = ase.io.read(out / "trajectory.xyz", index=":")
+    check(len(frames) == len(times), f"ASE: {len(frames)} frames, observables.csv {len(times)}")
+    types = sorted(set(species), key=species.index)
+    for k, a in enumerate(frames):
+        check(len(a) == len(species), f"ASE frame {k}: {len(a)} atoms")
+        check(np.array_equal(a.get_masses(), mass), f"ASE frame {k}: masses {a.get_masses()} != {mass}")
+        check(np.array_equal(a.arrays["radius"], radius), f"ASE frame {k}: radii")
+        check(a.info["Time"] == times[k], f"ASE frame {k}: Time {a.info['Time']} != {times[k]}")
+        # ASE's velocities are momenta / masses: equal to the exact `velo` column to rounding.
+        v = a.get_velocities()
+        check(np.allclose(v, a.arrays["velo"], rtol=1e-12, atol=1e-300), f"ASE frame {k}: velocities")
+        ids = [types.index(s) + 1 for s in species]
+        check(list(a.numbers) == ids, f"ASE frame {k}: Z {list(a.numbers)} != type numbers {ids}")
+    return frames
+
+
+def check_gsd(out, species, mass, radius, bonds, ase_frames):
+    import gsd.hoomd
+
+    types = sorted(set(species), key=species.index)
+    with gsd.hoomd.open(out / "trajectory.gsd", "r") as traj:
+        check(len(traj) == len(ase_frames), f"gsd: {len(traj)} frames, xyz {len(ase_frames)}")
+        for k, f in enumerate(traj):
+            p = f.particles
+            check(p.N == len(species), f"gsd frame {k}: N = {p.N}")
+            check(list(p.types) == types, f"gsd frame {k}: types {p.types} != {types}")
+            check([p.types[t] for t in p.typeid] == species, f"gsd frame {k}: typeid")
+            check(np.array_equal(p.mass, mass.astype(np.float32)), f"gsd frame {k}: mass")
+            check(np.array_equal(p.diameter, (2 * radius).astype(np.float32)), f"gsd frame {k}: diameter")
+            a = ase_frames[k]
+            check(np.array_equal(p.position, a.positions.astype(np.float32)), f"gsd frame {k}: positions")
+            check(np.array_equal(p.velocity, a.arrays["velo"].astype(np.float32)), f"gsd frame {k}: velocities")
+            check(f.bonds.N == len(bonds), f"gsd frame {k}: {f.bonds.N} bonds")
+            check(np.array_equal(f.bonds.group, bonds), f"gsd frame {k}: bond groups")
+            check(f.log["time"][0] == a.info["Time"], f"gsd frame {k}: log/time")
+            box = f.configuration.box
+            check(np.all(np.abs(p.position) < np.array(box[:3]) / 2), f"gsd frame {k}: a particle outside the box")
+
+
+def check_ovito(out, species, mass, bonds, nframes):
+    from ovito.io import import_file
+
+    pipe = import_file(str(out / "trajectory.xyz"))
+    check(pipe.source.num_frames == nframes, f"OVITO xyz: {pipe.source.num_frames} frames")
+    d = pipe.compute(nframes - 1)
+    ptype = d.particles["Particle Type"]
+    names = [ptype.type_by_id(t).name for t in ptype[...]]
+    check(names == species, f"OVITO xyz: types {names[:4]}...")
+    check(np.array_equal(d.particles["Mass"][...], mass), "OVITO xyz: Mass")
+    check("Velocity" in d.particles, "OVITO xyz: no standard Velocity property")
+    check("Radius" in d.particles, "OVITO xyz: no standard Radius property")
+
+    pipe = import_file(str(out / "trajectory.gsd"))
+    check(pipe.source.num_frames == nframes, f"OVITO gsd: {pipe.source.num_frames} frames")
+    d = pipe.compute(nframes - 1)
+    check(d.particles.count == len(species), "OVITO gsd: particle count")
+    got = d.particles.bonds.topology[...] if d.particles.bonds is not None else np.zeros((0, 2))
+    check(np.array_equal(np.asarray(got, dtype=np.uint32).reshape(-1, 2), bonds), "OVITO gsd: bonds")
+    check(np.allclose(d.particles["Mass"][...], mass, rtol=1e-6), "OVITO gsd: Mass")
+    check("Velocity" in d.particles, "OVITO gsd: Velocity")
+
+
+def main(argv):
+    use_ovito = "--no-ovito" not in argv
+    dirs = [Path(a) for a in argv if not a.startswith("--")]
+    if not dirs:
+        fail("usage: readback.py OUT_DIR [OUT_DIR ...] [--no-ovito]")
+    for out in dirs:
+        s, species, mass, radius, bonds = expected(out)
+        times = read_csv_times(out)
+        check(times[-1] == s["final_observables"]["time"], "observables.csv ends at another time than summary.json")
+        frames = check_ase(out, species, mass, radius, times)
+        check_gsd(out, species, mass, radius, bonds, frames)
+        if use_ovito:
+            check_ovito(out, species, mass, bonds, len(frames))
+        tools = "ASE, gsd" + (", OVITO" if use_ovito else "")
+        print(f"readback: {out}: {len(frames)} frames of {len(species)} particles, "
+              f"{len(bonds)} bonds, types {sorted(set(species), key=species.index)}: read by {tools}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
