@@ -3,6 +3,8 @@
 //! Each test crate uses a different subset of these helpers.
 #![allow(dead_code)]
 
+pub mod fuzz;
+
 use hydrorattle::{
     BondSet, ExternalForce, Method, Params, Particle, ParticleSet, Real, SolverKind, StepError,
     StepReport, Workspace, step,

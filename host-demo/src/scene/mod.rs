@@ -162,23 +162,29 @@ impl Scene {
     /// [`from_path`](Self::from_path) under `limits` (step storage and output size).
     pub fn from_path_limited(path: &Path, limits: Limits) -> Result<Scene, SceneError> {
         let origin = path.display().to_string();
-        let error = |location, message| SceneError {
+        let bytes = std::fs::read(path).map_err(|e| SceneError {
             origin: origin.clone(),
-            location,
-            message,
+            location: None,
+            message: format!("cannot read scene file: {e}"),
             too_large: None,
-        };
-        let bytes =
-            std::fs::read(path).map_err(|e| error(None, format!("cannot read scene file: {e}")))?;
-        let text = std::str::from_utf8(&bytes).map_err(|e| {
-            let valid = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
-            let at = line_col(valid, valid.len());
-            error(
-                Some(at),
-                "the file is not valid UTF-8 here (TOML files are UTF-8, comments too)".into(),
-            )
         })?;
-        Scene::parse_limited(text, &origin, limits)
+        Scene::parse_bytes(&bytes, &origin, limits)
+    }
+
+    /// [`parse_limited`](Self::parse_limited) of raw bytes: text that is not UTF-8 is
+    /// refused at the line of the first bad byte.
+    pub fn parse_bytes(bytes: &[u8], origin: &str, limits: Limits) -> Result<Scene, SceneError> {
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            let valid = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
+            SceneError {
+                origin: origin.to_string(),
+                location: Some(line_col(valid, valid.len())),
+                message: "the file is not valid UTF-8 here (TOML files are UTF-8, comments too)"
+                    .into(),
+                too_large: None,
+            }
+        })?;
+        Scene::parse_limited(text, origin, limits)
     }
 
     /// Parses scene text; `origin` names it in error messages (usually its path).

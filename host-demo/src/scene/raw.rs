@@ -30,7 +30,7 @@ pub(super) struct RawScene {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawContact {
-    pub(super) stiffness: S<f64>,
+    pub(super) stiffness: Spanned<f64>,
 }
 
 #[derive(Deserialize)]

@@ -58,7 +58,7 @@ impl RawScene {
         let contact = match &self.contact {
             None => None,
             Some(c) => Some(number(
-                &c.stiffness,
+                &Some(c.stiffness.clone()),
                 0.0,
                 "contact stiffness",
                 Bound::Positive,
@@ -79,7 +79,9 @@ impl RawScene {
             Some(e) if *e.get_ref() == 0 => {
                 return Err(issue(e.span(), "every must be >= 1 (steps between frames)"));
             }
-            Some(e) => *e.get_ref(),
+            // Past the last step `every` changes nothing: held at the step count, it
+            // stays a number a scene file can hold.
+            Some(e) => (*e.get_ref()).min(integrator.steps()),
         };
         let plans = plans(&model, &integrator, &flow);
         let every_span = self
@@ -291,7 +293,8 @@ fn resolve_integrator(r: &RawIntegrator) -> Result<Integrator, Issue> {
         Some(m) if *m.get_ref() == 0 => {
             return Err(issue(m.span(), "max_iterations must be >= 1"));
         }
-        Some(m) => *m.get_ref(),
+        // The kernel counts iterations in 32 bits.
+        Some(m) => (*m.get_ref()).min(u32::MAX as usize),
     };
     Ok(Integrator {
         method: r.method,

@@ -1,0 +1,267 @@
+//! Fuzzing `step_slices` with a fixed seed: hostile particles (NaN, infinities, huge,
+//! subnormal, zero and negative radii, nested and overlapping spheres), hostile bonds
+//! (out of range, self, duplicate, lengths whose square overflows), hostile parameters
+//! (every method, solver and mobility; NaN, negative and huge time steps, tolerances,
+//! viscosities, gravity, time) and mismatched or undersized storage. Every call must
+//! return without a panic; a refused step must leave the state bit-identical; an
+//! accepted one must leave it finite with the time advanced.
+//!
+//! 100 000 cases per precision by default (`FUZZ_CASES`, `FUZZ_SEED` to change; a longer run is
+//! documented in the README).
+
+mod common;
+
+use common::fuzz::{Rng, report, settings};
+use common::*;
+use hydrorattle::workspace::Buffers;
+use hydrorattle::{
+    Bond, Hydro, Layout, Method, NoForce, Params, Real, SolverKind, State, step_slices,
+};
+
+/// The case's generator; in a hostile case, some values it draws are hostile.
+struct Draw(Rng, bool);
+
+impl Draw {
+    fn below(&mut self, n: u64) -> u64 {
+        self.0.below(n as usize) as u64
+    }
+
+    fn unit(&mut self) -> f64 {
+        self.0.unit()
+    }
+
+    fn next(&mut self) -> u64 {
+        self.0.next()
+    }
+
+    /// Values near `typical`; in a hostile case, one draw in eight is hostile.
+    fn value(&mut self, typical: f64) -> f64 {
+        if !self.1 || self.below(8) != 0 {
+            return typical * (0.5 + self.unit());
+        }
+        match self.below(12) {
+            0 => f64::NAN,
+            1 => f64::INFINITY,
+            2 => f64::NEG_INFINITY,
+            3 => 0.0,
+            4 => -typical,
+            5 => 1e300,
+            6 => 5e-324,
+            7 => 1e-30,
+            8 => f64::from_bits(self.next()),
+            9 => 1e20,
+            _ => typical * (0.5 + self.unit()),
+        }
+    }
+
+    fn vec3(&mut self, typical: f64) -> [f64; 3] {
+        if self.1 && self.below(4) == 0 {
+            [
+                self.value(typical),
+                self.value(typical),
+                self.value(typical),
+            ]
+        } else {
+            [
+                typical * (self.unit() - 0.5),
+                typical * (self.unit() - 0.5),
+                typical * (self.unit() - 0.5),
+            ]
+        }
+    }
+}
+
+const METHODS: [Method; 5] = [
+    Method::Overdamped,
+    Method::Overdamped2,
+    Method::Rattle,
+    Method::RattleStable,
+    Method::Springs,
+];
+const SOLVERS: [SolverKind; 4] = [
+    SolverKind::Auto,
+    SolverKind::Sweep,
+    SolverKind::Newton,
+    SolverKind::Krylov,
+];
+const HYDRO: [Hydro; 3] = [Hydro::Rpy, Hydro::Oseen, Hydro::FreeDraining];
+
+fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
+    v.iter()
+        .flat_map(|&x| f64s::<T>(x))
+        .map(f64::to_bits)
+        .collect()
+}
+
+/// One fuzz case in precision `T`: whether the step was accepted, or `Err` describing
+/// a broken promise.
+fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
+    let n = 1 + rng.below(6) as usize;
+    // Mostly a chain along x with gaps, so that many cases are valid and step.
+    let mut pos = Vec::with_capacity(n);
+    let mut radius = Vec::with_capacity(n);
+    for k in 0..n {
+        let r = if rng.1 && rng.below(10) == 0 {
+            rng.value(1.0)
+        } else {
+            0.5 + rng.unit()
+        };
+        let jitter = rng.vec3(0.3);
+        let at = if rng.1 && rng.below(12) == 0 {
+            rng.vec3(3.0)
+        } else {
+            [3.0 * k as f64 + jitter[0], jitter[1], jitter[2]]
+        };
+        pos.push(T::v3_from(at));
+        radius.push(T::from_f64(r));
+    }
+    let mut vel: Vec<T::V3> = (0..n).map(|_| T::v3_from(rng.vec3(0.1))).collect();
+    let mut omega: Vec<T::V3> = (0..n).map(|_| T::v3_from(rng.vec3(0.1))).collect();
+    let density: Vec<T> = (0..n).map(|_| T::from_f64(rng.value(4.5))).collect();
+    let mut time = T::from_f64(if rng.1 && rng.below(8) == 0 {
+        rng.value(1.0)
+    } else {
+        rng.unit()
+    });
+    let nb = rng.below(n as u64 + 2) as usize;
+    let bonds: Vec<Bond<T>> = (0..nb)
+        .map(|k| {
+            let (i, j) = if rng.1 && rng.below(10) == 0 {
+                (
+                    rng.below(n as u64 + 2) as usize,
+                    rng.below(n as u64 + 2) as usize,
+                )
+            } else {
+                (k % n, (k + 1) % n)
+            };
+            let length = if rng.1 && rng.below(8) == 0 {
+                rng.value(3.0)
+            } else {
+                // The current distance, so that a clean case starts on its constraints.
+                let d = sub(f64s::<T>(pos[i % n]), f64s::<T>(pos[j % n]));
+                norm(d).max(1e-3)
+            };
+            Bond {
+                i,
+                j,
+                length: T::from_f64(length),
+            }
+        })
+        .collect();
+    let mut p = Params::<T>::new(T::from_f64(if rng.1 && rng.below(8) == 0 {
+        rng.value(0.01)
+    } else {
+        0.001 + 0.05 * rng.unit()
+    }));
+    p.method = METHODS[rng.below(5) as usize];
+    p.solver.kind = SOLVERS[rng.below(4) as usize];
+    p.hydro = HYDRO[rng.below(3) as usize];
+    p.rotation = rng.below(2) == 0;
+    p.allow_overlap = rng.below(2) == 0;
+    p.stability_guard = rng.below(2) == 0;
+    p.solver.max_iterations = 1 + rng.below(60) as u32;
+    if rng.1 && rng.below(6) == 0 {
+        p.solver.tolerance = T::from_f64(rng.value(1e-6));
+    }
+    if rng.below(10) == 0 {
+        p.viscosity = T::from_f64(rng.value(1.0));
+    }
+    if rng.below(10) == 0 {
+        p.gravity = T::v3_from(rng.vec3(1.0));
+    }
+    if rng.below(10) == 0 {
+        p.vorticity = T::v3_from(rng.vec3(0.5));
+    }
+    if rng.below(10) == 0 {
+        p.spring_stiffness = T::from_f64(rng.value(1e3));
+    }
+    // Storage: usually what the step needs, sometimes too little.
+    let (ln, lb) = match (rng.1, rng.below(16)) {
+        (true, 0) => (n.saturating_sub(1), nb),
+        (true, 1) => (n, nb.saturating_sub(1)),
+        _ => (n, nb),
+    };
+    let mut store = Buffers::<T>::new(Layout::for_params(&p, ln, lb));
+    let mut ws = store.workspace();
+    // Sometimes a slice of the wrong length.
+    let short = rng.below(40) == 0 && n > 1;
+    let (pos0, vel0, omega0, time0) = (
+        bits::<T>(&pos),
+        bits::<T>(&vel),
+        bits::<T>(&omega),
+        time.to_f64().to_bits(),
+    );
+    let state = State {
+        pos: &mut pos,
+        vel: if short { &mut vel[..n - 1] } else { &mut vel },
+        omega: &mut omega,
+        radius: &radius,
+        density: &density,
+        time: &mut time,
+    };
+    let result = step_slices(state, &bonds, &p, &mut ws, &mut NoForce);
+    let accepted = result.is_ok();
+    match result {
+        Err(e) => {
+            let same = bits::<T>(&pos) == pos0
+                && bits::<T>(&vel) == vel0
+                && bits::<T>(&omega) == omega0
+                && time.to_f64().to_bits() == time0;
+            if !same {
+                return Err(format!("refused ({e}) but changed the state"));
+            }
+        }
+        Ok(_) => {
+            let finite = pos
+                .iter()
+                .chain(&vel)
+                .chain(&omega)
+                .all(|&v| f64s::<T>(v).iter().all(|x| x.is_finite()));
+            if !finite {
+                return Err("accepted with a non-finite state".into());
+            }
+            if time.to_f64().partial_cmp(&f64::from_bits(time0))
+                != Some(std::cmp::Ordering::Greater)
+            {
+                return Err(format!(
+                    "accepted without advancing time ({} -> {})",
+                    f64::from_bits(time0),
+                    time.to_f64()
+                ));
+            }
+        }
+    }
+    Ok(accepted)
+}
+
+fn fuzz<T: Real>(salt: u64) {
+    let (cases, seed) = settings(0x5EED_0011);
+    let seed = seed ^ salt;
+    let mut failures = Vec::new();
+    let mut accepted = 0u64;
+    for k in 0..cases {
+        let mut rng = Draw(Rng::case(seed, k), false);
+        // Half the cases clean (they should mostly step), half hostile.
+        rng.1 = rng.below(2) == 0;
+        let outcome =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| case::<T>(&mut rng)));
+        match outcome {
+            Ok(Ok(true)) => accepted += 1,
+            Ok(Ok(false)) => {}
+            Ok(Err(m)) => failures.push(format!("case {k}: {m}")),
+            Err(_) => failures.push(format!("case {k}: panicked")),
+        }
+    }
+    let name = format!("fuzz_step {}", core::any::type_name::<T>());
+    report(&name, cases, seed, accepted, &failures);
+}
+
+#[test]
+fn step_survives_hostile_inputs_f64() {
+    fuzz::<f64>(0);
+}
+
+#[test]
+fn step_survives_hostile_inputs_f32() {
+    fuzz::<f32>(1);
+}
