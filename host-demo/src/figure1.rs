@@ -108,7 +108,10 @@ pub fn figure1(out: &Path, max_steps: Option<usize>) -> Result<Figure1Summary> {
         let r = r?;
         cases.push(summarise(case, scene, &r));
         panels.push(Figure1Case {
-            title: title(case, scene),
+            title: match max_steps {
+                Some(m) => format!("{} [QUICK: {m} steps at most]", title(case, scene)),
+                None => title(case, scene),
+            },
             initial: r.initial.clone(),
             last: r.last.clone(),
         });

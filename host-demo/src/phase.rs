@@ -132,7 +132,12 @@ pub fn phase(out: &Path, n: usize, max_steps: Option<usize>) -> Result<()> {
     csv.into_inner().commit()?;
     let index = |o: &str| CATEGORIES.iter().position(|c| c.0 == o);
     let map = CategoryMap {
-        title: "Late-state outcome of a settling 1+24 bead helix".to_string(),
+        title: match max_steps {
+            Some(m) => format!(
+                "Late-state outcome of a settling 1+24 bead helix [QUICK: {m} steps per cell]"
+            ),
+            None => "Late-state outcome of a settling 1+24 bead helix".to_string(),
+        },
         x_label: "D = bond length / (a_i + a_j)".to_string(),
         y_label: "head radius / tail radius".to_string(),
         x: ds,

@@ -147,7 +147,7 @@ pub(super) fn work_precision(out: &Path, quick: bool) -> Result<String> {
         log_y: true,
         series: Vec::new(),
     };
-    write_chart(out, "work_precision", chart, &points)?;
+    write_chart(out, quick, "work_precision", chart, &points)?;
     Ok(format!(
         "work_precision: overdamped reference dt=5e-4 (Heun), estimated error {ref_err:.1e}; inertial reference (St=0.1): paper RATTLE Richardson-extrapolated from dt=5e-4 and 2.5e-4 (first-order error of the finer run {inertial_ref_err:.1e}, removed to leading order)"
     ))
@@ -204,9 +204,31 @@ pub(super) fn models(out: &Path, quick: bool) -> Result<String> {
             }
         }
     }
-    // One cost per model (mean over its runs): timing noise would otherwise zig-zag the
-    // lines; the points of a model then stack vertically, one per Stokes number.
-    let names: Vec<String> = points.iter().map(|p| p.series.clone()).collect();
+    mean_cost_per_model(&mut points);
+    let chart = LineChart {
+        title: format!(
+            "Model error at t = {t_end} vs cost (reference: RPY + rotation + inertia; points: St = {sts:?})"
+        ),
+        x_label: "wall seconds per simulated time unit".into(),
+        y_label: "RMS position error (tail radii)".into(),
+        log_x: true,
+        log_y: true,
+        series: Vec::new(),
+    };
+    write_chart(out, quick, "models", chart, &points)?;
+    Ok(notes.join("\n"))
+}
+
+/// One cost per model (mean over its runs): timing noise would otherwise zig-zag the
+/// lines; the points of a model then stack vertically, one per Stokes number. Each
+/// point keeps its own run's cost as `measured_cost` (one column).
+fn mean_cost_per_model(points: &mut [Point]) {
+    let mut names: Vec<String> = Vec::new();
+    for p in points.iter() {
+        if !names.contains(&p.series) {
+            names.push(p.series.clone());
+        }
+    }
     for name in names {
         let costs: Vec<f64> = points
             .iter()
@@ -219,16 +241,28 @@ pub(super) fn models(out: &Path, quick: bool) -> Result<String> {
             p.x = mean;
         }
     }
-    let chart = LineChart {
-        title: format!(
-            "Model error at t = {t_end} vs cost (reference: RPY + rotation + inertia; points: St = {sts:?})"
-        ),
-        x_label: "wall seconds per simulated time unit".into(),
-        y_label: "RMS position error (tail radii)".into(),
-        log_x: true,
-        log_y: true,
-        series: Vec::new(),
-    };
-    write_chart(out, "models", chart, &points)?;
-    Ok(notes.join("\n"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_point_keeps_one_measured_cost_and_the_model_mean() {
+        let mut pts: Vec<Point> = [("rpy", 1.0), ("rpy", 3.0), ("fd", 5.0)]
+            .iter()
+            .map(|&(s, x)| Point {
+                series: s.into(),
+                x,
+                y: 0.1,
+                extra: Vec::new(),
+            })
+            .collect();
+        mean_cost_per_model(&mut pts);
+        for p in &pts {
+            assert_eq!(p.extra.len(), 1, "{:?}", p.extra);
+        }
+        assert_eq!((pts[0].x, pts[1].x, pts[2].x), (2.0, 2.0, 5.0));
+        assert_eq!(pts[1].extra[0].1, 3.0);
+    }
 }

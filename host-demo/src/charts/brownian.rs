@@ -146,7 +146,7 @@ pub(super) fn trimer(out: &Path, quick: bool) -> Result<String> {
         y_label: "probability density".into(),
         ..Default::default()
     };
-    write_chart(out, "brownian_trimer", chart, &rows)?;
+    write_chart(out, quick, "brownian_trimer", chart, &rows)?;
     Ok(format!(
         "trimer ({steps} steps each; flexible 0.3333, rigid 0.3210): {}",
         notes.join(", ")
@@ -199,6 +199,7 @@ pub(super) fn dimer(out: &Path, quick: bool) -> Result<String> {
     };
     write_chart(
         out,
+        quick,
         "brownian_dimer_orientation",
         chart(
             "Rigid dimer (a = 1, d = 3): axis autocorrelation",
@@ -209,6 +210,7 @@ pub(super) fn dimer(out: &Path, quick: bool) -> Result<String> {
     )?;
     write_chart(
         out,
+        quick,
         "brownian_dimer_msd",
         chart(
             "Rigid dimer: midpoint mean-square displacement",

@@ -130,25 +130,55 @@ struct Point {
     extra: Vec<(String, f64)>,
 }
 
-fn write_chart(out: &Path, file: &str, mut chart: LineChart, points: &[Point]) -> Result<()> {
+/// Writes `FILE.png` and `FILE.csv`; a `quick` (smoke) run says so in the title.
+/// Points of `|y| >= 1e3` (diverged runs) stay in the CSV but are left off the plot.
+fn write_chart(
+    out: &Path,
+    quick: bool,
+    file: &str,
+    chart: LineChart,
+    points: &[Point],
+) -> Result<()> {
+    write_chart_clipped(out, quick, file, chart, points, Some(1e3))
+}
+
+/// One plotted series per series name, in order of first appearance, with the points
+/// of `|y| < clip` (every point for `None`).
+fn series_of(points: &[Point], clip: Option<f64>) -> Vec<Series> {
     let mut names: Vec<String> = Vec::new();
     for p in points {
         if !names.contains(&p.series) {
             names.push(p.series.clone());
         }
     }
-    chart.series = names
+    names
         .iter()
         .map(|n| Series {
             name: n.clone(),
             points: points
                 .iter()
-                // Diverged runs (error above 1e3) stay in the CSV but would flatten the plot.
-                .filter(|p| &p.series == n && p.y.abs() < 1e3)
+                .filter(|p| &p.series == n && clip.is_none_or(|c| p.y.abs() < c))
                 .map(|p| (p.x, p.y))
                 .collect(),
         })
-        .collect();
+        .collect()
+}
+
+/// [`write_chart`] with the plot clipped at `|y| < clip` (`None`: every point drawn).
+fn write_chart_clipped(
+    out: &Path,
+    quick: bool,
+    file: &str,
+    mut chart: LineChart,
+    points: &[Point],
+    clip: Option<f64>,
+) -> Result<()> {
+    if quick {
+        chart
+            .title
+            .push_str(" [QUICK smoke run: fewer, shorter runs]");
+    }
+    chart.series = series_of(points, clip);
     line_chart(&out.join(format!("{file}.png")), &chart, (1100, 750))?;
     let extra: Vec<String> = points
         .first()
@@ -249,4 +279,27 @@ pub fn charts(out: &Path, quick: bool) -> Result<Vec<String>> {
     notes.push(peclet::peclet(out, quick)?);
     log::info!("Brownian charts done in {:.1} s", t.elapsed().as_secs_f64());
     Ok(notes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(series: &str, y: f64) -> Point {
+        Point {
+            series: series.into(),
+            x: 1.0,
+            y,
+            extra: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn failures_at_the_cap_are_drawn_when_not_clipped() {
+        let pts = [point("Sweep", 12.0), point("Sweep: failed", 2000.0)];
+        let drawn = series_of(&pts, None);
+        assert_eq!(drawn.len(), 2);
+        assert_eq!(drawn[1].points, vec![(1.0, 2000.0)]);
+        assert!(series_of(&pts, Some(1e3))[1].points.is_empty());
+    }
 }

@@ -116,7 +116,7 @@ pub(super) fn peclet(out: &Path, quick: bool) -> Result<String> {
         log_x: true,
         ..Default::default()
     };
-    write_chart(out, "brownian_peclet", chart, &rows)?;
+    write_chart(out, quick, "brownian_peclet", chart, &rows)?;
     Ok(format!(
         "Peclet sweep (Figure 1 (c), t = {duration}): deterministic verticality {:.3}, extension {:.3}, settling speed {:.3}",
         base[0], base[1], base[3]

@@ -65,7 +65,7 @@ pub(super) fn springs_vs_constraints(out: &Path, quick: bool) -> Result<String> 
         log_y: true,
         series: Vec::new(),
     };
-    write_chart(out, "springs_vs_constraints", chart, &rows)?;
+    write_chart(out, quick, "springs_vs_constraints", chart, &rows)?;
     Ok(match at_target {
         Some(cost) => format!(
             "springs at bond error 1e-6 cost {cost:.3e} s per time unit; constraints {:.3e}: ratio {:.0}",

@@ -11,7 +11,10 @@ use rayon::prelude::*;
 
 use super::cube::{cube_cholesky_ok, cube_min_eigen};
 use super::precision::{precision_drift, tolerance_ok};
-use super::{Point, base_scene, build, max_stable, setup, stays_bounded, storage, write_chart};
+use super::{
+    Point, base_scene, build, max_stable, setup, stays_bounded, storage, write_chart,
+    write_chart_clipped,
+};
 use crate::render::LineChart;
 use crate::scene::Scene;
 
@@ -111,7 +114,7 @@ pub(super) fn stability(out: &Path, quick: bool) -> Result<String> {
         log_y: true,
         series: Vec::new(),
     };
-    write_chart(out, "stability", chart, &pts)?;
+    write_chart(out, quick, "stability", chart, &pts)?;
     // (2) Springs over (dt, stiffness).
     let ks: Vec<f64> = if quick {
         vec![1e2]
@@ -142,7 +145,7 @@ pub(super) fn stability(out: &Path, quick: bool) -> Result<String> {
         log_y: true,
         series: Vec::new(),
     };
-    write_chart(out, "stability_springs", chart, &spring)?;
+    write_chart(out, quick, "stability_springs", chart, &spring)?;
     // (3) Sweep versus Newton as dt grows (one step from the helix).
     let dts: Vec<f64> = if quick {
         vec![0.01, 0.1]
@@ -179,8 +182,14 @@ pub(super) fn stability(out: &Path, quick: bool) -> Result<String> {
                     (2000.0, 1.0)
                 }
             };
+            // Failures get their own series, drawn at the cap, so that they show.
+            let series = if failed > 0.0 {
+                format!("{name}: failed (drawn at the cap)")
+            } else {
+                name
+            };
             solver_pts.push(Point {
-                series: name,
+                series,
                 x: dt,
                 y: its.max(0.5),
                 extra: vec![("failed".into(), failed), ("bond_rotation_deg".into(), rot)],
@@ -196,7 +205,8 @@ pub(super) fn stability(out: &Path, quick: bool) -> Result<String> {
         log_y: true,
         series: Vec::new(),
     };
-    write_chart(out, "stability_solvers", chart, &solver_pts)?;
+    // The failures sit at the cap (2000), above the usual clip for diverged errors.
+    write_chart_clipped(out, quick, "stability_solvers", chart, &solver_pts, None)?;
     // (4) Oseen losing positive definiteness as the gap closes (3x3x3 cube of spheres).
     let mut oseen_pts = Vec::new();
     let mut first_fail = None;
@@ -231,7 +241,7 @@ pub(super) fn stability(out: &Path, quick: bool) -> Result<String> {
         log_y: false,
         series: Vec::new(),
     };
-    write_chart(out, "stability_oseen", chart, &oseen_pts)?;
+    write_chart(out, quick, "stability_oseen", chart, &oseen_pts)?;
     // (5) f32 against f64: the tolerance floor and the drift of a long run.
     let mut floor_pts = Vec::new();
     for e in 2..=13 {
@@ -256,7 +266,7 @@ pub(super) fn stability(out: &Path, quick: bool) -> Result<String> {
         log_y: false,
         series: Vec::new(),
     };
-    write_chart(out, "stability_precision", chart, &floor_pts)?;
+    write_chart(out, quick, "stability_precision", chart, &floor_pts)?;
     let drift = precision_drift(&scene, if quick { 2.0 } else { 100.0 })?;
     let chart = LineChart {
         title: "f32 vs f64 over a long run: bond error and distance between trajectories".into(),
@@ -266,6 +276,6 @@ pub(super) fn stability(out: &Path, quick: bool) -> Result<String> {
         log_y: true,
         series: Vec::new(),
     };
-    write_chart(out, "stability_drift", chart, &drift)?;
+    write_chart(out, quick, "stability_drift", chart, &drift)?;
     Ok(notes.join("\n"))
 }
