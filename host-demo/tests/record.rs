@@ -176,3 +176,40 @@ fn a_run_resumed_from_its_checkpoint_writes_the_same_bytes_as_one_run() {
         assert_eq!(s1[key], s2[key], "{key}");
     }
 }
+
+#[test]
+fn a_killed_run_resumes_from_the_files_it_left() {
+    // A killed run leaves its files under their temporary names, with frames past the
+    // checkpoint: resume cuts them back and continues, to the bytes of one run.
+    let dir = scratch("killed");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(manifest().join("scenes/ring.toml")).unwrap();
+    let scene = |name: &str, duration: &str| {
+        let path = dir.join(name);
+        // A fixed `every`: the default depends on the duration.
+        let t = text.replace("duration = 20.0", &format!("duration = {duration}"))
+            + "\n[output]\nevery = 3\n";
+        std::fs::write(&path, t).unwrap();
+        path
+    };
+    let one = dir.join("one");
+    run(&scene("long.toml", "4.0"), &one, &[]);
+    let killed = dir.join("killed");
+    run(
+        &scene("short.toml", "2.0"),
+        &killed,
+        &["--checkpoint-every", "2"],
+    );
+    for f in TRAJECTORY_FILES {
+        // What the killed run had written past its checkpoint, under the .tmp name.
+        let mut partial = bytes(&killed, f);
+        partial.extend_from_slice(b"frames written after the checkpoint, then killed");
+        std::fs::write(killed.join(format!("{f}.tmp")), partial).unwrap();
+        std::fs::remove_file(killed.join(f)).unwrap();
+    }
+    cli(&["resume", killed.to_str().unwrap(), "--until", "4"]);
+    for f in TRAJECTORY_FILES {
+        assert!(bytes(&one, f) == bytes(&killed, f), "{f} differs");
+        assert!(!killed.join(format!("{f}.tmp")).exists());
+    }
+}

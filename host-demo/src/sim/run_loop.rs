@@ -115,14 +115,15 @@ pub(super) fn run_t<T: Real>(
     let (first, mut last, mut total_iterations) = match from {
         Some(c) => {
             twist.total = T::from_f64(f64::from_bits(c.twist));
-            if let (Some(dir), true) = (out, opts.keep_series) {
-                each_row(&dir.join(OBSERVABLES_CSV), c.marks.csv_bytes, |o| {
-                    series.push(o)
-                })?;
-            }
+            // The recorder has cut the rows back to the checkpoint, under the
+            // temporary name: replay them into the twist-rate window (and the series).
             if let Some(dir) = out {
-                each_row(&dir.join(OBSERVABLES_CSV), c.marks.csv_bytes, |o| {
-                    tail.add(&o)
+                let rows = crate::output::tmp_path(&dir.join(OBSERVABLES_CSV));
+                each_row(&rows, c.marks.csv_bytes, |o| {
+                    tail.add(&o);
+                    if opts.keep_series {
+                        series.push(o);
+                    }
                 })?;
             }
             (c.step as usize + 1, c.last, c.total_iterations)
