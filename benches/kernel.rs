@@ -22,9 +22,10 @@ use criterion::{BatchSize, BenchmarkId, Criterion};
 use hydrorattle::linalg::{cholesky, cholesky_solve, sym_matvec};
 use hydrorattle::mobility::{Hydro, assemble_grand, assemble_tt};
 use hydrorattle::{
-    Bond, BondSet, Buffers, Layout, Method, NoForce, Params, Particle, ParticleSet, Real,
-    SolverKind, State, step, step_slices,
+    Bond, BondSet, Layout, Method, NoForce, Params, Particle, ParticleSet, Real, SolverKind, State,
+    step, step_slices,
 };
+use hydrorattle_heap::Buffers;
 
 /// Stage sizes.
 const STAGE_SIZES: [usize; 4] = [8, 25, 100, 256];
@@ -157,7 +158,7 @@ fn step_benches<T: Real, const N: usize, const B: usize>(
     }
     init.validate(false).unwrap();
     let bonds = BondSet::<T, B>::chain(&init.pos).unwrap();
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(N, B));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(N, B));
     let mut ws = ws_store.workspace();
     for &method in methods {
         let mut params = Params::new(T::from_f64(0.01));

@@ -5,6 +5,7 @@
 //! `auto`), steps. Case (c) of Figure 1: head radius 2, tails 1, D = 1.05, dt = 0.01.
 
 use hydrorattle::*;
+use hydrorattle_heap::Buffers;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

@@ -32,8 +32,7 @@ fn main() {
     if std::env::args().nth(2).as_deref() == Some("sweep") {
         p.solver.kind = SolverKind::Sweep;
     }
-    let mut ws_store =
-        hydrorattle::workspace::Buffers::<f64>::new(hydrorattle::Layout::all(32, 32));
+    let mut ws_store = hydrorattle_heap::Buffers::<f64>::new(hydrorattle::Layout::all(32, 32));
     let mut ws = ws_store.workspace();
     let steps: usize = std::env::var("STEPS")
         .ok()

@@ -8,6 +8,7 @@
 //! `MF=1` runs matrix-free (Overdamped, Springs), `DT=x` sets the time step.
 
 use hydrorattle::*;
+use hydrorattle_heap::Buffers;
 
 fn helix(n: usize) -> (Vec<glam::DVec3>, Vec<f64>) {
     let mut pos = Vec::with_capacity(n);

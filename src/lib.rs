@@ -35,9 +35,6 @@ pub mod particles;
 pub mod real;
 pub mod workspace;
 
-#[cfg(feature = "alloc")]
-extern crate alloc;
-
 pub use bonds::{Bond, BondSet};
 pub use constraints::{DENSE_BONDS_MAX, Solver, SolverKind};
 pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
@@ -50,6 +47,4 @@ pub use noise::Noise;
 pub use params::{Brownian, Drift, Method, Params};
 pub use particles::{Particle, ParticleSet, State};
 pub use real::Real;
-#[cfg(feature = "alloc")]
-pub use workspace::Buffers;
 pub use workspace::{Layout, Storage, Workspace};

@@ -173,7 +173,7 @@ fn alloc_free_steps<T: Real>() {
     let init = chain::<T, N>();
     let bonds = BondSet::<T, B>::chain(&init.pos[..N]).unwrap();
     // The workspace is on the heap, allocated before counting starts.
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(N, B));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(N, B));
     let mut ws = ws_store.workspace();
     let methods = [
         Method::Overdamped,

@@ -25,8 +25,9 @@ mod common;
 use common::*;
 use hydrorattle::{
     BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, ParticleSet, Real, SolverKind,
-    StepError, step, step_slices, step_thermal, workspace::Buffers,
+    StepError, step, step_slices, step_thermal,
 };
+use hydrorattle_heap::Buffers;
 use std::f64::consts::PI;
 
 /// Thermal parameters: no gravity, `kT = 1`, the given drift and hydrodynamics.

@@ -33,7 +33,7 @@ fn digest<T: Real>(method: Method, dirty: bool) -> u64 {
     let scene = helix(25, 2f64.powf(1.0 / 3.0), 3.0, 0.5, 1.5);
     let fresh: ParticleSet<T, 25> = particles(&scene);
     let bonds: BondSet<T, 24> = BondSet::chain(&fresh.pos[..25]).unwrap();
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(25, 24));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(25, 24));
     let mut ws = ws_store.workspace();
     if dirty {
         let mut other = fresh.clone();

@@ -99,8 +99,7 @@ impl Dimer {
         let bonds: BondSet<T, 1> = BondSet::chain(&ps.pos[..2]).unwrap();
         let mut p = params::<T>(dt, method, SolverKind::Newton);
         p.gravity = v3::<T>(0.0, 0.0, -1.0 / self.st);
-        let mut ws_store =
-            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
         let mut ws = ws_store.workspace();
         let steps = (t_end / dt).round() as usize;
         run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, steps);
@@ -359,7 +358,7 @@ fn bonds_hold<T: Real>() {
                 let start = f64s::<T>(ps.pos[0]);
                 let p = params::<T>(0.05, method, kind);
                 let mut ws_store =
-                    hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+                    hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
                 let mut ws = ws_store.workspace();
                 let (mut worst, mut worst_rate) = (0.0f64, 0.0f64);
                 for k in 0..40 {
@@ -410,8 +409,7 @@ fn constraint_forces_internal<T: Real>() {
             let n = ps.len();
             let mut p = params::<T>(dt, method, SolverKind::Newton);
             p.hydro = Hydro::FreeDraining;
-            let mut ws_store =
-                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+            let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
             let mut ws = ws_store.workspace();
             // Gravity plus a pull on bead 0 through the force hook.
             let mut hook = |_: &[T::V3], _: &[T], f: &mut [T::V3]| {
@@ -462,8 +460,7 @@ fn constraint_work_vanishes<T: Real>() {
         let (mut ps, bonds) = tree_scene().build::<T, 8, 8>();
         let n = ps.len();
         let p = params::<T>(dt, Method::Overdamped, SolverKind::Newton);
-        let mut ws_store =
-            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+        let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
         let mut ws = ws_store.workspace();
         let (mut w_c, mut w_g) = (0.0f64, 0.0f64);
         for _ in 0..(t_end / dt).round() as usize {
@@ -523,8 +520,7 @@ fn uniform_flow<T: Real>() {
             let mut p = params::<T>(dt, method, kind);
             p.gravity = T::V3_ZERO;
             p.flow_velocity = T::v3_from(flow);
-            let mut ws_store =
-                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+            let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
             let mut ws = ws_store.workspace();
             run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, steps);
             let tol = pick::<T>(2e-5, 1e-12);
@@ -578,8 +574,7 @@ fn rigid_rotation<T: Real>() {
             let mut p = params::<T>(dt, method, SolverKind::Newton);
             p.gravity = T::V3_ZERO;
             p.vorticity = T::v3_from(omega);
-            let mut ws_store =
-                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+            let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
             let mut ws = ws_store.workspace();
             let steps = (t_end / dt).round() as usize;
             run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, steps);
@@ -633,7 +628,7 @@ fn spin_up<T: Real>() {
     p.rotation = true;
     p.gravity = T::V3_ZERO;
     p.vorticity = T::v3_from(omega);
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(1, 1));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(1, 1));
     let mut ws = ws_store.workspace();
     let mass = 4.0 / 3.0 * PI * a.powi(3) * RHO;
     let tau_r = 0.4 * mass * a * a / (8.0 * PI * a.powi(3));
@@ -697,8 +692,7 @@ fn side_by_side<T: Real>() {
             };
             let mut p = params::<T>(0.1, method, SolverKind::Newton);
             p.rotation = true;
-            let mut ws_store =
-                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+            let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
             let mut ws = ws_store.workspace();
             step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
             let weight = |a: f64| 4.0 / 3.0 * PI * a.powi(3) * RHO;
@@ -739,8 +733,7 @@ fn side_by_side<T: Real>() {
         let bonds: BondSet<T, 1> = BondSet::new();
         let mut p = params::<T>(0.1, method, SolverKind::Newton);
         p.rotation = true;
-        let mut ws_store =
-            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
         let mut ws = ws_store.workspace();
         run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, 300);
         let want = 6.0 * PI / (8.0 * PI * 16.0);
@@ -785,7 +778,7 @@ fn rotation_massless_limit<T: Real>() {
     p.rotation = true;
     p.gravity = v3::<T>(0.0, 0.0, -1.0 / st);
     p.vorticity = v3::<T>(0.0, 0.1, 0.0);
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
     let mut ws = ws_store.workspace();
     run(&mut inertial, &bonds, &p, &mut ws, &mut NoForce, 20);
     p.method = Method::Overdamped;
@@ -830,7 +823,7 @@ fn sweep_vs_newton<T: Real>() {
             let mut p = params::<T>(dt, Method::Overdamped, kind);
             p.solver.max_iterations = 1000;
             let mut ws_store =
-                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(25, 24));
+                hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(25, 24));
             let mut ws = ws_store.workspace();
             let reports = run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, steps);
             let its: Vec<u32> = reports.iter().map(|r| r.iterations).collect();

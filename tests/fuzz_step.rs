@@ -13,10 +13,10 @@ mod common;
 
 use common::fuzz::{Rng, report, settings};
 use common::*;
-use hydrorattle::workspace::Buffers;
 use hydrorattle::{
     Bond, Hydro, Layout, Method, NoForce, Params, Real, SolverKind, State, step_slices,
 };
+use hydrorattle_heap::Buffers;
 
 /// The case's generator; in a hostile case, some values it draws are hostile.
 struct Draw(Rng, bool);

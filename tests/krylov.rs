@@ -7,7 +7,8 @@
 mod common;
 
 use common::*;
-use hydrorattle::{BondSet, Buffers, Layout, Method, NoForce, ParticleSet, Real, SolverKind};
+use hydrorattle::{BondSet, Layout, Method, NoForce, ParticleSet, Real, SolverKind};
+use hydrorattle_heap::Buffers;
 
 const METHODS: [(Method, bool); 5] = [
     (Method::Overdamped, false),

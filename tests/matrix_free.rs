@@ -8,8 +8,9 @@ mod common;
 
 use common::*;
 use hydrorattle::{
-    BondSet, Buffers, Layout, Method, NoForce, ParticleSet, Real, SolverKind, StepError, step,
+    BondSet, Layout, Method, NoForce, ParticleSet, Real, SolverKind, StepError, step,
 };
+use hydrorattle_heap::Buffers;
 
 const N: usize = 40;
 

@@ -91,8 +91,7 @@ fn the_guard_sees_the_stiffest_mode_in_every_direction() {
         let mut p = Params::new(1e6);
         p.method = Method::Rattle;
         p.stability_guard = true;
-        let mut ws_store =
-            hydrorattle::workspace::Buffers::<f64>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws_store = hydrorattle_heap::Buffers::<f64>::new(hydrorattle::Layout::all(2, 1));
         let mut ws = ws_store.workspace();
         match step(&mut ps, &bonds, &p, &mut ws, &mut NoForce) {
             Err(StepError::Unstable { limit, .. }) => {
@@ -121,8 +120,7 @@ fn overdamped2_spin_includes_the_constraint_forces() {
         p.method = method;
         p.rotation = true;
         p.gravity = DVec3::new(0.3, 0.0, -1.0);
-        let mut ws_store =
-            hydrorattle::workspace::Buffers::<f64>::new(hydrorattle::Layout::all(3, 2));
+        let mut ws_store = hydrorattle_heap::Buffers::<f64>::new(hydrorattle::Layout::all(3, 2));
         let mut ws = ws_store.workspace();
         step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
         ps.omega

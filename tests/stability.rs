@@ -44,7 +44,7 @@ fn diverges<T: Real, const N: usize>(spheres: &[Sphere], dt: f64, steps: usize) 
     let mut p = params::<T>(dt, Method::Rattle, SolverKind::Newton);
     p.gravity = T::V3_ZERO;
     p.allow_overlap = true;
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(N, N));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(N, N));
     let mut ws = ws_store.workspace();
     let e0 = kinetic(&ps);
     for _ in 0..steps {
@@ -85,7 +85,7 @@ fn guard_limit<T: Real, const N: usize>(spheres: &[Sphere]) -> f64 {
     let bonds: BondSet<T, N> = BondSet::chain(&ps.pos[..n]).unwrap();
     let mut p = params::<T>(1e6, Method::Rattle, SolverKind::Newton);
     p.stability_guard = true;
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(N, N));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(N, N));
     let mut ws = ws_store.workspace();
     let before = snapshot(&ps);
     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
@@ -179,8 +179,7 @@ fn blow_up_is_an_error<T: Real>() {
         let n = ps.len();
         let bonds: BondSet<T, 2> = BondSet::chain(&ps.pos[..n]).unwrap();
         let p = params::<T>(10.0 * tau(1.0, RHO), Method::Rattle, SolverKind::Newton);
-        let mut ws_store =
-            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 2));
+        let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(2, 2));
         let mut ws = ws_store.workspace();
         let mut failed = None;
         for k in 0..5000 {
@@ -226,7 +225,7 @@ fn guard_refuses<T: Real>() {
     let bonds: BondSet<T, 1> = BondSet::new();
     let mut p = params::<T>(1.05 * two_tau, Method::Rattle, SolverKind::Newton);
     p.stability_guard = true;
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(1, 1));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(1, 1));
     let mut ws = ws_store.workspace();
     let before = snapshot(&ps);
     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
@@ -254,7 +253,7 @@ fn implicit_bounded<T: Real>() {
     let mut ps: ParticleSet<T, 1> = particles(&lone);
     let bonds: BondSet<T, 1> = BondSet::new();
     let p = params::<T>(dt, Method::RattleStable, SolverKind::Newton);
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(1, 1));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(1, 1));
     let mut ws = ws_store.workspace();
     let mut v = 0.0;
     for _ in 0..50 {
@@ -276,7 +275,7 @@ fn implicit_bounded<T: Real>() {
     let mut p = params::<T>(dt, Method::RattleStable, SolverKind::Newton);
     p.gravity = T::V3_ZERO;
     p.allow_overlap = true;
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
     let mut ws = ws_store.workspace();
     let mut e = kinetic(&ps);
     for k in 0..50 {
@@ -308,7 +307,7 @@ fn silent_regime_needs_guard<T: Real>() {
     let mut p = params::<T>(dt, Method::Rattle, SolverKind::Newton);
     p.gravity = T::V3_ZERO;
     p.stability_guard = true;
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(25, 24));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(25, 24));
     let mut ws = ws_store.workspace();
     let before = snapshot(&ps);
     let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);

@@ -30,7 +30,7 @@ fn warmed_chain<T: Real>(method: Method) -> (ParticleSet<T, 8>, BondSet<T, 8>) {
     let (mut ps, bonds) = chain_scene().build::<T, 8, 8>();
     let mut p = params::<T>(0.05, method, SolverKind::Newton);
     p.rotation = method == Method::RattleStable;
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
     let mut ws = ws_store.workspace();
     run(&mut ps, &bonds, &p, &mut ws, &mut NoForce, 3);
     (ps, bonds)
@@ -44,8 +44,7 @@ fn no_convergence<T: Real>() {
             let mut p = params::<T>(1.0, method, kind);
             p.solver.max_iterations = 1;
             p.solver.tolerance = T::from_f64(pick::<T>(2e-6, 1e-13));
-            let mut ws_store =
-                hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+            let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
             let mut ws = ws_store.workspace();
             let before = snapshot(&ps);
             let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
@@ -76,8 +75,7 @@ fn nan_force<T: Real>() {
         let (mut ps, bonds) = warmed_chain::<T>(method);
         let mut p = params::<T>(0.01, method, SolverKind::Newton);
         p.rotation = method == Method::RattleStable;
-        let mut ws_store =
-            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+        let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
         let mut ws = ws_store.workspace();
         let mut at_once = |_: &[T::V3], _: &[T], f: &mut [T::V3]| {
             f[2] = T::v3_from([f64::NAN, 0.0, 0.0]);
@@ -141,8 +139,7 @@ fn overlap<T: Real>() {
         let mut ps: ParticleSet<T, 2> = particles(&spheres);
         let bonds: BondSet<T, 1> = BondSet::new();
         let mut p = params::<T>(0.1, method, SolverKind::Newton);
-        let mut ws_store =
-            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
         let mut ws = ws_store.workspace();
         let mut push = |_: &[T::V3], _: &[T], f: &mut [T::V3]| {
             f[0] += T::v3_from([-154.0, 0.0, 0.0]);
@@ -201,8 +198,7 @@ fn not_positive_definite<T: Real>() {
         let mut p = params::<T>(0.01, method, SolverKind::Newton);
         p.hydro = hydrorattle::Hydro::Oseen;
         p.allow_overlap = true;
-        let mut ws_store =
-            hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
+        let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(2, 1));
         let mut ws = ws_store.workspace();
         let before = snapshot(&ps);
         let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
@@ -223,7 +219,7 @@ fn not_positive_definite<T: Real>() {
 /// Bad time steps and viscosities, and massless particles with inertial methods.
 fn bad_inputs<T: Real>() {
     let (mut ps, bonds) = warmed_chain::<T>(Method::Overdamped);
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
     let mut ws = ws_store.workspace();
     let before = snapshot(&ps);
     for method in ALL {
@@ -266,7 +262,7 @@ fn bad_inputs<T: Real>() {
 /// tolerance bounds the relative length error as documented, compressed bonds included.
 fn tolerance_and_time<T: Real>() {
     let (mut ps, bonds) = warmed_chain::<T>(Method::Overdamped);
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(8, 8));
     let mut ws = ws_store.workspace();
     let before = snapshot(&ps);
     let mut p = params::<T>(0.05, Method::Overdamped, SolverKind::Newton);
@@ -400,7 +396,7 @@ fn random_chain_property<T: Real>(c: &Case) -> Result<(), TestCaseError> {
     };
     let p = params::<T>(c.dt, method, kind);
     let tol = p.solver.tolerance.to_f64() + 16.0 * T::EPSILON.to_f64();
-    let mut ws_store = hydrorattle::workspace::Buffers::<T>::new(hydrorattle::Layout::all(12, 12));
+    let mut ws_store = hydrorattle_heap::Buffers::<T>::new(hydrorattle::Layout::all(12, 12));
     let mut ws = ws_store.workspace();
     for k in 0..c.steps {
         let before = snapshot(&ps);

@@ -5,7 +5,7 @@
 //! them is the caller's choice:
 //! * firmware: a [`Storage`] sized at compile time from a `const` [`Layout`], which can
 //!   live in a `static` (its constructor is `const`);
-//! * a host: `Buffers` (feature `alloc`), built directly on the heap, never on the
+//! * a host: `Buffers` (crate `hydrorattle-heap`), built directly on the heap, never on the
 //!   stack, so thousands of beads fit;
 //! * anything else: four slices from wherever (an arena, a C caller).
 //!
@@ -104,60 +104,6 @@ impl<T: Real, const BL: usize, const VE: usize, const SC: usize, const IX: usize
     }
 
     /// A workspace over this storage.
-    pub fn workspace(&mut self) -> Workspace<'_, T> {
-        Workspace::new(
-            &mut self.blocks,
-            &mut self.vectors,
-            &mut self.scalars,
-            &mut self.indices,
-        )
-    }
-}
-
-/// Heap storage sized at run time (feature `alloc`): built element by element on the
-/// heap, so no size ever passes through the stack.
-#[cfg(feature = "alloc")]
-#[derive(Clone, Debug, Default)]
-pub struct Buffers<T: Real> {
-    blocks: alloc::vec::Vec<T::M3>,
-    vectors: alloc::vec::Vec<T::V3>,
-    scalars: alloc::vec::Vec<T>,
-    indices: alloc::vec::Vec<usize>,
-}
-
-#[cfg(feature = "alloc")]
-impl<T: Real> Buffers<T> {
-    /// Zeroed buffers holding `layout`.
-    pub fn new(layout: Layout) -> Self {
-        Self {
-            blocks: alloc::vec![T::M3_ZERO; layout.blocks],
-            vectors: alloc::vec![T::V3_ZERO; layout.vectors],
-            scalars: alloc::vec![T::ZERO; layout.scalars],
-            indices: alloc::vec![0; layout.indices],
-        }
-    }
-
-    /// Like [`Buffers::new`], but an allocation the system refuses is an error instead
-    /// of an abort (hosts sizing storage from user input).
-    pub fn try_new(layout: Layout) -> Result<Self, alloc::collections::TryReserveError> {
-        fn zeroed<X: Clone>(
-            len: usize,
-            x: X,
-        ) -> Result<alloc::vec::Vec<X>, alloc::collections::TryReserveError> {
-            let mut v = alloc::vec::Vec::new();
-            v.try_reserve_exact(len)?;
-            v.resize(len, x);
-            Ok(v)
-        }
-        Ok(Self {
-            blocks: zeroed(layout.blocks, T::M3_ZERO)?,
-            vectors: zeroed(layout.vectors, T::V3_ZERO)?,
-            scalars: zeroed(layout.scalars, T::ZERO)?,
-            indices: zeroed(layout.indices, 0)?,
-        })
-    }
-
-    /// A workspace over these buffers.
     pub fn workspace(&mut self) -> Workspace<'_, T> {
         Workspace::new(
             &mut self.blocks,

@@ -340,7 +340,8 @@ where
 /// this machine: what the firmware must print.
 #[cfg(feature = "alloc")]
 pub fn host_summaries(only: &[&str]) -> alloc::string::String {
-    use hydrorattle::{Buffers, Layout};
+    use hydrorattle::Layout;
+    use hydrorattle_heap::Buffers;
     let mut out = alloc::string::String::new();
     for (name, method, rotation) in RUNS {
         if !only.is_empty() && !only.contains(&name) {

@@ -2,7 +2,8 @@
 //! defaults with the scene's changes, a chain that satisfies its bonds, and a run that
 //! gives the same bits twice.
 
-use hydrorattle::{Buffers, Layout, ParticleSet};
+use hydrorattle::{Layout, ParticleSet};
+use hydrorattle_heap::Buffers;
 use hydrorattle_scene::{B, N, RUNS, chain, digest, params, params_f32, run};
 
 #[test]

@@ -17,8 +17,9 @@ use anyhow::{Result, anyhow};
 use hydrorattle::glam::DVec3;
 use hydrorattle::{
     BondSet, Brownian, Drift, Hydro, Layout, NoForce, Noise, Params, Particle, ParticleSet,
-    step_thermal, workspace::Buffers,
+    step_thermal,
 };
+use hydrorattle_heap::Buffers;
 
 use super::{Point, write_chart};
 use crate::render::LineChart;

@@ -21,8 +21,9 @@ use std::time::Instant;
 
 use anyhow::Result;
 use hydrorattle::{
-    Bond, Buffers, ExternalForce, Layout, Method, Params, Real, SoftContact, StepError, step_slices,
+    Bond, ExternalForce, Layout, Method, Params, Real, SoftContact, StepError, step_slices,
 };
+use hydrorattle_heap::Buffers;
 
 use crate::output::{AtomicFile, CsvWriter};
 use crate::render::{LineChart, Series, line_chart};

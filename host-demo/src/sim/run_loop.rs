@@ -5,7 +5,8 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use hydrorattle::observables::{self, Thresholds, Twist};
-use hydrorattle::{Buffers, Noise, Params, Real, SoftContact, step_slices_thermal};
+use hydrorattle::{Noise, Params, Real, SoftContact, step_slices_thermal};
+use hydrorattle_heap::Buffers;
 
 use super::checkpoint::Checkpoint;
 use super::record::{OBSERVABLES_CSV, Recorder, each_row};
