@@ -121,6 +121,8 @@ pub enum Stage {
     Velocities,
     /// Estimating the explicit-drag stability limit.
     Stability,
+    /// The active set of hard-sphere contacts (which pairs touch).
+    Contacts,
 }
 
 /// A step failed; the caller's state is exactly as it was before the call.
@@ -151,9 +153,11 @@ pub enum StepError {
         residual: f64,
     },
     /// A bond turned so far in one step that the linearised update has no root
-    /// (the SHAKE denominator vanished or changed sign).
+    /// (the SHAKE denominator vanished or changed sign), or a hard contact would end
+    /// on the far side of where its pair started (the step carried one sphere past the
+    /// other).
     Degenerate {
-        /// The bond.
+        /// The bond; past the bonds, contact `bond - bonds` of the step.
         bond: usize,
     },
     /// A force, velocity or position became NaN or infinite.
@@ -183,6 +187,12 @@ pub enum StepError {
         dt: f64,
         /// The largest stable step for this configuration.
         limit: f64,
+    },
+    /// More spheres would touch at once than [`Contacts::capacity`](crate::Contacts)
+    /// holds.
+    ContactsFull {
+        /// The capacity.
+        capacity: usize,
     },
     /// The combination asked for is not implemented (named): for example thermal noise
     /// with a method other than `Overdamped`, or without a stored mobility.
@@ -271,20 +281,26 @@ impl fmt::Display for StepError {
             Self::Overlap { i, j } => write!(f, "particles {i} and {j} overlap after the step"),
             Self::Storage { need, have } => write!(
                 f,
-                "workspace too small: need {} blocks, {} vectors, {} scalars, {} indices; have {}, {}, {}, {}",
+                "workspace too small: need {} blocks, {} vectors, {} scalars, {} indices, {} links; have {}, {}, {}, {}, {}",
                 need.blocks,
                 need.vectors,
                 need.scalars,
                 need.indices,
+                need.links,
                 have.blocks,
                 have.vectors,
                 have.scalars,
-                have.indices
+                have.indices,
+                have.links
             ),
             Self::StateLength => write!(f, "state slices differ in length"),
             Self::Unstable { dt, limit } => write!(
                 f,
                 "explicit drag unstable: dt = {dt:e} exceeds the stability limit {limit:e}"
+            ),
+            Self::ContactsFull { capacity } => write!(
+                f,
+                "more than {capacity} contacts at once (raise the contact capacity)"
             ),
             Self::Unsupported(what) => write!(f, "not supported: {what}"),
         }

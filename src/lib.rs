@@ -44,7 +44,7 @@ pub use glam;
 pub use integrate::{StepReport, step, step_slices, step_slices_thermal, step_thermal};
 pub use mobility::Hydro;
 pub use noise::Noise;
-pub use params::{Brownian, Drift, Method, Params};
+pub use params::{Brownian, Contacts, Drift, Method, Params};
 pub use particles::{Particle, ParticleSet, State};
 pub use real::Real;
 pub use workspace::{Layout, Storage, Workspace};

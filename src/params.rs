@@ -68,6 +68,36 @@ impl<T: Real> Brownian<T> {
     }
 }
 
+/// Hard-sphere excluded volume as one-sided constraints in the position solve
+/// ([`Method::Overdamped`] and [`Method::Overdamped2`]).
+///
+/// Each pair of spheres that would overlap becomes a constraint `|r_i - r_j| = a_i + a_j`
+/// solved together with the bonds through the same metric and solver; a contact whose
+/// multiplier would pull the pair together is released (an active-set iteration: the
+/// projection's KKT conditions). Unlike a soft repulsion it has no stiffness, so it does
+/// not limit `dt`. Bonded pairs are never contacts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Contacts {
+    /// Most contacts held at once. Storage counts them as extra constraints
+    /// ([`Layout::for_params`](crate::Layout::for_params)); a step needing more returns
+    /// [`StepError::ContactsFull`](crate::StepError::ContactsFull).
+    pub capacity: usize,
+    /// Active-set rounds (one constraint solve each) before the step gives up with
+    /// [`StepError::NoConvergence`](crate::StepError::NoConvergence) at
+    /// [`Stage::Contacts`](crate::Stage::Contacts). Default 64.
+    pub max_rounds: u32,
+}
+
+impl Contacts {
+    /// Room for `capacity` contacts, default rounds.
+    pub const fn new(capacity: usize) -> Self {
+        Self {
+            capacity,
+            max_rounds: 64,
+        }
+    }
+}
+
 /// Everything a step needs besides the state. Build with [`Params::new`] and adjust.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params<T: Real> {
@@ -115,6 +145,11 @@ pub struct Params<T: Real> {
     /// and [`Params::matrix_free`] refuse a positive temperature with
     /// [`StepError::Unsupported`](crate::StepError::Unsupported)). Default `None`.
     pub brownian: Option<Brownian<T>>,
+    /// Hard-sphere contacts as one-sided constraints ([`Contacts`];
+    /// [`Method::Overdamped`] and [`Method::Overdamped2`] without thermal noise; the other
+    /// methods refuse them with [`StepError::Unsupported`](crate::StepError::Unsupported)).
+    /// Default `None`: spheres may overlap (see [`Params::allow_overlap`]).
+    pub contacts: Option<Contacts>,
 }
 
 impl<T: Real> Params<T> {
@@ -145,6 +180,7 @@ impl<T: Real> Params<T> {
             spring_stiffness: T::from_f64(1e3),
             stability_guard: false,
             brownian: None,
+            contacts: None,
         }
     }
 
@@ -152,5 +188,14 @@ impl<T: Real> Params<T> {
     #[inline]
     pub fn flow_at(&self, r: T::V3) -> T::V3 {
         self.flow_velocity + T::cross(self.vorticity, r)
+    }
+
+    /// Constraint slots a step with `bonds` bonds holds: the bonds, and the contact
+    /// capacity when contacts are on.
+    pub const fn constraints(&self, bonds: usize) -> usize {
+        match self.contacts {
+            Some(c) => bonds + c.capacity,
+            None => bonds,
+        }
     }
 }

@@ -54,6 +54,10 @@ enum HrStatus
   HR_STATUS_UNSTABLE = 12,
   // `StepError::Unsupported`: the combination of parameters is not implemented.
   HR_STATUS_UNSUPPORTED = 13,
+  // `StepError::ContactsFull`: more contacts at once than the capacity
+  // (`error_index`). The C interface sets no contacts, so this is never returned
+  // today; the value is reserved so that codes stay stable.
+  HR_STATUS_CONTACTS_FULL = 14,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -275,7 +279,7 @@ typedef struct {
   // of storage given.
   uint64_t error_other;
   // On failure: the stage (1 mobility, 2 drag, 3 positions, 4 velocities,
-  // 5 stability), 0 where none applies.
+  // 5 stability, 6 contacts), 0 where none applies.
   uint32_t error_stage;
   // On failure: the residual left, or the time step refused as unstable.
   double error_value;
@@ -349,7 +353,7 @@ typedef struct {
   // of storage given.
   uint64_t error_other;
   // On failure: the stage (1 mobility, 2 drag, 3 positions, 4 velocities,
-  // 5 stability), 0 where none applies.
+  // 5 stability, 6 contacts), 0 where none applies.
   uint32_t error_stage;
   // On failure: the residual left, or the time step refused as unstable.
   double error_value;

@@ -227,6 +227,8 @@ pub extern "C" fn hr_error_message(status: i32) -> *const c_char {
         10 => c"storage too small (need error_index bytes, have error_other)",
         11 => c"state slices differ in length",
         12 => c"explicit drag unstable (error_value > error_limit)",
+        13 => c"the combination of parameters is not implemented",
+        14 => c"more contacts at once than the capacity (error_index)",
         _ => c"unknown status",
     };
     s.as_ptr()

@@ -332,6 +332,10 @@ fn describe<T>(e: StepError, r: &mut HrReport<T>) -> HrStatus {
             (r.error_value, r.error_limit) = (dt, limit);
             HrStatus::Unstable
         }
+        StepError::ContactsFull { capacity } => {
+            r.error_index = capacity as u64;
+            HrStatus::ContactsFull
+        }
         StepError::Unsupported(_) => HrStatus::Unsupported,
     }
 }

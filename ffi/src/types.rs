@@ -49,6 +49,10 @@ pub enum HrStatus {
     Unstable = 12,
     /// `StepError::Unsupported`: the combination of parameters is not implemented.
     Unsupported = 13,
+    /// `StepError::ContactsFull`: more contacts at once than the capacity
+    /// (`error_index`). The C interface sets no contacts, so this is never returned
+    /// today; the value is reserved so that codes stay stable.
+    ContactsFull = 14,
 }
 
 /// Values of [`HrParams::method`] (the kernel's `Method`).
@@ -199,7 +203,7 @@ pub struct HrReport<T> {
     /// of storage given.
     pub error_other: u64,
     /// On failure: the stage (1 mobility, 2 drag, 3 positions, 4 velocities,
-    /// 5 stability), 0 where none applies.
+    /// 5 stability, 6 contacts), 0 where none applies.
     pub error_stage: u32,
     /// On failure: the residual left, or the time step refused as unstable.
     pub error_value: f64,

@@ -7,7 +7,7 @@
 
 use std::collections::TryReserveError;
 
-use hydrorattle::{Layout, Real, Workspace};
+use hydrorattle::{Bond, Layout, Real, Workspace};
 
 /// Heap storage holding a [`Layout`]: built element by element on the heap, so no
 /// size ever passes through the stack.
@@ -17,9 +17,17 @@ pub struct Buffers<T: Real> {
     vectors: Vec<T::V3>,
     scalars: Vec<T>,
     indices: Vec<usize>,
+    links: Vec<Bond<T>>,
 }
 
 impl<T: Real> Buffers<T> {
+    /// A placeholder link (overwritten by every step that reads it).
+    const EMPTY_LINK: Bond<T> = Bond {
+        i: 0,
+        j: 0,
+        length: T::ZERO,
+    };
+
     /// Zeroed buffers holding `layout`.
     pub fn new(layout: Layout) -> Self {
         Self {
@@ -27,6 +35,7 @@ impl<T: Real> Buffers<T> {
             vectors: vec![T::V3_ZERO; layout.vectors],
             scalars: vec![T::ZERO; layout.scalars],
             indices: vec![0; layout.indices],
+            links: vec![Self::EMPTY_LINK; layout.links],
         }
     }
 
@@ -44,6 +53,7 @@ impl<T: Real> Buffers<T> {
             vectors: zeroed(layout.vectors, T::V3_ZERO)?,
             scalars: zeroed(layout.scalars, T::ZERO)?,
             indices: zeroed(layout.indices, 0)?,
+            links: zeroed(layout.links, Self::EMPTY_LINK)?,
         })
     }
 
@@ -55,5 +65,6 @@ impl<T: Real> Buffers<T> {
             &mut self.scalars,
             &mut self.indices,
         )
+        .with_links(&mut self.links)
     }
 }

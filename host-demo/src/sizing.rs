@@ -10,7 +10,7 @@ use std::fmt;
 
 use hydrorattle::Layout;
 
-use crate::scene::{Method, Precision, Scene, Solver};
+use crate::scene::{Contact, Method, Precision, Scene, Solver};
 
 /// Default limit on one run's step storage (`run --max-storage`): 8 GiB holds every
 /// method at 4096 beads in f64.
@@ -109,6 +109,9 @@ pub struct Plan {
     pub solver: Solver,
     /// Precision.
     pub precision: Precision,
+    /// Hard contacts: their capacity, `None` for a given count per particle
+    /// ([`Contact::hard_capacity`]); `None` without hard contacts.
+    pub contacts: Option<Option<usize>>,
 }
 
 impl Plan {
@@ -119,14 +122,29 @@ impl Plan {
             rotation: scene.model.rotation,
             solver: scene.integrator.solver,
             precision: scene.integrator.precision,
+            contacts: scene.contact.and_then(|c| match c {
+                Contact::Hard { capacity } => Some(capacity),
+                Contact::Soft { .. } => None,
+            }),
         }
     }
 
     /// The kernel's storage for `n` particles and `b` bonds; `None` past counting.
+    /// Hard contacts count as constraints beside the bonds, as in the kernel's
+    /// `Layout::for_params`.
     pub fn layout(&self, n: usize, b: usize) -> Option<Layout> {
         let kernel = (self.method.kernel(), self.solver.kind());
-        (n <= COUNT_MAX && b <= COUNT_MAX)
-            .then(|| Layout::with_solver(kernel.0, self.rotation, kernel.1, n, b))
+        let contacts = self
+            .contacts
+            .map(|c| Contact::Hard { capacity: c }.hard_capacity(n).unwrap_or(0));
+        let c = b.saturating_add(contacts.unwrap_or(0));
+        (n <= COUNT_MAX && c <= COUNT_MAX).then(|| {
+            let mut l = Layout::with_solver(kernel.0, self.rotation, kernel.1, n, c);
+            if contacts.is_some() {
+                l.links = c;
+            }
+            l
+        })
     }
 
     /// Bytes of [`layout`](Self::layout) in this plan's precision.
@@ -167,6 +185,7 @@ mod tests {
             rotation,
             solver: Solver::Auto,
             precision,
+            contacts: None,
         }
     }
 

@@ -107,11 +107,17 @@ fn figure1_scenes_are_the_papers_cases() {
         assert_eq!(scene.particles.len(), 25);
         assert_eq!(scene.species()[0], "head");
         assert!(scene.species()[1..].iter().all(|s| *s == "tail"));
-        // Soft contact is on, and the explicit step is stable with it:
-        // dt k / (3 pi eta a_tail) < 1 (relative mobility of two tails ~ 2/(6 pi eta a)).
-        let k = scene.contact.expect("figure 1 scenes use soft contact");
-        let eta = scene.fluid.viscosity;
-        assert!(scene.integrator.dt * k / (3.0 * std::f64::consts::PI * eta) < 1.0);
+        // Hard contacts (no stiffness, so no explicit-stability limit on dt), with the
+        // second-order method at dt = 0.1 (README, "Figure 1 at dt = 0.1").
+        assert_eq!(
+            scene.contact,
+            Some(host_demo::scene::Contact::Hard { capacity: None })
+        );
+        assert_eq!(
+            scene.integrator.method,
+            host_demo::scene::Method::Overdamped2
+        );
+        assert_eq!(scene.integrator.dt, 0.1);
         assert!(scene.integrator.duration >= 400.0);
     }
     // The embedded copies are the files on disk.

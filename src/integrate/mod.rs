@@ -10,6 +10,7 @@
 //! This file holds `step` and the stages they share.
 
 mod brownian;
+mod contacts;
 mod overdamped;
 mod rattle;
 mod springs;
@@ -45,6 +46,12 @@ pub struct StepReport<T> {
     /// Largest bond tension magnitude `|lambda_k| d_k` (force units); for springs
     /// `k | |r_ij| - d |`.
     pub max_tension: T,
+    /// Hard-sphere contacts held at the end of the step ([`Params::contacts`]; 0
+    /// without).
+    pub contacts: u32,
+    /// Active-set rounds of the contact projection (constraint solves; 0 without
+    /// contacts).
+    pub contact_rounds: u32,
 }
 
 /// Read-only view of the state at the start of a step.
@@ -129,6 +136,8 @@ fn advance<T: Real, E: ExternalForce<T>>(
     // 1. Inputs and storage.
     check_inputs(&state, bonds, p)?;
     let thermal = check_thermal(p, noise.is_some())?;
+    let resolved = check_contacts(p, bonds.len(), thermal.is_some())?;
+    let p = &resolved;
     let s = Start {
         pos: state.pos,
         vel: state.vel,
@@ -156,7 +165,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
     let (new_vel, rest) = rest.split_at(n);
     let new_omega = &rest[..n];
     let mut report = integrated
-        .and_then(|r| accept(new_pos, new_vel, new_omega, s.radius, p.allow_overlap).map(|()| r))
+        .and_then(|r| accept(new_pos, new_vel, new_omega, s.radius, p).map(|()| r))
         .inspect_err(|e| log::debug!("step at t = {} refused, state kept: {e}", *state.time))?;
     log::trace!(
         "t = {}: {} position / {} velocity iterations",
@@ -211,6 +220,33 @@ fn check_thermal<T: Real>(
         ));
     }
     Ok(Some(b))
+}
+
+/// The parameters a step runs with: as given, or with contacts the solver resolved for
+/// the bonds plus the contact capacity (so that the storage and the solver agree however
+/// many contacts a step holds). Refuses contacts where they are not implemented.
+fn check_contacts<T: Real>(
+    p: &Params<T>,
+    bonds: usize,
+    thermal: bool,
+) -> Result<Params<T>, StepError> {
+    let Some(c) = p.contacts else {
+        return Ok(*p);
+    };
+    if !matches!(p.method, Method::Overdamped | Method::Overdamped2) {
+        return Err(StepError::Unsupported(
+            "contacts with a method other than Overdamped or Overdamped2",
+        ));
+    }
+    if thermal {
+        return Err(StepError::Unsupported("contacts with thermal noise"));
+    }
+    if c.max_rounds == 0 {
+        return Err(StepError::BadParameter("contacts.max_rounds (> 0)"));
+    }
+    let mut q = *p;
+    q.solver.kind = p.solver.kind.resolve(p.constraints(bonds));
+    Ok(q)
 }
 
 /// Cheap checks (O(N + B)); pair checks happen in assembly and in [`accept`].
@@ -296,13 +332,19 @@ fn check_inputs<T: Real>(
 }
 
 /// Finite, no nested spheres, no overlap unless allowed (squared distances: no sqrt).
+/// With contacts, spheres touch to within the solver's tolerance, which is accepted.
 fn accept<T: Real>(
     pos: &[T::V3],
     vel: &[T::V3],
     omega: &[T::V3],
     radius: &[T],
-    allow_overlap: bool,
+    p: &Params<T>,
 ) -> Result<(), StepError> {
+    let allow_overlap = p.allow_overlap;
+    let reach = match p.contacts {
+        Some(_) => T::ONE - p.solver.tolerance * T::TWO,
+        None => T::ONE,
+    };
     for i in 0..pos.len() {
         if !(T::v3_is_finite(pos[i]) && T::v3_is_finite(vel[i]) && T::v3_is_finite(omega[i])) {
             return Err(StepError::NonFinite { particle: i });
@@ -311,7 +353,7 @@ fn accept<T: Real>(
     for i in 0..pos.len() {
         for j in i + 1..pos.len() {
             let s2 = T::norm2(pos[i] - pos[j]);
-            let (dif, sum) = (radius[i] - radius[j], radius[i] + radius[j]);
+            let (dif, sum) = (radius[i] - radius[j], (radius[i] + radius[j]) * reach);
             if s2 <= dif * dif || (!allow_overlap && s2 < sum * sum) {
                 return Err(StepError::Overlap { i, j });
             }
@@ -481,5 +523,58 @@ pub(super) fn report<T: Real>(
         velocity_iterations,
         residual: stats.residual,
         max_tension: max_tension(bonds, lambda),
+        contacts: 0,
+        contact_rounds: 0,
     }
+}
+
+/// The slices the overdamped position projection works in.
+pub(super) struct Projection<'l, 'v, 'a, T: Real> {
+    pub links: &'l mut [Bond<T>],
+    pub grad: &'v mut [T::V3],
+    pub disp: &'v mut [T::V3],
+    pub lambda: &'v mut [T],
+    pub scratch: &'v mut Scratch<'a, T>,
+}
+
+/// What the overdamped position projection did.
+pub(super) struct Projected<'l, T: Real> {
+    /// The solve (of the last active-set round with contacts).
+    pub stats: SolveStats<T>,
+    /// The constraints held: the bonds, then the contacts (rows of `grad`, `lambda`).
+    pub held: &'l [Bond<T>],
+    /// Contacts held (0 without contacts).
+    pub contacts: u32,
+    /// Active-set rounds (0 without contacts).
+    pub rounds: u32,
+}
+
+/// The overdamped position projection along the mobility at `start` (`mu`, scaled by
+/// `dt`): `free` writes the unconstrained move into `x`, which is then projected onto
+/// the bonds, or onto the bonds and the hard-sphere contacts when [`Params::contacts`]
+/// is on.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn project_overdamped<'l, T: Real>(
+    p: &Params<T>,
+    bonds: &'l [Bond<T>],
+    start: &[T::V3],
+    radius: &[T],
+    mu: &[T::M3],
+    v: Projection<'l, '_, '_, T>,
+    x: &mut [T::V3],
+    free: impl Fn(&mut [T::V3]),
+) -> Result<Projected<'l, T>, StepError> {
+    let Some(c) = p.contacts else {
+        bond_vectors(bonds, start, v.grad);
+        let metric = mobility_metric(p, bonds, start, radius, mu, v.grad, p.dt, v.disp);
+        free(x);
+        let stats = project_positions(p, bonds, &metric, x, v.lambda, v.scratch)?;
+        return Ok(Projected {
+            stats,
+            held: bonds,
+            contacts: 0,
+            rounds: 0,
+        });
+    };
+    contacts::project_with_contacts(p, c, bonds, start, radius, mu, p.dt, v, x, free)
 }

@@ -3,8 +3,9 @@
 //! predictor-corrector with the same projection.
 
 use super::{
-    Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors, max_tension,
-    mobility_metric, mobility_product, project_positions, report, spin, step_velocity,
+    Projection, Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors,
+    max_tension, mobility_metric, mobility_product, project_overdamped, report, spin,
+    step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch, SolveStats};
@@ -35,23 +36,36 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         disp,
         lambda,
         mut scratch,
+        links,
         ..
     } = v;
-    // Forces and mobility at the start; unconstrained move r* = r + dt (U_inf + mu F).
+    // Forces and mobility at the start; unconstrained velocity U_inf + mu F.
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     mobility_product(p, s.pos, s.radius, mu, force, u)?;
     add_flow(p, s.pos, u);
-    for i in 0..n {
-        new_pos[i] = s.pos[i] + u[i] * dt;
-    }
-    // Constraint move through the full mobility: r' = r* + dt mu G^T lambda.
-    bond_vectors(bonds, s.pos, grad);
-    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu, grad, dt, disp);
-    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut scratch)?;
+    // Unconstrained move r* = r + dt (U_inf + mu F), then the constraint move through
+    // the full mobility: r' = r* + dt mu G^T lambda (bonds, and contacts if on).
+    let free = |x: &mut [T::V3]| {
+        for i in 0..n {
+            x[i] = s.pos[i] + u[i] * dt;
+        }
+    };
+    let views = Projection {
+        links,
+        grad: &mut *grad,
+        disp,
+        lambda: &mut *lambda,
+        scratch: &mut scratch,
+    };
+    let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
-    add_constraint_forces(bonds, grad, lambda, force);
+    add_constraint_forces(r.held, grad, lambda, force);
     spin(p, s.pos, s.radius, force, new_omega)?;
-    Ok(report(stats, 0, bonds, lambda))
+    Ok(StepReport {
+        contacts: r.contacts,
+        contact_rounds: r.rounds,
+        ..report(r.stats, 0, bonds, lambda)
+    })
 }
 
 /// Projected overdamped velocity at `pos`: `U = U_inf + mu (F + G^T kappa)` with `kappa`
@@ -110,6 +124,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         lambda,
         kappa,
         scratch: mut sc,
+        links,
         ..
     } = v;
     // Predictor: projected velocity at r, one projected Euler step.
@@ -123,26 +138,44 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     let tension = max_tension(bonds, kappa);
     add_constraint_forces(bonds, grad, kappa, force);
     spin(p, s.pos, s.radius, force, new_omega)?;
-    for i in 0..n {
-        x_p[i] = s.pos[i] + f0[i] * dt;
-    }
-    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu0, grad, dt, disp);
-    project_positions(p, bonds, &metric, x_p, lambda, &mut sc)?;
+    let predict = |x: &mut [T::V3]| {
+        for i in 0..n {
+            x[i] = s.pos[i] + f0[i] * dt;
+        }
+    };
+    let views = Projection {
+        links: &mut *links,
+        grad: &mut *grad,
+        disp: &mut *disp,
+        lambda: &mut *lambda,
+        scratch: &mut sc,
+    };
+    project_overdamped(p, bonds, s.pos, s.radius, mu0, views, x_p, predict)?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
     assemble_tt(p, x_p, s.radius, mu1)?;
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
     projected_velocity(
         p, x_p, s.radius, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1,
     )?;
-    for i in 0..n {
-        new_pos[i] = s.pos[i] + (f0[i] + f1[i]) * (dt * T::HALF);
-    }
     // Projection as in the first-order scheme: r' = r* + dt mu(r) G(r)^T lambda.
-    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu0, grad, dt, disp);
-    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut sc)?;
+    let trapezoid = |x: &mut [T::V3]| {
+        for i in 0..n {
+            x[i] = s.pos[i] + (f0[i] + f1[i]) * (dt * T::HALF);
+        }
+    };
+    let views = Projection {
+        links,
+        grad,
+        disp,
+        lambda: &mut *lambda,
+        scratch: &mut sc,
+    };
+    let r = project_overdamped(p, bonds, s.pos, s.radius, mu0, views, new_pos, trapezoid)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
     Ok(StepReport {
         max_tension: tension,
-        ..report(stats, 0, bonds, lambda)
+        contacts: r.contacts,
+        contact_rounds: r.rounds,
+        ..report(r.stats, 0, bonds, lambda)
     })
 }

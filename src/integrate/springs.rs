@@ -43,5 +43,6 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         velocity_iterations: 0,
         residual: worst,
         max_tension: tension,
+        ..StepReport::default()
     })
 }

@@ -7,7 +7,8 @@ use crate::linalg::tri;
 use crate::params::{Method, Params};
 use crate::real::Real;
 
-/// Element counts of the four storage arrays one step uses.
+/// Element counts of the storage arrays one step uses: four numeric arrays, and the
+/// constraint list of a step with contacts (`links`, zero otherwise).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Layout {
     /// 3x3 blocks (packed mobilities and factors).
@@ -18,6 +19,9 @@ pub struct Layout {
     pub scalars: usize,
     /// Indices (LU pivots).
     pub indices: usize,
+    /// Constraint links (bonds followed by contacts) of a step with
+    /// [`Params::contacts`]; zero otherwise.
+    pub links: usize,
 }
 
 /// Block rows of the mobility: `2n` when rotation is resolved (only the stable inertial
@@ -69,6 +73,7 @@ impl Layout {
             vectors: 3 * n + m + b,
             scalars: b,
             indices: 0,
+            links: 0,
         };
         match method {
             Method::Overdamped | Method::Springs => {
@@ -110,10 +115,17 @@ impl Layout {
         l
     }
 
-    /// Storage for one step with parameters `p` (method, rotation flag, solver and the
-    /// matrix-free flag), `n` particles and `bonds` bonds.
+    /// Storage for one step with parameters `p` (method, rotation flag, solver, the
+    /// matrix-free flag, thermal noise and contacts), `n` particles and `bonds` bonds.
+    /// Contacts count as constraints beside the bonds (up to their capacity) and add the
+    /// list of links they are solved over.
     pub const fn for_params<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Self {
-        let l = Self::with_solver(p.method, p.rotation, p.solver.kind, n, bonds);
+        let c = p.constraints(bonds);
+        let mut l = Self::with_solver(p.method, p.rotation, p.solver.kind, n, c);
+        if p.contacts.is_some() {
+            l.links = c;
+        }
+        let bonds = c;
         let l = if p.brownian.is_some() {
             l.thermal(p.method, n, bonds)
         } else {
@@ -184,6 +196,7 @@ impl Layout {
             vectors: 0,
             scalars: 0,
             indices: 0,
+            links: 0,
         };
         let mut i = 0;
         while i < methods.len() * kinds.len() * 2 {
@@ -205,6 +218,7 @@ impl Layout {
             vectors: mx(self.vectors, o.vectors),
             scalars: mx(self.scalars, o.scalars),
             indices: mx(self.indices, o.indices),
+            links: mx(self.links, o.links),
         }
     }
 
@@ -214,6 +228,7 @@ impl Layout {
             + self.vectors * core::mem::size_of::<T::V3>()
             + self.scalars * core::mem::size_of::<T>()
             + self.indices * core::mem::size_of::<usize>()
+            + self.links * core::mem::size_of::<crate::bonds::Bond<T>>()
     }
 
     /// `true` when every count of `need` fits in `self`.
@@ -222,5 +237,6 @@ impl Layout {
             && need.vectors <= self.vectors
             && need.scalars <= self.scalars
             && need.indices <= self.indices
+            && need.links <= self.links
     }
 }

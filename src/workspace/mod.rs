@@ -24,6 +24,7 @@ pub use layout::Layout;
 pub(crate) use layout::block_rows;
 pub(crate) use views::Views;
 
+use crate::bonds::Bond;
 use crate::real::Real;
 
 /// Scratch for one step, borrowed from caller-owned slices. Any sizes work; a step
@@ -35,6 +36,7 @@ pub struct Workspace<'a, T: Real> {
     pub(crate) vectors: &'a mut [T::V3],
     pub(crate) scalars: &'a mut [T],
     pub(crate) indices: &'a mut [usize],
+    pub(crate) links: &'a mut [Bond<T>],
 }
 
 impl<'a, T: Real> Workspace<'a, T> {
@@ -50,7 +52,14 @@ impl<'a, T: Real> Workspace<'a, T> {
             vectors,
             scalars,
             indices,
+            links: &mut [],
         }
+    }
+
+    /// This workspace with a constraint list for steps with contacts
+    /// ([`Layout::links`] entries: the bonds are copied in, the contacts follow).
+    pub fn with_links(self, links: &'a mut [Bond<T>]) -> Self {
+        Self { links, ..self }
     }
 
     /// The element counts this workspace holds.
@@ -60,6 +69,7 @@ impl<'a, T: Real> Workspace<'a, T> {
             vectors: self.vectors.len(),
             scalars: self.scalars.len(),
             indices: self.indices.len(),
+            links: self.links.len(),
         }
     }
 

@@ -2,6 +2,7 @@
 //! its own parts (the others are empty), in the order [`Layout`] counts them.
 
 use super::{Layout, Workspace};
+use crate::bonds::Bond;
 use crate::constraints::Scratch;
 use crate::constraints::{SolverKind, krylov_scratch_per_bond};
 use crate::error::StepError;
@@ -28,6 +29,8 @@ pub(crate) struct Views<'a, T: Real> {
     pub new_vel: &'a mut [T::V3],
     pub new_omega: &'a mut [T::V3],
     pub scratch: Scratch<'a, T>,
+    /// Bonds then contacts (steps with contacts only; empty otherwise).
+    pub links: &'a mut [Bond<T>],
 }
 
 /// Takes slices off the front of a slice.
@@ -44,19 +47,22 @@ impl<'a, X> Carve<'a, X> {
 }
 
 impl<T: Real> Workspace<'_, T> {
-    /// Checks that the layout of this step fits, then splits the storage.
+    /// Checks that the layout of this step fits, then splits the storage. Every
+    /// per-constraint slice holds the bonds and, with contacts, the contact capacity.
     pub(crate) fn views(
         &mut self,
         p: &Params<T>,
         n: usize,
-        nb: usize,
+        bonds: usize,
     ) -> Result<Views<'_, T>, StepError> {
         let (method, rotation, kind) = (p.method, p.rotation, p.solver.kind);
-        let need = Layout::for_params(p, n, nb);
+        let need = Layout::for_params(p, n, bonds);
         let have = self.capacity();
         if !have.holds(&need) {
             return Err(StepError::Storage { need, have });
         }
+        let nb = p.constraints(bonds);
+        let links = Carve(&mut *self.links).take(need.links);
         let m = super::block_rows(method, rotation, n);
         let kind = kind.resolve(nb);
         let krylov = matches!(kind, SolverKind::Krylov);
@@ -125,6 +131,7 @@ impl<T: Real> Workspace<'_, T> {
             new_vel,
             new_omega,
             scratch,
+            links,
         })
     }
 }

@@ -189,6 +189,7 @@ pub const fn params_f32(method: Method, rotation: bool) -> Params<f32> {
         spring_stiffness: 1e3,
         stability_guard: false,
         brownian: None,
+        contacts: None,
     }
 }
 
@@ -377,6 +378,7 @@ pub fn error_name(e: &StepError) -> &'static str {
         StepError::Storage { .. } => "Storage",
         StepError::StateLength => "StateLength",
         StepError::Unstable { .. } => "Unstable",
+        StepError::ContactsFull { .. } => "ContactsFull",
         StepError::Unsupported(what) => what,
     }
 }

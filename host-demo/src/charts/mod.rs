@@ -68,7 +68,7 @@ fn simulate<T: Real>(
     let steps = (t_end / s.p.dt.to_f64()).round().max(1.0) as usize;
     let mut p = s.p;
     p.gravity *= T::from_f64(1.0 / s.st);
-    let contact = scene.contact.map(|k| SoftContact {
+    let contact = scene.contact.and_then(|c| c.soft()).map(|k| SoftContact {
         stiffness: T::from_f64(k),
     });
     let mut best = f64::INFINITY;

@@ -27,8 +27,11 @@ pub(super) fn precision_drift(scene: &Scene, t_end: f64) -> Result<Vec<Point>> {
     let mut wa = wa_store.workspace();
     let mut wb_store = storage(&p32.p, &b, &bonds_b);
     let mut wb = wb_store.workspace();
-    let ka = scene.contact.map(|k| SoftContact { stiffness: k });
-    let kb = scene.contact.map(|k| SoftContact {
+    let ka = scene
+        .contact
+        .and_then(|c| c.soft())
+        .map(|k| SoftContact { stiffness: k });
+    let kb = scene.contact.and_then(|c| c.soft()).map(|k| SoftContact {
         stiffness: k as f32,
     });
     let steps = (t_end / 0.005) as usize;

@@ -39,6 +39,7 @@
 //! lying wholly inside another is refused either way (the mobility is not defined for
 //! it).
 
+mod contact;
 mod error;
 mod helix;
 mod model;
@@ -50,6 +51,7 @@ mod tests;
 mod thermal;
 mod write;
 
+pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE};
 pub use error::{SceneError, line_col};
 pub use helix::{Chain, HeadEnd, Helix};
 pub use model::{
@@ -130,9 +132,9 @@ pub struct Scene {
     pub integrator: Integrator,
     /// Output settings.
     pub output: Output,
-    /// Soft excluded-volume stiffness (`[contact] stiffness`); `None`: spheres may
-    /// pass through each other, as in the paper.
-    pub contact: Option<f64>,
+    /// Excluded volume (`[contact]`: soft repulsion or hard contacts); `None`: spheres
+    /// may pass through each other, as in the paper.
+    pub contact: Option<Contact>,
     /// Thermal noise (`[brownian]`); `None`: deterministic.
     pub brownian: Option<Thermal>,
     /// Species (type name) of each particle: `head` and `tail` for a helix; the

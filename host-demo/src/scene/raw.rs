@@ -23,14 +23,8 @@ pub(super) struct RawScene {
     pub(super) model: Option<RawModel>,
     pub(super) integrator: S<RawIntegrator>,
     pub(super) output: Option<RawOutput>,
-    pub(super) contact: Option<RawContact>,
+    pub(super) contact: S<super::contact::RawContact>,
     pub(super) brownian: Option<super::thermal::RawBrownian>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawContact {
-    pub(super) stiffness: Spanned<f64>,
 }
 
 #[derive(Deserialize)]

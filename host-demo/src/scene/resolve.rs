@@ -55,15 +55,11 @@ impl RawScene {
                 overlap: m.overlap.unwrap_or_default(),
             },
         };
-        let contact = match &self.contact {
-            None => None,
-            Some(c) => Some(number(
-                &Some(c.stiffness.clone()),
-                0.0,
-                "contact stiffness",
-                Bound::Positive,
-            )?),
-        };
+        let contact = self
+            .contact
+            .as_ref()
+            .map(super::contact::resolve)
+            .transpose()?;
         let Some(raw_int) = &self.integrator else {
             return Err(Issue::unplaced(
                 "missing table [integrator] (method, dt and duration are required)",
@@ -74,6 +70,9 @@ impl RawScene {
             None => None,
             Some(b) => Some(b.resolve(&model, &integrator)?),
         };
+        if let (Some(c), Some(raw)) = (contact, &self.contact) {
+            super::contact::check_method(c, raw, &integrator, brownian.as_ref())?;
+        }
         let every = match self.output.as_ref().and_then(|o| o.every.as_ref()) {
             None => integrator.steps().div_ceil(TARGET_FRAMES).max(1),
             Some(e) if *e.get_ref() == 0 => {
@@ -83,7 +82,7 @@ impl RawScene {
             // stays a number a scene file can hold.
             Some(e) => (*e.get_ref()).min(integrator.steps()),
         };
-        let plans = plans(&model, &integrator, &flow);
+        let plans = plans(&model, &integrator, &flow, contact);
         let every_span = self
             .output
             .as_ref()
@@ -228,12 +227,21 @@ fn check_output(integrator: &Integrator, every: usize, n: usize, limit: u64) -> 
 
 /// What sizes the scene's storage: its own method, or with `level = "auto"` each method
 /// the rules may pick.
-fn plans(model: &Model, integrator: &Integrator, flow: &Flow) -> Vec<Plan> {
+fn plans(
+    model: &Model,
+    integrator: &Integrator,
+    flow: &Flow,
+    contact: Option<super::Contact>,
+) -> Vec<Plan> {
     let plan = |(method, rotation)| Plan {
         method,
         rotation,
         solver: integrator.solver,
         precision: integrator.precision,
+        contacts: contact.and_then(|c| match c {
+            super::Contact::Hard { capacity } => Some(capacity),
+            super::Contact::Soft { .. } => None,
+        }),
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],

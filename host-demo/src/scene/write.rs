@@ -68,8 +68,18 @@ impl Scene {
             "output".into(),
             table([("every", value(self.output.every as i64))]),
         );
-        if let Some(k) = self.contact {
-            t.insert("contact".into(), table([("stiffness", value(k))]));
+        match self.contact {
+            Some(super::Contact::Soft { stiffness }) => {
+                t.insert("contact".into(), table([("stiffness", value(stiffness))]));
+            }
+            Some(super::Contact::Hard { capacity: None }) => {
+                t.insert("contact".into(), table([("model", value("hard"))]));
+            }
+            Some(super::Contact::Hard { capacity: Some(k) }) => {
+                let c = table([("model", value("hard")), ("capacity", value(k as i64))]);
+                t.insert("contact".into(), c);
+            }
+            None => {}
         }
         if let Some(b) = self.brownian {
             t.insert(

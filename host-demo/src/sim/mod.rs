@@ -118,7 +118,7 @@ impl Summary {
             model: scene.model,
             integrator: scene.integrator,
             tolerance_used: scene.integrator.tolerance,
-            contact_stiffness: scene.contact.unwrap_or(0.0),
+            contact_stiffness: scene.contact.map_or(0.0, |c| c.stiffness()),
             steps: scene.integrator.steps(),
             steps_done: 0,
             resumed_from: None,
@@ -300,6 +300,10 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     // The paper's explicit drag can shiver silently (bounded, wrong) beyond its limit:
     // the demo refuses such steps up front.
     p.stability_guard = true;
+    p.contacts = scene
+        .contact
+        .and_then(|c| c.hard_capacity(scene.particles.len()))
+        .map(hydrorattle::Contacts::new);
     p.brownian = scene.brownian.map(|b| hydrorattle::Brownian {
         temperature: T::from_f64(b.temperature),
         drift: b.drift.kernel(),

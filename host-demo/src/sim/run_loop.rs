@@ -80,7 +80,7 @@ pub(super) fn run_t<T: Real>(
     }
     let mut ws = store.workspace();
     let mut noise = Noise::new(scene.brownian.map_or(DEFAULT_SEED, |b| b.seed));
-    let contact = scene.contact.map(|k| SoftContact {
+    let contact = scene.contact.and_then(|c| c.soft()).map(|k| SoftContact {
         stiffness: T::from_f64(k),
     });
     let mut ext = |pos: &[T::V3], radius: &[T], force: &mut [T::V3]| {
