@@ -255,6 +255,9 @@ fn settling_helix_never_overlaps<T: Real>() -> u64 {
     state_digest(&ps)
 }
 
+/// Parameters, storage, the error expected, and what is tried.
+type Refusal<'a, T> = (Params<T>, Layout, &'a dyn Fn(&StepError) -> bool, &'a str);
+
 fn refusals_keep_the_state<T: Real>() {
     // Three spheres stacked with gaps of 0.2, heavier on top: in a step of 2 both gaps
     // close (two contacts at once).
@@ -282,7 +285,7 @@ fn refusals_keep_the_state<T: Real>() {
         contacts: None,
         ..p
     };
-    let cases: [(Params<T>, Layout, &dyn Fn(&StepError) -> bool, &str); 6] = [
+    let cases: [Refusal<'_, T>; 6] = [
         (
             with(1, 64),
             Layout::for_params(&with(1, 64), 3, 0),
