@@ -4,6 +4,7 @@
 //! * [`scene`]: TOML scene files parsed and validated into a plain [`scene::Scene`];
 //! * [`output`]: atomic file writes, extended XYZ trajectories (writer and reader),
 //!   CSV and JSON;
+//! * [`reference`]: the Figure 1 runs against a small-dt reference (agreement horizons);
 //! * [`render`]: sphere pictures (side and top views, the Figure 1 layout) and charts;
 //! * [`progress`]: a progress bar that stays out of the way of short or piped runs.
 
@@ -14,6 +15,7 @@ pub mod output;
 pub mod phase;
 pub mod progress;
 pub mod provenance;
+pub mod reference;
 pub mod render;
 pub mod scene;
 pub mod sim;

@@ -70,6 +70,19 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Figure 1's trajectories against a reference at a small time step: RMS deviation
+    /// over time and agreement horizons of the main job's settings and alternatives.
+    Reference {
+        /// Output directory.
+        #[arg(long, default_value = "out/reference")]
+        out: PathBuf,
+        /// Time step of the reference.
+        #[arg(long, default_value_t = 0.005, value_parser = positive)]
+        dt: f64,
+        /// Smoke run: at most 2000 steps per run.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Outcome phase diagram over the bond gap D and the head ratio.
     Phase {
         /// Output directory.
@@ -149,6 +162,29 @@ fn run(cli: Cli) -> Result<()> {
             let opts = file_run(limits, checkpoint_every);
             let r = host_demo::sim::resume(&dir, until, limits, opts)?;
             report(&r.summary.scene.clone(), &r.summary, &dir)?;
+        }
+        Command::Reference { out, dt, quick } => {
+            let cases = host_demo::reference::reference(&out, dt, quick.then_some(2000))?;
+            println!(
+                "case variant                     method       dt      horizon(>0.1a) horizon(>0.5a) outcome (reference)"
+            );
+            for c in &cases {
+                for v in &c.variants {
+                    let h = |x: Option<f64>| x.map_or("never".to_string(), |t| format!("{t}"));
+                    println!(
+                        "{:<4} {:<27} {:<12} {:<7} {:<14} {:<14} {} ({})",
+                        c.case,
+                        v.variant.name,
+                        format!("{:?}", v.variant.method),
+                        v.variant.dt,
+                        h(v.horizons[0]),
+                        h(v.horizons[1]),
+                        v.outcome,
+                        c.reference_outcome
+                    );
+                }
+            }
+            println!("wrote {}", out.join("reference.json").display());
         }
         Command::Figure1 { out, quick } => {
             let s = host_demo::figure1::figure1(&out, quick.then_some(2000))?;

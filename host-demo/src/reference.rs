@@ -1,0 +1,257 @@
+//! How far the main job's trajectories can be trusted: each Figure 1 case is run at the
+//! main job's settings and at cheaper or older ones, and compared frame by frame with
+//! a reference at a small time step (same model: hard contacts, RPY).
+//!
+//! Writes `reference.json` (per case and variant: RMS deviation from the reference at
+//! every common frame, the horizons where it first exceeds 0.1 and 0.5 tail radii, the
+//! final outcome of both) and `reference_{a,b,c}.png` (deviation against time).
+
+use std::path::Path;
+
+use anyhow::{Result, bail};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::output::{read_xyz_file, write_json};
+use crate::render::{LineChart, Series, line_chart};
+use crate::scene::{Method, Scene};
+use crate::sim::{RunOptions, TRAJECTORY_XYZ, run};
+
+/// Time between compared frames (every variant writes a frame this often).
+const FRAME_DT: f64 = 2.0;
+/// Deviation thresholds of the horizons, tail radii.
+pub const THRESHOLDS: [f64; 2] = [0.1, 0.5];
+
+/// One way of running a case.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Variant {
+    /// Short name (`main`, `first-order`, ...).
+    pub name: &'static str,
+    /// Integrator.
+    pub method: Method,
+    /// Time step.
+    pub dt: f64,
+}
+
+/// The variants compared with the reference: the main job's settings first.
+pub fn variants(main: &Scene) -> Vec<Variant> {
+    let dt = main.integrator.dt;
+    vec![
+        Variant {
+            name: "main",
+            method: main.integrator.method,
+            dt,
+        },
+        Variant {
+            name: "first order, same dt",
+            method: Method::Overdamped,
+            dt,
+        },
+        Variant {
+            name: "first order, dt / 2",
+            method: Method::Overdamped,
+            dt: dt / 2.0,
+        },
+        Variant {
+            name: "main, dt / 2",
+            method: main.integrator.method,
+            dt: dt / 2.0,
+        },
+        Variant {
+            name: "first order, dt = 0.005",
+            method: Method::Overdamped,
+            dt: 0.005,
+        },
+    ]
+}
+
+/// A variant's comparison with the reference.
+#[derive(Debug, Clone, Serialize)]
+pub struct Comparison {
+    /// The variant.
+    pub variant: Variant,
+    /// `(time, RMS deviation of the centres from the reference, tail radii)`.
+    pub deviation: Vec<(f64, f64)>,
+    /// First time the deviation exceeds each of [`THRESHOLDS`]; `None`: never in the run.
+    pub horizons: Vec<Option<f64>>,
+    /// The variant's outcome at the end.
+    pub outcome: String,
+    /// CPU time of the run, seconds.
+    pub wall_time_s: f64,
+}
+
+/// One case: the reference and the variants.
+#[derive(Debug, Clone, Serialize)]
+pub struct CaseReference {
+    /// "a", "b" or "c".
+    pub case: String,
+    /// The reference's method and time step.
+    pub reference: Variant,
+    /// The reference's outcome at the end.
+    pub reference_outcome: String,
+    /// The comparisons, main job first.
+    pub variants: Vec<Comparison>,
+}
+
+/// `scene` run as `v`, with a frame every [`FRAME_DT`].
+fn as_variant(scene: &Scene, v: Variant) -> Scene {
+    let mut s = scene.clone();
+    s.integrator.method = v.method;
+    s.integrator.dt = v.dt;
+    s.output.every = ((FRAME_DT / v.dt).round() as usize).max(1);
+    s
+}
+
+/// Frames of a trajectory written by a run: `(time, centres)`.
+fn read_frames(path: &Path) -> Result<Vec<(f64, Vec<[f64; 3]>)>> {
+    let frames = read_xyz_file(path)?;
+    Ok(frames.into_iter().map(|f| (f.time, f.positions)).collect())
+}
+
+/// RMS distance between matching centres.
+fn rms(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>())
+        .sum();
+    (sum / a.len().max(1) as f64).sqrt()
+}
+
+/// Deviation at the frame times both runs share (to a millionth of a time unit).
+fn deviation(
+    reference: &[(f64, Vec<[f64; 3]>)],
+    other: &[(f64, Vec<[f64; 3]>)],
+) -> Vec<(f64, f64)> {
+    let key = |t: f64| (t * 1e6).round() as i64;
+    let at: std::collections::BTreeMap<i64, &Vec<[f64; 3]>> =
+        other.iter().map(|(t, p)| (key(*t), p)).collect();
+    // Times are sums of time steps: report them rounded to a millionth.
+    reference
+        .iter()
+        .filter_map(|(t, p)| at.get(&key(*t)).map(|q| (key(*t) as f64 * 1e-6, rms(p, q))))
+        .collect()
+}
+
+fn horizons(dev: &[(f64, f64)]) -> Vec<Option<f64>> {
+    THRESHOLDS
+        .iter()
+        .map(|&h| dev.iter().find(|(_, d)| *d > h).map(|(t, _)| *t))
+        .collect()
+}
+
+/// Runs every case at every variant and at `reference_dt`, into `out/{case}/...`, and
+/// writes `reference.json` and `reference_{a,b,c}.png`. `max_steps` caps each run (smoke runs).
+pub fn reference(
+    out: &Path,
+    reference_dt: f64,
+    max_steps: Option<usize>,
+) -> Result<Vec<CaseReference>> {
+    if !(reference_dt.is_finite() && reference_dt > 0.0) {
+        bail!("--dt {reference_dt}: the reference time step must be positive");
+    }
+    std::fs::create_dir_all(out)?;
+    let scenes = Scene::figure1()?;
+    let opts = RunOptions {
+        max_steps,
+        keep_series: false,
+        ..RunOptions::default()
+    };
+    // Every run of every case, in parallel: the reference first, then the variants.
+    let mut jobs = Vec::new();
+    for (case, scene) in &scenes {
+        let refv = Variant {
+            name: "reference",
+            method: scene.integrator.method,
+            dt: reference_dt,
+        };
+        jobs.push((case.to_string(), refv, as_variant(scene, refv)));
+        for v in variants(scene) {
+            jobs.push((case.to_string(), v, as_variant(scene, v)));
+        }
+    }
+    let done: Vec<Result<(String, Variant, String, f64)>> = jobs
+        .par_iter()
+        .enumerate()
+        .map(|(k, (case, v, s))| {
+            let dir = out.join(case).join(format!("{k:02}"));
+            let r = run(s, case, Some(&dir), opts)?;
+            Ok((case.clone(), *v, r.summary.outcome, r.summary.wall_time_s))
+        })
+        .collect();
+    let mut cases = Vec::new();
+    for (case, _) in &scenes {
+        let mut rows = Vec::new();
+        for (k, d) in done.iter().enumerate() {
+            let (c, v, outcome, wall) = d.as_ref().map_err(|e| anyhow::anyhow!("{e:#}"))?;
+            if c == case {
+                let dir = out.join(case).join(format!("{k:02}"));
+                rows.push((
+                    *v,
+                    outcome.clone(),
+                    *wall,
+                    read_frames(&dir.join(TRAJECTORY_XYZ))?,
+                ));
+            }
+        }
+        let (refv, ref_outcome, _, ref_frames) = rows.remove(0);
+        let variants = rows
+            .into_iter()
+            .map(|(variant, outcome, wall_time_s, frames)| {
+                let dev = deviation(&ref_frames, &frames);
+                Comparison {
+                    variant,
+                    horizons: horizons(&dev),
+                    deviation: dev,
+                    outcome,
+                    wall_time_s,
+                }
+            })
+            .collect();
+        cases.push(CaseReference {
+            case: case.to_string(),
+            reference: refv,
+            reference_outcome: ref_outcome,
+            variants,
+        });
+    }
+    write_json(&out.join("reference.json"), &cases)?;
+    draw(out, &cases, max_steps.is_some())?;
+    Ok(cases)
+}
+
+fn draw(out: &Path, cases: &[CaseReference], quick: bool) -> Result<()> {
+    for c in cases {
+        let series = c
+            .variants
+            .iter()
+            .map(|v| Series {
+                name: format!(
+                    "{} ({:?}, dt {})",
+                    v.variant.name, v.variant.method, v.variant.dt
+                ),
+                points: v.deviation.iter().copied().filter(|p| p.1 > 0.0).collect(),
+            })
+            .collect();
+        let chart = LineChart {
+            title: format!(
+                "Figure 1 ({}): RMS deviation from the {:?} dt = {} reference{}",
+                c.case,
+                c.reference.method,
+                c.reference.dt,
+                if quick { " [QUICK]" } else { "" }
+            ),
+            x_label: "time (a / U0)".into(),
+            y_label: "RMS deviation of the centres (tail radii)".into(),
+            log_x: false,
+            log_y: true,
+            series,
+        };
+        line_chart(
+            &out.join(format!("reference_{}.png", c.case)),
+            &chart,
+            (1100, 700),
+        )?;
+    }
+    Ok(())
+}
