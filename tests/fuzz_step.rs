@@ -14,7 +14,7 @@ mod common;
 use common::fuzz::{Rng, report, settings};
 use common::*;
 use hydrorattle::{
-    Bond, Hydro, Layout, Method, NoForce, Params, Real, SolverKind, State, step_slices,
+    Bond, Contacts, Hydro, Layout, Method, NoForce, Params, Real, SolverKind, State, step_slices,
 };
 use hydrorattle_heap::Buffers;
 
@@ -174,6 +174,13 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
     }
     if rng.below(10) == 0 {
         p.spring_stiffness = T::from_f64(rng.value(1e3));
+    }
+    // Hard contacts on a quarter of the cases: any capacity (zero included), any rounds.
+    if rng.below(4) == 0 {
+        p.contacts = Some(Contacts {
+            capacity: rng.below(2 * n as u64 + 2) as usize,
+            max_rounds: rng.below(20) as u32,
+        });
     }
     // Storage: usually what the step needs, sometimes too little.
     let (ln, lb) = match (rng.1, rng.below(16)) {
