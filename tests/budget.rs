@@ -77,6 +77,22 @@ fn paper_chain_fits_the_budgets() {
         "| Overdamped thermal | false | {} | {th64} | - |",
         free(th.bytes::<f32>())
     );
+    // Hard contacts (issue 10): 3 per bead counted as extra constraints, Newton solver
+    // (the Figure 1 scenes' settings).
+    for (method, capacity) in [(Method::Overdamped, 75), (Method::Overdamped2, 75)] {
+        let mut p = hydrorattle::Params::<f32>::new(0.1);
+        p.method = method;
+        p.solver.kind = SolverKind::Newton;
+        p.contacts = Some(hydrorattle::Contacts::new(capacity));
+        let l = Layout::for_params(&p, N, B);
+        let d64 = core::mem::size_of::<ParticleSet<f64, N>>()
+            + core::mem::size_of::<BondSet<f64, B>>()
+            + l.bytes::<f64>();
+        eprintln!(
+            "| {method:?} with {capacity} contacts | false | {} | {d64} | - |",
+            free(l.bytes::<f32>())
+        );
+    }
     assert!(over.is_empty(), "over budget: {over:?}");
 }
 

@@ -35,7 +35,7 @@
 //! start are almost always a typing error, so such a scene is refused at the line of
 //! the later sphere unless it says `overlap = "allow"`. During the run spheres may come
 //! to overlap whatever the setting (the paper's chains have no excluded volume; the RPY
-//! tensors have a regularised form for it; `[contact]` adds a soft repulsion). A sphere
+//! tensors have a regularised form for it; `[contact]` adds hard or soft excluded volume). A sphere
 //! lying wholly inside another is refused either way (the mobility is not defined for
 //! it).
 

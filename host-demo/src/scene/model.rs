@@ -76,7 +76,7 @@ pub enum Level {
 /// What to do with spheres that overlap (without nesting) at t = 0. Overlap at the
 /// start is almost always a typing error, so it is refused unless the scene asks for
 /// it; during the run spheres may come to overlap (the paper's chains have no excluded
-/// volume; `[contact]` adds a soft repulsion).
+/// volume; `[contact]` adds hard or soft excluded volume).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Overlap {
