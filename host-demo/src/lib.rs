@@ -9,6 +9,7 @@
 
 pub mod auto;
 pub mod charts;
+pub mod claims;
 pub mod figure1;
 pub mod output;
 pub mod phase;
@@ -18,3 +19,4 @@ pub mod render;
 pub mod scene;
 pub mod sim;
 pub mod sizing;
+pub mod timeline;
