@@ -135,7 +135,7 @@ pub fn figure1(out: &Path, max_steps: Option<usize>) -> Result<Figure1Summary> {
     let mut cases = Vec::new();
     let mut panels = Vec::new();
     for ((case, scene), r) in scenes.iter().zip(&results) {
-        cases.push(summarise(case, scene, &r));
+        cases.push(summarise(case, scene, r));
         panels.push(Figure1Case {
             title: match max_steps {
                 Some(m) => format!("{} [QUICK: {m} steps at most]", title(case, scene)),

@@ -7,7 +7,7 @@ use anyhow::{Result, anyhow};
 use plotters::style::RGBColor;
 use rayon::prelude::*;
 
-use crate::claims::{CaseRun, SPECS, Verdict, claims};
+use crate::claims::{CaseRun, claim_tables};
 use crate::output::{AtomicFile, CsvWriter};
 use crate::progress::Progress;
 use crate::render::{CategoryMap, Mark, category_map};
@@ -332,92 +332,22 @@ pub fn sensitivity(out: &Path, max_steps: Option<usize>) -> Result<String> {
         ])?;
     }
     csv.into_inner().commit()?;
-    claim_tables(out, &cases, &vars, &jobs, &results)
-}
-
-/// The claims of every variant: `claims_variants.csv`, `claims_sensitivity.csv`, and
-/// the latter as a table.
-fn claim_tables(
-    out: &Path,
-    cases: &[(&str, Scene)],
-    vars: &[Variant],
-    jobs: &[(usize, usize)],
-    results: &[(Summary, Vec<Observables>)],
-) -> Result<String> {
-    let mut detail = CsvWriter::new(
-        AtomicFile::create(&out.join("claims_variants.csv"))?,
-        &["parameter", "value", "claim", "case", "verdict", "window"],
-    )?;
-    // Per claim: holds, transient, fails, not judged (a case's run failed at once).
-    let mut counts = vec![[0usize; 4]; SPECS.len()];
-    for (v, (what, value, _)) in vars.iter().enumerate() {
-        let runs: Vec<CaseRun<'_>> = jobs
-            .iter()
-            .zip(results)
-            .filter(|(j, _)| j.1 == v)
-            .map(|(j, (s, series))| CaseRun {
-                case: cases[j.0].0,
-                series,
-                front: &s.front,
-            })
-            .collect();
-        let judged = claims(&runs);
-        for (k, spec) in SPECS.iter().enumerate() {
-            let Some(c) = judged.iter().find(|c| c.id == spec.id) else {
-                counts[k][3] += 1;
-                continue;
-            };
-            counts[k][c.verdict as usize] += 1;
-            let window = c
-                .window
-                .map_or(String::new(), |w| format!("{} {}", w[0], w[1]));
-            detail.write_record(&[
-                what.to_string(),
-                value.clone(),
-                spec.id.to_string(),
-                spec.case.to_string(),
-                c.verdict.name().to_string(),
-                window,
-            ])?;
-        }
-    }
-    detail.into_inner().commit()?;
-    let mut csv = CsvWriter::new(
-        AtomicFile::create(&out.join("claims_sensitivity.csv"))?,
-        &[
-            "claim",
-            "case",
-            "variants",
-            "holds",
-            "transient",
-            "fails",
-            "not_judged",
-        ],
-    )?;
-    let mut table = format!(
-        "{:<20} {:>4} {:>8} {:>5} {:>9} {:>5}\n",
-        "claim", "case", "variants", "holds", "transient", "fails"
-    );
-    for (spec, n) in SPECS.iter().zip(&counts) {
-        csv.write_record(&[
-            spec.id.to_string(),
-            spec.case.to_string(),
-            vars.len().to_string(),
-            n[Verdict::Holds as usize].to_string(),
-            n[Verdict::Transient as usize].to_string(),
-            n[Verdict::Fails as usize].to_string(),
-            n[3].to_string(),
-        ])?;
-        table += &format!(
-            "{:<20} {:>4} {:>8} {:>5} {:>9} {:>5}\n",
-            spec.id,
-            spec.case,
-            vars.len(),
-            n[0],
-            n[1],
-            n[2]
-        );
-    }
-    csv.into_inner().commit()?;
-    Ok(table)
+    let names: Vec<(String, String)> = vars
+        .iter()
+        .map(|v| (v.0.to_string(), v.1.clone()))
+        .collect();
+    let runs: Vec<Vec<CaseRun<'_>>> = (0..vars.len())
+        .map(|v| {
+            jobs.iter()
+                .zip(&results)
+                .filter(|(j, _)| j.1 == v)
+                .map(|(j, (s, series))| CaseRun {
+                    case: cases[j.0].0,
+                    series,
+                    front: &s.front,
+                })
+                .collect()
+        })
+        .collect();
+    claim_tables(out, &names, &runs)
 }
