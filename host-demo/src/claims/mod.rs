@@ -5,7 +5,7 @@
 //! quarter `[t0, t0 + T/4]`, the *late window* the last quarter `[t0 + 3T/4, t0 + T]`.
 //! A claim about a state reads either a named state of the timeline (stretched) or
 //! *twisting*: coherent rotation about the vertical
-//! ([`is_rotating`](hydrorattle::observables::is_rotating)) whatever the shape, since
+//! ([`is_rotating`]) whatever the shape, since
 //! the paper's (c) twists while it stretches. A state is *seen* when it holds in at
 //! least [`MIN_FRAMES`] consecutive frames; a *segment* runs from its first frame's time
 //! to the next frame's (the last frame's at the end), as in the timeline.
