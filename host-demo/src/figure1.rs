@@ -1,5 +1,6 @@
 //! The paper's Figure 1: three helical chains settling, run in parallel, drawn like the
-//! paper's figure, and summarised in `figure1.json`.
+//! paper's figure, and summarised in `figure1.json`: per case the final numbers and the
+//! outcome timeline, and the paper's claims with their verdicts ([`crate::claims`]).
 
 use std::path::Path;
 
@@ -7,10 +8,13 @@ use anyhow::Result;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::claims::{CaseRun, Claim, claims};
 use crate::output::write_json;
 use crate::render::{Figure1Case, draw_figure1};
 use crate::scene::Scene;
-use crate::sim::{RunOptions, RunResult, run};
+use crate::sim::{Front, RunOptions, RunResult, run};
+use crate::timeline::{Segment, segments};
+use hydrorattle::observables::State;
 
 /// One case's line of `figure1.json`.
 #[derive(Debug, Clone, Serialize)]
@@ -29,8 +33,12 @@ pub struct CaseSummary {
     pub twist_rate: f64,
     /// Final head settling speed.
     pub head_speed: f64,
-    /// Classified outcome.
+    /// Late state: the named state of most frames in the last quarter (or "failed").
     pub outcome: String,
+    /// The named state over time, in segments of one state.
+    pub timeline: Vec<Segment>,
+    /// The order in which bonds first turned near-vertical.
+    pub front: Front,
     /// Time to reach extension 0.95 (None if never).
     pub time_to_stretch: Option<f64>,
     /// Simulated time.
@@ -44,8 +52,12 @@ pub struct CaseSummary {
 /// `figure1.json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct Figure1Summary {
+    /// Every state name, in a fixed order (for legends).
+    pub states: Vec<&'static str>,
     /// The three cases.
     pub cases: Vec<CaseSummary>,
+    /// The paper's claims, with verdicts computed from the runs.
+    pub claims: Vec<Claim>,
     /// Wall time of the three runs together (they run in parallel), seconds.
     pub wall_time_s: f64,
 }
@@ -75,6 +87,8 @@ pub fn summarise(case: &str, scene: &Scene, r: &RunResult) -> CaseSummary {
         twist_rate: r.summary.twist_rate,
         head_speed: f.head_speed,
         outcome: r.summary.outcome.clone(),
+        timeline: segments(&r.series),
+        front: r.summary.front.clone(),
         time_to_stretch: r
             .series
             .iter()
@@ -84,6 +98,21 @@ pub fn summarise(case: &str, scene: &Scene, r: &RunResult) -> CaseSummary {
         wall_time_s: r.summary.wall_time_s,
         failure: r.summary.failure.clone(),
     }
+}
+
+/// The claims of the three cases' runs (`scenes` as from `Scene::figure1`, results in
+/// the same order).
+pub fn claims_of(scenes: &[(&str, Scene)], results: &[RunResult]) -> Vec<Claim> {
+    let runs: Vec<CaseRun<'_>> = scenes
+        .iter()
+        .zip(results)
+        .map(|((case, _), r)| CaseRun {
+            case,
+            series: &r.series,
+            front: &r.summary.front,
+        })
+        .collect();
+    claims(&runs)
 }
 
 /// Runs the three cases into `out/{a,b,c}` and writes `figure1.png` and `figure1.json`.
@@ -102,11 +131,11 @@ pub fn figure1(out: &Path, max_steps: Option<usize>) -> Result<Figure1Summary> {
         .map(|(case, scene)| run(scene, case, Some(&out.join(case)), opts))
         .collect();
     let wall = start.elapsed().as_secs_f64();
+    let results: Vec<RunResult> = results.into_iter().collect::<Result<_>>()?;
     let mut cases = Vec::new();
     let mut panels = Vec::new();
-    for ((case, scene), r) in scenes.iter().zip(results) {
-        let r = r?;
-        cases.push(summarise(case, scene, &r));
+    for ((case, scene), r) in scenes.iter().zip(&results) {
+        cases.push(summarise(case, scene, r));
         panels.push(Figure1Case {
             title: match max_steps {
                 Some(m) => format!("{} [QUICK: {m} steps at most]", title(case, scene)),
@@ -118,7 +147,9 @@ pub fn figure1(out: &Path, max_steps: Option<usize>) -> Result<Figure1Summary> {
     }
     draw_figure1(&out.join("figure1.png"), &panels)?;
     let summary = Figure1Summary {
+        states: State::ALL.iter().map(|s| s.name()).collect(),
         cases,
+        claims: claims_of(&scenes, &results),
         wall_time_s: wall,
     };
     write_json(&out.join("figure1.json"), &summary)?;

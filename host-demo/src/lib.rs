@@ -10,6 +10,7 @@
 
 pub mod auto;
 pub mod charts;
+pub mod claims;
 pub mod figure1;
 pub mod output;
 pub mod phase;
@@ -20,3 +21,4 @@ pub mod render;
 pub mod scene;
 pub mod sim;
 pub mod sizing;
+pub mod timeline;

@@ -189,11 +189,11 @@ fn run(cli: Cli) -> Result<()> {
         Command::Figure1 { out, quick } => {
             let s = host_demo::figure1::figure1(&out, quick.then_some(2000))?;
             println!(
-                "case  D     head   extension verticality twist_rate head_speed outcome    t(ext>=0.95) wall_s"
+                "case  D     head   extension verticality twist_rate head_speed outcome          t(ext>=0.95) wall_s"
             );
             for c in &s.cases {
                 println!(
-                    "{:<5} {:<5.2} {:<6.3} {:<9.3} {:<11.3} {:<10.4} {:<10.3} {:<10} {:<12} {:.2}",
+                    "{:<5} {:<5.2} {:<6.3} {:<9.3} {:<11.3} {:<10.4} {:<10.3} {:<16} {:<12} {:.2}",
                     c.case,
                     c.dhat,
                     c.head_ratio,
@@ -205,6 +205,18 @@ fn run(cli: Cli) -> Result<()> {
                     c.time_to_stretch
                         .map_or("never".to_string(), |t| format!("{t:.1}")),
                     c.wall_time_s
+                );
+            }
+            println!("claim                case verdict    window");
+            for c in &s.claims {
+                let window = c
+                    .window
+                    .map_or("-".to_string(), |w| format!("[{:.1}, {:.1}]", w[0], w[1]));
+                println!(
+                    "{:<20} {:<4} {:<10} {window}",
+                    c.id,
+                    c.case,
+                    c.verdict.name()
                 );
             }
             println!(
@@ -230,9 +242,11 @@ fn run(cli: Cli) -> Result<()> {
             );
             if !no_sensitivity {
                 let t = std::time::Instant::now();
-                host_demo::phase::sensitivity(&out, cap)?;
+                let table = host_demo::phase::sensitivity(&out, cap)?;
+                print!("claims: in how many variants each holds\n{table}");
                 println!(
-                    "sensitivity table in {:.1} s: wrote {}/sensitivity.csv",
+                    "sensitivity table in {:.1} s: wrote {}/sensitivity.csv, \
+                     claims_sensitivity.csv and claims_variants.csv",
                     t.elapsed().as_secs_f64(),
                     out.display()
                 );

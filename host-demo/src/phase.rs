@@ -1,5 +1,5 @@
 //! Beyond the paper: the outcome map over (D, head ratio), and how robust each of the
-//! paper's three outcomes is to the choices the paper leaves unstated.
+//! paper's outcomes and claims is to the choices the paper leaves unstated.
 
 use std::path::Path;
 
@@ -7,16 +7,21 @@ use anyhow::{Result, anyhow};
 use plotters::style::RGBColor;
 use rayon::prelude::*;
 
+use crate::claims::{CaseRun, claim_tables};
 use crate::output::{AtomicFile, CsvWriter};
 use crate::progress::Progress;
 use crate::render::{CategoryMap, Mark, category_map};
-use crate::scene::{Bond, HeadEnd, Helix, Method, Particle, Scene};
-use crate::sim::{RunOptions, Summary, run};
+use crate::scene::{Bond, HeadEnd, Helix, Hydrodynamics, Method, Particle, Scene};
+use crate::sim::{Observables, RunOptions, Summary, run};
 
-/// Outcome names in map order, with their colours.
-const CATEGORIES: [(&str, RGBColor); 4] = [
+/// Outcome names (the late states, in `State::ALL` order, and "failed") in map order,
+/// with their colours.
+const CATEGORIES: [(&str, RGBColor); 7] = [
     ("stretched", RGBColor(230, 159, 0)),
-    ("twisting", RGBColor(86, 180, 233)),
+    ("column_over_knot", RGBColor(0, 158, 115)),
+    ("rolling_ring", RGBColor(204, 121, 167)),
+    ("rotating", RGBColor(86, 180, 233)),
+    ("folded", RGBColor(0, 114, 178)),
     ("other", RGBColor(160, 160, 160)),
     ("failed", RGBColor(200, 40, 40)),
 ];
@@ -48,17 +53,18 @@ fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
-fn run_quiet(scene: &Scene, name: &str, max_steps: Option<usize>) -> Summary {
+/// The summary and the observables series of a run (a failed one: empty series).
+fn run_quiet(scene: &Scene, name: &str, max_steps: Option<usize>) -> (Summary, Vec<Observables>) {
     let opts = RunOptions {
         progress: false,
         max_steps,
         ..RunOptions::default()
     };
     match run(scene, name, None, opts) {
-        Ok(r) => r.summary,
+        Ok(r) => (r.summary, r.series),
         Err(e) => {
             log::warn!("{name}: {e:#}");
-            failed_summary(scene, name, &format!("{e:#}"))
+            (failed_summary(scene, name, &format!("{e:#}")), Vec::new())
         }
     }
 }
@@ -95,7 +101,7 @@ pub fn phase(out: &Path, n: usize, max_steps: Option<usize>) -> Result<()> {
                 ..base
             };
             let s = match with_helix(&template, helix) {
-                Ok(scene) => run_quiet(&scene, &name, max_steps),
+                Ok(scene) => run_quiet(&scene, &name, max_steps).0,
                 Err(e) => failed_summary(&template, &name, &format!("{e:#}")),
             };
             bar.inc(1);
@@ -228,7 +234,16 @@ fn variants() -> Vec<Variant> {
             Ok(s)
         }),
     ));
-    for st in [0.1, 1.0] {
+    v.push((
+        "hydrodynamics",
+        "free_draining".into(),
+        Box::new(|s: &Scene| {
+            let mut s = s.clone();
+            s.model.hydrodynamics = Hydrodynamics::FreeDraining;
+            Ok(s)
+        }),
+    ));
+    for st in [0.1, 1.0, 3.0, 10.0] {
         v.push((
             "stokes_number",
             format!("{st}"),
@@ -257,8 +272,11 @@ fn stokes(s: &Scene, st: f64) -> Result<Scene> {
     Ok(s)
 }
 
-/// Runs every variant on the three Figure 1 cases; writes `sensitivity.csv`.
-pub fn sensitivity(out: &Path, max_steps: Option<usize>) -> Result<()> {
+/// Runs every variant on the three Figure 1 cases; writes `sensitivity.csv` (per case
+/// and variant), `claims_variants.csv` (every claim's verdict per variant) and
+/// `claims_sensitivity.csv` (per claim, in how many variants it holds), and returns the
+/// last as a printable table.
+pub fn sensitivity(out: &Path, max_steps: Option<usize>) -> Result<String> {
     std::fs::create_dir_all(out)?;
     let cases = Scene::figure1()?;
     let vars = variants();
@@ -266,7 +284,7 @@ pub fn sensitivity(out: &Path, max_steps: Option<usize>) -> Result<()> {
         .flat_map(|c| (0..vars.len()).map(move |v| (c, v)))
         .collect();
     let bar = Progress::new(jobs.len() as u64, "sensitivity");
-    let results: Vec<Summary> = jobs
+    let results: Vec<(Summary, Vec<Observables>)> = jobs
         .par_iter()
         .map(|&(c, v)| {
             let (case, scene) = &cases[c];
@@ -274,7 +292,7 @@ pub fn sensitivity(out: &Path, max_steps: Option<usize>) -> Result<()> {
             let name = format!("{case} {what}={value}");
             let s = match change(scene) {
                 Ok(sc) => run_quiet(&sc, &name, max_steps),
-                Err(e) => failed_summary(scene, &name, &format!("{e:#}")),
+                Err(e) => (failed_summary(scene, &name, &format!("{e:#}")), Vec::new()),
             };
             bar.inc(1);
             s
@@ -292,11 +310,12 @@ pub fn sensitivity(out: &Path, max_steps: Option<usize>) -> Result<()> {
             "verticality",
             "twist_rate",
             "head_speed",
+            "front_correlation",
             "wall_s",
             "failure",
         ],
     )?;
-    for (&(c, v), s) in jobs.iter().zip(&results) {
+    for (&(c, v), (s, _)) in jobs.iter().zip(&results) {
         let f = &s.final_observables;
         csv.write_record(&[
             cases[c].0.to_string(),
@@ -307,10 +326,28 @@ pub fn sensitivity(out: &Path, max_steps: Option<usize>) -> Result<()> {
             format!("{:.4}", f.verticality),
             format!("{:.5}", s.twist_rate),
             format!("{:.4}", f.head_speed),
+            format!("{:.3}", s.front.correlation),
             format!("{:.2}", s.wall_time_s),
             s.failure.clone().unwrap_or_default(),
         ])?;
     }
     csv.into_inner().commit()?;
-    Ok(())
+    let names: Vec<(String, String)> = vars
+        .iter()
+        .map(|v| (v.0.to_string(), v.1.clone()))
+        .collect();
+    let runs: Vec<Vec<CaseRun<'_>>> = (0..vars.len())
+        .map(|v| {
+            jobs.iter()
+                .zip(&results)
+                .filter(|(j, _)| j.1 == v)
+                .map(|(j, (s, series))| CaseRun {
+                    case: cases[j.0].0,
+                    series,
+                    front: &s.front,
+                })
+                .collect()
+        })
+        .collect();
+    claim_tables(out, &names, &runs)
 }

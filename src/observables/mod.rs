@@ -1,17 +1,19 @@
-//! Outcome metrics of a settling chain, defined once here, and the classifier that turns
-//! them into the paper's words. Motion and shape measures over time (rotation about the
-//! vertical, poloidal circulation, vertical runs and fronts, extents, settling speed)
-//! are in `motion.rs`.
+//! Outcome metrics of a settling chain, defined once here. Motion and shape measures over
+//! time (rotation about the vertical, poloidal circulation, vertical runs and fronts,
+//! extents, settling speed) are in `motion.rs`; the named states they add up to (the
+//! vocabulary of an outcome timeline) in `state.rs`.
 //!
 //! Conventions: particle 0 is the head, the last particle the chain's end; "down" is
 //! the direction of gravity.
 
 mod motion;
+mod state;
 
 pub use motion::{
     FrontOrder, Rotation, VerticalFront, bond_is_vertical, com_settling_speed, extents,
     poloidal_circulation, spin_about_vertical, vertical_run,
 };
+pub use state::{Shape, State, StateThresholds, is_rotating, state_name, state_of};
 
 use crate::bonds::Bond;
 use crate::real::Real;
@@ -138,68 +140,5 @@ impl<'a, T: Real> Twist<'a, T> {
         }
         self.started = true;
         self.total
-    }
-}
-
-/// The paper's words for a chain's late state.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Outcome {
-    /// Hangs straight and vertical ("stretched like a chopstick").
-    Stretched,
-    /// Keeps turning about the vertical ("everlasting twisting").
-    Twisting,
-    /// Neither: folded, tilted or tumbling.
-    Other,
-}
-
-impl Outcome {
-    /// Lower-case name, as written to summaries.
-    pub fn name(self) -> &'static str {
-        match self {
-            Outcome::Stretched => "stretched",
-            Outcome::Twisting => "twisting",
-            Outcome::Other => "other",
-        }
-    }
-}
-
-/// Classifier thresholds.
-///
-/// Defaults: stretched when verticality is at least 0.95 and extension at least 0.85;
-/// otherwise twisting when the late twist rate is at least 0.002 rad per time unit
-/// (about one turn per 3000 time units).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Thresholds<T> {
-    /// Minimum verticality of a stretched chain.
-    pub verticality: T,
-    /// Minimum extension of a stretched chain.
-    pub extension: T,
-    /// Minimum `|twist rate|` of a twisting chain.
-    pub twist_rate: T,
-}
-
-impl<T: Real> Default for Thresholds<T> {
-    fn default() -> Self {
-        Self {
-            verticality: T::from_f64(0.95),
-            extension: T::from_f64(0.85),
-            twist_rate: T::from_f64(0.002),
-        }
-    }
-}
-
-/// Classifies a late state from its verticality, extension and twist rate.
-pub fn classify<T: Real>(
-    verticality: T,
-    extension: T,
-    twist_rate: T,
-    th: &Thresholds<T>,
-) -> Outcome {
-    if verticality >= th.verticality && extension >= th.extension {
-        Outcome::Stretched
-    } else if twist_rate.abs() >= th.twist_rate {
-        Outcome::Twisting
-    } else {
-        Outcome::Other
     }
 }

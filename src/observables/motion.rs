@@ -286,6 +286,12 @@ impl<'a, T: Real> VerticalFront<'a, T> {
         }
     }
 
+    /// A tracker that carries on over `first` as it stands (times recorded before,
+    /// negative for "not yet"): a run resumed from a saved state.
+    pub fn resume(first: &'a mut [T]) -> Self {
+        Self { first }
+    }
+
     /// First-vertical times (negative: not yet).
     pub fn times(&self) -> &[T] {
         self.first

@@ -21,7 +21,7 @@ use crate::scene::Precision;
 pub const CHECKPOINT: &str = "checkpoint.json";
 
 /// Format version of the checkpoint file.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// The state of a run after time step `step`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -42,6 +42,8 @@ pub struct Checkpoint {
     pub omega: Vec<u64>,
     /// Twist accumulated so far, `f64` bits.
     pub twist: u64,
+    /// Per bond, the first time it was near-vertical (`f64` bits; negative: not yet).
+    pub front: Vec<u64>,
     /// Constraint iterations summed over the steps done.
     pub total_iterations: u64,
     /// Where the run's files stand.
@@ -72,16 +74,18 @@ fn restore<T: Real>(bits: &[u64], out: &mut [T::V3], what: &str) -> Result<()> {
 }
 
 impl Checkpoint {
-    /// The state of `beads` after `step` steps.
+    /// The state of `beads` after `step` steps, with the trackers' state (twist and
+    /// stretching-front times).
     pub(super) fn of<T: Real>(
         step: u64,
         precision: Precision,
         beads: &Beads<T>,
-        twist: T,
+        trackers: (T, &[T]),
         total_iterations: u64,
         marks: Marks,
         last: Observables,
     ) -> Self {
+        let (twist, front) = trackers;
         Checkpoint {
             version: VERSION,
             step,
@@ -91,6 +95,7 @@ impl Checkpoint {
             vel: bits::<T>(&beads.vel),
             omega: bits::<T>(&beads.omega),
             twist: twist.to_f64().to_bits(),
+            front: front.iter().map(|t| t.to_f64().to_bits()).collect(),
             total_iterations,
             marks,
             last,
@@ -103,6 +108,21 @@ impl Checkpoint {
         restore::<T>(&self.vel, &mut beads.vel, "velocity")?;
         restore::<T>(&self.omega, &mut beads.omega, "angular velocity")?;
         beads.time = T::from_f64(f64::from_bits(self.time));
+        Ok(())
+    }
+
+    /// Puts the stretching-front times back into `front` (one per bond).
+    pub(super) fn restore_front<T: Real>(&self, front: &mut [T]) -> Result<()> {
+        if self.front.len() != front.len() {
+            bail!(
+                "the checkpoint has {} front times for {} bonds",
+                self.front.len(),
+                front.len()
+            );
+        }
+        for (f, &b) in front.iter_mut().zip(&self.front) {
+            *f = T::from_f64(f64::from_bits(b));
+        }
         Ok(())
     }
 

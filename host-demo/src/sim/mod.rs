@@ -23,7 +23,10 @@ mod tail;
 
 pub use beads::{Beads, BuildError, bonds};
 pub use checkpoint::{CHECKPOINT, Checkpoint};
-pub use record::{COLUMNS, Marks, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD, TRAJECTORY_XYZ};
+pub use record::{
+    COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
+    TRAJECTORY_XYZ,
+};
 
 use std::path::{Path, PathBuf};
 
@@ -90,8 +93,11 @@ pub struct Summary {
     /// Late-time twist rate (slope over the last quarter of the run's time), rad per
     /// time unit.
     pub twist_rate: f64,
-    /// Classified outcome: stretched, twisting, other (or failed).
+    /// Late state: the named state of most frames in the last quarter of the run's time
+    /// (`observables::State` names), or "failed".
     pub outcome: String,
+    /// The order in which the bonds first turned near-vertical (the stretching front).
+    pub front: Front,
     /// Why the run stopped early, if it did.
     pub failure: Option<String>,
     /// What `level = "auto"` chose and why (None for a manual level).
@@ -128,11 +134,26 @@ impl Summary {
             final_observables: Observables::default(),
             twist_rate: 0.0,
             outcome: String::new(),
+            front: Front::default(),
             failure: None,
             level_choice: None,
             resolved_scene: scene.clone(),
         }
     }
+}
+
+/// The order in which bonds first turned near-vertical (checked after every step).
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct Front {
+    /// A bond is near-vertical when `|cos|` of its angle with gravity is at least this.
+    pub cos_min: f64,
+    /// Bonds that turned near-vertical at some time.
+    pub count: usize,
+    /// Correlation between bond index (bond 0 at the head) and first-vertical time:
+    /// +1 for a front from the head to the end, -1 the other way, 0 without order.
+    pub correlation: f64,
+    /// Per bond, in bond order, the first time it was near-vertical (None: never).
+    pub first_vertical: Vec<Option<f64>>,
 }
 
 /// A finished run: summary, first and last configurations, the observables series.

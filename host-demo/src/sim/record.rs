@@ -6,15 +6,15 @@ use std::io::Seek;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use hydrorattle::observables;
+use hydrorattle::observables::{self, Shape, State, StateThresholds, state_of};
 use hydrorattle::{Bond, Real};
 use serde::{Deserialize, Serialize};
 
 use super::beads::Beads;
-use crate::output::{AtomicFile, CsvWriter, Topology, XyzWriter, gsd::GsdWriter};
+use crate::output::{AtomicFile, CsvWriter, Topology, XyzWriter, format_f64, gsd::GsdWriter};
 
 /// Columns of `observables.csv`, in order.
-pub const COLUMNS: [&str; 12] = [
+pub const COLUMNS: [&str; 21] = [
     "time",
     "extension",
     "verticality",
@@ -27,7 +27,21 @@ pub const COLUMNS: [&str; 12] = [
     "bond_residual",
     "iterations",
     "max_tension",
+    "spin_rate",
+    "spin_coherence",
+    "poloidal_rate",
+    "poloidal_coherence",
+    "vertical_run",
+    "horizontal_extent",
+    "vertical_extent",
+    "com_speed",
+    "state",
 ];
+
+/// A bond counts as near-vertical when the cosine of its angle with gravity is at least
+/// this (within about 26 degrees of the vertical): the vertical runs and the stretching
+/// front.
+pub const NEAR_VERTICAL_COS: f64 = 0.9;
 
 /// The files of a run, in the output folder.
 pub const TRAJECTORY_XYZ: &str = "trajectory.xyz";
@@ -35,6 +49,31 @@ pub const TRAJECTORY_XYZ: &str = "trajectory.xyz";
 pub const TRAJECTORY_GSD: &str = "trajectory.gsd";
 /// Observables, one row per frame.
 pub const OBSERVABLES_CSV: &str = "observables.csv";
+
+/// A frame's named state ([`State`]), written by its name; `other` by default.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Label(pub State);
+
+impl Default for Label {
+    fn default() -> Self {
+        Label(State::Other)
+    }
+}
+
+impl Serialize for Label {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.0.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for Label {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        State::from_name(&name)
+            .map(Label)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown state {name:?}")))
+    }
+}
 
 /// One row of observables.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
@@ -60,37 +99,79 @@ pub struct Observables {
     pub iterations: u32,
     /// Largest bond tension of the step that led to this row (0 likewise).
     pub max_tension: f64,
+    /// Rotation rate about the vertical through the centre of mass (rad per time unit,
+    /// right-handed about "up").
+    pub spin_rate: f64,
+    /// Share of the horizontal relative motion that rotation explains, in `[0, 1]`.
+    pub spin_coherence: f64,
+    /// Poloidal circulation rate (rolling over itself), rad per time unit.
+    pub poloidal_rate: f64,
+    /// Share of the relative motion that the poloidal circulation explains.
+    pub poloidal_coherence: f64,
+    /// Longest run of consecutive near-vertical bonds ([`NEAR_VERTICAL_COS`]).
+    pub vertical_run: u32,
+    /// Largest horizontal distance between two centres.
+    pub horizontal_extent: f64,
+    /// Spread of the centres' heights.
+    pub vertical_extent: f64,
+    /// Centre-of-mass settling speed (along gravity).
+    pub com_speed: f64,
+    /// The frame's named state.
+    pub state: Label,
+}
+
+/// What [`Observables::of`] needs besides the state: the bonds, masses, gravity, and
+/// the state thresholds.
+pub(super) struct Observer<'a, T: Real> {
+    /// Bonds in chain order.
+    pub bonds: &'a [Bond<T>],
+    /// Bead masses.
+    pub mass: &'a [T],
+    /// Gravitational acceleration.
+    pub gravity: T::V3,
+    /// Thresholds of the named states.
+    pub thresholds: StateThresholds<T>,
 }
 
 impl Observables {
     /// The observables of `beads` (bead 0 is the head), with the twist so far and the
     /// last step's iterations and largest tension.
-    pub fn of<T: Real>(
+    pub(super) fn of<T: Real>(
         beads: &Beads<T>,
-        bonds: &[Bond<T>],
-        gravity: T::V3,
+        ob: &Observer<'_, T>,
         twist: T,
         iterations: u32,
         tension: T,
     ) -> Self {
-        let pos = &beads.pos[..];
+        let (pos, vel, g) = (&beads.pos[..], &beads.vel[..], ob.gravity);
         let com = observables::centre_of_mass::<T>(pos, |i| beads.mass(i));
+        let cos = T::from_f64(NEAR_VERTICAL_COS);
+        let shape = Shape::measure(pos, vel, ob.mass, ob.bonds, g, cos);
         Observables {
             time: beads.time.to_f64(),
-            extension: observables::extension::<T>(pos, bonds).to_f64(),
-            verticality: observables::verticality::<T>(pos, gravity).to_f64(),
+            extension: shape.extension.to_f64(),
+            verticality: shape.verticality.to_f64(),
             twist: twist.to_f64(),
             head_z: T::xyz(pos[0])[2].to_f64(),
-            head_speed: observables::settling_speed::<T>(&beads.vel, 0, gravity).to_f64(),
+            head_speed: observables::settling_speed::<T>(vel, 0, g).to_f64(),
             com: T::v3_to_f64(com),
-            bond_residual: hydrorattle::bonds::max_residual(bonds, pos).1.to_f64(),
+            bond_residual: hydrorattle::bonds::max_residual(ob.bonds, pos).1.to_f64(),
             iterations,
             max_tension: tension.to_f64(),
+            spin_rate: shape.spin.rate.to_f64(),
+            spin_coherence: shape.spin.coherence.to_f64(),
+            poloidal_rate: shape.poloidal.rate.to_f64(),
+            poloidal_coherence: shape.poloidal.coherence.to_f64(),
+            vertical_run: u32::try_from(shape.vertical_run).unwrap_or(u32::MAX),
+            horizontal_extent: shape.horizontal.to_f64(),
+            vertical_extent: shape.vertical.to_f64(),
+            com_speed: observables::com_settling_speed::<T>(vel, ob.mass, g).to_f64(),
+            state: Label(state_of(&shape, &ob.thresholds)),
         }
     }
 
-    fn row(&self) -> [f64; 12] {
-        [
+    fn row(&self) -> Vec<String> {
+        let numbers = [
             self.time,
             self.extension,
             self.verticality,
@@ -103,16 +184,30 @@ impl Observables {
             self.bond_residual,
             f64::from(self.iterations),
             self.max_tension,
-        ]
+            self.spin_rate,
+            self.spin_coherence,
+            self.poloidal_rate,
+            self.poloidal_coherence,
+            f64::from(self.vertical_run),
+            self.horizontal_extent,
+            self.vertical_extent,
+            self.com_speed,
+        ];
+        let mut row: Vec<String> = numbers.iter().map(|&x| format_f64(x)).collect();
+        row.push(self.state.0.name().to_string());
+        row
     }
 
     /// Reads a row written by a run (bit-exact: numbers round-trip).
     pub fn from_row(line: &str) -> Option<Observables> {
-        let x: Vec<f64> = line
-            .split(',')
+        let fields: Vec<&str> = line.split(',').collect();
+        let (state, numbers) = fields.split_last()?;
+        let x: Vec<f64> = numbers
+            .iter()
             .map(|f| f.parse().ok())
             .collect::<Option<_>>()?;
-        (x.len() == COLUMNS.len()).then(|| Observables {
+        (fields.len() == COLUMNS.len()).then_some(())?;
+        Some(Observables {
             time: x[0],
             extension: x[1],
             verticality: x[2],
@@ -123,6 +218,15 @@ impl Observables {
             bond_residual: x[9],
             iterations: x[10] as u32,
             max_tension: x[11],
+            spin_rate: x[12],
+            spin_coherence: x[13],
+            poloidal_rate: x[14],
+            poloidal_coherence: x[15],
+            vertical_run: x[16] as u32,
+            horizontal_extent: x[17],
+            vertical_extent: x[18],
+            com_speed: x[19],
+            state: Label(State::from_name(state)?),
         })
     }
 }
@@ -211,7 +315,7 @@ impl Recorder {
         let (pos, vel) = (f64s(&beads.pos), f64s(&beads.vel));
         f.xyz.write_frame(&self.topology, o.time, &pos, &vel)?;
         f.gsd.write_frame(step, o.time, &pos, &vel)?;
-        f.csv.write_row(&o.row())?;
+        f.csv.write_record(&o.row())?;
         Ok(())
     }
 

@@ -4,15 +4,15 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use hydrorattle::observables::{self, Thresholds, Twist};
+use hydrorattle::observables::{StateThresholds, Twist, VerticalFront};
 use hydrorattle::{Noise, Params, Real, SoftContact, step_slices_thermal};
 use hydrorattle_heap::Buffers;
 
 use super::checkpoint::Checkpoint;
-use super::record::{OBSERVABLES_CSV, Recorder, each_row};
+use super::record::{NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, each_row};
 use super::tail::TailSlope;
 use super::{
-    Beads, BuildError, Observables, RunOptions, RunResult, Summary, bonds, params, snapshot,
+    Beads, BuildError, Front, Observables, RunOptions, RunResult, Summary, bonds, params, snapshot,
 };
 use crate::progress::Progress;
 use crate::scene::{DEFAULT_SEED, Overlap, Scene};
@@ -106,9 +106,26 @@ pub(super) fn run_t<T: Real>(
     let mut twist = Twist::new(&mut twist_prev, T::from_f64(0.25));
     let mut tail = TailSlope::new(steps as f64 * scene.integrator.dt);
     let mut series = Vec::new();
-    let observe = |beads: &Beads<T>, twist: T, iterations: u32, tension: T| {
-        Observables::of(beads, &bonds, p.gravity, twist, iterations, tension)
+    let mass: Vec<T> = (0..beads.len()).map(|i| beads.mass(i)).collect();
+    let observer = Observer {
+        bonds: &bonds,
+        mass: &mass,
+        gravity: p.gravity,
+        thresholds: StateThresholds::default(),
     };
+    let observe = |beads: &Beads<T>, twist: T, iterations: u32, tension: T| {
+        Observables::of(beads, &observer, twist, iterations, tension)
+    };
+    // The stretching front, checked after every step (frames are too far apart).
+    let cos_vertical = T::from_f64(NEAR_VERTICAL_COS);
+    let mut front_times = vec![-T::ONE; bonds.len()];
+    if let Some(c) = from {
+        c.restore_front(&mut front_times)?;
+    }
+    let mut front = VerticalFront::resume(&mut front_times);
+    if from.is_none() {
+        front.update(&bonds, &beads.pos, p.gravity, cos_vertical, beads.time);
+    }
     let initial = snapshot::<T>(&beads.pos, &beads.radius, beads.time);
     // The twist tracker starts from the current positions; a resumed run carries the
     // total on.
@@ -152,6 +169,7 @@ pub(super) fn run_t<T: Real>(
                 done = s;
                 total_iterations += u64::from(rep.iterations);
                 let tw = twist.update(&beads.pos, p.gravity);
+                front.update(&bonds, &beads.pos, p.gravity, cos_vertical, beads.time);
                 let scheduled = s % every == 0;
                 let mut frame = |rec: &mut Recorder| -> Result<Observables> {
                     let o = observe(&beads, tw, rep.iterations, rep.max_tension);
@@ -176,7 +194,7 @@ pub(super) fn run_t<T: Real>(
                             s as u64,
                             precision,
                             &beads,
-                            tw,
+                            (tw, front.times()),
                             total_iterations,
                             marks,
                             last,
@@ -211,12 +229,20 @@ pub(super) fn run_t<T: Real>(
         last = o;
     }
     let twist_rate = tail.slope();
-    let th = Thresholds::<f64>::default();
-    let outcome = match failure {
-        Some(_) => "failed".to_string(),
-        None => observables::classify(last.verticality, last.extension, twist_rate, &th)
-            .name()
-            .to_string(),
+    let outcome = match (&failure, tail.late_state()) {
+        (None, Some(s)) => s.name().to_string(),
+        _ => "failed".to_string(),
+    };
+    let order = front.order();
+    let front = Front {
+        cos_min: NEAR_VERTICAL_COS,
+        count: order.count,
+        correlation: order.correlation.to_f64(),
+        first_vertical: front
+            .times()
+            .iter()
+            .map(|t| (*t >= T::ZERO).then(|| t.to_f64()))
+            .collect(),
     };
     let stepped = done + 1 - first;
     let summary = Summary {
@@ -231,6 +257,7 @@ pub(super) fn run_t<T: Real>(
         final_observables: last,
         twist_rate,
         outcome,
+        front,
         failure,
         ..Summary::for_scene(scene, name)
     };

@@ -1,7 +1,10 @@
-//! The late-time twist rate, accumulated as the frames go by: the least-squares slope of
-//! twist against time over the frames in the last quarter of the run's time, in
-//! constant memory (running means and co-moments, updated in frame order, so a resumed
-//! run that replays the same rows gets the same bits).
+//! The late-time twist rate and late state, accumulated as the frames go by: the
+//! least-squares slope of twist against time over the frames in the last quarter of the
+//! run's time, and how many of those frames are in each named state, in constant memory
+//! (running means and co-moments, updated in frame order, so a resumed run that replays
+//! the same rows gets the same bits).
+
+use hydrorattle::observables::State;
 
 use super::record::Observables;
 
@@ -16,6 +19,8 @@ pub(super) struct TailSlope {
     stt: f64,
     /// Sum of (t - mean_t)(w - mean_w).
     stw: f64,
+    /// Frames in each state of [`State::ALL`].
+    states: [u64; State::ALL.len()],
 }
 
 impl TailSlope {
@@ -29,6 +34,7 @@ impl TailSlope {
             mean_w: 0.0,
             stt: 0.0,
             stw: 0.0,
+            states: [0; State::ALL.len()],
         }
     }
 
@@ -38,11 +44,25 @@ impl TailSlope {
             return;
         }
         self.n += 1.0;
+        self.states[o.state.0.index()] += 1;
         let dt = o.time - self.mean_t;
         self.mean_t += dt / self.n;
         self.mean_w += (o.twist - self.mean_w) / self.n;
         self.stt += dt * (o.time - self.mean_t);
         self.stw += dt * (o.twist - self.mean_w);
+    }
+
+    /// The state of most frames in the window (the first in [`State::ALL`] on a tie);
+    /// None without frames.
+    pub(super) fn late_state(&self) -> Option<State> {
+        let mut best: Option<(State, u64)> = None;
+        for s in State::ALL {
+            let n = self.states[s.index()];
+            if n > 0 && best.is_none_or(|b| n > b.1) {
+                best = Some((s, n));
+            }
+        }
+        best.map(|b| b.0)
     }
 
     /// The slope (0 with fewer than two frames or no spread in time).
@@ -74,5 +94,31 @@ mod tests {
         }
         assert!((s.slope() - 3.0).abs() < 1e-12, "{}", s.slope());
         assert_eq!(TailSlope::new(1.0).slope(), 0.0);
+    }
+
+    #[test]
+    fn the_late_state_is_the_most_frequent_in_the_last_quarter() {
+        use super::super::record::Label;
+        let mut s = TailSlope::new(10.0);
+        assert_eq!(s.late_state(), None);
+        // Stretched early (outside the window), rotating in 3 late frames, folded in 2.
+        let states = [
+            (1.0, State::Stretched),
+            (2.0, State::Stretched),
+            (3.0, State::Stretched),
+            (7.6, State::Folded),
+            (8.0, State::Rotating),
+            (8.5, State::Folded),
+            (9.0, State::Rotating),
+            (10.0, State::Rotating),
+        ];
+        for (time, st) in states {
+            s.add(&Observables {
+                time,
+                state: Label(st),
+                ..Observables::default()
+            });
+        }
+        assert_eq!(s.late_state(), Some(State::Rotating));
     }
 }
