@@ -164,11 +164,11 @@ fn run(cli: Cli) -> Result<()> {
             report(&r.summary.scene.clone(), &r.summary, &dir)?;
         }
         Command::Reference { out, dt, quick } => {
-            let cases = host_demo::reference::reference(&out, dt, quick.then_some(2000))?;
+            let report = host_demo::reference::reference(&out, dt, quick.then_some(2000))?;
             println!(
                 "case variant                     method       dt      horizon(>0.1a) horizon(>0.5a) outcome (reference)"
             );
-            for c in &cases {
+            for c in &report.cases {
                 for v in &c.variants {
                     let h = |x: Option<f64>| x.map_or("never".to_string(), |t| format!("{t}"));
                     println!(
@@ -184,7 +184,34 @@ fn run(cli: Cli) -> Result<()> {
                     );
                 }
             }
+            println!(
+                "\nclaim                reference  {}",
+                report.variant_names.join(" | ")
+            );
+            for v in &report.verdicts {
+                let others: Vec<String> = v.variants.iter().map(|x| format!("{x:?}")).collect();
+                println!(
+                    "{:<20} {:<10} {}",
+                    v.id,
+                    format!("{:?}", v.reference),
+                    others.join(" | ")
+                );
+            }
             println!("wrote {}", out.join("reference.json").display());
+            // The main job's verdicts must be the reference's (a full run only: a smoke
+            // run's claims mean little).
+            let differ: Vec<&str> = report
+                .verdicts
+                .iter()
+                .filter(|v| v.variants.first() != Some(&v.reference))
+                .map(|v| v.id.as_str())
+                .collect();
+            if !quick && !differ.is_empty() {
+                anyhow::bail!(
+                    "the main job's verdicts differ from the dt = {dt} reference's: {}",
+                    differ.join(", ")
+                );
+            }
         }
         Command::Figure1 { out, quick } => {
             let s = host_demo::figure1::figure1(&out, quick.then_some(2000))?;

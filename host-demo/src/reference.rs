@@ -4,7 +4,8 @@
 //!
 //! Writes `reference.json` (per case and variant: RMS deviation from the reference at
 //! every common frame, the horizons where it first exceeds 0.1 and 0.5 tail radii, the
-//! final outcome of both) and `reference_{a,b,c}.png` (deviation against time).
+//! final outcome of both; per variant: the paper's claims judged on its runs next to
+//! the reference's verdicts) and `reference_{a,b,c}.png` (deviation against time).
 
 use std::path::Path;
 
@@ -12,10 +13,11 @@ use anyhow::{Result, bail};
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::claims::{CaseRun, Verdict, claims};
 use crate::output::{read_xyz_file, write_json};
 use crate::render::{LineChart, Series, line_chart};
 use crate::scene::{Method, Scene};
-use crate::sim::{RunOptions, TRAJECTORY_XYZ, run};
+use crate::sim::{RunOptions, RunResult, TRAJECTORY_XYZ, run};
 
 /// Time between compared frames (every variant writes a frame this often).
 const FRAME_DT: f64 = 2.0;
@@ -93,6 +95,30 @@ pub struct CaseReference {
     pub variants: Vec<Comparison>,
 }
 
+/// One claim's verdict on a variant's runs next to the reference's.
+#[derive(Debug, Clone, Serialize)]
+pub struct VerdictRow {
+    /// The claim's id.
+    pub id: String,
+    /// Its case.
+    pub case: String,
+    /// The reference's verdict.
+    pub reference: Verdict,
+    /// The variant's verdict, in the order of [`variants`].
+    pub variants: Vec<Verdict>,
+}
+
+/// `reference.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReferenceReport {
+    /// Per case: deviations and horizons.
+    pub cases: Vec<CaseReference>,
+    /// The variants' names, in order.
+    pub variant_names: Vec<String>,
+    /// Per claim: the reference's verdict and each variant's.
+    pub verdicts: Vec<VerdictRow>,
+}
+
 /// `scene` run as `v`, with a frame every [`FRAME_DT`].
 fn as_variant(scene: &Scene, v: Variant) -> Scene {
     let mut s = scene.clone();
@@ -146,7 +172,7 @@ pub fn reference(
     out: &Path,
     reference_dt: f64,
     max_steps: Option<usize>,
-) -> Result<Vec<CaseReference>> {
+) -> Result<ReferenceReport> {
     if !(reference_dt.is_finite() && reference_dt > 0.0) {
         bail!("--dt {reference_dt}: the reference time step must be positive");
     }
@@ -154,7 +180,6 @@ pub fn reference(
     let scenes = Scene::figure1()?;
     let opts = RunOptions {
         max_steps,
-        keep_series: false,
         ..RunOptions::default()
     };
     // Every run of every case, in parallel: the reference first, then the variants.
@@ -170,28 +195,25 @@ pub fn reference(
             jobs.push((case.to_string(), v, as_variant(scene, v)));
         }
     }
-    let done: Vec<Result<(String, Variant, String, f64)>> = jobs
+    let done: Vec<Result<RunResult>> = jobs
         .par_iter()
         .enumerate()
-        .map(|(k, (case, v, s))| {
-            let dir = out.join(case).join(format!("{k:02}"));
-            let r = run(s, case, Some(&dir), opts)?;
-            Ok((case.clone(), *v, r.summary.outcome, r.summary.wall_time_s))
-        })
+        .map(|(k, (case, _, s))| run(s, case, Some(&out.join(case).join(format!("{k:02}"))), opts))
         .collect();
+    let done: Vec<(&str, Variant, RunResult)> = jobs
+        .iter()
+        .zip(done)
+        .map(|((case, v, _), r)| r.map(|r| (case.as_str(), *v, r)))
+        .collect::<Result<_>>()?;
     let mut cases = Vec::new();
     for (case, _) in &scenes {
         let mut rows = Vec::new();
-        for (k, d) in done.iter().enumerate() {
-            let (c, v, outcome, wall) = d.as_ref().map_err(|e| anyhow::anyhow!("{e:#}"))?;
+        for (k, (c, v, r)) in done.iter().enumerate() {
             if c == case {
                 let dir = out.join(case).join(format!("{k:02}"));
-                rows.push((
-                    *v,
-                    outcome.clone(),
-                    *wall,
-                    read_frames(&dir.join(TRAJECTORY_XYZ))?,
-                ));
+                let frames = read_frames(&dir.join(TRAJECTORY_XYZ))?;
+                let s = &r.summary;
+                rows.push((*v, s.outcome.clone(), s.wall_time_s, frames));
             }
         }
         let (refv, ref_outcome, _, ref_frames) = rows.remove(0);
@@ -215,9 +237,56 @@ pub fn reference(
             variants,
         });
     }
-    write_json(&out.join("reference.json"), &cases)?;
-    draw(out, &cases, max_steps.is_some())?;
-    Ok(cases)
+    let report = ReferenceReport {
+        variant_names: variants(&scenes[0].1)
+            .iter()
+            .map(|v| v.name.to_string())
+            .collect(),
+        verdicts: verdicts(&done),
+        cases,
+    };
+    write_json(&out.join("reference.json"), &report)?;
+    draw(out, &report.cases, max_steps.is_some())?;
+    Ok(report)
+}
+
+/// The claims judged on each variant's three runs (and the reference's), side by side.
+fn verdicts(done: &[(&str, Variant, RunResult)]) -> Vec<VerdictRow> {
+    let judged = |name: &str| {
+        let runs: Vec<CaseRun<'_>> = done
+            .iter()
+            .filter(|(_, v, _)| v.name == name)
+            .map(|(case, _, r)| CaseRun {
+                case,
+                series: &r.series,
+                front: &r.summary.front,
+            })
+            .collect();
+        claims(&runs)
+    };
+    let names: Vec<&str> = done
+        .iter()
+        .filter(|(case, ..)| *case == done[0].0)
+        .map(|(_, v, _)| v.name)
+        .filter(|n| *n != "reference")
+        .collect();
+    let others: Vec<_> = names.iter().map(|n| judged(n)).collect();
+    judged("reference")
+        .into_iter()
+        .map(|c| VerdictRow {
+            variants: others
+                .iter()
+                .map(|o| {
+                    o.iter()
+                        .find(|x| x.id == c.id)
+                        .map_or(Verdict::Fails, |x| x.verdict)
+                })
+                .collect(),
+            id: c.id,
+            case: c.case,
+            reference: c.verdict,
+        })
+        .collect()
 }
 
 fn draw(out: &Path, cases: &[CaseReference], quick: bool) -> Result<()> {
