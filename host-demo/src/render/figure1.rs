@@ -37,6 +37,28 @@ const FIG1_GAP: f64 = 24.0;
 /// 2x2 block (upper row: side view, initial | final; lower row: top view, initial |
 /// final), the four panels of a case at one scale, the largest that fits all four.
 pub fn draw_figure1(path: &Path, cases: &[Figure1Case]) -> Result<()> {
+    draw_figure1_scaled(path, cases, false)
+}
+
+/// [`draw_figure1`] with one common scale: every panel of every case at the largest
+/// scale at which all of them fit, so that sizes compare across cases.
+pub fn draw_figure1_common(path: &Path, cases: &[Figure1Case]) -> Result<()> {
+    draw_figure1_scaled(path, cases, true)
+}
+
+/// The largest scale at which the four panels of `case` fit.
+fn case_scale(case: &Figure1Case, side: (u32, u32), top: (u32, u32)) -> f64 {
+    fit_scale(
+        &[(&case.initial, View::Side), (&case.last, View::Side)],
+        side,
+    )
+    .min(fit_scale(
+        &[(&case.initial, View::Top), (&case.last, View::Top)],
+        top,
+    ))
+}
+
+fn draw_figure1_scaled(path: &Path, cases: &[Figure1Case], common: bool) -> Result<()> {
     if cases.is_empty() {
         return Err(anyhow!("figure 1 needs at least one case"));
     }
@@ -48,10 +70,21 @@ pub fn draw_figure1(path: &Path, cases: &[Figure1Case]) -> Result<()> {
     let side_size = (FIG1_PANEL_W - 2.0 * inset, FIG1_SIDE_H - 2.0 * inset);
     let top_size = (FIG1_PANEL_W - 2.0 * inset, FIG1_TOP_H - 2.0 * inset);
     let as_u32 = |s: (f64, f64)| (s.0 as u32, s.1 as u32);
+    let scales: Vec<f64> = cases
+        .iter()
+        .map(|c| case_scale(c, as_u32(side_size), as_u32(top_size)))
+        .collect();
+    let smallest = scales.iter().copied().fold(f64::INFINITY, f64::min);
+    let heading = if common {
+        "Settling helical chains at one common scale (every panel): side view (upper row) and \
+         top view (lower row), initial (left) and final (right); head red, tails blue"
+    } else {
+        "Settling helical chains: side view (upper row) and top view (lower row), \
+         initial (left) and final (right) state; head red, tails blue, last tail green"
+    };
     save_png(path, (width as u32, height as u32), |root, k| {
         root.draw(&Text::new(
-            "Settling helical chains: side view (upper row) and top view (lower row), \
-             initial (left) and final (right) state; head red, tails blue, last tail green",
+            heading,
             (px(k, FIG1_GAP), px(k, 14.0)),
             (FONT, 19.0 * k).into_font().color(&BLACK),
         ))
@@ -67,14 +100,7 @@ pub fn draw_figure1(path: &Path, cases: &[Figure1Case]) -> Result<()> {
                     .color(&BLACK),
             ))
             .map_err(drawing)?;
-            let scale = fit_scale(
-                &[(&case.initial, View::Side), (&case.last, View::Side)],
-                as_u32(side_size),
-            )
-            .min(fit_scale(
-                &[(&case.initial, View::Top), (&case.last, View::Top)],
-                as_u32(top_size),
-            ));
+            let scale = if common { smallest } else { scales[c] };
             let colors = chain_colors(case.initial.positions.len());
             let states = [(&case.initial, "initial"), (&case.last, "final")];
             for (col, (snap, when)) in states.into_iter().enumerate() {
@@ -92,6 +118,92 @@ pub fn draw_figure1(path: &Path, cases: &[Figure1Case]) -> Result<()> {
                     let name = if view == View::Side { "side" } else { "top" };
                     let title = format!("{name}, {when}, t = {}", short(snap.time));
                     draw_panel(&area, snap, &colors, view, scale, &title, k)?;
+                }
+            }
+        }
+        Ok(())
+    })
+}
+
+/// One row of a snapshot grid: a case's title and its configurations, by time (None
+/// for a time the run did not reach).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SnapshotRow {
+    /// Row title, e.g. the case's.
+    pub title: String,
+    /// One configuration per column.
+    pub snapshots: Vec<Option<Snapshot>>,
+}
+
+/// Width and height of a snapshot panel, pixels.
+const SNAP_PANEL: (f64, f64) = (230.0, 420.0);
+
+/// Draws a grid of side views to a PNG: rows (cases) by columns (the times asked,
+/// `times`), every panel at one common scale; a panel is titled with the time of its
+/// configuration (the first step at or after the time asked) and left empty for a time
+/// the run did not reach.
+pub fn draw_snapshots(path: &Path, rows: &[SnapshotRow], times: &[f64]) -> Result<()> {
+    let columns = times.len();
+    if rows.is_empty() || columns == 0 || rows.iter().any(|r| r.snapshots.len() != columns) {
+        return Err(anyhow!(
+            "a snapshot grid needs rows with one configuration per time ({columns} times)"
+        ));
+    }
+    let (pw, ph) = SNAP_PANEL;
+    let inset = 2.0;
+    let panel = ((pw - 2.0 * inset) as u32, (ph - 2.0 * inset) as u32);
+    let items: Vec<(&Snapshot, View)> = rows
+        .iter()
+        .flat_map(|r| r.snapshots.iter().flatten())
+        .map(|s| (s, View::Side))
+        .collect();
+    let scale = if items.is_empty() {
+        1.0
+    } else {
+        fit_scale(&items, panel)
+    };
+    let width = 2.0 * FIG1_GAP + columns as f64 * pw;
+    let row_h = FIG1_CASE_TITLE + ph;
+    let height = FIG1_HEADING + rows.len() as f64 * row_h + FIG1_GAP;
+    save_png(path, (width as u32, height as u32), |root, k| {
+        let font = |size: f64| (FONT, size * k).into_font().color(&BLACK);
+        root.draw(&Text::new(
+            "Side views at the times asked, one common scale; head red, tails blue",
+            (px(k, FIG1_GAP), px(k, 14.0)),
+            font(19.0),
+        ))
+        .map_err(drawing)?;
+        for (r, row) in rows.iter().enumerate() {
+            let top = FIG1_HEADING + r as f64 * row_h;
+            root.draw(&Text::new(
+                row.title.clone(),
+                (px(k, FIG1_GAP), px(k, top + 4.0)),
+                (FONT, 20.0 * k)
+                    .into_font()
+                    .style(FontStyle::Bold)
+                    .color(&BLACK),
+            ))
+            .map_err(drawing)?;
+            for (c, (snap, &asked)) in row.snapshots.iter().zip(times).enumerate() {
+                let left = FIG1_GAP + c as f64 * pw;
+                let area = root.clone().shrink(
+                    (px(k, left + inset), px(k, top + FIG1_CASE_TITLE + inset)),
+                    (
+                        px(k, f64::from(panel.0)) as u32,
+                        px(k, f64::from(panel.1)) as u32,
+                    ),
+                );
+                match snap {
+                    Some(s) => {
+                        let colors = chain_colors(s.positions.len());
+                        let title = format!("t = {}", short(s.time));
+                        draw_panel(&area, s, &colors, View::Side, scale, &title, k)?;
+                    }
+                    None => {
+                        let note = format!("t = {}: not reached", short(asked));
+                        area.draw(&Text::new(note, (px(k, 6.0), px(k, 4.0)), font(15.0)))
+                            .map_err(drawing)?;
+                    }
                 }
             }
         }

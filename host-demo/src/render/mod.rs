@@ -115,25 +115,26 @@ where
     let (bw, bh) = (w * k, h * k);
     let mut big = vec![255u8; bw as usize * bh as usize * 3];
     {
+        // The buffer starts white.
         let root = BitMapBackend::with_buffer(&mut big, (bw, bh)).into_drawing_area();
-        root.fill(&WHITE).map_err(drawing)?;
         draw(&root, f64::from(k))?;
         root.present().map_err(drawing)?;
     }
-    let (k, bw) = (k as usize, bw as usize);
-    let mut small = vec![0u8; w as usize * h as usize * 3];
-    for y in 0..h as usize {
-        for x in 0..w as usize {
-            for c in 0..3 {
-                let mut sum = 0usize;
-                for dy in 0..k {
-                    let row = ((y * k + dy) * bw + x * k) * 3 + c;
-                    for dx in 0..k {
-                        sum += usize::from(big[row + dx * 3]);
-                    }
+    let (k, bw, w) = (k as usize, bw as usize, w as usize);
+    let mut small = vec![0u8; w * h as usize * 3];
+    let mut sums = vec![0u32; w * 3];
+    for (y, out) in small.chunks_exact_mut(w * 3).enumerate() {
+        sums.fill(0);
+        for row in big[y * k * bw * 3..(y + 1) * k * bw * 3].chunks_exact(bw * 3) {
+            for (x, px) in row.chunks_exact(3 * k).enumerate() {
+                for (c, v) in px.iter().enumerate() {
+                    sums[3 * x + c % 3] += u32::from(*v);
                 }
-                small[(y * w as usize + x) * 3 + c] = ((sum + k * k / 2) / (k * k)) as u8;
             }
+        }
+        let n = (k * k) as u32;
+        for (o, s) in out.iter_mut().zip(&sums) {
+            *o = ((s + n / 2) / n) as u8;
         }
     }
     let mut backend = BitMapBackend::new(path, size);
