@@ -1,6 +1,7 @@
 //! The paper's Figure 1: three helical chains settling, run in parallel, drawn like the
-//! paper's figure, and summarised in `figure1.json`: per case the final numbers and the
-//! outcome timeline, and the paper's claims with their verdicts ([`crate::claims`]).
+//! paper's figure (and in more pictures: [`crate::pictures`]), and summarised in
+//! `figure1.json`: per case the final numbers and the outcome timeline, and the
+//! paper's claims with their verdicts ([`crate::claims`]).
 
 use std::path::Path;
 
@@ -10,9 +11,9 @@ use serde::Serialize;
 
 use crate::claims::{CaseRun, Claim, claims};
 use crate::output::write_json;
-use crate::render::{Figure1Case, draw_figure1};
+use crate::pictures::{self, ANIMATION_FRAMES, check_times, figure1_pictures};
 use crate::scene::Scene;
-use crate::sim::{Front, RunOptions, RunResult, run};
+use crate::sim::{Front, KeepFrames, RunOptions, RunResult, run};
 use crate::timeline::{Segment, segments};
 use hydrorattle::observables::State;
 
@@ -60,6 +61,11 @@ pub struct Figure1Summary {
     pub claims: Vec<Claim>,
     /// Wall time of the three runs together (they run in parallel), seconds.
     pub wall_time_s: f64,
+    /// Wall time of drawing every picture (in parallel), seconds.
+    pub drawing_wall_time_s: f64,
+    /// One line per picture written.
+    #[serde(skip)]
+    pub pictures: Vec<String>,
 }
 
 fn title(case: &str, s: &Scene) -> String {
@@ -115,42 +121,73 @@ pub fn claims_of(scenes: &[(&str, Scene)], results: &[RunResult]) -> Vec<Claim> 
     claims(&runs)
 }
 
-/// Runs the three cases into `out/{a,b,c}` and writes `figure1.png` and `figure1.json`.
-/// `max_steps` caps each run (a quick smoke run).
+/// Runs the three cases into `out/{a,b,c}` and writes `figure1.json` and the pictures
+/// ([`crate::pictures`]). `max_steps` caps each run (a quick smoke run).
 pub fn figure1(out: &Path, max_steps: Option<usize>) -> Result<Figure1Summary> {
-    std::fs::create_dir_all(out)?;
+    figure1_at(out, max_steps, &[])
+}
+
+/// [`figure1`], with `snapshots.png` at the times `at` (none: no such file); times are
+/// checked (finite, within the runs' duration) before anything runs.
+pub fn figure1_at(out: &Path, max_steps: Option<usize>, at: &[f64]) -> Result<Figure1Summary> {
     let scenes = Scene::figure1()?;
+    let duration = scenes
+        .iter()
+        .map(|(_, s)| s.integrator.duration)
+        .fold(f64::INFINITY, f64::min);
+    check_times(at, duration)?;
+    std::fs::create_dir_all(out)?;
     let start = std::time::Instant::now();
-    let opts = RunOptions {
-        progress: true,
-        max_steps,
-        ..RunOptions::default()
-    };
     let results: Vec<Result<RunResult>> = scenes
         .par_iter()
-        .map(|(case, scene)| run(scene, case, Some(&out.join(case)), opts))
+        .map(|(case, scene)| {
+            let steps = max_steps.map_or(scene.integrator.steps(), |m| {
+                m.min(scene.integrator.steps())
+            });
+            let opts = RunOptions {
+                progress: true,
+                max_steps,
+                keep: KeepFrames {
+                    every: Some((steps / ANIMATION_FRAMES).max(1)),
+                    at,
+                },
+                ..RunOptions::default()
+            };
+            run(scene, case, Some(&out.join(case)), opts)
+        })
         .collect();
     let wall = start.elapsed().as_secs_f64();
     let results: Vec<RunResult> = results.into_iter().collect::<Result<_>>()?;
     let mut cases = Vec::new();
-    let mut panels = Vec::new();
-    for ((case, scene), r) in scenes.iter().zip(&results) {
-        cases.push(summarise(case, scene, r));
-        panels.push(Figure1Case {
-            title: match max_steps {
-                Some(m) => format!("{} [QUICK: {m} steps at most]", title(case, scene)),
-                None => title(case, scene),
-            },
-            initial: r.initial.clone(),
-            last: r.last.clone(),
+    let mut titles = Vec::new();
+    let mut runs = Vec::new();
+    for ((case, scene), r) in scenes.iter().zip(results) {
+        cases.push(summarise(case, scene, &r));
+        titles.push(match max_steps {
+            Some(m) => format!("{} [QUICK: {m} steps at most]", title(case, scene)),
+            None => title(case, scene),
         });
+        runs.push(r);
     }
-    draw_figure1(&out.join("figure1.png"), &panels)?;
+    let case_runs: Vec<pictures::CaseRun<'_>> = scenes
+        .iter()
+        .zip(&titles)
+        .zip(&runs)
+        .map(|(((case, _), title), result)| pictures::CaseRun {
+            case,
+            title,
+            result,
+        })
+        .collect();
+    let (pictures, drawing) = figure1_pictures(out, &case_runs, at)?;
+    log::info!("figure 1 pictures drawn in {drawing:.3} s");
     let summary = Figure1Summary {
         states: State::ALL.iter().map(|s| s.name()).collect(),
         cases,
-        claims: claims_of(&scenes, &results),
+        claims: claims_of(&scenes, &runs),
         wall_time_s: wall,
+        drawing_wall_time_s: drawing,
+        pictures,
     };
     write_json(&out.join("figure1.json"), &summary)?;
     Ok(summary)

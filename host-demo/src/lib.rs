@@ -4,8 +4,10 @@
 //! * [`scene`]: TOML scene files parsed and validated into a plain [`scene::Scene`];
 //! * [`output`]: atomic file writes, extended XYZ trajectories (writer and reader),
 //!   CSV and JSON;
-//! * [`reference`]: the Figure 1 runs against a small-dt reference (agreement horizons);
-//! * [`render`]: sphere pictures (side and top views, the Figure 1 layout) and charts;
+//! * [`crate::reference`]: the Figure 1 runs against a small-dt reference (agreement horizons);
+//! * [`render`]: sphere pictures (side and top views, the Figure 1 layout, snapshots,
+//!   GIF animations), state timelines and charts;
+//! * [`pictures`]: the pictures of a run and of Figure 1;
 //! * [`progress`]: a progress bar that stays out of the way of short or piped runs.
 
 pub mod auto;
@@ -14,6 +16,7 @@ pub mod claims;
 pub mod figure1;
 pub mod output;
 pub mod phase;
+pub mod pictures;
 pub mod progress;
 pub mod provenance;
 pub mod reference;

@@ -69,6 +69,17 @@ enum Command {
         /// Smoke run: at most 2000 steps per case.
         #[arg(long)]
         quick: bool,
+        /// Also draw snapshots.png: side views of the cases at these times (comma
+        /// separated, each from 0 to the duration; each drawn at the first step at or
+        /// after it).
+        #[arg(
+            long,
+            value_name = "T1,T2,...",
+            value_delimiter = ',',
+            num_args = 1,
+            allow_negative_numbers = true
+        )]
+        at: Vec<f64>,
     },
     /// Figure 1's trajectories against a reference at a small time step: RMS deviation
     /// over time and agreement horizons of the main job's settings and alternatives.
@@ -149,6 +160,7 @@ fn run(cli: Cli) -> Result<()> {
                 checkpoint: None,
             };
             let r = host_demo::sim::run_from(&scene, &name, Some(&out), opts, start)?;
+            host_demo::pictures::draw_run(&out, &r, true)?;
             report(&name, &r.summary, &out)?;
         }
         Command::Resume {
@@ -161,6 +173,7 @@ fn run(cli: Cli) -> Result<()> {
             let limits = limits(max_storage, max_output);
             let opts = file_run(limits, checkpoint_every);
             let r = host_demo::sim::resume(&dir, until, limits, opts)?;
+            host_demo::pictures::draw_run(&dir, &r, false)?;
             report(&r.summary.scene.clone(), &r.summary, &dir)?;
         }
         Command::Reference { out, dt, quick } => {
@@ -213,8 +226,8 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
         }
-        Command::Figure1 { out, quick } => {
-            let s = host_demo::figure1::figure1(&out, quick.then_some(2000))?;
+        Command::Figure1 { out, quick, at } => {
+            let s = host_demo::figure1::figure1_at(&out, quick.then_some(2000), &at)?;
             println!(
                 "case  D     head   extension verticality twist_rate head_speed outcome          t(ext>=0.95) wall_s"
             );
@@ -246,9 +259,13 @@ fn run(cli: Cli) -> Result<()> {
                     c.verdict.name()
                 );
             }
+            for line in &s.pictures {
+                println!("{line}");
+            }
             println!(
-                "three cases in {:.2} s (parallel); wrote {}/figure1.png and figure1.json",
+                "three cases in {:.2} s (parallel), pictures in {:.3} s; wrote {}/figure1.json",
                 s.wall_time_s,
+                s.drawing_wall_time_s,
                 out.display()
             );
         }
@@ -303,7 +320,7 @@ fn limits(max_storage: f64, max_output: f64) -> Limits {
 }
 
 /// The options of a run from the command line: progress shown, nothing kept in memory.
-fn file_run(limits: Limits, checkpoint_every: Option<f64>) -> RunOptions {
+fn file_run(limits: Limits, checkpoint_every: Option<f64>) -> RunOptions<'static> {
     RunOptions {
         progress: true,
         max_storage: limits.storage,

@@ -17,12 +17,14 @@
 
 mod beads;
 mod checkpoint;
+mod frames;
 mod record;
 mod run_loop;
 mod tail;
 
 pub use beads::{Beads, BuildError, bonds};
 pub use checkpoint::{CHECKPOINT, Checkpoint};
+pub use frames::{KeepFrames, MAX_FRAME_BEADS, MAX_FRAMES, step_at_or_after};
 pub use record::{
     COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
     TRAJECTORY_XYZ,
@@ -168,11 +170,16 @@ pub struct RunResult {
     /// Observables every `output.every` steps (empty unless
     /// [`RunOptions::keep_series`]).
     pub series: Vec<Observables>,
+    /// Configurations at the cadence of [`RunOptions::keep`] (empty by default).
+    pub frames: Vec<Snapshot>,
+    /// Configurations at the times of [`RunOptions::keep`], in the order asked (None
+    /// for a time past the run's last step).
+    pub at: Vec<Option<Snapshot>>,
 }
 
 /// Options of a run.
 #[derive(Debug, Clone, Copy)]
-pub struct RunOptions {
+pub struct RunOptions<'a> {
     /// Show a progress bar (on a terminal, after a second).
     pub progress: bool,
     /// Stop after at most this many steps (smoke runs); None: the whole duration.
@@ -185,9 +192,11 @@ pub struct RunOptions {
     /// Write a checkpoint every this much simulated time (rounded to whole steps), when
     /// the run writes files.
     pub checkpoint_every: Option<f64>,
+    /// Configurations to keep in memory for pictures (none by default).
+    pub keep: KeepFrames<'a>,
 }
 
-impl Default for RunOptions {
+impl Default for RunOptions<'_> {
     fn default() -> Self {
         RunOptions {
             progress: false,
@@ -195,6 +204,7 @@ impl Default for RunOptions {
             max_storage: DEFAULT_LIMIT,
             keep_series: true,
             checkpoint_every: None,
+            keep: KeepFrames::default(),
         }
     }
 }

@@ -9,6 +9,7 @@ use hydrorattle::{Noise, Params, Real, SoftContact, step_slices_thermal};
 use hydrorattle_heap::Buffers;
 
 use super::checkpoint::Checkpoint;
+use super::frames::Keeper;
 use super::record::{NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, each_row};
 use super::tail::TailSlope;
 use super::{
@@ -156,6 +157,8 @@ pub(super) fn run_t<T: Real>(
             (1, o, 0)
         }
     };
+    let mut keeper = Keeper::new(&opts.keep, steps, scene.integrator.dt, beads.len());
+    keeper.take(first - 1, &beads);
     let bar = if opts.progress {
         Progress::new(steps as u64, name)
     } else {
@@ -167,6 +170,7 @@ pub(super) fn run_t<T: Real>(
         match step_slices_thermal(beads.state(), &bonds, &p, &mut ws, &mut ext, &mut noise) {
             Ok(rep) => {
                 done = s;
+                keeper.take(s, &beads);
                 total_iterations += u64::from(rep.iterations);
                 let tw = twist.update(&beads.pos, p.gravity);
                 front.update(&bonds, &beads.pos, p.gravity, cos_vertical, beads.time);
@@ -262,10 +266,13 @@ pub(super) fn run_t<T: Real>(
         ..Summary::for_scene(scene, name)
     };
     rec.commit()?;
+    let (frames, at) = keeper.finish(done, &beads);
     Ok(RunResult {
         summary,
         initial,
         last: snapshot::<T>(&beads.pos, &beads.radius, beads.time),
         series,
+        frames,
+        at,
     })
 }
