@@ -28,23 +28,29 @@ fn state_by_name<S: serde::Serializer>(s: &State, ser: S) -> Result<S::Ok, S::Er
     ser.serialize_str(s.name())
 }
 
-/// The series' states as segments, in time order.
+/// `t` rounded to a nanosecond of simulated time: frame times are sums of time steps,
+/// and `2.0000000000000004` reads as 2 in a file meant for people.
+pub fn tidy(t: f64) -> f64 {
+    (t * 1e9).round() / 1e9
+}
+
+/// The series' states as segments, in time order (times [`tidy`]).
 pub fn segments(series: &[Observables]) -> Vec<Segment> {
     let mut out: Vec<Segment> = Vec::new();
     for o in series {
         match out.last_mut() {
             Some(s) if s.state == o.state.0 => {
-                s.t_end = o.time;
+                s.t_end = tidy(o.time);
                 s.frames += 1;
             }
             last => {
                 if let Some(s) = last {
-                    s.t_end = o.time;
+                    s.t_end = tidy(o.time);
                 }
                 out.push(Segment {
                     state: o.state.0,
-                    t_start: o.time,
-                    t_end: o.time,
+                    t_start: tidy(o.time),
+                    t_end: tidy(o.time),
                     frames: 1,
                 });
             }

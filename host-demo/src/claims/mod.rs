@@ -243,7 +243,7 @@ pub fn claims(runs: &[CaseRun<'_>]) -> Vec<Claim> {
                 case: spec.case.to_string(),
                 claim: spec.words.to_string(),
                 verdict,
-                window,
+                window: window.map(|w| w.map(crate::timeline::tidy)),
                 evidence,
             })
         })
