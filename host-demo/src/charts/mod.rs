@@ -111,8 +111,15 @@ fn rms(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     (s / a.len() as f64).sqrt()
 }
 
+/// Figure 1 (a) with the soft contact (stiffness 1000) the charts compare every method
+/// under: hard contacts are for the overdamped methods only, and each chart sets its
+/// own method and step.
 fn base_scene() -> Result<Scene> {
-    Ok(Scene::figure1()?.remove(0).1)
+    let mut s = Scene::figure1()?.remove(0).1;
+    s.contact = Some(crate::scene::Contact::Soft { stiffness: 1000.0 });
+    s.integrator.method = crate::scene::Method::Overdamped;
+    s.integrator.dt = 0.005;
+    Ok(s)
 }
 
 fn setup<T: Real>(scene: &Scene, method: Method, dt: f64, st: f64) -> Setup<T> {
