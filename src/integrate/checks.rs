@@ -1,0 +1,185 @@
+//! The first and third stages of a step: checking the inputs (parameters, particles,
+//! bonds, thermal noise, contacts) before anything is touched, and accepting the
+//! candidate state before it is committed.
+
+use crate::bonds::Bond;
+use crate::constraints::Solver;
+use crate::error::{ParticleError, StepError};
+use crate::params::{Method, Params};
+use crate::particles::{State, sphere_volume};
+use crate::real::Real;
+
+/// The thermal settings when this step has noise (`brownian` with `kT > 0`), after
+/// checking that the temperature is valid and the combination is implemented.
+pub(super) fn check_thermal<T: Real>(
+    p: &Params<T>,
+    has_generator: bool,
+) -> Result<Option<crate::params::Brownian<T>>, StepError> {
+    let Some(b) = p.brownian else {
+        return Ok(None);
+    };
+    if !(b.temperature >= T::ZERO && b.temperature.is_finite()) {
+        return Err(StepError::BadParameter(
+            "brownian.temperature (finite, >= 0)",
+        ));
+    }
+    if b.temperature == T::ZERO {
+        return Ok(None);
+    }
+    if p.method != Method::Overdamped {
+        return Err(StepError::Unsupported(
+            "thermal noise with a method other than Overdamped",
+        ));
+    }
+    if p.matrix_free {
+        return Err(StepError::Unsupported(
+            "thermal noise without a stored mobility (matrix_free: no Lanczos square root)",
+        ));
+    }
+    if !has_generator {
+        return Err(StepError::Unsupported(
+            "thermal noise without a generator (call step_thermal / step_slices_thermal)",
+        ));
+    }
+    Ok(Some(b))
+}
+
+/// The parameters a step runs with: as given, or with contacts the solver resolved for
+/// the bonds plus the contact capacity (so that the storage and the solver agree however
+/// many contacts a step holds). Refuses contacts where they are not implemented.
+pub(super) fn check_contacts<T: Real>(
+    p: &Params<T>,
+    bonds: usize,
+    thermal: bool,
+) -> Result<Params<T>, StepError> {
+    let Some(c) = p.contacts else {
+        return Ok(*p);
+    };
+    if !matches!(p.method, Method::Overdamped | Method::Overdamped2) {
+        return Err(StepError::Unsupported(
+            "contacts with a method other than Overdamped or Overdamped2",
+        ));
+    }
+    if thermal {
+        return Err(StepError::Unsupported("contacts with thermal noise"));
+    }
+    if c.max_rounds == 0 {
+        return Err(StepError::BadParameter("contacts.max_rounds (> 0)"));
+    }
+    let mut q = *p;
+    q.solver.kind = p.solver.kind.resolve(p.constraints(bonds));
+    Ok(q)
+}
+
+/// Cheap checks (O(N + B)); pair checks happen in assembly and in [`accept`].
+pub(super) fn check_inputs<T: Real>(
+    state: &State<'_, T>,
+    bonds: &[Bond<T>],
+    p: &Params<T>,
+) -> Result<(), StepError> {
+    let n = state.len();
+    let lengths = [
+        state.vel.len(),
+        state.omega.len(),
+        state.radius.len(),
+        state.density.len(),
+    ];
+    if lengths.iter().any(|&l| l != n) {
+        return Err(StepError::StateLength);
+    }
+    if !(p.dt > T::ZERO && p.dt.is_finite()) {
+        return Err(StepError::BadTimeStep);
+    }
+    let bad = |ok: bool, name| {
+        if ok {
+            Ok(())
+        } else {
+            Err(StepError::BadParameter(name))
+        }
+    };
+    bad(
+        p.viscosity > T::ZERO && p.viscosity.is_finite(),
+        "viscosity",
+    )?;
+    bad(p.fluid_density.is_finite(), "fluid_density")?;
+    bad(T::v3_is_finite(p.gravity), "gravity")?;
+    bad(T::v3_is_finite(p.flow_velocity), "flow_velocity")?;
+    bad(T::v3_is_finite(p.vorticity), "vorticity")?;
+    bad(
+        p.solver.tolerance >= Solver::min_tolerance() && p.solver.tolerance.is_finite(),
+        "tolerance (at least 16 machine epsilons, finite)",
+    )?;
+    // Time must stay finite and advance (a huge time would swallow dt).
+    bad(
+        state.time.is_finite()
+            && *state.time + p.dt > *state.time
+            && (*state.time + p.dt).is_finite(),
+        "time (finite, and advanced by dt)",
+    )?;
+    bad(p.solver.max_iterations > 0, "max_iterations")?;
+    bad(
+        !p.matrix_free || matches!(p.method, Method::Overdamped | Method::Springs),
+        "matrix_free (Overdamped and Springs only)",
+    )?;
+    if p.method == Method::Springs {
+        bad(
+            p.spring_stiffness > T::ZERO && p.spring_stiffness.is_finite(),
+            "spring_stiffness",
+        )?;
+    }
+    let inertial = matches!(p.method, Method::Rattle | Method::RattleStable);
+    for i in 0..n {
+        let finite = T::v3_is_finite(state.pos[i])
+            && T::v3_is_finite(state.vel[i])
+            && T::v3_is_finite(state.omega[i])
+            && state.radius[i].is_finite()
+            && state.density[i].is_finite();
+        if !finite {
+            return Err(ParticleError::NonFinite { particle: i }.into());
+        }
+        if state.radius[i] <= T::ZERO {
+            return Err(ParticleError::BadRadius { particle: i }.into());
+        }
+        if state.density[i] < T::ZERO {
+            return Err(ParticleError::BadDensity { particle: i }.into());
+        }
+        if inertial && sphere_volume(state.radius[i]) * state.density[i] <= T::ZERO {
+            return Err(ParticleError::Massless { particle: i }.into());
+        }
+    }
+    for (bond, b) in bonds.iter().enumerate() {
+        crate::bonds::check_one(bond, b, n)?;
+    }
+    Ok(())
+}
+
+/// Finite, no nested spheres, no overlap unless allowed (squared distances: no sqrt).
+/// With contacts, spheres touch to within the solver's tolerance, which is accepted.
+pub(super) fn accept<T: Real>(
+    pos: &[T::V3],
+    vel: &[T::V3],
+    omega: &[T::V3],
+    radius: &[T],
+    p: &Params<T>,
+) -> Result<(), StepError> {
+    let allow_overlap = p.allow_overlap;
+    let reach = match p.contacts {
+        Some(_) => T::ONE - p.solver.tolerance * T::TWO,
+        None => T::ONE,
+    };
+    for i in 0..pos.len() {
+        if !(T::v3_is_finite(pos[i]) && T::v3_is_finite(vel[i]) && T::v3_is_finite(omega[i])) {
+            return Err(StepError::NonFinite { particle: i });
+        }
+    }
+    for i in 0..pos.len() {
+        for j in i + 1..pos.len() {
+            let s2 = T::norm2(pos[i] - pos[j]);
+            let (dif, sum) = (radius[i] - radius[j], (radius[i] + radius[j]) * reach);
+            if s2 <= dif * dif || (!allow_overlap && s2 < sum * sum) {
+                return Err(StepError::Overlap { i, j });
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,230 @@
+//! Stages the integrators share: the mobility product and the constraint metric, bond
+//! vectors, flow, constraint forces, spins, the position projection (with or without
+//! hard contacts) and the report.
+
+use super::StepReport;
+use super::contacts;
+use crate::bonds::Bond;
+use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind};
+use crate::error::{ParticleError, StepError};
+use crate::linalg;
+use crate::mobility::{self, Hydro};
+use crate::params::Params;
+use crate::real::Real;
+
+/// `u = mu_tt(pos) f`: from the assembled mobility in `mu`, or matrix-free (then `mu`
+/// is empty and nothing is stored).
+pub(super) fn mobility_product<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    mu: &mut [T::M3],
+    f: &[T::V3],
+    u: &mut [T::V3],
+) -> Result<(), StepError> {
+    if p.matrix_free {
+        return mobility::tt_product(p.hydro, p.viscosity, pos, radius, f, u)
+            .map_err(StepError::from);
+    }
+    assemble_tt(p, pos, radius, mu)?;
+    linalg::sym_matvec::<T>(mu, pos.len(), f, u);
+    Ok(())
+}
+
+/// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`: matrix-free when asked;
+/// read from the packed mobility where it is used for Krylov (one product per
+/// iteration, no table); tabulated once into `disp` (`n x B`) for the dense solvers,
+/// which read every `D_l(p)` at every iteration.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn mobility_metric<'a, T: Real>(
+    p: &Params<T>,
+    bonds: &[Bond<T>],
+    pos: &'a [T::V3],
+    radius: &'a [T],
+    mu: &'a [T::M3],
+    grad: &'a [T::V3],
+    scale: T,
+    disp: &'a mut [T::V3],
+) -> Metric<'a, T> {
+    if p.matrix_free {
+        return Metric::Free {
+            level: p.hydro,
+            eta: p.viscosity,
+            pos,
+            radius,
+            grad,
+            scale,
+        };
+    }
+    if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
+        return Metric::Mobility { mu, grad, scale };
+    }
+    let n = pos.len();
+    constraints::tabulate(mu, bonds, grad, scale, n, disp);
+    Metric::Dense { disp, n, grad }
+}
+
+pub(super) fn assemble_tt<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    mu: &mut [T::M3],
+) -> Result<(), StepError> {
+    mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
+}
+
+/// `g_l = r_i - r_j` for every bond.
+pub(super) fn bond_vectors<T: Real>(bonds: &[Bond<T>], pos: &[T::V3], out: &mut [T::V3]) {
+    for (g, b) in out.iter_mut().zip(bonds) {
+        *g = pos[b.i] - pos[b.j];
+    }
+}
+
+/// `u_i += U_inf(r_i)`.
+pub(super) fn add_flow<T: Real>(p: &Params<T>, pos: &[T::V3], u: &mut [T::V3]) {
+    for (ui, &r) in u.iter_mut().zip(pos) {
+        *ui += p.flow_at(r);
+    }
+}
+
+/// Largest `|lambda_k| d_k`.
+pub(super) fn max_tension<T: Real>(bonds: &[Bond<T>], lambda: &[T]) -> T {
+    bonds
+        .iter()
+        .zip(lambda)
+        .fold(T::ZERO, |m, (b, &l)| m.max((l * b.length).abs()))
+}
+
+/// `f_i += sum_l lambda_l (+-g_l)`: the constraint forces.
+pub(super) fn add_constraint_forces<T: Real>(
+    bonds: &[Bond<T>],
+    grad: &[T::V3],
+    lambda: &[T],
+    f: &mut [T::V3],
+) {
+    for (l, b) in bonds.iter().enumerate() {
+        f[b.i] += grad[l] * lambda[l];
+        f[b.j] -= grad[l] * lambda[l];
+    }
+}
+
+/// Angular velocities of torque-free spheres: `W_i = Omega_inf + sum_j rt_ij f_j`, with
+/// `f` the force each sphere exerts on the fluid; `Omega_inf` alone when not resolved.
+pub(super) fn spin<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    f: &[T::V3],
+    out: &mut [T::V3],
+) -> Result<(), StepError> {
+    out.fill(p.vorticity);
+    if !p.rotation || p.hydro == Hydro::FreeDraining {
+        return Ok(());
+    }
+    for i in 0..pos.len() {
+        for j in 0..i {
+            let b =
+                mobility::pair_blocks(p.hydro, p.viscosity, radius[i], radius[j], pos[i] - pos[j])
+                    .ok_or(StepError::Particle(ParticleError::Nested { i: j, j: i }))?;
+            out[i] += b.rt_ij * f[j];
+            out[j] += b.rt_ji * f[i];
+        }
+    }
+    Ok(())
+}
+
+/// Projects `x` onto the bonds along `metric`; the multipliers start from zero and end
+/// in `lambda`.
+pub(super) fn project_positions<T: Real>(
+    p: &Params<T>,
+    bonds: &[Bond<T>],
+    metric: &Metric<'_, T>,
+    x: &mut [T::V3],
+    lambda: &mut [T],
+    scratch: &mut Scratch<'_, T>,
+) -> Result<SolveStats<T>, StepError> {
+    lambda.fill(T::ZERO);
+    constraints::solve(
+        Problem::Positions,
+        metric,
+        bonds,
+        &p.solver,
+        x,
+        lambda,
+        scratch,
+    )
+}
+
+/// `v = (x' - x) / dt`.
+pub(super) fn step_velocity<T: Real>(start: &[T::V3], end: &[T::V3], dt: T, v: &mut [T::V3]) {
+    for ((v, &a), &b) in v.iter_mut().zip(start).zip(end) {
+        *v = (b - a) / dt;
+    }
+}
+
+pub(super) fn report<T: Real>(
+    stats: SolveStats<T>,
+    velocity_iterations: u32,
+    bonds: &[Bond<T>],
+    lambda: &[T],
+) -> StepReport<T> {
+    StepReport {
+        iterations: stats.iterations,
+        velocity_iterations,
+        residual: stats.residual,
+        max_tension: max_tension(bonds, lambda),
+        contacts: 0,
+        contact_rounds: 0,
+    }
+}
+
+/// The slices the overdamped position projection works in.
+pub(super) struct Projection<'l, 'v, 'a, T: Real> {
+    pub links: &'l mut [Bond<T>],
+    pub grad: &'v mut [T::V3],
+    pub disp: &'v mut [T::V3],
+    pub lambda: &'v mut [T],
+    pub scratch: &'v mut Scratch<'a, T>,
+}
+
+/// What the overdamped position projection did.
+pub(super) struct Projected<'l, T: Real> {
+    /// The solve (of the last active-set round with contacts).
+    pub stats: SolveStats<T>,
+    /// The constraints held: the bonds, then the contacts (rows of `grad`, `lambda`).
+    pub held: &'l [Bond<T>],
+    /// Contacts held (0 without contacts).
+    pub contacts: u32,
+    /// Active-set rounds (0 without contacts).
+    pub rounds: u32,
+}
+
+/// The overdamped position projection along the mobility at `start` (`mu`, scaled by
+/// `dt`): `free` writes the unconstrained move into `x`, which is then projected onto
+/// the bonds, or onto the bonds and the hard-sphere contacts when [`Params::contacts`]
+/// is on.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn project_overdamped<'l, T: Real>(
+    p: &Params<T>,
+    bonds: &'l [Bond<T>],
+    start: &[T::V3],
+    radius: &[T],
+    mu: &[T::M3],
+    v: Projection<'l, '_, '_, T>,
+    x: &mut [T::V3],
+    free: impl Fn(&mut [T::V3]),
+) -> Result<Projected<'l, T>, StepError> {
+    let Some(c) = p.contacts else {
+        bond_vectors(bonds, start, v.grad);
+        let metric = mobility_metric(p, bonds, start, radius, mu, v.grad, p.dt, v.disp);
+        free(x);
+        let stats = project_positions(p, bonds, &metric, x, v.lambda, v.scratch)?;
+        return Ok(Projected {
+            stats,
+            held: bonds,
+            contacts: 0,
+            rounds: 0,
+        });
+    };
+    contacts::project_with_contacts(p, c, bonds, start, radius, mu, p.dt, v, x, free)
+}
