@@ -44,17 +44,16 @@ pub(super) fn check_thermal<T: Real>(
     Ok(Some(b))
 }
 
-/// The parameters a step runs with: as given, or with contacts the solver resolved for
-/// the bonds plus the contact capacity (so that the storage and the solver agree however
-/// many contacts a step holds). Refuses contacts where they are not implemented.
-pub(super) fn check_contacts<T: Real>(
-    p: &Params<T>,
-    bonds: usize,
-    thermal: bool,
-) -> Result<Params<T>, StepError> {
+/// Refuses contacts where they are not implemented.
+pub(super) fn check_contacts<T: Real>(p: &Params<T>, thermal: bool) -> Result<(), StepError> {
     let Some(c) = p.contacts else {
-        return Ok(*p);
+        return Ok(());
     };
+    if !cfg!(feature = "contacts") {
+        return Err(StepError::Unsupported(
+            "contacts: the kernel was built without its `contacts` feature",
+        ));
+    }
     if !matches!(p.method, Method::Overdamped | Method::Overdamped2) {
         return Err(StepError::Unsupported(
             "contacts with a method other than Overdamped or Overdamped2",
@@ -66,9 +65,7 @@ pub(super) fn check_contacts<T: Real>(
     if c.max_rounds == 0 {
         return Err(StepError::BadParameter("contacts.max_rounds (> 0)"));
     }
-    let mut q = *p;
-    q.solver.kind = p.solver.kind.resolve(p.constraints(bonds));
-    Ok(q)
+    Ok(())
 }
 
 /// Cheap checks (O(N + B)); pair checks happen in assembly and in [`accept`].

@@ -22,17 +22,23 @@
 
 use super::{Projected, Projection, bond_vectors, mobility_metric, project_positions};
 use crate::bonds::Bond;
+use crate::constraints::Solver;
 use crate::error::{Stage, StepError};
 use crate::params::{Contacts, Params};
 use crate::real::Real;
 
-/// Projects `x` onto the bonds and the contacts along the hydrodynamic metric at
-/// `start` (`mu` holds the mobility there, `scale` the time step). `free` writes the
-/// unconstrained move into `x` (called once per round).
+/// Projects `x` onto the bonds, and the contacts when `contacts` is on, along the
+/// hydrodynamic metric at `start` (`mu` holds the mobility there, `scale` the time
+/// step). `free` writes the unconstrained move into `x` (once per round).
+///
+/// Without contacts this is one round over the caller's bonds. Both cases share the
+/// one call of the constraint solve: a second call site would stop the compiler from
+/// inlining it where the parameters are a constant (firmware), and every solver would
+/// be linked.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn project_with_contacts<'l, T: Real>(
+pub(super) fn project<'l, T: Real>(
     p: &Params<T>,
-    c: Contacts,
+    contacts: Option<Contacts>,
     bonds: &'l [Bond<T>],
     start: &[T::V3],
     radius: &[T],
@@ -49,29 +55,61 @@ pub(super) fn project_with_contacts<'l, T: Real>(
         lambda,
         scratch,
     } = v;
+    // A constant without the `contacts` feature: the contact path folds away.
+    let contacts = contacts.filter(|_| cfg!(feature = "contacts"));
+    // With contacts the solver is resolved once for the bonds plus the capacity, as the
+    // storage was ([`Layout::for_params`](crate::Layout::for_params)), however many
+    // contacts a round holds.
+    let resolved;
+    let p = match contacts {
+        Some(c) => {
+            resolved = Params {
+                solver: Solver {
+                    kind: p.solver.kind.resolve(bonds.len() + c.capacity),
+                    ..p.solver
+                },
+                ..*p
+            };
+            &resolved
+        }
+        None => p,
+    };
     let nb = bonds.len();
-    links[..nb].copy_from_slice(bonds);
     let tol = p.solver.tolerance;
-    // The last step's contacts end within the tolerance of touching.
     let mut nc = 0;
-    add_pairs(
-        bonds,
-        start,
-        start,
-        radius,
-        T::ONE + tol * T::TWO,
-        c,
-        links,
-        &mut nc,
-    )?;
+    if let Some(c) = contacts {
+        links[..nb].copy_from_slice(bonds);
+        // The last step's contacts end within the tolerance of touching.
+        add_pairs(
+            bonds,
+            start,
+            start,
+            radius,
+            T::ONE + tol * T::TWO,
+            c,
+            links,
+            &mut nc,
+        )?;
+    }
     let mut round = 0;
     loop {
         round += 1;
-        let active = &links[..nb + nc];
+        let active = match contacts {
+            Some(_) => &links[..nb + nc],
+            None => bonds,
+        };
         bond_vectors(active, start, grad);
         let metric = mobility_metric(p, active, start, radius, mu, grad, scale, disp);
         free(x);
         let stats = project_positions(p, active, &metric, x, lambda, scratch)?;
+        let Some(c) = contacts else {
+            return Ok(Projected {
+                stats,
+                held: bonds,
+                contacts: 0,
+                rounds: 0,
+            });
+        };
         let added = add_pairs(bonds, start, x, radius, T::ONE - tol, c, links, &mut nc)?;
         if added == 0 && !release_pulling(nb, links, lambda, &mut nc) {
             // Every contact must end on the side it started from.

@@ -202,7 +202,7 @@ pub(super) struct Projected<'l, T: Real> {
 /// The overdamped position projection along the mobility at `start` (`mu`, scaled by
 /// `dt`): `free` writes the unconstrained move into `x`, which is then projected onto
 /// the bonds, or onto the bonds and the hard-sphere contacts when [`Params::contacts`]
-/// is on.
+/// is on (`contacts.rs`).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn project_overdamped<'l, T: Real>(
     p: &Params<T>,
@@ -214,17 +214,5 @@ pub(super) fn project_overdamped<'l, T: Real>(
     x: &mut [T::V3],
     free: impl Fn(&mut [T::V3]),
 ) -> Result<Projected<'l, T>, StepError> {
-    let Some(c) = p.contacts else {
-        bond_vectors(bonds, start, v.grad);
-        let metric = mobility_metric(p, bonds, start, radius, mu, v.grad, p.dt, v.disp);
-        free(x);
-        let stats = project_positions(p, bonds, &metric, x, v.lambda, v.scratch)?;
-        return Ok(Projected {
-            stats,
-            held: bonds,
-            contacts: 0,
-            rounds: 0,
-        });
-    };
-    contacts::project_with_contacts(p, c, bonds, start, radius, mu, p.dt, v, x, free)
+    contacts::project(p, p.contacts, bonds, start, radius, mu, p.dt, v, x, free)
 }
