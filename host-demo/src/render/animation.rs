@@ -16,8 +16,8 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 
 use super::{
-    FONT, HEAD_COLOR, LAST_COLOR, OUTLINE_COLOR, RULER_COLOR, RULER_TEXT, Snapshot, TAIL_COLOR,
-    View, draw_panel_ruled, drawing, fit_scale,
+    FONT, HEAD_COLOR, LAST_COLOR, OUTLINE_COLOR, Snapshot, TAIL_COLOR, View, draw_panel, drawing,
+    fit_scale,
 };
 
 /// Palette index of "unchanged since the previous frame".
@@ -61,8 +61,6 @@ fn palette() -> &'static (Vec<u8>, Vec<u8>) {
             rgb(TAIL_COLOR),
             rgb(LAST_COLOR),
             [190, 190, 190],
-            rgb(RULER_COLOR),
-            rgb(RULER_TEXT),
         ];
         let mix = |a: [u8; 3], b: [u8; 3], t: f64| -> [u8; 3] {
             std::array::from_fn(|c| {
@@ -129,7 +127,7 @@ fn frame_indices(a: &Animation<'_>, snapshot: &Snapshot, scale: f64) -> Result<V
     let mut rgb = vec![255u8; w as usize * h as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-        draw_panel_ruled(&root, snapshot, a.colors, View::Side, scale, "", 1.0, false)?;
+        draw_panel(&root, snapshot, a.colors, View::Side, scale, "", 1.0)?;
         // The time, centred over the spheres: the pixels that change from frame to
         // frame stay in one narrow column (small frames, fast encoding).
         let stamp = format!("{}  t = {:.1}", a.title, snapshot.time);

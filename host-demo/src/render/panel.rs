@@ -52,11 +52,6 @@ pub fn extent(snapshot: &Snapshot, view: View) -> (f64, f64, f64, f64) {
     if b.0 > b.2 { (0.0, 0.0, 0.0, 0.0) } else { b }
 }
 
-/// Level lines of a ruled panel.
-pub const RULER_COLOR: RGBColor = RGBColor(222, 222, 222);
-/// Labels of the level lines.
-pub const RULER_TEXT: RGBColor = RGBColor(130, 130, 130);
-
 /// Height kept at the top of a sphere panel for its title (output pixels).
 const PANEL_TITLE: f64 = 22.0;
 /// Height kept at the bottom of a sphere panel for the scale bar (output pixels).
@@ -79,6 +74,10 @@ pub fn fit_scale(items: &[(&Snapshot, View)], size: (u32, u32)) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Spheres beyond this many are drawn without outlines (a big scene stays fast and
+/// readable).
+pub const OUTLINE_MAX: usize = 2000;
+
 /// Draws one sphere panel: the spheres of `snapshot` in `view` at `scale` output
 /// pixels per length unit, centred on their bounding box, under `title`, with a scale
 /// bar (lengths in tail radii `a`) and, in side views, an arrow for gravity (`-z`).
@@ -92,27 +91,6 @@ pub fn draw_panel<DB: DrawingBackend>(
     scale: f64,
     title: &str,
     k: f64,
-) -> Result<()> {
-    draw_panel_ruled(area, snapshot, colors, view, scale, title, k, false)
-}
-
-/// Spheres beyond this many are drawn without outlines (a big scene stays fast and
-/// readable).
-pub const OUTLINE_MAX: usize = 2000;
-
-/// [`draw_panel`], with `ruler`: faint level lines across the panel at fixed heights
-/// (screen-up coordinate, labelled on the left), so that motion shows even though the
-/// panel follows the spheres.
-#[allow(clippy::too_many_arguments)]
-pub fn draw_panel_ruled<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    snapshot: &Snapshot,
-    colors: &[RGBColor],
-    view: View,
-    scale: f64,
-    title: &str,
-    k: f64,
-    ruler: bool,
 ) -> Result<()> {
     let (w, h) = area.dim_in_pixel();
     let (w, h) = (f64::from(w) / k, f64::from(h) / k);
@@ -134,25 +112,6 @@ pub fn draw_panel_ruled<DB: DrawingBackend>(
     let b = extent(snapshot, view);
     let (uc, vc) = (0.5 * (b.0 + b.2), 0.5 * (b.1 + b.3));
     let (xc, yc) = (0.5 * w, PANEL_TITLE + 0.5 * (h - PANEL_TITLE - PANEL_FOOT));
-    if ruler {
-        let step = nice_length(0.25 * h / scale);
-        let axis = if view == View::Side { "z" } else { "y" };
-        let lowest = vc - (h - yc) / scale;
-        let mut level = (lowest / step).floor() * step;
-        while level <= vc + yc / scale {
-            let y = yc - (level - vc) * scale;
-            if y > PANEL_TITLE + 4.0 && y < h - PANEL_FOOT {
-                let line = vec![(px(k, 1.0), px(k, y)), (px(k, w - 2.0), px(k, y))];
-                area.draw(&PathElement::new(line, thin(RULER_COLOR)))
-                    .map_err(drawing)?;
-                let label = format!("{axis} = {}", short(level));
-                let style = (FONT, 11.0 * k).into_font().color(&RULER_TEXT);
-                area.draw(&Text::new(label, (px(k, 3.0), px(k, y - 12.0)), style))
-                    .map_err(drawing)?;
-            }
-            level += step;
-        }
-    }
     let outline = snapshot.positions.len() <= OUTLINE_MAX;
     let mut order: Vec<usize> = (0..snapshot.positions.len()).collect();
     let nearness = |i: usize| view.project(snapshot.positions[i]).2;
