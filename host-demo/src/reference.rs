@@ -13,11 +13,12 @@ use anyhow::{Result, bail};
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::charts::rms;
 use crate::claims::{CaseRun, Verdict, claims};
-use crate::output::{read_xyz_file, write_json};
-use crate::render::{LineChart, Series, line_chart};
+use crate::output::write_json;
+use crate::render::{LineChart, Series, Snapshot, line_chart};
 use crate::scene::{Method, Scene};
-use crate::sim::{RunOptions, RunResult, TRAJECTORY_XYZ, run};
+use crate::sim::{KeepFrames, RunOptions, RunResult, run};
 
 /// Time between compared frames (every variant writes a frame this often).
 const FRAME_DT: f64 = 2.0;
@@ -128,34 +129,19 @@ fn as_variant(scene: &Scene, v: Variant) -> Scene {
     s
 }
 
-/// Frames of a trajectory written by a run: `(time, centres)`.
-fn read_frames(path: &Path) -> Result<Vec<(f64, Vec<[f64; 3]>)>> {
-    let frames = read_xyz_file(path)?;
-    Ok(frames.into_iter().map(|f| (f.time, f.positions)).collect())
-}
-
-/// RMS distance between matching centres.
-fn rms(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    let sum: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>())
-        .sum();
-    (sum / a.len().max(1) as f64).sqrt()
-}
-
 /// Deviation at the frame times both runs share (to a millionth of a time unit).
-fn deviation(
-    reference: &[(f64, Vec<[f64; 3]>)],
-    other: &[(f64, Vec<[f64; 3]>)],
-) -> Vec<(f64, f64)> {
+fn deviation(reference: &[Snapshot], other: &[Snapshot]) -> Vec<(f64, f64)> {
     let key = |t: f64| (t * 1e6).round() as i64;
-    let at: std::collections::BTreeMap<i64, &Vec<[f64; 3]>> =
-        other.iter().map(|(t, p)| (key(*t), p)).collect();
+    let at: std::collections::BTreeMap<i64, &Snapshot> =
+        other.iter().map(|f| (key(f.time), f)).collect();
     // Times are sums of time steps: report them rounded to a millionth.
     reference
         .iter()
-        .filter_map(|(t, p)| at.get(&key(*t)).map(|q| (key(*t) as f64 * 1e-6, rms(p, q))))
+        .filter_map(|f| {
+            let t = key(f.time);
+            at.get(&t)
+                .map(|g| (t as f64 * 1e-6, rms(&f.positions, &g.positions)))
+        })
         .collect()
 }
 
@@ -178,11 +164,8 @@ pub fn reference(
     }
     std::fs::create_dir_all(out)?;
     let scenes = Scene::figure1()?;
-    let opts = RunOptions {
-        max_steps,
-        ..RunOptions::default()
-    };
-    // Every run of every case, in parallel: the reference first, then the variants.
+    // Every run of every case, in parallel: per case the reference first, then the
+    // variants. Each keeps its frames (every FRAME_DT) in memory.
     let mut jobs = Vec::new();
     for (case, scene) in &scenes {
         let refv = Variant {
@@ -190,50 +173,44 @@ pub fn reference(
             method: scene.integrator.method,
             dt: reference_dt,
         };
-        jobs.push((case.to_string(), refv, as_variant(scene, refv)));
-        for v in variants(scene) {
-            jobs.push((case.to_string(), v, as_variant(scene, v)));
+        for v in std::iter::once(refv).chain(variants(scene)) {
+            jobs.push((*case, v, as_variant(scene, v)));
         }
     }
-    let done: Vec<Result<RunResult>> = jobs
-        .par_iter()
-        .enumerate()
-        .map(|(k, (case, _, s))| run(s, case, Some(&out.join(case).join(format!("{k:02}"))), opts))
-        .collect();
     let done: Vec<(&str, Variant, RunResult)> = jobs
-        .iter()
-        .zip(done)
-        .map(|((case, v, _), r)| r.map(|r| (case.as_str(), *v, r)))
+        .par_iter()
+        .map(|(case, v, s)| {
+            let opts = RunOptions {
+                max_steps,
+                keep: KeepFrames {
+                    every: Some(s.output.every),
+                    at: &[],
+                },
+                ..RunOptions::default()
+            };
+            run(s, case, None, opts).map(|r| (*case, *v, r))
+        })
         .collect::<Result<_>>()?;
     let mut cases = Vec::new();
     for (case, _) in &scenes {
-        let mut rows = Vec::new();
-        for (k, (c, v, r)) in done.iter().enumerate() {
-            if c == case {
-                let dir = out.join(case).join(format!("{k:02}"));
-                let frames = read_frames(&dir.join(TRAJECTORY_XYZ))?;
-                let s = &r.summary;
-                rows.push((*v, s.outcome.clone(), s.wall_time_s, frames));
-            }
-        }
-        let (refv, ref_outcome, _, ref_frames) = rows.remove(0);
-        let variants = rows
-            .into_iter()
-            .map(|(variant, outcome, wall_time_s, frames)| {
-                let dev = deviation(&ref_frames, &frames);
+        let mut runs = done.iter().filter(|(c, ..)| c == case);
+        let (_, refv, reference) = runs.next().expect("the reference runs first");
+        let variants = runs
+            .map(|(_, variant, r)| {
+                let dev = deviation(&reference.frames, &r.frames);
                 Comparison {
-                    variant,
+                    variant: *variant,
                     horizons: horizons(&dev),
                     deviation: dev,
-                    outcome,
-                    wall_time_s,
+                    outcome: r.summary.outcome.clone(),
+                    wall_time_s: r.summary.wall_time_s,
                 }
             })
             .collect();
         cases.push(CaseReference {
             case: case.to_string(),
-            reference: refv,
-            reference_outcome: ref_outcome,
+            reference: *refv,
+            reference_outcome: reference.summary.outcome.clone(),
             variants,
         });
     }

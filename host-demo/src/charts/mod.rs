@@ -102,7 +102,8 @@ fn simulate<T: Real>(
     Ok(o)
 }
 
-fn rms(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+/// RMS distance between matching centres of two configurations.
+pub(crate) fn rms(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     let s: f64 = a
         .iter()
         .zip(b)
@@ -116,9 +117,8 @@ fn rms(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
 /// own method and step.
 fn base_scene() -> Result<Scene> {
     let mut s = Scene::figure1()?.remove(0).1;
-    s.contact = Some(crate::scene::Contact::Soft { stiffness: 1000.0 });
+    s.with_soft_contact();
     s.integrator.method = crate::scene::Method::Overdamped;
-    s.integrator.dt = 0.005;
     Ok(s)
 }
 
