@@ -1,5 +1,5 @@
-//! Hard-sphere contacts as one-sided constraints inside the position projection
-//! ([`Params::contacts`]).
+//! The overdamped position projection, and the hard-sphere contacts it holds as
+//! one-sided constraints ([`Params::contacts`]).
 //!
 //! A contact is a link `(i, j)` of length `a_i + a_j` solved with the bonds, through the
 //! same metric (the start-of-step mobility) and the same solver. Which pairs are in
@@ -20,30 +20,51 @@
 //! that a pair would end in contact on the far side of where it started is refused
 //! ([`StepError::Degenerate`], indexed past the bonds), as a bond turned too far is.
 
-use super::{Projected, Projection, bond_vectors, mobility_metric, project_positions};
+use super::{bond_vectors, mobility_metric, project_positions};
 use crate::bonds::Bond;
 use crate::constraints::Solver;
+use crate::constraints::{Scratch, SolveStats};
 use crate::error::{Stage, StepError};
 use crate::params::{Contacts, Params};
 use crate::real::Real;
 
-/// Projects `x` onto the bonds, and the contacts when `contacts` is on, along the
-/// hydrodynamic metric at `start` (`mu` holds the mobility there, `scale` the time
-/// step). `free` writes the unconstrained move into `x` (once per round).
+/// The slices the overdamped position projection works in.
+pub(super) struct Projection<'l, 'v, 'a, T: Real> {
+    pub links: &'l mut [Bond<T>],
+    pub grad: &'v mut [T::V3],
+    pub disp: &'v mut [T::V3],
+    pub lambda: &'v mut [T],
+    pub scratch: &'v mut Scratch<'a, T>,
+}
+
+/// What the overdamped position projection did.
+pub(super) struct Projected<'l, T: Real> {
+    /// The solve (of the last active-set round with contacts).
+    pub stats: SolveStats<T>,
+    /// The constraints held: the bonds, then the contacts (rows of `grad`, `lambda`).
+    pub held: &'l [Bond<T>],
+    /// Contacts held (0 without contacts).
+    pub contacts: u32,
+    /// Active-set rounds (0 without contacts).
+    pub rounds: u32,
+}
+
+/// The overdamped position projection along the mobility at `start` (`mu`, scaled by
+/// `dt`): `free` writes the unconstrained move into `x` (once per round), which is then
+/// projected onto the bonds, or onto the bonds and the hard-sphere contacts when
+/// [`Params::contacts`] is on.
 ///
 /// Without contacts this is one round over the caller's bonds. Both cases share the
 /// one call of the constraint solve: a second call site would stop the compiler from
 /// inlining it where the parameters are a constant (firmware), and every solver would
 /// be linked.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn project<'l, T: Real>(
+pub(super) fn project_overdamped<'l, T: Real>(
     p: &Params<T>,
-    contacts: Option<Contacts>,
     bonds: &'l [Bond<T>],
     start: &[T::V3],
     radius: &[T],
     mu: &[T::M3],
-    scale: T,
     v: Projection<'l, '_, '_, T>,
     x: &mut [T::V3],
     free: impl Fn(&mut [T::V3]),
@@ -56,7 +77,7 @@ pub(super) fn project<'l, T: Real>(
         scratch,
     } = v;
     // A constant without the `contacts` feature: the contact path folds away.
-    let contacts = contacts.filter(|_| cfg!(feature = "contacts"));
+    let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
     // With contacts the solver is resolved once for the bonds plus the capacity, as the
     // storage was ([`Layout::for_params`](crate::Layout::for_params)), however many
     // contacts a round holds.
@@ -99,7 +120,7 @@ pub(super) fn project<'l, T: Real>(
             None => bonds,
         };
         bond_vectors(active, start, grad);
-        let metric = mobility_metric(p, active, start, radius, mu, grad, scale, disp);
+        let metric = mobility_metric(p, active, start, radius, mu, grad, p.dt, disp);
         free(x);
         let stats = project_positions(p, active, &metric, x, lambda, scratch)?;
         let Some(c) = contacts else {

@@ -28,6 +28,7 @@ use stable::rattle_stable;
 use stages::*;
 
 use checks::{accept, check_contacts, check_inputs, check_thermal};
+use contacts::{Projection, project_overdamped};
 
 use crate::bonds::{Bond, BondSet, max_residual};
 use crate::error::StepError;

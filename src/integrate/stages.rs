@@ -1,9 +1,8 @@
 //! Stages the integrators share: the mobility product and the constraint metric, bond
-//! vectors, flow, constraint forces, spins, the position projection (with or without
-//! hard contacts) and the report.
+//! vectors, flow, constraint forces, spins, the position projection onto the bonds and
+//! the report (the overdamped projection with its contacts is in `contacts.rs`).
 
 use super::StepReport;
-use super::contacts;
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind};
 use crate::error::{ParticleError, StepError};
@@ -176,43 +175,4 @@ pub(super) fn report<T: Real>(
         contacts: 0,
         contact_rounds: 0,
     }
-}
-
-/// The slices the overdamped position projection works in.
-pub(super) struct Projection<'l, 'v, 'a, T: Real> {
-    pub links: &'l mut [Bond<T>],
-    pub grad: &'v mut [T::V3],
-    pub disp: &'v mut [T::V3],
-    pub lambda: &'v mut [T],
-    pub scratch: &'v mut Scratch<'a, T>,
-}
-
-/// What the overdamped position projection did.
-pub(super) struct Projected<'l, T: Real> {
-    /// The solve (of the last active-set round with contacts).
-    pub stats: SolveStats<T>,
-    /// The constraints held: the bonds, then the contacts (rows of `grad`, `lambda`).
-    pub held: &'l [Bond<T>],
-    /// Contacts held (0 without contacts).
-    pub contacts: u32,
-    /// Active-set rounds (0 without contacts).
-    pub rounds: u32,
-}
-
-/// The overdamped position projection along the mobility at `start` (`mu`, scaled by
-/// `dt`): `free` writes the unconstrained move into `x`, which is then projected onto
-/// the bonds, or onto the bonds and the hard-sphere contacts when [`Params::contacts`]
-/// is on (`contacts.rs`).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn project_overdamped<'l, T: Real>(
-    p: &Params<T>,
-    bonds: &'l [Bond<T>],
-    start: &[T::V3],
-    radius: &[T],
-    mu: &[T::M3],
-    v: Projection<'l, '_, '_, T>,
-    x: &mut [T::V3],
-    free: impl Fn(&mut [T::V3]),
-) -> Result<Projected<'l, T>, StepError> {
-    contacts::project(p, p.contacts, bonds, start, radius, mu, p.dt, v, x, free)
 }
