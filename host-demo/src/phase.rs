@@ -11,7 +11,7 @@ use crate::claims::{CaseRun, claim_tables};
 use crate::output::{AtomicFile, CsvWriter};
 use crate::progress::Progress;
 use crate::render::{CategoryMap, Mark, category_map};
-use crate::scene::{Bond, Contact, HeadEnd, Helix, Hydrodynamics, Method, Particle, Scene};
+use crate::scene::{Bond, HeadEnd, Helix, Hydrodynamics, Method, Particle, Scene};
 use crate::sim::{Observables, RunOptions, Summary, run};
 
 /// Outcome names (the late states, in `State::ALL` order, and "failed") in map order,
@@ -220,7 +220,7 @@ fn variants() -> Vec<Variant> {
         Box::new(|s: &Scene| {
             // The earlier main job: soft contact, first order, dt = 0.005.
             let mut s = s.clone();
-            soft_contact(&mut s);
+            s.with_soft_contact();
             s.integrator.method = Method::Overdamped;
             Ok(s)
         }),
@@ -281,18 +281,8 @@ fn stokes(s: &Scene, st: f64) -> Result<Scene> {
     s.model.inertia = true;
     s.integrator.method = Method::RattleStable;
     // Hard contacts are for the overdamped methods: the inertial runs keep the soft one.
-    soft_contact(&mut s);
+    s.with_soft_contact();
     Ok(s)
-}
-
-/// The soft contact of the earlier main job (stiffness 1000, overlaps below ~0.05 a) at
-/// the step its explicit force allows (`dt k / (3 pi eta a) = 0.53`), with frames as
-/// often in time.
-fn soft_contact(s: &mut Scene) {
-    let every_time = s.output.every as f64 * s.integrator.dt;
-    s.contact = Some(Contact::Soft { stiffness: 1000.0 });
-    s.integrator.dt = s.integrator.dt.min(0.005);
-    s.output.every = ((every_time / s.integrator.dt).round() as usize).max(1);
 }
 
 /// Runs every variant on the three Figure 1 cases; writes `sensitivity.csv` (per case

@@ -8,7 +8,7 @@
 
 use std::fmt;
 
-use hydrorattle::Layout;
+use hydrorattle::{Contacts, Layout, Params};
 
 use crate::scene::{Contact, Method, Precision, Scene, Solver};
 
@@ -99,7 +99,7 @@ pub fn human(bytes: u64) -> String {
 impl std::error::Error for TooLarge {}
 
 /// What sizes a run's storage: method, rotation flag, solver and precision.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plan {
     /// Integrator.
     pub method: Method,
@@ -109,9 +109,8 @@ pub struct Plan {
     pub solver: Solver,
     /// Precision.
     pub precision: Precision,
-    /// Hard contacts: their capacity, `None` for a given count per particle
-    /// ([`Contact::hard_capacity`]); `None` without hard contacts.
-    pub contacts: Option<Option<usize>>,
+    /// The contact model (hard contacts add constraint slots).
+    pub contact: Option<Contact>,
 }
 
 impl Plan {
@@ -122,28 +121,23 @@ impl Plan {
             rotation: scene.model.rotation,
             solver: scene.integrator.solver,
             precision: scene.integrator.precision,
-            contacts: scene.contact.and_then(|c| match c {
-                Contact::Hard { capacity } => Some(capacity),
-                Contact::Soft { .. } => None,
-            }),
+            contact: scene.contact,
         }
     }
 
     /// The kernel's storage for `n` particles and `b` bonds; `None` past counting.
-    /// Hard contacts count as constraints beside the bonds, as in the kernel's
-    /// `Layout::for_params`.
+    /// Sized by the kernel's own rule (`Layout::for_params`): hard contacts count as
+    /// constraints beside the bonds.
     pub fn layout(&self, n: usize, b: usize) -> Option<Layout> {
-        let kernel = (self.method.kernel(), self.solver.kind());
-        let contacts = self
-            .contacts
-            .map(|c| Contact::Hard { capacity: c }.hard_capacity(n).unwrap_or(0));
+        let contacts = self.contact.and_then(|c| c.hard_capacity(n));
         let c = b.saturating_add(contacts.unwrap_or(0));
         (n <= COUNT_MAX && c <= COUNT_MAX).then(|| {
-            let mut l = Layout::with_solver(kernel.0, self.rotation, kernel.1, n, c);
-            if contacts.is_some() {
-                l.links = c;
-            }
-            l
+            let mut p = Params::<f64>::new(1.0);
+            p.method = self.method.kernel();
+            p.rotation = self.rotation;
+            p.solver.kind = self.solver.kind();
+            p.contacts = contacts.map(Contacts::new);
+            Layout::for_params(&p, n, b)
         })
     }
 
@@ -185,7 +179,7 @@ mod tests {
             rotation,
             solver: Solver::Auto,
             precision,
-            contacts: None,
+            contact: None,
         }
     }
 

@@ -12,7 +12,7 @@ use anyhow::{Result, anyhow};
 
 use super::{Point, write_chart};
 use crate::render::LineChart;
-use crate::scene::{Contact, Drift, Method, Scene, Thermal};
+use crate::scene::{Drift, Method, Scene, Thermal};
 use crate::sim::{RunOptions, RunResult, run};
 
 /// `(verticality, extension, stretched, settling speed)` at the end of a run.
@@ -46,9 +46,8 @@ pub(super) fn peclet(out: &Path, quick: bool) -> Result<String> {
     let (duration, seeds) = if quick { (5.0, 1) } else { (100.0, 6) };
     // Thermal noise runs in the first-order overdamped step without hard contacts: the
     // soft contact at the step it allows.
+    scene.with_soft_contact();
     scene.integrator.method = Method::Overdamped;
-    scene.integrator.dt = 0.005;
-    scene.contact = Some(Contact::Soft { stiffness: 1000.0 });
     scene.integrator.duration = duration;
     scene.output.every = scene.integrator.steps();
     let base = at(&scene, 0.0, 0)?;

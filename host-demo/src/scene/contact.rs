@@ -114,6 +114,26 @@ pub(super) fn check_method(
     Ok(())
 }
 
+/// Stiffness of the soft contact the project used before hard contacts (overlaps below
+/// ~0.05 a) and still uses where hard contacts do not run (inertial methods, noise,
+/// the charts that compare every method under one model).
+pub const SOFT_STIFFNESS: f64 = 1000.0;
+/// The largest step that soft contact allows: `dt k / (3 pi eta a) = 0.53`.
+pub const SOFT_DT: f64 = 0.005;
+
+impl super::Scene {
+    /// Switches to the soft contact ([`SOFT_STIFFNESS`]) at the step it allows
+    /// ([`SOFT_DT`], or the scene's if smaller), with frames as often in time.
+    pub fn with_soft_contact(&mut self) {
+        let every_time = self.output.every as f64 * self.integrator.dt;
+        self.contact = Some(Contact::Soft {
+            stiffness: SOFT_STIFFNESS,
+        });
+        self.integrator.dt = self.integrator.dt.min(SOFT_DT);
+        self.output.every = ((every_time / self.integrator.dt).round() as usize).max(1);
+    }
+}
+
 /// `[contact]` as written.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -51,7 +51,7 @@ mod tests;
 mod thermal;
 mod write;
 
-pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE};
+pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE, SOFT_DT, SOFT_STIFFNESS};
 pub use error::{SceneError, line_col};
 pub use helix::{Chain, HeadEnd, Helix};
 pub use model::{

@@ -238,10 +238,7 @@ fn plans(
         rotation,
         solver: integrator.solver,
         precision: integrator.precision,
-        contacts: contact.and_then(|c| match c {
-            super::Contact::Hard { capacity } => Some(capacity),
-            super::Contact::Soft { .. } => None,
-        }),
+        contact,
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],

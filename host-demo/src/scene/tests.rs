@@ -135,7 +135,7 @@ fn overdamped() -> Plan {
         rotation: false,
         solver: Solver::Auto,
         precision: Precision::F64,
-        contacts: None,
+        contact: None,
     }
 }
 
