@@ -1,5 +1,5 @@
-//! The grand mobility against `../shared/reference/rpy_grand_mobility.json`, produced by
-//! an independent implementation (pygrpy). Ordering there: all translations, then all
+//! The grand mobility against `tests/data/rpy_grand_mobility.json`, produced by an
+//! independent implementation (pygrpy; provenance in `tests/data/README.md`). Ordering there: all translations, then all
 //! rotations, particle-major then x, y, z — the same as `assemble_grand`'s blocks.
 
 use hydrorattle::linalg::{sym_get, tri};
@@ -17,10 +17,9 @@ struct Case {
 fn load() -> Vec<Case> {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../shared/reference/rpy_grand_mobility.json"
+        "/tests/data/rpy_grand_mobility.json"
     );
-    let text =
-        std::fs::read_to_string(path).expect("reference file ../shared/reference is required");
+    let text = std::fs::read_to_string(path).expect("tests/data/rpy_grand_mobility.json");
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let arr = |x: &serde_json::Value| -> Vec<f64> {
         x.as_array()
