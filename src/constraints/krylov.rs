@@ -31,6 +31,11 @@ pub const BAND: usize = 3;
 /// of the tolerance, whichever is reached first).
 const INNER_REDUCTION: f64 = 1e-3;
 
+/// The solve stops as diverging when its residual exceeds the first one this many
+/// times (the chord's contraction factor is then above one: bonds that turned too far
+/// in one step for a projection along the start-of-step bond vectors).
+const DIVERGED: f64 = 100.0;
+
 /// Scalars of scratch per bond: `r, z, p, q, delta` and the band.
 pub const SCALARS_PER_BOND: usize = 5 + BAND + 1;
 
@@ -58,6 +63,7 @@ pub fn krylov<T: Real>(
     precondition(metric, bonds, c, pre);
     let mut products = 0u32;
     let mut outer = 0u32;
+    let mut initial = None;
     loop {
         // Nonlinear residual of the chord iteration.
         let mut worst = T::ZERO;
@@ -75,7 +81,12 @@ pub fn krylov<T: Real>(
                 residual: worst,
             });
         }
-        if outer == solver.max_iterations || products >= solver.max_iterations * 10 {
+        // A chord iteration that has grown the residual a hundredfold is diverging.
+        let first = *initial.get_or_insert(worst);
+        if outer == solver.max_iterations
+            || products >= solver.max_iterations * 10
+            || worst > first * T::from_f64(DIVERGED)
+        {
             return Err(problem.no_convergence(products, worst));
         }
         outer += 1;
@@ -94,6 +105,11 @@ pub fn krylov<T: Real>(
                 q[k] = T::dot(metric.grad(k), w[b.i] - w[b.j]) * c;
             }
             let pq = dot(p, q);
+            if !pq.is_finite() {
+                // The iterate overflowed: a diverging chord iteration (the projection
+                // has no solution near the start), not an indefinite matrix.
+                return Err(problem.no_convergence(products, worst));
+            }
             if !(pq > T::ZERO) {
                 if inner == 0 {
                     return Err(StepError::Linalg {
