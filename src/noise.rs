@@ -7,6 +7,12 @@
 //! rounded. The generator is the caller's state, like the particles: a
 //! [`step_thermal`](crate::integrate::step_thermal) draws from a copy and writes the
 //! copy back only when the step succeeds, so a refused step leaves it untouched.
+//!
+//! A refused step can be retried as `2^depth` shorter steps whose noise refines the
+//! refused one's (a Brownian bridge, [`Noise::split`]): the sub-steps' Wiener
+//! increments add up to the refused step's increment and are, given it, independent
+//! with the bridge's conditional law. Redrawing a fresh increment instead would bias
+//! the run against the large kicks that made the step fail.
 
 use rand_core::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -19,7 +25,19 @@ pub struct Noise {
     rng: Xoshiro256PlusPlus,
     /// The second deviate of the last Box–Muller pair, as bits (so `Eq` holds).
     spare: Option<u64>,
+    /// Sub-step of a split step ([`Noise::split`]); `depth == 0` is a plain generator.
+    part: Part,
 }
+
+/// Which of the `2^depth` sub-steps of a split step a generator feeds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Part {
+    depth: u8,
+    index: u32,
+}
+
+/// Deepest split [`Noise::split`] accepts (`2^12` sub-steps).
+pub const MAX_SPLIT_DEPTH: u8 = 12;
 
 /// `2^-53`: a 53-bit integer times this is a uniform double in `[0, 1)`.
 const UNIT: f64 = 1.0 / (1u64 << 53) as f64;
@@ -31,7 +49,40 @@ impl Noise {
         Self {
             rng: Xoshiro256PlusPlus::seed_from_u64(seed),
             spare: None,
+            part: Part::default(),
         }
+    }
+
+    /// The generator of sub-step `index` (`0 .. 2^depth`) when one step of length `dt`
+    /// is split into `2^depth` steps of length `dt / 2^depth`, each drawn from a clone
+    /// of `self` taken before the step (a Brownian bridge; `depth` is capped at
+    /// [`MAX_SPLIT_DEPTH`], `index` taken modulo `2^depth`).
+    ///
+    /// Its [`Noise::fill`] of `n` vectors first draws the `n` vectors `xi` the unsplit
+    /// step would have drawn, then one vector set `eta_q` per node `q` of the binary
+    /// tree of halvings (breadth first, `2^depth - 1` sets), and returns the leaf
+    /// `index` of the recursion `xi_left = (xi + eta) / sqrt 2`,
+    /// `xi_right = (xi - eta) / sqrt 2`. Each leaf is standard normal, the leaves are
+    /// independent, and they sum to `2^(depth/2) xi`: the sub-steps' increments
+    /// `sqrt(dt / 2^depth) xi_leaf` add up to the unsplit step's `sqrt(dt) xi`.
+    ///
+    /// Every sub-step draws the whole tree, so the generator a successful last sub-step
+    /// leaves, passed through [`Noise::join`], continues after the tree.
+    pub fn split(&self, depth: u8, index: u32) -> Self {
+        let depth = depth.min(MAX_SPLIT_DEPTH);
+        let mut g = self.clone();
+        g.part = Part {
+            depth,
+            index: index & ((1u32 << depth) - 1),
+        };
+        g
+    }
+
+    /// The plain generator that continues where this one is (after the tree of a
+    /// split sub-step's draws).
+    pub fn join(mut self) -> Self {
+        self.part = Part::default();
+        self
     }
 
     /// One standard normal deviate (Box–Muller: `sqrt(-2 ln u1) (cos, sin)(2 pi u2)`,
@@ -49,13 +100,37 @@ impl Noise {
         r * libm::cos(phase)
     }
 
-    /// Fills `out` with independent standard normal vectors, bead by bead (x, y, z).
+    /// Fills `out` with independent standard normal vectors, bead by bead (x, y, z);
+    /// for a split generator, with its leaf of the bridge ([`Noise::split`]).
     pub fn fill<T: Real>(&mut self, out: &mut [T::V3]) {
-        for v in out {
-            let x = self.normal();
-            let y = self.normal();
-            let z = self.normal();
-            *v = T::v3_from([x, y, z]);
+        for v in out.iter_mut() {
+            *v = T::v3_from(self.vector());
         }
+        let Part { depth, index } = self.part;
+        let root = T::from_f64(core::f64::consts::FRAC_1_SQRT_2);
+        for level in 1..=depth {
+            // The node on the path at the level above, and which half the path takes.
+            let parent = index >> (depth - level + 1);
+            let sign = if (index >> (depth - level)) & 1 == 0 {
+                T::ONE
+            } else {
+                -T::ONE
+            };
+            for node in 0..1u32 << (level - 1) {
+                for v in out.iter_mut() {
+                    let eta = T::v3_from(self.vector());
+                    if node == parent {
+                        *v = (*v + eta * sign) * root;
+                    }
+                }
+            }
+        }
+    }
+
+    fn vector(&mut self) -> [f64; 3] {
+        let x = self.normal();
+        let y = self.normal();
+        let z = self.normal();
+        [x, y, z]
     }
 }
