@@ -71,3 +71,26 @@ fn the_seed_fixes_the_run() {
         );
     }
 }
+
+/// The issue-19 star: every solver refuses its step 2557 (no root near the start);
+/// the run retries it as two half steps along a Brownian bridge, counts the retry in
+/// the summary and runs to the end. Without the retry the run stopped at step 2557.
+#[test]
+fn a_refused_step_is_retried_split_and_counted() {
+    let text = include_str!("data/star_kt1.toml");
+    for solver in ["newton", "sweep", "krylov"] {
+        let text = text.replace(
+            "duration = 270.0",
+            &format!("duration = 270.0\nsolver = \"{solver}\""),
+        );
+        let s = Scene::parse(&text, "star").unwrap();
+        let r = run(&s, "star", None, RunOptions::default()).unwrap();
+        assert_eq!(r.summary.failure, None, "{solver}");
+        assert_eq!(r.summary.steps_done, 3000, "{solver}");
+        assert_eq!(r.summary.retries.steps, 1, "{solver}");
+        assert_eq!(r.summary.retries.substeps, 2, "{solver}");
+        // The retried step ends at the unsplit step's time.
+        let t = (0..3000).fold(0.0f64, |t, _| t + 0.09);
+        assert_eq!(r.last.time, t, "{solver}");
+    }
+}

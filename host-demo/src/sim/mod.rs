@@ -19,6 +19,7 @@ mod beads;
 mod checkpoint;
 mod frames;
 mod record;
+pub mod retry;
 mod run_loop;
 mod tail;
 
@@ -102,6 +103,8 @@ pub struct Summary {
     pub front: Front,
     /// Why the run stopped early, if it did.
     pub failure: Option<String>,
+    /// Brownian steps the kernel refused and the run completed as split steps.
+    pub retries: retry::Retries,
     /// What `level = "auto"` chose and why (None for a manual level).
     pub level_choice: Option<crate::auto::Choice>,
     /// The scene as run: every default filled in and the `auto` choice applied
@@ -138,6 +141,7 @@ impl Summary {
             outcome: String::new(),
             front: Front::default(),
             failure: None,
+            retries: retry::Retries::default(),
             level_choice: None,
             resolved_scene: scene.clone(),
         }

@@ -5,12 +5,13 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use hydrorattle::observables::{StateThresholds, Twist, VerticalFront};
-use hydrorattle::{Noise, Params, Real, SoftContact, step_slices_thermal};
+use hydrorattle::{Noise, Params, Real, SoftContact};
 use hydrorattle_heap::Buffers;
 
 use super::checkpoint::Checkpoint;
 use super::frames::Keeper;
 use super::record::{NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, each_row};
+use super::retry::{self, Retries};
 use super::tail::TailSlope;
 use super::{
     Beads, BuildError, Front, Observables, RunOptions, RunResult, Summary, bonds, params, snapshot,
@@ -166,8 +167,17 @@ pub(super) fn run_t<T: Real>(
     };
     let start = Instant::now();
     let (mut done, mut failure) = (first - 1, None);
+    let mut retries = Retries::default();
     for s in first..=steps {
-        match step_slices_thermal(beads.state(), &bonds, &p, &mut ws, &mut ext, &mut noise) {
+        match retry::step(
+            &mut beads,
+            &bonds,
+            &p,
+            &mut ws,
+            &mut ext,
+            &mut noise,
+            &mut retries,
+        ) {
             Ok(rep) => {
                 done = s;
                 keeper.take(s, &beads);
@@ -263,6 +273,7 @@ pub(super) fn run_t<T: Real>(
         outcome,
         front,
         failure,
+        retries,
         ..Summary::for_scene(scene, name)
     };
     rec.commit()?;

@@ -1,0 +1,100 @@
+//! A Brownian step that the kernel refuses is retried before the run gives up.
+//!
+//! At temperature the unconstrained move carries a random kick of size `sqrt(dt)`; on
+//! rare steps it is so large, for the chain's local shape, that the projection along
+//! the start-of-step bond vectors has no solution near the start (the constraint
+//! solvers then fail, each in its own way; issue 19 in the README, "Brownian
+//! dynamics"). Such a step is retried as 2, then 4, ... up to `2^MAX_DEPTH` shorter
+//! steps whose noise refines the refused step's (a Brownian bridge, the kernel's
+//! [`Noise::split`]): the sub-steps' increments add up to the refused one, so the
+//! retry does not bias the run against large kicks. Only when the deepest split fails
+//! too does the run stop, with the state and the generator as they were before the
+//! step (and the last checkpoint kept).
+
+use hydrorattle::{ExternalForce, Noise, Params, Real, StepError, StepReport, Workspace};
+
+use super::Beads;
+
+/// Deepest split tried: a refused step is retried as at most `2^MAX_DEPTH` sub-steps.
+pub const MAX_DEPTH: u8 = 4;
+
+/// Steps the run retried, and the sub-steps they took in the end.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Retries {
+    /// Steps refused at full length and completed as split steps.
+    pub steps: u64,
+    /// Sub-steps those steps took (`2^depth` each, the depth that succeeded).
+    pub substeps: u64,
+}
+
+/// One step of `p` from `beads`, drawing from `noise`; a thermal step the kernel
+/// refuses is retried split (see the module). On error the state and `noise` are as
+/// they were.
+pub fn step<T: Real, E: ExternalForce<T>>(
+    beads: &mut Beads<T>,
+    bonds: &[hydrorattle::Bond<T>],
+    p: &Params<T>,
+    ws: &mut Workspace<'_, T>,
+    ext: &mut E,
+    noise: &mut Noise,
+    retries: &mut Retries,
+) -> Result<StepReport<T>, StepError> {
+    let refused = match hydrorattle::step_slices_thermal(beads.state(), bonds, p, ws, ext, noise) {
+        Ok(r) => return Ok(r),
+        Err(e) => e,
+    };
+    let thermal = p.brownian.is_some_and(|b| b.temperature > T::ZERO);
+    if !thermal || !retryable(&refused) {
+        return Err(refused);
+    }
+    let start = beads.clone();
+    for depth in 1..=MAX_DEPTH {
+        let parts = 1u32 << depth;
+        let mut q = *p;
+        q.dt = p.dt / T::from_f64(f64::from(parts));
+        let mut report = StepReport::<T>::default();
+        let mut last = None;
+        for index in 0..parts {
+            let mut g = noise.split(depth, index);
+            match hydrorattle::step_slices_thermal(beads.state(), bonds, &q, ws, ext, &mut g) {
+                Ok(r) => {
+                    report.iterations += r.iterations;
+                    report.max_tension = report.max_tension.max(r.max_tension);
+                    report.residual = r.residual;
+                    last = Some(g);
+                }
+                Err(e) => {
+                    log::debug!("split step {index} of {parts} refused: {e}");
+                    last = None;
+                    break;
+                }
+            }
+        }
+        match last {
+            Some(g) => {
+                log::debug!("step at t = {} done as {parts} sub-steps", start.time);
+                *noise = g.join();
+                // The time the unsplit step would have reached, bit for bit.
+                beads.time = start.time + p.dt;
+                retries.steps += 1;
+                retries.substeps += u64::from(parts);
+                return Ok(report);
+            }
+            None => beads.clone_from(&start),
+        }
+    }
+    Err(refused)
+}
+
+/// Failures of the step itself, which a shorter step can avoid (not bad input).
+fn retryable(e: &StepError) -> bool {
+    matches!(
+        e,
+        StepError::NoConvergence { .. }
+            | StepError::Linalg { .. }
+            | StepError::Degenerate { .. }
+            | StepError::NonFinite { .. }
+            | StepError::Overlap { .. }
+            | StepError::Particle(_)
+    )
+}
