@@ -190,13 +190,22 @@ impl Helix {
 
 fn check_number(name: &str, value: f64, min: f64, strict: bool) -> Result<(), String> {
     if !value.is_finite() {
-        return Err(format!("{name} must be a finite number, not {value}"));
+        return Err(format!(
+            "{name} must be a finite number, not {}",
+            crate::output::format_f64(value)
+        ));
     }
     if strict && value <= min {
-        return Err(format!("{name} must be > {min}, not {value}"));
+        return Err(format!(
+            "{name} must be > {min}, not {}",
+            crate::output::format_f64(value)
+        ));
     }
     if !strict && value < min {
-        return Err(format!("{name} must be >= {min}, not {value}"));
+        return Err(format!(
+            "{name} must be >= {min}, not {}",
+            crate::output::format_f64(value)
+        ));
     }
     Ok(())
 }

@@ -126,7 +126,13 @@ pub(super) fn number(value: &S<f64>, default: f64, name: &str, bound: Bound) -> 
         _ => None,
     };
     match bad {
-        Some(what) => Err(issue(v.span(), format!("{name} must be {what}, not {x}"))),
+        Some(what) => Err(issue(
+            v.span(),
+            format!(
+                "{name} must be {what}, not {}",
+                crate::output::format_f64(x)
+            ),
+        )),
         None => Ok(x),
     }
 }

@@ -150,6 +150,10 @@ impl RawScene {
 
         check_geometry(&particles, model.overlap, &body_span)?;
         super::precision::check(&particles, &bonds, integrator.precision, &body_span)?;
+        if let (Some(raw), Some(thermal)) = (&self.brownian, &brownian) {
+            let min_radius = particles.iter().fold(f64::INFINITY, |m, p| m.min(p.radius));
+            raw.check_precision(thermal, &integrator, fluid.viscosity, min_radius)?;
+        }
         if integrator.method.is_inertial() {
             if let Some(k) = particles.iter().position(|p| p.density <= 0.0) {
                 return Err(issue(

@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 use toml::Spanned;
 
 use super::error::{Issue, issue};
-use super::model::{Integrator, Level, Method, Model};
+use super::model::{Integrator, Level, Method, Model, Precision};
 use super::raw::{Bound, S, number};
 
 /// Drift scheme of a Brownian run (the kernel's [`hydrorattle::Drift`]).
@@ -74,6 +74,57 @@ impl RawBrownian {
             temperature,
             seed,
             drift: self.drift.unwrap_or_default(),
+        })
+    }
+
+    /// Checks a positive temperature against the run's precision, at its line: it must
+    /// not round to zero or to a subnormal (the run would silently be deterministic or
+    /// lose digits), and the largest per-step displacement variance
+    /// `2 kT dt / (6 pi eta a_min)` must be a normal number at most the square root of
+    /// the precision's largest value (1.8e19 in f32, 1.3e154 in f64), so that squared
+    /// distances between kicked beads stay finite.
+    pub(super) fn check_precision(
+        &self,
+        thermal: &Thermal,
+        integrator: &Integrator,
+        viscosity: f64,
+        min_radius: f64,
+    ) -> Result<(), Issue> {
+        let kt = thermal.temperature;
+        if kt == 0.0 {
+            return Ok(());
+        }
+        let (name, tiny, huge, rounded) = match integrator.precision {
+            Precision::F32 => (
+                "f32",
+                f64::from(f32::MIN_POSITIVE),
+                f64::from(f32::MAX),
+                f64::from(kt as f32),
+            ),
+            Precision::F64 => ("f64", f64::MIN_POSITIVE, f64::MAX, kt),
+        };
+        let variance =
+            2.0 * kt * integrator.dt / (6.0 * std::f64::consts::PI * viscosity * min_radius);
+        let show = crate::output::format_f64;
+        let message = if rounded < tiny {
+            format!(
+                "temperature {} vanishes in {name} (it rounds to {}; the smallest normal {name} is {tiny:.2e})",
+                show(kt),
+                show(rounded),
+            )
+        } else if !(tiny..=huge.sqrt()).contains(&variance) {
+            format!(
+                "temperature {} gives a per-step displacement variance 2 kT dt / (6 pi eta a) = {variance:.3e} \
+                 for the smallest sphere, outside what {name} can hold and square ({tiny:.2e} to {:.2e})",
+                show(kt),
+                huge.sqrt()
+            )
+        } else {
+            return Ok(());
+        };
+        Err(match self.temperature.as_ref().map(|t| t.span()) {
+            Some(span) => issue(span, message),
+            None => Issue::unplaced(message),
         })
     }
 }
