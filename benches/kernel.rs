@@ -228,6 +228,7 @@ fn scaling_bench(
                 radius: &r,
                 density: &density,
                 time: &mut time,
+                noise: None,
             };
             step_slices(state, &bonds, &params, ws, &mut NoForce).unwrap()
         };

@@ -80,6 +80,7 @@ fn main() {
                 radius: &radius,
                 density: &density,
                 time: &mut time,
+                noise: None,
             };
             let r = step_slices(state, &bonds, &p, &mut ws, &mut NoForce).unwrap();
             its += r.iterations;

@@ -41,7 +41,7 @@ pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
 pub use forces::{ExternalForce, NoForce, SoftContact};
 /// The vector crate the kernel is written against (re-exported so callers match versions).
 pub use glam;
-pub use integrate::{StepReport, step, step_slices, step_slices_thermal, step_thermal};
+pub use integrate::{StepReport, step, step_slices};
 pub use mobility::Hydro;
 pub use noise::Noise;
 pub use params::{Brownian, Contacts, Drift, Method, Params};

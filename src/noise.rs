@@ -5,7 +5,7 @@
 //! to `T`: the same seed gives the same `f64` deviates on every platform (libm is plain
 //! Rust, no platform maths library), and an `f32` run sees exactly those deviates
 //! rounded. The generator is the caller's state, like the particles: a
-//! [`step_thermal`](crate::integrate::step_thermal) draws from a copy and writes the
+//! [`step`](crate::integrate::step) draws from a copy of [`State::noise`](crate::State::noise) and writes the
 //! copy back only when the step succeeds, so a refused step leaves it untouched.
 //!
 //! A refused step can be retried as `2^depth` shorter steps whose noise refines the

@@ -48,7 +48,8 @@ pub enum Drift {
 /// Thermal noise for [`Method::Overdamped`]: displacements with covariance
 /// `2 kT dt mu`, drawn through the Cholesky factor of the stored mobility, and
 /// projected onto the constraints. Steps with noise go through
-/// [`step_thermal`](crate::integrate::step_thermal), which takes the caller's generator.
+/// [`step`](crate::integrate::step), which draws from the state's generator
+/// ([`State::noise`](crate::State::noise)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Brownian<T> {
     /// Thermal energy `kT` (>= 0, same units as force x length). Zero runs the

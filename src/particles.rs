@@ -1,6 +1,7 @@
 //! Fixed-capacity set of rigid spheres: the dynamic state and the per-particle data.
 
 use crate::error::ParticleError;
+use crate::noise::Noise;
 use crate::real::Real;
 
 /// One sphere, as handed to [`ParticleSet::push`].
@@ -47,6 +48,9 @@ pub struct ParticleSet<T: Real, const N: usize> {
     pub density: [T; N],
     /// Simulated time.
     pub time: T,
+    /// The thermal-noise generator a step at temperature draws from ([`State::noise`]);
+    /// `None` (the default) for deterministic runs.
+    pub noise: Option<Noise>,
 }
 
 impl<T: Real, const N: usize> Default for ParticleSet<T, N> {
@@ -67,6 +71,7 @@ impl<T: Real, const N: usize> ParticleSet<T, N> {
             radius: [T::ZERO; N],
             density: [T::ZERO; N],
             time: T::ZERO,
+            noise: None,
         }
     }
 
@@ -153,6 +158,11 @@ pub struct State<'a, T: Real> {
     pub density: &'a [T],
     /// Simulated time.
     pub time: &'a mut T,
+    /// The generator of the thermal noise ([`Params::brownian`](crate::Params::brownian)
+    /// with `kT > 0`), part of the state a step carries: the step draws from a copy and
+    /// writes it back only when it succeeds, so a refused step leaves it as it was. A
+    /// step at `kT > 0` without one is refused; at `kT = 0` it is not touched.
+    pub noise: Option<&'a mut Noise>,
 }
 
 impl<T: Real> State<'_, T> {
@@ -178,6 +188,7 @@ impl<T: Real, const N: usize> ParticleSet<T, N> {
             radius: &self.radius[..n],
             density: &self.density[..n],
             time: &mut self.time,
+            noise: self.noise.as_mut(),
         }
     }
 }

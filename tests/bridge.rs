@@ -15,9 +15,12 @@
 use hydrorattle::glam::DVec3;
 use hydrorattle::{
     Bond, BondSet, Brownian, Drift, Hydro, Layout, NoForce, Noise, Params, Particle, ParticleSet,
-    SolverKind, Stage, StepError, step_thermal,
+    SolverKind, Stage, StepError,
 };
 use hydrorattle_heap::Buffers;
+
+mod common;
+use common::step_thermal;
 
 /// The issue's star: hub at the origin, tips at 3 e_x, 3 e_y, 3 e_z, radius 1,
 /// `eta = 1 / (6 pi)` rounded as in the issue, free draining, dt 0.09, kT = 1.

@@ -25,7 +25,7 @@ mod common;
 use common::*;
 use hydrorattle::{
     BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, ParticleSet, Real, SolverKind,
-    StepError, step, step_slices, step_thermal,
+    StepError, step, step_slices,
 };
 use hydrorattle_heap::Buffers;
 use std::f64::consts::PI;

@@ -205,6 +205,7 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
         radius: &radius,
         density: &density,
         time: &mut time,
+        noise: None,
     };
     let result = step_slices(state, &bonds, &p, &mut ws, &mut NoForce);
     let accepted = result.is_ok();

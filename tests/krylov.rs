@@ -182,6 +182,7 @@ fn thousands_of_beads_matrix_free() {
             radius: &radius,
             density: &density,
             time: &mut time,
+            noise: None,
         };
         let r = step_slices(state, &bonds, &p, &mut ws, &mut NoForce).unwrap();
         eprintln!(

@@ -245,6 +245,7 @@ pub unsafe fn step<T: Precision>(
             radius: core::slice::from_raw_parts(st.radius, n),
             density: core::slice::from_raw_parts(st.density, n),
             time: &mut time,
+            noise: None,
         }
     };
     let mut hook = CForce { f: force, user };

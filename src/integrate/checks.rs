@@ -38,7 +38,7 @@ pub(super) fn check_thermal<T: Real>(
     }
     if !has_generator {
         return Err(StepError::Unsupported(
-            "thermal noise without a generator (call step_thermal / step_slices_thermal)",
+            "thermal noise without a generator (State::noise / ParticleSet::noise)",
         ));
     }
     Ok(Some(b))

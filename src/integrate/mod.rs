@@ -33,7 +33,6 @@ use contacts::{Projection, project_overdamped};
 use crate::bonds::{Bond, BondSet, max_residual};
 use crate::error::StepError;
 use crate::forces::ExternalForce;
-use crate::noise::Noise;
 use crate::params::{Method, Params};
 use crate::particles::{ParticleSet, State};
 use crate::real::Real;
@@ -69,7 +68,8 @@ pub(super) struct Start<'a, T: Real> {
 }
 
 /// Advances the particles of a [`ParticleSet`] by one step of `p.method`: the
-/// fixed-capacity front door of [`step_slices`].
+/// fixed-capacity front door of [`step_slices`]. A step at temperature
+/// ([`Params::brownian`]) draws from the set's generator ([`ParticleSet::noise`]).
 pub fn step<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
     ps: &mut ParticleSet<T, N>,
     bonds: &BondSet<T, B>,
@@ -90,6 +90,11 @@ pub fn step<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
 ///
 /// Bonds are checked for range, self-bonds and lengths on every call; duplicates are
 /// the caller's to avoid ([`BondSet`] refuses them), and make the dense Jacobian singular.
+///
+/// With thermal noise ([`Params::brownian`], `kT > 0`) the step draws from
+/// [`State::noise`], a copy of which it writes back only when it succeeds: a refused
+/// step leaves the state and the generator as they were. Without a temperature the
+/// generator is not touched, and the step is the deterministic one bit for bit.
 pub fn step_slices<T: Real, E: ExternalForce<T>>(
     state: State<'_, T>,
     bonds: &[Bond<T>],
@@ -97,47 +102,19 @@ pub fn step_slices<T: Real, E: ExternalForce<T>>(
     ws: &mut Workspace<'_, T>,
     ext: &mut E,
 ) -> Result<StepReport<T>, StepError> {
-    advance(state, bonds, p, ws, ext, None)
+    advance(state, bonds, p, ws, ext)
 }
 
-/// [`step`] with thermal noise ([`Params::brownian`]) drawn from the caller's generator.
-pub fn step_thermal<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
-    ps: &mut ParticleSet<T, N>,
-    bonds: &BondSet<T, B>,
-    p: &Params<T>,
-    ws: &mut Workspace<'_, T>,
-    ext: &mut E,
-    noise: &mut Noise,
-) -> Result<StepReport<T>, StepError> {
-    advance(ps.state(), bonds.as_slice(), p, ws, ext, Some(noise))
-}
-
-/// [`step_slices`] with thermal noise ([`Params::brownian`]) drawn from the caller's
-/// generator. The step draws from a copy of `noise` and stores the copy only when it
-/// succeeds: a refused step leaves the state and the generator as they were. With no
-/// [`Params::brownian`], or a zero temperature, this is [`step_slices`] bit for bit and
-/// draws nothing.
-pub fn step_slices_thermal<T: Real, E: ExternalForce<T>>(
-    state: State<'_, T>,
-    bonds: &[Bond<T>],
-    p: &Params<T>,
-    ws: &mut Workspace<'_, T>,
-    ext: &mut E,
-    noise: &mut Noise,
-) -> Result<StepReport<T>, StepError> {
-    advance(state, bonds, p, ws, ext, Some(noise))
-}
-
-/// The stages of every step; `noise` is the generator of a thermal step.
+/// The stages of every step; the state's generator feeds a thermal step.
 fn advance<T: Real, E: ExternalForce<T>>(
-    state: State<'_, T>,
+    mut state: State<'_, T>,
     bonds: &[Bond<T>],
     p: &Params<T>,
     ws: &mut Workspace<'_, T>,
     ext: &mut E,
-    noise: Option<&mut Noise>,
 ) -> Result<StepReport<T>, StepError> {
     let n = state.len();
+    let noise = state.noise.take();
     // 1. Inputs and storage.
     check_inputs(&state, bonds, p)?;
     let thermal = check_thermal(p, noise.is_some())?;

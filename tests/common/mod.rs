@@ -64,6 +64,24 @@ pub fn rotate(r: [f64; 3], axis: [f64; 3], angle: f64) -> [f64; 3] {
     )
 }
 
+/// One step of the front door with the generator `noise` lent to the set for it (it
+/// is the set's again afterwards: advanced when the step succeeds, as it was when not).
+pub fn step_thermal<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
+    ps: &mut ParticleSet<T, N>,
+    bonds: &BondSet<T, B>,
+    p: &Params<T>,
+    ws: &mut Workspace<'_, T>,
+    ext: &mut E,
+    noise: &mut hydrorattle::Noise,
+) -> Result<StepReport<T>, StepError> {
+    ps.noise = Some(noise.clone());
+    let r = step(ps, bonds, p, ws, ext);
+    if let Some(g) = ps.noise.take() {
+        *noise = g;
+    }
+    r
+}
+
 /// One sphere as plain data: centre, radius, density.
 #[derive(Clone, Copy, Debug)]
 pub struct Sphere {

@@ -16,8 +16,7 @@ use std::path::Path;
 use anyhow::{Result, anyhow};
 use hydrorattle::glam::DVec3;
 use hydrorattle::{
-    BondSet, Brownian, Drift, Hydro, Layout, NoForce, Noise, Params, Particle, ParticleSet,
-    step_thermal,
+    BondSet, Brownian, Drift, Hydro, Layout, NoForce, Noise, Params, Particle, ParticleSet, step,
 };
 use hydrorattle_heap::Buffers;
 
@@ -41,9 +40,9 @@ fn sample<const N: usize, const B: usize>(
     let bonds = BondSet::<f64, B>::chain(&ps.pos[..N]).map_err(|e| anyhow!("{e}"))?;
     let mut store = Buffers::<f64>::new(Layout::for_params(p, N, bonds.len()));
     let mut ws = store.workspace();
-    let mut noise = Noise::new(seed);
+    ps.noise = Some(Noise::new(seed));
     for _ in 0..steps {
-        step_thermal(&mut ps, &bonds, p, &mut ws, &mut NoForce, &mut noise)?;
+        step(&mut ps, &bonds, p, &mut ws, &mut NoForce)?;
         observe(&ps.pos[..N]);
     }
     Ok(())

@@ -83,6 +83,7 @@ impl<T: Real> Beads<T> {
             radius: &self.radius,
             density: &self.density,
             time: &mut self.time,
+            noise: None,
         }
     }
 

@@ -39,7 +39,9 @@ pub fn step<T: Real, E: ExternalForce<T>>(
     noise: &mut Noise,
     retries: &mut Retries,
 ) -> Result<StepReport<T>, StepError> {
-    let refused = match hydrorattle::step_slices_thermal(beads.state(), bonds, p, ws, ext, noise) {
+    let mut state = beads.state();
+    state.noise = Some(noise);
+    let refused = match hydrorattle::step_slices(state, bonds, p, ws, ext) {
         Ok(r) => return Ok(r),
         Err(e) => e,
     };
@@ -56,7 +58,9 @@ pub fn step<T: Real, E: ExternalForce<T>>(
         let mut last = None;
         for index in 0..parts {
             let mut g = noise.split(depth, index);
-            match hydrorattle::step_slices_thermal(beads.state(), bonds, &q, ws, ext, &mut g) {
+            let mut state = beads.state();
+            state.noise = Some(&mut g);
+            match hydrorattle::step_slices(state, bonds, &q, ws, ext) {
                 Ok(r) => {
                     report.iterations += r.iterations;
                     report.max_tension = report.max_tension.max(r.max_tension);
