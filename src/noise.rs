@@ -14,15 +14,13 @@
 //! with the bridge's conditional law. Redrawing a fresh increment instead would bias
 //! the run against the large kicks that made the step fail.
 
-use rand_core::{Rng, SeedableRng};
-use rand_xoshiro::Xoshiro256PlusPlus;
-
 use crate::real::Real;
 
 /// A seedable, deterministic source of standard normal deviates.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Noise {
-    rng: Xoshiro256PlusPlus,
+    /// xoshiro256++ state (Blackman and Vigna 2019).
+    rng: [u64; 4],
     /// The second deviate of the last Box–Muller pair, as bits (so `Eq` holds).
     spare: Option<u64>,
     /// Sub-step of a split step ([`Noise::split`]); `depth == 0` is a plain generator.
@@ -43,14 +41,72 @@ pub const MAX_SPLIT_DEPTH: u8 = 12;
 const UNIT: f64 = 1.0 / (1u64 << 53) as f64;
 
 impl Noise {
-    /// A generator seeded from `seed` (xoshiro256++ state filled by SplitMix64, as
-    /// `rand_xoshiro` does for `seed_from_u64`).
-    pub fn new(seed: u64) -> Self {
-        Self {
-            rng: Xoshiro256PlusPlus::seed_from_u64(seed),
-            spare: None,
-            part: Part::default(),
+    /// A generator seeded from `seed`: the xoshiro256++ state is four outputs of
+    /// SplitMix64 started at `seed`, as `rand_xoshiro` seeds `seed_from_u64` (the
+    /// same stream bit for bit: `tests/bridge.rs` compares them).
+    pub const fn new(seed: u64) -> Self {
+        let mut sm = seed;
+        let mut rng = [0u64; 4];
+        let mut k = 0;
+        while k < 4 {
+            sm = sm.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = sm;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            rng[k] = z ^ (z >> 31);
+            k += 1;
         }
+        Self {
+            rng,
+            spare: None,
+            part: Part { depth: 0, index: 0 },
+        }
+    }
+
+    /// The generator's whole state as six words, for a checkpoint: the four
+    /// xoshiro256++ words, then `1` and the spare deviate's bits when a Box–Muller
+    /// spare is pending (`0, 0` otherwise). A split sub-step's generator saves as the
+    /// plain generator at the same point of the stream ([`Noise::join`]).
+    pub fn save(&self) -> [u64; 6] {
+        let [a, b, c, d] = self.rng;
+        let (flag, spare) = match self.spare {
+            Some(bits) => (1, bits),
+            None => (0, 0),
+        };
+        [a, b, c, d, flag, spare]
+    }
+
+    /// The generator [`Noise::save`] saved; `None` for words no generator has (an
+    /// all-zero xoshiro state, a spare flag other than 0 or 1, or a spare without it).
+    pub fn restore(words: [u64; 6]) -> Option<Self> {
+        let [a, b, c, d, flag, spare] = words;
+        let spare = match (flag, spare) {
+            (0, 0) => None,
+            (1, bits) => Some(bits),
+            _ => return None,
+        };
+        if a | b | c | d == 0 {
+            return None;
+        }
+        Some(Self {
+            rng: [a, b, c, d],
+            spare,
+            part: Part::default(),
+        })
+    }
+
+    /// The next 64 random bits (xoshiro256++).
+    fn next_u64(&mut self) -> u64 {
+        let s = &mut self.rng;
+        let out = s[0].wrapping_add(s[3]).rotate_left(23).wrapping_add(s[0]);
+        let t = s[1] << 17;
+        s[2] ^= s[0];
+        s[3] ^= s[1];
+        s[1] ^= s[2];
+        s[0] ^= s[3];
+        s[2] ^= t;
+        s[3] = s[3].rotate_left(45);
+        out
     }
 
     /// The generator of sub-step `index` (`0 .. 2^depth`) when one step of length `dt`
@@ -92,8 +148,8 @@ impl Noise {
         if let Some(bits) = self.spare.take() {
             return f64::from_bits(bits);
         }
-        let u1 = ((self.rng.next_u64() >> 11) + 1) as f64 * UNIT;
-        let u2 = (self.rng.next_u64() >> 11) as f64 * UNIT;
+        let u1 = ((self.next_u64() >> 11) + 1) as f64 * UNIT;
+        let u2 = (self.next_u64() >> 11) as f64 * UNIT;
         let r = libm::sqrt(-2.0 * libm::log(u1));
         let phase = 2.0 * core::f64::consts::PI * u2;
         self.spare = Some((r * libm::sin(phase)).to_bits());

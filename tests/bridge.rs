@@ -197,3 +197,42 @@ fn joined_generator_continues_after_the_tree() {
         assert_eq!(g.join(), plain, "leaf {index}");
     }
 }
+
+/// The kernel's own xoshiro256++ seeded by SplitMix64 is the `rand_xoshiro` stream
+/// (`Xoshiro256PlusPlus::seed_from_u64`), bit for bit: the Box-Muller deviates built
+/// from it agree exactly over 10 000 draws for three seeds.
+#[test]
+fn generator_is_the_reference_xoshiro256plusplus() {
+    use rand_core::{Rng, SeedableRng};
+    for seed in [0, 7, u64::MAX] {
+        let mut reference = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut ours = Noise::new(seed);
+        for _ in 0..5_000 {
+            let u1 = ((reference.next_u64() >> 11) + 1) as f64 / (1u64 << 53) as f64;
+            let u2 = (reference.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+            let r = libm::sqrt(-2.0 * libm::log(u1));
+            let phase = 2.0 * std::f64::consts::PI * u2;
+            assert_eq!(ours.normal().to_bits(), (r * libm::cos(phase)).to_bits());
+            assert_eq!(ours.normal().to_bits(), (r * libm::sin(phase)).to_bits());
+        }
+    }
+}
+
+/// A saved generator restores to the same stream, with a Box-Muller spare pending or
+/// not; words no generator has are refused.
+#[test]
+fn saved_generator_restores_the_same_stream() {
+    let mut g = Noise::new(3);
+    for draws in [0, 1, 2, 7] {
+        for _ in 0..draws {
+            g.normal();
+        }
+        let mut back = Noise::restore(g.save()).unwrap();
+        assert_eq!(back, g);
+        let (mut a, b) = (g.clone(), draw(&mut back, 4));
+        assert_eq!(draw(&mut a, 4), b);
+    }
+    assert_eq!(Noise::restore([0; 6]), None);
+    assert_eq!(Noise::restore([1, 2, 3, 4, 2, 0]), None);
+    assert_eq!(Noise::restore([1, 2, 3, 4, 0, 5]), None);
+}
