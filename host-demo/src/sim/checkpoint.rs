@@ -50,6 +50,13 @@ pub struct Checkpoint {
     pub marks: Marks,
     /// The last row written.
     pub last: Observables,
+    /// The thermal-noise generator after `step` ([`hydrorattle::Noise::save`]); absent
+    /// for a deterministic run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<[u64; 6]>,
+    /// Steps retried split so far (Brownian runs).
+    #[serde(default)]
+    pub retries: super::retry::Retries,
 }
 
 fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
@@ -99,6 +106,18 @@ impl Checkpoint {
             total_iterations,
             marks,
             last,
+            noise: None,
+            retries: super::retry::Retries::default(),
+        }
+    }
+
+    /// The generator saved with the state, checked (a Brownian run's checkpoint has one).
+    pub(super) fn noise(&self) -> Result<Option<hydrorattle::Noise>> {
+        match self.noise {
+            None => Ok(None),
+            Some(words) => hydrorattle::Noise::restore(words)
+                .map(Some)
+                .context("the checkpoint's noise generator state is not one a generator has"),
         }
     }
 

@@ -19,7 +19,7 @@ use super::Beads;
 pub const MAX_DEPTH: u8 = 4;
 
 /// Steps the run retried, and the sub-steps they took in the end.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Retries {
     /// Steps refused at full length and completed as split steps.
     pub steps: u64,

@@ -98,10 +98,13 @@ pub(super) fn run_t<T: Real>(
         (Some(t), Some(_)) => Some(((t / scene.integrator.dt).round() as usize).max(1)),
         _ => None,
     };
-    if checkpoint_every.is_some() && scene.brownian.is_some_and(|b| b.temperature > 0.0) {
-        bail!(
-            "checkpoints of Brownian runs are not supported (the noise generator's state cannot be saved)"
-        );
+    let thermal = scene.brownian.is_some_and(|b| b.temperature > 0.0);
+    if let Some(c) = from {
+        match c.noise()? {
+            Some(g) => noise = g,
+            None if thermal => bail!("the checkpoint of a Brownian run has no generator state"),
+            None => {}
+        }
     }
     let mut rec = Recorder::new(out, scene.topology(), from.map(|c| c.marks))?;
     let mut twist_prev = vec![T::ZERO; beads.len()];
@@ -167,7 +170,7 @@ pub(super) fn run_t<T: Real>(
     };
     let start = Instant::now();
     let (mut done, mut failure) = (first - 1, None);
-    let mut retries = Retries::default();
+    let mut retries = from.map_or(Retries::default(), |c| c.retries);
     for s in first..=steps {
         match retry::step(
             &mut beads,
@@ -204,7 +207,7 @@ pub(super) fn run_t<T: Real>(
                     if s % k == 0 {
                         let marks = rec.marks()?;
                         let precision = scene.integrator.precision;
-                        Checkpoint::of(
+                        let mut c = Checkpoint::of(
                             s as u64,
                             precision,
                             &beads,
@@ -212,8 +215,12 @@ pub(super) fn run_t<T: Real>(
                             total_iterations,
                             marks,
                             last,
-                        )
-                        .save(dir)?;
+                        );
+                        if thermal {
+                            c.noise = Some(noise.save());
+                            c.retries = retries;
+                        }
+                        c.save(dir)?;
                     }
                 }
                 if s == steps && !scheduled {
