@@ -136,6 +136,25 @@ typedef uint32_t HrSolver;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
+// Values of [`HrParams::drift`] (the kernel's `Drift`).
+enum HrDrift
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // Fixman-type midpoint: the stiff-bond (flexible chain) equilibrium.
+  HR_DRIFT_MIDPOINT = 0,
+  // Noise then projection, no correction (the rigid-constraint bias).
+  HR_DRIFT_UNCORRECTED = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum HrDrift HrDrift;
+#else
+typedef uint32_t HrDrift;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
 // Step parameters (the kernel's `Params`); start from `hr_params_default_*`.
 // Flags are bytes: 0 is false, anything else true.
 typedef struct {
@@ -171,6 +190,11 @@ typedef struct {
   uint8_t allow_overlap;
   // Refuse explicit-drag steps beyond the stability limit.
   uint8_t stability_guard;
+  // Thermal energy kT (>= 0; 0: deterministic). A step at kT > 0 needs the state's
+  // generator ([`HrState::noise`]) and `method` Overdamped.
+  float temperature;
+  // An [`HrDrift`] value (used when `temperature > 0`).
+  uint32_t drift;
 } HrParams_f32;
 
 // `f32` parameters.
@@ -211,10 +235,25 @@ typedef struct {
   uint8_t allow_overlap;
   // Refuse explicit-drag steps beyond the stability limit.
   uint8_t stability_guard;
+  // Thermal energy kT (>= 0; 0: deterministic). A step at kT > 0 needs the state's
+  // generator ([`HrState::noise`]) and `method` Overdamped.
+  double temperature;
+  // An [`HrDrift`] value (used when `temperature > 0`).
+  uint32_t drift;
 } HrParams_f64;
 
 // `f64` parameters.
 typedef HrParams_f64 HrParamsF64;
+
+// A thermal-noise generator (the kernel's `Noise`) as plain data: its whole state is
+// these six words, so saving it is copying the struct and restoring it is copying it
+// back (`hr_noise_seed` makes one). A step at temperature draws from it and writes it
+// back only when it succeeds; words no generator has are refused with
+// [`HrStatus::BadParameter`].
+typedef struct {
+  // xoshiro256++ state, then the pending Box-Muller spare (flag, bits).
+  uint64_t words[6];
+} HrNoise;
 
 // The caller's particles: `n` entries in each array, positions, velocities and
 // angular velocities as `[x, y, z]` triples. `time` advances by `dt` on success.
@@ -233,6 +272,9 @@ typedef struct {
   const float *density;
   // Simulation time (written).
   float time;
+  // The thermal-noise generator (read, and written when a step at temperature
+  // succeeds); null for a deterministic run.
+  HrNoise *noise;
 } HrState_f32;
 
 // `f32` state.
@@ -307,6 +349,9 @@ typedef struct {
   const double *density;
   // Simulation time (written).
   double time;
+  // The thermal-noise generator (read, and written when a step at temperature
+  // succeeds); null for a deterministic run.
+  HrNoise *noise;
 } HrState_f64;
 
 // `f64` state.
@@ -430,6 +475,10 @@ HrStatus hr_step_f64(HrStateF64 *state,
                      HrForceF64 force,
                      void *user,
                      HrReportF64 *report);
+
+// A thermal-noise generator seeded with `seed` (the kernel's `Noise::new`: the same
+// seed gives the same deviates, and the same run, on every platform).
+HrNoise hr_noise_seed(uint64_t seed);
 
 // A static, NUL-terminated description of a status code.
 const char *hr_error_message(int32_t status);

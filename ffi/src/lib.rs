@@ -205,6 +205,15 @@ pub unsafe extern "C" fn hr_step_f64(
     }
 }
 
+/// A thermal-noise generator seeded with `seed` (the kernel's `Noise::new`: the same
+/// seed gives the same deviates, and the same run, on every platform).
+#[unsafe(no_mangle)]
+pub extern "C" fn hr_noise_seed(seed: u64) -> HrNoise {
+    HrNoise {
+        words: kernel::Noise::new(seed).save(),
+    }
+}
+
 /// A static, NUL-terminated description of a status code.
 #[unsafe(no_mangle)]
 pub extern "C" fn hr_error_message(status: i32) -> *const c_char {

@@ -6,9 +6,9 @@
 use core::ffi::c_void;
 use core::mem::{align_of, size_of};
 
-use kernel::{Bond, ExternalForce, Layout, Params, Real, State, StepError, Workspace};
+use kernel::{Bond, ExternalForce, Layout, Noise, Params, Real, State, StepError, Workspace};
 
-use crate::types::{HrBond, HrParams, HrReport, HrState, HrStatus};
+use crate::types::{HrBond, HrNoise, HrParams, HrReport, HrState, HrStatus};
 
 /// Most particles a call accepts: keeps every storage count within `usize` on 32-bit
 /// targets (the kernel's layout is `O(n^2)` blocks).
@@ -201,7 +201,16 @@ pub unsafe fn step<T: Precision>(
     } else {
         (span(bonds, nb, false), align_of::<HrBond<T>>())
     };
+    let noise_span = if st.noise.is_null() {
+        (span(core::ptr::dangling::<HrNoise>(), 0, false), 1)
+    } else {
+        (
+            span(st.noise as *const HrNoise, 1, true),
+            align_of::<HrNoise>(),
+        )
+    };
     check_pointers(&[
+        noise_span,
         (span(st.pos, n, true), v3),
         (span(st.vel, n, true), v3),
         (span(st.omega, n, true), v3),
@@ -237,6 +246,14 @@ pub unsafe fn step<T: Precision>(
         )
     };
     let mut time = st.time;
+    let mut generator = if st.noise.is_null() {
+        None
+    } else {
+        // SAFETY: non-null, aligned and apart from every other argument (checked);
+        // read by value, written back below only after a successful step.
+        let words = unsafe { st.noise.read() }.words;
+        Some(Noise::restore(words).ok_or(HrStatus::BadParameter)?)
+    };
     let state_k = unsafe {
         State {
             pos: core::slice::from_raw_parts_mut(st.pos.cast(), n),
@@ -245,7 +262,7 @@ pub unsafe fn step<T: Precision>(
             radius: core::slice::from_raw_parts(st.radius, n),
             density: core::slice::from_raw_parts(st.density, n),
             time: &mut time,
-            noise: None,
+            noise: generator.as_mut(),
         }
     };
     let mut hook = CForce { f: force, user };
@@ -257,6 +274,10 @@ pub unsafe fn step<T: Precision>(
             report.max_tension = r.max_tension;
             // SAFETY: `state` is valid and aligned (checked); only `time` changes.
             unsafe { (*state).time = time };
+            if let Some(g) = generator {
+                // SAFETY: `st.noise` is non-null and aligned (checked above).
+                unsafe { st.noise.write(HrNoise { words: g.save() }) };
+            }
             Ok(())
         }
         Err(e) => Err(describe(e, report)),

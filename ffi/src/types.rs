@@ -4,7 +4,7 @@
 //! an enum, and an out-of-range value in a Rust enum would be undefined behaviour);
 //! the named values are the `Hr*` enums below, exported to the header.
 
-use kernel::{Hydro, Method, Params, Real, SolverKind};
+use kernel::{Brownian, Drift, Hydro, Method, Params, Real, SolverKind};
 
 /// Status of a call: 0 for success, negative for a misuse of the interface caught
 /// before the kernel ran, positive for the kernel's `StepError` variants (same order).
@@ -97,6 +97,28 @@ pub enum HrSolver {
     Krylov = 3,
 }
 
+/// Values of [`HrParams::drift`] (the kernel's `Drift`).
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HrDrift {
+    /// Fixman-type midpoint: the stiff-bond (flexible chain) equilibrium.
+    Midpoint = 0,
+    /// Noise then projection, no correction (the rigid-constraint bias).
+    Uncorrected = 1,
+}
+
+/// A thermal-noise generator (the kernel's `Noise`) as plain data: its whole state is
+/// these six words, so saving it is copying the struct and restoring it is copying it
+/// back (`hr_noise_seed` makes one). A step at temperature draws from it and writes it
+/// back only when it succeeds; words no generator has are refused with
+/// [`HrStatus::BadParameter`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HrNoise {
+    /// xoshiro256++ state, then the pending Box-Muller spare (flag, bits).
+    pub words: [u64; 6],
+}
+
 /// Step parameters (the kernel's `Params`); start from `hr_params_default_*`.
 /// Flags are bytes: 0 is false, anything else true.
 #[repr(C)]
@@ -134,6 +156,11 @@ pub struct HrParams<T> {
     pub allow_overlap: u8,
     /// Refuse explicit-drag steps beyond the stability limit.
     pub stability_guard: u8,
+    /// Thermal energy kT (>= 0; 0: deterministic). A step at kT > 0 needs the state's
+    /// generator ([`HrState::noise`]) and `method` Overdamped.
+    pub temperature: T,
+    /// An [`HrDrift`] value (used when `temperature > 0`).
+    pub drift: u32,
 }
 
 /// `f32` parameters.
@@ -177,6 +204,9 @@ pub struct HrState<T> {
     pub density: *const T,
     /// Simulation time (written).
     pub time: T,
+    /// The thermal-noise generator (read, and written when a step at temperature
+    /// succeeds); null for a deterministic run.
+    pub noise: *mut HrNoise,
 }
 
 /// `f32` state.
@@ -252,6 +282,11 @@ impl<T: Real> HrParams<T> {
             matrix_free: p.matrix_free.into(),
             allow_overlap: p.allow_overlap.into(),
             stability_guard: p.stability_guard.into(),
+            temperature: p.brownian.map_or(T::ZERO, |b| b.temperature),
+            drift: match p.brownian.map_or(Drift::Midpoint, |b| b.drift) {
+                Drift::Midpoint => HrDrift::Midpoint,
+                Drift::Uncorrected => HrDrift::Uncorrected,
+            } as u32,
         }
     }
 
@@ -294,6 +329,19 @@ impl<T: Real> HrParams<T> {
         p.matrix_free = self.matrix_free != 0;
         p.allow_overlap = self.allow_overlap != 0;
         p.stability_guard = self.stability_guard != 0;
+        let drift = match self.drift {
+            0 => Drift::Midpoint,
+            1 => Drift::Uncorrected,
+            _ => return Err(HrStatus::Enum),
+        };
+        // kT = 0 is the deterministic step (and its storage); anything else, even a
+        // bad value, goes to the kernel, which refuses what is invalid.
+        if self.temperature != T::ZERO {
+            p.brownian = Some(Brownian {
+                temperature: self.temperature,
+                drift,
+            });
+        }
         Ok(p)
     }
 }

@@ -50,6 +50,7 @@ fn state(c: &mut Chain) -> HrStateF32 {
         radius: c.radius.as_ptr(),
         density: c.density.as_ptr(),
         time: 0.0,
+        noise: null_mut(),
     }
 }
 
@@ -173,6 +174,7 @@ fn every_method_steps_in_both_precisions() {
         radius: radius.as_ptr(),
         density: density.as_ptr(),
         time: 0.0,
+        noise: null_mut(),
     };
     let s = unsafe {
         hr_step_f64(
