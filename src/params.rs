@@ -45,9 +45,9 @@ pub enum Drift {
     Uncorrected,
 }
 
-/// Thermal noise for [`Method::Overdamped`]: displacements with covariance
-/// `2 kT dt mu`, drawn through the Cholesky factor of the stored mobility, and
-/// projected onto the constraints. Steps with noise go through
+/// Thermal noise for [`Method::Overdamped`] and [`Method::Springs`]: displacements with
+/// covariance `2 kT dt mu`, drawn through the Cholesky factor of the stored mobility
+/// (and for `Overdamped` projected onto the constraints). Steps with noise go through
 /// [`step`](crate::integrate::step), which draws from the state's generator
 /// ([`State::noise`](crate::State::noise)).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,7 +142,8 @@ pub struct Params<T: Real> {
     /// oscillate silently (bounded but wrong) instead of blowing up. Costs about 60
     /// Cholesky solves per step. Default false.
     pub stability_guard: bool,
-    /// Thermal noise ([`Method::Overdamped`] with a stored mobility only; other methods
+    /// Thermal noise ([`Method::Overdamped`] and [`Method::Springs`] with a stored
+    /// mobility only; other methods
     /// and [`Params::matrix_free`] refuse a positive temperature with
     /// [`StepError::Unsupported`](crate::StepError::Unsupported)). Default `None`.
     pub brownian: Option<Brownian<T>>,

@@ -23,7 +23,7 @@ use super::{
     mobility_product, project_positions, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
-use crate::constraints::{self, Problem};
+use crate::constraints::{self, Problem, Scratch};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
 use crate::linalg;
@@ -42,7 +42,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     ext: &mut E,
     noise: &mut Noise,
 ) -> Result<StepReport<T>, StepError> {
-    let (n, dt, kt) = (s.pos.len(), p.dt, b.temperature);
+    let (n, dt) = (s.pos.len(), p.dt);
     // The normal deviates and the midpoint borrow the candidate velocities and spins,
     // which are written only at the end.
     let Views {
@@ -66,6 +66,55 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     mobility_product(p, s.pos, s.radius, mu, force, u)?;
     add_flow(p, s.pos, u);
+    let held = Held {
+        bonds,
+        grad_mid,
+        disp,
+        kappa,
+        scratch: &mut scratch,
+    };
+    kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held))?;
+    // r* = r + dt (U_inf + mu F) + noise, projected as in the deterministic step.
+    for i in 0..n {
+        new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
+    }
+    bond_vectors(bonds, s.pos, grad);
+    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu, grad, dt, disp);
+    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut scratch)?;
+    step_velocity(s.pos, new_pos, dt, xi);
+    add_constraint_forces(bonds, grad, lambda, force);
+    spin(p, s.pos, s.radius, force, mid)?;
+    Ok(report(stats, 0, bonds, lambda))
+}
+
+/// The bonds the midpoint's noise is projected onto (constraints), and its storage.
+pub(super) struct Held<'a, 'b, T: Real> {
+    pub(super) bonds: &'a [Bond<T>],
+    pub(super) grad_mid: &'a mut [T::V3],
+    pub(super) disp: &'a mut [T::V3],
+    pub(super) kappa: &'a mut [T],
+    pub(super) scratch: &'a mut Scratch<'b, T>,
+}
+
+/// The thermal displacement `dx` of one step from the packed mobility `mu` at the
+/// start (see the module): `fac` takes its Cholesky factor (then, with the midpoint,
+/// the mobility at the midpoint), `xi` the deviates, `mid` the midpoint. With `held`
+/// the midpoint's noise is projected onto its bonds; without (springs), it is
+/// `sqrt(2 kT dt) mu(x~) L^-T xi`, whose mean is `kT dt div mu` (zero for RPY).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn kick<T: Real>(
+    p: &Params<T>,
+    b: Brownian<T>,
+    s: &Start<'_, T>,
+    mu: &[T::M3],
+    fac: &mut [T::M3],
+    xi: &mut [T::V3],
+    mid: &mut [T::V3],
+    dx: &mut [T::V3],
+    noise: &mut Noise,
+    held: Option<Held<'_, '_, T>>,
+) -> Result<(), StepError> {
+    let (n, dt, kt) = (s.pos.len(), p.dt, b.temperature);
     // L L^T = mu.
     fac.copy_from_slice(mu);
     linalg::cholesky::<T>(fac, n).map_err(|error| StepError::Linalg {
@@ -95,25 +144,18 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
             // dx = P(x~) mu(x~) xi: the factor's storage takes mu(x~).
             assemble_tt(p, mid, s.radius, fac)?;
             linalg::sym_matvec::<T>(fac, n, xi, dx);
-            bond_vectors(bonds, mid, grad_mid);
-            kappa.fill(T::ZERO);
-            let metric = mobility_metric(p, bonds, mid, s.radius, fac, grad_mid, T::ONE, disp);
-            let problem = Problem::Velocities {
-                bond: grad_mid,
-                dt: T::ONE,
-            };
-            constraints::solve(problem, &metric, bonds, &p.solver, dx, kappa, &mut scratch)?;
+            if let Some(h) = held {
+                bond_vectors(h.bonds, mid, h.grad_mid);
+                h.kappa.fill(T::ZERO);
+                let metric =
+                    mobility_metric(p, h.bonds, mid, s.radius, fac, h.grad_mid, T::ONE, h.disp);
+                let problem = Problem::Velocities {
+                    bond: h.grad_mid,
+                    dt: T::ONE,
+                };
+                constraints::solve(problem, &metric, h.bonds, &p.solver, dx, h.kappa, h.scratch)?;
+            }
         }
     }
-    // r* = r + dt (U_inf + mu F) + noise, projected as in the deterministic step.
-    for i in 0..n {
-        new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
-    }
-    bond_vectors(bonds, s.pos, grad);
-    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu, grad, dt, disp);
-    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut scratch)?;
-    step_velocity(s.pos, new_pos, dt, xi);
-    add_constraint_forces(bonds, grad, lambda, force);
-    spin(p, s.pos, s.radius, force, mid)?;
-    Ok(report(stats, 0, bonds, lambda))
+    Ok(())
 }

@@ -26,9 +26,9 @@ pub(super) fn check_thermal<T: Real>(
     if b.temperature == T::ZERO {
         return Ok(None);
     }
-    if p.method != Method::Overdamped {
+    if !matches!(p.method, Method::Overdamped | Method::Springs) {
         return Err(StepError::Unsupported(
-            "thermal noise with a method other than Overdamped",
+            "thermal noise with a method other than Overdamped or Springs",
         ));
     }
     if p.matrix_free {

@@ -1,11 +1,15 @@
 //! Hookean springs instead of constraints (the paper's costly alternative): overdamped
-//! explicit Euler, stable only for `dt` below about `1 / (k mu)`.
+//! explicit Euler, stable only for `dt` below about `1 / (k mu)`; at temperature the
+//! Ermak–McCammon step, `r' = r + dt (U_inf + mu F) + dx` with the thermal
+//! displacement `dx` of covariance `2 kT dt mu` (`brownian.rs`, without constraints).
 
-use super::{Start, StepReport, add_flow, mobility_product, spin};
+use super::brownian::kick;
+use super::{Start, StepReport, add_flow, mobility_product, spin, step_velocity};
 use crate::bonds::{Bond, max_residual};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
-use crate::params::Params;
+use crate::noise::Noise;
+use crate::params::{Brownian, Params};
 use crate::real::Real;
 use crate::workspace::Views;
 
@@ -36,13 +40,54 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         new_vel[i] = u[i];
     }
     spin(p, s.pos, s.radius, force, new_omega)?;
+    Ok(spring_report(p, bonds, new_pos))
+}
+
+/// Hookean springs at temperature (stored mobility): the deterministic move plus the
+/// thermal displacement.
+pub(super) fn springs_thermal<T: Real, E: ExternalForce<T>>(
+    p: &Params<T>,
+    b: Brownian<T>,
+    s: &Start<'_, T>,
+    bonds: &[Bond<T>],
+    v: Views<'_, T>,
+    ext: &mut E,
+    noise: &mut Noise,
+) -> Result<StepReport<T>, StepError> {
+    let (n, dt) = (s.pos.len(), p.dt);
+    let Views {
+        mu,
+        fac,
+        force,
+        work_a: u,
+        work_b: dx,
+        new_pos,
+        new_vel: xi,
+        new_omega: mid,
+        ..
+    } = v;
+    forces::external(p, s.pos, s.radius, s.density, ext, force)?;
+    forces::springs(bonds, p.spring_stiffness, s.pos, force);
+    mobility_product(p, s.pos, s.radius, mu, force, u)?;
+    add_flow(p, s.pos, u);
+    kick(p, b, s, mu, fac, xi, mid, dx, noise, None)?;
+    for i in 0..n {
+        new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
+    }
+    step_velocity(s.pos, new_pos, dt, xi);
+    spin(p, s.pos, s.radius, force, mid)?;
+    Ok(spring_report(p, bonds, new_pos))
+}
+
+/// The report of a spring step: the largest relative length error and spring force.
+fn spring_report<T: Real>(p: &Params<T>, bonds: &[Bond<T>], new_pos: &[T::V3]) -> StepReport<T> {
     let (_, worst) = max_residual(bonds, new_pos);
     let tension = bonds.iter().fold(T::ZERO, |a, b| a.max(b.length)) * worst * p.spring_stiffness;
-    Ok(StepReport {
+    StepReport {
         iterations: 0,
         velocity_iterations: 0,
         residual: worst,
         max_tension: tension,
         ..StepReport::default()
-    })
+    }
 }

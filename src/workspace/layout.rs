@@ -138,8 +138,9 @@ impl Layout {
         }
     }
 
-    /// This layout with room for thermal noise ([`Params::brownian`]), for the method
-    /// that takes it (`Overdamped`; unchanged for the others): the mobility's Cholesky
+    /// This layout with room for thermal noise ([`Params::brownian`]), for the methods
+    /// that take it (`Overdamped`, and `Springs` with the factor and one vector array;
+    /// unchanged for the others): the mobility's Cholesky
     /// factor, later the mobility at the midpoint (`tri(n)` blocks), the noise
     /// displacement (`n` vectors), the bond vectors at the midpoint (`B` vectors) and
     /// the midpoint projection's multipliers (`B` scalars). The normal deviates and the
@@ -150,6 +151,12 @@ impl Layout {
                 blocks: self.blocks + tri(n),
                 vectors: self.vectors + n + bonds,
                 scalars: self.scalars + bonds,
+                ..self
+            },
+            // The factor (then the midpoint's mobility) and the noise displacement.
+            Method::Springs => Self {
+                blocks: self.blocks + tri(n),
+                vectors: self.vectors + n,
                 ..self
             },
             _ => self,

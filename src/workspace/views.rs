@@ -83,6 +83,7 @@ impl<T: Real> Workspace<'_, T> {
         let (mats, work, extra_bonds, inv_mass, sqrt_m, disp) = match method {
             Method::Overdamped if thermal => (2, [n, n, 0], nb, 0, 0, table),
             Method::Overdamped => (1, [n, 0, 0], 0, 0, 0, table),
+            Method::Springs if thermal => (2, [n, n, 0], 0, 0, 0, 0),
             Method::Springs => (1, [n, 0, 0], 0, 0, 0, 0),
             Method::Overdamped2 => (2, [n, n, n], nb, 0, 0, table),
             Method::Rattle => (2, [n, n, n], nb, n, 0, 0),
