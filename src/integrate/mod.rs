@@ -23,7 +23,7 @@ mod stages;
 use brownian::overdamped_thermal;
 use overdamped::{overdamped, overdamped2};
 use rattle::rattle_explicit;
-use springs::{springs, springs_thermal};
+use springs::springs;
 use stable::rattle_stable;
 use stages::*;
 
@@ -140,8 +140,8 @@ fn advance<T: Real, E: ExternalForce<T>>(
             (Method::Overdamped2, ..) => overdamped2(p, &s, bonds, v, ext),
             (Method::Rattle, ..) => rattle_explicit(p, &s, bonds, v, ext),
             (Method::RattleStable, ..) => rattle_stable(p, &s, bonds, v, ext),
-            (Method::Springs, Some(b), Some(g)) => springs_thermal(p, b, &s, bonds, v, ext, g),
-            (Method::Springs, ..) => springs(p, &s, bonds, v, ext),
+            (Method::Springs, Some(b), Some(g)) => springs(p, &s, bonds, v, ext, Some((b, g))),
+            (Method::Springs, ..) => springs(p, &s, bonds, v, ext, None),
         }
     };
     // 3. Accept. The candidate state heads the vector storage (see `Workspace::views`).

@@ -13,19 +13,25 @@ use crate::params::{Brownian, Params};
 use crate::real::Real;
 use crate::workspace::Views;
 
-/// Hookean springs, overdamped explicit Euler.
+/// Hookean springs, overdamped explicit Euler; at temperature (`thermal`: the
+/// settings and the generator) with the thermal displacement added.
 pub(super) fn springs<T: Real, E: ExternalForce<T>>(
     p: &Params<T>,
     s: &Start<'_, T>,
     bonds: &[Bond<T>],
     v: Views<'_, T>,
     ext: &mut E,
+    thermal: Option<(Brownian<T>, &mut Noise)>,
 ) -> Result<StepReport<T>, StepError> {
     let (n, dt) = (s.pos.len(), p.dt);
+    // `fac` and `dx` are empty without noise; the deviates and the midpoint borrow the
+    // candidate velocities and spins, written at the end.
     let Views {
         mu,
+        fac,
         force,
         work_a: u,
+        work_b: dx,
         new_pos,
         new_vel,
         new_omega,
@@ -35,47 +41,22 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
     forces::springs(bonds, p.spring_stiffness, s.pos, force);
     mobility_product(p, s.pos, s.radius, mu, force, u)?;
     add_flow(p, s.pos, u);
-    for i in 0..n {
-        new_pos[i] = s.pos[i] + u[i] * dt;
-        new_vel[i] = u[i];
+    match thermal {
+        None => {
+            for i in 0..n {
+                new_pos[i] = s.pos[i] + u[i] * dt;
+                new_vel[i] = u[i];
+            }
+        }
+        Some((b, noise)) => {
+            kick(p, b, s, mu, fac, new_vel, new_omega, dx, noise, None)?;
+            for i in 0..n {
+                new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
+            }
+            step_velocity(s.pos, new_pos, dt, new_vel);
+        }
     }
     spin(p, s.pos, s.radius, force, new_omega)?;
-    Ok(spring_report(p, bonds, new_pos))
-}
-
-/// Hookean springs at temperature (stored mobility): the deterministic move plus the
-/// thermal displacement.
-pub(super) fn springs_thermal<T: Real, E: ExternalForce<T>>(
-    p: &Params<T>,
-    b: Brownian<T>,
-    s: &Start<'_, T>,
-    bonds: &[Bond<T>],
-    v: Views<'_, T>,
-    ext: &mut E,
-    noise: &mut Noise,
-) -> Result<StepReport<T>, StepError> {
-    let (n, dt) = (s.pos.len(), p.dt);
-    let Views {
-        mu,
-        fac,
-        force,
-        work_a: u,
-        work_b: dx,
-        new_pos,
-        new_vel: xi,
-        new_omega: mid,
-        ..
-    } = v;
-    forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    forces::springs(bonds, p.spring_stiffness, s.pos, force);
-    mobility_product(p, s.pos, s.radius, mu, force, u)?;
-    add_flow(p, s.pos, u);
-    kick(p, b, s, mu, fac, xi, mid, dx, noise, None)?;
-    for i in 0..n {
-        new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
-    }
-    step_velocity(s.pos, new_pos, dt, xi);
-    spin(p, s.pos, s.radius, force, mid)?;
     Ok(spring_report(p, bonds, new_pos))
 }
 
