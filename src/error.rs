@@ -86,6 +86,14 @@ pub enum BondError {
         /// Relative length error `| |r_ij| - d | / d`.
         residual: f64,
     },
+    /// A FENE spring at or past its maximum extension (at the start of a step, or in
+    /// the step's candidate: the step is refused; a shorter step may pass).
+    Overstretched {
+        /// Index of the bond.
+        bond: usize,
+        /// Length over the maximum extension (>= 1, or NaN).
+        ratio: f64,
+    },
     /// A tree needs `parents.len() == particles` and each parent index below its child.
     BadTree {
         /// The child whose parent is invalid.
@@ -232,6 +240,10 @@ impl fmt::Display for BondError {
             Self::Violated { bond, residual } => {
                 write!(f, "bond {bond}: configuration off by relative {residual:e}")
             }
+            Self::Overstretched { bond, ratio } => write!(
+                f,
+                "bond {bond}: FENE spring at {ratio:.6} of its maximum extension (must stay below 1)"
+            ),
             Self::BadTree { particle } => {
                 write!(
                     f,

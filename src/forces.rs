@@ -47,19 +47,44 @@ pub fn external<T: Real, E: ExternalForce<T>>(
     }
 }
 
-/// Hookean bond forces `-k (|b| - d) b / |b|`, added into `out`.
+/// Hookean bond forces `-k (|b| - d) b / |b|`, or with `fene = Some(Q0)` the FENE
+/// forces `-k b / (1 - |b|^2 / Q0^2)`, added into `out`. A FENE bond at or past `Q0`
+/// is refused ([`BondError::Overstretched`](crate::BondError::Overstretched)).
 pub fn springs<T: Real>(
     bonds: &[crate::bonds::Bond<T>],
     stiffness: T,
+    fene: Option<T>,
     pos: &[T::V3],
     out: &mut [T::V3],
-) {
-    for b in bonds {
+) -> Result<(), crate::BondError> {
+    for (k, b) in bonds.iter().enumerate() {
         let r = pos[b.i] - pos[b.j];
-        let s = T::norm(r);
-        let f = r * (-stiffness * (s - b.length) / s);
+        let f = match fene {
+            None => {
+                let s = T::norm(r);
+                r * (-stiffness * (s - b.length) / s)
+            }
+            Some(q0) => {
+                let x = T::norm2(r) / (q0 * q0);
+                overstretched(k, x)?;
+                r * (-stiffness / (T::ONE - x))
+            }
+        };
         out[b.i] += f;
         out[b.j] -= f;
+    }
+    Ok(())
+}
+
+/// Refuses a FENE bond `k` at `x = Q^2 / Q0^2 >= 1` (or NaN).
+pub(crate) fn overstretched<T: Real>(k: usize, x: T) -> Result<(), crate::BondError> {
+    if x < T::ONE {
+        Ok(())
+    } else {
+        Err(crate::BondError::Overstretched {
+            bond: k,
+            ratio: x.to_f64().sqrt(),
+        })
     }
 }
 

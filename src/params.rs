@@ -136,6 +136,13 @@ pub struct Params<T: Real> {
     pub allow_overlap: bool,
     /// Spring stiffness for [`Method::Springs`]. Default 1e3.
     pub spring_stiffness: T,
+    /// FENE springs for [`Method::Springs`]: the maximum extension `Q0` (> 0). A bond
+    /// then pulls with `-H Q / (1 - Q^2 / Q0^2)` along itself (`H` the stiffness; the
+    /// bond's length is not used: FENE's rest length is zero), and a step that would
+    /// stretch one to `Q0` or beyond is refused
+    /// ([`BondError::Overstretched`](crate::BondError::Overstretched)). `None` (the
+    /// default): Hookean springs.
+    pub fene: Option<T>,
     /// Refuse an explicit-drag ([`Method::Rattle`]) step beyond the linear stability limit
     /// of the unconstrained drag, `dt < 2 lambda_min(M^1/2 mu M^1/2)`. Bonds usually remove
     /// the stiffest modes, so the true limit is often larger; beyond it the scheme can
@@ -180,6 +187,7 @@ impl<T: Real> Params<T> {
             },
             allow_overlap: false,
             spring_stiffness: T::from_f64(1e3),
+            fene: None,
             stability_guard: false,
             brownian: None,
             contacts: None,

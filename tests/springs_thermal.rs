@@ -9,11 +9,17 @@
 //! draining (uncorrected noise) and with RPY (Fixman midpoint), each within 3 block
 //! standard errors, and the standard error asserted small enough (below 1 %) that a
 //! wrong noise amplitude (twice the variance) would fail by far.
+//!
+//! FENE dumbbell (force `-H Q / (1 - Q^2 / Q0^2)`): `p(Q) ~ Q^2 (1 - Q^2/Q0^2)^(b/2)`,
+//! `b = H Q0^2 / kT`, so `<Q^2> = 3 kT / H * b / (b + 5)` (Bird et al., Dynamics of
+//! Polymeric Liquids vol. 2). A step that would stretch the spring to `Q0` is refused;
+//! the test retries it as 2, 4, ... sub-steps along the Brownian bridge
+//! (`Noise::split`), as the demo does, and counts the retries.
 
 use hydrorattle::glam::DVec3;
 use hydrorattle::{
-    Bond, BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, Params, Particle,
-    ParticleSet, step,
+    Bond, BondError, BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, Params,
+    Particle, ParticleSet, StepError, Workspace, step,
 };
 use hydrorattle_heap::Buffers;
 
@@ -52,11 +58,13 @@ fn block_mean(x: &[f64]) -> (f64, f64) {
     (m, (var / blocks as f64).sqrt())
 }
 
-/// `<Q^2>` of a dumbbell of unit spheres, spring `h` (kT = 1), rest length `d`.
-fn dumbbell(hydro: Hydro, drift: Drift, h: f64, d: f64, seed: u64) -> (f64, f64) {
+/// A dumbbell of unit spheres at distance `q` (bond length `q` too), free space,
+/// `eta = 1/(6 pi)` (a lone sphere's mobility is 1), kT = 1, spring `h`, time step
+/// `dt`, seed `seed`; the caller sets the rest.
+fn setup(q: f64, h: f64, dt: f64, hydro: Hydro, drift: Drift, seed: u64) -> Dumbbell {
     let mut ps = ParticleSet::<f64, 2>::new();
     ps.push(Particle::new(DVec3::ZERO, 1.0, 0.0)).unwrap();
-    ps.push(Particle::new(DVec3::new(d.max(2.5), 0.0, 0.0), 1.0, 0.0))
+    ps.push(Particle::new(DVec3::new(q, 0.0, 0.0), 1.0, 0.0))
         .unwrap();
     let mut bonds = BondSet::<f64, 1>::new();
     bonds
@@ -64,13 +72,12 @@ fn dumbbell(hydro: Hydro, drift: Drift, h: f64, d: f64, seed: u64) -> (f64, f64)
             Bond {
                 i: 0,
                 j: 1,
-                length: d,
+                length: q,
             },
             2,
         )
         .unwrap();
-    // eta = 1/(6 pi): a lone sphere's mobility is 1; the bond relaxes at rate 2 h.
-    let mut p = Params::<f64>::new(0.005);
+    let mut p = Params::<f64>::new(dt);
     p.method = Method::Springs;
     p.viscosity = 1.0 / (6.0 * std::f64::consts::PI);
     p.gravity = DVec3::ZERO;
@@ -82,6 +89,15 @@ fn dumbbell(hydro: Hydro, drift: Drift, h: f64, d: f64, seed: u64) -> (f64, f64)
         drift,
     });
     ps.noise = Some(Noise::new(seed));
+    (ps, bonds, p)
+}
+
+type Dumbbell = (ParticleSet<f64, 2>, BondSet<f64, 1>, Params<f64>);
+
+/// `<Q^2>` of a dumbbell of unit spheres, spring `h` (kT = 1), rest length `d`.
+fn dumbbell(hydro: Hydro, drift: Drift, h: f64, d: f64, seed: u64) -> (f64, f64) {
+    // The bond relaxes at rate 2 h; it starts at its rest length.
+    let (mut ps, bonds, p) = setup(d, h, 0.005, hydro, drift, seed);
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, 2, 1));
     let mut ws = buf.workspace();
     let steps = 1_000_000;
@@ -114,4 +130,113 @@ fn hookean_dumbbell_equilibrium_free_draining_and_rpy() {
             "{hydro:?}: {m} vs {exact} (se {se})"
         );
     }
+}
+
+/// One step of `ps`; a refused one (FENE overstretch) retried as `2^d` bridge
+/// sub-steps, `d = 1..=8`. Returns whether it was retried.
+fn step_or_split<const N: usize, const B: usize>(
+    ps: &mut ParticleSet<f64, N>,
+    bonds: &BondSet<f64, B>,
+    p: &Params<f64>,
+    ws: &mut Workspace<'_, f64>,
+) -> bool {
+    let e = match step(ps, bonds, p, ws, &mut NoForce) {
+        Ok(_) => return false,
+        Err(e) => e,
+    };
+    assert!(
+        matches!(e, StepError::Bond(BondError::Overstretched { .. })),
+        "{e}"
+    );
+    let start = ps.clone();
+    let base = ps.noise.clone().unwrap();
+    for depth in 1..=8u8 {
+        let mut q = *p;
+        q.dt = p.dt / f64::from(1u32 << depth);
+        let done = (0..1u32 << depth).all(|index| {
+            ps.noise = Some(base.split(depth, index));
+            step(ps, bonds, &q, ws, &mut NoForce).is_ok()
+        });
+        if done {
+            ps.noise = ps.noise.take().map(Noise::join);
+            return true;
+        }
+        *ps = start.clone();
+    }
+    panic!("a step refused even as 256 sub-steps");
+}
+
+#[test]
+fn fene_dumbbell_equilibrium() {
+    // H = kT = 1, b = 10: <Q^2> = 3 * 10 / 15 = 2.
+    let (h, b) = (1.0, 10.0f64);
+    let exact = 3.0 * b / (b + 5.0);
+    for (hydro, drift, seed) in [
+        (Hydro::FreeDraining, Drift::Uncorrected, 3),
+        (Hydro::Rpy, Drift::Midpoint, 4),
+    ] {
+        let (mut ps, bonds, mut p) = setup(1.4, h, 0.002, hydro, drift, seed);
+        p.fene = Some(b.sqrt());
+        let mut buf = Buffers::<f64>::new(Layout::for_params(&p, 2, 1));
+        let mut ws = buf.workspace();
+        let (steps, mut retried) = (1_000_000, 0);
+        let mut q2 = Vec::with_capacity(steps);
+        for k in 0..steps {
+            retried += usize::from(step_or_split(&mut ps, &bonds, &p, &mut ws));
+            if k >= 2_000 {
+                q2.push((ps.pos[0] - ps.pos[1]).length_squared());
+            }
+        }
+        let (m, se) = block_mean(&q2);
+        eprintln!(
+            "FENE {hydro:?}: <Q^2> = {m:.4} +- {se:.4}, exact {exact:.4}; {retried} steps retried"
+        );
+        assert!(se < 0.02 * exact, "too few samples: se {se}");
+        assert!(
+            (m - exact).abs() < 3.0 * se,
+            "{hydro:?}: {m} vs {exact} (se {se})"
+        );
+        // A Hookean spring of the same H would give 3 kT / H = 3: far outside.
+        assert!((3.0 - exact) > 10.0 * se);
+    }
+}
+
+/// A FENE spring is never stretched to its maximum: a state past it is refused, and a
+/// step whose kick would overstretch it is refused with the state and the generator
+/// kept, then passes split along the bridge (b = 10 and dt = 0.05: 7 of 20 000 steps
+/// at this seed). (With the explicit step a very stiff case, b = 2 at dt = 0.01, can
+/// stay refused even as 256 sub-steps: the FENE force's divergence outruns an
+/// explicit step near the wall; a semi-implicit FENE step would remove that.)
+#[test]
+fn fene_refuses_overstretching_and_the_split_step_passes() {
+    let q0 = 10f64.sqrt();
+    let (mut ps, bonds, mut p) = setup(1.0, 1.0, 0.05, Hydro::FreeDraining, Drift::Midpoint, 8);
+    p.fene = Some(q0);
+    let mut buf = Buffers::<f64>::new(Layout::for_params(&p, 2, 1));
+    let mut ws = buf.workspace();
+    let mut refused = 0;
+    for _ in 0..20_000 {
+        let before = ps.clone();
+        if let Err(e) = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce) {
+            assert!(
+                matches!(e, StepError::Bond(BondError::Overstretched { bond: 0, .. })),
+                "{e}"
+            );
+            assert_eq!((ps.pos, ps.time), (before.pos, before.time));
+            assert_eq!(ps.noise, before.noise);
+            refused += 1;
+            assert!(step_or_split(&mut ps, &bonds, &p, &mut ws));
+        }
+        let q = (ps.pos[0] - ps.pos[1]).length();
+        assert!(q < q0, "{q} >= {q0}");
+    }
+    eprintln!("FENE b = 10, dt = 0.05: {refused} of 20000 steps refused and split");
+    assert!(refused > 0);
+    // A state already past the maximum is refused.
+    ps.pos[1] = DVec3::new(4.0, 0.0, 0.0);
+    let e = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap_err();
+    assert!(
+        matches!(e, StepError::Bond(BondError::Overstretched { bond: 0, .. })),
+        "{e}"
+    );
 }

@@ -315,6 +315,10 @@ fn describe<T>(e: StepError, r: &mut HrReport<T>) -> HrStatus {
                     (bond as u64, 0)
                 }
                 B::BadTree { particle } => (particle as u64, 0),
+                B::Overstretched { bond, ratio } => {
+                    r.error_value = ratio;
+                    (bond as u64, 0)
+                }
             };
             HrStatus::Bond
         }

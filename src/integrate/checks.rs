@@ -123,6 +123,10 @@ pub(super) fn check_inputs<T: Real>(
             p.spring_stiffness > T::ZERO && p.spring_stiffness.is_finite(),
             "spring_stiffness",
         )?;
+        bad(
+            p.fene.is_none_or(|q| q > T::ZERO && (q * q).is_finite()),
+            "fene (maximum extension > 0, its square finite)",
+        )?;
     }
     let inertial = matches!(p.method, Method::Rattle | Method::RattleStable);
     for i in 0..n {

@@ -38,7 +38,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         ..
     } = v;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    forces::springs(bonds, p.spring_stiffness, s.pos, force);
+    forces::springs(bonds, p.spring_stiffness, p.fene, s.pos, force)?;
     mobility_product(p, s.pos, s.radius, mu, force, u)?;
     add_flow(p, s.pos, u);
     match thermal {
@@ -54,6 +54,11 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
                 new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
             }
             step_velocity(s.pos, new_pos, dt, new_vel);
+        }
+    }
+    if let Some(q0) = p.fene {
+        for (k, b) in bonds.iter().enumerate() {
+            forces::overstretched(k, T::norm2(new_pos[b.i] - new_pos[b.j]) / (q0 * q0))?;
         }
     }
     spin(p, s.pos, s.radius, force, new_omega)?;

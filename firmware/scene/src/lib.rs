@@ -187,6 +187,7 @@ pub const fn params_f32(method: Method, rotation: bool) -> Params<f32> {
         },
         allow_overlap: true,
         spring_stiffness: 1e3,
+        fene: None,
         stability_guard: false,
         brownian: None,
         contacts: None,

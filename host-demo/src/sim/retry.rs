@@ -100,5 +100,6 @@ fn retryable(e: &StepError) -> bool {
             | StepError::NonFinite { .. }
             | StepError::Overlap { .. }
             | StepError::Particle(_)
+            | StepError::Bond(hydrorattle::BondError::Overstretched { .. })
     )
 }
