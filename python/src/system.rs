@@ -359,14 +359,20 @@ fn call_force<T: Real>(
     out: &mut [T::V3],
 ) -> PyResult<()> {
     let ret = f.call1((rows_f64::<T>(py, pos),))?;
-    let np = py.import("numpy")?;
-    let arr = np.call_method1("ascontiguousarray", (ret, "float64"))?;
-    let arr: PyReadonlyArray2<'_, f64> = arr.extract().map_err(|_| {
-        PyValueError::new_err(format!(
-            "the force callable must return shape ({}, 3)",
-            pos.len()
-        ))
-    })?;
+    // A C-contiguous float64 array is read as it is; anything else goes through NumPy.
+    let arr: PyReadonlyArray2<'_, f64> = match ret.extract::<PyReadonlyArray2<'_, f64>>() {
+        Ok(a) if a.is_c_contiguous() => a,
+        _ => py
+            .import("numpy")?
+            .call_method1("ascontiguousarray", (ret, "float64"))?
+            .extract()
+            .map_err(|_| {
+                PyValueError::new_err(format!(
+                    "the force callable must return shape ({}, 3)",
+                    pos.len()
+                ))
+            })?,
+    };
     let forces = rows(&arr, "the force callable's result")?;
     if forces.len() != out.len() {
         return Err(PyValueError::new_err(format!(
