@@ -230,3 +230,21 @@ def test_bad_system_input_is_refused():
     s = hr.System(pos, 1.0, RHO, bonds=bonds, dt=-0.1)
     with pytest.raises(hr.InvalidStateError, match="time step"):
         s.step()
+
+
+def test_helix_keys_build_the_scene_files_chain():
+    import pathlib
+
+    scene = pathlib.Path(__file__).resolve().parents[2] / "host-demo" / "scenes" / "figure1c.toml"
+    a = hr.System.from_scene(scene)
+    b = hr.System.helix(
+        tails=24, head_ratio=2.0, dhat=1.05, radius=2.0, pitch=7.0, density=4.5,
+        contact={"model": "hard"},
+        integrator={"method": "overdamped2", "dt": 0.1, "solver": "newton", "tolerance": 1e-10,
+                    "max_iterations": 500},
+    )
+    assert a.state_bits() == b.state_bits()
+    a.step(20)
+    b.step(20)
+    assert a.state_bits() == b.state_bits()
+    assert len(b) == 25 and b.radii[0] == 2.0
