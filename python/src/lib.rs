@@ -14,6 +14,7 @@ use pyo3::prelude::*;
 mod errors;
 mod input;
 mod mobility;
+mod params;
 mod runs;
 mod system;
 
