@@ -119,8 +119,11 @@ METHODS = ["overdamped", "overdamped2", "rattle", "rattle-stable"]
     dt=st.floats(1e-3, 2.0),
     steps=st.integers(1, 6),
     precision=st.sampled_from(["f64", "f32"]),
+    temperature=st.sampled_from([None, 0.0, 0.2]),
 )
-def test_a_step_keeps_every_bond_or_raises_and_changes_nothing(n, seed, method, solver, hydro, dt, steps, precision):
+def test_a_step_keeps_every_bond_or_raises_and_changes_nothing(
+    n, seed, method, solver, hydro, dt, steps, precision, temperature
+):
     rng = np.random.default_rng(seed)
     radii = rng.uniform(0.5, 1.5, n)
     pos = np.zeros((n, 3))
@@ -130,7 +133,8 @@ def test_a_step_keeps_every_bond_or_raises_and_changes_nothing(n, seed, method, 
     bonds = [[i, i + 1] for i in range(n - 1)]
     try:
         s = hr.System(pos, radii, rng.uniform(0.5, 5.0, n), bonds=bonds, dt=dt, method=method,
-                      solver=solver, hydro=hydro, allow_overlap=True, precision=precision)
+                      solver=solver, hydro=hydro, allow_overlap=True, precision=precision,
+                      temperature=temperature, seed=seed)
     except ValueError as e:  # the random walk put one sphere inside another
         assert "inside" in str(e)
         assume(False)

@@ -11,9 +11,12 @@
 //! * `checkpoint.json` with `--checkpoint-every` ([`Checkpoint`]).
 //!
 //! Everything is streamed: memory does not grow with the duration. The state lives in
-//! vectors of any length ([`Beads`]), stepped by the kernel's `step_slices` in storage
-//! sized for the scene's method, rotation flag, solver and bead count ([`Plan`](crate::sizing::Plan)), under
-//! a storage limit checked before anything is built.
+//! vectors of any length ([`Beads`]), held with the bonds, parameters and storage by an
+//! [`Engine`], whose `step` is the one call of the kernel's step in the host code
+//! (storage sized for the scene's method, rotation flag, solver and bead count by
+//! [`Plan`](crate::sizing::Plan), under a storage limit checked before anything is
+//! built). The run itself is a short list of stages (`run_loop.rs`); the CLI's `run`
+//! and the Python package call it through [`run_scene_file`].
 
 mod beads;
 mod checkpoint;
