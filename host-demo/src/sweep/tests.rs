@@ -1,0 +1,1 @@
+//! Sweep files: expansion and errors.
