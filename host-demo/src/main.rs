@@ -378,7 +378,7 @@ fn run(cli: Cli) -> Result<()> {
                         host_demo::sweep::id::canonical_json(&p.statepoint)
                     );
                 }
-                println!("{} points, all valid", sweep.points.len());
+                eprintln!("{} points, all valid", sweep.points.len());
                 return Ok(());
             }
             if let Some(engine) = emit {
