@@ -44,6 +44,7 @@
 //! `summary.json` that describe the execution: `wall_time_s`, `steps_per_second`,
 //! `machine`, and `resumed_from` (the time a resumed run continued from).
 
+mod base;
 pub mod collect;
 pub mod emit;
 mod file;
