@@ -34,11 +34,16 @@ fi
 
 work=$(mktemp -d /tmp/hydrorattle-slurm.XXXXXX)
 chmod 755 "$work"
+started=()   # pids of the daemons this script started, stopped on exit
 cleanup() {
-    local f
-    for f in "$work"/slurmd.pid "$work"/slurmctld.pid "$work"/munged.pid; do
-        [ -s "$f" ] && $sudo kill "$(cat "$f")" 2>/dev/null || true
+    local p
+    for p in "${started[@]}"; do $sudo kill "$p" 2>/dev/null || true; done
+    # Wait for them to end (slurmctld saves its state on the way out) before removing
+    # their folder.
+    for p in "${started[@]}"; do
+        timeout 10 bash -c "while kill -0 $p 2>/dev/null; do sleep 0.1; done" || true
     done
+    if [ "${keep_work:-}" != 1 ]; then rm -rf "$work"; fi
 }
 trap cleanup EXIT
 
@@ -85,14 +90,28 @@ start_slurm() {
     $sudo mkdir -p /run/munge "$work/munge"
     $sudo chown munge:munge /run/munge "$work/munge"
     $sudo chmod 755 /run/munge
-    $sudo runuser -u munge -- /usr/sbin/munged --pid-file="$work/munge/munged.pid" \
-        || $sudo runuser -u munge -- /usr/sbin/munged --force --pid-file="$work/munge/munged.pid" \
-        || return 1
-    cp "$work/munge/munged.pid" "$work/munged.pid" 2>/dev/null || true
+    # A controller or node daemon left running (by another run) would answer in place
+    # of ours: refuse it rather than stop what this script did not start.
+    if pgrep -x slurmctld >/dev/null || pgrep -x slurmd >/dev/null; then
+        echo "a slurmctld or slurmd is already running on this machine (pids $(pgrep -d ' ' -x 'slurmctld|slurmd'))"
+        return 1
+    fi
+    if munge -n </dev/null 2>/dev/null | unmunge >/dev/null 2>&1; then
+        echo "    munged already running"
+    else
+        $sudo runuser -u munge -- /usr/sbin/munged --pid-file="$work/munge/munged.pid" \
+            || $sudo runuser -u munge -- /usr/sbin/munged --force --pid-file="$work/munge/munged.pid" \
+            || return 1
+        started+=("$(cat "$work/munge/munged.pid")")
+    fi
     timeout 10 bash -c 'until munge -n </dev/null | unmunge >/dev/null 2>&1; do sleep 0.2; done' \
         || { echo "munge does not answer"; return 1; }
     $sudo env SLURM_CONF="$SLURM_CONF" /usr/sbin/slurmctld -c || return 1
+    timeout 10 bash -c "until [ -s '$work/slurmctld.pid' ]; do sleep 0.1; done" || return 1
+    started+=("$(cat "$work/slurmctld.pid")")
     $sudo env SLURM_CONF="$SLURM_CONF" /usr/sbin/slurmd -N "$host" || return 1
+    timeout 10 bash -c "until [ -s '$work/slurmd.pid' ]; do sleep 0.1; done" || return 1
+    started+=("$(cat "$work/slurmd.pid")")
     if ! timeout 30 bash -c 'until sinfo -h -o %t 2>/dev/null | grep -qE "^(idle|mix|alloc)"; do sleep 0.5; done'; then
         echo "the node did not come up:"; sinfo 2>&1 || true
         tail -n 20 "$work/slurmctld.log" "$work/slurmd.log" 2>/dev/null || true
@@ -115,12 +134,18 @@ if [ -z "${SLURM_CI_SKIP:-}" ] && start_slurm; then
         --time 00:05:00 --cpus 1 --throttle 2
     cat "$engine_dir/slurm.sh"
     t0=$SECONDS
-    jobid=$(timeout 30 sbatch --parsable "$engine_dir/slurm.sh")
+    if ! jobid=$(timeout 30 sbatch --parsable "$engine_dir/slurm.sh"); then
+        loud "sbatch refused the array job"
+        keep_work=1
+        tail -n 20 "$work/slurmctld.log" 2>/dev/null || true
+        exit 1
+    fi
     echo "    submitted array job $jobid"
     # Polled every half second (sbatch --wait polls slower): done when the queue no
     # longer holds any of its tasks.
     if ! timeout 600 bash -c "while [ -n \"\$(squeue -h -j $jobid 2>/dev/null)\" ]; do sleep 0.5; done"; then
         loud "the SLURM array job did not end within 600 s"
+        keep_work=1
         scontrol show job "$jobid" 2>/dev/null || true
         tail -n 30 "$work/slurmctld.log" "$work/slurmd.log" "$engine_dir"/slurm/*.out 2>/dev/null || true
         exit 1
@@ -176,4 +201,3 @@ print(f"    {len(ids)} points, {files} files equal; collected.csv equal apart fr
 EOF
 cmp "$local_dir/sweep.json" "$engine_dir/sweep.json"
 say "sweep on $engine passed in $(( SECONDS - t_start )) s"
-rm -rf "$work"
