@@ -424,6 +424,71 @@ impl Core {
         }
     }
 
+    /// Replaces the positions, velocities, spins and time given (each `(N, 3)` or a
+    /// float), checked as the kernel checks a particle (finite values): all or nothing.
+    #[pyo3(signature = (positions=None, velocities=None, spins=None, time=None))]
+    fn set_state(
+        &mut self,
+        positions: Option<PyReadonlyArray2<'_, f64>>,
+        velocities: Option<PyReadonlyArray2<'_, f64>>,
+        spins: Option<PyReadonlyArray2<'_, f64>>,
+        time: Option<f64>,
+    ) -> PyResult<()> {
+        let n = each!(&self.inner, e, T => { let _: Option<T> = None; e.beads.len() });
+        let mut new: [Option<&[[f64; 3]]>; 3] = [None; 3];
+        let given = [
+            ("positions", &positions),
+            ("velocities", &velocities),
+            ("spins", &spins),
+        ];
+        for (slot, (what, a)) in new.iter_mut().zip(given) {
+            if let Some(a) = a {
+                let v = rows(a, what)?;
+                if v.len() != n {
+                    return Err(PyValueError::new_err(format!(
+                        "{what} must have shape ({n}, 3), not ({}, 3)",
+                        v.len()
+                    )));
+                }
+                if let Some(k) = v.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
+                    return Err(PyValueError::new_err(format!(
+                        "particle {k}: non-finite {what}"
+                    )));
+                }
+                *slot = Some(v);
+            }
+        }
+        if let Some(t) = time.filter(|t| !t.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "time must be finite, not {t}"
+            )));
+        }
+        each!(&mut self.inner, e, T => {
+            let b = &mut e.beads;
+            for (v, dst) in new.iter().zip([&mut b.pos, &mut b.vel, &mut b.omega]) {
+                if let Some(v) = v {
+                    for (d, &x) in dst.iter_mut().zip(v.iter()) {
+                        *d = T::v3_from(x);
+                    }
+                }
+            }
+            if let Some(t) = time {
+                b.time = T::from_f64(t);
+            }
+            Ok(())
+        })
+    }
+
+    /// An independent copy of the system (state, storage, noise generator).
+    fn copy(&self) -> Core {
+        Core {
+            inner: match &self.inner {
+                Inner::F64(e) => Inner::F64(e.clone()),
+                Inner::F32(e) => Inner::F32(e.clone()),
+            },
+        }
+    }
+
     /// The state's bits (positions, velocities, spins, time, then the noise
     /// generator's next draw on a copy), for exact comparisons.
     fn state_bits(&self) -> Vec<u64> {

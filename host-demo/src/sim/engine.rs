@@ -17,7 +17,9 @@ use crate::sizing::{Plan, TooLarge};
 /// called with candidate positions, possibly more than once per step.
 pub type Extra<'a, T> = &'a mut dyn FnMut(&[<T as Real>::V3], &[T], &mut [<T as Real>::V3]);
 
-/// The state, bonds, parameters and storage of one system in precision `T`.
+/// The state, bonds, parameters and storage of one system in precision `T`. A clone is
+/// an independent system in the same state (noise generator included).
+#[derive(Clone)]
 pub struct Engine<T: Real> {
     /// Particle state (positions, velocities, spins, radii, densities, time).
     pub beads: Beads<T>,

@@ -305,15 +305,49 @@ class System:
         """Centres, ``(N, 3)`` float64 (a copy)."""
         return self._core.positions
 
+    @positions.setter
+    def positions(self, value: Any) -> None:
+        self.set_state(positions=value)
+
     @property
     def velocities(self) -> np.ndarray:
         """Translational velocities, ``(N, 3)`` float64 (a copy)."""
         return self._core.velocities
 
+    @velocities.setter
+    def velocities(self, value: Any) -> None:
+        self.set_state(velocities=value)
+
     @property
     def spins(self) -> np.ndarray:
         """Angular velocities, ``(N, 3)`` float64 (a copy; zero unless ``rotation``)."""
         return self._core.spins
+
+    @spins.setter
+    def spins(self, value: Any) -> None:
+        self.set_state(spins=value)
+
+    def set_state(
+        self,
+        positions: Any = None,
+        velocities: Any = None,
+        spins: Any = None,
+        time: Optional[float] = None,
+    ) -> None:
+        """Replaces the parts of the state given (all or nothing: finite ``(N, 3)``
+        arrays, rounded to the system's precision). Positions off the bond lengths are
+        pulled back onto them by the next step (its constraint solve targets the
+        lengths); one sphere inside another is refused by it."""
+        conv = lambda a, w: None if a is None else _rows(a, w)  # noqa: E731
+        self._core.set_state(
+            conv(positions, "positions"), conv(velocities, "velocities"), conv(spins, "spins"), time
+        )
+
+    def copy(self) -> "System":
+        """An independent system in the same state (noise generator included)."""
+        return System._of(self._core.copy())
+
+    __copy__ = copy
 
     @property
     def radii(self) -> np.ndarray:

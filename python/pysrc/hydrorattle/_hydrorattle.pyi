@@ -93,4 +93,12 @@ class Core:
     time: float
     dt: float
     precision: str
+    def set_state(
+        self,
+        positions: Optional[_F64] = ...,
+        velocities: Optional[_F64] = ...,
+        spins: Optional[_F64] = ...,
+        time: Optional[float] = ...,
+    ) -> None: ...
+    def copy(self) -> Core: ...
     def state_bits(self) -> list[int]: ...
