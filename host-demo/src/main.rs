@@ -2,8 +2,7 @@
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
-use host_demo::scene::Scene;
-use host_demo::sim::{RunOptions, Start, Summary};
+use host_demo::sim::{RunOptions, Summary};
 use host_demo::sizing::{DEFAULT_LIMIT, DEFAULT_OUTPUT_LIMIT, Limits, limit_from_gib};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -205,22 +204,9 @@ fn run(cli: Cli) -> Result<()> {
             checkpoint_every,
         } => {
             let limits = limits(max_storage, max_output);
-            let scene = Scene::from_path_limited(&scene_path, limits)?;
-            log::info!(
-                "scene: {} particles, {} bonds, {:?}, {} steps",
-                scene.particles.len(),
-                scene.bonds.len(),
-                scene.integrator.method,
-                scene.integrator.steps()
-            );
-            let name = scene_name(&scene_path);
-            let opts = file_run(limits, checkpoint_every);
-            let start = Start {
-                scene_path: Some(scene_path),
-                checkpoint: None,
-            };
-            let r = host_demo::sim::run_from(&scene, &name, Some(&out), opts, start)?;
-            host_demo::pictures::draw_run(&out, &r, true)?;
+            let r =
+                host_demo::sim::run_scene_file(&scene_path, &out, limits, checkpoint_every, true)?;
+            let name = host_demo::sim::scene_name(&scene_path);
             report(&name, &r.summary, &out)?;
         }
         Command::Resume {
@@ -231,7 +217,7 @@ fn run(cli: Cli) -> Result<()> {
             max_output,
         } => {
             let limits = limits(max_storage, max_output);
-            let opts = file_run(limits, checkpoint_every);
+            let opts = RunOptions::files(limits, checkpoint_every, true);
             let r = host_demo::sim::resume(&dir, until, limits, opts)?;
             host_demo::pictures::draw_run(&dir, &r, false)?;
             report(&r.summary.scene.clone(), &r.summary, &dir)?;
@@ -461,17 +447,6 @@ fn limits(max_storage: f64, max_output: f64) -> Limits {
     }
 }
 
-/// The options of a run from the command line: progress shown, nothing kept in memory.
-fn file_run(limits: Limits, checkpoint_every: Option<f64>) -> RunOptions<'static> {
-    RunOptions {
-        progress: true,
-        max_storage: limits.storage,
-        keep_series: false,
-        checkpoint_every,
-        ..RunOptions::default()
-    }
-}
-
 /// Prints a run's one-line report; a run that stopped early is an error.
 fn report(name: &str, s: &Summary, out: &std::path::Path) -> Result<()> {
     println!(
@@ -506,11 +481,6 @@ fn gib(s: &str) -> Result<f64, String> {
         Ok(x) if limit_from_gib(x).is_some() => Ok(x),
         _ => Err(format!("expected a positive number of GiB, not {s:?}")),
     }
-}
-
-fn scene_name(path: &std::path::Path) -> String {
-    path.file_stem()
-        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned())
 }
 
 fn main() -> ExitCode {
