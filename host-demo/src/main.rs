@@ -151,6 +151,9 @@ enum Command {
         /// SLURM: CPUs per task; GNU parallel: jobs at once.
         #[arg(long, default_value_t = 1)]
         cpus: usize,
+        /// The host-demo the engine runs (default: this program, by its absolute path).
+        #[arg(long, value_name = "PATH")]
+        program: Option<PathBuf>,
     },
     /// Merge a sweep's points into DIR/collected.csv; list missing and failed points
     /// (exit status 1 if any).
@@ -353,6 +356,7 @@ fn run(cli: Cli) -> Result<()> {
             partition,
             time,
             cpus,
+            program,
         } => {
             use host_demo::sweep::{Selection, Sweep, run};
             let sweep = Sweep::from_path(&file)?;
@@ -374,6 +378,7 @@ fn run(cli: Cli) -> Result<()> {
                     partition,
                     time,
                     cpus,
+                    program,
                 };
                 let (path, command) = host_demo::sweep::emit(engine, &sweep, &file, &out, &opts)?;
                 println!(

@@ -37,6 +37,9 @@ pub struct SlurmOptions {
     pub time: Option<String>,
     /// CPUs per task (points run at once in a task).
     pub cpus: usize,
+    /// The `host-demo` the tasks run (default: this program), for nodes where it is
+    /// installed elsewhere.
+    pub program: Option<PathBuf>,
 }
 
 /// Quotes `s` for a POSIX shell.
@@ -65,8 +68,11 @@ pub fn emit(
     slurm: &SlurmOptions,
 ) -> Result<(PathBuf, String)> {
     prepare_points(sweep, dir)?;
-    let exe = std::env::current_exe().context("finding this program")?;
-    let (exe, file, dir) = (absolute(&exe)?, absolute(file)?, absolute(dir)?);
+    let exe = match &slurm.program {
+        Some(p) => p.clone(),
+        None => absolute(&std::env::current_exe().context("finding this program")?)?,
+    };
+    let (file, dir) = (absolute(file)?, absolute(dir)?);
     let base = format!(
         "{} sweep {} --out {}",
         sh(&exe.display().to_string()),
