@@ -8,7 +8,9 @@
 //! * [`render`]: sphere pictures (side and top views, the Figure 1 layout, snapshots,
 //!   GIF animations), state timelines and charts;
 //! * [`pictures`]: the pictures of a run and of Figure 1;
-//! * [`progress`]: a progress bar that stays out of the way of short or piped runs.
+//! * [`progress`]: a progress bar that stays out of the way of short or piped runs;
+//! * [`sweep`]: parameter sweeps (sweep files, point folders with signac ids, SLURM and
+//!   GNU parallel engines, the collected table).
 
 pub mod auto;
 pub mod charts;
@@ -24,4 +26,5 @@ pub mod render;
 pub mod scene;
 pub mod sim;
 pub mod sizing;
+pub mod sweep;
 pub mod timeline;

@@ -2,8 +2,7 @@
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
-use host_demo::scene::Scene;
-use host_demo::sim::{RunOptions, Start, Summary};
+use host_demo::sim::{RunOptions, Summary};
 use host_demo::sizing::{DEFAULT_LIMIT, DEFAULT_OUTPUT_LIMIT, Limits, limit_from_gib};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -109,6 +108,66 @@ enum Command {
         #[arg(long)]
         no_sensitivity: bool,
     },
+    /// Run a sweep file's points in DIR/points/<id>/ (finished points skipped,
+    /// unfinished ones resumed), or write the job script of an engine that runs them.
+    Sweep {
+        /// The sweep file (a scene with a [sweep] table, or [sweep] with base = ...).
+        file: PathBuf,
+        /// The sweep's folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Run shard K of N only (K from 0, as SLURM array task ids): the points whose
+        /// index is K modulo N.
+        #[arg(long, value_name = "K/N", conflicts_with = "point")]
+        shard: Option<String>,
+        /// Run this point only (its id, or a unique prefix of at least 4 characters).
+        #[arg(long, value_name = "ID")]
+        point: Option<String>,
+        /// Points run at once (default: the CPUs available).
+        #[arg(long, value_name = "J")]
+        jobs: Option<usize>,
+        /// Checkpoint every T of simulated time (default: about ten per run).
+        #[arg(long, value_name = "T", value_parser = positive)]
+        checkpoint_every: Option<f64>,
+        /// Expand and check the sweep, list its points, run nothing.
+        #[arg(long, conflicts_with_all = ["shard", "point", "emit"])]
+        dry_run: bool,
+        /// Write the point folders and an engine's job file instead of running:
+        /// DIR/slurm.sh, DIR/parallel.sh or DIR/workflow.toml (row).
+        #[arg(long, value_enum, conflicts_with_all = ["shard", "point"])]
+        emit: Option<host_demo::sweep::Engine>,
+        /// SLURM: array tasks (default: one per point, at most 1000).
+        #[arg(long, value_name = "N")]
+        tasks: Option<usize>,
+        /// SLURM: at most M tasks at once (%M).
+        #[arg(long, value_name = "M")]
+        throttle: Option<usize>,
+        /// SLURM: partition.
+        #[arg(long)]
+        partition: Option<String>,
+        /// SLURM (and row): time limit per task, as HH:MM:SS.
+        #[arg(long)]
+        time: Option<String>,
+        /// SLURM: CPUs per task; GNU parallel: jobs at once.
+        #[arg(long, default_value_t = 1)]
+        cpus: usize,
+        /// The host-demo the engine runs (default: this program, by its absolute path).
+        #[arg(long, value_name = "PATH")]
+        program: Option<PathBuf>,
+    },
+    /// Merge a sweep's points into DIR/collected.csv; list missing and failed points
+    /// (exit status 1 if any).
+    Collect {
+        /// The sweep's folder.
+        dir: PathBuf,
+        /// Chart: this parameter (a dotted key) on the horizontal axis...
+        #[arg(long, requires = "y")]
+        x: Option<String>,
+        /// ...and this column of collected.csv on the vertical (replica means, bars:
+        /// standard error).
+        #[arg(long, requires = "x")]
+        y: Option<String>,
+    },
     /// Accuracy and speed charts of the integrators and solvers.
     Chart {
         /// Output directory.
@@ -145,22 +204,9 @@ fn run(cli: Cli) -> Result<()> {
             checkpoint_every,
         } => {
             let limits = limits(max_storage, max_output);
-            let scene = Scene::from_path_limited(&scene_path, limits)?;
-            log::info!(
-                "scene: {} particles, {} bonds, {:?}, {} steps",
-                scene.particles.len(),
-                scene.bonds.len(),
-                scene.integrator.method,
-                scene.integrator.steps()
-            );
-            let name = scene_name(&scene_path);
-            let opts = file_run(limits, checkpoint_every);
-            let start = Start {
-                scene_path: Some(scene_path),
-                checkpoint: None,
-            };
-            let r = host_demo::sim::run_from(&scene, &name, Some(&out), opts, start)?;
-            host_demo::pictures::draw_run(&out, &r, true)?;
+            let r =
+                host_demo::sim::run_scene_file(&scene_path, &out, limits, checkpoint_every, true)?;
+            let name = host_demo::sim::scene_name(&scene_path);
             report(&name, &r.summary, &out)?;
         }
         Command::Resume {
@@ -171,7 +217,7 @@ fn run(cli: Cli) -> Result<()> {
             max_output,
         } => {
             let limits = limits(max_storage, max_output);
-            let opts = file_run(limits, checkpoint_every);
+            let opts = RunOptions::files(limits, checkpoint_every, true);
             let r = host_demo::sim::resume(&dir, until, limits, opts)?;
             host_demo::pictures::draw_run(&dir, &r, false)?;
             report(&r.summary.scene.clone(), &r.summary, &dir)?;
@@ -296,6 +342,88 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
         }
+        Command::Sweep {
+            file,
+            out,
+            shard,
+            point,
+            jobs,
+            checkpoint_every,
+            dry_run,
+            emit,
+            tasks,
+            throttle,
+            partition,
+            time,
+            cpus,
+            program,
+        } => {
+            use host_demo::sweep::{Selection, Sweep, run};
+            let sweep = Sweep::from_path(&file)?;
+            if dry_run {
+                for p in &sweep.points {
+                    println!(
+                        "{} {}",
+                        p.id,
+                        host_demo::sweep::id::canonical_json(&p.statepoint)
+                    );
+                }
+                eprintln!("{} points, all valid", sweep.points.len());
+                return Ok(());
+            }
+            if let Some(engine) = emit {
+                let opts = host_demo::sweep::SlurmOptions {
+                    tasks,
+                    throttle,
+                    partition,
+                    time,
+                    cpus,
+                    program,
+                };
+                let (path, command) = host_demo::sweep::emit(engine, &sweep, &file, &out, &opts)?;
+                println!(
+                    "{} points; wrote {}\n{command}",
+                    sweep.points.len(),
+                    path.display()
+                );
+                return Ok(());
+            }
+            let selection = match (shard, point) {
+                (Some(s), _) => Selection::shard(&s)?,
+                (None, Some(id)) => Selection::Point(id),
+                (None, None) => Selection::All,
+            };
+            let jobs =
+                jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+            let t = std::time::Instant::now();
+            let opts = run::Options {
+                jobs,
+                checkpoint_every,
+            };
+            let report = host_demo::sweep::run_points(&sweep, &out, &selection, opts)?;
+            println!(
+                "{report} in {:.1} s; wrote {}",
+                t.elapsed().as_secs_f64(),
+                out.display()
+            );
+            if !report.failed.is_empty() {
+                anyhow::bail!("{} points could not be run", report.failed.len());
+            }
+        }
+        Command::Collect { dir, x, y } => {
+            let chart = x.as_deref().zip(y.as_deref());
+            let c = host_demo::sweep::collect(&dir, chart)?;
+            println!("{} points; wrote {}", c.points, c.csv.display());
+            if let Some(p) = &c.chart {
+                println!("wrote {}", p.display());
+            }
+            if !c.problems.is_empty() {
+                for (id, status, why) in &c.problems {
+                    println!("{id} {status} {why}");
+                }
+                anyhow::bail!("{} of {} points are not done", c.problems.len(), c.points);
+            }
+        }
         Command::Chart { out, quick } => {
             let t = std::time::Instant::now();
             for note in host_demo::charts::charts(&out, quick)? {
@@ -316,17 +444,6 @@ fn limits(max_storage: f64, max_output: f64) -> Limits {
     Limits {
         storage: limit_from_gib(max_storage).unwrap_or(DEFAULT_LIMIT),
         output: limit_from_gib(max_output).map_or(DEFAULT_OUTPUT_LIMIT, |b| b as u64),
-    }
-}
-
-/// The options of a run from the command line: progress shown, nothing kept in memory.
-fn file_run(limits: Limits, checkpoint_every: Option<f64>) -> RunOptions<'static> {
-    RunOptions {
-        progress: true,
-        max_storage: limits.storage,
-        keep_series: false,
-        checkpoint_every,
-        ..RunOptions::default()
     }
 }
 
@@ -364,11 +481,6 @@ fn gib(s: &str) -> Result<f64, String> {
         Ok(x) if limit_from_gib(x).is_some() => Ok(x),
         _ => Err(format!("expected a positive number of GiB, not {s:?}")),
     }
-}
-
-fn scene_name(path: &std::path::Path) -> String {
-    path.file_stem()
-        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned())
 }
 
 fn main() -> ExitCode {

@@ -47,7 +47,9 @@ pub fn with_helix(template: &Scene, helix: Helix) -> Result<Scene> {
     Ok(s)
 }
 
-fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
+/// `n` evenly spaced values from `a` to `b` (both included; `a` alone for `n = 1`): the
+/// phase grid, and `linspace` in sweep files.
+pub fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
     (0..n)
         .map(|k| a + (b - a) * k as f64 / (n - 1).max(1) as f64)
         .collect()

@@ -114,6 +114,11 @@ impl<W: Write + Seek> GsdWriter<W> {
         self.frames
     }
 
+    /// Passes the frames written so far on to the file (a checkpoint names them).
+    pub fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
+
     /// The chunks of frame `frame`, in id order.
     fn shapes(&self, frame: u64) -> Vec<Shape> {
         shapes(&self.topology, frame)

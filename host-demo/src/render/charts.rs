@@ -45,26 +45,47 @@ fn padded_range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
     }
 }
 
+/// A series as drawn: its name and `(x, y, error bar half-width)` points.
+type Drawn<'a> = (&'a str, Vec<(f64, f64, f64)>);
+
 /// Draws a line chart to a PNG of `size` pixels.
 pub fn line_chart(path: &Path, chart: &LineChart, size: (u32, u32)) -> Result<()> {
-    let keep = |&(x, y): &(f64, f64)| {
+    line_chart_with_errors(path, chart, &[], size)
+}
+
+/// [`line_chart`] with error bars: `errors[s][k]` is the half-width of the bar at point
+/// `k` of series `s` (a series without an entry, or a zero, has none).
+pub fn line_chart_with_errors(
+    path: &Path,
+    chart: &LineChart,
+    errors: &[Vec<f64>],
+    size: (u32, u32),
+) -> Result<()> {
+    let keep = |&(x, y, _): &(f64, f64, f64)| {
         x.is_finite() && y.is_finite() && (!chart.log_x || x > 0.0) && (!chart.log_y || y > 0.0)
     };
-    let series: Vec<(&str, Vec<(f64, f64)>)> = chart
+    let series: Vec<Drawn<'_>> = chart
         .series
         .iter()
-        .map(|s| {
-            (
-                s.name.as_str(),
-                s.points.iter().copied().filter(keep).collect(),
-            )
+        .enumerate()
+        .map(|(n, s)| {
+            let err = |k: usize| errors.get(n).and_then(|e| e.get(k)).copied();
+            let points = s.points.iter().enumerate();
+            let with_err =
+                points.map(|(k, &(x, y))| (x, y, err(k).filter(|e| e.is_finite()).unwrap_or(0.0)));
+            (s.name.as_str(), with_err.filter(keep).collect())
         })
         .collect();
     let all = series.iter().flat_map(|(_, p)| p.iter());
     let (mut x0, mut x1, mut y0, mut y1) =
         (f64::INFINITY, -f64::INFINITY, f64::INFINITY, -f64::INFINITY);
-    for &(x, y) in all {
-        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    for &(x, y, e) in all {
+        let (lo, hi) = if chart.log_y && y - e <= 0.0 {
+            (y, y + e)
+        } else {
+            (y - e, y + e)
+        };
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(lo), y1.max(hi));
     }
     if x0 > x1 {
         return Err(anyhow!(
@@ -92,7 +113,7 @@ pub fn line_chart(path: &Path, chart: &LineChart, size: (u32, u32)) -> Result<()
 fn plot_lines<DB, X, Y>(
     root: &DrawingArea<DB, Shift>,
     chart: &LineChart,
-    series: &[(&str, Vec<(f64, f64)>)],
+    series: &[Drawn<'_>],
     x: X,
     y: Y,
     k: f64,
@@ -130,7 +151,7 @@ where
         let color = SERIES_COLORS[n % SERIES_COLORS.len()];
         let line = color.stroke_width(w(2.0));
         let (len, marker) = (px(k, 22.0), px(k, 3.0));
-        ctx.draw_series(LineSeries::new(points.iter().copied(), line))
+        ctx.draw_series(LineSeries::new(points.iter().map(|p| (p.0, p.1)), line))
             .map_err(drawing)?
             .label(*name)
             .legend(move |(x, y)| {
@@ -141,9 +162,25 @@ where
         ctx.draw_series(
             points
                 .iter()
-                .map(|&p| Circle::new(p, marker, color.filled())),
+                .map(|&(x, y, _)| Circle::new((x, y), marker, color.filled())),
         )
         .map_err(drawing)?;
+        let bars = points.iter().filter(|p| p.2 > 0.0).map(|&(x, y, e)| {
+            let lo = if chart.log_y && y - e <= 0.0 {
+                y
+            } else {
+                y - e
+            };
+            ErrorBar::new_vertical(
+                x,
+                lo,
+                y,
+                y + e,
+                color.stroke_width(w(1.5)),
+                px(k, 8.0) as u32,
+            )
+        });
+        ctx.draw_series(bars).map_err(drawing)?;
     }
     if series.iter().any(|(name, _)| !name.is_empty()) {
         ctx.configure_series_labels()

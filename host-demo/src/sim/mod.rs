@@ -11,12 +11,16 @@
 //! * `checkpoint.json` with `--checkpoint-every` ([`Checkpoint`]).
 //!
 //! Everything is streamed: memory does not grow with the duration. The state lives in
-//! vectors of any length ([`Beads`]), stepped by the kernel's `step_slices` in storage
-//! sized for the scene's method, rotation flag, solver and bead count ([`Plan`](crate::sizing::Plan)), under
-//! a storage limit checked before anything is built.
+//! vectors of any length ([`Beads`]), held with the bonds, parameters and storage by an
+//! [`Engine`], whose `step` is the one call of the kernel's step in the host code
+//! (storage sized for the scene's method, rotation flag, solver and bead count by
+//! [`Plan`](crate::sizing::Plan), under a storage limit checked before anything is
+//! built). The run itself is a short list of stages (`run_loop.rs`); the CLI's `run`
+//! and the Python package call it through [`run_scene_file`].
 
 mod beads;
 mod checkpoint;
+mod engine;
 mod frames;
 mod record;
 pub mod retry;
@@ -25,6 +29,7 @@ mod tail;
 
 pub use beads::{Beads, BuildError, bonds};
 pub use checkpoint::{CHECKPOINT, Checkpoint};
+pub use engine::{Engine, Extra};
 pub use frames::{KeepFrames, MAX_FRAME_BEADS, MAX_FRAMES, step_at_or_after};
 pub use record::{
     COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
@@ -37,7 +42,6 @@ use anyhow::{Context, Result, bail};
 use hydrorattle::{Hydro, Params, Real, Solver as KSolver};
 use serde::Serialize;
 
-use crate::output::{write_atomic, write_json};
 use crate::provenance::{CODE_VERSION, Machine};
 use crate::render::Snapshot;
 use crate::scene::{Flow, Fluid, Hydrodynamics, Precision, Scene};
@@ -213,6 +217,19 @@ impl Default for RunOptions<'_> {
     }
 }
 
+impl RunOptions<'static> {
+    /// The options of a run into files, as the CLI makes them: nothing kept in memory.
+    pub fn files(limits: Limits, checkpoint_every: Option<f64>, progress: bool) -> Self {
+        RunOptions {
+            progress,
+            max_storage: limits.storage,
+            keep_series: false,
+            checkpoint_every,
+            ..RunOptions::default()
+        }
+    }
+}
+
 /// Runs `scene`, writing the run's files into `out` when given. Refuses (before
 /// writing anything) a scene whose step storage would exceed `opts.max_storage`.
 pub fn run(scene: &Scene, name: &str, out: Option<&Path>, opts: RunOptions) -> Result<RunResult> {
@@ -237,39 +254,68 @@ pub fn run_from(
     opts: RunOptions,
     start: Start,
 ) -> Result<RunResult> {
-    let choice =
-        (scene.model.level == crate::scene::Level::Auto).then(|| crate::auto::choose(scene));
-    let scene = match &choice {
-        Some(c) => {
-            log::info!("{name}: level auto: {}", c.reason);
-            crate::auto::apply(scene, c)
-        }
-        None => scene.clone(),
-    };
+    let (scene, choice) = resolve_level(scene, name);
     let fresh = out.filter(|d| !d.exists());
-    let checkpoint = start.checkpoint.as_ref();
+    let origin = run_loop::Origin {
+        scene_path: start.scene_path.map(|p| p.display().to_string()),
+        level_choice: choice,
+        checkpoint: start.checkpoint.as_ref(),
+    };
     let result = match scene.integrator.precision {
-        Precision::F64 => run_loop::run_t::<f64>(&scene, name, out, opts, checkpoint),
-        Precision::F32 => run_loop::run_t::<f32>(&scene, name, out, opts, checkpoint),
-    }
-    .and_then(|mut r| {
-        r.summary.scene_path = start.scene_path.map(|p| p.display().to_string());
-        r.summary.level_choice = choice;
-        r.summary.resumed_from = checkpoint.map(Checkpoint::time);
-        r.summary.resolved_scene.model.level = crate::scene::Level::Manual;
-        if let Some(dir) = out {
-            let resolved = &r.summary.resolved_scene;
-            write_atomic(&dir.join(SCENE_TOML), resolved.to_toml().as_bytes())?;
-            write_json(&dir.join(SUMMARY_JSON), &r.summary)?;
-        }
-        Ok(r)
-    });
+        Precision::F64 => run_loop::run_t::<f64>(&scene, name, out, opts, origin),
+        Precision::F32 => run_loop::run_t::<f32>(&scene, name, out, opts, origin),
+    };
     if result.is_err() {
         if let Some(dir) = fresh.filter(|d| d.exists()) {
             let _ = std::fs::remove_dir_all(dir);
         }
     }
     result
+}
+
+/// `scene` with `level = "auto"` applied (and what was chosen), or as it is.
+pub fn resolve_level(scene: &Scene, name: &str) -> (Scene, Option<crate::auto::Choice>) {
+    if scene.model.level != crate::scene::Level::Auto {
+        return (scene.clone(), None);
+    }
+    let c = crate::auto::choose(scene);
+    log::info!("{name}: level auto: {}", c.reason);
+    (crate::auto::apply(scene, &c), Some(c))
+}
+
+/// What `host-demo run SCENE --out OUT` does: reads the scene file under `limits`,
+/// runs it into `out` (named after the file) and draws the run's pictures. The CLI and
+/// the Python package (`hydrorattle.run_scene`) both call this.
+pub fn run_scene_file(
+    scene_path: &Path,
+    out: &Path,
+    limits: Limits,
+    checkpoint_every: Option<f64>,
+    progress: bool,
+) -> Result<RunResult> {
+    let scene = Scene::from_path_limited(scene_path, limits)?;
+    log::info!(
+        "scene: {} particles, {} bonds, {:?}, {} steps",
+        scene.particles.len(),
+        scene.bonds.len(),
+        scene.integrator.method,
+        scene.integrator.steps()
+    );
+    let name = scene_name(scene_path);
+    let opts = RunOptions::files(limits, checkpoint_every, progress);
+    let start = Start {
+        scene_path: Some(scene_path.to_path_buf()),
+        checkpoint: None,
+    };
+    let r = run_from(&scene, &name, Some(out), opts, start)?;
+    crate::pictures::draw_run(out, &r, true)?;
+    Ok(r)
+}
+
+/// A run's name from its scene file: the file stem.
+pub fn scene_name(path: &Path) -> String {
+    path.file_stem()
+        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned())
 }
 
 /// Continues the run whose files are in `dir` from its checkpoint to simulated time

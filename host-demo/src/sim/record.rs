@@ -328,6 +328,9 @@ impl Recorder {
                 ..Marks::default()
             });
         };
+        // The GSD writer's buffer too: a run killed after this checkpoint must find
+        // every frame the checkpoint counts in the file.
+        f.gsd.flush()?;
         Ok(Marks {
             frames,
             xyz_bytes: f.xyz.get_mut().stream_position()?,

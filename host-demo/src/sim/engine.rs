@@ -1,0 +1,137 @@
+//! A system ready to step: the particle state, bonds, kernel parameters, step storage,
+//! noise generator and the scene's soft contact. The run loop and the Python package
+//! step through [`Engine::step`], the one place in the host code that calls the kernel's
+//! step.
+
+use hydrorattle::{
+    Bond, ExternalForce, Layout, Noise, Params, Real, SoftContact, StepError, StepReport,
+};
+use hydrorattle_heap::Buffers;
+
+use super::retry::{self, Retries};
+use super::{Beads, BuildError, bonds, params};
+use crate::scene::{DEFAULT_SEED, Overlap, Scene};
+use crate::sizing::{Plan, TooLarge};
+
+/// Extra forces added after gravity and the soft contact: `(positions, radii, forces)`,
+/// called with candidate positions, possibly more than once per step.
+pub type Extra<'a, T> = &'a mut dyn FnMut(&[<T as Real>::V3], &[T], &mut [<T as Real>::V3]);
+
+/// The state, bonds, parameters and storage of one system in precision `T`. A clone is
+/// an independent system in the same state (noise generator included).
+#[derive(Clone)]
+pub struct Engine<T: Real> {
+    /// Particle state (positions, velocities, spins, radii, densities, time).
+    pub beads: Beads<T>,
+    /// Bonds (validated against the particles).
+    pub bonds: Vec<Bond<T>>,
+    /// Kernel parameters.
+    pub params: Params<T>,
+    /// Thermal noise generator (drawn from only when `params.brownian` is on).
+    pub noise: Noise,
+    /// The soft contact force, when the scene asks for one.
+    pub contact: Option<SoftContact<T>>,
+    /// Brownian steps refused and completed as split steps so far ([`retry`]).
+    pub retries: Retries,
+    store: Buffers<T>,
+}
+
+impl<T: Real> Engine<T> {
+    /// The system of `scene` (its level already applied): particles and bonds checked,
+    /// storage sized for its method and refused beyond `limit` bytes before any
+    /// `O(N^2)` work.
+    pub fn new(scene: &Scene, limit: usize) -> Result<Self, BuildError> {
+        let p = params::<T>(scene);
+        let (n, b) = (scene.particles.len(), scene.bonds.len());
+        let layout = Plan::of(scene).check(n, b, limit)?;
+        // Thermal noise needs the mobility's factor on top (`Layout::thermal`).
+        let layout = match scene.brownian {
+            Some(_) => layout.thermal(p.method, n, b),
+            None => layout,
+        };
+        let beads = Beads::<T>::new(&scene.particles, 1.0)?;
+        beads.check_pairs(scene.model.overlap == Overlap::Allow)?;
+        let bonds = bonds::<T>(&scene.bonds, n)?;
+        let noise = Noise::new(scene.brownian.map_or(DEFAULT_SEED, |b| b.seed));
+        let contact = scene.contact.and_then(|c| c.soft()).map(|k| SoftContact {
+            stiffness: T::from_f64(k),
+        });
+        Self::with_layout(beads, bonds, p, noise, contact, layout, limit)
+    }
+
+    /// A system from its parts (checked by the caller), with storage sized by the
+    /// kernel's rule for `params` ([`Layout::for_params`]), refused beyond `limit`
+    /// bytes.
+    pub fn from_parts(
+        beads: Beads<T>,
+        bonds: Vec<Bond<T>>,
+        params: Params<T>,
+        noise: Noise,
+        contact: Option<SoftContact<T>>,
+        limit: usize,
+    ) -> Result<Self, BuildError> {
+        let layout = Layout::for_params(&params, beads.len(), bonds.len());
+        Self::with_layout(beads, bonds, params, noise, contact, layout, limit)
+    }
+
+    /// Storage for `layout`, within `limit` bytes.
+    fn with_layout(
+        beads: Beads<T>,
+        bonds: Vec<Bond<T>>,
+        params: Params<T>,
+        noise: Noise,
+        contact: Option<SoftContact<T>>,
+        layout: Layout,
+        limit: usize,
+    ) -> Result<Self, BuildError> {
+        let (n, b) = (beads.len(), bonds.len());
+        let bytes = layout.bytes::<T>();
+        if bytes > limit {
+            return Err(TooLarge {
+                particles: n,
+                bonds: b,
+                bytes: Some(bytes),
+                limit,
+            }
+            .into());
+        }
+        let store = Buffers::try_new(layout).map_err(|_| BuildError::OutOfMemory(bytes))?;
+        Ok(Engine {
+            beads,
+            bonds,
+            params,
+            noise,
+            contact,
+            retries: Retries::default(),
+            store,
+        })
+    }
+
+    /// One step with the scene's forces only.
+    pub fn step(&mut self) -> Result<StepReport<T>, StepError> {
+        self.step_with(&mut |_: &[T::V3], _: &[T], _: &mut [T::V3]| {})
+    }
+
+    /// One step, `extra` adding forces after gravity and the soft contact; a Brownian
+    /// step the kernel refuses is retried split along a Brownian bridge ([`retry`]).
+    /// A failed step leaves the state and the noise generator as they were.
+    pub fn step_with(&mut self, extra: Extra<'_, T>) -> Result<StepReport<T>, StepError> {
+        let contact = self.contact;
+        let mut ext = |pos: &[T::V3], radius: &[T], force: &mut [T::V3]| {
+            if let Some(mut c) = contact {
+                c.add(pos, radius, force);
+            }
+            extra(pos, radius, force);
+        };
+        let mut ws = self.store.workspace();
+        retry::step(
+            &mut self.beads,
+            &self.bonds,
+            &self.params,
+            &mut ws,
+            &mut ext,
+            &mut self.noise,
+            &mut self.retries,
+        )
+    }
+}

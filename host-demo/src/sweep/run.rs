@@ -1,0 +1,348 @@
+//! Running a sweep's points: each in its own folder, skipped when finished, resumed
+//! from its checkpoint when unfinished, and otherwise run from the start.
+//!
+//! A point is *finished* when its folder holds `summary.json` and a `scene.toml` equal
+//! to the point's resolved scene (the run writes both last). It is *resumable* when its
+//! `scene.toml` is the point's and a `checkpoint.json` is there (a run stopped by a
+//! signal or a time limit): it continues from the checkpoint, and its files come out
+//! byte for byte as those of an uninterrupted run. Anything else (a new point, a
+//! changed scene, a run that failed to start) is run from the start, its old run files
+//! removed first. Thermal-noise runs write no checkpoints (the noise generator's state
+//! is not saved), so an unfinished one is run again from the start.
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use anyhow::{Context, Result, bail};
+use rayon::prelude::*;
+
+use super::file::describe;
+use super::{POINTS, Point, STATEPOINT_JSON, SWEEP_JSON, Sweep, id::canonical_json};
+use crate::output::tmp_path;
+use crate::scene::{Level, Scene};
+use crate::sim::{
+    CHECKPOINT, Checkpoint, OBSERVABLES_CSV, SCENE_TOML, SUMMARY_JSON, Start, Summary,
+    TRAJECTORY_GSD, TRAJECTORY_XYZ,
+};
+
+/// A failed start, written in the point's folder (removed when the point runs again).
+pub const ERROR_TXT: &str = "error.txt";
+
+/// Which points a process runs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Selection {
+    /// Every point.
+    All,
+    /// Shard `k` of `n` (`k` from 0, as SLURM array task ids): the points whose index
+    /// is `k` modulo `n`.
+    Shard {
+        /// This shard.
+        k: usize,
+        /// Number of shards.
+        n: usize,
+    },
+    /// One point, by id (or a unique prefix of at least 4 characters).
+    Point(String),
+}
+
+impl Selection {
+    /// Parses `K/N`.
+    pub fn shard(text: &str) -> Result<Selection> {
+        let parsed = text
+            .split_once('/')
+            .and_then(|(k, n)| Some((k.trim().parse().ok()?, n.trim().parse().ok()?)));
+        match parsed {
+            Some((k, n)) if n >= 1 && k < n => Ok(Selection::Shard { k, n }),
+            _ => bail!("--shard takes K/N with 0 <= K < N (K counted from 0), not {text:?}"),
+        }
+    }
+
+    /// The selected points of `sweep`.
+    pub fn points<'a>(&self, sweep: &'a Sweep) -> Result<Vec<&'a Point>> {
+        Ok(match self {
+            Selection::All => sweep.points.iter().collect(),
+            Selection::Shard { k, n } => {
+                sweep.points.iter().filter(|p| p.index % n == *k).collect()
+            }
+            Selection::Point(id) => match sweep.find(id) {
+                Some(p) => vec![p],
+                None => bail!("the sweep has no point {id:?} (see sweep.json)"),
+            },
+        })
+    }
+}
+
+/// How a process runs its points.
+#[derive(Debug, Clone, Copy)]
+pub struct Options {
+    /// Points run at once (threads).
+    pub jobs: usize,
+    /// Checkpoint every this much simulated time; None: about ten per run, on frames.
+    pub checkpoint_every: Option<f64>,
+}
+
+/// What happened to one point.
+#[derive(Debug, Clone)]
+pub enum Outcome {
+    /// Already finished: not run.
+    Skipped,
+    /// Run, from the start or from its checkpoint (`resumed_from`).
+    Ran(Box<Summary>),
+    /// Could not be run (the message is also in the folder's `error.txt`).
+    Failed(String),
+}
+
+/// What a process did.
+#[derive(Debug, Clone, Default)]
+pub struct RunReport {
+    /// Points selected.
+    pub selected: usize,
+    /// Already finished.
+    pub skipped: usize,
+    /// Run from the start.
+    pub ran: usize,
+    /// Continued from a checkpoint.
+    pub resumed: usize,
+    /// Runs that stopped early (a step failed): finished, with their failure recorded.
+    pub stopped_early: Vec<String>,
+    /// Points that could not be run, with why.
+    pub failed: Vec<(String, String)>,
+}
+
+impl std::fmt::Display for RunReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "ran {} of {} points ({} from the start, {} resumed from their checkpoints), {} already finished, {} stopped early, {} failed",
+            self.ran + self.resumed,
+            self.selected,
+            self.ran,
+            self.resumed,
+            self.skipped,
+            self.stopped_early.len(),
+            self.failed.len()
+        )
+    }
+}
+
+/// The folder of point `id` under the sweep folder `dir`.
+pub fn point_dir(dir: &Path, id: &str) -> PathBuf {
+    dir.join(POINTS).join(id)
+}
+
+/// The scene as a run records it: `level = "auto"` applied, level manual.
+pub fn as_run(scene: &Scene) -> Scene {
+    let mut s = match scene.model.level {
+        Level::Auto => crate::auto::apply(scene, &crate::auto::choose(scene)),
+        Level::Manual => scene.clone(),
+    };
+    s.model.level = Level::Manual;
+    s
+}
+
+/// Writes `bytes` to `path` unless it already holds them, under a temporary name of
+/// this process (several processes may write the same file at once).
+fn write_same(path: &Path, bytes: &[u8]) -> Result<()> {
+    if std::fs::read(path).is_ok_and(|b| b == bytes) {
+        return Ok(());
+    }
+    let tmp = path.with_extension(format!("tmp.{}", std::process::id()));
+    std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))
+}
+
+/// Writes the sweep's own files in `dir`: `sweep.json`, and the signac project files
+/// (`.signac/config`, `workspace` linked to `points`).
+pub fn write_sweep(sweep: &Sweep, dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir.join(POINTS))
+        .with_context(|| format!("creating {}", dir.join(POINTS).display()))?;
+    let mut json = serde_json::to_vec_pretty(&sweep.record())?;
+    json.push(b'\n');
+    write_same(&dir.join(SWEEP_JSON), &json)?;
+    std::fs::create_dir_all(dir.join(".signac"))?;
+    write_same(&dir.join(".signac/config"), b"schema_version = 2\n")?;
+    let link = dir.join("workspace");
+    if std::fs::symlink_metadata(&link).is_err() {
+        #[cfg(unix)]
+        if let Err(e) = std::os::unix::fs::symlink(POINTS, &link) {
+            if std::fs::symlink_metadata(&link).is_err() {
+                log::warn!("{}: cannot link to {POINTS}: {e}", link.display());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Where a point stands.
+enum State {
+    Finished,
+    Resumable(Box<Checkpoint>),
+    New,
+}
+
+fn state(pdir: &Path, scene_text: &str, scene: &Scene) -> State {
+    let same_scene = std::fs::read_to_string(pdir.join(SCENE_TOML)).is_ok_and(|t| t == scene_text);
+    if !same_scene {
+        return State::New;
+    }
+    if pdir.join(SUMMARY_JSON).is_file() {
+        return State::Finished;
+    }
+    match Checkpoint::load(pdir) {
+        Ok(c) if c.precision == scene.integrator.precision => State::Resumable(Box::new(c)),
+        _ => State::New,
+    }
+}
+
+/// Clears a point's folder of run files and writes its state point and scene.
+fn prepare(point: &Point, pdir: &Path, scene_text: &str) -> Result<()> {
+    std::fs::create_dir_all(pdir).with_context(|| format!("creating {}", pdir.display()))?;
+    for name in [
+        SUMMARY_JSON,
+        CHECKPOINT,
+        OBSERVABLES_CSV,
+        TRAJECTORY_XYZ,
+        TRAJECTORY_GSD,
+        ERROR_TXT,
+    ] {
+        let path = pdir.join(name);
+        for p in [tmp_path(&path), path] {
+            if p.exists() {
+                std::fs::remove_file(&p).with_context(|| format!("removing {}", p.display()))?;
+            }
+        }
+    }
+    let mut sp = canonical_json(&point.statepoint).into_bytes();
+    sp.push(b'\n');
+    write_same(&pdir.join(STATEPOINT_JSON), &sp)?;
+    write_same(&pdir.join(SCENE_TOML), scene_text.as_bytes())
+}
+
+/// Writes the folders of the points that are not finished or resumable (state point
+/// and scene), without running them: what `--emit` leaves for the engines.
+pub fn prepare_points(sweep: &Sweep, dir: &Path) -> Result<usize> {
+    write_sweep(sweep, dir)?;
+    let mut prepared = 0;
+    for p in &sweep.points {
+        let pdir = point_dir(dir, &p.id);
+        let text = as_run(&p.scene).to_toml();
+        if let State::New = state(&pdir, &text, &p.scene) {
+            prepare(p, &pdir, &text)?;
+            prepared += 1;
+        }
+    }
+    Ok(prepared)
+}
+
+/// The checkpoint interval of a point: `every` if given, else about a tenth of the run
+/// on a frame step; none for thermal-noise runs.
+fn checkpoint_every(scene: &Scene, every: Option<f64>) -> Option<f64> {
+    if scene.brownian.is_some_and(|b| b.temperature > 0.0) {
+        return None;
+    }
+    every.or_else(|| {
+        let (steps, frame) = (scene.integrator.steps(), scene.output.every.max(1));
+        let k = steps.div_ceil(10).div_ceil(frame) * frame;
+        (k < steps).then_some(k as f64 * scene.integrator.dt)
+    })
+}
+
+/// Runs one point (the one place a sweep calls the run).
+pub fn run_point(point: &Point, dir: &Path, opts: Options) -> Outcome {
+    let pdir = point_dir(dir, &point.id);
+    let text = as_run(&point.scene).to_toml();
+    let checkpoint = match state(&pdir, &text, &point.scene) {
+        State::Finished => return Outcome::Skipped,
+        State::Resumable(c) => Some(*c),
+        State::New => {
+            if let Err(e) = prepare(point, &pdir, &text) {
+                return Outcome::Failed(format!("{e:#}"));
+            }
+            None
+        }
+    };
+    let run_opts = crate::sim::RunOptions {
+        progress: false,
+        keep_series: false,
+        checkpoint_every: checkpoint_every(&point.scene, opts.checkpoint_every),
+        ..crate::sim::RunOptions::default()
+    };
+    let start = Start {
+        scene_path: None,
+        checkpoint,
+    };
+    match crate::sim::run_from(&point.scene, &point.id, Some(&pdir), run_opts, start) {
+        Ok(r) => Outcome::Ran(Box::new(r.summary)),
+        Err(e) => {
+            let why = format!("{e:#}");
+            let _ = std::fs::write(pdir.join(ERROR_TXT), format!("{why}\n"));
+            Outcome::Failed(why)
+        }
+    }
+}
+
+/// Runs the `selection` of `sweep` in `dir` with `opts.jobs` points at a time, printing
+/// a line per point as it ends.
+pub fn run_points(
+    sweep: &Sweep,
+    dir: &Path,
+    selection: &Selection,
+    opts: Options,
+) -> Result<RunReport> {
+    write_sweep(sweep, dir)?;
+    let points = selection.points(sweep)?;
+    let report = Mutex::new(RunReport {
+        selected: points.len(),
+        ..RunReport::default()
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.jobs.max(1))
+        .build()?;
+    pool.install(|| {
+        points.par_iter().for_each(|p| {
+            let outcome = run_point(p, dir, opts);
+            let mut r = report.lock().unwrap_or_else(|e| e.into_inner());
+            let what = describe(&p.params);
+            match outcome {
+                Outcome::Skipped => r.skipped += 1,
+                Outcome::Ran(s) => {
+                    let how = match s.resumed_from {
+                        Some(t) => {
+                            r.resumed += 1;
+                            format!("resumed from t = {t}")
+                        }
+                        None => {
+                            r.ran += 1;
+                            "ran".to_string()
+                        }
+                    };
+                    if let Some(f) = &s.failure {
+                        r.stopped_early.push(p.id.clone());
+                        println!("{} {what}: {how}, stopped early: {f}", p.id);
+                    } else {
+                        println!(
+                            "{} {what}: {how}, {} steps at {:.0} steps/s, outcome {}",
+                            p.id, s.steps_done, s.steps_per_second, s.outcome
+                        );
+                    }
+                }
+                Outcome::Failed(why) => {
+                    println!("{} {what}: FAILED: {why}", p.id);
+                    r.failed.push((p.id.clone(), why));
+                }
+            }
+        });
+    });
+    Ok(report.into_inner().unwrap_or_else(|e| e.into_inner()))
+}
+
+/// [`run_points`] of a sweep file.
+pub fn run_sweep(
+    file: &Path,
+    dir: &Path,
+    selection: &Selection,
+    opts: Options,
+) -> Result<RunReport> {
+    let sweep = Sweep::from_path(file)?;
+    run_points(&sweep, dir, selection, opts)
+}

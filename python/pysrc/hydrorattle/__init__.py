@@ -1,0 +1,510 @@
+"""HydroRATTLE from Python: bonded rigid spheres of unequal size in a viscous fluid.
+
+The kernel (Rust, ``no_std``) computes far-field hydrodynamics from the polydisperse
+Rotne-Prager-Yamakawa grand mobility and holds bond lengths with SHAKE/RATTLE
+constraint solves. This package calls it with NumPy arrays:
+
+* :func:`mobility`, :func:`mobility_dot`: the mobility matrix and its product;
+* :class:`System`: particles and bonds stepped by the kernel (:meth:`System.step`,
+  :meth:`System.run`);
+* :func:`load_scene`, :func:`run_scene`, :func:`read_run`: the scene files and runs of
+  the ``host-demo`` CLI, through the same library code (same files, same bits).
+
+Units are the caller's, consistent: with lengths in ``L``, viscosity in ``eta`` and
+forces in ``F``, velocities come out in ``F / (eta L)``, times in ``eta L^2 / F``. The
+project's scenes use the tail radius, the viscosity and a tail's buoyant weight as
+units (a lone tail settles at speed 1).
+
+Every array returned is a new float64 (or int64) array: a copy, never a view of the
+kernel's state, which only a successful step changes.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterator, NamedTuple, Optional, Union
+
+import numpy as np
+
+from . import _hydrorattle as _core
+from ._hydrorattle import (
+    ConvergenceError,
+    ContactsFullError,
+    DegenerateError,
+    InvalidStateError,
+    LinalgError,
+    NonFiniteError,
+    OverlapError,
+    Report,
+    SceneError,
+    StepError,
+    UnstableError,
+    UnsupportedError,
+    __version__,
+)
+
+__all__ = [
+    "__version__",
+    "mobility",
+    "mobility_dot",
+    "System",
+    "Frame",
+    "Report",
+    "Run",
+    "load_scene",
+    "run_scene",
+    "read_run",
+    "StepError",
+    "InvalidStateError",
+    "ConvergenceError",
+    "LinalgError",
+    "DegenerateError",
+    "NonFiniteError",
+    "OverlapError",
+    "UnstableError",
+    "ContactsFullError",
+    "UnsupportedError",
+    "SceneError",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+Force = Callable[[np.ndarray], Any]
+
+
+def _rows(a: Any, what: str) -> np.ndarray:
+    """`a` as a C-contiguous float64 ``(N, 3)`` array (no copy when it already is one)."""
+    x = np.ascontiguousarray(a, dtype=np.float64)
+    if x.ndim != 2 or x.shape[1] != 3:
+        raise ValueError(f"{what} must have shape (N, 3), not {x.shape}")
+    return x
+
+
+def _column(a: Any, what: str, n: int) -> np.ndarray:
+    """`a` as a contiguous float64 ``(n,)`` array (a scalar is repeated)."""
+    x = np.asarray(a, dtype=np.float64)
+    x = np.full(n, float(x)) if x.ndim == 0 else np.ascontiguousarray(x)
+    if x.shape != (n,):
+        raise ValueError(f"{what} must have shape ({n},) to match the positions, not {x.shape}")
+    return x
+
+
+def mobility(
+    positions: Any,
+    radii: Any,
+    viscosity: float = 1.0,
+    hydro: str = "rpy",
+    rotation: bool = False,
+    precision: str = "f64",
+) -> np.ndarray:
+    """The dense mobility matrix of spheres at ``positions`` with ``radii``.
+
+    Parameters
+    ----------
+    positions : array_like, shape (N, 3)
+        Sphere centres (length units ``L``).
+    radii : array_like, shape (N,) or scalar
+        Sphere radii (``L``, > 0). Overlapping spheres are allowed (the RPY overlapping
+        branch); one sphere inside another is not.
+    viscosity : float
+        Fluid viscosity ``eta`` (> 0).
+    hydro : {"rpy", "oseen", "free-draining"}
+        Polydisperse Rotne-Prager-Yamakawa (Zuk et al. 2014), Oseen, or no interactions.
+    rotation : bool
+        With rotation, the ``(6N, 6N)`` grand mobility ``[[tt, tr], [rt, rr]]``.
+    precision : {"f64", "f32"}
+        Precision of the arithmetic and of the result's dtype.
+
+    Returns
+    -------
+    ndarray, shape (3N, 3N) or (6N, 6N)
+        ``U = M F``: translational velocities (``F / (eta L)``) from forces; with
+        rotation also spins from torques. Ordered all translations, then all rotations,
+        each particle-major then x, y, z: entry ``[3 i + a, 3 j + b]`` couples particle
+        ``i``'s component ``a`` to particle ``j``'s ``b``; rotations start at row ``3N``.
+        This is pygrpy's ``grpy_tensors.mu`` order (its ``(2, N, 3, 2, N, 3)`` tensor
+        reshaped); libMobility's interleaved per-particle layouts must be permuted.
+        A lone sphere's block is Stokes' ``1 / (6 pi eta a)``.
+
+    Raises
+    ------
+    ValueError
+        Wrong shapes, NaN or infinite values, a radius <= 0, nested spheres; the
+        message names the particle (``index`` attribute: the particle or pair).
+    """
+    pos = _rows(positions, "positions")
+    return _core.mobility(
+        pos, _column(radii, "radii", len(pos)), viscosity, hydro, rotation, precision
+    )
+
+
+def mobility_dot(
+    positions: Any,
+    radii: Any,
+    forces: Any,
+    torques: Any = None,
+    viscosity: float = 1.0,
+    hydro: str = "rpy",
+    rotation: bool = False,
+    precision: str = "f64",
+) -> Union[np.ndarray, "tuple[np.ndarray, np.ndarray]"]:
+    """Velocities of spheres under ``forces`` (and ``torques``), ``M [F; T]``.
+
+    Arguments as :func:`mobility`; ``forces`` and ``torques`` are ``(N, 3)`` (force
+    units ``F``, torque ``F L``). Without torques and rotation the product is
+    matrix-free (``O(N)`` memory, ``O(N^2)`` time, the same bits as the stored matrix
+    times the forces) and returns the ``(N, 3)`` velocities (``F / (eta L)``). With
+    torques or ``rotation=True`` it returns ``(velocities, spins)`` (spins in
+    ``F / (eta L^2)``) through the packed grand mobility (``O(N^2)`` memory).
+    """
+    pos = _rows(positions, "positions")
+    n = len(pos)
+    f = _rows(forces, "forces")
+    t = None if torques is None else _rows(torques, "torques")
+    return _core.mobility_dot(
+        pos, _column(radii, "radii", n), f, t, viscosity, hydro, rotation, precision
+    )
+
+
+class Frame(NamedTuple):
+    """One configuration yielded by :meth:`System.run` (arrays are copies)."""
+
+    #: Simulated time.
+    time: float
+    #: Centres, ``(N, 3)``.
+    positions: np.ndarray
+    #: Velocities, ``(N, 3)``.
+    velocities: np.ndarray
+    #: Angular velocities, ``(N, 3)``.
+    spins: np.ndarray
+    #: Report of the last step (None for the first frame).
+    report: Optional[Report]
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v))
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {v!r} into a scene")
+
+
+def _scene_text(sections: "dict[str, dict[str, Any]]") -> str:
+    out = []
+    for name, keys in sections.items():
+        out.append(f"[{name}]")
+        out.extend(f"{k} = {_toml_value(v)}" for k, v in keys.items())
+        out.append("")
+    return "\n".join(out)
+
+
+class System:
+    """Particles and bonds stepped by the kernel.
+
+    ``System(positions, radii, densities, bonds=None, lengths=None, precision="f64",
+    **params)``: ``positions`` ``(N, 3)`` (C-contiguous float64 is read without a copy;
+    other dtypes and layouts are converted), ``radii`` and ``densities`` ``(N,)`` or
+    scalars, ``bonds`` a ``(B, 2)`` integer array of particle pairs held at fixed
+    ``lengths`` (``(B,)``; measured from the positions when omitted).
+
+    ``params`` mirror the kernel's ``Params`` with its names and defaults: ``dt``
+    (required), ``method`` ("overdamped", "overdamped2", "rattle", "rattle-stable",
+    "springs"; default "overdamped"), ``viscosity`` (1), ``fluid_density`` (0),
+    ``gravity`` ((0, 0, -1)), ``flow`` ((0, 0, 0)), ``vorticity`` ((0, 0, 0)), ``hydro``
+    ("rpy"), ``rotation`` (False), ``matrix_free`` (False), ``solver`` ("auto",
+    "sweep", "newton", "krylov"), ``tolerance`` (1e-10 in f64, 1e-5 in f32),
+    ``max_iterations`` (100), ``allow_overlap`` (False), ``spring_stiffness`` (1e3),
+    ``stability_guard`` (False), ``contacts`` (None, or the hard-contact capacity),
+    ``temperature`` (None: no thermal noise; ``kT``), ``drift`` ("midpoint",
+    "uncorrected"), ``seed`` (1). A particle's mass is ``4/3 pi a^3 density``; gravity
+    acts on the buoyant mass (``density - fluid_density``).
+
+    Constructors for the CLI's shapes: :meth:`from_scene` (a scene file, read by the
+    CLI's parser, every default as the CLI's) and :meth:`helix`.
+    """
+
+    _core: Any
+
+    def __init__(
+        self,
+        positions: Any,
+        radii: Any,
+        densities: Any,
+        bonds: Any = None,
+        lengths: Any = None,
+        precision: str = "f64",
+        **params: Any,
+    ) -> None:
+        pos = _rows(positions, "positions")
+        n = len(pos)
+        b = np.zeros((0, 2), dtype=np.int64) if bonds is None else bonds
+        b = np.ascontiguousarray(b, dtype=np.int64)
+        if b.ndim != 2 or b.shape[1] != 2:
+            raise ValueError(f"bonds must have shape (B, 2), not {b.shape}")
+        ls = None if lengths is None else _column(lengths, "lengths", len(b))
+        self._core = _core.Core.build(
+            pos,
+            _column(radii, "radii", n),
+            _column(densities, "densities", n),
+            b,
+            ls,
+            precision,
+            params,
+        )
+
+    @classmethod
+    def _of(cls, core: Any) -> "System":
+        s = cls.__new__(cls)
+        s._core = core
+        return s
+
+    @classmethod
+    def from_scene(cls, path: PathLike) -> "System":
+        """The system of a scene file (TOML, the CLI's format), in the scene's
+        precision, with the scene's parameters exactly as ``host-demo run`` sets them.
+        A bad file raises :class:`SceneError` with ``file`` and ``line``."""
+        return cls._of(_core.Core.from_scene_file(os.fspath(path)))
+
+    @classmethod
+    def from_scene_text(cls, text: str, origin: str = "<scene>") -> "System":
+        """As :meth:`from_scene`, from the scene's TOML text."""
+        return cls._of(_core.Core.from_scene_text(text, origin))
+
+    @classmethod
+    def helix(cls, **keys: Any) -> "System":
+        """A helical chain as the CLI builds it: the ``[helix]`` keys (``tails``,
+        ``head_ratio``, ``dhat``, ``head_end``, ``radius``, ``pitch``, ``density``) as
+        keyword arguments, any other scene section as a dict (``fluid``, ``gravity``,
+        ``model``, ``contact``, ``brownian``, ``integrator``, ``output``). Missing keys
+        take the scene file's defaults. Example: ``System.helix(tails=24,
+        head_ratio=2.0, dhat=1.05, integrator={"method": "overdamped2", "dt": 0.1})``.
+        """
+        sections: "dict[str, dict[str, Any]]" = {"helix": {}}
+        for k, v in keys.items():
+            if isinstance(v, dict):
+                sections[k] = v
+            else:
+                sections["helix"][k] = v
+        integrator = sections.setdefault("integrator", {})
+        if "dt" not in integrator:
+            raise TypeError("System.helix needs integrator={'dt': ...}")
+        # A System steps as asked: the scene's duration only has to be valid.
+        integrator.setdefault("duration", integrator["dt"])
+        return cls.from_scene_text(_scene_text(sections), "<System.helix>")
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Centres, ``(N, 3)`` float64 (a copy)."""
+        return self._core.positions
+
+    @positions.setter
+    def positions(self, value: Any) -> None:
+        self.set_state(positions=value)
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """Translational velocities, ``(N, 3)`` float64 (a copy)."""
+        return self._core.velocities
+
+    @velocities.setter
+    def velocities(self, value: Any) -> None:
+        self.set_state(velocities=value)
+
+    @property
+    def spins(self) -> np.ndarray:
+        """Angular velocities, ``(N, 3)`` float64 (a copy; zero unless ``rotation``)."""
+        return self._core.spins
+
+    @spins.setter
+    def spins(self, value: Any) -> None:
+        self.set_state(spins=value)
+
+    def set_state(
+        self,
+        positions: Any = None,
+        velocities: Any = None,
+        spins: Any = None,
+        time: Optional[float] = None,
+    ) -> None:
+        """Replaces the parts of the state given (all or nothing: finite ``(N, 3)``
+        arrays, rounded to the system's precision). Positions off the bond lengths are
+        pulled back onto them by the next step (its constraint solve targets the
+        lengths); one sphere inside another is refused by it."""
+        conv = lambda a, w: None if a is None else _rows(a, w)  # noqa: E731
+        self._core.set_state(
+            conv(positions, "positions"), conv(velocities, "velocities"), conv(spins, "spins"), time
+        )
+
+    def copy(self) -> "System":
+        """An independent system in the same state (noise generator included)."""
+        return System._of(self._core.copy())
+
+    __copy__ = copy
+
+    @property
+    def radii(self) -> np.ndarray:
+        """Radii, ``(N,)`` (a copy)."""
+        return self._core.radii
+
+    @property
+    def densities(self) -> np.ndarray:
+        """Material densities, ``(N,)`` (a copy)."""
+        return self._core.densities
+
+    @property
+    def bonds(self) -> np.ndarray:
+        """Bonded pairs, ``(B, 2)`` int64 (a copy)."""
+        return self._core.bonds
+
+    @property
+    def lengths(self) -> np.ndarray:
+        """Bond lengths, ``(B,)`` (a copy)."""
+        return self._core.lengths
+
+    @property
+    def time(self) -> float:
+        """Simulated time."""
+        return self._core.time
+
+    @property
+    def dt(self) -> float:
+        """Time step."""
+        return self._core.dt
+
+    @property
+    def precision(self) -> str:
+        """"f64" or "f32"."""
+        return self._core.precision
+
+    def __len__(self) -> int:
+        return len(self._core.radii)
+
+    def __repr__(self) -> str:
+        return (
+            f"System(N={len(self)}, bonds={len(self._core.lengths)}, t={self.time}, "
+            f"dt={self.dt}, precision={self.precision!r})"
+        )
+
+    def step(self, n: int = 1, force: Optional[Force] = None) -> Report:
+        """Makes ``n`` steps inside Rust; returns the last step's :class:`Report`
+        (constraint iterations, residual, largest tension).
+
+        Without ``force`` the GIL is released for the whole call (other Python threads
+        run; two systems step in parallel in two threads), and Ctrl-C interrupts it
+        between two steps: ``KeyboardInterrupt`` is raised with the state as after the
+        last completed step.
+
+        ``force``: a callable ``f(positions) -> forces`` taking the candidate ``(N, 3)``
+        positions (a new float64 array) and returning ``(N, 3)`` forces added to
+        gravity (and any soft contact). It is called once per force evaluation (once
+        per step for the first-order methods, twice for "overdamped2"), with the GIL
+        held; its cost is the Python call plus two ``(N, 3)`` array conversions (a few
+        microseconds at N = 25; see the README). An exception it raises aborts the step
+        and propagates, leaving the state unchanged.
+
+        Raises a :class:`StepError` subclass (``kind``, ``stage``, ``index``,
+        ``value``) when a step fails: the state (positions, velocities, spins, time,
+        noise generator) is then exactly as it was before that step; the steps before
+        it are kept.
+        """
+        return self._core.step(int(n), force)
+
+    def run(
+        self, until: float, every: int = 1, force: Optional[Force] = None
+    ) -> Iterator[Frame]:
+        """Steps to simulated time ``until``, yielding a :class:`Frame` now and every
+        ``every`` steps (and at the end). Stepping happens between the yields: stop
+        iterating to stop the run."""
+        every = max(1, int(every))
+        total = max(0, math.ceil((until - self.time) / self.dt - 1e-9))
+        yield self._frame(None)
+        done = 0
+        while done < total:
+            k = min(every, total - done)
+            report = self.step(k, force)
+            done += k
+            yield self._frame(report)
+
+    def _frame(self, report: Optional[Report]) -> Frame:
+        c = self._core
+        return Frame(c.time, c.positions, c.velocities, c.spins, report)
+
+    def state_bits(self) -> "list[int]":
+        """The exact bits of positions, velocities, spins, time and the noise
+        generator's next draw: equal lists mean bit-identical states."""
+        return self._core.state_bits()
+
+
+def load_scene(path: PathLike) -> "dict[str, Any]":
+    """The scene file at ``path`` read by the CLI's parser, every default filled in
+    (particles generated, bond lengths resolved), as a dict. A bad file raises
+    :class:`SceneError` (a ``ValueError``) with ``file``, ``line`` and ``column``."""
+    return json.loads(_core.load_scene_json(os.fspath(path)))
+
+
+def run_scene(
+    path: PathLike, out: PathLike, checkpoint_every: Optional[float] = None
+) -> "dict[str, Any]":
+    """Runs the scene file ``path`` into the folder ``out`` exactly as
+    ``host-demo run PATH --out OUT`` does: the same files, byte for byte apart from the
+    wall times in ``summary.json`` (trajectory.xyz, trajectory.gsd, observables.csv,
+    scene.toml, summary.json, pictures). Returns the summary. The GIL is released
+    during the run. Raises :class:`SceneError` for a bad file and ``RuntimeError``
+    when the run stops early."""
+    return json.loads(_core.run_scene(os.fspath(path), os.fspath(out), checkpoint_every))
+
+
+@dataclass
+class Run:
+    """A run's files read back (:func:`read_run`)."""
+
+    #: Frame times, ``(F,)``.
+    time: np.ndarray
+    #: Centres, ``(F, N, 3)``.
+    positions: np.ndarray
+    #: Velocities, ``(F, N, 3)``.
+    velocities: np.ndarray
+    #: Radii, ``(N,)``.
+    radii: np.ndarray
+    #: Masses, ``(N,)``.
+    masses: np.ndarray
+    #: Type name of each particle.
+    species: "list[str]"
+    #: ``summary.json`` (empty when absent).
+    summary: "dict[str, Any]" = field(default_factory=dict)
+
+    def atoms(self) -> "list[Any]":
+        """The frames as ASE ``Atoms`` (needs ``ase``): species as chemical symbols are
+        not elements, so each atom is "X" with the species in the ``species`` array,
+        radii, masses and velocities set."""
+        from ase import Atoms  # noqa: PLC0415 (optional dependency)
+
+        out = []
+        for t, p, v in zip(self.time, self.positions, self.velocities):
+            a = Atoms(symbols=["X"] * len(p), positions=p, masses=self.masses)
+            a.set_velocities(v)
+            a.new_array("radius", self.radii)
+            a.new_array("species", np.array(self.species))
+            a.info["time"] = float(t)
+            out.append(a)
+        return out
+
+
+def read_run(out: PathLike) -> Run:
+    """The trajectory of the run in folder ``out`` (``trajectory.xyz``, exact) as
+    NumPy arrays, with its summary; :meth:`Run.atoms` gives ASE ``Atoms``."""
+    d = _core.read_trajectory(os.fspath(out))
+    summary_path = os.path.join(os.fspath(out), "summary.json")
+    summary = {}
+    if os.path.exists(summary_path):
+        with open(summary_path, encoding="utf-8") as f:
+            summary = json.load(f)
+    return Run(summary=summary, **d)

@@ -1,0 +1,97 @@
+//! Input arrays checked and converted: `(N, 3)` positions, `(N,)` radii, densities.
+//! The Python layer hands C-contiguous float64 arrays (converting other dtypes and
+//! layouts); they are read here without a copy.
+
+use hydrorattle::particles::{check_one, check_pairs};
+use hydrorattle::{Particle, Real};
+use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::errors::particle_error;
+
+/// The `(N, 3)` rows of `a` as `[x, y, z]` (a `ValueError` for another shape).
+pub fn rows<'a>(a: &'a PyReadonlyArray2<'_, f64>, what: &str) -> PyResult<&'a [[f64; 3]]> {
+    let shape = a.shape();
+    if shape[1] != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{what} must have shape (N, 3), not {shape:?}"
+        )));
+    }
+    let flat = a
+        .as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{what} must be C-contiguous")))?;
+    let (chunks, rest) = flat.as_chunks::<3>();
+    debug_assert!(rest.is_empty());
+    Ok(chunks)
+}
+
+/// The `(n,)` values of `a` (a `ValueError` for another length).
+pub fn column<'a>(a: &'a PyReadonlyArray1<'_, f64>, what: &str, n: usize) -> PyResult<&'a [f64]> {
+    let v = a
+        .as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{what} must be contiguous")))?;
+    if v.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "{what} must have shape ({n},) to match the positions, not ({},)",
+            v.len()
+        )));
+    }
+    Ok(v)
+}
+
+/// Positions and radii in precision `T`, each particle checked by the kernel (finite,
+/// radius > 0, density >= 0) and every pair (no sphere inside another; overlaps are
+/// allowed): a `ValueError` naming the particle otherwise.
+pub fn spheres<T: Real>(
+    py: Python<'_>,
+    pos: &[[f64; 3]],
+    radii: &[f64],
+    densities: Option<&[f64]>,
+) -> PyResult<(Vec<T::V3>, Vec<T>)> {
+    let mut p = Vec::with_capacity(pos.len());
+    let mut r = Vec::with_capacity(pos.len());
+    for (k, (&x, &a)) in pos.iter().zip(radii).enumerate() {
+        let d = densities.map_or(0.0, |d| d[k]);
+        let q = Particle::new(T::v3_from(x), T::from_f64(a), T::from_f64(d));
+        check_one(k, &q).map_err(|e| particle_error(py, e))?;
+        p.push(q.position);
+        r.push(q.radius);
+    }
+    check_pairs(&p, &r, true).map_err(|e| particle_error(py, e))?;
+    Ok((p, r))
+}
+
+/// A positive, finite viscosity.
+pub fn viscosity(eta: f64) -> PyResult<f64> {
+    if eta.is_finite() && eta > 0.0 {
+        Ok(eta)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "viscosity must be finite and > 0, not {eta}"
+        )))
+    }
+}
+
+/// The kernel's hydrodynamic level from its name.
+pub fn hydro(name: &str) -> PyResult<hydrorattle::Hydro> {
+    match name {
+        "rpy" => Ok(hydrorattle::Hydro::Rpy),
+        "oseen" => Ok(hydrorattle::Hydro::Oseen),
+        "free-draining" | "free_draining" => Ok(hydrorattle::Hydro::FreeDraining),
+        _ => Err(PyValueError::new_err(format!(
+            "hydro must be 'rpy', 'oseen' or 'free-draining', not {name:?}"
+        ))),
+    }
+}
+
+/// `true` for "f32", `false` for "f64".
+pub fn is_f32(precision: &str) -> PyResult<bool> {
+    match precision {
+        "f64" | "float64" => Ok(false),
+        "f32" | "float32" => Ok(true),
+        _ => Err(PyValueError::new_err(format!(
+            "precision must be 'f64' or 'f32', not {precision:?}"
+        ))),
+    }
+}

@@ -1,0 +1,507 @@
+//! A system stepped by the kernel: the host library's [`Engine`] in f64 or f32, with
+//! NumPy getters (copies) and `step(n)` run with the GIL released.
+
+use std::time::{Duration, Instant};
+
+use host_demo::scene::Scene;
+use host_demo::sim::{Beads, Engine, resolve_level};
+use host_demo::sizing::DEFAULT_LIMIT;
+use hydrorattle::{Bond, Noise, Real, StepReport};
+use numpy::ndarray::{Array1, Array2};
+use numpy::{
+    Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::{bond_error, scene_error, step_error};
+use crate::input::{column, is_f32, rows, spheres};
+use crate::params::params_from;
+
+/// How often a long `step(n)` looks for Ctrl-C.
+const SIGNAL_EVERY: Duration = Duration::from_millis(20);
+
+/// The report of the last step.
+#[pyclass(module = "hydrorattle", frozen, get_all)]
+#[derive(Clone, Copy, Debug)]
+pub struct Report {
+    /// Position-constraint iterations of the final solve.
+    pub iterations: u32,
+    /// Velocity-constraint iterations (RATTLE stage), 0 where there is none.
+    pub velocity_iterations: u32,
+    /// Largest relative bond-length error after the step.
+    pub residual: f64,
+    /// Largest bond tension magnitude (force units).
+    pub max_tension: f64,
+    /// Hard-sphere contacts held at the end of the step.
+    pub contacts: u32,
+    /// Active-set rounds of the contact projection.
+    pub contact_rounds: u32,
+    /// Steps made by this call.
+    pub steps: usize,
+}
+
+#[pymethods]
+impl Report {
+    fn __repr__(&self) -> String {
+        format!(
+            "Report(steps={}, iterations={}, residual={:e}, max_tension={}, contacts={})",
+            self.steps, self.iterations, self.residual, self.max_tension, self.contacts
+        )
+    }
+}
+
+impl Report {
+    fn of<T: Real>(r: &StepReport<T>, steps: usize) -> Self {
+        Report {
+            iterations: r.iterations,
+            velocity_iterations: r.velocity_iterations,
+            residual: r.residual.to_f64(),
+            max_tension: r.max_tension.to_f64(),
+            contacts: r.contacts,
+            contact_rounds: r.contact_rounds,
+            steps,
+        }
+    }
+}
+
+/// The engine in its precision.
+enum Inner {
+    F64(Engine<f64>),
+    F32(Engine<f32>),
+}
+
+/// Runs `$body` with `$e` bound to the engine, `$t` to its precision.
+macro_rules! each {
+    ($inner:expr, $e:ident, $t:ident => $body:expr) => {
+        match $inner {
+            Inner::F64($e) => {
+                type $t = f64;
+                $body
+            }
+            Inner::F32($e) => {
+                type $t = f32;
+                $body
+            }
+        }
+    };
+}
+
+/// The Rust side of `hydrorattle.System`.
+#[pyclass(module = "hydrorattle")]
+pub struct Core {
+    inner: Inner,
+}
+
+/// `(N, 3)` rows in precision `T` as a float64 array.
+fn rows_f64<'py, T: Real>(py: Python<'py>, v: &[T::V3]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = v.iter().flat_map(|&x| T::v3_to_f64(x)).collect();
+    Array2::from_shape_vec((v.len(), 3), flat)
+        .expect("3 values per row")
+        .into_pyarray(py)
+}
+
+/// Values in precision `T` as a float64 array.
+fn values_f64<'py, T: Real>(py: Python<'py>, v: &[T]) -> Bound<'py, PyArray1<f64>> {
+    Array1::from_iter(v.iter().map(|x| x.to_f64())).into_pyarray(py)
+}
+
+/// The engine of explicit arrays in precision `T`.
+#[allow(clippy::too_many_arguments)]
+fn engine_from<T: Real>(
+    py: Python<'_>,
+    pos: &[[f64; 3]],
+    radii: &[f64],
+    densities: &[f64],
+    bonds: &[[i64; 2]],
+    lengths: Option<&[f64]>,
+    kw: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Engine<T>> {
+    let (params, seed) = params_from::<T>(kw)?;
+    let (p, r) = spheres::<T>(py, pos, radii, Some(densities))?;
+    let n = p.len();
+    let index = |k: usize, i: i64| -> PyResult<usize> {
+        usize::try_from(i).ok().filter(|&i| i < n).ok_or_else(|| {
+            PyValueError::new_err(format!("bond {k}: particle index {i} out of range"))
+        })
+    };
+    let mut links = Vec::with_capacity(bonds.len());
+    for (k, &[i, j]) in bonds.iter().enumerate() {
+        let (i, j) = (index(k, i)?, index(k, j)?);
+        // Measured in f64 (as a scene file's bonds are), then rounded to `T`.
+        let length = match lengths {
+            Some(l) => l[k],
+            None => {
+                let d: Vec<f64> = (0..3).map(|c| pos[i][c] - pos[j][c]).collect();
+                (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+            }
+        };
+        links.push(Bond {
+            i,
+            j,
+            length: T::from_f64(length),
+        });
+    }
+    hydrorattle::bonds::validate(&links, n).map_err(bond_error)?;
+    let beads = Beads {
+        pos: p,
+        vel: vec![T::V3_ZERO; n],
+        omega: vec![T::V3_ZERO; n],
+        radius: r,
+        density: densities.iter().map(|&d| T::from_f64(d)).collect(),
+        time: T::ZERO,
+    };
+    Engine::from_parts(beads, links, params, Noise::new(seed), None, DEFAULT_LIMIT)
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// The engine of a scene (its level resolved), in the scene's precision.
+fn engine_of_scene(scene: &Scene) -> PyResult<Inner> {
+    let (scene, _) = resolve_level(scene, "scene");
+    let fail = |e: host_demo::sim::BuildError| PyValueError::new_err(e.to_string());
+    Ok(match scene.integrator.precision {
+        host_demo::scene::Precision::F64 => {
+            Inner::F64(Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?)
+        }
+        host_demo::scene::Precision::F32 => {
+            Inner::F32(Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?)
+        }
+    })
+}
+
+/// `n` steps of `e`; the first failure ends them (the state as after the last good
+/// step). `force` adds the Python callable's forces; without it the steps run with
+/// the GIL released, looking for Ctrl-C every [`SIGNAL_EVERY`].
+fn steps<T: Real + Element>(
+    py: Python<'_>,
+    e: &mut Engine<T>,
+    n: usize,
+    force: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Report> {
+    let mut last = None;
+    match force {
+        None => {
+            let mut done = 0;
+            let outcome = py.detach(|| -> Result<(), PyErr> {
+                let mut checked = Instant::now();
+                while done < n {
+                    let r = e
+                        .step()
+                        .map_err(|k| Python::attach(|py| step_error(py, k)))?;
+                    last = Some(r);
+                    done += 1;
+                    if done < n && checked.elapsed() >= SIGNAL_EVERY {
+                        Python::attach(|py| py.check_signals())?;
+                        checked = Instant::now();
+                    }
+                }
+                Ok(())
+            });
+            outcome?;
+            Ok(last.map_or(empty(0), |r| Report::of(&r, done)))
+        }
+        Some(f) => {
+            for k in 0..n {
+                let mut failed: Option<PyErr> = None;
+                let mut extra = |pos: &[T::V3], _: &[T], out: &mut [T::V3]| {
+                    if failed.is_some() {
+                        return;
+                    }
+                    match call_force::<T>(py, f, pos, out) {
+                        Ok(()) => {}
+                        Err(err) => {
+                            // A NaN force makes the kernel refuse the step, leaving the
+                            // state as it was; the Python error is raised instead.
+                            out.iter_mut().for_each(|v| *v = T::v3_from([f64::NAN; 3]));
+                            failed = Some(err);
+                        }
+                    }
+                };
+                let r = e.step_with(&mut extra);
+                if let Some(err) = failed {
+                    return Err(err);
+                }
+                last = Some(r.map_err(|k| step_error(py, k))?);
+                if k + 1 < n {
+                    py.check_signals()?;
+                }
+            }
+            Ok(last.map_or(empty(0), |r| Report::of(&r, n)))
+        }
+    }
+}
+
+/// A report for a call that made no step.
+fn empty(steps: usize) -> Report {
+    Report {
+        iterations: 0,
+        velocity_iterations: 0,
+        residual: 0.0,
+        max_tension: 0.0,
+        contacts: 0,
+        contact_rounds: 0,
+        steps,
+    }
+}
+
+/// Calls `f(positions)` and adds its `(N, 3)` result into `out`.
+fn call_force<T: Real>(
+    py: Python<'_>,
+    f: &Bound<'_, PyAny>,
+    pos: &[T::V3],
+    out: &mut [T::V3],
+) -> PyResult<()> {
+    let ret = f.call1((rows_f64::<T>(py, pos),))?;
+    // A C-contiguous float64 array is read as it is; anything else goes through NumPy.
+    let arr: PyReadonlyArray2<'_, f64> = match ret.extract::<PyReadonlyArray2<'_, f64>>() {
+        Ok(a) if a.is_c_contiguous() => a,
+        _ => py
+            .import("numpy")?
+            .call_method1("ascontiguousarray", (ret, "float64"))?
+            .extract()
+            .map_err(|_| {
+                PyValueError::new_err(format!(
+                    "the force callable must return shape ({}, 3)",
+                    pos.len()
+                ))
+            })?,
+    };
+    let forces = rows(&arr, "the force callable's result")?;
+    if forces.len() != out.len() {
+        return Err(PyValueError::new_err(format!(
+            "the force callable returned {} rows for {} particles",
+            forces.len(),
+            out.len()
+        )));
+    }
+    for (o, &f) in out.iter_mut().zip(forces) {
+        *o += T::v3_from(f);
+    }
+    Ok(())
+}
+
+#[pymethods]
+impl Core {
+    /// A system of explicit particles and bonds; see `hydrorattle.System`.
+    #[staticmethod]
+    #[pyo3(signature = (positions, radii, densities, bonds, lengths, precision, params))]
+    #[allow(clippy::too_many_arguments)]
+    fn build(
+        py: Python<'_>,
+        positions: PyReadonlyArray2<'_, f64>,
+        radii: PyReadonlyArray1<'_, f64>,
+        densities: PyReadonlyArray1<'_, f64>,
+        bonds: PyReadonlyArray2<'_, i64>,
+        lengths: Option<PyReadonlyArray1<'_, f64>>,
+        precision: &str,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Core> {
+        let pos = rows(&positions, "positions")?;
+        let n = pos.len();
+        let radii = column(&radii, "radii", n)?;
+        let densities = column(&densities, "densities", n)?;
+        let flat = bonds
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("bonds must be C-contiguous"))?;
+        let (pairs, rest) = flat.as_chunks::<2>();
+        if !rest.is_empty() || bonds.shape()[1] != 2 {
+            return Err(PyValueError::new_err("bonds must have shape (B, 2)"));
+        }
+        let lengths = match &lengths {
+            Some(l) => Some(column(l, "lengths", pairs.len())?),
+            None => None,
+        };
+        let inner = if is_f32(precision)? {
+            Inner::F32(engine_from(
+                py, pos, radii, densities, pairs, lengths, params,
+            )?)
+        } else {
+            Inner::F64(engine_from(
+                py, pos, radii, densities, pairs, lengths, params,
+            )?)
+        };
+        Ok(Core { inner })
+    }
+
+    /// The system of a scene file, read by the CLI's parser.
+    #[staticmethod]
+    fn from_scene_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Core> {
+        let scene = Scene::from_path(&path).map_err(|e| scene_error(py, &e))?;
+        Ok(Core {
+            inner: engine_of_scene(&scene)?,
+        })
+    }
+
+    /// The system of scene text (TOML), read by the CLI's parser; `origin` names it.
+    #[staticmethod]
+    fn from_scene_text(py: Python<'_>, text: &str, origin: &str) -> PyResult<Core> {
+        let scene = Scene::parse(text, origin).map_err(|e| scene_error(py, &e))?;
+        Ok(Core {
+            inner: engine_of_scene(&scene)?,
+        })
+    }
+
+    /// `n` steps; the last step's report.
+    #[pyo3(signature = (n=1, force=None))]
+    fn step(
+        &mut self,
+        py: Python<'_>,
+        n: usize,
+        force: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Report> {
+        each!(&mut self.inner, e, T => steps::<T>(py, e, n, force.as_ref()))
+    }
+
+    /// Positions `(N, 3)`, a float64 copy.
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        each!(&self.inner, e, T => rows_f64::<T>(py, &e.beads.pos))
+    }
+
+    /// Velocities `(N, 3)`, a float64 copy.
+    #[getter]
+    fn velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        each!(&self.inner, e, T => rows_f64::<T>(py, &e.beads.vel))
+    }
+
+    /// Angular velocities `(N, 3)`, a float64 copy.
+    #[getter]
+    fn spins<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        each!(&self.inner, e, T => rows_f64::<T>(py, &e.beads.omega))
+    }
+
+    /// Radii `(N,)`, a float64 copy.
+    #[getter]
+    fn radii<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        each!(&self.inner, e, T => values_f64::<T>(py, &e.beads.radius))
+    }
+
+    /// Densities `(N,)`, a float64 copy.
+    #[getter]
+    fn densities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        each!(&self.inner, e, T => values_f64::<T>(py, &e.beads.density))
+    }
+
+    /// Bonds `(B, 2)`, an int64 copy.
+    #[getter]
+    fn bonds<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
+        each!(&self.inner, e, T => {
+            let _: Option<T> = None;
+            let flat: Vec<i64> = e.bonds.iter().flat_map(|b| [b.i as i64, b.j as i64]).collect();
+            Array2::from_shape_vec((e.bonds.len(), 2), flat).expect("2 per row").into_pyarray(py)
+        })
+    }
+
+    /// Bond lengths `(B,)`, a float64 copy.
+    #[getter]
+    fn lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        each!(&self.inner, e, T => {
+            let l: Vec<T> = e.bonds.iter().map(|b| b.length).collect();
+            values_f64::<T>(py, &l)
+        })
+    }
+
+    /// Simulated time.
+    #[getter]
+    fn time(&self) -> f64 {
+        each!(&self.inner, e, T => { let t: T = e.beads.time; t.to_f64() })
+    }
+
+    /// Time step.
+    #[getter]
+    fn dt(&self) -> f64 {
+        each!(&self.inner, e, T => { let t: T = e.params.dt; t.to_f64() })
+    }
+
+    /// "f64" or "f32".
+    #[getter]
+    fn precision(&self) -> &'static str {
+        match self.inner {
+            Inner::F64(_) => "f64",
+            Inner::F32(_) => "f32",
+        }
+    }
+
+    /// Replaces the positions, velocities, spins and time given (each `(N, 3)` or a
+    /// float), checked as the kernel checks a particle (finite values): all or nothing.
+    #[pyo3(signature = (positions=None, velocities=None, spins=None, time=None))]
+    fn set_state(
+        &mut self,
+        positions: Option<PyReadonlyArray2<'_, f64>>,
+        velocities: Option<PyReadonlyArray2<'_, f64>>,
+        spins: Option<PyReadonlyArray2<'_, f64>>,
+        time: Option<f64>,
+    ) -> PyResult<()> {
+        let n = each!(&self.inner, e, T => { let _: Option<T> = None; e.beads.len() });
+        let mut new: [Option<&[[f64; 3]]>; 3] = [None; 3];
+        let given = [
+            ("positions", &positions),
+            ("velocities", &velocities),
+            ("spins", &spins),
+        ];
+        for (slot, (what, a)) in new.iter_mut().zip(given) {
+            if let Some(a) = a {
+                let v = rows(a, what)?;
+                if v.len() != n {
+                    return Err(PyValueError::new_err(format!(
+                        "{what} must have shape ({n}, 3), not ({}, 3)",
+                        v.len()
+                    )));
+                }
+                if let Some(k) = v.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
+                    return Err(PyValueError::new_err(format!(
+                        "particle {k}: non-finite {what}"
+                    )));
+                }
+                *slot = Some(v);
+            }
+        }
+        if let Some(t) = time.filter(|t| !t.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "time must be finite, not {t}"
+            )));
+        }
+        each!(&mut self.inner, e, T => {
+            let b = &mut e.beads;
+            for (v, dst) in new.iter().zip([&mut b.pos, &mut b.vel, &mut b.omega]) {
+                if let Some(v) = v {
+                    for (d, &x) in dst.iter_mut().zip(v.iter()) {
+                        *d = T::v3_from(x);
+                    }
+                }
+            }
+            if let Some(t) = time {
+                b.time = T::from_f64(t);
+            }
+            Ok(())
+        })
+    }
+
+    /// An independent copy of the system (state, storage, noise generator).
+    fn copy(&self) -> Core {
+        Core {
+            inner: match &self.inner {
+                Inner::F64(e) => Inner::F64(e.clone()),
+                Inner::F32(e) => Inner::F32(e.clone()),
+            },
+        }
+    }
+
+    /// The state's bits (positions, velocities, spins, time, then the noise
+    /// generator's next draw on a copy), for exact comparisons.
+    fn state_bits(&self) -> Vec<u64> {
+        each!(&self.inner, e, T => {
+            let mut out = Vec::new();
+            for v in [&e.beads.pos, &e.beads.vel, &e.beads.omega] {
+                for &x in v.iter() {
+                    out.extend(T::v3_to_f64(x).map(f64::to_bits));
+                }
+            }
+            out.push(e.beads.time.to_f64().to_bits());
+            out.push(e.noise.clone().normal().to_bits());
+            out
+        })
+    }
+}

@@ -1,0 +1,279 @@
+"""System: physics from Python, transactional failures, threads, signals, memory."""
+
+import _thread
+import math
+import threading
+import time
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, event, given, settings
+from hypothesis import strategies as st
+
+import hydrorattle as hr
+
+RHO = 4.5  # a lone unit sphere settles at speed 1 under |g| = 1, eta = 1
+
+
+def dimer_rate(a1, a2, d, drho_g=RHO, eta=1.0):
+    """Turning rate C of a settling rigid dimer (far-field RPY), derived in
+    tests/dynamics.rs: d theta / dt = -C sin theta, so
+    tan(theta / 2) = tan(theta0 / 2) exp(-C t)."""
+    weight = lambda a: 4.0 / 3.0 * math.pi * a**3 * drho_g  # noqa: E731
+    mu = lambda a: 1.0 / (6.0 * math.pi * eta * a)  # noqa: E731
+    big_a = (1.0 + (a1 * a1 + a2 * a2) / (3.0 * d * d)) / (8.0 * math.pi * eta * d)
+    return (weight(a2) * (mu(a2) - big_a) - weight(a1) * (mu(a1) - big_a)) / d
+
+
+def dimer_theta(dt, t_end=4.0, theta0=2.5, phi=0.7, method="overdamped2"):
+    a1, a2, d = 1.0, 2.0, 4.5
+    e0 = np.array([math.sin(theta0) * math.cos(phi), math.sin(theta0) * math.sin(phi), -math.cos(theta0)])
+    p0 = np.array([0.5, -0.25, 1.0])
+    s = hr.System([p0, p0 + d * e0], [a1, a2], RHO, bonds=[[0, 1]], dt=dt, method=method)
+    s.step(round(t_end / dt))
+    e = s.positions[1] - s.positions[0]
+    assert np.linalg.norm(e) == pytest.approx(d, rel=1e-9)
+    return math.atan2(math.hypot(e[0], e[1]), -e[2])
+
+
+def test_settling_dimer_turns_as_the_closed_form():
+    c = dimer_rate(1.0, 2.0, 4.5)
+    exact = 2.0 * math.atan(math.tan(2.5 / 2) * math.exp(-c * 4.0))
+    errors = [abs(dimer_theta(dt) - exact) for dt in (0.04, 0.02)]
+    assert errors[1] < 1e-4
+    # Heun: second order, measured from the two step sizes.
+    order = math.log2(errors[0] / errors[1])
+    assert 1.7 < order < 2.3, order
+    first = abs(dimer_theta(0.01, method="overdamped") - exact)
+    assert first < 5e-3
+
+
+def chain(n, radius=1.0, gap=1.5):
+    pos = np.zeros((n, 3))
+    pos[:, 0] = np.arange(n) * 2 * radius * gap
+    pos[:, 2] = 0.3 * np.sin(np.arange(n))
+    return pos, [[i, i + 1] for i in range(n - 1)]
+
+
+def test_a_step_whose_force_raises_changes_nothing():
+    pos, bonds = chain(5)
+    s = hr.System(pos, 1.0, RHO, bonds=bonds, dt=0.05, method="overdamped2")
+    s.step(3)
+    before = s.state_bits()
+    calls = []
+
+    def force(p):
+        calls.append(1)
+        if len(calls) == 2:  # the corrector's evaluation of the first step
+            raise RuntimeError("boom")
+        return np.zeros_like(p)
+
+    with pytest.raises(RuntimeError, match="boom"):
+        s.step(5, force=force)
+    assert s.state_bits() == before
+
+
+def test_a_failed_step_changes_nothing_and_names_its_stage():
+    pos, bonds = chain(8)
+    s = hr.System(pos, 1.0, RHO, bonds=bonds, dt=0.05, solver="sweep", max_iterations=1, tolerance=1e-14)
+    before = s.state_bits()
+    with pytest.raises(hr.ConvergenceError) as e:
+        s.step(10)
+    assert isinstance(e.value, hr.StepError)
+    assert e.value.kind == "NoConvergence" and e.value.stage == "Positions"
+    assert e.value.index == 1 and e.value.value > 1e-14
+    assert s.state_bits() == before
+    with pytest.raises(hr.NonFiniteError) as e:
+        s.step(1, force=lambda p: np.where(np.arange(len(p))[:, None] == 3, np.inf, 0.0) + 0 * p)
+    assert e.value.index == 3
+    assert s.state_bits() == before
+
+
+def test_a_failed_thermal_step_leaves_the_noise_generator_as_it_was():
+    pos, bonds = chain(4)
+    kw = dict(bonds=bonds, dt=0.01, temperature=0.5, seed=7)
+    a = hr.System(pos, 1.0, RHO, **kw)
+    b = hr.System(pos, 1.0, RHO, **kw)
+    a.step(3)
+    b.step(3)
+    with pytest.raises(hr.NonFiniteError):
+        a.step(1, force=lambda p: np.full_like(p, np.nan))
+    a.step(20)
+    b.step(20)
+    assert a.state_bits() == b.state_bits()
+    c = hr.System(pos, 1.0, RHO, **{**kw, "seed": 8})
+    c.step(23)
+    assert c.state_bits() != a.state_bits()
+
+
+METHODS = ["overdamped", "overdamped2", "rattle", "rattle-stable"]
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    n=st.integers(2, 7),
+    seed=st.integers(0, 2**31),
+    method=st.sampled_from(METHODS),
+    solver=st.sampled_from(["auto", "sweep", "newton", "krylov"]),
+    hydro=st.sampled_from(["rpy", "oseen", "free-draining"]),
+    dt=st.floats(1e-3, 2.0),
+    steps=st.integers(1, 6),
+    precision=st.sampled_from(["f64", "f32"]),
+    temperature=st.sampled_from([None, 0.0, 0.2]),
+)
+def test_a_step_keeps_every_bond_or_raises_and_changes_nothing(
+    n, seed, method, solver, hydro, dt, steps, precision, temperature
+):
+    rng = np.random.default_rng(seed)
+    radii = rng.uniform(0.5, 1.5, n)
+    pos = np.zeros((n, 3))
+    for i in range(1, n):
+        d = rng.normal(size=3)
+        pos[i] = pos[i - 1] + d / np.linalg.norm(d) * (radii[i] + radii[i - 1]) * rng.uniform(1.05, 2.0)
+    bonds = [[i, i + 1] for i in range(n - 1)]
+    try:
+        s = hr.System(pos, radii, rng.uniform(0.5, 5.0, n), bonds=bonds, dt=dt, method=method,
+                      solver=solver, hydro=hydro, allow_overlap=True, precision=precision,
+                      temperature=temperature, seed=seed)
+    except ValueError as e:  # the random walk put one sphere inside another
+        assert "inside" in str(e)
+        assume(False)
+    lengths = s.lengths
+    tol = 1e-8 if precision == "f64" else 1e-3
+    event(method)
+    for _ in range(steps):
+        before = s.state_bits()
+        try:
+            s.step(1)
+        except hr.StepError as e:
+            assert s.state_bits() == before
+            event(f"raised {e.kind}")
+            return
+        p = s.positions
+        r = np.linalg.norm(p[1:] - p[:-1], axis=1)
+        assert np.max(np.abs(r - lengths) / lengths) <= tol
+
+
+def test_step_releases_the_gil():
+    pos, bonds = chain(25)
+    s = hr.System(pos, 1.0, RHO, bonds=bonds, dt=0.01)
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(1)
+            time.sleep(0)
+
+    t = threading.Thread(target=count)
+    t.start()
+    time.sleep(0.05)
+    start = len(ticks)
+    s.step(3000)
+    during = len(ticks) - start
+    done.set()
+    t.join()
+    assert during > 100, during
+
+
+def test_ctrl_c_stops_between_steps_in_a_consistent_state():
+    pos, bonds = chain(25)
+    s = hr.System(pos, 1.0, RHO, bonds=bonds, dt=0.001)
+    lengths = s.lengths
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        s.step(10**9)
+    timer.join()
+    steps = s.time / s.dt
+    assert steps > 0 and abs(steps - round(steps)) < 1e-6 * steps
+    p = s.positions
+    assert np.max(np.abs(np.linalg.norm(p[1:] - p[:-1], axis=1) - lengths)) < 1e-9
+    s.step(1)
+
+
+def rss_kib():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * 4
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/proc/self/statm"), reason="needs /proc")
+def test_many_single_steps_hold_memory_flat():
+    pos, bonds = chain(4)
+    s = hr.System(pos, 1.0, RHO, bonds=bonds, dt=1e-4)
+    for _ in range(10_000):
+        s.step(1)
+    before = rss_kib()
+    for _ in range(100_000):
+        s.step(1)
+    grown = rss_kib() - before
+    assert grown < 1024, f"RSS grew by {grown} KiB over 1e5 calls"
+
+
+def test_run_yields_frames_up_to_the_end():
+    s = hr.System.helix(tails=6, integrator={"dt": 0.01, "method": "rattle-stable"})
+    frames = list(s.run(until=0.25, every=10))
+    assert [round(f.time / 0.01) for f in frames] == [0, 10, 20, 25]
+    assert frames[0].report is None and frames[-1].report.steps == 5
+    assert frames[-1].positions.shape == (7, 3)
+    assert np.array_equal(frames[-1].positions, s.positions)
+
+
+def test_bad_system_input_is_refused():
+    pos, bonds = chain(3)
+    with pytest.raises(ValueError, match="particle 1: radius"):
+        hr.System(pos, [1, 0, 1], RHO, bonds=bonds, dt=0.1)
+    with pytest.raises(ValueError, match="bond 1: particle index 7"):
+        hr.System(pos, 1.0, RHO, bonds=[[0, 1], [1, 7]], dt=0.1)
+    with pytest.raises(TypeError, match='unexpected parameter "viscosty"'):
+        hr.System(pos, 1.0, RHO, bonds=bonds, dt=0.1, viscosty=2.0)
+    with pytest.raises(TypeError, match="dt"):
+        hr.System(pos, 1.0, RHO, bonds=bonds)
+    with pytest.raises(ValueError, match="method must be one of"):
+        hr.System(pos, 1.0, RHO, bonds=bonds, dt=0.1, method="verlet")
+    s = hr.System(pos, 1.0, RHO, bonds=bonds, dt=-0.1)
+    with pytest.raises(hr.InvalidStateError, match="time step"):
+        s.step()
+
+
+def test_helix_keys_build_the_scene_files_chain():
+    import pathlib
+
+    scene = pathlib.Path(__file__).resolve().parents[2] / "host-demo" / "scenes" / "figure1c.toml"
+    a = hr.System.from_scene(scene)
+    b = hr.System.helix(
+        tails=24, head_ratio=2.0, dhat=1.05, radius=2.0, pitch=7.0, density=4.5,
+        contact={"model": "hard"},
+        integrator={"method": "overdamped2", "dt": 0.1, "solver": "newton", "tolerance": 1e-10,
+                    "max_iterations": 500},
+    )
+    assert a.state_bits() == b.state_bits()
+    a.step(20)
+    b.step(20)
+    assert a.state_bits() == b.state_bits()
+    assert len(b) == 25 and b.radii[0] == 2.0
+
+
+def test_state_can_be_set_and_copied():
+    pos, bonds = chain(4)
+    s = hr.System(pos, 1.0, RHO, bonds=bonds, dt=0.02, temperature=0.3, seed=5)
+    s.step(5)
+    twin = s.copy()
+    s.step(10)
+    assert twin.time == pytest.approx(0.1) and s.state_bits() != twin.state_bits()
+    twin.step(10)
+    assert s.state_bits() == twin.state_bits()
+    moved = s.positions + [1.0, -2.0, 0.5]  # a rigid shift keeps every bond
+    s.positions = moved
+    assert np.array_equal(s.positions, moved)
+    s.set_state(velocities=np.ones((4, 3)), time=7.0)
+    assert s.time == 7.0 and np.all(s.velocities == 1)
+    s.step(1)
+    bad = s.positions.copy()
+    bad[2] += 0.3
+    with pytest.raises(ValueError, match="particle 1: non-finite positions"):
+        s.positions = np.where(np.arange(4)[:, None] == 1, np.nan, bad)
+    s.positions = bad
+    s.step()  # the constraint solve targets the lengths: the bonds are pulled back
+    p = s.positions
+    assert np.max(np.abs(np.linalg.norm(p[1:] - p[:-1], axis=1) - s.lengths)) < 1e-9
