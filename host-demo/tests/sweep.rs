@@ -375,3 +375,34 @@ fn sweep_and_collect_reproduce_the_phase_outcomes() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_point_with_level_auto_is_finished_once_run() {
+    // Its scene.toml is written with the auto choice applied, as the run records it, so
+    // the second invocation finds it finished.
+    let dir = scratch("auto");
+    let path = dir.join("auto.toml");
+    let base = scenes().join("dimer.toml");
+    let file = format!(
+        "[sweep]\nbase = {:?}\n\"model.level\" = [\"auto\"]\n\"integrator.dt\" = [0.01, 0.02]\n",
+        base.display().to_string()
+    );
+    std::fs::write(&path, file).unwrap();
+    let out = dir.join("out");
+    let run = || {
+        host_demo(&[
+            "sweep",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let first = text(&run());
+    assert!(first.contains("ran 2 of 2 points"), "{first}");
+    let second = text(&run());
+    assert!(
+        second.contains("ran 0 of 2 points") && second.contains("2 already finished"),
+        "{second}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

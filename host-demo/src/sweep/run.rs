@@ -130,12 +130,10 @@ pub fn point_dir(dir: &Path, id: &str) -> PathBuf {
     dir.join(POINTS).join(id)
 }
 
-/// The scene as a run records it: `level = "auto"` applied, level manual.
-pub fn as_run(scene: &Scene) -> Scene {
-    let mut s = match scene.model.level {
-        Level::Auto => crate::auto::apply(scene, &crate::auto::choose(scene)),
-        Level::Manual => scene.clone(),
-    };
+/// The scene as a run records it in `scene.toml`: `level = "auto"` applied (as the run
+/// applies it), level manual.
+pub fn as_run(scene: &Scene, name: &str) -> Scene {
+    let mut s = crate::sim::resolve_level(scene, name).0;
     s.model.level = Level::Manual;
     s
 }
@@ -225,7 +223,7 @@ pub fn prepare_points(sweep: &Sweep, dir: &Path) -> Result<usize> {
     let mut prepared = 0;
     for p in &sweep.points {
         let pdir = point_dir(dir, &p.id);
-        let text = as_run(&p.scene).to_toml();
+        let text = as_run(&p.scene, &p.id).to_toml();
         if let State::New = state(&pdir, &text, &p.scene) {
             prepare(p, &pdir, &text)?;
             prepared += 1;
@@ -250,7 +248,7 @@ fn checkpoint_every(scene: &Scene, every: Option<f64>) -> Option<f64> {
 /// Runs one point (the one place a sweep calls the run).
 pub fn run_point(point: &Point, dir: &Path, opts: Options) -> Outcome {
     let pdir = point_dir(dir, &point.id);
-    let text = as_run(&point.scene).to_toml();
+    let text = as_run(&point.scene, &point.id).to_toml();
     let checkpoint = match state(&pdir, &text, &point.scene) {
         State::Finished => return Outcome::Skipped,
         State::Resumable(c) => Some(*c),
