@@ -192,8 +192,12 @@ pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) ->
     }
 }
 
-/// Largest normalised residual over all bonds.
+/// Largest normalised residual over all bonds (positions: two square roots, see
+/// [`max_residual`](crate::bonds::max_residual)).
 fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T {
+    if let Problem::Positions = problem {
+        return crate::bonds::max_residual(bonds, x).1;
+    }
     let mut w = T::ZERO;
     for (k, b) in bonds.iter().enumerate() {
         w = w.max_sticky(problem.eval(b, k, x).2);

@@ -6,7 +6,6 @@ use super::StepReport;
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind};
 use crate::error::{ParticleError, StepError};
-use crate::linalg;
 use crate::mobility::{self, Hydro};
 use crate::params::Params;
 use crate::real::Real;
@@ -25,9 +24,8 @@ pub(super) fn mobility_product<T: Real>(
         return mobility::tt_product(p.hydro, p.viscosity, pos, radius, f, u)
             .map_err(StepError::from);
     }
-    assemble_tt(p, pos, radius, mu)?;
-    linalg::sym_matvec::<T>(mu, pos.len(), f, u);
-    Ok(())
+    mobility::assemble_tt_apply(p.hydro, p.viscosity, pos, radius, mu, f, u)
+        .map_err(StepError::from)
 }
 
 /// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`: matrix-free when asked;
