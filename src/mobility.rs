@@ -242,54 +242,7 @@ pub fn assemble_tt<T: Real>(
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), ParticleError> {
-    for i in 0..pos.len() {
-        let row = tri(i);
-        for j in 0..i {
-            out[row + j] = pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
-                .ok_or(ParticleError::Nested { i: j, j: i })?;
-        }
-        out[row + i] = T::m3_diag(self_tt(eta, radius[i]));
-    }
-    Ok(())
-}
-
-/// [`assemble_tt`] and the product `y = mu_tt x` in one pass over the pairs: the same
-/// blocks in `out`, and `y` bit-identical to [`sym_matvec`](crate::linalg::sym_matvec)
-/// on them (row `i` starts `y_i` from its diagonal term, then adds its lower blocks'
-/// products in order; the transposed products reach `y_j` from the rows below, in row
-/// order, as there), without reading the stored blocks back.
-pub fn assemble_tt_apply<T: Real>(
-    level: Hydro,
-    eta: T,
-    pos: &[T::V3],
-    radius: &[T],
-    out: &mut [T::M3],
-    x: &[T::V3],
-    y: &mut [T::V3],
-) -> Result<(), ParticleError> {
-    for i in 0..pos.len() {
-        let row = tri(i);
-        let diag = T::m3_diag(self_tt(eta, radius[i]));
-        let (pi, ai, xi) = (pos[i], radius[i], x[i]);
-        let (before, yi) = y[..=i].split_at_mut(i);
-        yi[0] = diag * xi;
-        let mut acc = T::V3_ZERO;
-        let pairs = out[row..row + i]
-            .iter_mut()
-            .zip(before)
-            .zip(pos)
-            .zip(radius);
-        for (j, (((o, yj), &pj), &aj)) in pairs.enumerate() {
-            let b =
-                pair_tt(level, eta, ai, aj, pi - pj).ok_or(ParticleError::Nested { i: j, j: i })?;
-            *o = b;
-            acc += crate::linalg::sym3_mul::<T>(b, x[j]);
-            *yj += crate::linalg::sym3_mul::<T>(b, xi);
-        }
-        out[row + i] = diag;
-        yi[0] += acc;
-    }
-    Ok(())
+    crate::parallel::assemble(&crate::parallel::Serial, level, eta, pos, radius, out)
 }
 
 /// Assembles the `2n x 2n` grand mobility `[[tt, tr], [rt, rr]]`, packed lower triangle

@@ -9,6 +9,7 @@
 use crate::bonds::Bond;
 use crate::linalg::{self, tri};
 use crate::mobility::{Hydro, tt_block_at, tt_product};
+use crate::parallel::Parallel;
 use crate::real::Real;
 
 /// How a unit multiplier on bond `l` displaces bead `p`.
@@ -33,6 +34,8 @@ pub enum Metric<'a, T: Real> {
         grad: &'a [T::V3],
         /// Overall factor (`dt` for positions).
         scale: T,
+        /// How its products run ([`crate::parallel::product`]).
+        par: &'a dyn Parallel,
     },
     /// The same hydrodynamic metric without a stored mobility: each pair block is
     /// evaluated where it is used (matrix-free; bit-identical to [`Metric::Mobility`]).
@@ -150,7 +153,9 @@ impl<T: Real> Metric<'_, T> {
                     T::V3_ZERO
                 }
             }
-            Metric::Mobility { mu, grad, scale } => {
+            Metric::Mobility {
+                mu, grad, scale, ..
+            } => {
                 let g = grad[l] * scale;
                 sym_diff_mul::<T>(sym_block::<T>(mu, p, b.i), sym_block::<T>(mu, p, b.j), g)
             }
@@ -240,7 +245,8 @@ impl<T: Real> Metric<'_, T> {
 
     /// `out = sum_l c_l D_l` over all bonds at once (the Krylov solver's product):
     /// `G^T c`, then one mobility product (and one drag solve). `tmp` holds at least
-    /// `2m` vectors (`m` block rows of the mobility).
+    /// `2m` vectors (`m` block rows of the mobility), and for [`Metric::Mobility`] `n`
+    /// and the product's [`band_scratch`](crate::parallel::band_scratch).
     pub fn apply_all(&self, bonds: &[Bond<T>], c: &[T], out: &mut [T::V3], tmp: &mut [T::V3]) {
         let n = out.len();
         match *self {
@@ -262,10 +268,15 @@ impl<T: Real> Metric<'_, T> {
                     self.apply_one(bonds, l, cl, out);
                 }
             }
-            Metric::Mobility { mu, grad, scale } => {
-                let f = &mut tmp[..n];
+            Metric::Mobility {
+                mu,
+                grad,
+                scale,
+                par,
+            } => {
+                let (f, bands) = tmp.split_at_mut(n);
                 spread(bonds, grad, c, scale, f);
-                linalg::sym_matvec::<T>(mu, n, f, out);
+                crate::parallel::product::<T>(par, mu, n, f, out, bands);
             }
             Metric::Free {
                 level,

@@ -25,11 +25,13 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         new_pos,
         new_vel,
         new_omega,
+        par,
+        bands,
         ..
     } = v;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     forces::springs(bonds, p.spring_stiffness, s.pos, force);
-    mobility_product(p, s.pos, s.radius, mu, force, u)?;
+    mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
     add_flow(p, s.pos, u);
     for i in 0..n {
         new_pos[i] = s.pos[i] + u[i] * dt;

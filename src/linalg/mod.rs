@@ -57,19 +57,13 @@ pub fn sym3_mul<T: Real>(b: T::M3, x: T::V3) -> T::V3 {
 }
 
 /// `y = A x` for a packed symmetric block matrix.
+///
+/// Row `i` starts `y_i` from its diagonal term and adds its lower blocks' products in
+/// order; the transposed products reach `y_j` from the rows below, in row order. In one
+/// pass on one thread at any size; [`crate::parallel::product`] is the same arithmetic
+/// cut into bands (the same bits below [`crate::parallel::BANDED_MIN`] rows).
 pub fn sym_matvec<T: Real>(a: &[T::M3], n: usize, x: &[T::V3], y: &mut [T::V3]) {
-    for i in 0..n {
-        y[i] = a[tri(i) + i] * x[i];
-    }
-    for i in 0..n {
-        let row = &a[tri(i)..tri(i) + i];
-        let mut acc = T::V3_ZERO;
-        for (j, &aij) in row.iter().enumerate() {
-            acc += aij * x[j];
-            y[j] += T::m3_tmul(aij, x[i]);
-        }
-        y[i] += acc;
-    }
+    crate::parallel::band::<T>(a, 0, x, &mut y[..n], &mut []);
 }
 
 /// Lower Cholesky factor of a symmetric 3x3 block; `row0` names the block's first row
