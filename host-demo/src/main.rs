@@ -42,6 +42,10 @@ enum Command {
         /// for `host-demo resume`.
         #[arg(long, value_name = "T", value_parser = positive)]
         checkpoint_every: Option<f64>,
+        /// Threads for the mobility of scenes from 512 beads on (0: every core); the
+        /// trajectory's bits do not depend on it.
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
     },
     /// Continue a run from its checkpoint (DIR/checkpoint.json, DIR/scene.toml) to a
     /// later time: the same bytes as one run to that time.
@@ -60,6 +64,9 @@ enum Command {
         /// As for `run`.
         #[arg(long, default_value_t = (DEFAULT_OUTPUT_LIMIT >> 30) as f64, value_name = "GIB", value_parser = gib)]
         max_output: f64,
+        /// As for `run`.
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
     },
     /// Reproduce the paper's Figure 1: three helical chains settling.
     Figure1 {
@@ -143,6 +150,7 @@ fn run(cli: Cli) -> Result<()> {
             max_storage,
             max_output,
             checkpoint_every,
+            threads,
         } => {
             let limits = limits(max_storage, max_output);
             let scene = Scene::from_path_limited(&scene_path, limits)?;
@@ -154,7 +162,7 @@ fn run(cli: Cli) -> Result<()> {
                 scene.integrator.steps()
             );
             let name = scene_name(&scene_path);
-            let opts = file_run(limits, checkpoint_every);
+            let opts = file_run(limits, checkpoint_every, threads);
             let start = Start {
                 scene_path: Some(scene_path),
                 checkpoint: None,
@@ -169,9 +177,10 @@ fn run(cli: Cli) -> Result<()> {
             checkpoint_every,
             max_storage,
             max_output,
+            threads,
         } => {
             let limits = limits(max_storage, max_output);
-            let opts = file_run(limits, checkpoint_every);
+            let opts = file_run(limits, checkpoint_every, threads);
             let r = host_demo::sim::resume(&dir, until, limits, opts)?;
             host_demo::pictures::draw_run(&dir, &r, false)?;
             report(&r.summary.scene.clone(), &r.summary, &dir)?;
@@ -320,12 +329,13 @@ fn limits(max_storage: f64, max_output: f64) -> Limits {
 }
 
 /// The options of a run from the command line: progress shown, nothing kept in memory.
-fn file_run(limits: Limits, checkpoint_every: Option<f64>) -> RunOptions<'static> {
+fn file_run(limits: Limits, checkpoint_every: Option<f64>, threads: usize) -> RunOptions<'static> {
     RunOptions {
         progress: true,
         max_storage: limits.storage,
         keep_series: false,
         checkpoint_every,
+        threads,
         ..RunOptions::default()
     }
 }

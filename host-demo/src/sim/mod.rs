@@ -194,6 +194,10 @@ pub struct RunOptions<'a> {
     pub checkpoint_every: Option<f64>,
     /// Configurations to keep in memory for pictures (none by default).
     pub keep: KeepFrames<'a>,
+    /// Threads for the mobility's bands from [`hydrorattle::parallel::BANDED_MIN`] beads
+    /// on (smaller scenes run on the calling thread); 0: every core. The bits do not
+    /// depend on it.
+    pub threads: usize,
 }
 
 impl Default for RunOptions<'_> {
@@ -205,6 +209,7 @@ impl Default for RunOptions<'_> {
             keep_series: true,
             checkpoint_every: None,
             keep: KeepFrames::default(),
+            threads: 0,
         }
     }
 }

@@ -79,7 +79,15 @@ pub(super) fn run_t<T: Real>(
     if let Some(dir) = out {
         std::fs::create_dir_all(dir).map_err(|e| crate::output::name_error(dir, e))?;
     }
-    let mut ws = store.workspace();
+    // A thread pool only where the kernel cuts the mobility into bands.
+    let pool = match hydrorattle::parallel::bands(beads.len()) > 1 && opts.threads != 1 {
+        true => Some(hydrorattle_parallel::Threads::new(opts.threads)?),
+        false => None,
+    };
+    let mut ws = match &pool {
+        Some(threads) => store.workspace().with_parallel(threads),
+        None => store.workspace(),
+    };
     let mut noise = Noise::new(scene.brownian.map_or(DEFAULT_SEED, |b| b.seed));
     let contact = scene.contact.and_then(|c| c.soft()).map(|k| SoftContact {
         stiffness: T::from_f64(k),
