@@ -63,13 +63,13 @@ pub fn newton<T: Real>(
             let (value, dir, _) = problem.eval(b, k, x);
             rhs[k] = -value;
             if refresh {
-                let row = &mut jac[k * nb..k * nb + nb];
-                if chord {
-                    let g = metric.grad(k) * problem.chord_factor();
-                    metric.jacobian_row(bonds, k, g, 0, &mut row[..=k]);
-                } else {
-                    metric.jacobian_row(bonds, k, dir, 0, row);
-                }
+                // The chord's lower triangle, or the whole row at the iterate (one call
+                // site, so that firmware inlines it for its one metric).
+                let (dir, len) = match chord {
+                    true => (metric.grad(k) * problem.chord_factor(), k + 1),
+                    false => (dir, nb),
+                };
+                metric.jacobian_row(bonds, k, dir, 0, &mut jac[k * nb..k * nb + len]);
             }
         }
         let fail = |error| StepError::Linalg {
