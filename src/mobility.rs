@@ -188,7 +188,9 @@ fn rt_coefficient<T: Real>(far: bool, eta: T, ai: T, aj: T, s: T) -> T {
 /// `y = mu_tt x` without storing `mu_tt`: each pair block is evaluated where it is
 /// used, in the orientation and summation order of [`assemble_tt`] followed by
 /// [`sym_matvec`](crate::linalg::sym_matvec), so the result is bit-identical to the
-/// stored path at the cost of re-evaluating the pairs (storage `O(N)` instead of
+/// stored path below [`BANDED_MIN`](crate::parallel::BANDED_MIN) rows (from there on the
+/// stored path sums in bands, [`crate::parallel`]; this one does not, so the two agree to
+/// rounding), at the cost of re-evaluating the pairs (storage `O(N)` instead of
 /// `O(N^2)`). Nested spheres are an error, as in assembly.
 pub fn tt_product<T: Real>(
     level: Hydro,
