@@ -143,10 +143,51 @@ pub fn validate<T: Real>(bonds: &[Bond<T>], n: usize) -> Result<(), BondError> {
     Ok(())
 }
 
-/// Largest relative length error over `bonds` and the bond where it occurs. NaN is
-/// sticky (a NaN residual is never hidden), and a bond naming a particle beyond `pos`
-/// counts as infinitely violated.
+/// Largest relative length error `| |r_ij| - d | / d` over `bonds` and the bond where it
+/// occurs. NaN is sticky (a NaN residual is never hidden), and a bond naming a particle
+/// beyond `pos` counts as infinitely violated.
+///
+/// Two square roots, not one per bond: the error grows with `|r_ij|^2 / d^2` away from 1
+/// on either side, so it is largest at the largest or the smallest of these ratios
+/// (exactly so in exact arithmetic; where two bonds' errors agree to rounding, either
+/// may be named).
 pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
+    let error = |b: &Bond<T>, a: T::V3, c: T::V3| ((T::norm(a - c) - b.length) / b.length).abs();
+    let (mut hi, mut lo) = ((0, T::ZERO), (0, T::ZERO));
+    for (k, b) in bonds.iter().enumerate() {
+        let (Some(&a), Some(&c)) = (pos.get(b.i), pos.get(b.j)) else {
+            return max_residual_each(bonds, pos);
+        };
+        let ratio = T::norm2(a - c) / (b.length * b.length);
+        if ratio.is_nan() {
+            return max_residual_each(bonds, pos);
+        }
+        if k == 0 || ratio > hi.1 {
+            hi = (k, ratio);
+        }
+        if k == 0 || ratio < lo.1 {
+            lo = (k, ratio);
+        }
+    }
+    let at = |k: usize| {
+        let b = &bonds[k];
+        (k, error(b, pos[b.i], pos[b.j]))
+    };
+    match bonds.len() {
+        0 => (0, T::ZERO),
+        _ => {
+            let (h, l) = (at(hi.0), at(lo.0));
+            if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
+                l
+            } else {
+                h
+            }
+        }
+    }
+}
+
+/// [`max_residual`] bond by bond, for the rare lists with a NaN or a bond out of range.
+fn max_residual_each<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
     let mut worst = (0, T::ZERO);
     for (k, b) in bonds.iter().enumerate() {
         let r = match (pos.get(b.i), pos.get(b.j)) {

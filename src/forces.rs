@@ -100,16 +100,18 @@ pub struct SoftContact<T> {
 
 impl<T: Real> ExternalForce<T> for SoftContact<T> {
     fn add(&mut self, pos: &[T::V3], radius: &[T], force: &mut [T::V3]) {
-        for i in 0..pos.len() {
-            for j in 0..i {
-                let r = pos[i] - pos[j];
-                let reach = radius[i] + radius[j];
+        for (i, (&pi, &ai)) in pos.iter().zip(radius).enumerate() {
+            let (before, fi) = force[..=i].split_at_mut(i);
+            let others = before.iter_mut().zip(pos).zip(radius);
+            for ((fj, &pj), &aj) in others {
+                let r = pi - pj;
+                let reach = ai + aj;
                 let s2 = T::norm2(r);
                 if s2 < reach * reach && s2 > T::ZERO {
                     let s = s2.sqrt();
                     let f = r * (self.stiffness * (reach - s) / s);
-                    force[i] += f;
-                    force[j] -= f;
+                    fi[0] += f;
+                    *fj -= f;
                 }
             }
         }

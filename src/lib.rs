@@ -9,7 +9,8 @@
 //!
 //! Where to look:
 //! * RPY formulas: [`mobility`];
-//! * Cholesky and solves: [`linalg`];
+//! * Cholesky and solves: [`linalg`]; the mobility's work in bands for hosts' threads:
+//!   [`parallel`];
 //! * the SHAKE sweep, Newton solve and RATTLE velocity sweep: [`constraints`];
 //! * [`step`] and its stages: [`integrate`] (one file per integrator; the paper's
 //!   velocity-Verlet HydroRATTLE step is `src/integrate/rattle.rs`).
@@ -30,6 +31,7 @@ pub mod linalg;
 pub mod mobility;
 pub mod noise;
 pub mod observables;
+pub mod parallel;
 pub mod params;
 pub mod particles;
 pub mod real;
@@ -44,6 +46,7 @@ pub use glam;
 pub use integrate::{StepReport, step, step_slices};
 pub use mobility::Hydro;
 pub use noise::Noise;
+pub use parallel::{Parallel, Serial};
 pub use params::{Brownian, Contacts, Drift, Method, Params};
 pub use particles::{Particle, ParticleSet, State};
 pub use real::Real;

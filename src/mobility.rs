@@ -69,8 +69,7 @@ impl<T: Real> Geometry<T> {
         if s2 <= dif * dif {
             return None;
         }
-        let s = s2.sqrt();
-        let inv_s = T::ONE / s;
+        let (s, inv_s) = s2.root_and_inverse();
         let e = r * inv_s;
         Some(Self {
             s2,
@@ -189,7 +188,9 @@ fn rt_coefficient<T: Real>(far: bool, eta: T, ai: T, aj: T, s: T) -> T {
 /// `y = mu_tt x` without storing `mu_tt`: each pair block is evaluated where it is
 /// used, in the orientation and summation order of [`assemble_tt`] followed by
 /// [`sym_matvec`](crate::linalg::sym_matvec), so the result is bit-identical to the
-/// stored path at the cost of re-evaluating the pairs (storage `O(N)` instead of
+/// stored path below [`BANDED_MIN`](crate::parallel::BANDED_MIN) rows (from there on the
+/// stored path sums in bands, [`crate::parallel`]; this one does not, so the two agree to
+/// rounding), at the cost of re-evaluating the pairs (storage `O(N)` instead of
 /// `O(N^2)`). Nested spheres are an error, as in assembly.
 pub fn tt_product<T: Real>(
     level: Hydro,
@@ -243,15 +244,7 @@ pub fn assemble_tt<T: Real>(
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), ParticleError> {
-    for i in 0..pos.len() {
-        let row = tri(i);
-        for j in 0..i {
-            out[row + j] = pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
-                .ok_or(ParticleError::Nested { i: j, j: i })?;
-        }
-        out[row + i] = T::m3_diag(self_tt(eta, radius[i]));
-    }
-    Ok(())
+    crate::parallel::assemble(&crate::parallel::Serial, level, eta, pos, radius, out)
 }
 
 /// Assembles the `2n x 2n` grand mobility `[[tt, tr], [rt, rr]]`, packed lower triangle

@@ -124,8 +124,9 @@ pub struct Params<T: Real> {
     /// reported as `Omega_inf + mu_rt F`). Default false.
     pub rotation: bool,
     /// Matrix-free mobility: never store `mu_tt`, evaluate each pair block where it is
-    /// used (storage `O(N + B)`; the same bits as the stored path, at the cost of one
-    /// pair evaluation per block per product). Honoured by [`Method::Overdamped`] and
+    /// used (storage `O(N + B)`; the same bits as the stored path below
+    /// [`BANDED_MIN`](crate::parallel::BANDED_MIN) beads, where the stored path does not
+    /// yet sum in bands; at the cost of one pair evaluation per block per product). Honoured by [`Method::Overdamped`] and
     /// [`Method::Springs`]; the other methods factorise or keep a second mobility and
     /// refuse it ([`StepError::BadParameter`](crate::StepError::BadParameter)).
     /// Default false.

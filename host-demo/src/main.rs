@@ -41,6 +41,10 @@ enum Command {
         /// for `host-demo resume`.
         #[arg(long, value_name = "T", value_parser = positive)]
         checkpoint_every: Option<f64>,
+        /// Threads for the mobility of scenes from 512 beads on (0: every core); the
+        /// trajectory's bits do not depend on it.
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
     },
     /// Continue a run from its checkpoint (DIR/checkpoint.json, DIR/scene.toml) to a
     /// later time: the same bytes as one run to that time.
@@ -59,6 +63,9 @@ enum Command {
         /// As for `run`.
         #[arg(long, default_value_t = (DEFAULT_OUTPUT_LIMIT >> 30) as f64, value_name = "GIB", value_parser = gib)]
         max_output: f64,
+        /// As for `run`.
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
     },
     /// Reproduce the paper's Figure 1: three helical chains settling.
     Figure1 {
@@ -202,10 +209,17 @@ fn run(cli: Cli) -> Result<()> {
             max_storage,
             max_output,
             checkpoint_every,
+            threads,
         } => {
             let limits = limits(max_storage, max_output);
-            let r =
-                host_demo::sim::run_scene_file(&scene_path, &out, limits, checkpoint_every, true)?;
+            let r = host_demo::sim::run_scene_file(
+                &scene_path,
+                &out,
+                limits,
+                checkpoint_every,
+                true,
+                threads,
+            )?;
             let name = host_demo::sim::scene_name(&scene_path);
             report(&name, &r.summary, &out)?;
         }
@@ -215,9 +229,13 @@ fn run(cli: Cli) -> Result<()> {
             checkpoint_every,
             max_storage,
             max_output,
+            threads,
         } => {
             let limits = limits(max_storage, max_output);
-            let opts = RunOptions::files(limits, checkpoint_every, true);
+            let opts = RunOptions {
+                threads,
+                ..RunOptions::files(limits, checkpoint_every, true)
+            };
             let r = host_demo::sim::resume(&dir, until, limits, opts)?;
             host_demo::pictures::draw_run(&dir, &r, false)?;
             report(&r.summary.scene.clone(), &r.summary, &dir)?;

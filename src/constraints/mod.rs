@@ -178,8 +178,10 @@ pub struct Scratch<'a, T: Real> {
     pub piv: &'a mut [usize],
     /// Krylov: preconditioner band and CG vectors (`krylov::SCALARS_PER_BOND x bonds`).
     pub krylov: &'a mut [T],
-    /// Krylov: bead-space vectors (`2n + 2m`).
+    /// Krylov: bead-space vectors (`2n + 2m`, and the mobility product's band scratch).
     pub beads: &'a mut [T::V3],
+    /// How the mobility products of the hydrodynamic metric run.
+    pub par: &'a dyn crate::parallel::Parallel,
 }
 
 /// Scratch sizes `[scalars, vectors, indices]` of `kind` for `n` beads, `m` block rows
@@ -187,13 +189,21 @@ pub struct Scratch<'a, T: Real> {
 pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) -> [usize; 3] {
     match kind.resolve(bonds) {
         SolverKind::Newton => [bonds * bonds + bonds, 0, bonds],
-        SolverKind::Krylov => [krylov::SCALARS_PER_BOND * bonds, 2 * n + 2 * m, 0],
+        SolverKind::Krylov => [
+            krylov::SCALARS_PER_BOND * bonds,
+            2 * n + 2 * m + crate::parallel::band_scratch(m),
+            0,
+        ],
         _ => [0, 0, 0],
     }
 }
 
-/// Largest normalised residual over all bonds.
+/// Largest normalised residual over all bonds (positions: two square roots, see
+/// [`max_residual`](crate::bonds::max_residual)).
 fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T {
+    if let Problem::Positions = problem {
+        return crate::bonds::max_residual(bonds, x).1;
+    }
     let mut w = T::ZERO;
     for (k, b) in bonds.iter().enumerate() {
         w = w.max_sticky(problem.eval(b, k, x).2);

@@ -7,10 +7,19 @@ use crate::error::StepError;
 use crate::linalg;
 use crate::real::Real;
 
-/// Newton iterations on the dense Jacobian `J_kl = dir_k . (D_l(i_k) - D_l(j_k))`,
-/// solved by LU. The factorisation is reused while the residual falls at least
-/// tenfold per iteration (a chord / quasi-Newton step: the Jacobian barely changes
-/// within one time step) and refreshed otherwise. Velocities are linear: one step.
+/// Newton iterations on the dense `bonds x bonds` Jacobian.
+///
+/// * Positions start on the symmetric chord Jacobian `J_kl = c g_k . (D_l(i_k) -
+///   D_l(j_k))` along the start-of-step bond vectors `g` on both sides (`c G D G^T`,
+///   positive definite for every metric here): its lower triangle, factorised by
+///   Cholesky, half the entries and half the factorisation of the Jacobian at the
+///   iterate, no pivoting. The chord converges linearly, by about the bonds' turn within
+///   the step per iteration; while the residual falls at least tenfold per iteration it
+///   is kept.
+/// * Otherwise (velocities from the start, positions once the chord slows: a move of
+///   many bond lengths) the Jacobian at the iterate `J_kl = dir_k . (D_l(i_k) -
+///   D_l(j_k))`, solved by LU, refreshed whenever the residual falls less than tenfold.
+///   Velocities are linear: one step.
 pub fn newton<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,
@@ -26,6 +35,9 @@ pub fn newton<T: Real>(
         &mut scratch.rhs[..nb],
         &mut scratch.piv[..nb],
     );
+    // Positions start on the chord; every solve falls back to the Jacobian at the
+    // iterate, refreshed whenever the residual falls less than tenfold.
+    let mut chord = matches!(problem, Problem::Positions);
     let mut previous: Option<T> = None;
     for it in 0..=solver.max_iterations {
         let residual = worst(&problem, bonds, x);
@@ -41,25 +53,40 @@ pub fn newton<T: Real>(
         if it == solver.max_iterations {
             return Err(problem.no_convergence(it, residual));
         }
-        let refresh = match previous {
-            None => true,
-            Some(p) => !(residual <= p * T::from_f64(0.1)),
-        };
+        let fast = previous.is_some_and(|p| residual <= p * T::from_f64(0.1));
+        let refresh = previous.is_none() || !fast;
+        if refresh && previous.is_some() {
+            chord = false;
+        }
         previous = Some(residual);
         for (k, b) in bonds.iter().enumerate() {
             let (value, dir, _) = problem.eval(b, k, x);
             rhs[k] = -value;
             if refresh {
-                metric.jacobian_row(bonds, k, dir, 0, &mut jac[k * nb..k * nb + nb]);
+                // The chord's lower triangle, or the whole row at the iterate (one call
+                // site, so that firmware inlines it for its one metric).
+                let (dir, len) = match chord {
+                    true => (metric.grad(k) * problem.chord_factor(), k + 1),
+                    false => (dir, nb),
+                };
+                metric.jacobian_row(bonds, k, dir, 0, &mut jac[k * nb..k * nb + len]);
             }
         }
-        if refresh {
-            linalg::lu(jac, nb, piv).map_err(|error| StepError::Linalg {
-                stage: problem.stage(),
-                error,
-            })?;
+        let fail = |error| StepError::Linalg {
+            stage: problem.stage(),
+            error,
+        };
+        if chord {
+            if refresh {
+                linalg::cholesky_dense(jac, nb).map_err(fail)?;
+            }
+            linalg::cholesky_dense_solve(jac, nb, rhs);
+        } else {
+            if refresh {
+                linalg::lu(jac, nb, piv).map_err(fail)?;
+            }
+            linalg::lu_solve(jac, nb, piv, rhs);
         }
-        linalg::lu_solve(jac, nb, piv, rhs);
         for l in 0..nb {
             mult[l] += rhs[l];
             metric.apply_one(bonds, l, rhs[l], x);

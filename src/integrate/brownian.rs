@@ -60,11 +60,13 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         lambda,
         kappa,
         mut scratch,
+        par,
+        bands,
         ..
     } = v;
     // Deterministic velocity at the start: U_inf + mu F.
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    mobility_product(p, s.pos, s.radius, mu, force, u)?;
+    mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
     add_flow(p, s.pos, u);
     let held = Held {
         bonds,
@@ -79,7 +81,8 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
     }
     bond_vectors(bonds, s.pos, grad);
-    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu, grad, dt, disp);
+    let par = scratch.par;
+    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu, grad, dt, disp, par);
     let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut scratch)?;
     step_velocity(s.pos, new_pos, dt, xi);
     add_constraint_forces(bonds, grad, lambda, force);
@@ -147,8 +150,18 @@ pub(super) fn kick<T: Real>(
             if let Some(h) = held {
                 bond_vectors(h.bonds, mid, h.grad_mid);
                 h.kappa.fill(T::ZERO);
-                let metric =
-                    mobility_metric(p, h.bonds, mid, s.radius, fac, h.grad_mid, T::ONE, h.disp);
+                let par = h.scratch.par;
+                let metric = mobility_metric(
+                    p,
+                    h.bonds,
+                    mid,
+                    s.radius,
+                    fac,
+                    h.grad_mid,
+                    T::ONE,
+                    h.disp,
+                    par,
+                );
                 let problem = Problem::Velocities {
                     bond: h.grad_mid,
                     dt: T::ONE,

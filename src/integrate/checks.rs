@@ -173,12 +173,13 @@ pub(super) fn accept<T: Real>(
             return Err(StepError::NonFinite { particle: i });
         }
     }
-    for i in 0..pos.len() {
-        for j in i + 1..pos.len() {
-            let s2 = T::norm2(pos[i] - pos[j]);
-            let (dif, sum) = (radius[i] - radius[j], (radius[i] + radius[j]) * reach);
+    for (i, (&pi, &ai)) in pos.iter().zip(radius).enumerate() {
+        let others = pos[i + 1..].iter().zip(&radius[i + 1..]);
+        for (k, (&pj, &aj)) in others.enumerate() {
+            let s2 = T::norm2(pi - pj);
+            let (dif, sum) = (ai - aj, (ai + aj) * reach);
             if s2 <= dif * dif || (!allow_overlap && s2 < sum * sum) {
-                return Err(StepError::Overlap { i, j });
+                return Err(StepError::Overlap { i, j: i + 1 + k });
             }
         }
     }

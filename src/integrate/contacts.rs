@@ -120,7 +120,8 @@ pub(super) fn project_overdamped<'l, T: Real>(
             None => bonds,
         };
         bond_vectors(active, start, grad);
-        let metric = mobility_metric(p, active, start, radius, mu, grad, p.dt, disp);
+        let par = scratch.par;
+        let metric = mobility_metric(p, active, start, radius, mu, grad, p.dt, disp, par);
         free(x);
         let stats = project_positions(p, active, &metric, x, lambda, scratch)?;
         let Some(c) = contacts else {

@@ -37,11 +37,13 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         lambda,
         mut scratch,
         links,
+        par,
+        bands,
         ..
     } = v;
     // Forces and mobility at the start; unconstrained velocity U_inf + mu F.
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    mobility_product(p, s.pos, s.radius, mu, force, u)?;
+    mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
     add_flow(p, s.pos, u);
     // Unconstrained move r* = r + dt (U_inf + mu F), then the constraint move through
     // the full mobility: r' = r* + dt mu G^T lambda (bonds, and contacts if on).
@@ -94,7 +96,8 @@ fn projected_velocity<T: Real>(
         bond: grad,
         dt: p.dt,
     };
-    let metric = mobility_metric(p, bonds, pos, radius, mu, grad, T::ONE, disp);
+    let par = scratch.par;
+    let metric = mobility_metric(p, bonds, pos, radius, mu, grad, T::ONE, disp, par);
     constraints::solve(problem, &metric, bonds, &p.solver, u, kappa, scratch)
 }
 

@@ -35,11 +35,13 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         new_pos,
         new_vel,
         new_omega,
+        par,
+        bands,
         ..
     } = v;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     forces::springs(bonds, p.spring_stiffness, p.fene, s.pos, force)?;
-    mobility_product(p, s.pos, s.radius, mu, force, u)?;
+    mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
     add_flow(p, s.pos, u);
     match thermal {
         None => {

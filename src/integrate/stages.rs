@@ -6,13 +6,15 @@ use super::StepReport;
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind};
 use crate::error::{ParticleError, StepError};
-use crate::linalg;
 use crate::mobility::{self, Hydro};
+use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
 
-/// `u = mu_tt(pos) f`: from the assembled mobility in `mu`, or matrix-free (then `mu`
-/// is empty and nothing is stored).
+/// `u = mu_tt(pos) f`: assembled into `mu` and applied in one pass, in bands through
+/// `par` (`bands` holds their partial sums, [`crate::parallel`]), or matrix-free (then
+/// `mu` is empty and nothing is stored).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn mobility_product<T: Real>(
     p: &Params<T>,
     pos: &[T::V3],
@@ -20,14 +22,15 @@ pub(super) fn mobility_product<T: Real>(
     mu: &mut [T::M3],
     f: &[T::V3],
     u: &mut [T::V3],
+    par: &dyn Parallel,
+    bands: &mut [T::V3],
 ) -> Result<(), StepError> {
     if p.matrix_free {
         return mobility::tt_product(p.hydro, p.viscosity, pos, radius, f, u)
             .map_err(StepError::from);
     }
-    assemble_tt(p, pos, radius, mu)?;
-    linalg::sym_matvec::<T>(mu, pos.len(), f, u);
-    Ok(())
+    crate::parallel::assemble_apply(par, p.hydro, p.viscosity, pos, radius, mu, f, u, bands)
+        .map_err(StepError::from)
 }
 
 /// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`: matrix-free when asked;
@@ -44,6 +47,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
     grad: &'a [T::V3],
     scale: T,
     disp: &'a mut [T::V3],
+    par: &'a dyn Parallel,
 ) -> Metric<'a, T> {
     if p.matrix_free {
         return Metric::Free {
@@ -56,7 +60,12 @@ pub(super) fn mobility_metric<'a, T: Real>(
         };
     }
     if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
-        return Metric::Mobility { mu, grad, scale };
+        return Metric::Mobility {
+            mu,
+            grad,
+            scale,
+            par,
+        };
     }
     let n = pos.len();
     constraints::tabulate(mu, bonds, grad, scale, n, disp);

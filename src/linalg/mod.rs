@@ -20,7 +20,7 @@
 pub mod band;
 mod lu;
 
-pub use lu::{lu, lu_solve};
+pub use lu::{cholesky_dense, cholesky_dense_solve, lu, lu_solve};
 
 use crate::error::LinalgError;
 use crate::real::Real;
@@ -41,20 +41,29 @@ pub fn sym_get<T: Real>(a: &[T::M3], i: usize, j: usize) -> T::M3 {
     }
 }
 
+/// `b x` for a symmetric 3x3 block from its lower triangle: the bits of both `b * x` and
+/// `b^T x` (the same products summed in glam's order, the upper entries equal to the
+/// lower), with 6 entries live instead of 9.
+#[inline(always)]
+pub fn sym3_mul<T: Real>(b: T::M3, x: T::V3) -> T::V3 {
+    let e = |r, c| T::m3_get(b, r, c);
+    let (b00, b10, b20, b11, b21, b22) = (e(0, 0), e(1, 0), e(2, 0), e(1, 1), e(2, 1), e(2, 2));
+    let [x, y, z] = T::xyz(x);
+    T::v3(
+        b00 * x + b10 * y + b20 * z,
+        b10 * x + b11 * y + b21 * z,
+        b20 * x + b21 * y + b22 * z,
+    )
+}
+
 /// `y = A x` for a packed symmetric block matrix.
+///
+/// Row `i` starts `y_i` from its diagonal term and adds its lower blocks' products in
+/// order; the transposed products reach `y_j` from the rows below, in row order. In one
+/// pass on one thread at any size; [`crate::parallel::product`] is the same arithmetic
+/// cut into bands (the same bits below [`crate::parallel::BANDED_MIN`] rows).
 pub fn sym_matvec<T: Real>(a: &[T::M3], n: usize, x: &[T::V3], y: &mut [T::V3]) {
-    for i in 0..n {
-        y[i] = a[tri(i) + i] * x[i];
-    }
-    for i in 0..n {
-        let row = &a[tri(i)..tri(i) + i];
-        let mut acc = T::V3_ZERO;
-        for (j, &aij) in row.iter().enumerate() {
-            acc += aij * x[j];
-            y[j] += T::m3_tmul(aij, x[i]);
-        }
-        y[i] += acc;
-    }
+    crate::parallel::band::<T>(a, 0, x, &mut y[..n], &mut []);
 }
 
 /// Lower Cholesky factor of a symmetric 3x3 block; `row0` names the block's first row

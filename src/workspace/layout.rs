@@ -4,6 +4,7 @@
 
 use crate::constraints::{SolverKind, scratch_size};
 use crate::linalg::tri;
+use crate::parallel::band_scratch;
 use crate::params::{Method, Params};
 use crate::real::Real;
 
@@ -78,7 +79,7 @@ impl Layout {
         match method {
             Method::Overdamped | Method::Springs => {
                 l.blocks = tri(n);
-                l.vectors += n;
+                l.vectors += n + band_scratch(n);
             }
             Method::Overdamped2 => {
                 l.blocks = 2 * tri(n);
@@ -175,12 +176,14 @@ impl Layout {
     ) -> Self {
         let table = match (method, kind.resolve(bonds)) {
             (Method::Overdamped, SolverKind::Sweep | SolverKind::Newton) => n * bonds,
+            // Krylov's scratch for the stored product's band partial sums.
+            (Method::Overdamped, SolverKind::Krylov) => band_scratch(n),
             _ => 0,
         };
         match method {
             Method::Overdamped | Method::Springs => Self {
                 blocks: self.blocks - tri(n),
-                vectors: self.vectors - table,
+                vectors: self.vectors - table - band_scratch(n),
                 ..self
             },
             _ => self,

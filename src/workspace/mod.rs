@@ -25,6 +25,7 @@ pub(crate) use layout::block_rows;
 pub(crate) use views::Views;
 
 use crate::bonds::Bond;
+use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
 
 /// Scratch for one step, borrowed from caller-owned slices. Any sizes work; a step
@@ -37,6 +38,7 @@ pub struct Workspace<'a, T: Real> {
     pub(crate) scalars: &'a mut [T],
     pub(crate) indices: &'a mut [usize],
     pub(crate) links: &'a mut [Bond<T>],
+    pub(crate) parallel: &'a dyn Parallel,
 }
 
 impl<'a, T: Real> Workspace<'a, T> {
@@ -53,7 +55,14 @@ impl<'a, T: Real> Workspace<'a, T> {
             scalars,
             indices,
             links: &mut [],
+            parallel: &Serial,
         }
+    }
+
+    /// This workspace with a host's way of running the mobility's bands on several
+    /// threads ([`crate::parallel`]; [`Serial`] by default). The bits do not depend on it.
+    pub fn with_parallel(self, parallel: &'a dyn Parallel) -> Self {
+        Self { parallel, ..self }
     }
 
     /// This workspace with a constraint list for steps with contacts

@@ -7,6 +7,7 @@ use crate::constraints::Scratch;
 use crate::constraints::{SolverKind, krylov_scratch_per_bond};
 use crate::error::StepError;
 use crate::linalg::tri;
+use crate::parallel::{Parallel, band_scratch};
 use crate::params::{Method, Params};
 use crate::real::Real;
 
@@ -31,6 +32,10 @@ pub(crate) struct Views<'a, T: Real> {
     pub scratch: Scratch<'a, T>,
     /// Bonds then contacts (steps with contacts only; empty otherwise).
     pub links: &'a mut [Bond<T>],
+    /// How the mobility's bands run ([`Workspace::with_parallel`]).
+    pub par: &'a dyn Parallel,
+    /// The stored `mu_tt` product's band partial sums ([`band_scratch`]).
+    pub bands: &'a mut [T::V3],
 }
 
 /// Takes slices off the front of a slice.
@@ -97,6 +102,8 @@ impl<T: Real> Workspace<'_, T> {
         let inv_mass = sc.take(inv_mass);
         let sqrt_m = sc.take(sqrt_m);
         let disp = ve.take(disp);
+        let banded = stored && matches!(method, Method::Overdamped | Method::Springs);
+        let bands = ve.take(if banded { band_scratch(n) } else { 0 });
         let constrained = !matches!(method, Method::Springs);
         let newton = constrained && matches!(kind, SolverKind::Newton);
         let scratch = Scratch {
@@ -109,10 +116,11 @@ impl<T: Real> Workspace<'_, T> {
                 0
             }),
             beads: ve.take(if constrained && krylov {
-                2 * n + 2 * m
+                2 * n + 2 * m + if stored { band_scratch(m) } else { 0 }
             } else {
                 0
             }),
+            par: self.parallel,
         };
         Ok(Views {
             mu,
@@ -133,6 +141,8 @@ impl<T: Real> Workspace<'_, T> {
             new_omega,
             scratch,
             links,
+            par: self.parallel,
+            bands,
         })
     }
 }

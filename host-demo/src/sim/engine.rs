@@ -6,7 +6,10 @@
 use hydrorattle::{
     Bond, ExternalForce, Layout, Noise, Params, Real, SoftContact, StepError, StepReport,
 };
+use std::sync::Arc;
+
 use hydrorattle_heap::Buffers;
+use hydrorattle_parallel::Threads;
 
 use super::retry::{self, Retries};
 use super::{Beads, BuildError, bonds, params};
@@ -34,6 +37,8 @@ pub struct Engine<T: Real> {
     /// Brownian steps refused and completed as split steps so far ([`retry`]).
     pub retries: Retries,
     store: Buffers<T>,
+    /// The pool for the mobility's bands (shared by copies of the system).
+    threads: Option<Arc<Threads>>,
 }
 
 impl<T: Real> Engine<T> {
@@ -104,7 +109,20 @@ impl<T: Real> Engine<T> {
             contact,
             retries: Retries::default(),
             store,
+            threads: None,
         })
+    }
+
+    /// This system with `threads` threads (0: every core) for the mobility's bands where
+    /// the kernel cuts it into bands ([`hydrorattle::parallel::BANDED_MIN`] beads on);
+    /// smaller systems stay on the calling thread. The bits do not depend on it.
+    pub fn with_threads(mut self, threads: usize) -> Result<Self, rayon::ThreadPoolBuildError> {
+        let banded = hydrorattle::parallel::bands(self.beads.len()) > 1;
+        self.threads = match banded && threads != 1 {
+            true => Some(Arc::new(Threads::new(threads)?)),
+            false => None,
+        };
+        Ok(self)
     }
 
     /// One step with the scene's forces only.
@@ -123,7 +141,10 @@ impl<T: Real> Engine<T> {
             }
             extra(pos, radius, force);
         };
-        let mut ws = self.store.workspace();
+        let mut ws = match &self.threads {
+            Some(pool) => self.store.workspace().with_parallel(pool.as_ref()),
+            None => self.store.workspace(),
+        };
         retry::step(
             &mut self.beads,
             &self.bonds,

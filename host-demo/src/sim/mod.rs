@@ -202,6 +202,10 @@ pub struct RunOptions<'a> {
     pub checkpoint_every: Option<f64>,
     /// Configurations to keep in memory for pictures (none by default).
     pub keep: KeepFrames<'a>,
+    /// Threads for the mobility's bands from [`hydrorattle::parallel::BANDED_MIN`] beads
+    /// on (smaller scenes run on the calling thread); 0: every core. The bits do not
+    /// depend on it.
+    pub threads: usize,
 }
 
 impl Default for RunOptions<'_> {
@@ -213,6 +217,7 @@ impl Default for RunOptions<'_> {
             keep_series: true,
             checkpoint_every: None,
             keep: KeepFrames::default(),
+            threads: 0,
         }
     }
 }
@@ -292,6 +297,7 @@ pub fn run_scene_file(
     limits: Limits,
     checkpoint_every: Option<f64>,
     progress: bool,
+    threads: usize,
 ) -> Result<RunResult> {
     let scene = Scene::from_path_limited(scene_path, limits)?;
     log::info!(
@@ -302,7 +308,10 @@ pub fn run_scene_file(
         scene.integrator.steps()
     );
     let name = scene_name(scene_path);
-    let opts = RunOptions::files(limits, checkpoint_every, progress);
+    let opts = RunOptions {
+        threads,
+        ..RunOptions::files(limits, checkpoint_every, progress)
+    };
     let start = Start {
         scene_path: Some(scene_path.to_path_buf()),
         checkpoint: None,

@@ -47,7 +47,7 @@ pub(super) fn run_t<T: Real>(
     opts: RunOptions,
     origin: Origin,
 ) -> Result<RunResult> {
-    let mut engine = Engine::<T>::new(scene, opts.max_storage)?;
+    let mut engine = Engine::<T>::new(scene, opts.max_storage)?.with_threads(opts.threads)?;
     if let Some(c) = origin.checkpoint {
         c.restore(&mut engine.beads)?;
         // A Brownian run continues its generator and its retry count.

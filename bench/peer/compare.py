@@ -1,0 +1,128 @@
+"""Times the kernel's f64 overdamped step through `host-demo run` against the NumPy +
+pygrpy peer (overdamped_numpy.py) in one run, after checking that both give the same
+trajectory (issue 20, item 2).
+
+    python3 bench/peer/compare.py [--demo target/release/host-demo] [--scene S] [--rounds 3]
+
+1. Agreement: the scene cut to 20 steps with a frame every step is run through
+   `host-demo run`; the peer starts from its first frame and must stay within 1e-9 of
+   every frame (both solve the bonds to a relative error of 1e-12; only the Newton
+   iterates differ).
+2. Speed: `host-demo run` on the full scene (its run loop: step, observables, frames, as
+   `summary.json` times it; process wall time printed too) and the peer for `--peer-steps`
+   steps, alternately, `--rounds` times; the best of each is compared.
+
+Needs numpy and pygrpy (`pip install numpy pygrpy`). Prints a table and the ratio.
+"""
+
+import argparse
+import json
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+
+import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from overdamped_numpy import OverdampedChain, read_xyz_frames  # noqa: E402
+
+HERE = pathlib.Path(__file__).resolve().parent
+ROOT = HERE.parent.parent
+
+
+def toml_text(scene, **changes):
+    """The scene file with `[integrator] duration` / `[output] every` replaced."""
+    out, section = [], None
+    for line in scene.splitlines():
+        s = line.strip()
+        if s.startswith("["):
+            section = s
+        key = s.split("=")[0].strip()
+        if section == "[integrator]" and key == "duration" and "duration" in changes:
+            line = f"duration = {changes['duration']!r}"
+        if section == "[output]" and key == "every" and "every" in changes:
+            line = f"every = {changes['every']}"
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def demo_run(demo, scene_path, out, threads=None):
+    cmd = [str(demo), "run", str(scene_path), "--out", str(out)]
+    if threads is not None:
+        cmd += ["--threads", str(threads)]
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wall = time.perf_counter() - t0
+    summary = json.loads((pathlib.Path(out) / "summary.json").read_text())
+    return summary, wall
+
+
+def peer_from(frame, cfg):
+    _, pos, radius, mass = frame
+    g = np.array(cfg["gravity"]["acceleration"], dtype=float)
+    dhat = cfg["helix"]["dhat"]
+    length = dhat * (radius[:-1] + radius[1:])
+    weight = mass[:, None] * g[None, :]  # fluid density 0 in this scene: (rho - 0) V g
+    integ = cfg["integrator"]
+    return OverdampedChain(
+        pos, radius, weight, length, integ["dt"],
+        eta=cfg["fluid"]["viscosity"], tol=integ["tolerance"],
+        max_iterations=integ["max_iterations"],
+    )
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--demo", default=str(ROOT / "target/release/host-demo"))
+    ap.add_argument("--scene", default=str(HERE / "helix25.toml"))
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--peer-steps", type=int, default=500)
+    ap.add_argument("--threads", type=int, default=None, help="passed to host-demo run")
+    args = ap.parse_args()
+    text = pathlib.Path(args.scene).read_text()
+    cfg = tomllib.loads(text)
+    if cfg["fluid"].get("density", 0.0) != 0.0 or cfg["integrator"]["method"] != "overdamped":
+        sys.exit("the peer covers overdamped scenes with fluid density 0")
+    dt = cfg["integrator"]["dt"]
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = pathlib.Path(tmp)
+        # 1. Agreement over 20 steps.
+        short = tmp / "short.toml"
+        short.write_text(toml_text(text, duration=20 * dt, every=1))
+        demo_run(args.demo, short, tmp / "short", args.threads)
+        frames = read_xyz_frames(tmp / "short" / "trajectory.xyz")
+        peer = peer_from(frames[0], cfg)
+        worst = 0.0
+        for k, frame in enumerate(frames[1:], start=1):
+            peer.step()
+            worst = max(worst, float(np.max(np.abs(peer.pos - frame[1]))))
+        print(f"agreement: {len(frames) - 1} steps, largest position difference {worst:.2e}"
+              f" (peer Newton iterations per step {peer.iterations / (len(frames) - 1):.2f})")
+        if not worst <= 1e-9:
+            sys.exit("the peer and the kernel disagree")
+        # 2. Speed, alternating, best of `rounds`.
+        demo_best, wall_best, peer_best = np.inf, np.inf, np.inf
+        for _ in range(args.rounds):
+            s, wall = demo_run(args.demo, args.scene, tmp / "full", args.threads)
+            demo_best = min(demo_best, s["wall_time_s"] / s["steps_done"])
+            wall_best = min(wall_best, wall / s["steps_done"])
+            peer = peer_from(frames[0], cfg)
+            t0 = time.perf_counter()
+            for _ in range(args.peer_steps):
+                peer.step()
+            peer_best = min(peer_best, (time.perf_counter() - t0) / args.peer_steps)
+        steps = s["steps_done"]
+    print(f"host-demo run ({steps} steps, run loop)      {demo_best * 1e6:9.2f} us/step"
+          f"  (mean Newton iterations {s['mean_iterations']:.2f})")
+    print(f"host-demo run (process wall, with start-up) {wall_best * 1e6:9.2f} us/step")
+    print(f"NumPy + pygrpy peer ({args.peer_steps} steps)           {peer_best * 1e6:9.2f} us/step"
+          f"  (mean Newton iterations {peer.iterations / args.peer_steps:.2f})")
+    print(f"ratio peer / host-demo: {peer_best / demo_best:.1f}x (run loop), "
+          f"{peer_best / wall_best:.1f}x (process wall)")
+
+
+if __name__ == "__main__":
+    main()
