@@ -78,6 +78,7 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
             "max_iterations" => p.solver.max_iterations = x.extract()?,
             "allow_overlap" => p.allow_overlap = x.extract()?,
             "spring_stiffness" => p.spring_stiffness = T::from_f64(x.extract()?),
+            "fene" => p.fene = x.extract::<Option<f64>>()?.map(T::from_f64),
             "stability_guard" => p.stability_guard = x.extract()?,
             "contacts" => {
                 p.contacts = x.extract::<Option<usize>>()?.map(Contacts::new);

@@ -403,6 +403,15 @@ impl Core {
         })
     }
 
+    /// Bond tensions `(B,)` after the last accepted step, a float64 copy (force units;
+    /// positive when the bond pulls its ends together; rigid bonds: `-lambda_k d_k`,
+    /// springs: the spring law at the current length). `None` before the first step
+    /// and for `overdamped2`, whose last projection's multipliers are only a correction.
+    #[getter]
+    fn tensions<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        each!(&self.inner, e, T => e.tensions().map(|t| values_f64::<T>(py, &t)))
+    }
+
     /// Simulated time.
     #[getter]
     fn time(&self) -> f64 {

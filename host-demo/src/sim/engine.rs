@@ -4,7 +4,8 @@
 //! step.
 
 use hydrorattle::{
-    Bond, ExternalForce, Layout, Noise, Params, Real, SoftContact, StepError, StepReport,
+    Bond, ExternalForce, Layout, Method, Noise, Params, Real, SoftContact, StepError, StepReport,
+    forces,
 };
 use std::sync::Arc;
 
@@ -37,6 +38,8 @@ pub struct Engine<T: Real> {
     /// Brownian steps refused and completed as split steps so far ([`retry`]).
     pub retries: Retries,
     store: Buffers<T>,
+    /// The multipliers of the last accepted step ([`Engine::tensions`]).
+    multipliers: Vec<T>,
     /// The pool for the mobility's bands (shared by copies of the system).
     threads: Option<Arc<Threads>>,
 }
@@ -109,6 +112,7 @@ impl<T: Real> Engine<T> {
             contact,
             retries: Retries::default(),
             store,
+            multipliers: Vec::new(),
             threads: None,
         })
     }
@@ -145,7 +149,7 @@ impl<T: Real> Engine<T> {
             Some(pool) => self.store.workspace().with_parallel(pool.as_ref()),
             None => self.store.workspace(),
         };
-        retry::step(
+        let report = retry::step(
             &mut self.beads,
             &self.bonds,
             &self.params,
@@ -153,6 +157,51 @@ impl<T: Real> Engine<T> {
             &mut ext,
             &mut self.noise,
             &mut self.retries,
-        )
+        )?;
+        // The multipliers are the workspace's until the next step, which may fail and
+        // leave them partial: keep the accepted step's.
+        self.multipliers.clear();
+        self.multipliers
+            .extend_from_slice(ws.multipliers(self.bonds.len()));
+        Ok(report)
+    }
+
+    /// The tension of every bond after the last accepted step (force; positive when the
+    /// bond pulls its ends together), `None` before the first step and for
+    /// `Overdamped2`, whose final projection's multipliers are only a correction to the
+    /// predictor's.
+    /// * Rigid bonds: `-lambda_k d_k`, the constraint force `f_i = lambda_k (r_i - r_j)`
+    ///   along the bond (the kernel's `max_tension` is the largest magnitude).
+    /// * Springs: the spring law (Hookean or FENE) at the current length, from the
+    ///   kernel's [`hydrorattle::forces::springs`].
+    pub fn tensions(&self) -> Option<Vec<T>> {
+        match self.params.method {
+            Method::Overdamped2 => None,
+            Method::Springs => self.spring_tensions(),
+            _ if self.multipliers.len() != self.bonds.len() => None,
+            _ => Some(
+                self.bonds
+                    .iter()
+                    .zip(&self.multipliers)
+                    .map(|(b, &l)| -l * b.length)
+                    .collect(),
+            ),
+        }
+    }
+
+    /// Each spring's force along its bond at the current positions.
+    fn spring_tensions(&self) -> Option<Vec<T>> {
+        let (p, pos) = (&self.params, &self.beads.pos);
+        self.bonds
+            .iter()
+            .map(|b| {
+                let ends = [pos[b.i], pos[b.j]];
+                let one = [Bond { i: 0, j: 1, ..*b }];
+                let mut f = [T::V3_ZERO; 2];
+                forces::springs(&one, p.spring_stiffness, p.fene, &ends, &mut f).ok()?;
+                let r = ends[0] - ends[1];
+                Some(-T::dot(f[0], r) / T::norm(r))
+            })
+            .collect()
     }
 }

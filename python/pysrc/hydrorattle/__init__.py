@@ -221,7 +221,8 @@ class System:
     ``gravity`` ((0, 0, -1)), ``flow`` ((0, 0, 0)), ``vorticity`` ((0, 0, 0)), ``hydro``
     ("rpy"), ``rotation`` (False), ``matrix_free`` (False), ``solver`` ("auto",
     "sweep", "newton", "krylov"), ``tolerance`` (1e-10 in f64, 1e-5 in f32),
-    ``max_iterations`` (100), ``allow_overlap`` (False), ``spring_stiffness`` (1e3),
+    ``max_iterations`` (100), ``allow_overlap`` (False), ``spring_stiffness`` (1e3), ``fene`` (None:
+    Hookean springs; ``Q0``: FENE springs of maximum extension ``Q0``),
     ``stability_guard`` (False), ``contacts`` (None, or the hard-contact capacity),
     ``temperature`` (None: no thermal noise; ``kT``), ``drift`` ("midpoint",
     "uncorrected"), ``seed`` (1). A particle's mass is ``4/3 pi a^3 density``; gravity
@@ -368,6 +369,15 @@ class System:
     def lengths(self) -> np.ndarray:
         """Bond lengths, ``(B,)`` (a copy)."""
         return self._core.lengths
+
+    @property
+    def tensions(self) -> Optional[np.ndarray]:
+        """Bond tensions after the last accepted step, ``(B,)`` (a copy; force units,
+        positive when a bond pulls its ends together): ``-lambda_k d_k`` for rigid bonds
+        (the constraint force along the bond), the spring law at the current length for
+        ``method="springs"``. ``None`` before the first step and for ``"overdamped2"``,
+        whose last projection's multipliers are only a correction to the predictor's."""
+        return self._core.tensions
 
     @property
     def time(self) -> float:

@@ -90,6 +90,7 @@ class Core:
     densities: _F64
     bonds: npt.NDArray[np.int64]
     lengths: _F64
+    tensions: Optional[_F64]
     time: float
     dt: float
     precision: str
