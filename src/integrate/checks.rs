@@ -36,6 +36,14 @@ pub(super) fn check_thermal<T: Real>(
             "thermal noise without a stored mobility (matrix_free: no Lanczos square root)",
         ));
     }
+    let l = p.lanczos;
+    if p.noise_sqrt != crate::params::NoiseSqrt::Cholesky
+        && (l.max_iterations == 0 || !(l.tolerance > T::ZERO && l.tolerance.is_finite()))
+    {
+        return Err(StepError::BadParameter(
+            "lanczos (tolerance finite and > 0, max_iterations > 0)",
+        ));
+    }
     if !has_generator {
         return Err(StepError::Unsupported(
             "thermal noise without a generator (State::noise / ParticleSet::noise)",
