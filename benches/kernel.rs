@@ -267,10 +267,16 @@ fn scaling(c: &mut Criterion) {
         ("Cholesky", NoiseSqrt::Cholesky),
         ("Lanczos", NoiseSqrt::Lanczos),
     ] {
-        scaling_bench(c, "noise_sqrt", label, &[64, 128, 256, 512, 1024], |p| {
-            p.brownian = Some(Brownian::new(1.0));
-            p.noise_sqrt = sqrt;
-        });
+        scaling_bench(
+            c,
+            "noise_sqrt",
+            label,
+            &[64, 96, 128, 256, 512, 1024],
+            |p| {
+                p.brownian = Some(Brownian::new(1.0));
+                p.noise_sqrt = sqrt;
+            },
+        );
     }
     let small = [16, 24, 32, 48, 64];
     for (label, kind) in [

@@ -87,10 +87,11 @@ pub enum NoiseSqrt {
     Auto,
 }
 
-/// Beads above which [`NoiseSqrt::Auto`] draws the noise by Lanczos: measured
-/// (`cargo bench --bench kernel -- noise_sqrt`) as where the Lanczos step overtakes the
-/// Cholesky one for an RPY chain.
-pub const LANCZOS_CROSSOVER: usize = 128;
+/// Beads above which [`NoiseSqrt::Auto`] draws the noise by Lanczos: where the Lanczos
+/// step overtakes the Cholesky one for an RPY chain (f64, midpoint), measured with
+/// `cargo bench --bench kernel -- noise_sqrt`: Cholesky / Lanczos 1.21 / 1.61 ms at
+/// N = 96, 2.90 / 2.07 ms at 128, so about 110 interpolated.
+pub const LANCZOS_CROSSOVER: usize = 112;
 
 impl NoiseSqrt {
     /// `true` when a step of `n` beads uses the Lanczos square root.
