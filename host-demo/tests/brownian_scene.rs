@@ -173,6 +173,9 @@ fn sqrt_key() {
         "f32",
     );
     assert_eq!(s.brownian.map(|b| b.sqrt), Some(Sqrt::Cholesky));
+    // A written scene keeps the choice.
+    let back = Scene::parse(&s.to_toml(), "written").unwrap();
+    assert_eq!(back.brownian, s.brownian);
     // Both square roots run the shipped chain.
     for sqrt in ["cholesky", "lanczos"] {
         let table = format!("[brownian]\ntemperature = 0.5\nseed = 7\nsqrt = \"{sqrt}\"\n");

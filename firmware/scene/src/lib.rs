@@ -18,7 +18,7 @@ use core::fmt::{self, Write};
 
 use hydrorattle::glam::Vec3;
 use hydrorattle::{
-    Bond, BondSet, Hydro, Method, Params, Particle, ParticleSet, Real, SoftContact, Solver,
+    Bond, BondSet, Hydro, Lanczos, Method, NoiseSqrt, Params, Particle, ParticleSet, Real, SoftContact, Solver,
     SolverKind, StepError, StepReport, Workspace, step,
 };
 
@@ -190,6 +190,12 @@ pub const fn params_f32(method: Method, rotation: bool) -> Params<f32> {
         fene: None,
         stability_guard: false,
         brownian: None,
+        // The firmware keeps the Cholesky path (no Lanczos basis to size).
+        noise_sqrt: NoiseSqrt::Cholesky,
+        lanczos: Lanczos {
+            tolerance: 1e-4,
+            max_iterations: 64,
+        },
         contacts: None,
     }
 }
