@@ -33,7 +33,7 @@ pub(super) fn check_thermal<T: Real>(
     }
     if p.matrix_free {
         return Err(StepError::Unsupported(
-            "thermal noise without a stored mobility (matrix_free: no Lanczos square root)",
+            "thermal noise without a stored mobility (matrix_free: not implemented)",
         ));
     }
     let l = p.lanczos;
