@@ -8,6 +8,9 @@
 //! * `scaling/...`: `step_slices` on runtime-sized chains up to N = 2048 (Overdamped
 //!   stored and matrix-free, RattleStable), and `solver/...`: dense Newton against
 //!   Krylov at N = 16 ... 64 (the `Auto` switch), f64, with iteration counts printed;
+//! * `noise_sqrt/{Cholesky,Lanczos}/N`: the thermal overdamped step (kT = 1, midpoint)
+//!   with each square root of the mobility at N = 64 ... 1024, Lanczos iterations
+//!   printed (the `NoiseSqrt::Auto` crossover);
 //! * `contacts/...`: one overdamped step (first and second order) of a folded 25-bead
 //!   chain with and without hard contacts, f64, with contact and round counts printed.
 //!
@@ -24,8 +27,8 @@ use criterion::{BatchSize, BenchmarkId, Criterion};
 use hydrorattle::linalg::{cholesky, cholesky_solve, sym_matvec};
 use hydrorattle::mobility::{Hydro, assemble_grand, assemble_tt};
 use hydrorattle::{
-    Bond, BondSet, Layout, Method, NoForce, Params, Particle, ParticleSet, Real, SolverKind, State,
-    step, step_slices,
+    Bond, BondSet, Brownian, Layout, Method, NoForce, Noise, NoiseSqrt, Params, Particle,
+    ParticleSet, Real, SolverKind, State, step, step_slices,
 };
 use hydrorattle_heap::Buffers;
 
@@ -221,6 +224,7 @@ fn scaling_bench(
         let zero = vec![glam::DVec3::ZERO; n];
         let go = |pos: &mut Vec<glam::DVec3>, ws: &mut hydrorattle::Workspace<'_, f64>| {
             let (mut vel, mut omega, mut time) = (zero.clone(), zero.clone(), 0.0);
+            let mut noise = Noise::new(1);
             let state = State {
                 pos,
                 vel: &mut vel,
@@ -228,12 +232,15 @@ fn scaling_bench(
                 radius: &r,
                 density: &density,
                 time: &mut time,
-                noise: None,
+                noise: params.brownian.map(|_| &mut noise),
             };
             step_slices(state, &bonds, &params, ws, &mut NoForce).unwrap()
         };
-        let its = go(&mut pos0.clone(), &mut ws).iterations;
-        eprintln!("{group}/{label}/{n}: {its} constraint iterations per step");
+        let r = go(&mut pos0.clone(), &mut ws);
+        let (its, lz) = (r.iterations, r.noise_iterations);
+        eprintln!(
+            "{group}/{label}/{n}: {its} constraint iterations, {lz} Lanczos iterations per step"
+        );
         g.bench_function(BenchmarkId::from_parameter(n), |b| {
             b.iter_batched_ref(
                 || pos0.clone(),
@@ -254,6 +261,23 @@ fn scaling(c: &mut Criterion) {
     scaling_bench(c, "scaling", "RattleStable", &big[..4], |p| {
         p.method = Method::RattleStable
     });
+    // The thermal step's square root of the mobility: Cholesky against Lanczos (the
+    // `NoiseSqrt::Auto` crossover), kT = 1, midpoint drift.
+    for (label, sqrt) in [
+        ("Cholesky", NoiseSqrt::Cholesky),
+        ("Lanczos", NoiseSqrt::Lanczos),
+    ] {
+        scaling_bench(
+            c,
+            "noise_sqrt",
+            label,
+            &[64, 96, 128, 256, 512, 1024],
+            |p| {
+                p.brownian = Some(Brownian::new(1.0));
+                p.noise_sqrt = sqrt;
+            },
+        );
+    }
     let small = [16, 24, 32, 48, 64];
     for (label, kind) in [
         ("Newton", SolverKind::Newton),

@@ -2,6 +2,7 @@
 
 use crate::constraints::{Solver, SolverKind};
 use crate::mobility::Hydro;
+use crate::noise::lanczos::Lanczos;
 use crate::real::Real;
 
 /// Which integrator [`step`](crate::integrate::step) runs.
@@ -46,7 +47,8 @@ pub enum Drift {
 }
 
 /// Thermal noise for [`Method::Overdamped`] and [`Method::Springs`]: displacements with
-/// covariance `2 kT dt mu`, drawn through the Cholesky factor of the stored mobility
+/// covariance `2 kT dt mu`, drawn through a square root of the stored mobility
+/// ([`Params::noise_sqrt`]: its Cholesky factor or the Lanczos `mu^(1/2)`)
 /// (and for `Overdamped` projected onto the constraints). Steps with noise go through
 /// [`step`](crate::integrate::step), which draws from the state's generator
 /// ([`State::noise`](crate::State::noise)).
@@ -65,6 +67,39 @@ impl<T: Real> Brownian<T> {
         Self {
             temperature,
             drift: Drift::Midpoint,
+        }
+    }
+}
+
+/// How a thermal step draws `L xi` with `L L^T = mu` from the stored mobility.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NoiseSqrt {
+    /// Block Cholesky factor of the packed mobility: exact, `O(N^3)` a step, `tri(N)`
+    /// blocks for the factor. The small-`N` and firmware path.
+    Cholesky,
+    /// Krylov square root `mu^(1/2) xi` from mobility products only
+    /// ([`noise::lanczos`](crate::noise::lanczos)): `O(m N^2)` a step for `m`
+    /// iterations, to the relative tolerance of [`Params::lanczos`]; storage
+    /// `(m_max + 1) N` vectors (and no factor with [`Drift::Uncorrected`]).
+    Lanczos,
+    /// [`NoiseSqrt::Lanczos`] above [`LANCZOS_CROSSOVER`] beads, Cholesky up to it.
+    #[default]
+    Auto,
+}
+
+/// Beads above which [`NoiseSqrt::Auto`] draws the noise by Lanczos: where the Lanczos
+/// step overtakes the Cholesky one for an RPY chain (f64, midpoint), measured with
+/// `cargo bench --bench kernel -- noise_sqrt`: Cholesky / Lanczos 1.21 / 1.61 ms at
+/// N = 96, 2.90 / 2.07 ms at 128, so about 110 interpolated.
+pub const LANCZOS_CROSSOVER: usize = 112;
+
+impl NoiseSqrt {
+    /// `true` when a step of `n` beads uses the Lanczos square root.
+    pub const fn lanczos(self, n: usize) -> bool {
+        match self {
+            Self::Cholesky => false,
+            Self::Lanczos => true,
+            Self::Auto => n > LANCZOS_CROSSOVER,
         }
     }
 }
@@ -155,6 +190,12 @@ pub struct Params<T: Real> {
     /// and [`Params::matrix_free`] refuse a positive temperature with
     /// [`StepError::Unsupported`](crate::StepError::Unsupported)). Default `None`.
     pub brownian: Option<Brownian<T>>,
+    /// How the thermal noise's square root of the mobility is taken. Default
+    /// [`NoiseSqrt::Auto`] (Cholesky up to [`LANCZOS_CROSSOVER`] beads, Lanczos above).
+    pub noise_sqrt: NoiseSqrt,
+    /// Tolerance and iteration cap of the Lanczos square root (read only when it is
+    /// used). Default: relative change `1e-6` (f64) / `1e-4` (f32), 64 iterations.
+    pub lanczos: Lanczos<T>,
     /// Hard-sphere contacts as one-sided constraints ([`Contacts`];
     /// [`Method::Overdamped`] and [`Method::Overdamped2`] without thermal noise; the other
     /// methods refuse them with [`StepError::Unsupported`](crate::StepError::Unsupported)).
@@ -191,6 +232,8 @@ impl<T: Real> Params<T> {
             fene: None,
             stability_guard: false,
             brownian: None,
+            noise_sqrt: NoiseSqrt::Auto,
+            lanczos: Lanczos::default(),
             contacts: None,
         }
     }

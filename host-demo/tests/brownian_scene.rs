@@ -2,7 +2,7 @@
 //! its seed (same seed same bits in f32 and f64; another seed another run; `kT = 0` the
 //! deterministic run).
 
-use host_demo::scene::{Drift, Precision, Scene, Thermal};
+use host_demo::scene::{Drift, Precision, Scene, Sqrt, Thermal};
 use host_demo::sim::{RunOptions, run};
 
 const SHIPPED: &str = include_str!("../scenes/brownian_chain.toml");
@@ -36,7 +36,8 @@ fn keys_and_defaults() {
         Some(Thermal {
             temperature: 0.5,
             seed: 7,
-            drift: Drift::Midpoint
+            drift: Drift::Midpoint,
+            sqrt: Sqrt::Auto,
         })
     );
     let s = scene("[brownian]\ntemperature = 2.0\n", "f64");
@@ -159,4 +160,30 @@ fn a_brownian_run_resumes_to_the_bytes_of_one_run() {
     for key in ["final_observables", "steps_done", "retries"] {
         assert_eq!(s1[key], s2[key], "{key}");
     }
+}
+
+/// `sqrt` picks the kernel's square root of the mobility; a bad value is refused at
+/// its file and line.
+#[test]
+fn sqrt_key() {
+    let s = scene("[brownian]\ntemperature = 2.0\nsqrt = \"lanczos\"\n", "f64");
+    assert_eq!(s.brownian.map(|b| b.sqrt), Some(Sqrt::Lanczos));
+    let s = scene(
+        "[brownian]\ntemperature = 2.0\nsqrt = \"cholesky\"\n",
+        "f32",
+    );
+    assert_eq!(s.brownian.map(|b| b.sqrt), Some(Sqrt::Cholesky));
+    // A written scene keeps the choice.
+    let back = Scene::parse(&s.to_toml(), "written").unwrap();
+    assert_eq!(back.brownian, s.brownian);
+    // Both square roots run the shipped chain.
+    for sqrt in ["cholesky", "lanczos"] {
+        let table = format!("[brownian]\ntemperature = 0.5\nseed = 7\nsqrt = \"{sqrt}\"\n");
+        assert_eq!(last(&scene(&table, "f64")).len(), 25);
+    }
+    let body = SHIPPED.split("[brownian]").next().unwrap();
+    let text = format!("{body}[brownian]\ntemperature = 2.0\nsqrt = \"qr\"\n");
+    let err = Scene::parse(&text, "bad.toml").unwrap_err();
+    assert_eq!(err.line(), Some(text.lines().count()), "{err}");
+    assert!(err.to_string().contains("qr"), "{err}");
 }

@@ -28,6 +28,7 @@ use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
 use crate::linalg;
 use crate::noise::Noise;
+use crate::noise::lanczos::{self, LanczosError};
 use crate::params::{Brownian, Drift, Params};
 use crate::real::Real;
 use crate::workspace::Views;
@@ -62,6 +63,8 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         mut scratch,
         par,
         bands,
+        basis,
+        krylov_t,
         ..
     } = v;
     // Deterministic velocity at the start: U_inf + mu F.
@@ -75,7 +78,8 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         kappa,
         scratch: &mut scratch,
     };
-    kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held))?;
+    let krylov = (basis, krylov_t);
+    let noise_iterations = kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held), krylov)?;
     // r* = r + dt (U_inf + mu F) + noise, projected as in the deterministic step.
     for i in 0..n {
         new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
@@ -87,7 +91,10 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     step_velocity(s.pos, new_pos, dt, xi);
     add_constraint_forces(bonds, grad, lambda, force);
     spin(p, s.pos, s.radius, force, mid)?;
-    Ok(report(stats, 0, bonds, lambda))
+    Ok(StepReport {
+        noise_iterations,
+        ..report(stats, 0, bonds, lambda)
+    })
 }
 
 /// The bonds the midpoint's noise is projected onto (constraints), and its storage.
@@ -99,11 +106,18 @@ pub(super) struct Held<'a, 'b, T: Real> {
     pub(super) scratch: &'a mut Scratch<'b, T>,
 }
 
+/// The Lanczos basis and its scalars ([`Views::basis`], [`Views::krylov_t`]); empty
+/// with the Cholesky factor.
+pub(super) type Krylov<'a, T> = (&'a mut [<T as Real>::V3], &'a mut [T]);
+
 /// The thermal displacement `dx` of one step from the packed mobility `mu` at the
 /// start (see the module): `fac` takes its Cholesky factor (then, with the midpoint,
 /// the mobility at the midpoint), `xi` the deviates, `mid` the midpoint. With `held`
 /// the midpoint's noise is projected onto its bonds; without (springs), it is
 /// `sqrt(2 kT dt) mu(x~) L^-T xi`, whose mean is `kT dt div mu` (zero for RPY).
+/// With the Lanczos square root ([`Params::noise_sqrt`]) `L` is the symmetric
+/// `mu^(1/2)`, drawn from products with `mu` in the basis `krylov`, and the returned
+/// count is its iterations (0 with Cholesky).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn kick<T: Real>(
     p: &Params<T>,
@@ -116,31 +130,50 @@ pub(super) fn kick<T: Real>(
     dx: &mut [T::V3],
     noise: &mut Noise,
     held: Option<Held<'_, '_, T>>,
-) -> Result<(), StepError> {
+    krylov: Krylov<'_, T>,
+) -> Result<u32, StepError> {
     let (n, dt, kt) = (s.pos.len(), p.dt, b.temperature);
-    // L L^T = mu.
-    fac.copy_from_slice(mu);
-    linalg::cholesky::<T>(fac, n).map_err(|error| StepError::Linalg {
-        stage: Stage::Mobility,
-        error,
-    })?;
+    let lanczos = p.noise_sqrt.lanczos(n);
+    if !lanczos {
+        // L L^T = mu.
+        fac.copy_from_slice(mu);
+        linalg::cholesky::<T>(fac, n).map_err(|error| StepError::Linalg {
+            stage: Stage::Mobility,
+            error,
+        })?;
+    }
     noise.fill::<T>(xi);
     let amplitude = (T::TWO * kt * dt).sqrt();
+    let (basis, work) = krylov;
+    let product = |v: &[T::V3], w: &mut [T::V3]| linalg::sym_matvec::<T>(mu, n, v, w);
+    let mut iterations = 0;
     match b.drift {
         Drift::Uncorrected => {
-            linalg::lower_mul::<T>(fac, n, xi, dx);
+            if lanczos {
+                iterations = lanczos::sqrt(p.lanczos, product, xi, basis, work, dx, None)
+                    .map_err(refused)?;
+            } else {
+                linalg::lower_mul::<T>(fac, n, xi, dx);
+            }
             for d in dx.iter_mut() {
                 *d *= amplitude;
             }
         }
         Drift::Midpoint => {
             // x~ = x + sqrt(kT dt / 2) L xi; then xi <- sqrt(2 kT dt) L^-T xi.
-            linalg::lower_mul::<T>(fac, n, xi, mid);
+            if lanczos {
+                iterations =
+                    lanczos::sqrt(p.lanczos, product, xi, basis, work, mid, Some(&mut *dx))
+                        .map_err(refused)?;
+                xi.copy_from_slice(dx);
+            } else {
+                linalg::lower_mul::<T>(fac, n, xi, mid);
+                linalg::solve_upper::<T>(fac, n, xi);
+            }
             let half = (kt * dt * T::HALF).sqrt();
             for (m, &r) in mid.iter_mut().zip(s.pos) {
                 *m = r + *m * half;
             }
-            linalg::solve_upper::<T>(fac, n, xi);
             for z in xi.iter_mut() {
                 *z *= amplitude;
             }
@@ -170,5 +203,21 @@ pub(super) fn kick<T: Real>(
             }
         }
     }
-    Ok(())
+    Ok(iterations)
+}
+
+/// A failed Lanczos square root as the step's error (at the mobility stage).
+fn refused(e: LanczosError) -> StepError {
+    match e {
+        LanczosError::NoConvergence { iterations, change } => StepError::NoConvergence {
+            stage: Stage::Mobility,
+            iterations,
+            residual: change,
+        },
+        LanczosError::NotPositiveDefinite { .. } => StepError::Linalg {
+            stage: Stage::Mobility,
+            error: crate::error::LinalgError::NotPositiveDefinite { row: 0 },
+        },
+        LanczosError::Storage => StepError::BadParameter("lanczos.max_iterations (> 0)"),
+    }
 }

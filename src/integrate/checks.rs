@@ -33,7 +33,15 @@ pub(super) fn check_thermal<T: Real>(
     }
     if p.matrix_free {
         return Err(StepError::Unsupported(
-            "thermal noise without a stored mobility (matrix_free: no Lanczos square root)",
+            "thermal noise without a stored mobility (matrix_free: not implemented)",
+        ));
+    }
+    let l = p.lanczos;
+    if p.noise_sqrt != crate::params::NoiseSqrt::Cholesky
+        && (l.max_iterations == 0 || !(l.tolerance > T::ZERO && l.tolerance.is_finite()))
+    {
+        return Err(StepError::BadParameter(
+            "lanczos (tolerance finite and > 0, max_iterations > 0)",
         ));
     }
     if !has_generator {

@@ -56,6 +56,9 @@ pub struct StepReport<T> {
     /// Active-set rounds of the contact projection (constraint solves; 0 without
     /// contacts).
     pub contact_rounds: u32,
+    /// Lanczos iterations of the thermal noise's square root ([`Params::noise_sqrt`]);
+    /// 0 without noise or with the Cholesky factor.
+    pub noise_iterations: u32,
 }
 
 /// Read-only view of the state at the start of a step.

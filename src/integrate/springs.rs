@@ -37,12 +37,15 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         new_omega,
         par,
         bands,
+        basis,
+        krylov_t,
         ..
     } = v;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     forces::springs(bonds, p.spring_stiffness, p.fene, s.pos, force)?;
     mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
     add_flow(p, s.pos, u);
+    let mut noise_iterations = 0;
     match thermal {
         None => {
             for i in 0..n {
@@ -51,7 +54,10 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
             }
         }
         Some((b, noise)) => {
-            kick(p, b, s, mu, fac, new_vel, new_omega, dx, noise, None)?;
+            let krylov = (basis, krylov_t);
+            noise_iterations = kick(
+                p, b, s, mu, fac, new_vel, new_omega, dx, noise, None, krylov,
+            )?;
             for i in 0..n {
                 new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
             }
@@ -64,7 +70,10 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         }
     }
     spin(p, s.pos, s.radius, force, new_omega)?;
-    Ok(spring_report(p, bonds, new_pos))
+    Ok(StepReport {
+        noise_iterations,
+        ..spring_report(p, bonds, new_pos)
+    })
 }
 
 /// The report of a spring step: the largest relative length error and spring force.

@@ -183,5 +183,6 @@ pub(super) fn report<T: Real>(
         max_tension: max_tension(bonds, lambda),
         contacts: 0,
         contact_rounds: 0,
+        noise_iterations: 0,
     }
 }

@@ -4,6 +4,7 @@
 
 use crate::constraints::{SolverKind, scratch_size};
 use crate::linalg::tri;
+use crate::noise::lanczos;
 use crate::parallel::band_scratch;
 use crate::params::{Method, Params};
 use crate::real::Real;
@@ -128,7 +129,7 @@ impl Layout {
         }
         let bonds = c;
         let l = if p.brownian.is_some() {
-            l.thermal(p.method, n, bonds)
+            l.thermal(p.method, n, bonds).noise_sqrt(p, n)
         } else {
             l
         };
@@ -161,6 +162,30 @@ impl Layout {
                 ..self
             },
             _ => self,
+        }
+    }
+
+    /// This thermal layout ([`Layout::thermal`]) adjusted for the square root
+    /// [`Params::noise_sqrt`] picks at `n` beads: with Lanczos, the basis
+    /// (`(cap + 1) n` vectors) and its small matrices (`2 cap^2 + 8 cap + 1` scalars),
+    /// and no Cholesky factor with [`Drift::Uncorrected`](crate::Drift::Uncorrected)
+    /// (the midpoint keeps its storage for the mobility at the midpoint). Unchanged with
+    /// Cholesky and for methods without noise.
+    pub const fn noise_sqrt<T: Real>(self, p: &Params<T>, n: usize) -> Self {
+        let thermal = matches!(p.method, Method::Overdamped | Method::Springs);
+        if !thermal || !p.noise_sqrt.lanczos(n) {
+            return self;
+        }
+        let cap = p.lanczos.max_iterations as usize;
+        let uncorrected = match p.brownian {
+            Some(b) => matches!(b.drift, crate::params::Drift::Uncorrected),
+            None => false,
+        };
+        Self {
+            blocks: self.blocks - if uncorrected { tri(n) } else { 0 },
+            vectors: self.vectors + lanczos::vectors(cap, n),
+            scalars: self.scalars + lanczos::scalars(cap),
+            ..self
         }
     }
 

@@ -7,6 +7,7 @@ use crate::constraints::Scratch;
 use crate::constraints::{SolverKind, krylov_scratch_per_bond};
 use crate::error::StepError;
 use crate::linalg::tri;
+use crate::noise::lanczos::{scalars as lanczos_scalars, vectors as lanczos_vectors};
 use crate::parallel::{Parallel, band_scratch};
 use crate::params::{Method, Params};
 use crate::real::Real;
@@ -30,6 +31,9 @@ pub(crate) struct Views<'a, T: Real> {
     pub new_vel: &'a mut [T::V3],
     pub new_omega: &'a mut [T::V3],
     pub scratch: Scratch<'a, T>,
+    /// The Lanczos basis and its scalars (thermal steps by Lanczos only).
+    pub basis: &'a mut [T::V3],
+    pub krylov_t: &'a mut [T],
     /// Bonds then contacts (steps with contacts only; empty otherwise).
     pub links: &'a mut [Bond<T>],
     /// How the mobility's bands run ([`Workspace::with_parallel`]).
@@ -85,6 +89,11 @@ impl<T: Real> Workspace<'_, T> {
         // Thermal noise (`Layout::thermal`): the factor, one vector array, the midpoint's
         // bond vectors and multipliers.
         let thermal = p.brownian.is_some();
+        let lanczos = thermal
+            && matches!(method, Method::Overdamped | Method::Springs)
+            && p.noise_sqrt.lanczos(n);
+        let uncorrected =
+            matches!(p.brownian, Some(b) if b.drift == crate::params::Drift::Uncorrected);
         let (mats, work, extra_bonds, inv_mass, sqrt_m, disp) = match method {
             Method::Overdamped if thermal => (2, [n, n, 0], nb, 0, 0, table),
             Method::Overdamped => (1, [n, 0, 0], 0, 0, 0, table),
@@ -95,7 +104,8 @@ impl<T: Real> Workspace<'_, T> {
             Method::RattleStable => (2, [m, m, 0], nb, 0, m, table),
         };
         let mu = bl.take(if stored { tri(m) } else { 0 });
-        let fac = bl.take(if mats == 2 { tri(m) } else { 0 });
+        let factor = mats == 2 && !(lanczos && uncorrected);
+        let fac = bl.take(if factor { tri(m) } else { 0 });
         let (work_a, work_b, work_c) = (ve.take(work[0]), ve.take(work[1]), ve.take(work[2]));
         let grad_new = ve.take(extra_bonds);
         let kappa = sc.take(extra_bonds);
@@ -122,6 +132,9 @@ impl<T: Real> Workspace<'_, T> {
             }),
             par: self.parallel,
         };
+        let cap = p.lanczos.max_iterations as usize;
+        let basis = ve.take(if lanczos { lanczos_vectors(cap, n) } else { 0 });
+        let krylov_t = sc.take(if lanczos { lanczos_scalars(cap) } else { 0 });
         Ok(Views {
             mu,
             fac,
@@ -140,6 +153,8 @@ impl<T: Real> Workspace<'_, T> {
             new_vel,
             new_omega,
             scratch,
+            basis,
+            krylov_t,
             links,
             par: self.parallel,
             bands,

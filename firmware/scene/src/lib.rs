@@ -18,8 +18,8 @@ use core::fmt::{self, Write};
 
 use hydrorattle::glam::Vec3;
 use hydrorattle::{
-    Bond, BondSet, Hydro, Method, Params, Particle, ParticleSet, Real, SoftContact, Solver,
-    SolverKind, StepError, StepReport, Workspace, step,
+    Bond, BondSet, Hydro, Lanczos, Method, NoiseSqrt, Params, Particle, ParticleSet, Real,
+    SoftContact, Solver, SolverKind, StepError, StepReport, Workspace, step,
 };
 
 /// Beads: one head and 24 tails.
@@ -190,6 +190,12 @@ pub const fn params_f32(method: Method, rotation: bool) -> Params<f32> {
         fene: None,
         stability_guard: false,
         brownian: None,
+        // The kernel's defaults (no noise here; at N = 25 `Auto` is the Cholesky path).
+        noise_sqrt: NoiseSqrt::Auto,
+        lanczos: Lanczos {
+            tolerance: 1e-4,
+            max_iterations: 64,
+        },
         contacts: None,
     }
 }

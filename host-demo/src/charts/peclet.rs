@@ -12,7 +12,7 @@ use anyhow::{Result, anyhow};
 
 use super::{Point, write_chart};
 use crate::render::LineChart;
-use crate::scene::{Drift, Method, Scene, Thermal};
+use crate::scene::{Drift, Method, Scene, Sqrt, Thermal};
 use crate::sim::{RunOptions, RunResult, run};
 
 /// `(verticality, extension, stretched, settling speed)` at the end of a run.
@@ -32,6 +32,7 @@ fn at(scene: &Scene, kt: f64, seed: u64) -> Result<[f64; 4]> {
         temperature: kt,
         seed,
         drift: Drift::Midpoint,
+        sqrt: Sqrt::Auto,
     });
     outcome(&run(&s, "peclet", None, RunOptions::default())?)
 }

@@ -58,7 +58,7 @@ pub use model::{
     Bond, Flow, Fluid, Hydrodynamics, Integrator, Level, Method, Model, Output, Overlap, Particle,
     Precision, Solver,
 };
-pub use thermal::{DEFAULT_SEED, Drift, Thermal};
+pub use thermal::{DEFAULT_SEED, Drift, Sqrt, Thermal};
 
 use serde::Serialize;
 use std::path::Path;

@@ -28,6 +28,32 @@ impl Drift {
     }
 }
 
+/// Square root of the mobility for the noise (the kernel's [`hydrorattle::NoiseSqrt`]):
+/// `sqrt = "auto" | "cholesky" | "lanczos"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Sqrt {
+    /// Cholesky up to the kernel's crossover ([`hydrorattle::LANCZOS_CROSSOVER`]
+    /// beads), Lanczos above.
+    #[default]
+    Auto,
+    /// The block Cholesky factor (exact, `O(N^3)`).
+    Cholesky,
+    /// The Lanczos square root from mobility products (`O(m N^2)`).
+    Lanczos,
+}
+
+impl Sqrt {
+    /// The kernel's choice.
+    pub fn kernel(self) -> hydrorattle::NoiseSqrt {
+        match self {
+            Sqrt::Auto => hydrorattle::NoiseSqrt::Auto,
+            Sqrt::Cholesky => hydrorattle::NoiseSqrt::Cholesky,
+            Sqrt::Lanczos => hydrorattle::NoiseSqrt::Lanczos,
+        }
+    }
+}
+
 /// Thermal noise settings (`[brownian]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Thermal {
@@ -37,6 +63,8 @@ pub struct Thermal {
     pub seed: u64,
     /// Drift scheme.
     pub drift: Drift,
+    /// Square root of the mobility.
+    pub sqrt: Sqrt,
 }
 
 /// Default seed when `[brownian]` gives none.
@@ -48,6 +76,7 @@ pub(super) struct RawBrownian {
     temperature: S<f64>,
     seed: Option<Spanned<i64>>,
     drift: Option<Drift>,
+    sqrt: Option<Sqrt>,
 }
 
 impl RawBrownian {
@@ -75,6 +104,7 @@ impl RawBrownian {
             temperature,
             seed,
             drift: self.drift.unwrap_or_default(),
+            sqrt: self.sqrt.unwrap_or_default(),
         })
     }
 

@@ -82,14 +82,16 @@ impl Scene {
             None => {}
         }
         if let Some(b) = self.brownian {
-            t.insert(
-                "brownian".into(),
-                table([
-                    ("temperature", value(b.temperature)),
-                    ("seed", value(b.seed as i64)),
-                    ("drift", value(b.drift)),
-                ]),
-            );
+            let mut bt = table([
+                ("temperature", value(b.temperature)),
+                ("seed", value(b.seed as i64)),
+                ("drift", value(b.drift)),
+            ]);
+            // Written only when chosen: scenes written before the key stay the same.
+            if let (Value::Table(m), false) = (&mut bt, b.sqrt == super::Sqrt::Auto) {
+                m.insert("sqrt".into(), value(b.sqrt));
+            }
+            t.insert("brownian".into(), bt);
         }
         match &self.helix {
             Some(h) => {

@@ -52,9 +52,10 @@ impl<T: Real> Engine<T> {
         let p = params::<T>(scene);
         let (n, b) = (scene.particles.len(), scene.bonds.len());
         let layout = Plan::of(scene).check(n, b, limit)?;
-        // Thermal noise needs the mobility's factor on top (`Layout::thermal`).
+        // Thermal noise needs the mobility's factor on top (`Layout::thermal`), or the
+        // Lanczos basis (`Layout::noise_sqrt`).
         let layout = match scene.brownian {
-            Some(_) => layout.thermal(p.method, n, b),
+            Some(_) => layout.thermal(p.method, n, b).noise_sqrt(&p, n),
             None => layout,
         };
         let beads = Beads::<T>::new(&scene.particles, 1.0)?;

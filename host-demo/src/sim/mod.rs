@@ -398,6 +398,9 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
         temperature: T::from_f64(b.temperature),
         drift: b.drift.kernel(),
     });
+    if let Some(b) = scene.brownian {
+        p.noise_sqrt = b.sqrt.kernel();
+    }
     p
 }
 

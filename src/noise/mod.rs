@@ -14,6 +14,8 @@
 //! with the bridge's conditional law. Redrawing a fresh increment instead would bias
 //! the run against the large kicks that made the step fail.
 
+pub mod lanczos;
+
 use crate::real::Real;
 
 /// A seedable, deterministic source of standard normal deviates.
