@@ -1,6 +1,6 @@
 //! Kernel parameters from keyword arguments, with the kernel's names and defaults.
 
-use hydrorattle::{Brownian, Contacts, Drift, Method, Params, Real, SolverKind};
+use hydrorattle::{Brownian, Contacts, Drift, Method, NoiseSqrt, Params, Real, SolverKind};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -95,6 +95,19 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
                 )?
             }
             "seed" => seed = x.extract()?,
+            "noise_sqrt" => {
+                p.noise_sqrt = pick(
+                    "noise_sqrt",
+                    &x.extract::<String>()?,
+                    &[
+                        ("auto", NoiseSqrt::Auto),
+                        ("cholesky", NoiseSqrt::Cholesky),
+                        ("lanczos", NoiseSqrt::Lanczos),
+                    ],
+                )?
+            }
+            "lanczos_tolerance" => p.lanczos.tolerance = T::from_f64(x.extract()?),
+            "lanczos_max_iterations" => p.lanczos.max_iterations = x.extract()?,
             other => {
                 return Err(PyTypeError::new_err(format!(
                     "System got an unexpected parameter {other:?}"

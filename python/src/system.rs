@@ -39,6 +39,8 @@ pub struct Report {
     pub contacts: u32,
     /// Active-set rounds of the contact projection.
     pub contact_rounds: u32,
+    /// Lanczos iterations of the thermal noise (0 with Cholesky or without noise).
+    pub noise_iterations: u32,
     /// Steps made by this call.
     pub steps: usize,
 }
@@ -62,6 +64,7 @@ impl Report {
             max_tension: r.max_tension.to_f64(),
             contacts: r.contacts,
             contact_rounds: r.contact_rounds,
+            noise_iterations: r.noise_iterations,
             steps,
         }
     }
@@ -242,6 +245,7 @@ fn empty(steps: usize) -> Report {
         max_tension: 0.0,
         contacts: 0,
         contact_rounds: 0,
+        noise_iterations: 0,
         steps,
     }
 }

@@ -320,3 +320,20 @@ def test_overdamped2_has_no_tensions():
                   dt=0.01, method="overdamped2")
     s.step(1)
     assert s.tensions is None
+
+
+def test_lanczos_noise_is_reported_and_keeps_the_bonds():
+    """The Krylov square root is chosen by name, reports its iterations (the kernel's
+    tests/lanczos.rs checks its covariance), and the step still holds every bond."""
+    pos, bonds = chain(8)
+    kw = dict(bonds=bonds, dt=0.01, method="overdamped", temperature=1.0, seed=3)
+    lan = hr.System(pos, 1.0, RHO, noise_sqrt="lanczos", **kw)
+    chol = hr.System(pos, 1.0, RHO, noise_sqrt="cholesky", **kw)
+    r = lan.step(5)
+    assert 1 <= r.noise_iterations <= 64
+    assert chol.step(5).noise_iterations == 0
+    p = lan.positions
+    lengths = [np.linalg.norm(p[i] - p[j]) for i, j in bonds]
+    assert np.allclose(lengths, lan.lengths, rtol=1e-8)
+    with pytest.raises(ValueError):
+        hr.System(pos, 1.0, RHO, noise_sqrt="qr", **kw)

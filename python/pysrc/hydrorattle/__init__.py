@@ -225,7 +225,9 @@ class System:
     Hookean springs; ``Q0``: FENE springs of maximum extension ``Q0``),
     ``stability_guard`` (False), ``contacts`` (None, or the hard-contact capacity),
     ``temperature`` (None: no thermal noise; ``kT``), ``drift`` ("midpoint",
-    "uncorrected"), ``seed`` (1). A particle's mass is ``4/3 pi a^3 density``; gravity
+    "uncorrected"), ``seed`` (1), ``noise_sqrt`` ("auto": Lanczos above
+    ``LANCZOS_CROSSOVER`` beads, "cholesky", "lanczos"), ``lanczos_tolerance`` (1e-6 in
+    f64, 1e-4 in f32) and ``lanczos_max_iterations`` (64). A particle's mass is ``4/3 pi a^3 density``; gravity
     acts on the buoyant mass (``density - fluid_density``).
 
     Constructors for the CLI's shapes: :meth:`from_scene` (a scene file, read by the

@@ -36,6 +36,7 @@ class Report:
     max_tension: float
     contacts: int
     contact_rounds: int
+    noise_iterations: int
     steps: int
 
 _F64 = npt.NDArray[np.float64]
