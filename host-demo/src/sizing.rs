@@ -10,7 +10,7 @@ use std::fmt;
 
 use hydrorattle::{Contacts, Layout, Params};
 
-use crate::scene::{Contact, Method, Precision, Scene, Solver};
+use crate::scene::{Contact, Method, Precision, Scene, Solver, Thermal};
 
 /// Default limit on one run's step storage (`run --max-storage`): 8 GiB holds every
 /// method at 4096 beads in f64.
@@ -111,6 +111,8 @@ pub struct Plan {
     pub precision: Precision,
     /// The contact model (hard contacts add constraint slots).
     pub contact: Option<Contact>,
+    /// Thermal noise (adds the mobility's factor or the Lanczos basis).
+    pub brownian: Option<Thermal>,
 }
 
 impl Plan {
@@ -122,6 +124,7 @@ impl Plan {
             solver: scene.integrator.solver,
             precision: scene.integrator.precision,
             contact: scene.contact,
+            brownian: scene.brownian,
         }
     }
 
@@ -137,6 +140,13 @@ impl Plan {
             p.rotation = self.rotation;
             p.solver.kind = self.solver.kind();
             p.contacts = contacts.map(Contacts::new);
+            if let Some(t) = self.brownian {
+                p.brownian = Some(hydrorattle::Brownian {
+                    temperature: t.temperature,
+                    drift: t.drift.kernel(),
+                });
+                p.noise_sqrt = t.sqrt.kernel();
+            }
             Layout::for_params(&p, n, b)
         })
     }
@@ -180,6 +190,7 @@ mod tests {
             solver: Solver::Auto,
             precision,
             contact: None,
+            brownian: None,
         }
     }
 

@@ -82,7 +82,7 @@ impl RawScene {
             // stays a number a scene file can hold.
             Some(e) => (*e.get_ref()).min(integrator.steps()),
         };
-        let plans = plans(&model, &integrator, &flow, contact);
+        let plans = plans(&model, &integrator, &flow, contact, brownian);
         let every_span = self
             .output
             .as_ref()
@@ -236,6 +236,7 @@ fn plans(
     integrator: &Integrator,
     flow: &Flow,
     contact: Option<super::Contact>,
+    brownian: Option<super::Thermal>,
 ) -> Vec<Plan> {
     let plan = |(method, rotation)| Plan {
         method,
@@ -243,6 +244,7 @@ fn plans(
         solver: integrator.solver,
         precision: integrator.precision,
         contact,
+        brownian,
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],

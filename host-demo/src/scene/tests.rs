@@ -136,6 +136,7 @@ fn overdamped() -> Plan {
         solver: Solver::Auto,
         precision: Precision::F64,
         contact: None,
+        brownian: None,
     }
 }
 

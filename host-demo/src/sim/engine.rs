@@ -51,13 +51,8 @@ impl<T: Real> Engine<T> {
     pub fn new(scene: &Scene, limit: usize) -> Result<Self, BuildError> {
         let p = params::<T>(scene);
         let (n, b) = (scene.particles.len(), scene.bonds.len());
+        // The plan sizes thermal noise too (the factor or the Lanczos basis).
         let layout = Plan::of(scene).check(n, b, limit)?;
-        // Thermal noise needs the mobility's factor on top (`Layout::thermal`), or the
-        // Lanczos basis (`Layout::noise_sqrt`).
-        let layout = match scene.brownian {
-            Some(_) => layout.thermal(p.method, n, b).noise_sqrt(&p, n),
-            None => layout,
-        };
         let beads = Beads::<T>::new(&scene.particles, 1.0)?;
         beads.check_pairs(scene.model.overlap == Overlap::Allow)?;
         let bonds = bonds::<T>(&scene.bonds, n)?;

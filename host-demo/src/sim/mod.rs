@@ -451,4 +451,39 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn the_storage_checked_counts_the_thermal_noise() {
+        use crate::scene::{Drift, Sqrt, Thermal};
+        let mut scene = Scene::figure1().unwrap().remove(0).1;
+        scene.contact = None;
+        for method in [Method::Overdamped, Method::Springs] {
+            for sqrt in [Sqrt::Auto, Sqrt::Cholesky, Sqrt::Lanczos] {
+                for drift in [Drift::Midpoint, Drift::Uncorrected] {
+                    scene.integrator.method = method;
+                    scene.brownian = Some(Thermal {
+                        temperature: 1.0,
+                        seed: 1,
+                        drift,
+                        sqrt,
+                    });
+                    let (n, b) = (scene.particles.len(), scene.bonds.len());
+                    let want = Layout::for_params(&params::<f64>(&scene), n, b);
+                    let plain = Layout::for_params(
+                        &params::<f64>(&Scene {
+                            brownian: None,
+                            ..scene.clone()
+                        }),
+                        n,
+                        b,
+                    );
+                    assert_ne!(
+                        want, plain,
+                        "{method:?} {sqrt:?} {drift:?}: noise needs storage"
+                    );
+                    assert_eq!(Plan::of(&scene).layout(n, b), Some(want));
+                }
+            }
+        }
+    }
 }
