@@ -48,7 +48,7 @@ pub use mobility::Hydro;
 pub use noise::Noise;
 pub use noise::lanczos::{Lanczos, LanczosError};
 pub use parallel::{Parallel, Serial};
-pub use params::{Brownian, Contacts, Drift, LANCZOS_CROSSOVER, Method, NoiseSqrt, Params};
+pub use params::{Brownian, Contacts, Drift, LANCZOS_CROSSOVER, Method, NoiseSqrt, Params, Wall};
 pub use particles::{Particle, ParticleSet, State};
 pub use real::Real;
 pub use workspace::{Layout, Storage, Workspace};

@@ -134,6 +134,22 @@ impl Contacts {
     }
 }
 
+/// A no-slip plane wall `z = height` below the spheres, its normal `+z` (gravity is
+/// expected to point towards it). It changes the mobility (the wall's image system) and
+/// is a one-sided constraint: no sphere's centre may go below `height + a_i`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wall<T> {
+    /// The plane's `z` coordinate (finite).
+    pub height: T,
+}
+
+impl<T> Wall<T> {
+    /// The plane `z = height`.
+    pub const fn new(height: T) -> Self {
+        Self { height }
+    }
+}
+
 /// Everything a step needs besides the state. Build with [`Params::new`] and adjust.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params<T: Real> {
@@ -201,6 +217,8 @@ pub struct Params<T: Real> {
     /// methods refuse them with [`StepError::Unsupported`](crate::StepError::Unsupported)).
     /// Default `None`: spheres may overlap (see [`Params::allow_overlap`]).
     pub contacts: Option<Contacts>,
+    /// A no-slip plane wall below the spheres ([`Wall`]). Default `None`: unbounded fluid.
+    pub wall: Option<Wall<T>>,
 }
 
 impl<T: Real> Params<T> {
@@ -235,6 +253,7 @@ impl<T: Real> Params<T> {
             noise_sqrt: NoiseSqrt::Auto,
             lanczos: Lanczos::default(),
             contacts: None,
+            wall: None,
         }
     }
 

@@ -52,6 +52,15 @@ pub(super) fn check_thermal<T: Real>(
     Ok(Some(b))
 }
 
+/// Refuses a wall until it is implemented.
+pub(super) fn check_wall<T: Real>(p: &Params<T>) -> Result<(), StepError> {
+    match p.wall {
+        None => Ok(()),
+        Some(w) if !w.height.is_finite() => Err(StepError::BadParameter("wall.height (finite)")),
+        Some(_) => Err(StepError::Unsupported("a wall (not implemented yet)")),
+    }
+}
+
 /// Refuses contacts where they are not implemented.
 pub(super) fn check_contacts<T: Real>(p: &Params<T>, thermal: bool) -> Result<(), StepError> {
     let Some(c) = p.contacts else {

@@ -27,7 +27,7 @@ use springs::springs;
 use stable::rattle_stable;
 use stages::*;
 
-use checks::{accept, check_contacts, check_inputs, check_thermal};
+use checks::{accept, check_contacts, check_inputs, check_thermal, check_wall};
 use contacts::{Projection, project_overdamped};
 
 use crate::bonds::{Bond, BondSet, max_residual};
@@ -124,6 +124,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
     // `p` stays the caller's reference: a firmware's `static` must stay visible to the
     // compiler, which then links only the method it runs.
     check_contacts(p, thermal.is_some())?;
+    check_wall(p)?;
     let s = Start {
         pos: state.pos,
         vel: state.vel,

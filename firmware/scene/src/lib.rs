@@ -197,6 +197,7 @@ pub const fn params_f32(method: Method, rotation: bool) -> Params<f32> {
             max_iterations: 64,
         },
         contacts: None,
+        wall: None,
     }
 }
 
