@@ -1,7 +1,10 @@
 //! Fixed-capacity bond lists: chains, rings, trees and arbitrary topologies.
 //!
 //! Bond `k` joins particles `(i, j)` with length `d_k`; its constraint is
-//! `sigma_k = |r_i - r_j|^2 - d_k^2 = 0`.
+//! `sigma_k = |r_i - r_j|^2 - d_k^2 = 0`. A length of zero is allowed for
+//! [`Method::Springs`](crate::Method::Springs) only (a spring of rest length zero, the
+//! classic Hookean dumbbell); a constrained step refuses it
+//! ([`BondError::BadLength`]).
 
 use crate::error::BondError;
 use crate::real::Real;
@@ -14,7 +17,7 @@ pub struct Bond<T: Real> {
     pub i: usize,
     /// Second particle.
     pub j: usize,
-    /// Centre-to-centre length.
+    /// Centre-to-centre length (> 0; a spring's rest length may be 0).
     pub length: T,
 }
 
@@ -113,7 +116,8 @@ impl<T: Real, const B: usize> BondSet<T, B> {
         validate(&self.bonds, n)
     }
 
-    /// Largest relative length error `| |r_ij| - d | / d` and its bond (0 if none).
+    /// Largest relative length error `| |r_ij| - d | / d` and its bond (0 if none;
+    /// bonds of length zero have none and are skipped).
     pub fn max_residual(&self, pos: &[T::V3]) -> (usize, T) {
         max_residual(&self.bonds, pos)
     }
@@ -145,7 +149,8 @@ pub fn validate<T: Real>(bonds: &[Bond<T>], n: usize) -> Result<(), BondError> {
 
 /// Largest relative length error `| |r_ij| - d | / d` over `bonds` and the bond where it
 /// occurs. NaN is sticky (a NaN residual is never hidden), and a bond naming a particle
-/// beyond `pos` counts as infinitely violated.
+/// beyond `pos` counts as infinitely violated. A bond of length zero (a spring's rest
+/// length) has no relative error and is skipped.
 ///
 /// Two square roots, not one per bond: the error grows with `|r_ij|^2 / d^2` away from 1
 /// on either side, so it is largest at the largest or the smallest of these ratios
@@ -154,35 +159,38 @@ pub fn validate<T: Real>(bonds: &[Bond<T>], n: usize) -> Result<(), BondError> {
 pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
     let error = |b: &Bond<T>, a: T::V3, c: T::V3| ((T::norm(a - c) - b.length) / b.length).abs();
     let (mut hi, mut lo) = ((0, T::ZERO), (0, T::ZERO));
+    let mut first = true;
     for (k, b) in bonds.iter().enumerate() {
         let (Some(&a), Some(&c)) = (pos.get(b.i), pos.get(b.j)) else {
             return max_residual_each(bonds, pos);
         };
+        if b.length == T::ZERO {
+            continue;
+        }
         let ratio = T::norm2(a - c) / (b.length * b.length);
         if ratio.is_nan() {
             return max_residual_each(bonds, pos);
         }
-        if k == 0 || ratio > hi.1 {
+        if first || ratio > hi.1 {
             hi = (k, ratio);
         }
-        if k == 0 || ratio < lo.1 {
+        if first || ratio < lo.1 {
             lo = (k, ratio);
         }
+        first = false;
     }
     let at = |k: usize| {
         let b = &bonds[k];
         (k, error(b, pos[b.i], pos[b.j]))
     };
-    match bonds.len() {
-        0 => (0, T::ZERO),
-        _ => {
-            let (h, l) = (at(hi.0), at(lo.0));
-            if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
-                l
-            } else {
-                h
-            }
-        }
+    if first {
+        return (0, T::ZERO);
+    }
+    let (h, l) = (at(hi.0), at(lo.0));
+    if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
+        l
+    } else {
+        h
     }
 }
 
@@ -191,6 +199,7 @@ fn max_residual_each<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
     let mut worst = (0, T::ZERO);
     for (k, b) in bonds.iter().enumerate() {
         let r = match (pos.get(b.i), pos.get(b.j)) {
+            (Some(_), Some(_)) if b.length == T::ZERO => continue,
             (Some(&a), Some(&c)) => ((T::norm(a - c) - b.length) / b.length).abs(),
             _ => T::ONE / T::ZERO,
         };
@@ -215,7 +224,8 @@ fn check_bond<T: Real>(
     Ok(())
 }
 
-/// Bond `k` on its own against `n` particles: range, self-bond, length (`O(1)`).
+/// Bond `k` on its own against `n` particles: range, self-bond, length (finite, >= 0;
+/// `O(1)`).
 pub(crate) fn check_one<T: Real>(k: usize, b: &Bond<T>, n: usize) -> Result<(), BondError> {
     for p in [b.i, b.j] {
         if p >= n {
@@ -231,8 +241,9 @@ pub(crate) fn check_one<T: Real>(k: usize, b: &Bond<T>, n: usize) -> Result<(), 
             particle: b.i,
         });
     }
-    // The constraint squares the length: d^2 must be finite too.
-    if !(b.length > T::ZERO && (b.length * b.length).is_finite()) {
+    // The constraint squares the length: d^2 must be finite too. Zero is a spring's
+    // rest length; a constrained step refuses it (`integrate::checks`).
+    if !(b.length >= T::ZERO && (b.length * b.length).is_finite()) {
         return Err(BondError::BadLength { bond: k });
     }
     Ok(())

@@ -165,8 +165,13 @@ pub(super) fn check_inputs<T: Real>(
             return Err(ParticleError::Massless { particle: i }.into());
         }
     }
+    let springs = p.method == Method::Springs;
     for (bond, b) in bonds.iter().enumerate() {
         crate::bonds::check_one(bond, b, n)?;
+        // A constraint of length zero has no direction to hold.
+        if b.length == T::ZERO && !springs {
+            return Err(crate::error::BondError::BadLength { bond }.into());
+        }
     }
     Ok(())
 }

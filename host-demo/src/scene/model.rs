@@ -209,6 +209,9 @@ pub struct Integrator {
     pub precision: Precision,
     /// Spring constant for `method = "springs"` (> 0).
     pub stiffness: f64,
+    /// FENE springs for `method = "springs"`: their maximum extension `Q0` (> 0; the
+    /// kernel's [`hydrorattle::Params::fene`]). `None`: Hookean springs.
+    pub fene: Option<f64>,
 }
 
 impl Integrator {

@@ -12,8 +12,8 @@ use super::raw::{
     number, vector,
 };
 use super::{
-    Bond, DEFAULT_DENSITY, Flow, Fluid, Helix, Integrator, Level, Model, Output, Overlap, Particle,
-    Scene, TARGET_FRAMES,
+    Bond, DEFAULT_DENSITY, Flow, Fluid, Helix, Integrator, Level, Method, Model, Output, Overlap,
+    Particle, Scene, TARGET_FRAMES,
 };
 use crate::sizing::{Limits, Plan, TooLarge};
 
@@ -137,7 +137,8 @@ impl RawScene {
                 check_output(&integrator, every, ps.get_ref().len(), limits.output)
                     .map_err(|m| issue(output_span.clone(), m))?;
                 let (particles, spans, species) = resolve_particles(ps)?;
-                let (bonds, bond_spans) = resolve_bonds(self.bonds.as_ref(), &particles)?;
+                let (bonds, bond_spans) =
+                    resolve_bonds(self.bonds.as_ref(), &particles, &integrator)?;
                 let spans = BodySpans::Particles(spans, bond_spans);
                 (particles, bonds, None, spans, species)
             }
@@ -316,7 +317,22 @@ fn resolve_integrator(r: &RawIntegrator) -> Result<Integrator, Issue> {
         max_iterations,
         precision: r.precision.unwrap_or_default(),
         stiffness: number(&r.stiffness, 1e4, "stiffness", Bound::Positive)?,
+        fene: resolve_fene(r)?,
     })
+}
+
+/// `fene` (the FENE springs' maximum extension): > 0 and finite, springs only.
+fn resolve_fene(r: &RawIntegrator) -> Result<Option<f64>, Issue> {
+    let Some(q0) = &r.fene else {
+        return Ok(None);
+    };
+    if r.method != Method::Springs {
+        return Err(issue(
+            q0.span(),
+            "fene (the FENE springs' maximum extension) needs method = \"springs\"",
+        ));
+    }
+    number(&r.fene, 0.0, "fene (maximum extension)", Bound::Positive).map(Some)
 }
 
 fn resolve_helix(r: &RawHelix) -> Result<Helix, Issue> {
@@ -416,10 +432,14 @@ fn class_name(k: usize) -> String {
     }
 }
 
+/// The bonds: a length of 0 only for springs (their rest length), and with FENE
+/// springs every bond starts shorter than the maximum extension.
 fn resolve_bonds(
     bonds: Option<&Spanned<Vec<RawBond>>>,
     particles: &[Particle],
+    integrator: &Integrator,
 ) -> Result<(Vec<Bond>, Vec<Range<usize>>), Issue> {
+    let springs = integrator.method == Method::Springs;
     let Some(bonds) = bonds else {
         return Ok((Vec::new(), Vec::new()));
     };
@@ -453,7 +473,27 @@ fn resolve_bonds(
             ));
         }
         let initial = distance(particles[i].position, particles[j].position);
-        let length = number(&b.length, initial, "bond length", Bound::Positive)?;
+        let bound = if springs {
+            Bound::NonNegative
+        } else {
+            Bound::Positive
+        };
+        let length =
+            number(&b.length, initial, "bond length", bound).map_err(|e| match &b.length {
+                Some(l) if *l.get_ref() == 0.0 => issue(
+                    l.span(),
+                    "bond length must be > 0 (a rest length of 0 is for method = \"springs\" only)",
+                ),
+                _ => e,
+            })?;
+        if let Some(q0) = integrator.fene.filter(|&q0| initial >= q0) {
+            return Err(issue(
+                b.between.span(),
+                format!(
+                    "bond between [{i}, {j}] starts at distance {initial}, not below the FENE maximum extension {q0}"
+                ),
+            ));
+        }
         out.push(Bond { i, j, length });
         spans.push(b.length.as_ref().map_or(b.between.span(), |l| l.span()));
     }

@@ -64,6 +64,10 @@ impl Scene {
                 ("stiffness", value(i.stiffness)),
             ]),
         );
+        // Written only when set: scenes written before the key stay the same.
+        if let (Some(q0), Some(Value::Table(it))) = (i.fene, t.get_mut("integrator")) {
+            it.insert("fene".into(), value(q0));
+        }
         t.insert(
             "output".into(),
             table([("every", value(self.output.every as i64))]),

@@ -387,6 +387,7 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     // prepared); during the run spheres may come to overlap, as in the paper.
     p.allow_overlap = true;
     p.spring_stiffness = T::from_f64(i.stiffness);
+    p.fene = i.fene.map(T::from_f64);
     // The paper's explicit drag can shiver silently (bounded, wrong) beyond its limit:
     // the demo refuses such steps up front.
     p.stability_guard = true;
