@@ -201,13 +201,16 @@ pub struct Params<T: Real> {
     /// oscillate silently (bounded but wrong) instead of blowing up. Costs about 60
     /// Cholesky solves per step. Default false.
     pub stability_guard: bool,
-    /// Thermal noise ([`Method::Overdamped`] and [`Method::Springs`] with a stored
-    /// mobility only; other methods
-    /// and [`Params::matrix_free`] refuse a positive temperature with
-    /// [`StepError::Unsupported`](crate::StepError::Unsupported)). Default `None`.
+    /// Thermal noise ([`Method::Overdamped`] and [`Method::Springs`] only; other methods
+    /// refuse a positive temperature with
+    /// [`StepError::Unsupported`](crate::StepError::Unsupported)). With
+    /// [`Params::matrix_free`] the noise is drawn by Lanczos from matrix-free products
+    /// (storage `O(N)`). Default `None`.
     pub brownian: Option<Brownian<T>>,
     /// How the thermal noise's square root of the mobility is taken. Default
-    /// [`NoiseSqrt::Auto`] (Cholesky up to [`LANCZOS_CROSSOVER`] beads, Lanczos above).
+    /// [`NoiseSqrt::Auto`] (Cholesky up to [`LANCZOS_CROSSOVER`] beads, Lanczos above;
+    /// Lanczos at every size with [`Params::matrix_free`], which refuses
+    /// [`NoiseSqrt::Cholesky`]).
     pub noise_sqrt: NoiseSqrt,
     /// Tolerance and iteration cap of the Lanczos square root (read only when it is
     /// used). Default: relative change `1e-6` (f64) / `1e-4` (f32), 64 iterations.
@@ -261,6 +264,14 @@ impl<T: Real> Params<T> {
     #[inline]
     pub fn flow_at(&self, r: T::V3) -> T::V3 {
         self.flow_velocity + T::cross(self.vorticity, r)
+    }
+
+    /// `true` when a thermal step of `n` beads draws its noise by Lanczos: as
+    /// [`NoiseSqrt::lanczos`] picks, and always with [`Params::matrix_free`] (there is no
+    /// stored mobility to factorise; [`NoiseSqrt::Cholesky`] with `matrix_free` is
+    /// refused).
+    pub const fn lanczos_noise(&self, n: usize) -> bool {
+        self.matrix_free || self.noise_sqrt.lanczos(n)
     }
 
     /// Constraint slots a step with `bonds` bonds holds: the bonds, and the contact

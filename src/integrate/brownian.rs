@@ -19,7 +19,7 @@
 //! would supply it anyway (it differentiates `P mu` as a whole).
 
 use super::{
-    Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors, mobility_metric,
+    Start, StepReport, add_constraint_forces, add_flow, bond_vectors, mobility_metric,
     mobility_product, project_positions, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
@@ -27,8 +27,10 @@ use crate::constraints::{self, Problem, Scratch};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
 use crate::linalg;
+use crate::mobility;
 use crate::noise::Noise;
 use crate::noise::lanczos::{self, LanczosError};
+use crate::parallel::{self, Parallel};
 use crate::params::{Brownian, Drift, Params};
 use crate::real::Real;
 use crate::workspace::Views;
@@ -78,7 +80,12 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         kappa,
         scratch: &mut scratch,
     };
-    let krylov = (basis, krylov_t);
+    let krylov = Krylov {
+        basis,
+        work: krylov_t,
+        par,
+        bands,
+    };
     let noise_iterations = kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held), krylov)?;
     // r* = r + dt (U_inf + mu F) + noise, projected as in the deterministic step.
     for i in 0..n {
@@ -106,18 +113,26 @@ pub(super) struct Held<'a, 'b, T: Real> {
     pub(super) scratch: &'a mut Scratch<'b, T>,
 }
 
-/// The Lanczos basis and its scalars ([`Views::basis`], [`Views::krylov_t`]); empty
-/// with the Cholesky factor.
-pub(super) type Krylov<'a, T> = (&'a mut [<T as Real>::V3], &'a mut [T]);
+/// The Lanczos basis and its scalars ([`Views::basis`], [`Views::krylov_t`]; empty with
+/// the Cholesky factor), and how the stored mobility's products run ([`Views::par`],
+/// [`Views::bands`]; the start's product is done with them when the noise is drawn).
+pub(super) struct Krylov<'a, T: Real> {
+    pub(super) basis: &'a mut [T::V3],
+    pub(super) work: &'a mut [T],
+    pub(super) par: &'a dyn Parallel,
+    pub(super) bands: &'a mut [T::V3],
+}
 
 /// The thermal displacement `dx` of one step from the packed mobility `mu` at the
 /// start (see the module): `fac` takes its Cholesky factor (then, with the midpoint,
 /// the mobility at the midpoint), `xi` the deviates, `mid` the midpoint. With `held`
 /// the midpoint's noise is projected onto its bonds; without (springs), it is
 /// `sqrt(2 kT dt) mu(x~) L^-T xi`, whose mean is `kT dt div mu` (zero for RPY).
-/// With the Lanczos square root ([`Params::noise_sqrt`]) `L` is the symmetric
+/// With the Lanczos square root ([`Params::lanczos_noise`]) `L` is the symmetric
 /// `mu^(1/2)`, drawn from products with `mu` in the basis `krylov`, and the returned
-/// count is its iterations (0 with Cholesky).
+/// count is its iterations (0 with Cholesky). With [`Params::matrix_free`] `mu` and
+/// `fac` are empty: every product (the Lanczos ones at the start, the midpoint's)
+/// evaluates the pair blocks where it uses them.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn kick<T: Real>(
     p: &Params<T>,
@@ -133,7 +148,7 @@ pub(super) fn kick<T: Real>(
     krylov: Krylov<'_, T>,
 ) -> Result<u32, StepError> {
     let (n, dt, kt) = (s.pos.len(), p.dt, b.temperature);
-    let lanczos = p.noise_sqrt.lanczos(n);
+    let lanczos = p.lanczos_noise(n);
     if !lanczos {
         // L L^T = mu.
         fac.copy_from_slice(mu);
@@ -144,8 +159,21 @@ pub(super) fn kick<T: Real>(
     }
     noise.fill::<T>(xi);
     let amplitude = (T::TWO * kt * dt).sqrt();
-    let (basis, work) = krylov;
-    let product = |v: &[T::V3], w: &mut [T::V3]| linalg::sym_matvec::<T>(mu, n, v, w);
+    let Krylov {
+        basis,
+        work,
+        par,
+        bands,
+    } = krylov;
+    // `w = mu v` at the start: the stored mobility in bands, or matrix-free (the start
+    // has passed a product at these positions already, so no pair is nested).
+    let product = |v: &[T::V3], w: &mut [T::V3]| {
+        if p.matrix_free {
+            let _ = mobility::tt_product(p.hydro, p.viscosity, s.pos, s.radius, v, w);
+        } else {
+            parallel::product::<T>(par, mu, n, v, w, bands);
+        }
+    };
     let mut iterations = 0;
     match b.drift {
         Drift::Uncorrected => {
@@ -177,9 +205,15 @@ pub(super) fn kick<T: Real>(
             for z in xi.iter_mut() {
                 *z *= amplitude;
             }
-            // dx = P(x~) mu(x~) xi: the factor's storage takes mu(x~).
-            assemble_tt(p, mid, s.radius, fac)?;
-            linalg::sym_matvec::<T>(fac, n, xi, dx);
+            // dx = P(x~) mu(x~) xi: the factor's storage takes mu(x~), assembled and
+            // applied in one pass (matrix-free: applied only).
+            let mid = &*mid;
+            if p.matrix_free {
+                mobility::tt_product(p.hydro, p.viscosity, mid, s.radius, xi, dx)?;
+            } else {
+                let (h, eta) = (p.hydro, p.viscosity);
+                parallel::assemble_apply(par, h, eta, mid, s.radius, fac, xi, dx, bands)?;
+            }
             if let Some(h) = held {
                 bond_vectors(h.bonds, mid, h.grad_mid);
                 h.kappa.fill(T::ZERO);

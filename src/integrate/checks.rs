@@ -31,9 +31,9 @@ pub(super) fn check_thermal<T: Real>(
             "thermal noise with a method other than Overdamped or Springs",
         ));
     }
-    if p.matrix_free {
+    if p.matrix_free && p.noise_sqrt == crate::params::NoiseSqrt::Cholesky {
         return Err(StepError::Unsupported(
-            "thermal noise without a stored mobility (matrix_free: not implemented)",
+            "a Cholesky factor of the noise without a stored mobility (matrix_free: use Lanczos or Auto)",
         ));
     }
     let l = p.lanczos;

@@ -66,6 +66,21 @@ impl RawScene {
             ));
         };
         let integrator = resolve_integrator(raw_int.get_ref())?;
+        if let Some(m) = raw_int
+            .get_ref()
+            .matrix_free
+            .as_ref()
+            .filter(|m| *m.get_ref())
+        {
+            let runs = matches!(integrator.method, Method::Overdamped | Method::Springs);
+            if !runs || model.level != Level::Manual {
+                return Err(issue(
+                    m.span(),
+                    "matrix_free needs method = \"overdamped\" or \"springs\" and level = \"manual\" \
+                     (the other methods store or factorise the mobility)",
+                ));
+            }
+        }
         let brownian = match &self.brownian {
             None => None,
             Some(b) => Some(b.resolve(&model, &integrator)?),
@@ -246,6 +261,7 @@ fn plans(
         precision: integrator.precision,
         contact,
         brownian,
+        matrix_free: integrator.matrix_free,
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],
@@ -318,6 +334,7 @@ fn resolve_integrator(r: &RawIntegrator) -> Result<Integrator, Issue> {
         precision: r.precision.unwrap_or_default(),
         stiffness: number(&r.stiffness, 1e4, "stiffness", Bound::Positive)?,
         fene: resolve_fene(r)?,
+        matrix_free: r.matrix_free.as_ref().is_some_and(|m| *m.get_ref()),
     })
 }
 
