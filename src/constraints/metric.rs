@@ -97,19 +97,18 @@ fn sym_block<T: Real>(mu: &[T::M3], p: usize, q: usize) -> T::M3 {
     }
 }
 
-/// `(a - c)^T g`, reading only the lower triangles of `a - c` (12 loads and 6
-/// subtractions instead of 18 and 9): `(A_pi - A_pj) g` from the blocks
-/// [`sym_block`] gives. For symmetric blocks these are the bits of `(a - c) * g` (the
-/// same products summed in glam's order; the upper entries equal the lower ones exactly).
+/// `(a - c)^T g`: `(A_pi - A_pj) g` from the blocks [`sym_block`] gives (the wall's
+/// pair blocks are not symmetric). For symmetric blocks these are the bits of
+/// `(a - c) * g` (the same products summed in glam's order, the entries equal to their
+/// transposes).
 #[inline(always)]
 fn sym_diff_mul<T: Real>(a: T::M3, c: T::M3, g: T::V3) -> T::V3 {
     let d = |r, col| T::m3_get(a, r, col) - T::m3_get(c, r, col);
-    let (d00, d10, d20, d11, d21, d22) = (d(0, 0), d(1, 0), d(2, 0), d(1, 1), d(2, 1), d(2, 2));
     let [x, y, z] = T::xyz(g);
     T::v3(
-        d00 * x + d10 * y + d20 * z,
-        d10 * x + d11 * y + d21 * z,
-        d20 * x + d21 * y + d22 * z,
+        d(0, 0) * x + d(1, 0) * y + d(2, 0) * z,
+        d(0, 1) * x + d(1, 1) * y + d(2, 1) * z,
+        d(0, 2) * x + d(1, 2) * y + d(2, 2) * z,
     )
 }
 

@@ -92,9 +92,9 @@ pub(super) fn assemble_tt<T: Real>(
     mu: &mut [T::M3],
 ) -> Result<(), StepError> {
     if let Some(w) = p.wall {
-        let (level, eta) = (p.hydro, p.viscosity);
-        return Ok(mobility::wall::assemble_tt(
-            level, eta, w.height, pos, radius, mu,
+        let (level, eta, serial) = (p.hydro, p.viscosity, &crate::parallel::Serial);
+        return Ok(mobility::wall::assemble(
+            serial, level, eta, w.height, pos, radius, mu,
         )?);
     }
     mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)

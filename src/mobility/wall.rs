@@ -232,27 +232,7 @@ pub fn assemble<T: Real>(
     })
 }
 
-/// [`assemble`] on one thread.
-pub fn assemble_tt<T: Real>(
-    level: Hydro,
-    eta: T,
-    height: T,
-    pos: &[T::V3],
-    radius: &[T],
-    out: &mut [T::M3],
-) -> Result<(), ParticleError> {
-    assemble(
-        &crate::parallel::Serial,
-        level,
-        eta,
-        height,
-        pos,
-        radius,
-        out,
-    )
-}
-
-/// `y = mu_tt x` above the wall without storing `mu_tt`, in the order of [`assemble_tt`]
+/// `y = mu_tt x` above the wall without storing `mu_tt`, in the order of [`assemble`]
 /// followed by [`sym_matvec`](crate::linalg::sym_matvec) (the same bits below
 /// [`BANDED_MIN`](crate::parallel::BANDED_MIN) rows, as in free space).
 pub fn tt_product<T: Real>(
