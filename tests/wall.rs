@@ -474,10 +474,17 @@ fn cholesky_ok<T: Real>(level: Hydro, height: f64, s: &[([f64; 3], f64)]) -> boo
     linalg::cholesky::<T>(&mut out, n).is_ok()
 }
 
-/// Random polydisperse spheres above the wall: radii 0.3..2, no overlaps, heights from
+/// Random polydisperse spheres above the wall: radii 0.3..2, no overlaps (or, with
+/// `overlap`, overlapping but not nested: `allow_overlap`'s configurations), heights from
 /// touching the wall to a few radii, packed in a box so that many pairs nearly touch;
-/// `lift` of them within `a` of the wall (damped, as the contacts' tolerance allows).
-fn configuration(n: usize, seed: u64, height: f64, lifts: bool) -> Vec<([f64; 3], f64)> {
+/// with `lifts` some within `a` of the wall (damped, as the contacts' tolerance allows).
+fn configuration(
+    n: usize,
+    seed: u64,
+    height: f64,
+    lifts: bool,
+    overlap: bool,
+) -> Vec<([f64; 3], f64)> {
     let mut rng = fuzz::Rng::case(seed, 0);
     let mut s: Vec<([f64; 3], f64)> = Vec::new();
     let side = 1.5 * (n as f64).sqrt() + 2.0;
@@ -488,7 +495,8 @@ fn configuration(n: usize, seed: u64, height: f64, lifts: bool) -> Vec<([f64; 3]
             h = a * (0.2 + 0.8 * rng.unit());
         }
         let c = [side * rng.unit(), side * rng.unit(), height + h];
-        if s.iter().all(|&(p, b)| norm(sub(p, c)) >= a + b) {
+        let apart = |b: f64| if overlap { (a - b).abs() + 0.05 } else { a + b };
+        if s.iter().all(|&(p, b)| norm(sub(p, c)) >= apart(b)) {
             s.push((c, a));
         }
     }
@@ -499,10 +507,12 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(128))]
 
     /// Positive definite (Cholesky succeeds) for RPY and free draining, f64 and f32,
-    /// spheres wholly above the wall or within a radius of it (damped).
+    /// spheres wholly above the wall or within a radius of it (damped), or overlapping
+    /// each other (Zuk's branch; not with damped spheres, which could be lifted into
+    /// each other).
     #[test]
-    fn wall_mobility_is_positive_definite(n in 1usize..12, seed in 0u64..1_000_000, lifts in any::<bool>(), height in -5.0f64..5.0) {
-        let s = configuration(n, seed, height, lifts);
+    fn wall_mobility_is_positive_definite(n in 1usize..12, seed in 0u64..1_000_000, lifts in any::<bool>(), overlap in any::<bool>(), height in -5.0f64..5.0) {
+        let s = configuration(n, seed, height, lifts && !overlap, overlap);
         for level in [Hydro::Rpy, Hydro::FreeDraining] {
             prop_assert!(cholesky_ok::<f64>(level, height, &s), "f64 {level:?} {s:?}");
             prop_assert!(cholesky_ok::<f32>(level, height, &s), "f32 {level:?} {s:?}");
@@ -531,7 +541,7 @@ fn a_centre_below_the_wall_is_refused() {
 /// The matrix-free product has the bits of the stored mobility applied by `sym_matvec`
 /// (below the banded size), and the block read from either side agrees.
 fn matrix_free_bits<T: Real>() {
-    let s = configuration(40, 7, 0.5, true);
+    let s = configuration(40, 7, 0.5, true, false);
     let n = s.len();
     let pos: Vec<T::V3> = s.iter().map(|c| T::v3_from(c.0)).collect();
     let rad: Vec<T> = s.iter().map(|c| T::from_f64(c.1)).collect();

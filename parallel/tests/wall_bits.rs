@@ -4,7 +4,9 @@
 use hydrorattle::glam::DVec3;
 use hydrorattle::mobility::wall;
 use hydrorattle::parallel::{self, BANDED_MIN, Parallel, Serial, band_scratch, bands};
-use hydrorattle::{Hydro, Layout, NoForce, Params, Real, State, Wall, step_slices};
+use hydrorattle::{
+    BondSet, Hydro, Layout, NoForce, Params, Particle, ParticleSet, Real, Wall, step,
+};
 use hydrorattle_heap::Buffers;
 use hydrorattle_parallel::Threads;
 
@@ -60,40 +62,33 @@ fn wall_assembly_and_product_are_the_same_bits_on_any_thread_count() {
     }
 }
 
-/// Two overdamped steps of the grid settling towards the wall.
-fn steps<T: Real>(n: usize, par: &dyn Parallel) -> Vec<u64> {
-    let (p, radius) = grid(n);
-    let mut pos: Vec<T::V3> = p.iter().map(|&x| T::v3_from(x)).collect();
-    let radius: Vec<T> = radius.iter().map(|&a| T::from_f64(a)).collect();
+/// Two overdamped steps of the grid (`N` spheres) settling towards the wall.
+fn steps<T: Real, const N: usize>(par: &dyn Parallel) -> Vec<u64> {
+    let (p, radius) = grid(N);
+    let list: Vec<Particle<T>> = p
+        .iter()
+        .zip(&radius)
+        .map(|(&x, &a)| Particle::new(T::v3_from(x), T::from_f64(a), T::from_f64(2.0)))
+        .collect();
+    let mut ps = Box::new(ParticleSet::<T, N>::from_slice(&list, false).unwrap());
+    let bonds = BondSet::<T, 1>::new();
     let mut params = Params::<T>::new(T::from_f64(0.01));
     params.wall = Some(Wall::new(T::from_f64(-1.0)));
-    let mut store = Buffers::<T>::new(Layout::for_params(&params, n, 0));
+    let mut store = Buffers::<T>::new(Layout::for_params(&params, N, 0));
     let mut ws = store.workspace().with_parallel(par);
-    let (mut vel, mut omega) = (vec![T::V3_ZERO; n], vec![T::V3_ZERO; n]);
-    let density = vec![T::from_f64(2.0); n];
-    let mut time = T::ZERO;
     for _ in 0..2 {
-        let state = State {
-            pos: &mut pos,
-            vel: &mut vel,
-            omega: &mut omega,
-            radius: &radius,
-            density: &density,
-            time: &mut time,
-            noise: None,
-        };
-        step_slices(state, &[], &params, &mut ws, &mut NoForce).unwrap();
+        step(&mut ps, &bonds, &params, &mut ws, &mut NoForce).unwrap();
     }
-    bits::<T>(&pos)
+    bits::<T>(&ps.pos[..N])
 }
 
 #[test]
 fn steps_above_the_wall_are_the_same_bits_on_any_thread_count() {
-    let n = BANDED_MIN + 40;
-    let (one, one32) = (steps::<f64>(n, &Serial), steps::<f32>(n, &Serial));
+    const N: usize = BANDED_MIN + 40;
+    let (one, one32) = (steps::<f64, N>(&Serial), steps::<f32, N>(&Serial));
     for t in [2, 3] {
         let pool = Threads::new(t).unwrap();
-        assert_eq!(steps::<f64>(n, &pool), one, "{t} threads");
-        assert_eq!(steps::<f32>(n, &pool), one32, "{t} threads, f32");
+        assert_eq!(steps::<f64, N>(&pool), one, "{t} threads");
+        assert_eq!(steps::<f32, N>(&pool), one32, "{t} threads, f32");
     }
 }
