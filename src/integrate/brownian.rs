@@ -169,7 +169,13 @@ pub(super) fn kick<T: Real>(
     // has passed a product at these positions already, so no pair is nested).
     let product = |v: &[T::V3], w: &mut [T::V3]| {
         if p.matrix_free {
-            let _ = mobility::tt_product(p.hydro, p.viscosity, s.pos, s.radius, v, w);
+            let _ = match p.wall {
+                Some(wall) => {
+                    let h = wall.height;
+                    mobility::wall::tt_product(p.hydro, p.viscosity, h, s.pos, s.radius, v, w)
+                }
+                None => mobility::tt_product(p.hydro, p.viscosity, s.pos, s.radius, v, w),
+            };
         } else {
             parallel::product::<T>(par, mu, n, v, w, bands);
         }
@@ -206,14 +212,9 @@ pub(super) fn kick<T: Real>(
                 *z *= amplitude;
             }
             // dx = P(x~) mu(x~) xi: the factor's storage takes mu(x~), assembled and
-            // applied in one pass (matrix-free: applied only).
+            // applied (matrix-free: applied only), above the wall if there is one.
             let mid = &*mid;
-            if p.matrix_free {
-                mobility::tt_product(p.hydro, p.viscosity, mid, s.radius, xi, dx)?;
-            } else {
-                let (h, eta) = (p.hydro, p.viscosity);
-                parallel::assemble_apply(par, h, eta, mid, s.radius, fac, xi, dx, bands)?;
-            }
+            mobility_product(p, mid, s.radius, fac, xi, dx, par, bands)?;
             if let Some(h) = held {
                 bond_vectors(h.bonds, mid, h.grad_mid);
                 h.kappa.fill(T::ZERO);
