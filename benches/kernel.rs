@@ -237,9 +237,9 @@ fn scaling_bench(
             step_slices(state, &bonds, &params, ws, &mut NoForce).unwrap()
         };
         let r = go(&mut pos0.clone(), &mut ws);
-        let (its, lz) = (r.iterations, r.noise_iterations);
+        let (its, lz, mid) = (r.iterations, r.noise_iterations, r.velocity_iterations);
         eprintln!(
-            "{group}/{label}/{n}: {its} constraint iterations, {lz} Lanczos iterations per step"
+            "{group}/{label}/{n}: {its} constraint iterations, {lz} Lanczos iterations, {mid} midpoint projection iterations per step"
         );
         g.bench_function(BenchmarkId::from_parameter(n), |b| {
             b.iter_batched_ref(
