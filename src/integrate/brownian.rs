@@ -27,7 +27,7 @@ use crate::constraints::{self, Problem, Scratch};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
 use crate::linalg;
-use crate::mobility;
+use crate::mobility::{self, Hydro};
 use crate::noise::Noise;
 use crate::noise::lanczos::{self, LanczosError};
 use crate::parallel::{self, Parallel};
@@ -208,14 +208,21 @@ pub(super) fn kick<T: Real>(
                 *z *= amplitude;
             }
             // dx = P(x~) mu(x~) xi: the factor's storage takes mu(x~), assembled and
-            // applied in one pass (matrix-free: applied only).
+            // applied in one pass (matrix-free: applied only). Free draining's mobility
+            // does not depend on the positions: mu(x~) is mu, and is not assembled again.
             let mid = &*mid;
-            if p.matrix_free {
+            let free_draining = p.hydro == Hydro::FreeDraining;
+            let mu_mid: &[T::M3] = if p.matrix_free {
                 mobility::tt_product(p.hydro, p.viscosity, mid, s.radius, xi, dx)?;
+                &[]
+            } else if free_draining {
+                parallel::product::<T>(par, mu, n, xi, dx, bands);
+                mu
             } else {
                 let (h, eta) = (p.hydro, p.viscosity);
                 parallel::assemble_apply(par, h, eta, mid, s.radius, fac, xi, dx, bands)?;
-            }
+                fac
+            };
             if let Some(h) = held {
                 bond_vectors(h.bonds, mid, h.grad_mid);
                 h.kappa.fill(T::ZERO);
@@ -225,7 +232,7 @@ pub(super) fn kick<T: Real>(
                     h.bonds,
                     mid,
                     s.radius,
-                    fac,
+                    mu_mid,
                     h.grad_mid,
                     T::ONE,
                     h.disp,
