@@ -213,7 +213,7 @@ pub struct Params<T: Real> {
     /// [`NoiseSqrt::Cholesky`]).
     pub noise_sqrt: NoiseSqrt,
     /// Tolerance and iteration cap of the Lanczos square root (read only when it is
-    /// used). Default: relative change `1e-3`, 64 iterations.
+    /// used). Default: estimated relative error of the noise `1e-3`, 64 iterations.
     pub lanczos: Lanczos<T>,
     /// Hard-sphere contacts as one-sided constraints ([`Contacts`];
     /// [`Method::Overdamped`] and [`Method::Overdamped2`] without thermal noise; the other

@@ -118,7 +118,7 @@ fn the_library_refuses_an_oversized_run_with_a_typed_error() {
 /// keeps its bonds, stores no mobility, and gives the same bits on one thread and on
 /// two, and again with the same seed. The whole file: `host-demo run
 /// host-demo/tests/data/brownian_chain4096.toml --out DIR` (about 5 s a step on one
-/// core, 9 MB of step storage).
+/// core, 7.6 MiB of step storage).
 #[test]
 fn a_matrix_free_brownian_chain_runs_with_the_same_bits_on_any_threads() {
     let text = std::fs::read_to_string(manifest().join("tests/data/brownian_chain4096.toml"))

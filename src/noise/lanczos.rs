@@ -26,9 +26,10 @@ pub struct Lanczos<T> {
     /// Relative error of the noise at which the iteration stops, estimated from the
     /// change between successive iterations and the rate it falls at (the geometric
     /// tail of the remaining error; `tests/lanczos_chain.rs` checks the actual error
-    /// against roots from a dense eigen-decomposition, below this tolerance). Default `1e-3` (f64 and f32): the covariance of the noise is then right to
-    /// about `1e-3`, below the statistical error of any run's averages, at about half
-    /// the iterations `1e-6` takes (12 against 25 at N = 1024).
+    /// against roots from a dense eigen-decomposition, below this tolerance). Default
+    /// `1e-3` (f64 and f32): the covariance of the noise is then right to about
+    /// `1e-3`, below the statistical error of any run's averages, at about half the
+    /// iterations `1e-6` takes (14 against 25 on a 1024-bead RPY chain).
     pub tolerance: T,
     /// Most iterations (Krylov dimension; storage grows with it: `(cap + 1) n`
     /// vectors). A step needing more is refused. Default 64.
