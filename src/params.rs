@@ -90,7 +90,9 @@ pub enum NoiseSqrt {
 /// Beads above which [`NoiseSqrt::Auto`] draws the noise by Lanczos: where the Lanczos
 /// step overtakes the Cholesky one for an RPY chain (f64, midpoint), measured with
 /// `cargo bench --bench kernel -- noise_sqrt`: Cholesky / Lanczos 1.21 / 1.61 ms at
-/// N = 96, 2.90 / 2.07 ms at 128, so about 110 interpolated.
+/// N = 96, 2.90 / 2.07 ms at 128, so about 110 interpolated (Lanczos tolerance
+/// `1e-6`); at the present default `1e-3`: 1.25 / 1.65 ms at 64, 3.66 / 3.74 ms at 96,
+/// 7.67 / 3.16 ms at 128 (a loaded machine), so between 96 and 128 still.
 pub const LANCZOS_CROSSOVER: usize = 112;
 
 impl NoiseSqrt {
@@ -213,7 +215,7 @@ pub struct Params<T: Real> {
     /// [`NoiseSqrt::Cholesky`]).
     pub noise_sqrt: NoiseSqrt,
     /// Tolerance and iteration cap of the Lanczos square root (read only when it is
-    /// used). Default: relative change `1e-6` (f64) / `1e-4` (f32), 64 iterations.
+    /// used). Default: estimated relative error of the noise `1e-3`, 64 iterations.
     pub lanczos: Lanczos<T>,
     /// Hard-sphere contacts as one-sided constraints ([`Contacts`];
     /// [`Method::Overdamped`] and [`Method::Overdamped2`] without thermal noise; the other

@@ -60,7 +60,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
                 par,
                 bands,
             };
-            noise_iterations = kick(
+            (noise_iterations, _) = kick(
                 p, b, s, mu, fac, new_vel, new_omega, dx, noise, None, krylov,
             )?;
             for i in 0..n {

@@ -13,7 +13,7 @@ use super::raw::{
 };
 use super::{
     Bond, DEFAULT_DENSITY, Flow, Fluid, Helix, Integrator, Level, Method, Model, Output, Overlap,
-    Particle, Scene, TARGET_FRAMES,
+    Particle, Scene, Sqrt, TARGET_FRAMES,
 };
 use crate::sizing::{Limits, Plan, TooLarge};
 
@@ -85,6 +85,16 @@ impl RawScene {
             None => None,
             Some(b) => Some(b.resolve(&model, &integrator)?),
         };
+        let cholesky = brownian.is_some_and(|b| b.temperature > 0.0 && b.sqrt == Sqrt::Cholesky);
+        if let Some(m) = raw_int.get_ref().matrix_free.as_ref() {
+            if *m.get_ref() && cholesky {
+                return Err(issue(
+                    m.span(),
+                    "matrix_free draws the noise by Lanczos: [brownian] sqrt = \"cholesky\" \
+                     needs the stored mobility (use \"auto\" or \"lanczos\")",
+                ));
+            }
+        }
         if let (Some(c), Some(raw)) = (contact, &self.contact) {
             super::contact::check_method(c, raw, &integrator, brownian.as_ref())?;
         }
