@@ -48,7 +48,10 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
         ..
     } = v;
     // Mobility (translation or grand) and the drag operator K = dt I + S mu S.
-    if p.rotation {
+    if let (true, Some(w)) = (p.rotation, p.wall) {
+        let (level, eta, h) = (p.hydro, p.viscosity, w.height);
+        mobility::wall::assemble_grand(level, eta, h, s.pos, s.radius, mu)?;
+    } else if p.rotation {
         mobility::assemble_grand(p.hydro, p.viscosity, s.pos, s.radius, mu)?;
     } else {
         assemble_tt(p, s.pos, s.radius, mu)?;

@@ -145,6 +145,12 @@ pub(super) fn spin<T: Real>(
     out: &mut [T::V3],
 ) -> Result<(), StepError> {
     out.fill(p.vorticity);
+    if let (true, Some(w)) = (p.rotation, p.wall) {
+        let (level, eta, h) = (p.hydro, p.viscosity, w.height);
+        return Ok(mobility::wall::add_spin(
+            level, eta, h, pos, radius, f, out,
+        )?);
+    }
     if !p.rotation || p.hydro == Hydro::FreeDraining {
         return Ok(());
     }
