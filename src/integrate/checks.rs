@@ -52,10 +52,14 @@ pub(super) fn check_thermal<T: Real>(
     Ok(Some(b))
 }
 
-/// Checks the wall's height (its mobility, `mobility::wall`, serves every method).
+/// Checks the wall's height (its mobility, `mobility::wall`, serves every method), and
+/// refuses a wall when the kernel was built without its `wall` feature.
 pub(super) fn check_wall<T: Real>(p: &Params<T>) -> Result<(), StepError> {
     match p.wall {
         Some(w) if !w.height.is_finite() => Err(StepError::BadParameter("wall.height (finite)")),
+        Some(_) if !cfg!(feature = "wall") => Err(StepError::Unsupported(
+            "a wall: the kernel was built without its `wall` feature",
+        )),
         _ => Ok(()),
     }
 }
