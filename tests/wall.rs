@@ -660,20 +660,12 @@ fn midpoint_gives_the_wall_drift_f32() {
 
 /// A lone sphere settling towards the wall: one overdamped step moves it by
 /// `dt mu_perp(h) W` (buoyant weight `W`), with Swan & Brady's `mu_perp`; with rotation
-/// the wall is refused.
+/// its spin stays zero.
 fn settles_with_mu_perp<T: Real>() {
     let (a, h, dt, rho) = (1.2, 2.0, 0.01, 3.0);
     let mut p = params::<T>(dt, Method::Overdamped, SolverKind::Auto);
     p.wall = Some(Wall::new(T::from_f64(1.0)));
-    let mut ps: ParticleSet<T, 1> = particles(&[Sphere {
-        pos: [0.0, 0.0, 1.0 + h],
-        radius: a,
-        density: rho,
-    }]);
-    let bonds: BondSet<T, 1> = BondSet::new();
-    let mut buf = Buffers::<T>::new(Layout::for_params(&p, 1, 0));
-    let mut ws = buf.workspace();
-    hydrorattle::step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
+    let ps = lone_step::<T>(&p, [0.0, 0.0, 1.0 + h], a, rho);
     let weight = 4.0 / 3.0 * PI * a.powi(3) * rho;
     let x = a / h;
     let mu = (1.0 - 1.125 * x + 0.5 * x.powi(3) - 0.125 * x.powi(5)) / (6.0 * PI * a);
@@ -685,8 +677,12 @@ fn settles_with_mu_perp<T: Real>() {
         -dt * mu * weight
     );
     p.rotation = true;
-    let e = hydrorattle::step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap_err();
-    assert!(matches!(e, hydrorattle::StepError::Unsupported(_)), "{e}");
+    let ps = lone_step::<T>(&p, [0.0, 0.0, 1.0 + h], a, rho);
+    assert_eq!(
+        f64s::<T>(ps.omega[0]),
+        [0.0; 3],
+        "a force along the normal turns nothing"
+    );
 }
 
 #[test]
@@ -821,4 +817,296 @@ fn trimer_step_matches_the_dense_solve_f64() {
 #[test]
 fn trimer_step_matches_the_dense_solve_f32() {
     trimer_step::<f32>();
+}
+
+/// The kernel's grand mobility above the wall at `height`, dense `6n x 6n` in f64
+/// (translations, then rotations).
+fn dense_grand<T: Real>(level: Hydro, height: f64, s: &[([f64; 3], f64)]) -> Vec<Vec<f64>> {
+    let m = 2 * s.len();
+    let pos: Vec<T::V3> = s.iter().map(|c| T::v3_from(c.0)).collect();
+    let rad: Vec<T> = s.iter().map(|c| T::from_f64(c.1)).collect();
+    let mut out = vec![T::M3_ZERO; m * (m + 1) / 2];
+    wall::assemble_grand(level, T::ONE, T::from_f64(height), &pos, &rad, &mut out).unwrap();
+    let mut d = vec![vec![0.0; 3 * m]; 3 * m];
+    for p in 0..m {
+        for q in 0..m {
+            let b = linalg::sym_get::<T>(&out, p, q);
+            for r in 0..3 {
+                for c in 0..3 {
+                    d[3 * p + r][3 * q + c] = T::m3_get(b, r, c).to_f64();
+                }
+            }
+        }
+    }
+    d
+}
+
+/// A lone sphere's rotation near the wall: the far-field coefficients of the method of
+/// reflections (Goldman, Cox & Brenner 1967): rotation about an axis along the wall
+/// `1 - 5/16 x^3`, about the normal `1 - 1/8 x^3` (units `1/(8 pi eta a^3)`), and the
+/// translation-rotation coupling `3/32 x^4` (units `1/(6 pi eta a^2)`), in the sense of
+/// rolling along the wall (`W = c z x F`); the self blocks are also the image formula
+/// at `j = i` (`image_rot` with `R = 2h z`) plus the free sphere's.
+fn lone_rotation<T: Real>() {
+    let tol = pick::<T>(1e-6, 1e-14);
+    for (h, a) in [(1.5, 1.0), (2.0, 0.5), (4.0, 2.0), (10.0, 1.0)] {
+        let x = 1.0 / h;
+        let g = dense_grand::<T>(Hydro::Rpy, 0.0, &[([0.3, 0.2, h * a], a)]);
+        let rr = 8.0 * PI * a.powi(3);
+        let rt = 6.0 * PI * a * a;
+        assert!((g[3][3] * rr - (1.0 - 5.0 / 16.0 * x.powi(3))).abs() < tol);
+        assert!((g[4][4] * rr - (1.0 - 5.0 / 16.0 * x.powi(3))).abs() < tol);
+        assert!((g[5][5] * rr - (1.0 - x.powi(3) / 8.0)).abs() < tol);
+        let c = 3.0 / 32.0 * x.powi(4);
+        // W_y = c F_x, W_x = -c F_y (z x F), and tr = rt^T.
+        assert!((g[4][0] * rt - c).abs() < tol && (g[3][1] * rt + c).abs() < tol);
+        assert!((g[0][4] - g[4][0]).abs() == 0.0);
+        for (r, q) in [(3, 0), (4, 1), (5, 0), (5, 1), (5, 2), (3, 2), (4, 2)] {
+            assert_eq!(g[r][q], 0.0, "({r}, {q})");
+        }
+        let (img_rt, img_rr) = wall::image_rot::<T>(
+            T::ONE,
+            T::from_f64(a),
+            T::V3_ZERO,
+            T::from_f64(2.0 * h * a),
+            T::from_f64(h * a),
+        );
+        let free_rr = 1.0 / rr;
+        for r in 0..3 {
+            for q in 0..3 {
+                let d = if r == q { free_rr } else { 0.0 };
+                let s = T::m3_get(img_rr, r, q).to_f64() + d;
+                assert!(
+                    (s - g[3 + r][3 + q]).abs() * rr < tol,
+                    "rr ({r}, {q}) at h/a {h}"
+                );
+                let t = T::m3_get(img_rt, r, q).to_f64();
+                assert!(
+                    (t - g[3 + r][q]).abs() * rt < tol,
+                    "rt ({r}, {q}) at h/a {h}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn lone_sphere_rotation_f64() {
+    lone_rotation::<f64>();
+}
+
+#[test]
+fn lone_sphere_rotation_f32() {
+    lone_rotation::<f32>();
+}
+
+/// `<G(x, y)>` over `y` on the sphere `pts` (Blake's tensor, divided by `8 pi eta`).
+fn averaged(x: [f64; 3], pts: &[([f64; 3], f64)]) -> [[f64; 3]; 3] {
+    let mut m = [[0.0; 3]; 3];
+    for &(y, w) in pts {
+        let g = blake(x, y);
+        for p in 0..3 {
+            for q in 0..3 {
+                m[p][q] += w * g[p][q] / (8.0 * PI);
+            }
+        }
+    }
+    m
+}
+
+/// The pair rotation blocks (unequal radii, free part and image) against Faxén's laws
+/// applied here by finite differences to the test's Blake tensor: `rt_ij = 1/2 curl_x
+/// <G(x, y)>_{y on sphere j}` at `x = r_i` (the average by quadrature), `rr_ij = 1/4
+/// curl_x curl_y G(r_i, r_j)`; also `rt_ji`. Central differences, step 1e-4 (3e-4 for
+/// the mixed second derivatives): agreement within 1e-6 of the block's largest entry.
+#[test]
+fn rotation_blocks_are_faxen_curls_of_blakes_tensor() {
+    let eps = |i: usize, j: usize, k: usize| -> f64 {
+        match (i, j, k) {
+            (0, 1, 2) | (1, 2, 0) | (2, 0, 1) => 1.0,
+            (0, 2, 1) | (2, 1, 0) | (1, 0, 2) => -1.0,
+            _ => 0.0,
+        }
+    };
+    let unit = |m: usize| {
+        let mut e = [0.0; 3];
+        e[m] = 1.0;
+        e
+    };
+    let gl = gauss_legendre(20);
+    let cases = [
+        ([0.0, 0.0, 2.5], 1.0, [4.0, 1.0, 3.2], 2.0),
+        ([0.3, -0.4, 1.2], 0.7, [0.5, 0.2, 4.4], 1.6),
+        ([0.0, 0.0, 2.0], 1.0, [0.0, 0.0, 5.5], 1.3),
+    ];
+    let mut worst = 0.0f64;
+    for (ci, ai, cj, aj) in cases {
+        let g = dense_grand::<f64>(Hydro::Rpy, 0.0, &[(ci, ai), (cj, aj)]);
+        // rt_ij = rows 9..12 (rotation of sphere 0... sphere i = 0), columns 3..6 (force on 1).
+        for (xi, xj, aj_, row, col) in [(ci, cj, aj, 6, 3), (cj, ci, ai, 9, 0)] {
+            let pts = sphere_points(xj, aj_, &gl, 40);
+            let d = 1e-4;
+            let mut rt = [[0.0; 3]; 3];
+            for m in 0..3 {
+                let gp = averaged(add(xi, scale(unit(m), d)), &pts);
+                let gm = averaged(sub(xi, scale(unit(m), d)), &pts);
+                for k in 0..3 {
+                    for n in 0..3 {
+                        for l in 0..3 {
+                            rt[k][l] += 0.5 * eps(k, m, n) * (gp[n][l] - gm[n][l]) / (2.0 * d);
+                        }
+                    }
+                }
+            }
+            let big = rt.iter().flatten().fold(0.0f64, |s, v| s.max(v.abs()));
+            for k in 0..3 {
+                for l in 0..3 {
+                    worst = worst.max((g[row + k][col + l] - rt[k][l]).abs() / big);
+                }
+            }
+        }
+        // rr_ij: block (rotation of 0, torque on 1) at rows 6..9, columns 9..12.
+        let d = 3e-4;
+        let mut rr = [[0.0; 3]; 3];
+        for p in 0..3 {
+            for m in 0..3 {
+                let (xp, xm) = (add(ci, scale(unit(p), d)), sub(ci, scale(unit(p), d)));
+                let (yp, ym) = (add(cj, scale(unit(m), d)), sub(cj, scale(unit(m), d)));
+                let (a, b, c, e) = (blake(xp, yp), blake(xp, ym), blake(xm, yp), blake(xm, ym));
+                for k in 0..3 {
+                    for l in 0..3 {
+                        for q in 0..3 {
+                            for n in 0..3 {
+                                let s = eps(k, p, q) * eps(l, m, n);
+                                if s != 0.0 {
+                                    let dd =
+                                        (a[q][n] - b[q][n] - c[q][n] + e[q][n]) / (4.0 * d * d);
+                                    rr[k][l] += 0.25 * s * dd / (8.0 * PI);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let big = rr.iter().flatten().fold(0.0f64, |s, v| s.max(v.abs()));
+        for k in 0..3 {
+            for l in 0..3 {
+                worst = worst.max((g[6 + k][9 + l] - rr[k][l]).abs() / big);
+            }
+        }
+    }
+    eprintln!(
+        "rotation blocks vs Faxén curls of Blake's tensor: largest relative difference {worst:.1e}"
+    );
+    assert!(worst < 1e-6, "{worst}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// The grand mobility above the wall is positive definite (f64 and f32), spheres
+    /// touching, damped or overlapping as in the translational test.
+    #[test]
+    fn grand_wall_mobility_is_positive_definite(n in 1usize..8, seed in 0u64..1_000_000, lifts in any::<bool>(), overlap in any::<bool>()) {
+        let s = configuration(n, seed, 0.0, lifts && !overlap, overlap);
+        for level in [Hydro::Rpy, Hydro::FreeDraining] {
+            for single in [false, true] {
+                let m = 2 * s.len();
+                let ok = if single {
+                    grand_cholesky::<f32>(level, &s, m)
+                } else {
+                    grand_cholesky::<f64>(level, &s, m)
+                };
+                prop_assert!(ok, "{level:?} f32 {single} {s:?}");
+            }
+        }
+    }
+}
+
+fn grand_cholesky<T: Real>(level: Hydro, s: &[([f64; 3], f64)], m: usize) -> bool {
+    let pos: Vec<T::V3> = s.iter().map(|c| T::v3_from(c.0)).collect();
+    let rad: Vec<T> = s.iter().map(|c| T::from_f64(c.1)).collect();
+    let mut out = vec![T::M3_ZERO; m * (m + 1) / 2];
+    wall::assemble_grand(level, T::ONE, T::ZERO, &pos, &rad, &mut out).unwrap();
+    linalg::cholesky::<T>(&mut out, m).is_ok()
+}
+
+/// Spins of a lone sphere pushed along the wall (gravity tilted): one overdamped step
+/// with `rotation` reports `W = c z x F`, the coupling `c` of `lone_sphere_rotation`.
+fn spin_along_wall<T: Real>() {
+    let (a, h, rho) = (1.0, 1.8, 2.0);
+    let mut p = params::<T>(1e-3, Method::Overdamped, SolverKind::Auto);
+    p.wall = Some(Wall::new(T::ZERO));
+    p.rotation = true;
+    p.gravity = v3::<T>(1.0, 0.0, -1.0);
+    let ps = lone_step::<T>(&p, [0.0, 0.0, h], a, rho);
+    let fx = 4.0 / 3.0 * PI * a.powi(3) * rho;
+    let c = 3.0 / 32.0 * (a / h).powi(4) / (6.0 * PI * a * a);
+    let w = f64s::<T>(ps.omega[0]);
+    eprintln!(
+        "spin along the wall: {w:?}, expected (0, {}, 0) to first order in dt",
+        c * fx
+    );
+    assert!((w[1] / (c * fx) - 1.0).abs() < 1e-2, "{w:?}");
+    assert!(w[0].abs() < 1e-12 && w[2].abs() < 1e-12);
+}
+
+#[test]
+fn spin_along_the_wall_f64() {
+    spin_along_wall::<f64>();
+}
+
+#[test]
+fn spin_along_the_wall_f32() {
+    spin_along_wall::<f32>();
+}
+
+/// The stable inertial method with rotation integrates on the wall's grand mobility:
+/// with `dt` far above the momentum relaxation time a lone sphere pushed along the wall
+/// moves after one step at the overdamped `mu_par W` (to `m mu / dt`, here 0.3 %).
+/// (Relies on the wall being accepted by `RattleStable`: if the wall's contacts stay
+/// limited to the overdamped methods, this becomes a check of their refusal.)
+fn stable_grand<T: Real>() {
+    let (a, h, rho, dt) = (1.0, 2.0, 3.0, 200.0);
+    let mut p = params::<T>(dt, Method::RattleStable, SolverKind::Auto);
+    p.wall = Some(Wall::new(T::ZERO));
+    p.rotation = true;
+    p.gravity = v3::<T>(1.0, 0.0, 0.0);
+    let ps = lone_step::<T>(&p, [0.0, 0.0, h], a, rho);
+    let x = a / h;
+    let mu = (1.0 - 9.0 / 16.0 * x + 0.125 * x.powi(3) - 0.0625 * x.powi(5)) / (6.0 * PI * a);
+    let w = 4.0 / 3.0 * PI * a.powi(3) * rho;
+    let v = f64s::<T>(ps.vel[0]);
+    assert!((v[0] / (mu * w) - 1.0).abs() < 0.01, "{v:?} vs {}", mu * w);
+    assert!(v[2].abs() < 1e-6 * v[0], "{v:?}");
+}
+
+#[test]
+fn stable_method_with_rotation_above_the_wall_f64() {
+    stable_grand::<f64>();
+}
+
+#[test]
+fn stable_method_with_rotation_above_the_wall_f32() {
+    stable_grand::<f32>();
+}
+
+/// One step of a lone sphere (centre `pos`, radius `a`, density `rho`) with `p`.
+fn lone_step<T: Real>(
+    p: &hydrorattle::Params<T>,
+    pos: [f64; 3],
+    a: f64,
+    rho: f64,
+) -> ParticleSet<T, 1> {
+    let mut ps: ParticleSet<T, 1> = particles(&[Sphere {
+        pos,
+        radius: a,
+        density: rho,
+    }]);
+    let bonds: BondSet<T, 1> = BondSet::new();
+    let mut buf = Buffers::<T>::new(Layout::for_params(p, 1, 0));
+    let mut ws = buf.workspace();
+    hydrorattle::step(&mut ps, &bonds, p, &mut ws, &mut NoForce).unwrap();
+    ps
 }

@@ -175,8 +175,10 @@ impl<T: Real> Metric<'_, T> {
                 // Nested pairs were refused by the product at these positions. The block
                 // (q, p), as `sym_block` reads it.
                 let block = |q| match wall {
-                    Some(h) => wall::tt_block_at(level, eta, h, pos, radius, q, p).ok(),
-                    None => tt_block_at(level, eta, pos, radius, p, q),
+                    Some(h) if cfg!(feature = "wall") => {
+                        wall::tt_block_at(level, eta, h, pos, radius, q, p).ok()
+                    }
+                    _ => tt_block_at(level, eta, pos, radius, p, q),
                 };
                 let block = |q| block(q).unwrap_or(T::M3_ZERO);
                 sym_diff_mul::<T>(block(b.i), block(b.j), grad[l] * scale)
@@ -301,8 +303,10 @@ impl<T: Real> Metric<'_, T> {
                 spread(bonds, grad, c, scale, f);
                 // Nested pairs were refused by the product at these positions.
                 let done = match wall {
-                    Some(h) => wall::tt_product(level, eta, h, pos, radius, f, out),
-                    None => tt_product(level, eta, pos, radius, f, out),
+                    Some(h) if cfg!(feature = "wall") => {
+                        wall::tt_product(level, eta, h, pos, radius, f, out)
+                    }
+                    _ => tt_product(level, eta, pos, radius, f, out),
                 };
                 if done.is_err() {
                     out.fill(T::V3_ZERO);

@@ -52,16 +52,15 @@ pub(super) fn check_thermal<T: Real>(
     Ok(Some(b))
 }
 
-/// Refuses a wall where it is not implemented: its mobility is translational only
-/// (`mobility::wall`), so rotation with a wall is refused.
+/// Checks the wall's height (its mobility, `mobility::wall`, serves every method), and
+/// refuses a wall when the kernel was built without its `wall` feature.
 pub(super) fn check_wall<T: Real>(p: &Params<T>) -> Result<(), StepError> {
     match p.wall {
-        None => Ok(()),
         Some(w) if !w.height.is_finite() => Err(StepError::BadParameter("wall.height (finite)")),
-        Some(_) if p.rotation => Err(StepError::Unsupported(
-            "rotation with a wall (the wall's mobility has no rotation blocks yet)",
+        Some(_) if !cfg!(feature = "wall") => Err(StepError::Unsupported(
+            "a wall: the kernel was built without its `wall` feature",
         )),
-        Some(_) => Ok(()),
+        _ => Ok(()),
     }
 }
 

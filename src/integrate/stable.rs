@@ -4,7 +4,7 @@
 
 use super::{
     Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors,
-    project_positions, report, step_velocity,
+    project_positions, report, step_velocity, wall_height,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, SolverKind, apply_drag};
@@ -48,7 +48,10 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
         ..
     } = v;
     // Mobility (translation or grand) and the drag operator K = dt I + S mu S.
-    if p.rotation {
+    if let (true, Some(h)) = (p.rotation, wall_height(p)) {
+        let (level, eta) = (p.hydro, p.viscosity);
+        mobility::wall::assemble_grand(level, eta, h, s.pos, s.radius, mu)?;
+    } else if p.rotation {
         mobility::assemble_grand(p.hydro, p.viscosity, s.pos, s.radius, mu)?;
     } else {
         assemble_tt(p, s.pos, s.radius, mu)?;

@@ -25,9 +25,9 @@ pub(super) fn mobility_product<T: Real>(
     par: &dyn Parallel,
     bands: &mut [T::V3],
 ) -> Result<(), StepError> {
-    if let Some(w) = p.wall {
+    if let Some(h) = wall_height(p) {
         // Above a wall: assembled (or not), then applied (`mobility::wall`).
-        let (level, eta, h) = (p.hydro, p.viscosity, w.height);
+        let (level, eta) = (p.hydro, p.viscosity);
         if p.matrix_free {
             return Ok(mobility::wall::tt_product(
                 level, eta, h, pos, radius, f, u,
@@ -69,7 +69,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
             radius,
             grad,
             scale,
-            wall: p.wall.map(|w| w.height),
+            wall: wall_height(p),
         };
     }
     if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
@@ -85,16 +85,26 @@ pub(super) fn mobility_metric<'a, T: Real>(
     Metric::Dense { disp, n, grad }
 }
 
+/// The wall's height when the step has one and the kernel its `wall` feature (without
+/// it the wall's code compiles away; `check_wall` refuses the wall then).
+#[inline(always)]
+pub(super) fn wall_height<T: Real>(p: &Params<T>) -> Option<T> {
+    match p.wall {
+        Some(w) if cfg!(feature = "wall") => Some(w.height),
+        _ => None,
+    }
+}
+
 pub(super) fn assemble_tt<T: Real>(
     p: &Params<T>,
     pos: &[T::V3],
     radius: &[T],
     mu: &mut [T::M3],
 ) -> Result<(), StepError> {
-    if let Some(w) = p.wall {
+    if let Some(h) = wall_height(p) {
         let (level, eta, serial) = (p.hydro, p.viscosity, &crate::parallel::Serial);
         return Ok(mobility::wall::assemble(
-            serial, level, eta, w.height, pos, radius, mu,
+            serial, level, eta, h, pos, radius, mu,
         )?);
     }
     mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
@@ -145,6 +155,12 @@ pub(super) fn spin<T: Real>(
     out: &mut [T::V3],
 ) -> Result<(), StepError> {
     out.fill(p.vorticity);
+    if let (true, Some(h)) = (p.rotation, wall_height(p)) {
+        let (level, eta) = (p.hydro, p.viscosity);
+        return Ok(mobility::wall::add_spin(
+            level, eta, h, pos, radius, f, out,
+        )?);
+    }
     if !p.rotation || p.hydro == Hydro::FreeDraining {
         return Ok(());
     }

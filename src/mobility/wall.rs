@@ -1,7 +1,8 @@
-//! The translational mobility `mu_tt` above a no-slip plane wall: the polydisperse RPY
-//! tensor plus the image system of Blake's solution with Faxén corrections (Swan &
-//! Brady, Phys. Fluids 19, 113306, 2007), derived for unequal radii in `docs/WALL.md`
-//! (the formulas here are that document's, term for term).
+//! The mobility above a no-slip plane wall: the polydisperse RPY tensor plus the image
+//! system of Blake's solution with Faxén corrections (Swan & Brady, Phys. Fluids 19,
+//! 113306, 2007), derived for unequal radii in `docs/WALL.md` (the formulas here are
+//! that document's, term for term). Translation here; the rotation blocks (the grand
+//! mobility, spins) in [`assemble_grand`] and [`add_spin`].
 //!
 //! The wall is the plane `z = height`, the spheres above it. With `h_i = z_i - height`,
 //! the block `(i, j)` is the free-space block plus the image block
@@ -30,6 +31,9 @@
 //! Blocks `(i, j)` and `(j, i)` are transposes of each other, not symmetric 3x3 blocks:
 //! the packed storage keeps `(i, j)` for `i > j` and every reader of the other triangle
 //! transposes ([`tt_block_at`] returns the block in the orientation asked for).
+
+mod rotation;
+pub use rotation::{add_spin, assemble_grand, image_rot, self_wall_rot};
 
 use crate::error::ParticleError;
 use crate::linalg::tri;
