@@ -122,7 +122,7 @@ fn lone_sphere_discrete_equipartition_and_diffusion_at_dt_equal_to_the_relaxatio
     eprintln!("h = 1: <w_x^2> = {iw2:.5} +- {se_w:.5}, exact for the scheme {want_w:.5}");
     assert!(se_w < 0.005 * want_w && (iw2 - want_w).abs() < 3.0 * se_w);
     let l = lag as f64;
-    let msd = 2.0 * l * dt - 4.0 * (1.0 + h) / (2.0 + h) * (1.0 - c.powi(lag as i32));
+    let msd = 2.0 * l * dt - 4.0 * (1.0 + h) / (2.0 + h) * (1.0 - c.powi(lag));
     let (mx2, se_x) = block_mean(&x2, 50);
     eprintln!(
         "h = 1: <X^2> over {lag} steps = {mx2:.4} +- {se_x:.4}, exact for the scheme {msd:.4}"
