@@ -113,6 +113,8 @@ pub struct Plan {
     pub contact: Option<Contact>,
     /// Thermal noise (adds the mobility's factor or the Lanczos basis).
     pub brownian: Option<Thermal>,
+    /// No stored mobility (`[integrator] matrix_free`).
+    pub matrix_free: bool,
 }
 
 impl Plan {
@@ -125,6 +127,7 @@ impl Plan {
             precision: scene.integrator.precision,
             contact: scene.contact,
             brownian: scene.brownian,
+            matrix_free: scene.integrator.matrix_free,
         }
     }
 
@@ -140,6 +143,7 @@ impl Plan {
             p.rotation = self.rotation;
             p.solver.kind = self.solver.kind();
             p.contacts = contacts.map(Contacts::new);
+            p.matrix_free = self.matrix_free;
             if let Some(t) = self.brownian {
                 p.brownian = Some(hydrorattle::Brownian {
                     temperature: t.temperature,
@@ -191,6 +195,7 @@ mod tests {
             precision,
             contact: None,
             brownian: None,
+            matrix_free: false,
         }
     }
 

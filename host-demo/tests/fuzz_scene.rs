@@ -154,7 +154,7 @@ fn case(bytes: &[u8], limits: Limits) -> Result<bool, String> {
         }
         Ok(s) => {
             let n = s.particles.len();
-            // A spring's rest length may be 0; a constraint's may not.
+            // Springs may rest at length zero; rigid bonds may not.
             let springs = s.integrator.method == host_demo::scene::Method::Springs;
             let ok = n > 0
                 && s.species.len() == n
@@ -165,7 +165,7 @@ fn case(bytes: &[u8], limits: Limits) -> Result<bool, String> {
                     b.i < n
                         && b.j < n
                         && b.i != b.j
-                        && (b.length > 0.0 || (springs && b.length == 0.0))
+                        && (b.length > 0.0 || springs && b.length == 0.0)
                 })
                 && s.integrator.dt > 0.0
                 && s.integrator.steps() >= 1

@@ -39,9 +39,9 @@ pub(super) fn check_thermal<T: Real>(
             "noise_sqrt = Lanczos with RattleStable (it factors its drag densely: Cholesky only)",
         ));
     }
-    if p.matrix_free {
+    if p.matrix_free && p.noise_sqrt == crate::params::NoiseSqrt::Cholesky {
         return Err(StepError::Unsupported(
-            "thermal noise without a stored mobility (matrix_free: not implemented)",
+            "a Cholesky factor of the noise without a stored mobility (matrix_free: use Lanczos or Auto)",
         ));
     }
     let l = p.lanczos;
@@ -60,12 +60,16 @@ pub(super) fn check_thermal<T: Real>(
     Ok(Some(b))
 }
 
-/// Refuses a wall until it is implemented.
+/// Refuses a wall where it is not implemented: its mobility is translational only
+/// (`mobility::wall`), so rotation with a wall is refused.
 pub(super) fn check_wall<T: Real>(p: &Params<T>) -> Result<(), StepError> {
     match p.wall {
         None => Ok(()),
         Some(w) if !w.height.is_finite() => Err(StepError::BadParameter("wall.height (finite)")),
-        Some(_) => Err(StepError::Unsupported("a wall (not implemented yet)")),
+        Some(_) if p.rotation => Err(StepError::Unsupported(
+            "rotation with a wall (the wall's mobility has no rotation blocks yet)",
+        )),
+        Some(_) => Ok(()),
     }
 }
 

@@ -43,7 +43,9 @@ use crate::workspace::Workspace;
 pub struct StepReport<T> {
     /// Position-constraint iterations (sweeps or Newton steps) of the final solve.
     pub iterations: u32,
-    /// Velocity-constraint iterations (RATTLE stage), 0 where there is none.
+    /// Velocity-constraint iterations (RATTLE stage; the projection of the thermal noise
+    /// at the midpoint, [`Drift::Midpoint`](crate::Drift::Midpoint)), 0 where there is
+    /// none.
     pub velocity_iterations: u32,
     /// Largest relative bond-length error `| |r_ij| - d | / d` after the step (springs
     /// of rest length zero have none and are skipped).

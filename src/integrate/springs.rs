@@ -3,7 +3,7 @@
 //! Ermak–McCammon step, `r' = r + dt (U_inf + mu F) + dx` with the thermal
 //! displacement `dx` of covariance `2 kT dt mu` (`brownian.rs`, without constraints).
 
-use super::brownian::kick;
+use super::brownian::{Krylov, kick};
 use super::{Start, StepReport, add_flow, mobility_product, spin, step_velocity};
 use crate::bonds::{Bond, max_residual};
 use crate::error::StepError;
@@ -54,8 +54,13 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
             }
         }
         Some((b, noise)) => {
-            let krylov = (basis, krylov_t);
-            noise_iterations = kick(
+            let krylov = Krylov {
+                basis,
+                work: krylov_t,
+                par,
+                bands,
+            };
+            (noise_iterations, _) = kick(
                 p, b, s, mu, fac, new_vel, new_omega, dx, noise, None, krylov,
             )?;
             for i in 0..n {

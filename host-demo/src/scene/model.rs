@@ -212,6 +212,10 @@ pub struct Integrator {
     /// FENE springs for `method = "springs"`: their maximum extension `Q0` (> 0; the
     /// kernel's [`hydrorattle::Params::fene`]). `None`: Hookean springs.
     pub fene: Option<f64>,
+    /// Never store the mobility (the kernel's `Params::matrix_free`: storage `O(N)`,
+    /// pair blocks evaluated where they are used; thermal noise by Lanczos).
+    /// `method = "overdamped"` or `"springs"` with `level = "manual"` only.
+    pub matrix_free: bool,
 }
 
 impl Integrator {

@@ -99,6 +99,7 @@ pub(super) struct RawIntegrator {
     pub(super) precision: Option<Precision>,
     pub(super) stiffness: S<f64>,
     pub(super) fene: S<f64>,
+    pub(super) matrix_free: Option<Spanned<bool>>,
 }
 
 #[derive(Deserialize)]

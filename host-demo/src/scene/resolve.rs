@@ -13,7 +13,7 @@ use super::raw::{
 };
 use super::{
     Bond, DEFAULT_DENSITY, Flow, Fluid, Helix, Integrator, Level, Method, Model, Output, Overlap,
-    Particle, Precision, Scene, TARGET_FRAMES,
+    Particle, Precision, Scene, Sqrt, TARGET_FRAMES,
 };
 use crate::sizing::{Limits, Plan, TooLarge};
 
@@ -66,10 +66,35 @@ impl RawScene {
             ));
         };
         let integrator = resolve_integrator(raw_int.get_ref())?;
+        if let Some(m) = raw_int
+            .get_ref()
+            .matrix_free
+            .as_ref()
+            .filter(|m| *m.get_ref())
+        {
+            let runs = matches!(integrator.method, Method::Overdamped | Method::Springs);
+            if !runs || model.level != Level::Manual {
+                return Err(issue(
+                    m.span(),
+                    "matrix_free needs method = \"overdamped\" or \"springs\" and level = \"manual\" \
+                     (the other methods store or factorise the mobility)",
+                ));
+            }
+        }
         let brownian = match &self.brownian {
             None => None,
             Some(b) => Some(b.resolve(&model, &integrator)?),
         };
+        let cholesky = brownian.is_some_and(|b| b.temperature > 0.0 && b.sqrt == Sqrt::Cholesky);
+        if let Some(m) = raw_int.get_ref().matrix_free.as_ref() {
+            if *m.get_ref() && cholesky {
+                return Err(issue(
+                    m.span(),
+                    "matrix_free draws the noise by Lanczos: [brownian] sqrt = \"cholesky\" \
+                     needs the stored mobility (use \"auto\" or \"lanczos\")",
+                ));
+            }
+        }
         if let (Some(c), Some(raw)) = (contact, &self.contact) {
             super::contact::check_method(c, raw, &integrator, brownian.as_ref())?;
         }
@@ -246,6 +271,7 @@ fn plans(
         precision: integrator.precision,
         contact,
         brownian,
+        matrix_free: integrator.matrix_free,
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],
@@ -318,6 +344,7 @@ fn resolve_integrator(r: &RawIntegrator) -> Result<Integrator, Issue> {
         precision: r.precision.unwrap_or_default(),
         stiffness: number(&r.stiffness, 1e4, "stiffness", Bound::Positive)?,
         fene: resolve_fene(r)?,
+        matrix_free: r.matrix_free.as_ref().is_some_and(|m| *m.get_ref()),
     })
 }
 

@@ -62,6 +62,7 @@ impl Scene {
                 ("max_iterations", value(i.max_iterations as i64)),
                 ("precision", value(i.precision)),
                 ("stiffness", value(i.stiffness)),
+                ("matrix_free", value(i.matrix_free)),
             ]),
         );
         // Written only when set: scenes written before the key stay the same.
