@@ -203,11 +203,22 @@ pub struct Params<T: Real> {
     /// oscillate silently (bounded but wrong) instead of blowing up. Costs about 60
     /// Cholesky solves per step. Default false.
     pub stability_guard: bool,
-    /// Thermal noise ([`Method::Overdamped`] and [`Method::Springs`] only; other methods
-    /// refuse a positive temperature with
-    /// [`StepError::Unsupported`](crate::StepError::Unsupported)). With
-    /// [`Params::matrix_free`] the noise is drawn by Lanczos from matrix-free products
-    /// (storage `O(N)`). Default `None`.
+    /// Thermal noise: [`Method::Overdamped`] and [`Method::Springs`] (Brownian
+    /// displacements of covariance `2 kT dt mu`, drift per [`Brownian::drift`]) and
+    /// [`Method::RattleStable`] (Langevin: a random force of covariance `2 kT R / dt`,
+    /// `R = mu^-1` its implicit drag, drawn by Cholesky whatever
+    /// [`Params::noise_sqrt`] says unless it names Lanczos, which is refused; the drift
+    /// setting does not apply). With [`Params::matrix_free`] (`Overdamped`, `Springs`)
+    /// the noise is drawn by Lanczos from matrix-free products (storage `O(N)`).
+    /// [`Method::Rattle`] and [`Method::Overdamped2`] refuse a positive temperature with
+    /// [`StepError::Unsupported`](crate::StepError::Unsupported). `Overdamped2` stays
+    /// refused because averaging its predictor's and corrector's velocities makes the
+    /// noisy step a Stratonovich-type scheme: with a position-dependent mobility it
+    /// samples a drift other than the Ito drift `kT div(P mu)` the constrained
+    /// equilibrium needs, and with noise of size `sqrt(dt)` its weak order is one at
+    /// best, so it would cost two mobility assemblies for no gain and a wrong drift.
+    /// `Rattle`'s explicit drag is stable only for `dt < ~2 m / zeta`; `RattleStable`
+    /// is its thermal counterpart. Default `None`.
     pub brownian: Option<Brownian<T>>,
     /// How the thermal noise's square root of the mobility is taken. Default
     /// [`NoiseSqrt::Auto`] (Cholesky up to [`LANCZOS_CROSSOVER`] beads, Lanczos above;

@@ -337,3 +337,23 @@ def test_lanczos_noise_is_reported_and_keeps_the_bonds():
     assert np.allclose(lengths, lan.lengths, rtol=1e-8)
     with pytest.raises(ValueError):
         hr.System(pos, 1.0, RHO, noise_sqrt="qr", **kw)
+
+
+def test_rattle_stable_at_temperature_equipartition_of_the_scheme():
+    """A lone unit sphere of mass 1 with zeta = 6 pi eta a = 1 under RattleStable at
+    kT = 1 and dt = m / zeta (h = 1): the kernel's discretised Langevin step samples
+    velocities of variance kT / (m + zeta dt / 2) = 2/3 per component exactly (the
+    kernel's tests/inertial_thermal.rs derives it and checks the dt -> 0 limit kT / m).
+    20000 steps, blocks of 400 (the velocity decorrelates in a few steps)."""
+    rho = 3.0 / (4.0 * math.pi)
+    s = hr.System([[0.0, 0.0, 0.0]], 1.0, rho, dt=1.0, method="rattle-stable",
+                  viscosity=1.0 / (6.0 * math.pi), gravity=[0.0, 0.0, 0.0],
+                  temperature=1.0, seed=4)
+    v2 = np.empty(20000)
+    for k in range(v2.size):
+        s.step(1)
+        v2[k] = np.mean(s.velocities[0] ** 2)
+    blocks = v2.reshape(50, -1).mean(axis=1)
+    mean, se = blocks.mean(), blocks.std(ddof=1) / math.sqrt(blocks.size)
+    assert se < 0.01
+    assert abs(mean - 2.0 / 3.0) < 3.0 * se, (mean, se)

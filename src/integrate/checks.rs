@@ -26,9 +26,17 @@ pub(super) fn check_thermal<T: Real>(
     if b.temperature == T::ZERO {
         return Ok(None);
     }
-    if !matches!(p.method, Method::Overdamped | Method::Springs) {
+    if !matches!(
+        p.method,
+        Method::Overdamped | Method::Springs | Method::RattleStable
+    ) {
         return Err(StepError::Unsupported(
-            "thermal noise with a method other than Overdamped or Springs",
+            "thermal noise with Rattle or Overdamped2 (Overdamped, Springs and RattleStable take it)",
+        ));
+    }
+    if p.method == Method::RattleStable && p.noise_sqrt == crate::params::NoiseSqrt::Lanczos {
+        return Err(StepError::Unsupported(
+            "noise_sqrt = Lanczos with RattleStable (it factors its drag densely: Cholesky only)",
         ));
     }
     if p.matrix_free && p.noise_sqrt == crate::params::NoiseSqrt::Cholesky {

@@ -147,7 +147,10 @@ fn advance<T: Real, E: ExternalForce<T>>(
             (Method::Overdamped, ..) => overdamped(p, &s, bonds, v, ext),
             (Method::Overdamped2, ..) => overdamped2(p, &s, bonds, v, ext),
             (Method::Rattle, ..) => rattle_explicit(p, &s, bonds, v, ext),
-            (Method::RattleStable, ..) => rattle_stable(p, &s, bonds, v, ext),
+            (Method::RattleStable, Some(b), Some(g)) => {
+                rattle_stable(p, &s, bonds, v, ext, Some((b, g)))
+            }
+            (Method::RattleStable, ..) => rattle_stable(p, &s, bonds, v, ext, None),
             (Method::Springs, Some(b), Some(g)) => springs(p, &s, bonds, v, ext, Some((b, g))),
             (Method::Springs, ..) => springs(p, &s, bonds, v, ext, None),
         }

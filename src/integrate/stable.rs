@@ -1,6 +1,30 @@
 //! Inertial RATTLE with the drag implicit (backward Euler in the velocity): stable at
 //! any `dt`, equal to the overdamped step as the masses go to zero; with rotation it
 //! runs on the 6N grand mobility.
+//!
+//! At temperature (Langevin dynamics with hydrodynamic friction) the generalised force
+//! gains the random force `g = sqrt(2 kT / dt) L^-T xi`, `L L^T = mu` (Cholesky of the
+//! translational or grand mobility), `xi` standard normal: covariance `2 kT R / dt`
+//! with `R = mu^-1` the drag, the fluctuation-dissipation theorem's, and `mu g =
+//! sqrt(2 kT / dt) L xi` is the overdamped Brownian velocity. For the discretised scheme
+//! `(M + R dt) v' = M v + g dt` this has two exact consequences, for any `dt`, `M` and
+//! `R` (without forces and bonds):
+//!
+//! * the stationary velocities are normal with covariance `kT (M + R dt / 2)^-1` (it
+//!   solves `V = A M V M A + A (2 kT R dt) A`, `A = (M + R dt)^-1`): equipartition with
+//!   the mass `M + R dt / 2`, so `<m v^2> = kT / (1 + zeta dt / 2m)` for a lone sphere,
+//!   `kT` as `dt -> 0`;
+//! * the long-time diffusion is exactly `kT mu` (the displacements over many steps
+//!   add up to `mu` times the summed impulses), and as `M -> 0` the step is the
+//!   overdamped Brownian step (`Drift::Uncorrected`).
+//!
+//! The impulse covariance that would make `<m v^2> = kT` exact at every `dt`,
+//! `kT dt (2 R + dt R M^-1 R)`, was not chosen: since the position moves by `v' dt`, it
+//! diffuses at `kT mu + kT dt M^-1 / 2`, without bound as `M -> 0` at fixed `dt`; the
+//! scheme would lose the overdamped limit that makes it stable at any `dt`. Bonds: the
+//! velocities are projected onto the constraints' tangent space as without noise
+//! (RATTLE), so a chain's kinetic energy tends to `(3N - B) kT / 2` as `dt -> 0`. No
+//! drift term: the noise enters the momentum, and the position is differentiable.
 
 use super::{
     Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors,
@@ -12,7 +36,8 @@ use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
 use crate::linalg::{self, tri};
 use crate::mobility;
-use crate::params::Params;
+use crate::noise::Noise;
+use crate::params::{Brownian, Params};
 use crate::particles::sphere_volume;
 use crate::real::Real;
 use crate::workspace::Views;
@@ -20,15 +45,19 @@ use crate::workspace::Views;
 /// Inertial with implicit drag: `(R + M/dt) v' = F + F_C + M v/dt + R U_inf`, solved as
 /// `v' = S^-1 dt K^-1 S (mu (F + F_C + M v/dt) + U_inf)`, `S = M^1/2`, `K = dt I + S mu S`.
 /// With rotation the same on the 6N grand mobility (`M` holds masses and moments).
+/// At temperature (`thermal`: the settings and the generator) `F` includes the random
+/// force of the module's documentation.
 pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     p: &Params<T>,
     s: &Start<'_, T>,
     bonds: &[Bond<T>],
     v: Views<'_, T>,
     ext: &mut E,
+    thermal: Option<(Brownian<T>, &mut Noise)>,
 ) -> Result<StepReport<T>, StepError> {
     let (n, dt) = (s.pos.len(), p.dt);
     let m = if p.rotation { 2 * n } else { n };
+    let noisy = thermal.is_some();
     let Views {
         mu,
         fac,
@@ -63,6 +92,21 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
             sq[n + i] = (T::from_f64(0.4) * mass * s.radius[i] * s.radius[i]).sqrt();
         }
     }
+    // The random force sqrt(2 kT / dt) L^-T xi (`t` holds it until the forces are
+    // known); `fac` holds L until it takes the drag operator.
+    if let Some((b, noise)) = thermal {
+        fac.copy_from_slice(mu);
+        linalg::cholesky::<T>(fac, m).map_err(|error| StepError::Linalg {
+            stage: Stage::Mobility,
+            error,
+        })?;
+        noise.fill::<T>(t);
+        linalg::solve_upper::<T>(fac, m, t);
+        let amplitude = (T::TWO * b.temperature / dt).sqrt();
+        for g in t.iter_mut() {
+            *g *= amplitude;
+        }
+    }
     for i in 0..m {
         for j in 0..=i {
             fac[tri(i) + j] = mu[tri(i) + j] * (sq[i] * sq[j]);
@@ -79,6 +123,11 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     for i in 0..m {
         let w = if i < n { s.vel[i] } else { s.omega[i - n] };
         rhs6[i] += w * (sq[i] * sq[i] / dt);
+    }
+    if noisy {
+        for (f, &g) in rhs6.iter_mut().zip(t.iter()) {
+            *f += g;
+        }
     }
     drag_velocity(p, s.pos, mu, fac, sq, rhs6, u);
     for i in 0..n {

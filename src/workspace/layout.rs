@@ -147,6 +147,9 @@ impl Layout {
     /// displacement (`n` vectors), the bond vectors at the midpoint (`B` vectors) and
     /// the midpoint projection's multipliers (`B` scalars). The normal deviates and the
     /// midpoint itself live in the candidate velocities and spins until those are written.
+    /// `RattleStable` at temperature needs nothing more: the mobility's factor lives in
+    /// the drag factor's blocks until the drag operator is assembled there, the random
+    /// force in a work array.
     pub const fn thermal(self, method: Method, n: usize, bonds: usize) -> Self {
         match method {
             Method::Overdamped => Self {

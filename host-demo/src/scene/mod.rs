@@ -20,7 +20,7 @@
 //! | `[model]` | `hydrodynamics = "rpy"\|"oseen"\|"free-draining"`, `inertia`, `rotation`, `level = "auto"\|"manual"`, `overlap = "reject"\|"allow"` | rpy, false, false, manual, reject |
 //! | `[integrator]` | `method` (required), `dt` (required), `duration` (required), `solver = "auto"\|"sweep"\|"newton"\|"krylov"`, `tolerance`, `max_iterations`, `precision = "f32"\|"f64"`, `stiffness`, `fene` (FENE maximum extension `Q0` > 0, springs only; every bond must start shorter), `matrix_free` (never store the mobility: `O(N)` storage; overdamped or springs, level manual) | auto, 1e-10, 500, f64, 1e4, none (Hookean), false |
 //! | `[output]` | `every` (steps between trajectory frames, >= 1) | about [`TARGET_FRAMES`] frames |
-//! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"` or `"springs"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
+//! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"`, `"springs"` or `"rattle-stable"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
 //!
 //! A scene gives either a `[helix]` table or explicit `[[particle]]` (and optionally
 //! `[[bond]]`) tables, never both. Units are those of `DESIGN.md` section 4: tail radius

@@ -13,7 +13,7 @@ use super::raw::{
 };
 use super::{
     Bond, DEFAULT_DENSITY, Flow, Fluid, Helix, Integrator, Level, Method, Model, Output, Overlap,
-    Particle, Scene, Sqrt, TARGET_FRAMES,
+    Particle, Precision, Scene, Sqrt, TARGET_FRAMES,
 };
 use crate::sizing::{Limits, Plan, TooLarge};
 
@@ -359,7 +359,25 @@ fn resolve_fene(r: &RawIntegrator) -> Result<Option<f64>, Issue> {
             "fene (the FENE springs' maximum extension) needs method = \"springs\"",
         ));
     }
-    number(&r.fene, 0.0, "fene (maximum extension)", Bound::Positive).map(Some)
+    let q = number(&r.fene, 0.0, "fene (maximum extension)", Bound::Positive)?;
+    // The kernel squares it in the run's precision.
+    let usable = match r.precision.unwrap_or_default() {
+        Precision::F32 => {
+            let q = q as f32;
+            q > 0.0 && (q * q).is_normal()
+        }
+        Precision::F64 => (q * q).is_normal(),
+    };
+    if !usable {
+        return Err(issue(
+            q0.span(),
+            format!(
+                "fene {} is not usable in the run's precision (its square must be a normal number)",
+                crate::output::format_f64(q)
+            ),
+        ));
+    }
+    Ok(Some(q))
 }
 
 fn resolve_helix(r: &RawHelix) -> Result<Helix, Issue> {

@@ -80,8 +80,9 @@ pub(super) struct RawBrownian {
 }
 
 impl RawBrownian {
-    /// Checks the keys; a positive temperature needs the overdamped or spring method
-    /// chosen by hand (the kernel has noise for those methods only).
+    /// Checks the keys; a positive temperature needs the overdamped, spring or
+    /// rattle-stable method chosen by hand (the kernel has noise for those methods
+    /// only).
     pub(super) fn resolve(&self, model: &Model, integrator: &Integrator) -> Result<Thermal, Issue> {
         let temperature = number(&self.temperature, 0.0, "temperature", Bound::NonNegative)?;
         let seed = match &self.seed {
@@ -89,12 +90,15 @@ impl RawBrownian {
             Some(s) => u64::try_from(*s.get_ref())
                 .map_err(|_| issue(s.span(), format!("seed must be >= 0, not {}", s.get_ref())))?,
         };
-        let manual = matches!(integrator.method, Method::Overdamped | Method::Springs)
-            && model.level == Level::Manual;
+        let manual = matches!(
+            integrator.method,
+            Method::Overdamped | Method::Springs | Method::RattleStable
+        ) && model.level == Level::Manual;
         if temperature > 0.0 && !manual {
             let at = self.temperature.as_ref().map(|t| t.span());
-            let message = "temperature > 0 needs method = \"overdamped\" or \"springs\" and \
-                           level = \"manual\" (thermal noise is implemented for those steps only)";
+            let message = "temperature > 0 needs method = \"overdamped\", \"springs\" or \
+                           \"rattle-stable\" and level = \"manual\" (thermal noise is implemented \
+                           for those steps only)";
             return Err(match at {
                 Some(span) => issue(span, message),
                 None => Issue::unplaced(message),
