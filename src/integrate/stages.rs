@@ -69,6 +69,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
     }
     let n = pos.len();
     constraints::tabulate(mu, bonds, grad, scale, n, disp);
+    let disp = &disp[..n * bonds.len()];
     Metric::Dense { disp, n, grad }
 }
 
