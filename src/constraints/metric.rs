@@ -342,7 +342,9 @@ impl<T: Real> Metric<'_, T> {
 
 /// Tabulates `disp[q * bonds + l] = (mu_qi - mu_qj) (scale g_l)` from the packed mobility:
 /// the values [`Metric::Mobility`] gives (one block difference and one block product per
-/// entry, not two products).
+/// entry, not two products). Never inlined: the metric's constructor is inlined at
+/// every call site (`mobility_metric`), the table is the same code at each.
+#[inline(never)]
 pub(crate) fn tabulate<T: Real>(
     mu: &[T::M3],
     bonds: &[Bond<T>],
