@@ -57,9 +57,12 @@ pub enum Metric<'a, T: Real> {
         /// The wall's height when there is one ([`wall`]).
         wall: Option<T>,
     },
-    /// Precomputed displacements `disp[l * n + p]` (`beads x bonds`).
+    /// Precomputed displacements `disp[p * bonds + l]` (`beads x bonds`, bead-major: a
+    /// bead's displacements by every multiplier are contiguous, so an update of all
+    /// multipliers sums each bead's moves in registers, and a Jacobian row reads two
+    /// contiguous runs).
     Dense {
-        /// Displacements, bond-major.
+        /// Displacements, bead-major.
         disp: &'a [T::V3],
         /// Beads.
         n: usize,
@@ -183,7 +186,7 @@ impl<T: Real> Metric<'_, T> {
                 let block = |q| block(q).unwrap_or(T::M3_ZERO);
                 sym_diff_mul::<T>(block(b.i), block(b.j), grad[l] * scale)
             }
-            Metric::Dense { disp, n, .. } => disp[l * n + p],
+            Metric::Dense { disp, n, .. } => disp[p * (disp.len() / n) + l],
             Metric::Drag {
                 mu, sq, dt, grad, ..
             } => {
@@ -221,8 +224,10 @@ impl<T: Real> Metric<'_, T> {
         let b = bonds[k];
         match *self {
             Metric::Dense { disp, n, .. } => {
-                for (l, r) in (first..).zip(row.iter_mut()) {
-                    *r = T::dot(dir, disp[l * n + b.i] - disp[l * n + b.j]);
+                let nb = disp.len() / n;
+                let (di, dj) = (&disp[b.i * nb + first..], &disp[b.j * nb + first..]);
+                for ((r, &a), &c) in row.iter_mut().zip(di).zip(dj) {
+                    *r = T::dot(dir, a - c);
                 }
             }
             _ => {
@@ -241,15 +246,38 @@ impl<T: Real> Metric<'_, T> {
                 x[b.i] += self.at(bonds, l, b.i) * c;
                 x[b.j] += self.at(bonds, l, b.j) * c;
             }
-            Metric::Dense { disp, .. } => {
-                let n = x.len();
-                for (xp, &d) in x.iter_mut().zip(&disp[l * n..l * n + n]) {
-                    *xp += d * c;
+            Metric::Dense { disp, n, .. } => {
+                let nb = disp.len() / n;
+                for (xp, row) in x.iter_mut().zip(disp.chunks_exact(nb)) {
+                    *xp += row[l] * c;
                 }
             }
             Metric::Mobility { .. } | Metric::Free { .. } | Metric::Drag { .. } => {
                 for p in 0..x.len() {
                     x[p] += self.at(bonds, l, p) * c;
+                }
+            }
+        }
+    }
+
+    /// `x += sum_l c_l D_l`, the multipliers' moves added bond after bond (the bits of
+    /// [`Metric::apply_one`] for `l = 0, 1, ...`; the dense Newton update). The
+    /// bead-major table sums each bead's moves in a register.
+    pub fn apply_each(&self, bonds: &[Bond<T>], c: &[T], x: &mut [T::V3]) {
+        match *self {
+            Metric::Dense { disp, n, .. } => {
+                let nb = disp.len() / n;
+                for (xp, row) in x.iter_mut().zip(disp.chunks_exact(nb)) {
+                    let mut acc = *xp;
+                    for (&d, &cl) in row.iter().zip(c) {
+                        acc += d * cl;
+                    }
+                    *xp = acc;
+                }
+            }
+            _ => {
+                for (l, &cl) in c.iter().enumerate().take(bonds.len()) {
+                    self.apply_one(bonds, l, cl, x);
                 }
             }
         }
@@ -276,9 +304,7 @@ impl<T: Real> Metric<'_, T> {
             }
             Metric::Dense { .. } => {
                 out.fill(T::V3_ZERO);
-                for (l, &cl) in c.iter().enumerate() {
-                    self.apply_one(bonds, l, cl, out);
-                }
+                self.apply_each(bonds, c, out);
             }
             Metric::Mobility {
                 mu,
@@ -333,10 +359,14 @@ impl<T: Real> Metric<'_, T> {
     }
 }
 
-/// Tabulates `disp[l * n + q] = (mu_qi - mu_qj) (scale g_l)` from the packed mobility:
+/// Tabulates `disp[q * bonds + l] = (mu_qi - mu_qj) (scale g_l)` from the packed mobility:
 /// the values [`Metric::Mobility`] gives (one block difference and one block product per
 /// entry, not two products). Blocks stored as `mu_qi` are transposed for
-/// [`sym_diff_mul`] (exact: the same bits for symmetric blocks).
+/// [`sym_diff_mul`] (exact: the same bits for symmetric blocks; only a wall's blocks
+/// are not symmetric, so without the `wall` feature nothing is transposed). Never
+/// inlined: the metric's constructor is inlined at every call site
+/// (`mobility_metric`), the table is the same code at each.
+#[inline(never)]
 pub(crate) fn tabulate<T: Real>(
     mu: &[T::M3],
     bonds: &[Bond<T>],
@@ -345,9 +375,18 @@ pub(crate) fn tabulate<T: Real>(
     n: usize,
     disp: &mut [T::V3],
 ) {
+    let nb = bonds.len();
+    let disp = &mut disp[..n * nb];
+    let tr = |m: T::M3| {
+        if cfg!(feature = "wall") {
+            T::transpose(m)
+        } else {
+            m
+        }
+    };
     for (l, b) in bonds.iter().enumerate() {
         let g = grad[l] * scale;
-        let d = &mut disp[l * n..l * n + n];
+        // Bead `q`'s entry of this bond is `disp[q * nb + l]` (bead-major).
         let (i, j) = (b.i, b.j);
         let (lo, hi) = (i.min(j), i.max(j));
         // The values of `sym_block(q, i) - sym_block(q, j)`, read in three runs of `q` so
@@ -355,28 +394,28 @@ pub(crate) fn tabulate<T: Real>(
         // rows `i` and `j` (contiguous); up to `hi` one is in row `hi`, the other in
         // column `lo`; beyond, both in columns `i` and `j` of the rows below.
         let (ri, rj) = (tri(i), tri(j));
-        for ((dq, &a), &c) in d[..=lo]
-            .iter_mut()
-            .zip(&mu[ri..=ri + lo])
-            .zip(&mu[rj..=rj + lo])
-        {
-            *dq = sym_diff_mul::<T>(a, c, g);
+        let mut at = l;
+        for (&a, &c) in mu[ri..=ri + lo].iter().zip(&mu[rj..=rj + lo]) {
+            disp[at] = sym_diff_mul::<T>(a, c, g);
+            at += nb;
         }
         let row_hi = &mu[tri(hi)..tri(hi) + hi + 1];
         let mut rq = tri(lo + 1);
         for q in lo + 1..=hi {
             let (on_row, on_col) = (row_hi[q], mu[rq + lo]);
-            let on_col = T::transpose(on_col);
-            d[q] = if i == hi {
+            let on_col = tr(on_col);
+            disp[at] = if i == hi {
                 sym_diff_mul::<T>(on_row, on_col, g)
             } else {
                 sym_diff_mul::<T>(on_col, on_row, g)
             };
             rq += q + 1;
+            at += nb;
         }
-        for (q, dq) in d.iter_mut().enumerate().skip(hi + 1) {
-            *dq = sym_diff_mul::<T>(T::transpose(mu[rq + i]), T::transpose(mu[rq + j]), g);
+        for q in hi + 1..n {
+            disp[at] = sym_diff_mul::<T>(tr(mu[rq + i]), tr(mu[rq + j]), g);
             rq += q + 1;
+            at += nb;
         }
     }
 }

@@ -213,6 +213,12 @@ fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T
 
 /// Solves for the multipliers, accumulating them into `mult` and moving `x`. The
 /// implicit-drag metric has no cheap single-bond form and is always solved by Krylov.
+///
+/// Always inlined (it is only this choice): where the parameters and the metric are
+/// known to the compiler (a firmware's `static`), only the solver that runs is linked;
+/// otherwise the metric's variant decides at run time and every solver is (firmware
+/// flash, `docs/BENCHMARKS.md`).
+#[inline(always)]
 pub fn solve<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,

@@ -87,10 +87,10 @@ pub fn newton<T: Real>(
             }
             linalg::lu_solve(jac, nb, piv, rhs);
         }
-        for l in 0..nb {
-            mult[l] += rhs[l];
-            metric.apply_one(bonds, l, rhs[l], x);
+        for (m, &r) in mult.iter_mut().zip(rhs.iter()) {
+            *m += r;
         }
+        metric.apply_each(bonds, rhs, x);
     }
     // The loop returns on its last pass (it == max_iterations).
     Err(StepError::NoConvergence {

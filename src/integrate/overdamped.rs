@@ -72,8 +72,10 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
 
 /// Projected overdamped velocity at `pos`: `U = U_inf + mu (F + G^T kappa)` with `kappa`
 /// such that every bond's length rate vanishes. `mu` and `force` must hold the mobility
-/// and external forces at `pos`; the result is left in `u`.
+/// and external forces at `pos`; the result is left in `u`. Inlined at both calls, so
+/// that the solver choice folds where the parameters are constant ([`constraints::solve`]).
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn projected_velocity<T: Real>(
     p: &Params<T>,
     pos: &[T::V3],

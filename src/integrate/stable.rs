@@ -158,10 +158,12 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
                 t[q] = (block(b.i) - block(b.j)) * grad[l];
             }
             apply_drag(fac, sq, dt, t);
+            let nb = bonds.len();
             for q in 0..n {
-                disp[l * n + q] = t[q] * dt;
+                disp[q * nb + l] = t[q] * dt;
             }
         }
+        let disp = &disp[..n * bonds.len()];
         Metric::Dense { disp, n, grad }
     };
     let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut sc)?;

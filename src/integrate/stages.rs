@@ -48,8 +48,10 @@ pub(super) fn mobility_product<T: Real>(
 /// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`: matrix-free when asked;
 /// read from the packed mobility where it is used for Krylov (one product per
 /// iteration, no table); tabulated once into `disp` (`n x B`) for the dense solvers,
-/// which read every `D_l(p)` at every iteration.
+/// which read every `D_l(p)` at every iteration. Inlined, so that the solve sees which
+/// metric it gets ([`constraints::solve`]).
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub(super) fn mobility_metric<'a, T: Real>(
     p: &Params<T>,
     bonds: &[Bond<T>],
@@ -82,6 +84,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
     }
     let n = pos.len();
     constraints::tabulate(mu, bonds, grad, scale, n, disp);
+    let disp = &disp[..n * bonds.len()];
     Metric::Dense { disp, n, grad }
 }
 
@@ -177,7 +180,9 @@ pub(super) fn spin<T: Real>(
 }
 
 /// Projects `x` onto the bonds along `metric`; the multipliers start from zero and end
-/// in `lambda`.
+/// in `lambda`. Inlined into every projection, so that the solver choice folds where
+/// the parameters are constant ([`constraints::solve`]).
+#[inline(always)]
 pub(super) fn project_positions<T: Real>(
     p: &Params<T>,
     bonds: &[Bond<T>],
