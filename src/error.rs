@@ -46,6 +46,12 @@ pub enum ParticleError {
         /// Index of the particle.
         particle: usize,
     },
+    /// The sphere crosses the wall or lies below it: its centre is below
+    /// `height + radius` ([`Wall`](crate::Wall)).
+    BelowWall {
+        /// Index of the particle.
+        particle: usize,
+    },
 }
 
 /// A bond set rejected an input.
@@ -197,7 +203,8 @@ pub enum StepError {
         limit: f64,
     },
     /// More spheres would touch at once than [`Contacts::capacity`](crate::Contacts)
-    /// holds.
+    /// holds (with a wall, plus one wall link per sphere: the pool of one-sided
+    /// constraints, [`Params::constraints`](crate::Params::constraints)).
     ContactsFull {
         /// The capacity.
         capacity: usize,
@@ -221,6 +228,10 @@ impl fmt::Display for ParticleError {
             Self::Massless { particle } => {
                 write!(f, "particle {particle}: inertial method needs mass > 0")
             }
+            Self::BelowWall { particle } => write!(
+                f,
+                "particle {particle}: sphere below or crossing the wall (centre below height + radius)"
+            ),
         }
     }
 }

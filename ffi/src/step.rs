@@ -297,7 +297,8 @@ fn describe<T>(e: StepError, r: &mut HrReport<T>) -> HrStatus {
                 P::NonFinite { particle }
                 | P::BadRadius { particle }
                 | P::BadDensity { particle }
-                | P::Massless { particle } => (particle as u64, 0),
+                | P::Massless { particle }
+                | P::BelowWall { particle } => (particle as u64, 0),
                 P::Nested { i, j } | P::Overlap { i, j } => (i as u64, j as u64),
             };
             HrStatus::Particle

@@ -109,7 +109,8 @@ fn particle_index(py: Python<'_>, e: ParticleError) -> Py<PyAny> {
         ParticleError::NonFinite { particle }
         | ParticleError::BadRadius { particle }
         | ParticleError::BadDensity { particle }
-        | ParticleError::Massless { particle } => one(particle),
+        | ParticleError::Massless { particle }
+        | ParticleError::BelowWall { particle } => one(particle),
         ParticleError::Nested { i, j } | ParticleError::Overlap { i, j } => pair(i, j),
         ParticleError::Full => None,
     }
