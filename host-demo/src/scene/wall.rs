@@ -99,7 +99,7 @@ pub(super) fn check_particles(
 fn below(wall: Wall, particles: &[Particle]) -> Option<(usize, String)> {
     let k = particles
         .iter()
-        .position(|p| !(wall.gap(p.position, p.radius) >= -1e-12 * p.radius))?;
+        .position(|p| wall.gap(p.position, p.radius) < -1e-12 * p.radius)?;
     let p = &particles[k];
     Some((
         k,
