@@ -13,6 +13,8 @@ use crate::error::ParticleError;
 use crate::linalg::tri;
 use crate::real::Real;
 
+pub mod wall;
+
 /// How much hydrodynamics to model.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Hydro {

@@ -231,7 +231,7 @@ fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn Parallel) {
 /// of `y` (or nothing) and its partial-sum slice of `z` (or nothing), runs
 /// `job(t, rows, y_t, z_t)` for every band through `par`, and returns the first error
 /// in band order (the one a single pass in row order meets first).
-fn by_bands<T: Real, E: Send, J>(
+pub(crate) fn by_bands<T: Real, E: Send, J>(
     par: &dyn Parallel,
     n: usize,
     out: &mut [T::M3],

@@ -12,7 +12,7 @@
 
 use crate::bonds::Bond;
 use crate::linalg::{self, tri};
-use crate::mobility::{Hydro, tt_block_at, tt_product};
+use crate::mobility::{Hydro, tt_block_at, tt_product, wall};
 use crate::parallel::Parallel;
 use crate::real::Real;
 
@@ -58,6 +58,8 @@ pub enum Metric<'a, T: Real> {
         grad: &'a [T::V3],
         /// Overall factor (`dt` for positions).
         scale: T,
+        /// The wall's height when there is one ([`wall`]).
+        wall: Option<T>,
     },
     /// Precomputed displacements `disp[l * n + p]` (`beads x bonds`).
     Dense {
@@ -86,29 +88,31 @@ pub enum Metric<'a, T: Real> {
     },
 }
 
-/// Block `(p, q)` of a packed symmetric matrix whose blocks are symmetric, so either
-/// triangle can be read without a transpose.
+/// Block `(q, p)` of a packed symmetric matrix, `mu_pq^T`: read as it is stored for
+/// `q > p`, transposed for `q <= p` (exact; the free-space blocks are symmetric, so
+/// this is their stored block bit for bit, while a wall's pair blocks are not,
+/// [`wall`]).
 #[inline(always)]
 fn sym_block<T: Real>(mu: &[T::M3], p: usize, q: usize) -> T::M3 {
     if q <= p {
-        mu[tri(p) + q]
+        T::transpose(mu[tri(p) + q])
     } else {
         mu[tri(q) + p]
     }
 }
 
-/// `(a - c) g` for two symmetric blocks, reading only their lower triangles (12 loads and
-/// 6 subtractions instead of 18 and 9): the bits of `(a - c) * g` (the same products
-/// summed in glam's order; the upper entries equal the lower ones exactly).
+/// `(a - c)^T g`: `(A_pi - A_pj) g` from the blocks [`sym_block`] gives (the wall's
+/// pair blocks are not symmetric). For symmetric blocks these are the bits of
+/// `(a - c) * g` (the same products summed in glam's order, the entries equal to their
+/// transposes).
 #[inline(always)]
 fn sym_diff_mul<T: Real>(a: T::M3, c: T::M3, g: T::V3) -> T::V3 {
     let d = |r, col| T::m3_get(a, r, col) - T::m3_get(c, r, col);
-    let (d00, d10, d20, d11, d21, d22) = (d(0, 0), d(1, 0), d(2, 0), d(1, 1), d(2, 1), d(2, 2));
     let [x, y, z] = T::xyz(g);
     T::v3(
-        d00 * x + d10 * y + d20 * z,
-        d10 * x + d11 * y + d21 * z,
-        d20 * x + d21 * y + d22 * z,
+        d(0, 0) * x + d(1, 0) * y + d(2, 0) * z,
+        d(0, 1) * x + d(1, 1) * y + d(2, 1) * z,
+        d(0, 2) * x + d(1, 2) * y + d(2, 2) * z,
     )
 }
 
@@ -174,9 +178,15 @@ impl<T: Real> Metric<'_, T> {
                 radius,
                 grad,
                 scale,
+                wall,
             } => {
-                // Nested pairs were refused by the product at these positions.
-                let block = |q| tt_block_at(level, eta, pos, radius, p, q).unwrap_or(T::M3_ZERO);
+                // Nested pairs were refused by the product at these positions. The block
+                // (q, p), as `sym_block` reads it.
+                let block = |q| match wall {
+                    Some(h) => wall::tt_block_at(level, eta, h, pos, radius, q, p).ok(),
+                    None => tt_block_at(level, eta, pos, radius, p, q),
+                };
+                let block = |q| block(q).unwrap_or(T::M3_ZERO);
                 let mu_pj = if b.is_wall() { T::M3_ZERO } else { block(b.j) };
                 sym_diff_mul::<T>(block(b.i), mu_pj, grad[l] * scale)
             }
@@ -190,8 +200,8 @@ impl<T: Real> Metric<'_, T> {
                 };
                 let cp = c(p);
                 let g = grad[l] * dt;
-                let q_pi = sym_block::<T>(mu, p, b.i) * (cp * c(b.i)).sqrt();
-                let q_pj = sym_block::<T>(mu, p, b.j) * (cp * c(b.j)).sqrt();
+                let q_pi = linalg::sym_get::<T>(mu, p, b.i) * (cp * c(b.i)).sqrt();
+                let q_pj = linalg::sym_get::<T>(mu, p, b.j) * (cp * c(b.j)).sqrt();
                 q_pi * g - q_pj * g
             }
         }
@@ -301,11 +311,16 @@ impl<T: Real> Metric<'_, T> {
                 radius,
                 grad,
                 scale,
+                wall,
             } => {
                 let f = &mut tmp[..n];
                 spread(bonds, grad, c, scale, f);
                 // Nested pairs were refused by the product at these positions.
-                if tt_product(level, eta, pos, radius, f, out).is_err() {
+                let done = match wall {
+                    Some(h) => wall::tt_product(level, eta, h, pos, radius, f, out),
+                    None => tt_product(level, eta, pos, radius, f, out),
+                };
+                if done.is_err() {
                     out.fill(T::V3_ZERO);
                 }
             }
@@ -332,7 +347,8 @@ impl<T: Real> Metric<'_, T> {
 
 /// Tabulates `disp[l * n + q] = (mu_qi - mu_qj) (scale g_l)` from the packed mobility:
 /// the values [`Metric::Mobility`] gives (one block difference and one block product per
-/// entry, not two products).
+/// entry, not two products). Blocks stored as `mu_qi` are transposed for
+/// [`sym_diff_mul`] (exact: the same bits for symmetric blocks).
 pub(crate) fn tabulate<T: Real>(
     mu: &[T::M3],
     bonds: &[Bond<T>],
@@ -368,6 +384,7 @@ pub(crate) fn tabulate<T: Real>(
         let mut rq = tri(lo + 1);
         for q in lo + 1..=hi {
             let (on_row, on_col) = (row_hi[q], mu[rq + lo]);
+            let on_col = T::transpose(on_col);
             d[q] = if i == hi {
                 sym_diff_mul::<T>(on_row, on_col, g)
             } else {
@@ -376,7 +393,7 @@ pub(crate) fn tabulate<T: Real>(
             rq += q + 1;
         }
         for (q, dq) in d.iter_mut().enumerate().skip(hi + 1) {
-            *dq = sym_diff_mul::<T>(mu[rq + i], mu[rq + j], g);
+            *dq = sym_diff_mul::<T>(T::transpose(mu[rq + i]), T::transpose(mu[rq + j]), g);
             rq += q + 1;
         }
     }

@@ -52,15 +52,21 @@ pub(super) fn check_thermal<T: Real>(
     Ok(Some(b))
 }
 
-/// Refuses a wall where it is not implemented, and a state with a sphere below its
-/// contact height `height + a_i` (beyond the contacts' tolerance: the last step's wall
-/// contacts end within it).
+/// Refuses a wall where it is not implemented (its mobility is translational only, so
+/// rotation with a wall is refused), and a state with a sphere below its contact height
+/// `height + a_i` (beyond the contacts' tolerance: the last step's wall contacts end
+/// within it).
 pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result<(), StepError> {
     let Some(w) = p.wall else {
         return Ok(());
     };
     if !w.height.is_finite() {
         return Err(StepError::BadParameter("wall.height (finite)"));
+    }
+    if p.rotation {
+        return Err(StepError::Unsupported(
+            "rotation with a wall (the wall's mobility has no rotation blocks yet)",
+        ));
     }
     if !cfg!(feature = "contacts") {
         return Err(StepError::Unsupported(

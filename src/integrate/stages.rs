@@ -25,6 +25,18 @@ pub(super) fn mobility_product<T: Real>(
     par: &dyn Parallel,
     bands: &mut [T::V3],
 ) -> Result<(), StepError> {
+    if let Some(w) = p.wall {
+        // Above a wall: assembled (or not), then applied (`mobility::wall`).
+        let (level, eta, h) = (p.hydro, p.viscosity, w.height);
+        if p.matrix_free {
+            return Ok(mobility::wall::tt_product(
+                level, eta, h, pos, radius, f, u,
+            )?);
+        }
+        mobility::wall::assemble(par, level, eta, h, pos, radius, mu)?;
+        crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
+        return Ok(());
+    }
     if p.matrix_free {
         return mobility::tt_product(p.hydro, p.viscosity, pos, radius, f, u)
             .map_err(StepError::from);
@@ -57,6 +69,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
             radius,
             grad,
             scale,
+            wall: p.wall.map(|w| w.height),
         };
     }
     if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
@@ -78,6 +91,12 @@ pub(super) fn assemble_tt<T: Real>(
     radius: &[T],
     mu: &mut [T::M3],
 ) -> Result<(), StepError> {
+    if let Some(w) = p.wall {
+        let (level, eta, serial) = (p.hydro, p.viscosity, &crate::parallel::Serial);
+        return Ok(mobility::wall::assemble(
+            serial, level, eta, w.height, pos, radius, mu,
+        )?);
+    }
     mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
 }
 
