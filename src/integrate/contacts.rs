@@ -222,14 +222,27 @@ fn add_wall<T: Real>(
         if links[nb..nb + *nc].iter().any(|l| l.is_wall() && l.i == i) {
             continue;
         }
-        if *nc == pool {
-            return Err(StepError::ContactsFull { capacity: pool });
-        }
-        links[nb + *nc] = Bond::wall(i, a);
-        *nc += 1;
+        push(Bond::wall(i, a), nb, pool, links, nc)?;
         added += 1;
     }
     Ok(added)
+}
+
+/// Appends `link` to the one-sided constraints held (`nc` of them after the `nb`
+/// bonds), unless the pool is full.
+fn push<T: Real>(
+    link: Bond<T>,
+    nb: usize,
+    pool: usize,
+    links: &mut [Bond<T>],
+    nc: &mut usize,
+) -> Result<(), StepError> {
+    if *nc == pool {
+        return Err(StepError::ContactsFull { capacity: pool });
+    }
+    links[nb + *nc] = link;
+    *nc += 1;
+    Ok(())
 }
 
 /// Appends every unbonded pair that ends closer than `reach` times its contact distance
@@ -262,15 +275,12 @@ fn add_pairs<T: Real>(
             if bonds.iter().any(joins) || links[nb..nb + *nc].iter().any(joins) {
                 continue;
             }
-            if *nc == pool {
-                return Err(StepError::ContactsFull { capacity: pool });
-            }
-            links[nb + *nc] = Bond {
+            let link = Bond {
                 i,
                 j,
                 length: sigma,
             };
-            *nc += 1;
+            push(link, nb, pool, links, nc)?;
             added += 1;
         }
     }
