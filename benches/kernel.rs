@@ -11,6 +11,9 @@
 //! * `noise_sqrt/{Cholesky,Lanczos}/N`: the thermal overdamped step (kT = 1, midpoint)
 //!   with each square root of the mobility at N = 64 ... 1024, Lanczos iterations
 //!   printed (the `NoiseSqrt::Auto` crossover);
+//! * `brownian/{Deterministic,Lanczos}/N`: the Brownian Overdamped step (kT = 1,
+//!   midpoint, Lanczos) and the deterministic one at N = 256 ... 2048 (issue 19's
+//!   ratio at 1024 and cost exponent), iteration counts printed;
 //! * `contacts/...`: one overdamped step (first and second order) of a folded 25-bead
 //!   chain with and without hard contacts, f64, with contact and round counts printed.
 //!
@@ -237,9 +240,9 @@ fn scaling_bench(
             step_slices(state, &bonds, &params, ws, &mut NoForce).unwrap()
         };
         let r = go(&mut pos0.clone(), &mut ws);
-        let (its, lz) = (r.iterations, r.noise_iterations);
+        let (its, lz, mid) = (r.iterations, r.noise_iterations, r.velocity_iterations);
         eprintln!(
-            "{group}/{label}/{n}: {its} constraint iterations, {lz} Lanczos iterations per step"
+            "{group}/{label}/{n}: {its} constraint iterations, {lz} Lanczos iterations, {mid} midpoint projection iterations per step"
         );
         g.bench_function(BenchmarkId::from_parameter(n), |b| {
             b.iter_batched_ref(
@@ -278,6 +281,15 @@ fn scaling(c: &mut Criterion) {
             },
         );
     }
+    // Issue 19, item 9: the Brownian Overdamped step (kT = 1, midpoint, Lanczos) against
+    // the deterministic one on the same chain, N = 256 ... 2048, in one run: the ratio
+    // at N = 1024 (target <= 3) and the thermal step's cost exponent (target <= 2.2).
+    let brownian = [256, 512, 1024, 2048];
+    scaling_bench(c, "brownian", "Deterministic", &brownian, |_| {});
+    scaling_bench(c, "brownian", "Lanczos", &brownian, |p| {
+        p.brownian = Some(Brownian::new(1.0));
+        p.noise_sqrt = NoiseSqrt::Lanczos;
+    });
     let small = [16, 24, 32, 48, 64];
     for (label, kind) in [
         ("Newton", SolverKind::Newton),

@@ -5,7 +5,11 @@
 //! chain (radius 3, rise 0.5 per bead, tails of radius 1, head 2^(1/3), bonds 1.05 (a_i +
 //! a_j)) settles under gravity with dt = 0.01 for `STEPS` steps (default 5). Prints
 //! milliseconds per step and constraint iterations (PCG iterations for Krylov).
-//! `MF=1` runs matrix-free (Overdamped, Springs), `DT=x` sets the time step.
+//! `MF=1` runs matrix-free (Overdamped, Springs), `DT=x` sets the time step. `KT=x` adds
+//! thermal noise at `kT = x` (Overdamped, Springs; midpoint drift, `UNCORRECTED=1` for
+//! the other) by Lanczos (`LTOL=x` its tolerance), and prints its iterations too. For
+//! instruction counts: `valgrind --tool=callgrind --collect-atstart=no
+//! --toggle-collect='*step_slices*' target/release/examples/scale o auto 1024`.
 
 use hydrorattle::*;
 use hydrorattle_heap::Buffers;
@@ -67,11 +71,27 @@ fn main() {
         p.solver.kind = kind;
         p.allow_overlap = true;
         p.matrix_free = std::env::var("MF").is_ok();
+        let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
+        if let Some(kt) = env("KT") {
+            p.brownian = Some(Brownian {
+                temperature: kt,
+                drift: if std::env::var("UNCORRECTED").is_ok() {
+                    Drift::Uncorrected
+                } else {
+                    Drift::Midpoint
+                },
+            });
+            p.noise_sqrt = NoiseSqrt::Lanczos;
+            if let Some(t) = env("LTOL") {
+                p.lanczos.tolerance = t;
+            }
+        }
+        let mut noise = Noise::new(1);
         let layout = Layout::for_params(&p, n, bonds.len());
         let mut store = Buffers::<f64>::new(layout);
         let mut ws = store.workspace();
         let t0 = std::time::Instant::now();
-        let mut its = 0;
+        let (mut its, mut lanczos, mut mid) = (0, 0, 0);
         for _ in 0..steps {
             let state = State {
                 pos: &mut pos,
@@ -80,15 +100,19 @@ fn main() {
                 radius: &radius,
                 density: &density,
                 time: &mut time,
-                noise: None,
+                noise: p.brownian.map(|_| &mut noise),
             };
             let r = step_slices(state, &bonds, &p, &mut ws, &mut NoForce).unwrap();
             its += r.iterations;
+            lanczos += r.noise_iterations;
+            mid += r.velocity_iterations;
         }
         let us = t0.elapsed().as_secs_f64() * 1e6 / steps as f64;
         println!(
-            "n {n:5}  {us:9.2} us/step  iterations {:6.1}  storage {:.1} MB",
+            "n {n:5}  {us:9.2} us/step  iterations {:6.1}  Lanczos {:5.1}  midpoint {:5.1}  storage {:.1} MB",
             its as f64 / steps as f64,
+            lanczos as f64 / steps as f64,
+            mid as f64 / steps as f64,
             layout.bytes::<f64>() as f64 / 1e6
         );
     }

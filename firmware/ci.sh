@@ -21,7 +21,7 @@ out="$root/target/fw-ci"
 thumb=thumbv7em-none-eabihf
 qemu=(qemu-system-arm -cpu cortex-m4 -machine mps2-an386 -nographic
       -semihosting-config enable=on,target=native -icount shift=0 -kernel)
-bins=(overdamped overdamped2 rattle stable springs)
+bins=(overdamped overdamped2 rattle stable springs brownian)
 mkdir -p "$out"
 
 say() { printf '\n==> %s\n' "$*"; }
@@ -159,6 +159,10 @@ if [ "$(digest "$out/c-host.txt")" != "$(digest "$out/overdamped.txt")" ]; then
     echo "C example and Rust firmware disagree" >&2
     exit 1
 fi
+if [ "$(grep kT= "$out/c-host.txt" | digest /dev/stdin)" != "$(digest "$out/brownian.txt")" ]; then
+    echo "C example and Rust firmware disagree on the Brownian run" >&2
+    exit 1
+fi
 
 say "summary (f32, N = 25, ${#bins[@]}+1 firmware binaries; bytes)"
 printf '%-16s %8s %8s %8s %8s %10s %8s %14s\n' binary flash bss stack ram_need min_ram \
@@ -175,5 +179,5 @@ for bin in "${bins[@]}" stable_rotation; do
         "$(digest "$out/$bin.txt" | cut -c1-8)" "$(field instructions_per_step)"
 done
 echo "host == Cortex-M4 bits for every binary; C example (host and QEMU) == firmware:" \
-    "$(digest "$out/c-host.txt")"
+    "$(digest "$out/c-host.txt") (Brownian: $(digest "$out/brownian.txt"))"
 say "firmware/ci.sh passed"

@@ -1,7 +1,10 @@
 //! Fixed-capacity bond lists: chains, rings, trees and arbitrary topologies.
 //!
 //! Bond `k` joins particles `(i, j)` with length `d_k`; its constraint is
-//! `sigma_k = |r_i - r_j|^2 - d_k^2 = 0`.
+//! `sigma_k = |r_i - r_j|^2 - d_k^2 = 0`. A length of zero is allowed for
+//! [`Method::Springs`](crate::Method::Springs) only (a spring of rest length zero, the
+//! classic Hookean dumbbell); a constrained step refuses it
+//! ([`BondError::BadLength`]).
 //!
 //! Inside a step the constraint solve also holds **wall links** ([`Bond::wall`]), which
 //! no caller's bond can be (`j == i`, refused as a self-bond): sphere `i` tied to its
@@ -21,7 +24,7 @@ pub struct Bond<T: Real> {
     pub i: usize,
     /// Second particle.
     pub j: usize,
-    /// Centre-to-centre length.
+    /// Centre-to-centre length (> 0; a spring's rest length may be 0).
     pub length: T,
 }
 
@@ -170,7 +173,8 @@ impl<T: Real, const B: usize> BondSet<T, B> {
         validate(&self.bonds, n)
     }
 
-    /// Largest relative length error `| |r_ij| - d | / d` and its bond (0 if none).
+    /// Largest relative length error `| |r_ij| - d | / d` and its bond (0 if none;
+    /// bonds of length zero have none and are skipped).
     pub fn max_residual(&self, pos: &[T::V3]) -> (usize, T) {
         max_residual(&self.bonds, pos)
     }
@@ -202,7 +206,8 @@ pub fn validate<T: Real>(bonds: &[Bond<T>], n: usize) -> Result<(), BondError> {
 
 /// Largest relative length error `| |r_ij| - d | / d` over `bonds` and the bond where it
 /// occurs. NaN is sticky (a NaN residual is never hidden), and a bond naming a particle
-/// beyond `pos` counts as infinitely violated. A wall link ([`Bond::wall`]) counts its
+/// beyond `pos` counts as infinitely violated. A bond of length zero (a spring's rest
+/// length) has no relative error and is skipped. A wall link ([`Bond::wall`]) counts its
 /// height error `|z_i - a| / a` (positions in the wall's frame).
 ///
 /// Two square roots, not one per bond: the error grows with `|r_ij|^2 / d^2` away from 1
@@ -211,9 +216,13 @@ pub fn validate<T: Real>(bonds: &[Bond<T>], n: usize) -> Result<(), BondError> {
 /// may be named).
 pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
     let (mut hi, mut lo) = ((0, T::ZERO), (0, T::ZERO));
+    let mut first = true;
     for (k, b) in bonds.iter().enumerate() {
         if b.i >= pos.len() || b.j >= pos.len() {
             return max_residual_each(bonds, pos);
+        }
+        if b.length == T::ZERO {
+            continue;
         }
         let r = b.relative(pos);
         let mut ratio = T::norm2(r) / (b.length * b.length);
@@ -226,27 +235,26 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
         if ratio.is_nan() {
             return max_residual_each(bonds, pos);
         }
-        if k == 0 || ratio > hi.1 {
+        if first || ratio > hi.1 {
             hi = (k, ratio);
         }
-        if k == 0 || ratio < lo.1 {
+        if first || ratio < lo.1 {
             lo = (k, ratio);
         }
+        first = false;
     }
     let at = |k: usize| {
         let b = &bonds[k];
         (k, link_error(b, b.relative(pos)))
     };
-    match bonds.len() {
-        0 => (0, T::ZERO),
-        _ => {
-            let (h, l) = (at(hi.0), at(lo.0));
-            if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
-                l
-            } else {
-                h
-            }
-        }
+    if first {
+        return (0, T::ZERO);
+    }
+    let (h, l) = (at(hi.0), at(lo.0));
+    if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
+        l
+    } else {
+        h
     }
 }
 
@@ -255,6 +263,7 @@ fn max_residual_each<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
     let mut worst = (0, T::ZERO);
     for (k, b) in bonds.iter().enumerate() {
         let r = match b.i < pos.len() && b.j < pos.len() {
+            true if b.length == T::ZERO => continue,
             true => link_error(b, b.relative(pos)),
             false => T::ONE / T::ZERO,
         };
@@ -279,7 +288,8 @@ fn check_bond<T: Real>(
     Ok(())
 }
 
-/// Bond `k` on its own against `n` particles: range, self-bond, length (`O(1)`).
+/// Bond `k` on its own against `n` particles: range, self-bond, length (finite, >= 0;
+/// `O(1)`).
 pub(crate) fn check_one<T: Real>(k: usize, b: &Bond<T>, n: usize) -> Result<(), BondError> {
     for p in [b.i, b.j] {
         if p >= n {
@@ -295,8 +305,9 @@ pub(crate) fn check_one<T: Real>(k: usize, b: &Bond<T>, n: usize) -> Result<(), 
             particle: b.i,
         });
     }
-    // The constraint squares the length: d^2 must be finite too.
-    if !(b.length > T::ZERO && (b.length * b.length).is_finite()) {
+    // The constraint squares the length: d^2 must be finite too. Zero is a spring's
+    // rest length; a constrained step refuses it (`integrate::checks`).
+    if !(b.length >= T::ZERO && (b.length * b.length).is_finite()) {
         return Err(BondError::BadLength { bond: k });
     }
     Ok(())

@@ -80,7 +80,9 @@ pub enum BondError {
         /// Index of the earlier bond.
         other: usize,
     },
-    /// Length is zero, negative, not finite, or so large that its square overflows.
+    /// Length is negative, not finite, or so large that its square overflows; or zero
+    /// in a step of a method other than [`Method::Springs`](crate::Method::Springs)
+    /// (only a spring may have rest length zero).
     BadLength {
         /// Index of the bond.
         bond: usize,
@@ -247,7 +249,10 @@ impl fmt::Display for BondError {
                 write!(f, "bond {bond}: particle index {particle} out of range")
             }
             Self::Duplicate { bond, other } => write!(f, "bond {bond} duplicates bond {other}"),
-            Self::BadLength { bond } => write!(f, "bond {bond}: length must be finite and > 0"),
+            Self::BadLength { bond } => write!(
+                f,
+                "bond {bond}: length must be finite and > 0 (0 only for springs)"
+            ),
             Self::Violated { bond, residual } => {
                 write!(f, "bond {bond}: configuration off by relative {residual:e}")
             }

@@ -47,7 +47,7 @@ pub fn external<T: Real, E: ExternalForce<T>>(
     }
 }
 
-/// Hookean bond forces `-k (|b| - d) b / |b|`, or with `fene = Some(Q0)` the FENE
+/// Hookean bond forces `-k (|b| - d) b / |b|` (`-k b` for rest length `d = 0`), or with `fene = Some(Q0)` the FENE
 /// forces `-k b / (1 - |b|^2 / Q0^2)`, added into `out`. A FENE bond at or past `Q0`
 /// is refused ([`BondError::Overstretched`](crate::BondError::Overstretched)).
 pub fn springs<T: Real>(
@@ -60,6 +60,8 @@ pub fn springs<T: Real>(
     for (k, b) in bonds.iter().enumerate() {
         let r = pos[b.i] - pos[b.j];
         let f = match fene {
+            // Rest length zero: -k r, defined at r = 0 too.
+            None if b.length == T::ZERO => r * -stiffness,
             None => {
                 let s = T::norm(r);
                 r * (-stiffness * (s - b.length) / s)

@@ -90,7 +90,9 @@ pub enum NoiseSqrt {
 /// Beads above which [`NoiseSqrt::Auto`] draws the noise by Lanczos: where the Lanczos
 /// step overtakes the Cholesky one for an RPY chain (f64, midpoint), measured with
 /// `cargo bench --bench kernel -- noise_sqrt`: Cholesky / Lanczos 1.21 / 1.61 ms at
-/// N = 96, 2.90 / 2.07 ms at 128, so about 110 interpolated.
+/// N = 96, 2.90 / 2.07 ms at 128, so about 110 interpolated (Lanczos tolerance
+/// `1e-6`); at the present default `1e-3`: 1.25 / 1.65 ms at 64, 3.66 / 3.74 ms at 96,
+/// 7.67 / 3.16 ms at 128 (a loaded machine), so between 96 and 128 still.
 pub const LANCZOS_CROSSOVER: usize = 112;
 
 impl NoiseSqrt {
@@ -211,16 +213,19 @@ pub struct Params<T: Real> {
     /// oscillate silently (bounded but wrong) instead of blowing up. Costs about 60
     /// Cholesky solves per step. Default false.
     pub stability_guard: bool,
-    /// Thermal noise ([`Method::Overdamped`] and [`Method::Springs`] with a stored
-    /// mobility only; other methods
-    /// and [`Params::matrix_free`] refuse a positive temperature with
-    /// [`StepError::Unsupported`](crate::StepError::Unsupported)). Default `None`.
+    /// Thermal noise ([`Method::Overdamped`] and [`Method::Springs`] only; other methods
+    /// refuse a positive temperature with
+    /// [`StepError::Unsupported`](crate::StepError::Unsupported)). With
+    /// [`Params::matrix_free`] the noise is drawn by Lanczos from matrix-free products
+    /// (storage `O(N)`). Default `None`.
     pub brownian: Option<Brownian<T>>,
     /// How the thermal noise's square root of the mobility is taken. Default
-    /// [`NoiseSqrt::Auto`] (Cholesky up to [`LANCZOS_CROSSOVER`] beads, Lanczos above).
+    /// [`NoiseSqrt::Auto`] (Cholesky up to [`LANCZOS_CROSSOVER`] beads, Lanczos above;
+    /// Lanczos at every size with [`Params::matrix_free`], which refuses
+    /// [`NoiseSqrt::Cholesky`]).
     pub noise_sqrt: NoiseSqrt,
     /// Tolerance and iteration cap of the Lanczos square root (read only when it is
-    /// used). Default: relative change `1e-6` (f64) / `1e-4` (f32), 64 iterations.
+    /// used). Default: estimated relative error of the noise `1e-3`, 64 iterations.
     pub lanczos: Lanczos<T>,
     /// Hard-sphere contacts as one-sided constraints ([`Contacts`];
     /// [`Method::Overdamped`] and [`Method::Overdamped2`] without thermal noise; the other
@@ -271,6 +276,14 @@ impl<T: Real> Params<T> {
     #[inline]
     pub fn flow_at(&self, r: T::V3) -> T::V3 {
         self.flow_velocity + T::cross(self.vorticity, r)
+    }
+
+    /// `true` when a thermal step of `n` beads draws its noise by Lanczos: as
+    /// [`NoiseSqrt::lanczos`] picks, and always with [`Params::matrix_free`] (there is no
+    /// stored mobility to factorise; [`NoiseSqrt::Cholesky`] with `matrix_free` is
+    /// refused).
+    pub const fn lanczos_noise(&self, n: usize) -> bool {
+        self.matrix_free || self.noise_sqrt.lanczos(n)
     }
 
     /// Constraint slots a step of `n` spheres with `bonds` bonds holds: the bonds, the

@@ -385,7 +385,7 @@ fn same_deviates_in_f32_and_f64() {
 }
 
 /// Refusals are typed and leave the state and the generator untouched: thermal noise
-/// with another method, matrix-free, without a generator, a bad temperature, storage
+/// with another method, a Cholesky factor without a stored mobility, without a generator, a bad temperature, storage
 /// one block short, and a constraint solve that fails after the deviates were drawn.
 #[test]
 fn refusals_leave_state_and_generator() {
@@ -412,7 +412,8 @@ fn refusals_leave_state_and_generator() {
     check(&p, &unsupported, "Overdamped2");
     let mut p = good;
     p.matrix_free = true;
-    check(&p, &unsupported, "matrix_free");
+    p.noise_sqrt = hydrorattle::NoiseSqrt::Cholesky;
+    check(&p, &unsupported, "matrix_free with a Cholesky factor");
     for bad in [f64::NAN, -1.0, f64::INFINITY] {
         let mut p = good;
         p.brownian = Some(Brownian::new(bad));

@@ -58,10 +58,15 @@ fn block_mean(x: &[f64]) -> (f64, f64) {
     (m, (var / blocks as f64).sqrt())
 }
 
-/// A dumbbell of unit spheres at distance `q` (bond length `q` too), free space,
-/// `eta = 1/(6 pi)` (a lone sphere's mobility is 1), kT = 1, spring `h`, time step
-/// `dt`, seed `seed`; the caller sets the rest.
+/// A dumbbell of unit spheres at distance `q` (bond length `q` too, or 0 when
+/// `rest_zero`), free space, `eta = 1/(6 pi)` (a lone sphere's mobility is 1), kT = 1,
+/// spring `h`, time step `dt`, seed `seed`; the caller sets the rest.
 fn setup(q: f64, h: f64, dt: f64, hydro: Hydro, drift: Drift, seed: u64) -> Dumbbell {
+    setup_rest(q, q, h, dt, hydro, drift, seed)
+}
+
+/// [`setup`] with the spring's rest length `d` apart from the starting distance `q`.
+fn setup_rest(q: f64, d: f64, h: f64, dt: f64, hydro: Hydro, drift: Drift, seed: u64) -> Dumbbell {
     let mut ps = ParticleSet::<f64, 2>::new();
     ps.push(Particle::new(DVec3::ZERO, 1.0, 0.0)).unwrap();
     ps.push(Particle::new(DVec3::new(q, 0.0, 0.0), 1.0, 0.0))
@@ -72,7 +77,7 @@ fn setup(q: f64, h: f64, dt: f64, hydro: Hydro, drift: Drift, seed: u64) -> Dumb
             Bond {
                 i: 0,
                 j: 1,
-                length: q,
+                length: d,
             },
             2,
         )
@@ -94,13 +99,21 @@ fn setup(q: f64, h: f64, dt: f64, hydro: Hydro, drift: Drift, seed: u64) -> Dumb
 
 type Dumbbell = (ParticleSet<f64, 2>, BondSet<f64, 1>, Params<f64>);
 
-/// `<Q^2>` of a dumbbell of unit spheres, spring `h` (kT = 1), rest length `d`.
-fn dumbbell(hydro: Hydro, drift: Drift, h: f64, d: f64, seed: u64) -> (f64, f64) {
-    // The bond relaxes at rate 2 h; it starts at its rest length.
-    let (mut ps, bonds, p) = setup(d, h, 0.005, hydro, drift, seed);
+/// `<Q^2>` of a dumbbell of unit spheres, spring `h` (kT = 1), rest length `d`, time
+/// step `dt`, `steps` steps.
+fn dumbbell(
+    hydro: Hydro,
+    drift: Drift,
+    h: f64,
+    d: f64,
+    dt: f64,
+    steps: usize,
+    seed: u64,
+) -> (f64, f64) {
+    // The bond relaxes at rate 2 h; it starts at its rest length (1.5 for rest length 0).
+    let (mut ps, bonds, p) = setup_rest(d.max(1.5), d, h, dt, hydro, drift, seed);
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, 2, 1));
     let mut ws = buf.workspace();
-    let steps = 1_000_000;
     let mut q2 = Vec::with_capacity(steps);
     for k in 0..steps {
         step(&mut ps, &bonds, &p, &mut ws, &mut NoForce)
@@ -122,7 +135,7 @@ fn hookean_dumbbell_equilibrium_free_draining_and_rpy() {
         (Hydro::FreeDraining, Drift::Uncorrected, 1),
         (Hydro::Rpy, Drift::Midpoint, 2),
     ] {
-        let (m, se) = dumbbell(hydro, drift, h, d, seed);
+        let (m, se) = dumbbell(hydro, drift, h, d, 0.005, 1_000_000, seed);
         eprintln!("{hydro:?} {drift:?}: <Q^2> = {m:.4} +- {se:.4}, exact {exact:.4}");
         assert!(se < 0.01 * exact, "too few samples: se {se}");
         assert!(
@@ -130,6 +143,78 @@ fn hookean_dumbbell_equilibrium_free_draining_and_rpy() {
             "{hydro:?}: {m} vs {exact} (se {se})"
         );
     }
+}
+
+/// The classic Hookean dumbbell: rest length zero, `<Q^2> = 3 kT / H` exactly. Time
+/// step bias: Euler-Maruyama on the free-draining bond vector (relative mobility `2 /
+/// zeta`, zeta = 1) is the discrete Ornstein-Uhlenbeck map `Q' = (1 - 2 H dt) Q +
+/// noise`, whose stationary `<Q^2> = 3 kT / H / (1 - H dt)`: +0.2 % at `H dt = 0.002`
+/// (dt is 1/250 of the relaxation time `zeta / 2H` of `Q`, 1/125 of the dumbbell's
+/// `lambda_H = zeta / 4H`), a quarter of the standard error (0.8 %). With RPY the beads
+/// overlap (`<Q^2>^(1/2) = 1.7 < 2a`) and the relative mobility is 2.5 times smaller
+/// (`3 Q / 8` along the bond, `9 Q / 16` across, at `Q = 1.7`), so dt = 0.005 gives
+/// the same bias and sampling.
+fn hookean_rest_zero(hydro: Hydro, drift: Drift, dt: f64, seed: u64) {
+    let h = 1.0;
+    let exact = 3.0 / h;
+    let (m, se) = dumbbell(hydro, drift, h, 0.0, dt, 2_000_000, seed);
+    // The free-draining Euler-Maruyama map's own stationary value (see above).
+    let map = exact / (1.0 - h * dt);
+    eprintln!("rest length 0, {hydro:?} {drift:?}: <Q^2> = {m:.4} +- {se:.4}, exact {exact}");
+    if hydro == Hydro::FreeDraining {
+        eprintln!("(the discrete map's stationary value: {map:.4})");
+    }
+    assert!(se < 0.012 * exact, "too few samples: se {se}");
+    assert!(
+        (m - exact).abs() < 3.0 * se,
+        "{hydro:?}: {m} vs {exact} (se {se})"
+    );
+}
+
+#[test]
+fn hookean_dumbbell_of_rest_length_zero_free_draining() {
+    hookean_rest_zero(Hydro::FreeDraining, Drift::Uncorrected, 0.002, 5);
+}
+
+#[test]
+fn hookean_dumbbell_of_rest_length_zero_rpy() {
+    hookean_rest_zero(Hydro::Rpy, Drift::Midpoint, 0.005, 6);
+}
+
+/// Only a spring may have rest length zero: the bond list takes it, the spring step
+/// runs it (its force `-H Q`, its report's largest force `H |Q|`), every constrained
+/// method refuses it with a typed error, the state kept.
+#[test]
+fn rest_length_zero_is_for_springs_only() {
+    let (mut ps, bonds, mut p) =
+        setup_rest(1.5, 0.0, 2.0, 0.01, Hydro::FreeDraining, Drift::Midpoint, 1);
+    p.brownian = None;
+    ps.density = [1.0; 2];
+    let mut buf = Buffers::<f64>::new(Layout::all(2, 1));
+    let mut ws = buf.workspace();
+    for method in [
+        Method::Overdamped,
+        Method::Overdamped2,
+        Method::Rattle,
+        Method::RattleStable,
+    ] {
+        let mut q = p;
+        q.method = method;
+        let before = ps.clone();
+        let e = step(&mut ps, &bonds, &q, &mut ws, &mut NoForce).unwrap_err();
+        assert_eq!(
+            e,
+            StepError::Bond(BondError::BadLength { bond: 0 }),
+            "{method:?}"
+        );
+        assert_eq!((ps.pos, ps.time), (before.pos, before.time));
+    }
+    // Free draining, no noise: each bead moves by H Q dt towards the other.
+    let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).unwrap();
+    let q = (ps.pos[1] - ps.pos[0]).x;
+    assert!((q - 1.5 * (1.0 - 2.0 * 2.0 * 0.01)).abs() < 1e-14, "{q}");
+    assert!((r.max_tension - 2.0 * q).abs() < 1e-12, "{}", r.max_tension);
+    assert_eq!(r.residual, 0.0);
 }
 
 /// One step of `ps`; a refused one (FENE overstretch) retried as `2^d` bridge

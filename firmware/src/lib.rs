@@ -41,18 +41,29 @@ const PAINT: u32 = 0xcccc_cccc;
 /// Instructions of the SysTick calibration loop (two per iteration).
 const CALIBRATION: u32 = 1_000_000;
 
-/// One firmware binary: a `main` that runs `$method` from statics sized by the
-/// method's `const` layout.
+/// One firmware binary: a `main` that runs `$method` (with thermal noise if
+/// `$brownian`) from statics sized by the method's `const` layout.
 #[macro_export]
 macro_rules! firmware {
     ($name:literal, $method:expr, $rotation:expr) => {
-        const L: hydrorattle::Layout = hydrorattle::Layout::with_solver(
-            $method,
-            $rotation,
-            hydrorattle::SolverKind::Newton,
-            hydrorattle_scene::N,
-            hydrorattle_scene::B,
-        );
+        $crate::firmware!($name, $method, $rotation, false);
+    };
+    ($name:literal, $method:expr, $rotation:expr, $brownian:expr) => {
+        const L: hydrorattle::Layout = {
+            let (n, b) = (hydrorattle_scene::N, hydrorattle_scene::B);
+            let l = hydrorattle::Layout::with_solver(
+                $method,
+                $rotation,
+                hydrorattle::SolverKind::Newton,
+                n,
+                b,
+            );
+            if $brownian {
+                l.thermal($method, n, b)
+            } else {
+                l
+            }
+        };
         type Store =
             hydrorattle::Storage<f32, { L.blocks }, { L.vectors }, { L.scalars }, { L.indices }>;
 
@@ -64,7 +75,7 @@ macro_rules! firmware {
                 hydrorattle::ParticleSet::new();
             // A constant the compiler can see through: only this method is linked.
             static PARAMS: hydrorattle::Params<f32> =
-                hydrorattle_scene::params_f32($method, $rotation);
+                hydrorattle_scene::params_f32($method, $rotation, $brownian);
             $crate::run($name, &PARAMS, &mut STORE.workspace(), CHAIN)
         }
     };
@@ -96,7 +107,7 @@ pub fn run(
         }
     });
     let mut out = Host;
-    let _ = scene::summary(&mut out, p.method, p.rotation, &outcome);
+    let _ = scene::summary(&mut out, p, &outcome);
     let steps = u64::from(scene::STEPS);
     let per_step = ticks * u64::from(CALIBRATION) / (u64::from(calibration.max(1)) * steps);
     let (bss, data, stack) = (

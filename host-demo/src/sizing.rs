@@ -115,6 +115,8 @@ pub struct Plan {
     pub brownian: Option<Thermal>,
     /// A wall (one more constraint slot per particle).
     pub wall: bool,
+    /// No stored mobility (`[integrator] matrix_free`).
+    pub matrix_free: bool,
 }
 
 impl Plan {
@@ -128,6 +130,7 @@ impl Plan {
             contact: scene.contact,
             brownian: scene.brownian,
             wall: scene.wall.is_some(),
+            matrix_free: scene.integrator.matrix_free,
         }
     }
 
@@ -147,6 +150,7 @@ impl Plan {
             p.solver.kind = self.solver.kind();
             p.contacts = contacts.map(Contacts::new);
             p.wall = self.wall.then_some(hydrorattle::Wall::new(0.0));
+            p.matrix_free = self.matrix_free;
             if let Some(t) = self.brownian {
                 p.brownian = Some(hydrorattle::Brownian {
                     temperature: t.temperature,
@@ -199,6 +203,7 @@ mod tests {
             contact: None,
             brownian: None,
             wall: false,
+            matrix_free: false,
         }
     }
 

@@ -187,3 +187,46 @@ fn sqrt_key() {
     assert_eq!(err.line(), Some(text.lines().count()), "{err}");
     assert!(err.to_string().contains("qr"), "{err}");
 }
+
+/// The shipped FENE dumbbell: a spring of rest length 0 and the `fene` key reach the
+/// kernel (a written scene keeps them), and the run samples `<Q^2> = 3 kT/H * b/(b+5)`
+/// = 2 (b = 10) within 3 block standard errors (its 1e5 steps give about 4 %).
+#[test]
+fn fene_dumbbell_scene() {
+    let text = include_str!("../scenes/fene_dumbbell.toml");
+    let s = Scene::parse(text, "fene_dumbbell.toml").unwrap();
+    assert_eq!(s.integrator.fene, Some(10f64.sqrt()));
+    assert_eq!(s.bonds[0].length, 0.0);
+    let back = Scene::parse(&s.to_toml(), "written").unwrap();
+    assert_eq!(back.integrator, s.integrator);
+    assert_eq!(back.bonds[0].length, 0.0);
+    let out = std::env::temp_dir().join(format!("fene-scene-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let opts = RunOptions {
+        progress: false,
+        ..Default::default()
+    };
+    let r = run(&s, "fene", Some(&out), opts).unwrap();
+    assert_eq!(r.summary.failure, None);
+    // One frame every 500 steps (1 time unit, 2 relaxation times apart): nearly
+    // independent samples; blocks of 10.
+    let frames = host_demo::output::read_xyz_file(&out.join("trajectory.xyz")).unwrap();
+    std::fs::remove_dir_all(&out).unwrap();
+    let q2: Vec<f64> = frames[1..]
+        .iter()
+        .map(|f| {
+            let (a, b) = (f.positions[0], f.positions[1]);
+            (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>()
+        })
+        .collect();
+    let blocks: Vec<f64> = q2
+        .chunks_exact(10)
+        .map(|c| c.iter().sum::<f64>() / 10.0)
+        .collect();
+    let k = blocks.len() as f64;
+    let mean = blocks.iter().sum::<f64>() / k;
+    let se = (blocks.iter().map(|b| (b - mean).powi(2)).sum::<f64>() / (k - 1.0) / k).sqrt();
+    eprintln!("FENE scene: <Q^2> = {mean:.4} +- {se:.4} (exact 2)");
+    assert!(se < 0.1, "{se}");
+    assert!((mean - 2.0).abs() < 3.0 * se, "{mean} +- {se}");
+}

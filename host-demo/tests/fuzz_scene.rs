@@ -154,14 +154,19 @@ fn case(bytes: &[u8], limits: Limits) -> Result<bool, String> {
         }
         Ok(s) => {
             let n = s.particles.len();
+            // Springs may rest at length zero; rigid bonds may not.
+            let springs = s.integrator.method == host_demo::scene::Method::Springs;
             let ok = n > 0
                 && s.species.len() == n
                 && s.particles
                     .iter()
                     .all(|p| p.radius > 0.0 && p.density >= 0.0)
-                && s.bonds
-                    .iter()
-                    .all(|b| b.i < n && b.j < n && b.i != b.j && b.length > 0.0)
+                && s.bonds.iter().all(|b| {
+                    b.i < n
+                        && b.j < n
+                        && b.i != b.j
+                        && (b.length > 0.0 || springs && b.length == 0.0)
+                })
                 && s.integrator.dt > 0.0
                 && s.integrator.steps() >= 1
                 && s.output.every >= 1;

@@ -112,3 +112,66 @@ fn the_library_refuses_an_oversized_run_with_a_typed_error() {
     };
     assert_eq!((t.particles, t.bonds, t.limit), (25, 24, 1024));
 }
+
+/// The 4096-bead Brownian chain (`tests/data/brownian_chain4096.toml`, matrix-free, kT
+/// = 0.5) cut to 256 beads so it runs in a moment: it runs through `host-demo run`,
+/// keeps its bonds, stores no mobility, and gives the same bits on one thread and on
+/// two, and again with the same seed. The whole file: `host-demo run
+/// host-demo/tests/data/brownian_chain4096.toml --out DIR` (about 5 s a step on one
+/// core, 7.6 MiB of step storage).
+#[test]
+fn a_matrix_free_brownian_chain_runs_with_the_same_bits_on_any_threads() {
+    let text = std::fs::read_to_string(manifest().join("tests/data/brownian_chain4096.toml"))
+        .unwrap()
+        .replace("tails = 4095", "tails = 255");
+    let dir = scratch("bd256");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("bd256.toml");
+    std::fs::write(&scene, text).unwrap();
+    let go = |name: &str, threads: &str| {
+        let out = dir.join(name);
+        let o = cli_run(&[
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--threads",
+            threads,
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["particles"], 256);
+        assert_eq!(summary["steps_done"], 2);
+        assert!(summary["failure"].is_null(), "{}", summary["failure"]);
+        read_xyz_file(&out.join("trajectory.xyz"))
+            .unwrap()
+            .last()
+            .unwrap()
+            .positions
+            .clone()
+    };
+    let one = go("one", "1");
+    assert_eq!(one, go("two", "2"), "threads changed the bits");
+    assert_eq!(one, go("again", "1"), "same seed, different bits");
+    // Bonds held; the noise moved the chain.
+    let start = read_xyz_file(&dir.join("one/trajectory.xyz")).unwrap()[0]
+        .positions
+        .clone();
+    assert_ne!(start, one);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("one/summary.json")).unwrap())
+            .unwrap();
+    let tolerance = summary["tolerance_used"].as_f64().unwrap();
+    let csv = std::fs::read_to_string(dir.join("one/observables.csv")).unwrap();
+    for l in csv.lines().skip(1) {
+        let r: f64 = l.split(',').nth(9).unwrap().parse().unwrap();
+        assert!(r <= 10.0 * tolerance, "bond residual {r:e}");
+    }
+    // No stored mobility: the plan's storage is O(N) (the 256-bead stored thermal
+    // layout would hold two packed mobilities, 2 x 2.4 MB).
+    let s = Scene::from_path(&scene).unwrap();
+    let bytes = host_demo::sizing::Plan::of(&s).bytes(256, 255).unwrap();
+    assert!(bytes < 1_000_000, "{bytes} bytes of step storage");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

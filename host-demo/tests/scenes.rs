@@ -62,7 +62,9 @@ fn every_shipped_scene_parses() {
     for path in files {
         let scene = Scene::from_path(&path).unwrap_or_else(|e| panic!("{e}"));
         assert!(!scene.particles.is_empty(), "{}", path.display());
-        for b in &scene.bonds {
+        // Constrained bonds start at their length (a spring may start stretched).
+        let springs = scene.integrator.method == host_demo::scene::Method::Springs;
+        for b in scene.bonds.iter().filter(|_| !springs) {
             let s = distance(scene.particles[b.i].position, scene.particles[b.j].position);
             assert!(
                 (s - b.length).abs() < 1e-12,

@@ -28,8 +28,13 @@ fn sweeps() -> PathBuf {
 
 /// A sweep file in `dir` on the Figure 1 (a) scene with `body` after `[sweep]`.
 fn sweep_file(dir: &Path, name: &str, body: &str) -> PathBuf {
+    sweep_file_on(dir, name, "figure1a.toml", body)
+}
+
+/// A sweep file over the shipped scene `base`.
+fn sweep_file_on(dir: &Path, name: &str, base: &str, body: &str) -> PathBuf {
     let path = dir.join(name);
-    let base = scenes().join("figure1a.toml");
+    let base = scenes().join(base);
     let text = format!("[sweep]\nbase = {:?}\n{body}", base.display().to_string());
     std::fs::write(&path, text).unwrap();
     path
@@ -224,13 +229,34 @@ fn two_shards_in_parallel_give_what_one_process_gives() {
 
 #[test]
 fn a_killed_shard_rerun_completes_only_the_missing_points() {
-    let dir = scratch("kill");
     // Four points of 4000 steps, checkpoints every 20 time units (200 steps).
-    let file = sweep_file(
-        &dir,
-        "kill.toml",
+    killed_and_rerun(
+        "kill",
+        "figure1a.toml",
         "\"helix.dhat\" = [1.05, 1.2, 1.35, 1.5]\n",
+        "20",
     );
+}
+
+/// Brownian points resume from their checkpoints too (the generator's state is in
+/// them), to the bits of an uninterrupted run.
+#[test]
+fn a_killed_brownian_shard_resumes_to_the_same_bits() {
+    // Four replicas of 4000 steps at kT = 0.5, checkpoints every 2 time units (400 steps).
+    killed_and_rerun(
+        "kill-brownian",
+        "brownian_chain.toml",
+        "replicas = 4\n\"integrator.duration\" = [20.0]\n\"output.every\" = [200]\n",
+        "2",
+    );
+}
+
+/// Runs the sweep `body` over `base` whole, and again killed (SIGKILL) once a point is
+/// finished and another is midway, then rerun: only the missing points run, at least
+/// one resumes from its checkpoint, and every file equals the whole run's.
+fn killed_and_rerun(name: &str, base: &str, body: &str, every: &str) {
+    let dir = scratch(name);
+    let file = sweep_file_on(&dir, "kill.toml", base, body);
     let file = file.to_str().unwrap();
     let (whole, killed) = (dir.join("whole"), dir.join("killed"));
     let args = |out: &Path| -> Vec<String> {
@@ -242,7 +268,7 @@ fn a_killed_shard_rerun_completes_only_the_missing_points() {
             "--jobs",
             "1",
             "--checkpoint-every",
-            "20",
+            every,
         ]
         .map(String::from)
         .to_vec()

@@ -1,11 +1,13 @@
 //! The mobility's bands on a thread pool give the bits of one thread (the bands and
 //! every sum's order depend on the bead count alone), and the banded product is the
-//! one-pass product up to rounding.
+//! one-pass product up to rounding. Thermal steps with the Lanczos noise
+//! too give the same bits on any thread count.
 
 use hydrorattle::glam::DVec3;
 use hydrorattle::parallel::{self, BANDED_MIN, Parallel, Serial, band_scratch, bands};
 use hydrorattle::{
-    Bond, Hydro, Layout, Method, NoForce, Params, Real, State, linalg, mobility, step_slices,
+    Bond, Brownian, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Params, Real, State, linalg,
+    mobility, step_slices,
 };
 use hydrorattle_heap::Buffers;
 use hydrorattle_parallel::Threads;
@@ -99,6 +101,12 @@ fn bits(v: &[DVec3]) -> Vec<[u64; 3]> {
 /// Three overdamped steps of a settling helix (Krylov, one banded assembly and product
 /// plus a banded product per iteration): the positions' bits, for a given executor.
 fn steps<T: Real>(n: usize, par: &dyn Parallel) -> Vec<u64> {
+    steps_at::<T>(n, par, None)
+}
+
+/// [`steps`], at temperature `kt` if given (Lanczos noise, midpoint drift: banded
+/// products at the start, a banded assembly and product at the midpoint).
+fn steps_at<T: Real>(n: usize, par: &dyn Parallel, kt: Option<f64>) -> Vec<u64> {
     let (p, radius) = helix(n);
     let mut pos: Vec<T::V3> = p.iter().map(|&x| T::v3_from(x)).collect();
     let radius: Vec<T> = radius.iter().map(|&a| T::from_f64(a)).collect();
@@ -109,8 +117,11 @@ fn steps<T: Real>(n: usize, par: &dyn Parallel) -> Vec<u64> {
             length: T::norm(pos[i] - pos[i - 1]),
         })
         .collect();
-    let params = Params::<T>::new(T::from_f64(0.05));
+    let mut params = Params::<T>::new(T::from_f64(0.05));
     assert_eq!(params.method, Method::Overdamped);
+    params.brownian = kt.map(|t| Brownian::new(T::from_f64(t)));
+    params.noise_sqrt = NoiseSqrt::Lanczos;
+    let mut noise = Noise::new(3);
     let mut store = Buffers::<T>::new(Layout::for_params(&params, n, n - 1));
     let mut ws = store.workspace().with_parallel(par);
     let (mut vel, mut omega) = (vec![T::V3_ZERO; n], vec![T::V3_ZERO; n]);
@@ -124,9 +135,10 @@ fn steps<T: Real>(n: usize, par: &dyn Parallel) -> Vec<u64> {
             radius: &radius,
             density: &density,
             time: &mut time,
-            noise: None,
+            noise: kt.map(|_| &mut noise),
         };
-        step_slices(state, &bonds, &params, &mut ws, &mut NoForce).unwrap();
+        let r = step_slices(state, &bonds, &params, &mut ws, &mut NoForce).unwrap();
+        assert_eq!(r.noise_iterations > 0, kt.is_some());
     }
     pos.iter()
         .flat_map(|&v| T::xyz(v).map(|c| c.to_f64().to_bits()))
@@ -170,4 +182,18 @@ fn overdamped_steps_are_the_same_bits_on_any_thread_count_f64() {
 #[test]
 fn overdamped_steps_are_the_same_bits_on_any_thread_count_f32() {
     steps_agree::<f32>();
+}
+
+#[test]
+fn brownian_lanczos_steps_are_the_same_bits_on_any_thread_count() {
+    let n = BANDED_MIN + 88;
+    let serial = steps_at::<f64>(n, &Serial, Some(1.0));
+    assert!(serial != steps::<f64>(n, &Serial), "no noise");
+    for pool in pools().into_iter().take(2) {
+        assert!(
+            steps_at::<f64>(n, &pool, Some(1.0)) == serial,
+            "{} threads: different bits at temperature",
+            pool.threads()
+        );
+    }
 }

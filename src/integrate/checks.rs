@@ -31,9 +31,9 @@ pub(super) fn check_thermal<T: Real>(
             "thermal noise with a method other than Overdamped or Springs",
         ));
     }
-    if p.matrix_free {
+    if p.matrix_free && p.noise_sqrt == crate::params::NoiseSqrt::Cholesky {
         return Err(StepError::Unsupported(
-            "thermal noise without a stored mobility (matrix_free: not implemented)",
+            "a Cholesky factor of the noise without a stored mobility (matrix_free: use Lanczos or Auto)",
         ));
     }
     let l = p.lanczos;
@@ -196,8 +196,13 @@ pub(super) fn check_inputs<T: Real>(
             return Err(ParticleError::Massless { particle: i }.into());
         }
     }
+    let springs = p.method == Method::Springs;
     for (bond, b) in bonds.iter().enumerate() {
         crate::bonds::check_one(bond, b, n)?;
+        // A constraint of length zero has no direction to hold.
+        if b.length == T::ZERO && !springs {
+            return Err(crate::error::BondError::BadLength { bond }.into());
+        }
     }
     Ok(())
 }

@@ -43,12 +43,16 @@ use crate::workspace::Workspace;
 pub struct StepReport<T> {
     /// Position-constraint iterations (sweeps or Newton steps) of the final solve.
     pub iterations: u32,
-    /// Velocity-constraint iterations (RATTLE stage), 0 where there is none.
+    /// Velocity-constraint iterations (RATTLE stage; the projection of the thermal noise
+    /// at the midpoint, [`Drift::Midpoint`](crate::Drift::Midpoint)), 0 where there is
+    /// none.
     pub velocity_iterations: u32,
-    /// Largest relative bond-length error `| |r_ij| - d | / d` after the step.
+    /// Largest relative bond-length error `| |r_ij| - d | / d` after the step (springs
+    /// of rest length zero have none and are skipped).
     pub residual: T,
-    /// Largest bond tension magnitude `|lambda_k| d_k` (force units); for springs
-    /// `k | |r_ij| - d |`.
+    /// Largest bond tension magnitude `|lambda_k| d_k` (force units); for springs the
+    /// largest spring force, Hookean `k | |r_ij| - d |` or FENE
+    /// `k |r_ij| / (1 - |r_ij|^2 / Q0^2)`.
     pub max_tension: T,
     /// Hard-sphere contacts held at the end of the step ([`Params::contacts`]; 0
     /// without).

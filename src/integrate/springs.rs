@@ -3,7 +3,7 @@
 //! Ermak–McCammon step, `r' = r + dt (U_inf + mu F) + dx` with the thermal
 //! displacement `dx` of covariance `2 kT dt mu` (`brownian.rs`, without constraints).
 
-use super::brownian::kick;
+use super::brownian::{Krylov, kick};
 use super::{Start, StepReport, add_flow, mobility_product, spin, step_velocity};
 use crate::bonds::{Bond, max_residual};
 use crate::error::StepError;
@@ -54,8 +54,13 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
             }
         }
         Some((b, noise)) => {
-            let krylov = (basis, krylov_t);
-            noise_iterations = kick(
+            let krylov = Krylov {
+                basis,
+                work: krylov_t,
+                par,
+                bands,
+            };
+            (noise_iterations, _) = kick(
                 p, b, s, mu, fac, new_vel, new_omega, dx, noise, None, krylov,
             )?;
             for i in 0..n {
@@ -76,10 +81,20 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
     })
 }
 
-/// The report of a spring step: the largest relative length error and spring force.
+/// The report of a spring step: the largest relative length error (over the bonds of
+/// nonzero rest length) and the largest spring force, Hookean `k | |r_ij| - d |` or
+/// FENE `k |r_ij| / (1 - |r_ij|^2 / Q0^2)`.
 fn spring_report<T: Real>(p: &Params<T>, bonds: &[Bond<T>], new_pos: &[T::V3]) -> StepReport<T> {
     let (_, worst) = max_residual(bonds, new_pos);
-    let tension = bonds.iter().fold(T::ZERO, |a, b| a.max(b.length)) * worst * p.spring_stiffness;
+    let k = p.spring_stiffness;
+    let tension = bonds.iter().fold(T::ZERO, |a, b| {
+        let r2 = T::norm2(new_pos[b.i] - new_pos[b.j]);
+        let f = match p.fene {
+            None => k * (r2.sqrt() - b.length).abs(),
+            Some(q0) => k * r2.sqrt() / (T::ONE - r2 / (q0 * q0)),
+        };
+        a.max(f)
+    });
     StepReport {
         iterations: 0,
         velocity_iterations: 0,

@@ -170,11 +170,12 @@ impl Layout {
     /// [`Params::noise_sqrt`] picks at `n` beads: with Lanczos, the basis
     /// (`(cap + 1) n` vectors) and its small matrices (`2 cap^2 + 8 cap + 1` scalars),
     /// and no Cholesky factor with [`Drift::Uncorrected`](crate::Drift::Uncorrected)
-    /// (the midpoint keeps its storage for the mobility at the midpoint). Unchanged with
+    /// (the midpoint keeps its storage for the mobility at the midpoint, except with
+    /// [`Params::matrix_free`], whose products at the midpoint store nothing). Unchanged with
     /// Cholesky and for methods without noise.
     pub const fn noise_sqrt<T: Real>(self, p: &Params<T>, n: usize) -> Self {
         let thermal = matches!(p.method, Method::Overdamped | Method::Springs);
-        if !thermal || !p.noise_sqrt.lanczos(n) {
+        if !thermal || !p.lanczos_noise(n) {
             return self;
         }
         let cap = p.lanczos.max_iterations as usize;
@@ -182,8 +183,10 @@ impl Layout {
             Some(b) => matches!(b.drift, crate::params::Drift::Uncorrected),
             None => false,
         };
+        // Matrix-free, the midpoint's mobility is not stored either.
+        let unstored = uncorrected || p.matrix_free;
         Self {
-            blocks: self.blocks - if uncorrected { tri(n) } else { 0 },
+            blocks: self.blocks - if unstored { tri(n) } else { 0 },
             vectors: self.vectors + lanczos::vectors(cap, n),
             scalars: self.scalars + lanczos::scalars(cap),
             ..self

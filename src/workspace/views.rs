@@ -89,9 +89,8 @@ impl<T: Real> Workspace<'_, T> {
         // Thermal noise (`Layout::thermal`): the factor, one vector array, the midpoint's
         // bond vectors and multipliers.
         let thermal = p.brownian.is_some();
-        let lanczos = thermal
-            && matches!(method, Method::Overdamped | Method::Springs)
-            && p.noise_sqrt.lanczos(n);
+        let lanczos =
+            thermal && matches!(method, Method::Overdamped | Method::Springs) && p.lanczos_noise(n);
         let uncorrected =
             matches!(p.brownian, Some(b) if b.drift == crate::params::Drift::Uncorrected);
         let (mats, work, extra_bonds, inv_mass, sqrt_m, disp) = match method {
@@ -104,7 +103,7 @@ impl<T: Real> Workspace<'_, T> {
             Method::RattleStable => (2, [m, m, 0], nb, 0, m, table),
         };
         let mu = bl.take(if stored { tri(m) } else { 0 });
-        let factor = mats == 2 && !(lanczos && uncorrected);
+        let factor = mats == 2 && !(lanczos && (uncorrected || !stored));
         let fac = bl.take(if factor { tri(m) } else { 0 });
         let (work_a, work_b, work_c) = (ve.take(work[0]), ve.take(work[1]), ve.take(work[2]));
         let grad_new = ve.take(extra_bonds);

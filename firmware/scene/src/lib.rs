@@ -18,8 +18,8 @@ use core::fmt::{self, Write};
 
 use hydrorattle::glam::Vec3;
 use hydrorattle::{
-    Bond, BondSet, Hydro, Lanczos, Method, NoiseSqrt, Params, Particle, ParticleSet, Real,
-    SoftContact, Solver, SolverKind, StepError, StepReport, Workspace, step,
+    Bond, BondSet, Brownian, Drift, Hydro, Lanczos, Method, Noise, NoiseSqrt, Params, Particle,
+    ParticleSet, Real, SoftContact, Solver, SolverKind, StepError, StepReport, Workspace, step,
 };
 
 /// Beads: one head and 24 tails.
@@ -43,14 +43,21 @@ pub const DT: f64 = 0.005;
 /// Soft-contact stiffness of the scene (`[contact] stiffness`).
 pub const CONTACT_STIFFNESS: f64 = 1000.0;
 
-/// The runs the firmware has a binary for: name, method, rotation resolved.
-pub const RUNS: [(&str, Method, bool); 6] = [
-    ("overdamped", Method::Overdamped, false),
-    ("overdamped2", Method::Overdamped2, false),
-    ("rattle", Method::Rattle, false),
-    ("stable", Method::RattleStable, false),
-    ("stable_rotation", Method::RattleStable, true),
-    ("springs", Method::Springs, false),
+/// Thermal energy of the Brownian run (the C example's: `ffi/examples/chain.c`).
+pub const KT: f64 = 0.5;
+/// Seed of the Brownian run's generator (the C example's).
+pub const SEED: u64 = 7;
+
+/// The runs the firmware has a binary for: name, method, rotation resolved, thermal
+/// noise at [`KT`] (midpoint drift, generator seeded with [`SEED`]).
+pub const RUNS: [(&str, Method, bool, bool); 7] = [
+    ("overdamped", Method::Overdamped, false, false),
+    ("overdamped2", Method::Overdamped2, false, false),
+    ("rattle", Method::Rattle, false, false),
+    ("stable", Method::RattleStable, false, false),
+    ("stable_rotation", Method::RattleStable, true, false),
+    ("springs", Method::Springs, false, false),
+    ("brownian", Method::Overdamped, false, true),
 ];
 
 /// The chain's geometry in `f64`.
@@ -154,21 +161,36 @@ pub fn chain_from<T: Real>(
 
 /// The scene's parameters for `method` (rotation resolved or not): `dt` 0.005, RPY,
 /// gravity `(0, 0, -1)`, Newton with the precision's default tolerance and a cap of
-/// 500, overlapping spheres allowed (the scene's soft contact keeps them apart).
-pub fn params<T: Real>(method: Method, rotation: bool) -> Params<T> {
+/// 500, overlapping spheres allowed (the scene's soft contact keeps them apart); with
+/// `brownian`, thermal noise at [`KT`] with the midpoint drift.
+pub fn params<T: Real>(method: Method, rotation: bool, brownian: bool) -> Params<T> {
     let mut p = Params::new(T::from_f64(DT));
     p.method = method;
     p.rotation = rotation;
     p.solver.kind = SolverKind::Newton;
     p.solver.max_iterations = 500;
     p.allow_overlap = true;
+    if brownian {
+        p.brownian = Some(Brownian::new(T::from_f64(KT)));
+    }
     p
 }
 
 /// [`params`] in `f32` as a constant (a test checks that the two agree). Firmware keeps
 /// it in a `static`: the compiler then sees the method, drops the other integrators
 /// and inlines the step (38 KB of flash instead of 87 KB for Overdamped).
-pub const fn params_f32(method: Method, rotation: bool) -> Params<f32> {
+pub const fn params_f32(method: Method, rotation: bool, brownian: bool) -> Params<f32> {
+    let mut p = deterministic_f32(method, rotation);
+    if brownian {
+        p.brownian = Some(Brownian {
+            temperature: KT as f32,
+            drift: Drift::Midpoint,
+        });
+    }
+    p
+}
+
+const fn deterministic_f32(method: Method, rotation: bool) -> Params<f32> {
     Params {
         dt: DT as f32,
         viscosity: 1.0,
@@ -270,7 +292,8 @@ pub struct Failure {
 }
 
 /// Runs `steps` steps of the scene from the chain in `ps`; `each` is called around
-/// every step (`true` before, `false` after), for timing.
+/// every step (`true` before, `false` after), for timing. A thermal run (`p.brownian`)
+/// draws from a generator seeded with [`SEED`], unless `ps` already carries one.
 pub fn run<T: Bits>(
     ps: &mut ParticleSet<T, N>,
     bonds: &BondSet<T, B>,
@@ -281,6 +304,9 @@ pub fn run<T: Bits>(
 ) -> Result<Outcome<T>, Failure> {
     let mut contact = contact::<T>();
     let mut report = StepReport::default();
+    if p.brownian.is_some() && ps.noise.is_none() {
+        ps.noise = Some(Noise::new(SEED));
+    }
     for s in 0..steps {
         each(true);
         let r = step(ps, bonds, p, ws, &mut contact);
@@ -310,10 +336,10 @@ impl fmt::Display for Hex<f64> {
 }
 
 /// The line both the firmware and the host check print for a run; CI compares them.
+/// A thermal run adds `kT=` (its bits) and `seed=`.
 pub fn summary<T: Bits>(
     w: &mut impl Write,
-    method: Method,
-    rotation: bool,
+    p: &Params<T>,
     outcome: &Result<Outcome<T>, Failure>,
 ) -> fmt::Result
 where
@@ -322,9 +348,12 @@ where
     let bits = core::mem::size_of::<T>() * 8;
     write!(
         w,
-        "figure1c f{bits} {method:?} rotation={} ",
-        rotation as u8
+        "figure1c f{bits} {:?} rotation={} ",
+        p.method, p.rotation as u8
     )?;
+    if let Some(b) = p.brownian {
+        write!(w, "kT={} seed={SEED} ", Hex(b.temperature))?;
+    }
     match outcome {
         Ok(o) => writeln!(
             w,
@@ -352,7 +381,7 @@ pub fn host_summaries(only: &[&str]) -> alloc::string::String {
     use hydrorattle::Layout;
     use hydrorattle_heap::Buffers;
     let mut out = alloc::string::String::new();
-    for (name, method, rotation) in RUNS {
+    for (name, method, rotation, brownian) in RUNS {
         if !only.is_empty() && !only.contains(&name) {
             continue;
         }
@@ -360,12 +389,16 @@ pub fn host_summaries(only: &[&str]) -> alloc::string::String {
         let outcome = chain(&mut ps)
             .map_err(|error| Failure { step: 0, error })
             .and_then(|bonds| {
-                let p = params::<f32>(method, rotation);
+                let p = params::<f32>(method, rotation, brownian);
                 let mut store = Buffers::<f32>::new(Layout::for_params(&p, N, bonds.len()));
                 run(&mut ps, &bonds, &p, &mut store.workspace(), STEPS, |_| {})
             });
         // Writing to a String cannot fail.
-        let _ = summary(&mut out, method, rotation, &outcome);
+        let _ = summary(
+            &mut out,
+            &params::<f32>(method, rotation, brownian),
+            &outcome,
+        );
     }
     out
 }

@@ -8,10 +8,10 @@ use hydrorattle_scene::{B, N, RUNS, chain, digest, params, params_f32, run};
 
 #[test]
 fn constant_parameters_match_the_kernel_defaults() {
-    for (name, method, rotation) in RUNS {
+    for (name, method, rotation, brownian) in RUNS {
         assert_eq!(
-            params_f32(method, rotation),
-            params::<f32>(method, rotation),
+            params_f32(method, rotation, brownian),
+            params::<f32>(method, rotation, brownian),
             "{name}"
         );
     }
@@ -31,7 +31,7 @@ fn runs_are_deterministic() {
     let once = || {
         let mut ps = ParticleSet::<f32, N>::new();
         let bonds = chain(&mut ps).unwrap();
-        let p = params::<f32>(hydrorattle::Method::Overdamped, false);
+        let p = params::<f32>(hydrorattle::Method::Overdamped, false, false);
         let mut store = Buffers::<f32>::new(Layout::for_params(&p, N, B));
         run(&mut ps, &bonds, &p, &mut store.workspace(), 20, |_| {}).unwrap()
     };

@@ -15,10 +15,10 @@
 //! | `[gravity]` | `acceleration = [x, y, z]` | `[0, 0, -1]` |
 //! | `[flow]` | `velocity = [..]`, `vorticity = [..]` (uniform flow plus rigid rotation) | zeros |
 //! | `[[particle]]` | `position = [..]` (required), `radius` (required, > 0), `density` (>= 0), `velocity = [..]`, `angular_velocity = [..]`, `species` (a type name) | density 4.5, at rest, one species per radius and density |
-//! | `[[bond]]` | `between = [i, j]` (required, 0-based), `length` (> 0) | initial distance |
+//! | `[[bond]]` | `between = [i, j]` (required, 0-based), `length` (> 0; >= 0 with `method = "springs"`: a spring's rest length) | initial distance |
 //! | `[helix]` | `tails`, `head_ratio`, `dhat`, `head_end`, `radius`, `pitch`, `density` | see [`Helix`] |
 //! | `[model]` | `hydrodynamics = "rpy"\|"oseen"\|"free-draining"`, `inertia`, `rotation`, `level = "auto"\|"manual"`, `overlap = "reject"\|"allow"` | rpy, false, false, manual, reject |
-//! | `[integrator]` | `method` (required), `dt` (required), `duration` (required), `solver = "auto"\|"sweep"\|"newton"\|"krylov"`, `tolerance`, `max_iterations`, `precision = "f32"\|"f64"`, `stiffness` | auto, 1e-10, 500, f64, 1e4 |
+//! | `[integrator]` | `method` (required), `dt` (required), `duration` (required), `solver = "auto"\|"sweep"\|"newton"\|"krylov"`, `tolerance`, `max_iterations`, `precision = "f32"\|"f64"`, `stiffness`, `fene` (FENE maximum extension `Q0` > 0, springs only; every bond must start shorter), `matrix_free` (never store the mobility: `O(N)` storage; overdamped or springs, level manual) | auto, 1e-10, 500, f64, 1e4, none (Hookean), false |
 //! | `[output]` | `every` (steps between trajectory frames, >= 1) | about [`TARGET_FRAMES`] frames |
 //! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"` or `"springs"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
 //! | `[wall]` | `height` (required, finite): a no-slip plane `z = height` below every sphere (`method = "overdamped"` or `"overdamped2"`, level manual; see [`Wall`]) | no wall |

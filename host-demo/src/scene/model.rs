@@ -209,6 +209,13 @@ pub struct Integrator {
     pub precision: Precision,
     /// Spring constant for `method = "springs"` (> 0).
     pub stiffness: f64,
+    /// FENE springs for `method = "springs"`: their maximum extension `Q0` (> 0; the
+    /// kernel's [`hydrorattle::Params::fene`]). `None`: Hookean springs.
+    pub fene: Option<f64>,
+    /// Never store the mobility (the kernel's `Params::matrix_free`: storage `O(N)`,
+    /// pair blocks evaluated where they are used; thermal noise by Lanczos).
+    /// `method = "overdamped"` or `"springs"` with `level = "manual"` only.
+    pub matrix_free: bool,
 }
 
 impl Integrator {

@@ -56,7 +56,7 @@ fn check_t<T: Real>(
             return Err(issue(
                 spans.bond(l),
                 format!(
-                    "bond {l} between [{}, {}]: length {} is not usable in {name} (it must be > 0 and its square finite)",
+                    "bond {l} between [{}, {}]: length {} is not usable in {name} (it must be >= 0 and its square finite)",
                     b.i,
                     b.j,
                     crate::output::format_f64(b.length)

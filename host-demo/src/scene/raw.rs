@@ -99,6 +99,8 @@ pub(super) struct RawIntegrator {
     pub(super) max_iterations: S<usize>,
     pub(super) precision: Option<Precision>,
     pub(super) stiffness: S<f64>,
+    pub(super) fene: S<f64>,
+    pub(super) matrix_free: Option<Spanned<bool>>,
 }
 
 #[derive(Deserialize)]

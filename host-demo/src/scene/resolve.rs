@@ -12,8 +12,8 @@ use super::raw::{
     number, vector,
 };
 use super::{
-    Bond, DEFAULT_DENSITY, Flow, Fluid, Helix, Integrator, Level, Model, Output, Overlap, Particle,
-    Scene, TARGET_FRAMES,
+    Bond, DEFAULT_DENSITY, Flow, Fluid, Helix, Integrator, Level, Method, Model, Output, Overlap,
+    Particle, Scene, Sqrt, TARGET_FRAMES,
 };
 use crate::sizing::{Limits, Plan, TooLarge};
 
@@ -66,10 +66,35 @@ impl RawScene {
             ));
         };
         let integrator = resolve_integrator(raw_int.get_ref())?;
+        if let Some(m) = raw_int
+            .get_ref()
+            .matrix_free
+            .as_ref()
+            .filter(|m| *m.get_ref())
+        {
+            let runs = matches!(integrator.method, Method::Overdamped | Method::Springs);
+            if !runs || model.level != Level::Manual {
+                return Err(issue(
+                    m.span(),
+                    "matrix_free needs method = \"overdamped\" or \"springs\" and level = \"manual\" \
+                     (the other methods store or factorise the mobility)",
+                ));
+            }
+        }
         let brownian = match &self.brownian {
             None => None,
             Some(b) => Some(b.resolve(&model, &integrator)?),
         };
+        let cholesky = brownian.is_some_and(|b| b.temperature > 0.0 && b.sqrt == Sqrt::Cholesky);
+        if let Some(m) = raw_int.get_ref().matrix_free.as_ref() {
+            if *m.get_ref() && cholesky {
+                return Err(issue(
+                    m.span(),
+                    "matrix_free draws the noise by Lanczos: [brownian] sqrt = \"cholesky\" \
+                     needs the stored mobility (use \"auto\" or \"lanczos\")",
+                ));
+            }
+        }
         if let (Some(c), Some(raw)) = (contact, &self.contact) {
             super::contact::check_method(c, raw, &integrator, brownian.as_ref())?;
         }
@@ -152,7 +177,8 @@ impl RawScene {
                 check_output(&integrator, every, ps.get_ref().len(), limits.output)
                     .map_err(|m| issue(output_span.clone(), m))?;
                 let (particles, spans, species) = resolve_particles(ps)?;
-                let (bonds, bond_spans) = resolve_bonds(self.bonds.as_ref(), &particles)?;
+                let (bonds, bond_spans) =
+                    resolve_bonds(self.bonds.as_ref(), &particles, &integrator)?;
                 let spans = BodySpans::Particles(spans, bond_spans);
                 (particles, bonds, None, spans, species)
             }
@@ -266,6 +292,7 @@ fn plans(
         contact,
         brownian,
         wall,
+        matrix_free: integrator.matrix_free,
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],
@@ -337,7 +364,23 @@ fn resolve_integrator(r: &RawIntegrator) -> Result<Integrator, Issue> {
         max_iterations,
         precision: r.precision.unwrap_or_default(),
         stiffness: number(&r.stiffness, 1e4, "stiffness", Bound::Positive)?,
+        fene: resolve_fene(r)?,
+        matrix_free: r.matrix_free.as_ref().is_some_and(|m| *m.get_ref()),
     })
+}
+
+/// `fene` (the FENE springs' maximum extension): > 0 and finite, springs only.
+fn resolve_fene(r: &RawIntegrator) -> Result<Option<f64>, Issue> {
+    let Some(q0) = &r.fene else {
+        return Ok(None);
+    };
+    if r.method != Method::Springs {
+        return Err(issue(
+            q0.span(),
+            "fene (the FENE springs' maximum extension) needs method = \"springs\"",
+        ));
+    }
+    number(&r.fene, 0.0, "fene (maximum extension)", Bound::Positive).map(Some)
 }
 
 fn resolve_helix(r: &RawHelix) -> Result<Helix, Issue> {
@@ -437,10 +480,14 @@ fn class_name(k: usize) -> String {
     }
 }
 
+/// The bonds: a length of 0 only for springs (their rest length), and with FENE
+/// springs every bond starts shorter than the maximum extension.
 fn resolve_bonds(
     bonds: Option<&Spanned<Vec<RawBond>>>,
     particles: &[Particle],
+    integrator: &Integrator,
 ) -> Result<(Vec<Bond>, Vec<Range<usize>>), Issue> {
+    let springs = integrator.method == Method::Springs;
     let Some(bonds) = bonds else {
         return Ok((Vec::new(), Vec::new()));
     };
@@ -474,7 +521,27 @@ fn resolve_bonds(
             ));
         }
         let initial = distance(particles[i].position, particles[j].position);
-        let length = number(&b.length, initial, "bond length", Bound::Positive)?;
+        let bound = if springs {
+            Bound::NonNegative
+        } else {
+            Bound::Positive
+        };
+        let length =
+            number(&b.length, initial, "bond length", bound).map_err(|e| match &b.length {
+                Some(l) if *l.get_ref() == 0.0 => issue(
+                    l.span(),
+                    "bond length must be > 0 (a rest length of 0 is for method = \"springs\" only)",
+                ),
+                _ => e,
+            })?;
+        if let Some(q0) = integrator.fene.filter(|&q0| initial >= q0) {
+            return Err(issue(
+                b.between.span(),
+                format!(
+                    "bond between [{i}, {j}] starts at distance {initial}, not below the FENE maximum extension {q0}"
+                ),
+            ));
+        }
         out.push(Bond { i, j, length });
         spans.push(b.length.as_ref().map_or(b.between.span(), |l| l.span()));
     }

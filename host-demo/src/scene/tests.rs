@@ -138,6 +138,7 @@ fn overdamped() -> Plan {
         contact: None,
         brownian: None,
         wall: false,
+        matrix_free: false,
     }
 }
 

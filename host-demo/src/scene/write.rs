@@ -62,8 +62,13 @@ impl Scene {
                 ("max_iterations", value(i.max_iterations as i64)),
                 ("precision", value(i.precision)),
                 ("stiffness", value(i.stiffness)),
+                ("matrix_free", value(i.matrix_free)),
             ]),
         );
+        // Written only when set: scenes written before the key stay the same.
+        if let (Some(q0), Some(Value::Table(it))) = (i.fene, t.get_mut("integrator")) {
+            it.insert("fene".into(), value(q0));
+        }
         t.insert(
             "output".into(),
             table([("every", value(self.output.every as i64))]),

@@ -381,6 +381,7 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     };
     p.method = i.method.kernel();
     p.rotation = scene.model.rotation;
+    p.matrix_free = i.matrix_free;
     // f32 cannot reach 1e-10: floor the tolerance at a few hundred ulps.
     let floor = 256.0 * T::EPSILON.to_f64();
     p.solver = KSolver {
@@ -392,6 +393,7 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     // prepared); during the run spheres may come to overlap, as in the paper.
     p.allow_overlap = true;
     p.spring_stiffness = T::from_f64(i.stiffness);
+    p.fene = i.fene.map(T::from_f64);
     // The paper's explicit drag can shiver silently (bounded, wrong) beyond its limit:
     // the demo refuses such steps up front.
     p.stability_guard = true;

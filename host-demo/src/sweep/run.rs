@@ -7,8 +7,8 @@
 //! signal or a time limit): it continues from the checkpoint, and its files come out
 //! byte for byte as those of an uninterrupted run. Anything else (a new point, a
 //! changed scene, a run that failed to start) is run from the start, its old run files
-//! removed first. Thermal-noise runs write no checkpoints (the noise generator's state
-//! is not saved), so an unfinished one is run again from the start.
+//! removed first. Thermal-noise runs resume the same way: their checkpoints hold the
+//! noise generator's state.
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -233,11 +233,8 @@ pub fn prepare_points(sweep: &Sweep, dir: &Path) -> Result<usize> {
 }
 
 /// The checkpoint interval of a point: `every` if given, else about a tenth of the run
-/// on a frame step; none for thermal-noise runs.
+/// on a frame step.
 fn checkpoint_every(scene: &Scene, every: Option<f64>) -> Option<f64> {
-    if scene.brownian.is_some_and(|b| b.temperature > 0.0) {
-        return None;
-    }
     every.or_else(|| {
         let (steps, frame) = (scene.integrator.steps(), scene.output.every.max(1));
         let k = steps.div_ceil(10).div_ceil(frame) * frame;

@@ -228,8 +228,8 @@ class System:
     sphere: its mobility and its one-sided constraint; "overdamped" and "overdamped2"),
     ``temperature`` (None: no thermal noise; ``kT``), ``drift`` ("midpoint",
     "uncorrected"), ``seed`` (1), ``noise_sqrt`` ("auto": Lanczos above
-    ``LANCZOS_CROSSOVER`` beads, "cholesky", "lanczos"), ``lanczos_tolerance`` (1e-6 in
-    f64, 1e-4 in f32) and ``lanczos_max_iterations`` (64). A particle's mass is ``4/3 pi a^3 density``; gravity
+    ``LANCZOS_CROSSOVER`` beads, "cholesky", "lanczos"), ``lanczos_tolerance`` (1e-3,
+    the noise's estimated relative error) and ``lanczos_max_iterations`` (64). A particle's mass is ``4/3 pi a^3 density``; gravity
     acts on the buoyant mass (``density - fluid_density``).
 
     Constructors for the CLI's shapes: :meth:`from_scene` (a scene file, read by the
