@@ -19,8 +19,8 @@
 //! would supply it anyway (it differentiates `P mu` as a whole).
 
 use super::{
-    Projection, Start, StepReport, add_constraint_forces, add_flow, bond_vectors,
-    mobility_metric, mobility_product, project_overdamped, report, spin, step_velocity,
+    Projection, Start, StepReport, add_constraint_forces, add_flow, bond_vectors, mobility_metric,
+    mobility_product, project_overdamped, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch};
