@@ -5,6 +5,13 @@
 //! [`Method::Springs`](crate::Method::Springs) only (a spring of rest length zero, the
 //! classic Hookean dumbbell); a constrained step refuses it
 //! ([`BondError::BadLength`]).
+//!
+//! Inside a step the constraint solve also holds **wall links** ([`Bond::wall`]), which
+//! no caller's bond can be (`j == i`, refused as a self-bond): sphere `i` tied to its
+//! foot on the wall, the point of the plane below its centre, which follows the sphere
+//! along the wall and takes no force. The projection runs in the wall's frame (the plane
+//! is `z = 0` there), so the link's relative vector is the normal component
+//! `(0, 0, z_i)` ([`Bond::relative`]); its length is the sphere's radius (touching).
 
 use crate::error::BondError;
 use crate::real::Real;
@@ -19,6 +26,56 @@ pub struct Bond<T: Real> {
     pub j: usize,
     /// Centre-to-centre length (> 0; a spring's rest length may be 0).
     pub length: T,
+}
+
+impl<T: Real> Bond<T> {
+    /// The wall link of sphere `i` of radius `radius` (see the module): it holds the
+    /// centre at height `radius` above the wall. Its constraint is linear,
+    /// `2 a (z_i - a) = 0`: the bond's `|r|^2 - d^2` linearised at contact, so that a
+    /// step carrying the sphere far through the wall has no second root to land on.
+    pub const fn wall(i: usize, radius: T) -> Self {
+        Self {
+            i,
+            j: i,
+            length: radius,
+        }
+    }
+
+    /// `true` for a wall link ([`Bond::wall`]).
+    #[inline(always)]
+    pub const fn is_wall(&self) -> bool {
+        self.i == self.j
+    }
+
+    /// `v_i - v_j` over per-particle vectors `v` (positions, displacements): for a
+    /// wall link, the normal component `(0, 0, v_i.z)` (its other end, the foot on the
+    /// wall, moves with the sphere along the wall).
+    #[inline(always)]
+    pub fn relative(&self, v: &[T::V3]) -> T::V3 {
+        if self.is_wall() {
+            normal::<T>(v[self.i])
+        } else {
+            v[self.i] - v[self.j]
+        }
+    }
+}
+
+/// `(0, 0, v.z)`: the component along the wall's normal.
+#[inline(always)]
+pub(crate) fn normal<T: Real>(v: T::V3) -> T::V3 {
+    T::v3(T::ZERO, T::ZERO, T::xyz(v)[2])
+}
+
+/// Relative length error of link `b` whose relative vector is `r`:
+/// `| |r| - d | / d`, or `|z - d| / d` for a wall link (signed: a centre below the
+/// wall's plane is not near its length).
+#[inline]
+fn link_error<T: Real>(b: &Bond<T>, r: T::V3) -> T {
+    if b.is_wall() {
+        ((T::xyz(r)[2] - b.length) / b.length).abs()
+    } else {
+        ((T::norm(r) - b.length) / b.length).abs()
+    }
 }
 
 /// Up to `B` bonds (heapless storage).
@@ -150,24 +207,31 @@ pub fn validate<T: Real>(bonds: &[Bond<T>], n: usize) -> Result<(), BondError> {
 /// Largest relative length error `| |r_ij| - d | / d` over `bonds` and the bond where it
 /// occurs. NaN is sticky (a NaN residual is never hidden), and a bond naming a particle
 /// beyond `pos` counts as infinitely violated. A bond of length zero (a spring's rest
-/// length) has no relative error and is skipped.
+/// length) has no relative error and is skipped. A wall link ([`Bond::wall`]) counts its
+/// height error `|z_i - a| / a` (positions in the wall's frame).
 ///
 /// Two square roots, not one per bond: the error grows with `|r_ij|^2 / d^2` away from 1
 /// on either side, so it is largest at the largest or the smallest of these ratios
 /// (exactly so in exact arithmetic; where two bonds' errors agree to rounding, either
 /// may be named).
 pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
-    let error = |b: &Bond<T>, a: T::V3, c: T::V3| ((T::norm(a - c) - b.length) / b.length).abs();
     let (mut hi, mut lo) = ((0, T::ZERO), (0, T::ZERO));
     let mut first = true;
     for (k, b) in bonds.iter().enumerate() {
-        let (Some(&a), Some(&c)) = (pos.get(b.i), pos.get(b.j)) else {
+        if b.i >= pos.len() || b.j >= pos.len() {
             return max_residual_each(bonds, pos);
-        };
+        }
         if b.length == T::ZERO {
             continue;
         }
-        let ratio = T::norm2(a - c) / (b.length * b.length);
+        let r = b.relative(pos);
+        let mut ratio = T::norm2(r) / (b.length * b.length);
+        // A wall link's centre at or below the plane has the error of a bond stretched
+        // to `(2 - z/a) d`: the ratio that orders it with the others.
+        let h = T::xyz(r)[2] / b.length;
+        if b.is_wall() && !(h > T::ZERO) {
+            ratio = (T::TWO - h) * (T::TWO - h);
+        }
         if ratio.is_nan() {
             return max_residual_each(bonds, pos);
         }
@@ -181,7 +245,7 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
     }
     let at = |k: usize| {
         let b = &bonds[k];
-        (k, error(b, pos[b.i], pos[b.j]))
+        (k, link_error(b, b.relative(pos)))
     };
     if first {
         return (0, T::ZERO);
@@ -198,10 +262,10 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
 fn max_residual_each<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
     let mut worst = (0, T::ZERO);
     for (k, b) in bonds.iter().enumerate() {
-        let r = match (pos.get(b.i), pos.get(b.j)) {
-            (Some(_), Some(_)) if b.length == T::ZERO => continue,
-            (Some(&a), Some(&c)) => ((T::norm(a - c) - b.length) / b.length).abs(),
-            _ => T::ONE / T::ZERO,
+        let r = match b.i < pos.len() && b.j < pos.len() {
+            true if b.length == T::ZERO => continue,
+            true => link_error(b, b.relative(pos)),
+            false => T::ONE / T::ZERO,
         };
         if !worst.1.is_nan() && (r.is_nan() || r > worst.1) {
             worst = (k, r);

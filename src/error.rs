@@ -205,7 +205,8 @@ pub enum StepError {
         limit: f64,
     },
     /// More spheres would touch at once than [`Contacts::capacity`](crate::Contacts)
-    /// holds.
+    /// holds (with a wall, plus one wall link per sphere: the pool of one-sided
+    /// constraints, [`Params::constraints`](crate::Params::constraints)).
     ContactsFull {
         /// The capacity.
         capacity: usize,

@@ -139,6 +139,16 @@ impl Contacts {
 /// A no-slip plane wall `z = height` below the spheres, its normal `+z` (gravity is
 /// expected to point towards it). It changes the mobility (the wall's image system) and
 /// is a one-sided constraint: no sphere's centre may go below `height + a_i`.
+///
+/// The constraint is held in the overdamped position projection with the bonds and the
+/// hard-sphere contacts ([`Method::Overdamped`], [`Method::Overdamped2`]; with or without
+/// [`Params::contacts`]; with thermal noise for [`Method::Overdamped`]): a sphere that
+/// would end below its contact height is held there, and released when the wall would
+/// have to pull it. Storage: one more constraint per sphere
+/// ([`Params::constraints`]). A state with a sphere below its contact height (beyond
+/// the solver's tolerance) is refused
+/// ([`ParticleError::BelowWall`](crate::ParticleError::BelowWall)). The other methods
+/// refuse a wall ([`StepError::Unsupported`](crate::StepError::Unsupported)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Wall<T> {
     /// The plane's `z` coordinate (finite).
@@ -287,12 +297,17 @@ impl<T: Real> Params<T> {
         self.matrix_free || self.noise_sqrt.lanczos(n)
     }
 
-    /// Constraint slots a step with `bonds` bonds holds: the bonds, and the contact
-    /// capacity when contacts are on.
-    pub const fn constraints(&self, bonds: usize) -> usize {
-        match self.contacts {
-            Some(c) => bonds + c.capacity,
-            None => bonds,
-        }
+    /// Constraint slots a step of `n` spheres with `bonds` bonds holds: the bonds, the
+    /// contact capacity when contacts are on, and one wall link per sphere with a wall.
+    pub const fn constraints(&self, n: usize, bonds: usize) -> usize {
+        let contacts = match self.contacts {
+            Some(c) => c.capacity,
+            None => 0,
+        };
+        let wall = match self.wall {
+            Some(_) => n,
+            None => 0,
+        };
+        bonds + contacts + wall
     }
 }

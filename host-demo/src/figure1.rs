@@ -48,6 +48,24 @@ pub struct CaseSummary {
     pub wall_time_s: f64,
     /// Failure, if the run stopped early.
     pub failure: Option<String>,
+    /// With a wall: the landing time, the end of the first step after which a sphere
+    /// was held on the wall (its first contact); `None` if it never landed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub landing_time: Option<f64>,
+    /// With a wall: the final state on it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub on_wall: Option<OnWall>,
+}
+
+/// A case's final state on the wall.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct OnWall {
+    /// Spheres in contact with the wall at the end.
+    pub contacts: u32,
+    /// Smallest sphere-wall gap at the end (0 at contact).
+    pub gap: f64,
+    /// Centre of mass's height above the wall at the end.
+    pub com_height: f64,
 }
 
 /// `figure1.json`.
@@ -55,6 +73,9 @@ pub struct CaseSummary {
 pub struct Figure1Summary {
     /// Every state name, in a fixed order (for legends).
     pub states: Vec<&'static str>,
+    /// The wall's height (`figure1 --wall`), if there was one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wall_height: Option<f64>,
     /// The three cases.
     pub cases: Vec<CaseSummary>,
     /// The paper's claims, with verdicts computed from the runs.
@@ -103,6 +124,15 @@ pub fn summarise(case: &str, scene: &Scene, r: &RunResult) -> CaseSummary {
         duration: f.time,
         wall_time_s: r.summary.wall_time_s,
         failure: r.summary.failure.clone(),
+        landing_time: r.summary.landing_time,
+        on_wall: match (f.wall_contacts, f.wall_gap, f.wall_height) {
+            (Some(contacts), Some(gap), Some(com_height)) => Some(OnWall {
+                contacts,
+                gap,
+                com_height,
+            }),
+            _ => None,
+        },
     }
 }
 
@@ -130,7 +160,27 @@ pub fn figure1(out: &Path, max_steps: Option<usize>) -> Result<Figure1Summary> {
 /// [`figure1`], with `snapshots.png` at the times `at` (none: no such file); times are
 /// checked (finite, within the runs' duration) before anything runs.
 pub fn figure1_at(out: &Path, max_steps: Option<usize>, at: &[f64]) -> Result<Figure1Summary> {
-    let scenes = Scene::figure1()?;
+    figure1_wall(out, max_steps, at, None)
+}
+
+/// [`figure1_at`] with the three chains above a wall at height `wall` (`figure1
+/// --wall H`): each lands on it; `figure1.json` gives each case's landing time and its
+/// final state on the wall, and the pictures show the landed chains.
+pub fn figure1_wall(
+    out: &Path,
+    max_steps: Option<usize>,
+    at: &[f64],
+    wall: Option<f64>,
+) -> Result<Figure1Summary> {
+    let mut scenes = Scene::figure1()?;
+    if let Some(h) = wall {
+        for (case, scene) in scenes.iter_mut() {
+            *scene = scene
+                .clone()
+                .with_wall(h)
+                .map_err(|e| anyhow::anyhow!("--wall {h}, case ({case}): {e}"))?;
+        }
+    }
     let duration = scenes
         .iter()
         .map(|(_, s)| s.integrator.duration)
@@ -156,7 +206,7 @@ pub fn figure1_at(out: &Path, max_steps: Option<usize>, at: &[f64]) -> Result<Fi
             run(scene, case, Some(&out.join(case)), opts)
         })
         .collect();
-    let wall = start.elapsed().as_secs_f64();
+    let elapsed = start.elapsed().as_secs_f64();
     let results: Vec<RunResult> = results.into_iter().collect::<Result<_>>()?;
     let mut cases = Vec::new();
     let mut titles = Vec::new();
@@ -183,9 +233,10 @@ pub fn figure1_at(out: &Path, max_steps: Option<usize>, at: &[f64]) -> Result<Fi
     log::info!("figure 1 pictures drawn in {drawing:.3} s");
     let summary = Figure1Summary {
         states: State::ALL.iter().map(|s| s.name()).collect(),
+        wall_height: wall,
         cases,
         claims: claims_of(&scenes, &runs),
-        wall_time_s: wall,
+        wall_time_s: elapsed,
         drawing_wall_time_s: drawing,
         pictures,
     };

@@ -86,6 +86,11 @@ enum Command {
             allow_negative_numbers = true
         )]
         at: Vec<f64>,
+        /// Put a no-slip wall at z = H below the chains (every sphere must start above
+        /// it): each chain lands on it; figure1.json gives the landing times and the
+        /// final states on the wall.
+        #[arg(long, value_name = "H", allow_negative_numbers = true)]
+        wall: Option<f64>,
     },
     /// Figure 1's trajectories against a reference at a small time step: RMS deviation
     /// over time and agreement horizons of the main job's settings and alternatives.
@@ -290,8 +295,13 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
         }
-        Command::Figure1 { out, quick, at } => {
-            let s = host_demo::figure1::figure1_at(&out, quick.then_some(2000), &at)?;
+        Command::Figure1 {
+            out,
+            quick,
+            at,
+            wall,
+        } => {
+            let s = host_demo::figure1::figure1_wall(&out, quick.then_some(2000), &at, wall)?;
             println!(
                 "case  D     head   extension verticality twist_rate head_speed outcome          t(ext>=0.95) wall_s"
             );
@@ -310,6 +320,21 @@ fn run(cli: Cli) -> Result<()> {
                         .map_or("never".to_string(), |t| format!("{t:.1}")),
                     c.wall_time_s
                 );
+            }
+            if let Some(h) = s.wall_height {
+                println!("wall at z = {h}: case landing_time contacts gap com_height");
+                for c in &s.cases {
+                    let landing = c
+                        .landing_time
+                        .map_or("never".to_string(), |t| format!("{t:.2}"));
+                    match c.on_wall {
+                        Some(w) => println!(
+                            "  {:<4} {landing:<12} {:<8} {:<10.3e} {:.3}",
+                            c.case, w.contacts, w.gap, w.com_height
+                        ),
+                        None => println!("  {:<4} {landing}", c.case),
+                    }
+                }
             }
             println!("claim                case verdict    window");
             for c in &s.claims {

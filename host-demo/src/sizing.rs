@@ -113,6 +113,8 @@ pub struct Plan {
     pub contact: Option<Contact>,
     /// Thermal noise (adds the mobility's factor or the Lanczos basis).
     pub brownian: Option<Thermal>,
+    /// A wall (one more constraint slot per particle).
+    pub wall: bool,
     /// No stored mobility (`[integrator] matrix_free`).
     pub matrix_free: bool,
 }
@@ -127,6 +129,7 @@ impl Plan {
             precision: scene.integrator.precision,
             contact: scene.contact,
             brownian: scene.brownian,
+            wall: scene.wall.is_some(),
             matrix_free: scene.integrator.matrix_free,
         }
     }
@@ -136,13 +139,17 @@ impl Plan {
     /// constraints beside the bonds.
     pub fn layout(&self, n: usize, b: usize) -> Option<Layout> {
         let contacts = self.contact.and_then(|c| c.hard_capacity(n));
-        let c = b.saturating_add(contacts.unwrap_or(0));
+        let walls = if self.wall { n } else { 0 };
+        let c = b
+            .saturating_add(contacts.unwrap_or(0))
+            .saturating_add(walls);
         (n <= COUNT_MAX && c <= COUNT_MAX).then(|| {
             let mut p = Params::<f64>::new(1.0);
             p.method = self.method.kernel();
             p.rotation = self.rotation;
             p.solver.kind = self.solver.kind();
             p.contacts = contacts.map(Contacts::new);
+            p.wall = self.wall.then_some(hydrorattle::Wall::new(0.0));
             p.matrix_free = self.matrix_free;
             if let Some(t) = self.brownian {
                 p.brownian = Some(hydrorattle::Brownian {
@@ -195,6 +202,7 @@ mod tests {
             precision,
             contact: None,
             brownian: None,
+            wall: false,
             matrix_free: false,
         }
     }

@@ -1,6 +1,6 @@
 //! Kernel parameters from keyword arguments, with the kernel's names and defaults.
 
-use hydrorattle::{Brownian, Contacts, Drift, Method, NoiseSqrt, Params, Real, SolverKind};
+use hydrorattle::{Brownian, Contacts, Drift, Method, NoiseSqrt, Params, Real, SolverKind, Wall};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -82,6 +82,11 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
             "stability_guard" => p.stability_guard = x.extract()?,
             "contacts" => {
                 p.contacts = x.extract::<Option<usize>>()?.map(Contacts::new);
+            }
+            "wall" => {
+                p.wall = x
+                    .extract::<Option<f64>>()?
+                    .map(|h| Wall::new(T::from_f64(h)))
             }
             "temperature" => temperature = x.extract::<Option<f64>>()?,
             "drift" => {

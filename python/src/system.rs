@@ -37,6 +37,8 @@ pub struct Report {
     pub max_tension: f64,
     /// Hard-sphere contacts held at the end of the step.
     pub contacts: u32,
+    /// Spheres held on the wall at the end of the step (0 without a wall).
+    pub wall_contacts: u32,
     /// Active-set rounds of the contact projection.
     pub contact_rounds: u32,
     /// Lanczos iterations of the thermal noise (0 with Cholesky or without noise).
@@ -63,6 +65,7 @@ impl Report {
             residual: r.residual.to_f64(),
             max_tension: r.max_tension.to_f64(),
             contacts: r.contacts,
+            wall_contacts: r.wall_contacts,
             contact_rounds: r.contact_rounds,
             noise_iterations: r.noise_iterations,
             steps,
@@ -244,6 +247,7 @@ fn empty(steps: usize) -> Report {
         residual: 0.0,
         max_tension: 0.0,
         contacts: 0,
+        wall_contacts: 0,
         contact_rounds: 0,
         noise_iterations: 0,
         steps,

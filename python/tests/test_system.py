@@ -357,3 +357,29 @@ def test_rattle_stable_at_temperature_equipartition_of_the_scheme():
     mean, se = blocks.mean(), blocks.std(ddof=1) / math.sqrt(blocks.size)
     assert se < 0.01
     assert abs(mean - 2.0 / 3.0) < 3.0 * se, (mean, se)
+
+
+def test_a_chain_lands_on_a_wall_from_the_scene_code():
+    """The [wall] table through the CLI's scene code (System.helix), and the wall=
+    keyword: spheres stop at contact, never below; a sphere below the wall is refused
+    with its index."""
+    h = -6.0
+    s = hr.System.helix(
+        tails=4, wall={"height": h}, contact={"model": "hard"},
+        integrator={"method": "overdamped", "dt": 0.2},
+    )
+    for _ in range(60):
+        r = s.step(1)
+        assert np.all(s.positions[:, 2] - s.radii - h >= -1e-9)
+    gap = s.positions[:, 2] - s.radii - h
+    assert r.wall_contacts == np.sum(gap < 1e-9) >= 3
+    with pytest.raises(hr.SceneError, match="particle 0 is below the wall") as e:
+        hr.System.helix(tails=4, wall={"height": 0.0}, integrator={"method": "overdamped", "dt": 0.2})
+    assert e.value.line is not None
+    one = hr.System([[0.0, 0.0, 2.5]], 1.0, RHO, dt=1.0, wall=0.0)
+    one.step(10)
+    assert one.positions[0, 2] == pytest.approx(1.0, abs=1e-9)
+    below = hr.System([[0.0, 0.0, 2.5], [3.0, 0.0, 0.5]], 1.0, RHO, dt=1.0, wall=0.0)
+    with pytest.raises(hr.InvalidStateError, match="particle 1") as e:
+        below.step()
+    assert e.value.index == 1

@@ -106,7 +106,7 @@ pub fn krylov<T: Real>(
             metric.apply_all(bonds, p, w, tmp);
             products += 1;
             for (k, b) in bonds.iter().enumerate() {
-                q[k] = T::dot(metric.grad(k), w[b.i] - w[b.j]) * c;
+                q[k] = T::dot(metric.grad(k), b.relative(w)) * c;
             }
             let pq = dot(p, q);
             if !pq.is_finite() {

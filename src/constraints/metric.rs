@@ -5,6 +5,10 @@
 //! hydrodynamic metrics move every bead, but none of them is ever stored as a dense
 //! `beads x bonds` array except [`Metric::Dense`], which the small dense solve of the
 //! implicit-drag integrator uses.
+//!
+//! A wall link ([`Bond::wall`]) pushes on its sphere alone: its `j` term is absent
+//! (`D_l(p) = scale mu_pi g_l`), and the change of its relative vector is the normal
+//! component of its sphere's displacement ([`Bond::relative`]).
 
 use crate::bonds::Bond;
 use crate::linalg::{self, tri};
@@ -164,7 +168,11 @@ impl<T: Real> Metric<'_, T> {
                 mu, grad, scale, ..
             } => {
                 let g = grad[l] * scale;
-                sym_diff_mul::<T>(sym_block::<T>(mu, p, b.i), sym_block::<T>(mu, p, b.j), g)
+                let mu_pj = match b.is_wall() {
+                    true => T::M3_ZERO,
+                    false => sym_block::<T>(mu, p, b.j),
+                };
+                sym_diff_mul::<T>(sym_block::<T>(mu, p, b.i), mu_pj, g)
             }
             Metric::Free {
                 level,
@@ -184,7 +192,8 @@ impl<T: Real> Metric<'_, T> {
                     _ => tt_block_at(level, eta, pos, radius, p, q),
                 };
                 let block = |q| block(q).unwrap_or(T::M3_ZERO);
-                sym_diff_mul::<T>(block(b.i), block(b.j), grad[l] * scale)
+                let mu_pj = if b.is_wall() { T::M3_ZERO } else { block(b.j) };
+                sym_diff_mul::<T>(block(b.i), mu_pj, grad[l] * scale)
             }
             Metric::Dense { disp, n, .. } => disp[p * (disp.len() / n) + l],
             Metric::Drag {
@@ -207,6 +216,9 @@ impl<T: Real> Metric<'_, T> {
     #[inline(always)]
     pub fn relative(&self, bonds: &[Bond<T>], k: usize, l: usize) -> T::V3 {
         let b = bonds[k];
+        if b.is_wall() {
+            return crate::bonds::normal::<T>(self.at(bonds, l, b.i));
+        }
         self.at(bonds, l, b.i) - self.at(bonds, l, b.j)
     }
 
@@ -225,9 +237,17 @@ impl<T: Real> Metric<'_, T> {
         match *self {
             Metric::Dense { disp, n, .. } => {
                 let nb = disp.len() / n;
-                let (di, dj) = (&disp[b.i * nb + first..], &disp[b.j * nb + first..]);
-                for ((r, &a), &c) in row.iter_mut().zip(di).zip(dj) {
-                    *r = T::dot(dir, a - c);
+                let di = &disp[b.i * nb + first..];
+                if b.is_wall() {
+                    // A wall link moves its sphere alone.
+                    for (r, &a) in row.iter_mut().zip(di) {
+                        *r = T::dot(dir, a);
+                    }
+                } else {
+                    let dj = &disp[b.j * nb + first..];
+                    for ((r, &a), &c) in row.iter_mut().zip(di).zip(dj) {
+                        *r = T::dot(dir, a - c);
+                    }
                 }
             }
             _ => {
@@ -244,7 +264,9 @@ impl<T: Real> Metric<'_, T> {
             Metric::Mass { .. } => {
                 let b = bonds[l];
                 x[b.i] += self.at(bonds, l, b.i) * c;
-                x[b.j] += self.at(bonds, l, b.j) * c;
+                if !b.is_wall() {
+                    x[b.j] += self.at(bonds, l, b.j) * c;
+                }
             }
             Metric::Dense { disp, n, .. } => {
                 let nb = disp.len() / n;
@@ -299,7 +321,9 @@ impl<T: Real> Metric<'_, T> {
                 for (l, b) in bonds.iter().enumerate() {
                     let g = grad[l] * (c[l] * scale);
                     out[b.i] += g * inv_mass[b.i];
-                    out[b.j] -= g * inv_mass[b.j];
+                    if !b.is_wall() {
+                        out[b.j] -= g * inv_mass[b.j];
+                    }
                 }
             }
             Metric::Dense { .. } => {
@@ -387,6 +411,12 @@ pub(crate) fn tabulate<T: Real>(
     for (l, b) in bonds.iter().enumerate() {
         let g = grad[l] * scale;
         // Bead `q`'s entry of this bond is `disp[q * nb + l]` (bead-major).
+        if b.is_wall() {
+            for q in 0..n {
+                disp[q * nb + l] = sym_diff_mul::<T>(sym_block::<T>(mu, q, b.i), T::M3_ZERO, g);
+            }
+            continue;
+        }
         let (i, j) = (b.i, b.j);
         let (lo, hi) = (i.min(j), i.max(j));
         // The values of `sym_block(q, i) - sym_block(q, j)`, read in three runs of `q` so
@@ -426,6 +456,8 @@ fn spread<T: Real>(bonds: &[Bond<T>], grad: &[T::V3], c: &[T], scale: T, f: &mut
     for (l, b) in bonds.iter().enumerate() {
         let g = grad[l] * (c[l] * scale);
         f[b.i] += g;
-        f[b.j] -= g;
+        if !b.is_wall() {
+            f[b.j] -= g;
+        }
     }
 }

@@ -6,6 +6,12 @@
 //! problem finds `lambda` with `|x_i - x_j|^2 = d^2` for `x = x* + sum_l lambda_l D_l`
 //! (paper eq. 3); the velocity problem finds `kappa` with `b_k . (v_i - v_j) = 0` for
 //! `v = v* + sum_l kappa_l D_l` (paper eq. 4), `b_k` the bond vectors at the new positions.
+//!
+//! The list may hold wall links ([`Bond::wall`]) after the bonds: a sphere held at its
+//! radius above the plane `z = 0` (positions in the wall's frame) by the linear
+//! constraint `2 a (z_i - a) = 0`. Its multiplier pushes on the sphere alone, along
+//! `g = (0, 0, a)`; everything else (metrics, Jacobians, solvers) treats it as a link
+//! whose other end does not move along the normal ([`Bond::relative`]).
 
 mod krylov;
 mod metric;
@@ -104,9 +110,20 @@ impl<T: Real> Problem<'_, T> {
     /// normalised magnitude compared with the tolerance.
     #[inline]
     fn eval(&self, b: &Bond<T>, k: usize, x: &[T::V3]) -> (T, T::V3, T) {
-        let rel = x[b.i] - x[b.j];
+        let rel = b.relative(x);
         let d2 = b.length * b.length;
         match *self {
+            // A wall link's linear constraint `2 d (z - d)` (see [`Bond::wall`]); its
+            // gradient `(0, 0, 2 d)` is the chord's `c g` (`g = (0, 0, d)`).
+            Problem::Positions if b.is_wall() => {
+                let z = T::xyz(rel)[2];
+                let two_d = T::TWO * b.length;
+                (
+                    two_d * (z - b.length),
+                    T::v3(T::ZERO, T::ZERO, two_d),
+                    ((z - b.length) / b.length).abs(),
+                )
+            }
             Problem::Positions => {
                 let r2 = T::norm2(rel);
                 // The relative length error `| |r| - d | / d` the tolerance is stated in

@@ -19,8 +19,8 @@
 //! would supply it anyway (it differentiates `P mu` as a whole).
 
 use super::{
-    Start, StepReport, add_constraint_forces, add_flow, bond_vectors, mobility_metric,
-    mobility_product, project_positions, report, spin, step_velocity,
+    Projection, Start, StepReport, add_constraint_forces, add_flow, bond_vectors, mobility_metric,
+    mobility_product, project_overdamped, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch};
@@ -67,6 +67,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         bands,
         basis,
         krylov_t,
+        links,
         ..
     } = v;
     // Deterministic velocity at the start: U_inf + mu F.
@@ -88,20 +89,30 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     };
     let (noise_iterations, midpoint) =
         kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held), krylov)?;
-    // r* = r + dt (U_inf + mu F) + noise, projected as in the deterministic step.
-    for i in 0..n {
-        new_pos[i] = s.pos[i] + u[i] * dt + dx[i];
-    }
-    bond_vectors(bonds, s.pos, grad);
-    let par = scratch.par;
-    let metric = mobility_metric(p, bonds, s.pos, s.radius, mu, grad, dt, disp, par);
-    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut scratch)?;
+    // r* = r + dt (U_inf + mu F) + noise, projected as in the deterministic step (with
+    // the wall's links when there is one).
+    let free = |x: &mut [T::V3]| {
+        for i in 0..n {
+            x[i] = s.pos[i] + u[i] * dt + dx[i];
+        }
+    };
+    let views = Projection {
+        links,
+        grad: &mut *grad,
+        disp,
+        lambda: &mut *lambda,
+        scratch: &mut scratch,
+    };
+    let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, xi);
-    add_constraint_forces(bonds, grad, lambda, force);
+    add_constraint_forces(r.held, grad, lambda, force);
     spin(p, s.pos, s.radius, force, mid)?;
     Ok(StepReport {
         noise_iterations,
-        ..report(stats, midpoint, bonds, lambda)
+        contacts: r.contacts,
+        wall_contacts: r.wall_contacts,
+        contact_rounds: r.rounds,
+        ..report(r.stats, midpoint, bonds, lambda)
     })
 }
 

@@ -60,16 +60,45 @@ pub(super) fn check_thermal<T: Real>(
     Ok(Some(b))
 }
 
-/// Checks the wall's height (its mobility, `mobility::wall`, serves every method), and
-/// refuses a wall when the kernel was built without its `wall` feature.
-pub(super) fn check_wall<T: Real>(p: &Params<T>) -> Result<(), StepError> {
-    match p.wall {
-        Some(w) if !w.height.is_finite() => Err(StepError::BadParameter("wall.height (finite)")),
-        Some(_) if !cfg!(feature = "wall") => Err(StepError::Unsupported(
-            "a wall: the kernel was built without its `wall` feature",
-        )),
-        _ => Ok(()),
+/// Checks the wall: a finite height; the kernel built with its `wall` feature (the
+/// wall's mobility, `mobility::wall`) and its `contacts` feature (the wall is held as
+/// a one-sided constraint); a method whose position projection holds it (Overdamped,
+/// Overdamped2); and no sphere below its contact height `height + a_i` (beyond the
+/// contacts' tolerance: the last step's wall contacts end within it).
+pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result<(), StepError> {
+    let Some(w) = p.wall else {
+        return Ok(());
+    };
+    if !w.height.is_finite() {
+        return Err(StepError::BadParameter("wall.height (finite)"));
     }
+    if !cfg!(feature = "wall") {
+        return Err(StepError::Unsupported(
+            "a wall: the kernel was built without its `wall` feature",
+        ));
+    }
+    if !cfg!(feature = "contacts") {
+        return Err(StepError::Unsupported(
+            "a wall: the kernel was built without its `contacts` feature",
+        ));
+    }
+    if !matches!(p.method, Method::Overdamped | Method::Overdamped2) {
+        return Err(StepError::Unsupported(
+            "a wall with a method other than Overdamped or Overdamped2",
+        ));
+    }
+    match below_wall(state.pos, state.radius, w.height, p.solver.tolerance) {
+        Some(particle) => Err(ParticleError::BelowWall { particle }.into()),
+        None => Ok(()),
+    }
+}
+
+/// The first sphere whose centre is below `height + a_i (1 - 2 tol)`.
+fn below_wall<T: Real>(pos: &[T::V3], radius: &[T], height: T, tol: T) -> Option<usize> {
+    let reach = T::ONE - tol * T::TWO;
+    pos.iter()
+        .zip(radius)
+        .position(|(&r, &a)| !(T::xyz(r)[2] - height >= a * reach))
 }
 
 /// Refuses contacts where they are not implemented.
@@ -187,8 +216,9 @@ pub(super) fn check_inputs<T: Real>(
     Ok(())
 }
 
-/// Finite, no nested spheres, no overlap unless allowed (squared distances: no sqrt).
-/// With contacts, spheres touch to within the solver's tolerance, which is accepted.
+/// Finite, no nested spheres, no overlap unless allowed (squared distances: no sqrt),
+/// no sphere below the wall. With contacts, spheres touch to within the solver's
+/// tolerance, which is accepted; so do spheres on the wall.
 pub(super) fn accept<T: Real>(
     pos: &[T::V3],
     vel: &[T::V3],
@@ -204,6 +234,11 @@ pub(super) fn accept<T: Real>(
     for i in 0..pos.len() {
         if !(T::v3_is_finite(pos[i]) && T::v3_is_finite(vel[i]) && T::v3_is_finite(omega[i])) {
             return Err(StepError::NonFinite { particle: i });
+        }
+    }
+    if let Some(w) = p.wall {
+        if let Some(particle) = below_wall(pos, radius, w.height, p.solver.tolerance) {
+            return Err(ParticleError::BelowWall { particle }.into());
         }
     }
     for (i, (&pi, &ai)) in pos.iter().zip(radius).enumerate() {

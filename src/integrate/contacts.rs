@@ -19,13 +19,23 @@
 //! depend on the path. No stiffness: the contacts do not limit `dt`. A step so large
 //! that a pair would end in contact on the far side of where it started is refused
 //! ([`StepError::Degenerate`], indexed past the bonds), as a bond turned too far is.
+//!
+//! **The wall** ([`Params::wall`]) takes part in the same iteration: a sphere whose
+//! centre would end below `height + a_i` gets a wall link ([`Bond::wall`]: the linear
+//! constraint `z_i = height + a_i`, pushing on that sphere alone along `+z`), released
+//! like a contact when its multiplier would pull the sphere down. The projection runs in
+//! the wall's frame: the candidate is moved by `-height` along `z` before each solve and
+//! back at the end (exact for `height = 0`; otherwise the candidate's `z` is rounded
+//! twice). With or without [`Params::contacts`]; with a wall, the pool of one-sided
+//! constraints holds one wall link per sphere beside the contacts' capacity
+//! ([`Params::constraints`]).
 
 use super::{bond_vectors, mobility_metric, project_positions};
 use crate::bonds::Bond;
 use crate::constraints::Solver;
 use crate::constraints::{Scratch, SolveStats};
 use crate::error::{Stage, StepError};
-use crate::params::{Contacts, Params};
+use crate::params::{Contacts, Params, Wall};
 use crate::real::Real;
 
 /// The slices the overdamped position projection works in.
@@ -45,6 +55,8 @@ pub(super) struct Projected<'l, T: Real> {
     pub held: &'l [Bond<T>],
     /// Contacts held (0 without contacts).
     pub contacts: u32,
+    /// Wall links held (0 without a wall).
+    pub wall_contacts: u32,
     /// Active-set rounds (0 without contacts).
     pub rounds: u32,
 }
@@ -76,17 +88,26 @@ pub(super) fn project_overdamped<'l, T: Real>(
         lambda,
         scratch,
     } = v;
-    // A constant without the `contacts` feature: the contact path folds away.
+    // Constants without the `contacts` feature: the one-sided path folds away.
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
-    // With contacts the solver is resolved once for the bonds plus the capacity, as the
-    // storage was ([`Layout::for_params`](crate::Layout::for_params)), however many
-    // contacts a round holds.
+    let wall = p.wall.filter(|_| cfg!(feature = "contacts"));
+    let nb = bonds.len();
+    // The pool of one-sided constraints: the contacts' capacity, one wall link per
+    // sphere ([`Params::constraints`]).
+    let pool = p.constraints(start.len(), nb) - nb;
+    let one_sided = match (contacts, wall) {
+        (None, None) => None,
+        (c, _) => Some(c.unwrap_or(Contacts::new(0))),
+    };
+    // With one-sided constraints the solver is resolved once for the bonds plus the
+    // pool, as the storage was ([`Layout::for_params`](crate::Layout::for_params)),
+    // however many a round holds.
     let resolved;
-    let p = match contacts {
-        Some(c) => {
+    let p = match one_sided {
+        Some(_) => {
             resolved = Params {
                 solver: Solver {
-                    kind: p.solver.kind.resolve(bonds.len() + c.capacity),
+                    kind: p.solver.kind.resolve(nb + pool),
                     ..p.solver
                 },
                 ..*p
@@ -95,27 +116,23 @@ pub(super) fn project_overdamped<'l, T: Real>(
         }
         None => p,
     };
-    let nb = bonds.len();
     let tol = p.solver.tolerance;
     let mut nc = 0;
-    if let Some(c) = contacts {
+    if one_sided.is_some() {
         links[..nb].copy_from_slice(bonds);
         // The last step's contacts end within the tolerance of touching.
-        add_pairs(
-            bonds,
-            start,
-            start,
-            radius,
-            T::ONE + tol * T::TWO,
-            c,
-            links,
-            &mut nc,
-        )?;
+        let reach = T::ONE + tol * T::TWO;
+        if contacts.is_some() {
+            add_pairs(bonds, start, start, radius, reach, pool, links, &mut nc)?;
+        }
+        if let Some(w) = wall {
+            add_wall(nb, start, w.height, radius, reach, pool, links, &mut nc)?;
+        }
     }
     let mut round = 0;
     loop {
         round += 1;
-        let active = match contacts {
+        let active = match one_sided {
             Some(_) => &links[..nb + nc],
             None => bonds,
         };
@@ -123,28 +140,42 @@ pub(super) fn project_overdamped<'l, T: Real>(
         let par = scratch.par;
         let metric = mobility_metric(p, active, start, radius, mu, grad, p.dt, disp, par);
         free(x);
+        shift(x, wall, -T::ONE);
         let stats = project_positions(p, active, &metric, x, lambda, scratch)?;
-        let Some(c) = contacts else {
+        let Some(c) = one_sided else {
             return Ok(Projected {
                 stats,
                 held: bonds,
                 contacts: 0,
+                wall_contacts: 0,
                 rounds: 0,
             });
         };
-        let added = add_pairs(bonds, start, x, radius, T::ONE - tol, c, links, &mut nc)?;
+        let reach = T::ONE - tol;
+        let mut added = 0;
+        if contacts.is_some() {
+            added += add_pairs(bonds, start, x, radius, reach, pool, links, &mut nc)?;
+        }
+        if wall.is_some() {
+            added += add_wall(nb, x, T::ZERO, radius, reach, pool, links, &mut nc)?;
+        }
         if added == 0 && !release_pulling(nb, links, lambda, &mut nc) {
-            // Every contact must end on the side it started from.
+            // Every contact must end on the side it started from (a sphere above the
+            // wall: `grad = (0, 0, a)`, its relative vector `(0, 0, z)`).
             for (k, l) in links[nb..nb + nc].iter().enumerate() {
-                if !(T::dot(x[l.i] - x[l.j], grad[nb + k]) > T::ZERO) {
+                if !(T::dot(l.relative(x), grad[nb + k]) > T::ZERO) {
                     return Err(StepError::Degenerate { bond: nb + k });
                 }
             }
+            shift(x, wall, T::ONE);
             let links: &'l [Bond<T>] = links;
+            let held = &links[..nb + nc];
+            let walls = held.iter().filter(|l| l.is_wall()).count();
             return Ok(Projected {
                 stats,
-                held: &links[..nb + nc],
-                contacts: nc as u32,
+                held,
+                contacts: (nc - walls) as u32,
+                wall_contacts: walls as u32,
                 rounds: round,
             });
         }
@@ -152,10 +183,66 @@ pub(super) fn project_overdamped<'l, T: Real>(
             return Err(StepError::NoConvergence {
                 stage: Stage::Contacts,
                 iterations: round,
-                residual: deepest_overlap(x, radius).to_f64(),
+                residual: deepest_overlap(x, radius, wall.is_some()).to_f64(),
             });
         }
     }
+}
+
+/// `z += sign * height` for every position (into the wall's frame with `sign = -1`,
+/// back with `+1`); nothing without a wall.
+fn shift<T: Real>(x: &mut [T::V3], wall: Option<Wall<T>>, sign: T) {
+    if let Some(w) = wall {
+        let dz = T::v3(T::ZERO, T::ZERO, w.height * sign);
+        for xi in x.iter_mut() {
+            *xi += dz;
+        }
+    }
+}
+
+/// Appends a wall link for every sphere whose centre is closer than `reach` times its
+/// radius to the plane `z = height` (or below it) and has none yet; returns how many
+/// were added.
+#[allow(clippy::too_many_arguments)]
+fn add_wall<T: Real>(
+    nb: usize,
+    pos: &[T::V3],
+    height: T,
+    radius: &[T],
+    reach: T,
+    pool: usize,
+    links: &mut [Bond<T>],
+    nc: &mut usize,
+) -> Result<usize, StepError> {
+    let mut added = 0;
+    for (i, (&r, &a)) in pos.iter().zip(radius).enumerate() {
+        if !(T::xyz(r)[2] - height < a * reach) {
+            continue;
+        }
+        if links[nb..nb + *nc].iter().any(|l| l.is_wall() && l.i == i) {
+            continue;
+        }
+        push(Bond::wall(i, a), nb, pool, links, nc)?;
+        added += 1;
+    }
+    Ok(added)
+}
+
+/// Appends `link` to the one-sided constraints held (`nc` of them after the `nb`
+/// bonds), unless the pool is full.
+fn push<T: Real>(
+    link: Bond<T>,
+    nb: usize,
+    pool: usize,
+    links: &mut [Bond<T>],
+    nc: &mut usize,
+) -> Result<(), StepError> {
+    if *nc == pool {
+        return Err(StepError::ContactsFull { capacity: pool });
+    }
+    links[nb + *nc] = link;
+    *nc += 1;
+    Ok(())
 }
 
 /// Appends every unbonded pair that ends closer than `reach` times its contact distance
@@ -168,7 +255,7 @@ fn add_pairs<T: Real>(
     to: &[T::V3],
     radius: &[T],
     reach: T,
-    c: Contacts,
+    pool: usize,
     links: &mut [Bond<T>],
     nc: &mut usize,
 ) -> Result<usize, StepError> {
@@ -188,17 +275,12 @@ fn add_pairs<T: Real>(
             if bonds.iter().any(joins) || links[nb..nb + *nc].iter().any(joins) {
                 continue;
             }
-            if *nc == c.capacity {
-                return Err(StepError::ContactsFull {
-                    capacity: c.capacity,
-                });
-            }
-            links[nb + *nc] = Bond {
+            let link = Bond {
                 i,
                 j,
                 length: sigma,
             };
-            *nc += 1;
+            push(link, nb, pool, links, nc)?;
             added += 1;
         }
     }
@@ -240,10 +322,14 @@ fn release_pulling<T: Real>(
     true
 }
 
-/// Largest relative overlap `1 - |r_ij| / (a_i + a_j)` (for the error report).
-fn deepest_overlap<T: Real>(pos: &[T::V3], radius: &[T]) -> T {
+/// Largest relative overlap `1 - |r_ij| / (a_i + a_j)`, and with a wall `1 - z_i / a_i`
+/// (positions in the wall's frame), for the error report.
+fn deepest_overlap<T: Real>(pos: &[T::V3], radius: &[T], wall: bool) -> T {
     let mut worst = T::ZERO;
     for i in 0..pos.len() {
+        if wall {
+            worst = worst.max(T::ONE - T::xyz(pos[i])[2] / radius[i]);
+        }
         for j in 0..i {
             let sigma = radius[i] + radius[j];
             worst = worst.max(T::ONE - T::norm(pos[i] - pos[j]) / sigma);

@@ -57,8 +57,10 @@ pub struct StepReport<T> {
     /// Hard-sphere contacts held at the end of the step ([`Params::contacts`]; 0
     /// without).
     pub contacts: u32,
+    /// Spheres held on the wall at the end of the step ([`Params::wall`]; 0 without).
+    pub wall_contacts: u32,
     /// Active-set rounds of the contact projection (constraint solves; 0 without
-    /// contacts).
+    /// contacts or a wall).
     pub contact_rounds: u32,
     /// Lanczos iterations of the thermal noise's square root ([`Params::noise_sqrt`]);
     /// 0 without noise or with the Cholesky factor.
@@ -128,7 +130,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
     // `p` stays the caller's reference: a firmware's `static` must stay visible to the
     // compiler, which then links only the method it runs.
     check_contacts(p, thermal.is_some())?;
-    check_wall(p)?;
+    check_wall(p, &state)?;
     let s = Start {
         pos: state.pos,
         vel: state.vel,
@@ -170,7 +172,10 @@ fn advance<T: Real, E: ExternalForce<T>>(
     );
     // The first-order overdamped step without contacts or noise ends on the position
     // solve's last iterate, whose residual over the bonds the solve has just measured.
-    let solved = p.method == Method::Overdamped && thermal.is_none() && p.contacts.is_none();
+    let solved = p.method == Method::Overdamped
+        && thermal.is_none()
+        && p.contacts.is_none()
+        && p.wall.is_none();
     if !solved {
         report.residual = max_residual(bonds, new_pos).1;
     }

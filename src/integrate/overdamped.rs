@@ -65,6 +65,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     spin(p, s.pos, s.radius, force, new_omega)?;
     Ok(StepReport {
         contacts: r.contacts,
+        wall_contacts: r.wall_contacts,
         contact_rounds: r.rounds,
         ..report(r.stats, 0, bonds, lambda)
     })
@@ -180,6 +181,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     Ok(StepReport {
         max_tension: tension,
         contacts: r.contacts,
+        wall_contacts: r.wall_contacts,
         contact_rounds: r.rounds,
         ..report(r.stats, 0, bonds, lambda)
     })

@@ -113,10 +113,14 @@ pub(super) fn assemble_tt<T: Real>(
     mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
 }
 
-/// `g_l = r_i - r_j` for every bond.
+/// `g_l = r_i - r_j` for every bond; `(0, 0, a)` for a wall link (the wall's normal,
+/// scaled as the link's relative vector at contact: [`Bond::wall`]).
 pub(super) fn bond_vectors<T: Real>(bonds: &[Bond<T>], pos: &[T::V3], out: &mut [T::V3]) {
     for (g, b) in out.iter_mut().zip(bonds) {
-        *g = pos[b.i] - pos[b.j];
+        *g = match b.is_wall() {
+            true => T::v3(T::ZERO, T::ZERO, b.length),
+            false => pos[b.i] - pos[b.j],
+        };
     }
 }
 
@@ -144,7 +148,9 @@ pub(super) fn add_constraint_forces<T: Real>(
 ) {
     for (l, b) in bonds.iter().enumerate() {
         f[b.i] += grad[l] * lambda[l];
-        f[b.j] -= grad[l] * lambda[l];
+        if !b.is_wall() {
+            f[b.j] -= grad[l] * lambda[l];
+        }
     }
 }
 
@@ -222,6 +228,7 @@ pub(super) fn report<T: Real>(
         residual: stats.residual,
         max_tension: max_tension(bonds, lambda),
         contacts: 0,
+        wall_contacts: 0,
         contact_rounds: 0,
         noise_iterations: 0,
     }

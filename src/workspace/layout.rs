@@ -10,7 +10,7 @@ use crate::params::{Method, Params};
 use crate::real::Real;
 
 /// Element counts of the storage arrays one step uses: four numeric arrays, and the
-/// constraint list of a step with contacts (`links`, zero otherwise).
+/// constraint list of a step with contacts or a wall (`links`, zero otherwise).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Layout {
     /// 3x3 blocks (packed mobilities and factors).
@@ -21,8 +21,8 @@ pub struct Layout {
     pub scalars: usize,
     /// Indices (LU pivots).
     pub indices: usize,
-    /// Constraint links (bonds followed by contacts) of a step with
-    /// [`Params::contacts`]; zero otherwise.
+    /// Constraint links (bonds followed by contacts and wall links) of a step with
+    /// [`Params::contacts`] or [`Params::wall`]; zero otherwise.
     pub links: usize,
 }
 
@@ -119,12 +119,13 @@ impl Layout {
 
     /// Storage for one step with parameters `p` (method, rotation flag, solver, the
     /// matrix-free flag, thermal noise and contacts), `n` particles and `bonds` bonds.
-    /// Contacts count as constraints beside the bonds (up to their capacity) and add the
-    /// list of links they are solved over.
+    /// Contacts count as constraints beside the bonds (up to their capacity), a wall as
+    /// one more per sphere ([`Params::constraints`]), and both add the list of links
+    /// they are solved over.
     pub const fn for_params<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Self {
-        let c = p.constraints(bonds);
+        let c = p.constraints(n, bonds);
         let mut l = Self::with_solver(p.method, p.rotation, p.solver.kind, n, c);
-        if p.contacts.is_some() {
+        if p.contacts.is_some() || p.wall.is_some() {
             l.links = c;
         }
         let bonds = c;

@@ -70,7 +70,7 @@ impl<T: Real> Workspace<'_, T> {
         if !have.holds(&need) {
             return Err(StepError::Storage { need, have });
         }
-        let nb = p.constraints(bonds);
+        let nb = p.constraints(n, bonds);
         let links = Carve(&mut *self.links).take(need.links);
         let m = super::block_rows(method, rotation, n);
         let kind = kind.resolve(nb);

@@ -21,6 +21,7 @@
 //! | `[integrator]` | `method` (required), `dt` (required), `duration` (required), `solver = "auto"\|"sweep"\|"newton"\|"krylov"`, `tolerance`, `max_iterations`, `precision = "f32"\|"f64"`, `stiffness`, `fene` (FENE maximum extension `Q0` > 0, springs only; every bond must start shorter), `matrix_free` (never store the mobility: `O(N)` storage; overdamped or springs, level manual) | auto, 1e-10, 500, f64, 1e4, none (Hookean), false |
 //! | `[output]` | `every` (steps between trajectory frames, >= 1) | about [`TARGET_FRAMES`] frames |
 //! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"`, `"springs"` or `"rattle-stable"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
+//! | `[wall]` | `height` (required, finite): a no-slip plane `z = height` below every sphere (`method = "overdamped"` or `"overdamped2"`, level manual; see [`Wall`]) | no wall |
 //!
 //! A scene gives either a `[helix]` table or explicit `[[particle]]` (and optionally
 //! `[[bond]]`) tables, never both. Units are those of `DESIGN.md` section 4: tail radius
@@ -49,6 +50,7 @@ mod resolve;
 #[cfg(test)]
 mod tests;
 mod thermal;
+mod wall;
 mod write;
 
 pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE, SOFT_DT, SOFT_STIFFNESS};
@@ -59,6 +61,7 @@ pub use model::{
     Precision, Solver,
 };
 pub use thermal::{DEFAULT_SEED, Drift, Sqrt, Thermal};
+pub use wall::Wall;
 
 use serde::Serialize;
 use std::path::Path;
@@ -137,6 +140,8 @@ pub struct Scene {
     pub contact: Option<Contact>,
     /// Thermal noise (`[brownian]`); `None`: deterministic.
     pub brownian: Option<Thermal>,
+    /// A no-slip plane wall below the spheres (`[wall]`); `None`: unbounded fluid.
+    pub wall: Option<Wall>,
     /// Species (type name) of each particle: `head` and `tail` for a helix; the
     /// `species` key, or one name per distinct radius and density, for explicit
     /// particles.

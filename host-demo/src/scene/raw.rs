@@ -25,6 +25,7 @@ pub(super) struct RawScene {
     pub(super) output: Option<RawOutput>,
     pub(super) contact: S<super::contact::RawContact>,
     pub(super) brownian: Option<super::thermal::RawBrownian>,
+    pub(super) wall: S<super::wall::RawWall>,
 }
 
 #[derive(Deserialize)]
@@ -113,6 +114,8 @@ pub(super) struct RawOutput {
 pub(super) enum Bound {
     Positive,
     NonNegative,
+    /// Finite, any sign.
+    Any,
 }
 
 /// Takes a spanned number (or its default), checks finiteness and bound.

@@ -98,6 +98,14 @@ impl RawScene {
         if let (Some(c), Some(raw)) = (contact, &self.contact) {
             super::contact::check_method(c, raw, &integrator, brownian.as_ref())?;
         }
+        let wall = match &self.wall {
+            None => None,
+            Some(raw) => {
+                let w = super::wall::resolve(raw)?;
+                super::wall::check_method(raw, &model, &integrator)?;
+                Some(w)
+            }
+        };
         let every = match self.output.as_ref().and_then(|o| o.every.as_ref()) {
             None => integrator.steps().div_ceil(TARGET_FRAMES).max(1),
             Some(e) if *e.get_ref() == 0 => {
@@ -107,7 +115,14 @@ impl RawScene {
             // stays a number a scene file can hold.
             Some(e) => (*e.get_ref()).min(integrator.steps()),
         };
-        let plans = plans(&model, &integrator, &flow, contact, brownian);
+        let plans = plans(
+            &model,
+            &integrator,
+            &flow,
+            contact,
+            brownian,
+            wall.is_some(),
+        );
         let every_span = self
             .output
             .as_ref()
@@ -175,6 +190,9 @@ impl RawScene {
         };
 
         check_geometry(&particles, model.overlap, &body_span)?;
+        if let Some(w) = wall {
+            super::wall::check_particles(w, &particles, &body_span)?;
+        }
         super::precision::check(&particles, &bonds, integrator.precision, &body_span)?;
         if let (Some(raw), Some(thermal)) = (&self.brownian, &brownian) {
             let min_radius = particles.iter().fold(f64::INFINITY, |m, p| m.min(p.radius));
@@ -205,6 +223,7 @@ impl RawScene {
             contact,
             brownian,
             species,
+            wall,
         })
     }
 }
@@ -263,6 +282,7 @@ fn plans(
     flow: &Flow,
     contact: Option<super::Contact>,
     brownian: Option<super::Thermal>,
+    wall: bool,
 ) -> Vec<Plan> {
     let plan = |(method, rotation)| Plan {
         method,
@@ -271,6 +291,7 @@ fn plans(
         precision: integrator.precision,
         contact,
         brownian,
+        wall,
         matrix_free: integrator.matrix_free,
     };
     match model.level {

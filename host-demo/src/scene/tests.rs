@@ -137,6 +137,7 @@ fn overdamped() -> Plan {
         precision: Precision::F64,
         contact: None,
         brownian: None,
+        wall: false,
         matrix_free: false,
     }
 }

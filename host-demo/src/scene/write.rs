@@ -98,6 +98,9 @@ impl Scene {
             }
             t.insert("brownian".into(), bt);
         }
+        if let Some(w) = self.wall {
+            t.insert("wall".into(), table([("height", value(w.height))]));
+        }
         match &self.helix {
             Some(h) => {
                 t.insert(

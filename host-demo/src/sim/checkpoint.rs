@@ -57,6 +57,9 @@ pub struct Checkpoint {
     /// Steps retried split so far (Brownian runs).
     #[serde(default)]
     pub retries: super::retry::Retries,
+    /// With a wall: the landing time so far (`f64` bits; absent: not landed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub landing: Option<u64>,
 }
 
 fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
@@ -108,6 +111,7 @@ impl Checkpoint {
             last,
             noise: None,
             retries: super::retry::Retries::default(),
+            landing: None,
         }
     }
 

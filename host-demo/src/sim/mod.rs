@@ -109,6 +109,10 @@ pub struct Summary {
     pub failure: Option<String>,
     /// Brownian steps the kernel refused and the run completed as split steps.
     pub retries: retry::Retries,
+    /// With a wall: the landing time, the end of the first step after which a sphere
+    /// is held on the wall (`StepReport::wall_contacts > 0`: the first contact);
+    /// `None` without a wall or before any sphere touches it.
+    pub landing_time: Option<f64>,
     /// What `level = "auto"` chose and why (None for a manual level).
     pub level_choice: Option<crate::auto::Choice>,
     /// The scene as run: every default filled in and the `auto` choice applied
@@ -146,6 +150,7 @@ impl Summary {
             front: Front::default(),
             failure: None,
             retries: retry::Retries::default(),
+            landing_time: None,
             level_choice: None,
             resolved_scene: scene.clone(),
         }
@@ -403,6 +408,9 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     if let Some(b) = scene.brownian {
         p.noise_sqrt = b.sqrt.kernel();
     }
+    p.wall = scene
+        .wall
+        .map(|w| hydrorattle::Wall::new(T::from_f64(w.height)));
     p
 }
 

@@ -14,7 +14,7 @@ use super::beads::Beads;
 use crate::output::{AtomicFile, CsvWriter, Topology, XyzWriter, format_f64, gsd::GsdWriter};
 
 /// Columns of `observables.csv`, in order.
-pub const COLUMNS: [&str; 21] = [
+pub const COLUMNS: [&str; 24] = [
     "time",
     "extension",
     "verticality",
@@ -35,8 +35,14 @@ pub const COLUMNS: [&str; 21] = [
     "horizontal_extent",
     "vertical_extent",
     "com_speed",
+    "wall_height",
+    "wall_gap",
+    "wall_contacts",
     "state",
 ];
+
+/// Numeric columns before the wall's (always written).
+const NUMBERS: usize = 20;
 
 /// A bond counts as near-vertical when the cosine of its angle with gravity is at least
 /// this (within about 26 degrees of the vertical): the vertical runs and the stretching
@@ -116,8 +122,41 @@ pub struct Observables {
     pub vertical_extent: f64,
     /// Centre-of-mass settling speed (along gravity).
     pub com_speed: f64,
+    /// With a wall: the centre of mass's height above it (empty in the CSV otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall_height: Option<f64>,
+    /// With a wall: the smallest gap between a sphere and the wall,
+    /// `min_i (z_i - height - a_i)` (0 at contact).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall_gap: Option<f64>,
+    /// With a wall: the spheres in contact with it (gap within the kernel's contact
+    /// tolerance, `2 tol a_i`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall_contacts: Option<u32>,
     /// The frame's named state.
     pub state: Label,
+}
+
+/// The wall as the observables see it: the plane's height and the contact tolerance.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct WallGauge<T> {
+    /// The plane `z = height`.
+    pub height: T,
+    /// The solver's tolerance: a sphere within `2 tol a_i` of the wall touches it.
+    pub tolerance: T,
+}
+
+impl<T: Real> WallGauge<T> {
+    /// `(smallest gap, spheres in contact)` of `pos` with radii `radius`.
+    pub(super) fn contact(&self, pos: &[T::V3], radius: &[T]) -> (f64, u32) {
+        let (mut gap, mut touching) = (f64::INFINITY, 0);
+        for (&r, &a) in pos.iter().zip(radius) {
+            let g = T::xyz(r)[2] - self.height - a;
+            gap = gap.min(g.to_f64());
+            touching += u32::from(g <= a * self.tolerance * T::TWO);
+        }
+        (gap, touching)
+    }
 }
 
 /// What [`Observables::of`] needs besides the state: the bonds, masses, gravity, and
@@ -131,6 +170,8 @@ pub(super) struct Observer<'a, T: Real> {
     pub gravity: T::V3,
     /// Thresholds of the named states.
     pub thresholds: StateThresholds<T>,
+    /// The wall, if any.
+    pub wall: Option<WallGauge<T>>,
 }
 
 impl Observables {
@@ -147,6 +188,7 @@ impl Observables {
         let com = observables::centre_of_mass::<T>(pos, |i| beads.mass(i));
         let cos = T::from_f64(NEAR_VERTICAL_COS);
         let shape = Shape::measure(pos, vel, ob.mass, ob.bonds, g, cos);
+        let wall = ob.wall.map(|w| (w.contact(pos, &beads.radius), w.height));
         Observables {
             time: beads.time.to_f64(),
             extension: shape.extension.to_f64(),
@@ -166,6 +208,9 @@ impl Observables {
             horizontal_extent: shape.horizontal.to_f64(),
             vertical_extent: shape.vertical.to_f64(),
             com_speed: observables::com_settling_speed::<T>(vel, ob.mass, g).to_f64(),
+            wall_height: wall.map(|(_, h)| (T::xyz(com)[2] - h).to_f64()),
+            wall_gap: wall.map(|((gap, _), _)| gap),
+            wall_contacts: wall.map(|((_, n), _)| n),
             state: Label(state_of(&shape, &ob.thresholds)),
         }
     }
@@ -194,6 +239,10 @@ impl Observables {
             self.com_speed,
         ];
         let mut row: Vec<String> = numbers.iter().map(|&x| format_f64(x)).collect();
+        let or_empty = |x: Option<f64>| x.map_or(String::new(), format_f64);
+        row.push(or_empty(self.wall_height));
+        row.push(or_empty(self.wall_gap));
+        row.push(or_empty(self.wall_contacts.map(f64::from)));
         row.push(self.state.0.name().to_string());
         row
     }
@@ -201,12 +250,21 @@ impl Observables {
     /// Reads a row written by a run (bit-exact: numbers round-trip).
     pub fn from_row(line: &str) -> Option<Observables> {
         let fields: Vec<&str> = line.split(',').collect();
+        (fields.len() == COLUMNS.len()).then_some(())?;
         let (state, numbers) = fields.split_last()?;
+        let (numbers, wall) = numbers.split_at(NUMBERS);
         let x: Vec<f64> = numbers
             .iter()
             .map(|f| f.parse().ok())
             .collect::<Option<_>>()?;
-        (fields.len() == COLUMNS.len()).then_some(())?;
+        // Empty without a wall.
+        let w: Vec<Option<f64>> = wall
+            .iter()
+            .map(|f| match f.is_empty() {
+                true => Some(None),
+                false => f.parse().ok().map(Some),
+            })
+            .collect::<Option<_>>()?;
         Some(Observables {
             time: x[0],
             extension: x[1],
@@ -226,6 +284,9 @@ impl Observables {
             horizontal_extent: x[17],
             vertical_extent: x[18],
             com_speed: x[19],
+            wall_height: w[0],
+            wall_gap: w[1],
+            wall_contacts: w[2].map(|n| n as u32),
             state: Label(State::from_name(state)?),
         })
     }

@@ -19,7 +19,7 @@ use hydrorattle::{Real, StepReport};
 use super::checkpoint::Checkpoint;
 use super::engine::Engine;
 use super::frames::Keeper;
-use super::record::{NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, each_row};
+use super::record::{NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, WallGauge, each_row};
 use super::tail::TailSlope;
 use super::{
     Beads, Front, Observables, RunOptions, RunResult, SCENE_TOML, SUMMARY_JSON, Summary, snapshot,
@@ -91,6 +91,10 @@ struct Tracks<'a, 's, T: Real> {
     mass: Vec<T>,
     gravity: T::V3,
     bonds: Vec<hydrorattle::Bond<T>>,
+    /// The wall, if any, as the observables see it.
+    wall: Option<WallGauge<T>>,
+    /// The end of the first step after which a sphere was held on the wall.
+    landing: Option<T>,
     initial: crate::render::Snapshot,
     /// Steps asked for (the scene's, cut by `max_steps`).
     steps: usize,
@@ -150,6 +154,11 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             mass: (0..beads.len()).map(|i| beads.mass(i)).collect(),
             gravity,
             bonds: engine.bonds.clone(),
+            wall: engine.params.wall.map(|w| WallGauge {
+                height: w.height,
+                tolerance: engine.params.solver.tolerance,
+            }),
+            landing: None,
             initial,
             steps,
             first: 1,
@@ -166,6 +175,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
                     each_row(&rows, c.marks.csv_bytes, |o| tracks.keep_row(o))?;
                 }
                 (tracks.first, tracks.last) = (c.step as usize + 1, c.last);
+                tracks.landing = c.landing.map(|t| T::from_f64(f64::from_bits(t)));
                 tracks.total_iterations = c.total_iterations;
             }
             None => {
@@ -183,6 +193,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             mass: &self.mass,
             gravity: self.gravity,
             thresholds: StateThresholds::default(),
+            wall: self.wall,
         };
         Observables::of(beads, &observer, twist, iterations, tension)
     }
@@ -253,6 +264,9 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         let gravity = self.gravity;
         self.keeper.take(s, beads);
         self.total_iterations += u64::from(rep.iterations);
+        if self.landing.is_none() && rep.wall_contacts > 0 {
+            self.landing = Some(beads.time);
+        }
         let tw = self.twist.update(&beads.pos, gravity);
         let cos_vertical = T::from_f64(NEAR_VERTICAL_COS);
         self.front
@@ -276,6 +290,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
                     c.noise = Some(engine.noise.save());
                     c.retries = engine.retries;
                 }
+                c.landing = self.landing.map(|t| t.to_f64().to_bits());
                 c.save(dir)?;
             }
         }
@@ -335,6 +350,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             front,
             failure,
             retries: engine.retries,
+            landing_time: self.landing.map(T::to_f64),
             level_choice: origin.level_choice,
             ..Summary::for_scene(self.scene, name)
         };

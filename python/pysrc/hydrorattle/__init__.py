@@ -224,6 +224,8 @@ class System:
     ``max_iterations`` (100), ``allow_overlap`` (False), ``spring_stiffness`` (1e3), ``fene`` (None:
     Hookean springs; ``Q0``: FENE springs of maximum extension ``Q0``),
     ``stability_guard`` (False), ``contacts`` (None, or the hard-contact capacity),
+    ``wall`` (None, or the height ``H`` of a no-slip plane wall ``z = H`` below every
+    sphere: its mobility and its one-sided constraint; "overdamped" and "overdamped2"),
     ``temperature`` (None: no thermal noise; ``kT``), ``drift`` ("midpoint",
     "uncorrected"), ``seed`` (1), ``noise_sqrt`` ("auto": Lanczos above
     ``LANCZOS_CROSSOVER`` beads, "cholesky", "lanczos"), ``lanczos_tolerance`` (1e-3,
@@ -286,7 +288,7 @@ class System:
         """A helical chain as the CLI builds it: the ``[helix]`` keys (``tails``,
         ``head_ratio``, ``dhat``, ``head_end``, ``radius``, ``pitch``, ``density``) as
         keyword arguments, any other scene section as a dict (``fluid``, ``gravity``,
-        ``model``, ``contact``, ``brownian``, ``integrator``, ``output``). Missing keys
+        ``model``, ``contact``, ``brownian``, ``integrator``, ``output``, ``wall``). Missing keys
         take the scene file's defaults. Example: ``System.helix(tails=24,
         head_ratio=2.0, dhat=1.05, integrator={"method": "overdamped2", "dt": 0.1})``.
         """

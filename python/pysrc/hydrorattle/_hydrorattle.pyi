@@ -35,6 +35,7 @@ class Report:
     residual: float
     max_tension: float
     contacts: int
+    wall_contacts: int
     contact_rounds: int
     noise_iterations: int
     steps: int
