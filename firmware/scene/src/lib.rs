@@ -215,7 +215,7 @@ const fn deterministic_f32(method: Method, rotation: bool) -> Params<f32> {
         // The kernel's defaults (no noise here; at N = 25 `Auto` is the Cholesky path).
         noise_sqrt: NoiseSqrt::Auto,
         lanczos: Lanczos {
-            tolerance: 1e-4,
+            tolerance: 1e-3,
             max_iterations: 64,
         },
         contacts: None,
