@@ -44,7 +44,9 @@ impl<T: Real> Bond<T> {
     /// `true` for a wall link ([`Bond::wall`]).
     #[inline(always)]
     pub const fn is_wall(&self) -> bool {
-        self.i == self.j
+        // Without the `wall` feature no wall link is ever made (a step with a wall is
+        // refused, a user's bond to itself too), so every wall branch compiles away.
+        cfg!(feature = "wall") && self.i == self.j
     }
 
     /// `v_i - v_j` over per-particle vectors `v` (positions, displacements): for a
