@@ -118,40 +118,12 @@ fn a_brownian_run_resumes_to_the_bytes_of_one_run() {
         text.replace("duration = 270.0", "duration = 234.0\n[output]\nevery = 50"),
     )
     .unwrap();
-    let cli = |args: &[&str]| {
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_host-demo"))
-            .args(args)
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-    };
-    let (one, two) = (dir.join("one"), dir.join("two"));
-    cli(&[
-        "run",
-        long.to_str().unwrap(),
-        "--out",
-        one.to_str().unwrap(),
-    ]);
-    cli(&[
-        "run",
-        short.to_str().unwrap(),
-        "--out",
-        two.to_str().unwrap(),
-        "--checkpoint-every",
-        "117",
-    ]);
-    cli(&["resume", two.to_str().unwrap(), "--until", "243"]);
-    for f in ["trajectory.xyz", "trajectory.gsd", "observables.csv"] {
-        let (a, b) = (
-            std::fs::read(one.join(f)).unwrap(),
-            std::fs::read(two.join(f)).unwrap(),
-        );
-        assert!(a == b, "{f} differs after resume");
-    }
+    let (one, two) = run_and_resume(&dir, &long, &short, "117", "243");
+    same_files(
+        &one,
+        &two,
+        &["trajectory.xyz", "trajectory.gsd", "observables.csv"],
+    );
     let json = |d: &std::path::Path| -> serde_json::Value {
         serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap()
     };
@@ -265,37 +237,47 @@ fn rattle_stable_scene_at_temperature() {
     let (long, short) = (dir.join("long.toml"), dir.join("short.toml"));
     std::fs::write(&long, scene_text(2.0)).unwrap();
     std::fs::write(&short, scene_text(1.0)).unwrap();
-    let cli = |args: &[&str]| {
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_host-demo"))
-            .args(args)
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-    };
+    let (one, two) = run_and_resume(&dir, &long, &short, "0.5", "2");
+    same_files(&one, &two, &["trajectory.xyz", "observables.csv"]);
+}
+
+/// Runs `host-demo`, which must succeed.
+fn cli(args: &[&str]) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_host-demo"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// Runs `long` in one go into `dir/one`, and `short` into `dir/two` with checkpoints
+/// every `every`, then resumes `dir/two` until `until`; returns the two folders.
+fn run_and_resume(
+    dir: &std::path::Path,
+    long: &std::path::Path,
+    short: &std::path::Path,
+    every: &str,
+    until: &str,
+) -> (std::path::PathBuf, std::path::PathBuf) {
     let (one, two) = (dir.join("one"), dir.join("two"));
-    cli(&[
-        "run",
-        long.to_str().unwrap(),
-        "--out",
-        one.to_str().unwrap(),
-    ]);
-    cli(&[
-        "run",
-        short.to_str().unwrap(),
-        "--out",
-        two.to_str().unwrap(),
-        "--checkpoint-every",
-        "0.5",
-    ]);
-    cli(&["resume", two.to_str().unwrap(), "--until", "2"]);
-    for f in ["trajectory.xyz", "observables.csv"] {
+    let (one_s, two_s) = (one.to_str().unwrap(), two.to_str().unwrap());
+    cli(&["run", long.to_str().unwrap(), "--out", one_s]);
+    let short = short.to_str().unwrap();
+    cli(&["run", short, "--out", two_s, "--checkpoint-every", every]);
+    cli(&["resume", two_s, "--until", until]);
+    (one, two)
+}
+
+/// The files `names` are byte for byte the same in `a` and `b`.
+fn same_files(a: &std::path::Path, b: &std::path::Path, names: &[&str]) {
+    for f in names {
         let (x, y) = (
-            std::fs::read(one.join(f)).unwrap(),
-            std::fs::read(two.join(f)).unwrap(),
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
         );
         assert!(x == y, "{f} differs after resume");
     }
