@@ -19,15 +19,15 @@
 //! would supply it anyway (it differentiates `P mu` as a whole).
 
 use super::{
-    Projection, Start, StepReport, add_constraint_forces, add_flow, bond_vectors, mobility_metric,
-    mobility_product, project_overdamped, report, spin, step_velocity,
+    Projection, Start, StepReport, add_constraint_forces, add_flow, bond_vectors, free_product,
+    mobility_metric, mobility_product, project_overdamped, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
 use crate::linalg;
-use crate::mobility::{self, Hydro};
+use crate::mobility::Hydro;
 use crate::noise::Noise;
 use crate::noise::lanczos::{self, LanczosError};
 use crate::parallel::{self, Parallel};
@@ -182,13 +182,7 @@ pub(super) fn kick<T: Real>(
     // has passed a product at these positions already, so no pair is nested).
     let product = |v: &[T::V3], w: &mut [T::V3]| {
         if p.matrix_free {
-            let _ = match p.wall {
-                Some(wall) => {
-                    let h = wall.height;
-                    mobility::wall::tt_product(p.hydro, p.viscosity, h, s.pos, s.radius, v, w)
-                }
-                None => mobility::tt_product(p.hydro, p.viscosity, s.pos, s.radius, v, w),
-            };
+            let _ = free_product(p, s.pos, s.radius, v, w);
         } else {
             parallel::product::<T>(par, mu, n, v, w, bands);
         }

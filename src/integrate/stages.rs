@@ -25,21 +25,15 @@ pub(super) fn mobility_product<T: Real>(
     par: &dyn Parallel,
     bands: &mut [T::V3],
 ) -> Result<(), StepError> {
+    if p.matrix_free {
+        return free_product(p, pos, radius, f, u);
+    }
     if let Some(h) = wall_height(p) {
-        // Above a wall: assembled (or not), then applied (`mobility::wall`).
+        // Above a wall: assembled, then applied (`mobility::wall`).
         let (level, eta) = (p.hydro, p.viscosity);
-        if p.matrix_free {
-            return Ok(mobility::wall::tt_product(
-                level, eta, h, pos, radius, f, u,
-            )?);
-        }
         mobility::wall::assemble(par, level, eta, h, pos, radius, mu)?;
         crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
         return Ok(());
-    }
-    if p.matrix_free {
-        return mobility::tt_product(p.hydro, p.viscosity, pos, radius, f, u)
-            .map_err(StepError::from);
     }
     crate::parallel::assemble_apply(par, p.hydro, p.viscosity, pos, radius, mu, f, u, bands)
         .map_err(StepError::from)
@@ -86,6 +80,23 @@ pub(super) fn mobility_metric<'a, T: Real>(
     constraints::tabulate(mu, bonds, grad, scale, n, disp);
     let disp = &disp[..n * bonds.len()];
     Metric::Dense { disp, n, grad }
+}
+
+/// `u = mu_tt(pos) f` matrix-free: every pair block evaluated where it is used (above
+/// the wall if there is one).
+pub(super) fn free_product<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    f: &[T::V3],
+    u: &mut [T::V3],
+) -> Result<(), StepError> {
+    let (level, eta) = (p.hydro, p.viscosity);
+    match wall_height(p) {
+        Some(h) => mobility::wall::tt_product(level, eta, h, pos, radius, f, u)?,
+        None => mobility::tt_product(level, eta, pos, radius, f, u)?,
+    }
+    Ok(())
 }
 
 /// The wall's height when the step has one and the kernel its `wall` feature (without
