@@ -162,7 +162,8 @@ pub fn chain_from<T: Real>(
 /// The scene's parameters for `method` (rotation resolved or not): `dt` 0.005, RPY,
 /// gravity `(0, 0, -1)`, Newton with the precision's default tolerance and a cap of
 /// 500, overlapping spheres allowed (the scene's soft contact keeps them apart); with
-/// `brownian`, thermal noise at [`KT`] with the midpoint drift.
+/// `brownian`, thermal noise at [`KT`] with the midpoint drift, its square root by
+/// [`NOISE_SQRT`].
 pub fn params<T: Real>(method: Method, rotation: bool, brownian: bool) -> Params<T> {
     let mut p = Params::new(T::from_f64(DT));
     p.method = method;
@@ -172,9 +173,15 @@ pub fn params<T: Real>(method: Method, rotation: bool, brownian: bool) -> Params
     p.allow_overlap = true;
     if brownian {
         p.brownian = Some(Brownian::new(T::from_f64(KT)));
+        p.noise_sqrt = NOISE_SQRT;
     }
     p
 }
+
+/// The thermal runs' square root of the mobility: Cholesky, what the kernel's default
+/// [`NoiseSqrt::Auto`] picks at [`N`] beads (a test checks it), named so that the
+/// firmware does not link the Lanczos path `Auto` would choose between at run time.
+pub const NOISE_SQRT: NoiseSqrt = NoiseSqrt::Cholesky;
 
 /// [`params`] in `f32` as a constant (a test checks that the two agree). Firmware keeps
 /// it in a `static`: the compiler then sees the method, drops the other integrators
@@ -186,6 +193,7 @@ pub const fn params_f32(method: Method, rotation: bool, brownian: bool) -> Param
             temperature: KT as f32,
             drift: Drift::Midpoint,
         });
+        p.noise_sqrt = NOISE_SQRT;
     }
     p
 }
@@ -212,7 +220,7 @@ const fn deterministic_f32(method: Method, rotation: bool) -> Params<f32> {
         fene: None,
         stability_guard: false,
         brownian: None,
-        // The kernel's defaults (no noise here; at N = 25 `Auto` is the Cholesky path).
+        // The kernel's defaults (no noise here; the thermal runs set `NOISE_SQRT`).
         noise_sqrt: NoiseSqrt::Auto,
         lanczos: Lanczos {
             tolerance: 1e-3,

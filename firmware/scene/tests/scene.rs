@@ -2,9 +2,9 @@
 //! defaults with the scene's changes, a chain that satisfies its bonds, and a run that
 //! gives the same bits twice.
 
-use hydrorattle::{Layout, ParticleSet};
+use hydrorattle::{Layout, NoiseSqrt, ParticleSet};
 use hydrorattle_heap::Buffers;
-use hydrorattle_scene::{B, N, RUNS, chain, digest, params, params_f32, run};
+use hydrorattle_scene::{B, N, NOISE_SQRT, RUNS, STEPS, chain, digest, params, params_f32, run};
 
 #[test]
 fn constant_parameters_match_the_kernel_defaults() {
@@ -15,6 +15,26 @@ fn constant_parameters_match_the_kernel_defaults() {
             "{name}"
         );
     }
+}
+
+/// The thermal runs name the square root the kernel's default picks at `N` beads
+/// (so the firmware links one path): the same bits as the default.
+#[test]
+fn the_named_noise_square_root_is_the_default_s_choice() {
+    assert!(!NoiseSqrt::Auto.lanczos(N));
+    assert_eq!(NOISE_SQRT, NoiseSqrt::Cholesky);
+    let thermal = |sqrt: NoiseSqrt| {
+        let mut ps = ParticleSet::<f32, N>::new();
+        let bonds = chain(&mut ps).unwrap();
+        let mut p = params::<f32>(hydrorattle::Method::Overdamped, false, true);
+        p.noise_sqrt = sqrt;
+        let mut store = Buffers::<f32>::new(Layout::for_params(&p, N, B));
+        run(&mut ps, &bonds, &p, &mut store.workspace(), STEPS, |_| {}).unwrap()
+    };
+    let named = thermal(NOISE_SQRT);
+    assert_eq!(named, thermal(NoiseSqrt::Auto));
+    assert_eq!(named.report.noise_iterations, 0, "Cholesky, not Lanczos");
+    assert_ne!(named, thermal(NoiseSqrt::Lanczos));
 }
 
 #[test]
