@@ -129,8 +129,67 @@ fn a_brownian_run_resumes_to_the_bytes_of_one_run() {
     };
     let (s1, s2) = (json(&one), json(&two));
     assert_eq!(s1["retries"]["steps"], 1);
-    for key in ["final_observables", "steps_done", "retries"] {
+    // Every kernel step that succeeded: the refused one's two halves instead of it.
+    assert_eq!(s1["noise_iterations"]["steps"], 2701);
+    for key in [
+        "final_observables",
+        "steps_done",
+        "retries",
+        "noise_iterations",
+    ] {
         assert_eq!(s1[key], s2[key], "{key}");
+    }
+}
+
+/// `summary.json` records the Lanczos iterations of a thermal run's noise per kernel
+/// step (`noise_iterations`): counted with `sqrt = "lanczos"`, zero with the Cholesky
+/// factor `auto` takes for the 25-bead chain, absent without a temperature.
+#[test]
+fn the_summary_records_the_noise_iterations() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("noise-iterations");
+    let _ = std::fs::remove_dir_all(&dir);
+    let summary = |table: &str, name: &str| -> serde_json::Value {
+        let out = dir.join(name);
+        let opts = RunOptions {
+            max_steps: Some(40),
+            ..Default::default()
+        };
+        let r = run(&scene(table, "f64"), name, Some(&out), opts).unwrap();
+        assert_eq!(r.summary.failure, None, "{name}");
+        let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        serde_json::from_str(&text).unwrap()
+    };
+    let lanczos = summary(
+        "[brownian]\ntemperature = 0.5\nsqrt = \"lanczos\"\n",
+        "lanczos",
+    );
+    let n = &lanczos["noise_iterations"];
+    assert_eq!(n["sqrt"], "lanczos", "{n}");
+    assert_eq!(n["steps"], 40, "{n}");
+    assert_eq!(n["cap"], 64, "{n}");
+    assert_eq!(n["capped"], 0, "{n}");
+    let (mean, max, total) = (
+        n["mean"].as_f64().unwrap(),
+        n["max"].as_u64().unwrap(),
+        n["total"].as_u64().unwrap(),
+    );
+    assert!(mean > 1.0 && mean <= max as f64 && max < 64, "{n}");
+    assert_eq!(mean, total as f64 / 40.0, "{n}");
+    let cholesky = summary("[brownian]\ntemperature = 0.5\n", "cholesky");
+    let n = &cholesky["noise_iterations"];
+    assert_eq!(n["sqrt"], "cholesky (auto)", "{n}");
+    assert_eq!(n["steps"], 40, "{n}");
+    assert_eq!(
+        (n["max"].as_u64(), n["total"].as_u64()),
+        (Some(0), Some(0)),
+        "{n}"
+    );
+    for (table, name) in [
+        ("", "deterministic"),
+        ("[brownian]\ntemperature = 0.0\n", "cold"),
+    ] {
+        let s = summary(table, name);
+        assert!(s.get("noise_iterations").is_none(), "{name}: {s}");
     }
 }
 

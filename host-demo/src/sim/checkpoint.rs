@@ -60,6 +60,11 @@ pub struct Checkpoint {
     /// With a wall: the landing time so far (`f64` bits; absent: not landed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub landing: Option<u64>,
+    /// At temperature: the noise's Lanczos iterations so far (absent for a
+    /// deterministic run, and in checkpoints written before it was kept: a run resumed
+    /// from one counts from the checkpoint on).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lanczos: Option<super::LanczosTally>,
 }
 
 fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
@@ -112,6 +117,7 @@ impl Checkpoint {
             noise: None,
             retries: super::retry::Retries::default(),
             landing: None,
+            lanczos: None,
         }
     }
 

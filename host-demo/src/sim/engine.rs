@@ -12,6 +12,7 @@ use std::sync::Arc;
 use hydrorattle_heap::Buffers;
 use hydrorattle_parallel::Threads;
 
+use super::lanczos::LanczosTally;
 use super::retry::{self, Retries};
 use super::{Beads, BuildError, bonds, params};
 use crate::scene::{DEFAULT_SEED, Overlap, Scene};
@@ -37,6 +38,9 @@ pub struct Engine<T: Real> {
     pub contact: Option<SoftContact<T>>,
     /// Brownian steps refused and completed as split steps so far ([`retry`]).
     pub retries: Retries,
+    /// The thermal noise's Lanczos iterations so far ([`LanczosTally`]; empty without
+    /// a temperature).
+    pub lanczos: LanczosTally,
     store: Buffers<T>,
     /// The multipliers of the last accepted step ([`Engine::tensions`]).
     multipliers: Vec<T>,
@@ -107,6 +111,7 @@ impl<T: Real> Engine<T> {
             noise,
             contact,
             retries: Retries::default(),
+            lanczos: LanczosTally::default(),
             store,
             multipliers: Vec::new(),
             threads: None,
@@ -152,7 +157,10 @@ impl<T: Real> Engine<T> {
             &mut ws,
             &mut ext,
             &mut self.noise,
-            &mut self.retries,
+            retry::Counters {
+                retries: &mut self.retries,
+                lanczos: &mut self.lanczos,
+            },
         )?;
         // The multipliers are the workspace's until the next step, which may fail and
         // leave them partial: keep the accepted step's.

@@ -22,6 +22,7 @@ mod beads;
 mod checkpoint;
 mod engine;
 mod frames;
+mod lanczos;
 mod record;
 pub mod retry;
 mod run_loop;
@@ -31,6 +32,7 @@ pub use beads::{Beads, BuildError, bonds};
 pub use checkpoint::{CHECKPOINT, Checkpoint};
 pub use engine::{Engine, Extra};
 pub use frames::{KeepFrames, MAX_FRAME_BEADS, MAX_FRAMES, step_at_or_after};
+pub use lanczos::{LanczosTally, NoiseIterations};
 pub use record::{
     COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
     TRAJECTORY_XYZ,
@@ -109,6 +111,10 @@ pub struct Summary {
     pub failure: Option<String>,
     /// Brownian steps the kernel refused and the run completed as split steps.
     pub retries: retry::Retries,
+    /// At temperature: the Lanczos iterations of the noise's square root per kernel
+    /// step (absent for a run without noise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_iterations: Option<NoiseIterations>,
     /// With a wall: the landing time, the end of the first step after which a sphere
     /// is held on the wall (`StepReport::wall_contacts > 0`: the first contact);
     /// `None` without a wall or before any sphere touches it.
@@ -150,6 +156,7 @@ impl Summary {
             front: Front::default(),
             failure: None,
             retries: retry::Retries::default(),
+            noise_iterations: None,
             landing_time: None,
             level_choice: None,
             resolved_scene: scene.clone(),

@@ -14,6 +14,7 @@
 use hydrorattle::{ExternalForce, Noise, Params, Real, StepError, StepReport, Workspace};
 
 use super::Beads;
+use super::lanczos::LanczosTally;
 
 /// Deepest split tried: a refused step is retried as at most `2^MAX_DEPTH` sub-steps.
 pub const MAX_DEPTH: u8 = 4;
@@ -27,6 +28,15 @@ pub struct Retries {
     pub substeps: u64,
 }
 
+/// What a run counts over its steps: the steps retried split and, at temperature, the
+/// noise's Lanczos iterations of every kernel step (full or sub-step, refused or not).
+pub struct Counters<'a> {
+    /// Steps retried split.
+    pub retries: &'a mut Retries,
+    /// The noise's square root.
+    pub lanczos: &'a mut LanczosTally,
+}
+
 /// One step of `p` from `beads`, drawing from `noise`; a thermal step the kernel
 /// refuses is retried split (see the module). On error the state and `noise` are as
 /// they were.
@@ -37,15 +47,20 @@ pub fn step<T: Real, E: ExternalForce<T>>(
     ws: &mut Workspace<'_, T>,
     ext: &mut E,
     noise: &mut Noise,
-    retries: &mut Retries,
+    counters: Counters<'_>,
 ) -> Result<StepReport<T>, StepError> {
+    let Counters { retries, lanczos } = counters;
+    let thermal = p.brownian.is_some_and(|b| b.temperature > T::ZERO);
     let mut state = beads.state();
     state.noise = Some(noise);
-    let refused = match hydrorattle::step_slices(state, bonds, p, ws, ext) {
+    let outcome = hydrorattle::step_slices(state, bonds, p, ws, ext);
+    if thermal {
+        lanczos.add(&outcome);
+    }
+    let refused = match outcome {
         Ok(r) => return Ok(r),
         Err(e) => e,
     };
-    let thermal = p.brownian.is_some_and(|b| b.temperature > T::ZERO);
     if !thermal || !retryable(&refused) {
         return Err(refused);
     }
@@ -60,11 +75,19 @@ pub fn step<T: Real, E: ExternalForce<T>>(
             let mut g = noise.split(depth, index);
             let mut state = beads.state();
             state.noise = Some(&mut g);
-            match hydrorattle::step_slices(state, bonds, &q, ws, ext) {
+            let outcome = hydrorattle::step_slices(state, bonds, &q, ws, ext);
+            lanczos.add(&outcome);
+            match outcome {
                 Ok(r) => {
+                    // Work adds up; the state's figures are the last sub-step's.
                     report.iterations += r.iterations;
+                    report.velocity_iterations += r.velocity_iterations;
+                    report.contact_rounds += r.contact_rounds;
+                    report.noise_iterations += r.noise_iterations;
                     report.max_tension = report.max_tension.max(r.max_tension);
                     report.residual = r.residual;
+                    report.contacts = r.contacts;
+                    report.wall_contacts = r.wall_contacts;
                     last = Some(g);
                 }
                 Err(e) => {

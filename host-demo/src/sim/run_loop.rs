@@ -58,6 +58,7 @@ pub(super) fn run_t<T: Real>(
             None => {}
         }
         engine.retries = c.retries;
+        engine.lanczos = c.lanczos.unwrap_or_default();
     }
     if let Some(dir) = out {
         std::fs::create_dir_all(dir).map_err(|e| crate::output::name_error(dir, e))?;
@@ -186,6 +187,11 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         Ok(tracks)
     }
 
+    /// A run at temperature (its steps draw noise).
+    fn thermal(&self) -> bool {
+        self.scene.brownian.is_some_and(|b| b.temperature > 0.0)
+    }
+
     /// The observables of `beads` with the twist so far and a step's solve figures.
     fn observe(&self, beads: &Beads<T>, twist: T, iterations: u32, tension: T) -> Observables {
         let observer = Observer {
@@ -286,9 +292,10 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
                 let its = self.total_iterations;
                 let mut c =
                     Checkpoint::of(s as u64, precision, beads, trackers, its, marks, self.last);
-                if self.scene.brownian.is_some_and(|b| b.temperature > 0.0) {
+                if self.thermal() {
                     c.noise = Some(engine.noise.save());
                     c.retries = engine.retries;
+                    c.lanczos = Some(engine.lanczos);
                 }
                 c.landing = self.landing.map(|t| t.to_f64().to_bits());
                 c.save(dir)?;
@@ -350,6 +357,9 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             front,
             failure,
             retries: engine.retries,
+            noise_iterations: self
+                .thermal()
+                .then(|| engine.lanczos.record(&engine.params, beads.len())),
             landing_time: self.landing.map(T::to_f64),
             level_choice: origin.level_choice,
             ..Summary::for_scene(self.scene, name)
