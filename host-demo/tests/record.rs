@@ -216,3 +216,65 @@ fn a_killed_run_resumes_from_the_files_it_left() {
         assert!(!killed.join(format!("{f}.tmp")).exists());
     }
 }
+
+/// A run written before `observables.csv` gained the wall's three columns is refused
+/// by `resume` with an error that names the file and the columns it lacks, before any
+/// file is touched (no migration).
+#[test]
+fn a_run_of_an_older_version_is_refused_with_the_columns_named() {
+    let old = scratch("older");
+    run(
+        &manifest().join("scenes/dimer.toml"),
+        &old,
+        &["--checkpoint-every", "10"],
+    );
+    // The file as the older version wrote it: without the wall's columns.
+    let csv = old.join("observables.csv");
+    let text = String::from_utf8(bytes(&old, "observables.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let keep: Vec<bool> = header.iter().map(|c| !c.starts_with("wall_")).collect();
+    assert_eq!(keep.iter().filter(|k| !**k).count(), 3);
+    let older: String = text
+        .lines()
+        .map(|l| {
+            let cells = l.split(',').zip(&keep).filter(|(_, k)| **k);
+            cells.map(|(c, _)| c).collect::<Vec<_>>().join(",") + "\n"
+        })
+        .collect();
+    std::fs::write(&csv, &older).unwrap();
+    let listing = |d: &Path| {
+        let mut names: Vec<_> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        names.sort();
+        names
+    };
+    let before = listing(&old);
+
+    let opts = host_demo::sim::RunOptions::default();
+    let limits = host_demo::sizing::Limits::default();
+    let e = host_demo::sim::resume(&old, 40.0, limits, opts).unwrap_err();
+    let m = e
+        .downcast_ref::<host_demo::sim::ColumnsMismatch>()
+        .unwrap_or_else(|| panic!("not a ColumnsMismatch: {e:#}"));
+    assert_eq!(m.path, csv);
+    assert_eq!(m.missing, ["wall_height", "wall_gap", "wall_contacts"]);
+    assert!(m.unknown.is_empty());
+    assert_eq!(m.found.len(), 21);
+    // The command line says the same, and nothing changed.
+    let o = Command::new(env!("CARGO_BIN_EXE_host-demo"))
+        .args(["resume", old.to_str().unwrap(), "--until", "40"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    let said = format!(
+        "{}: 21 columns where this program writes 24; it lacks wall_height, wall_gap, \
+         wall_contacts",
+        csv.display()
+    );
+    assert!(stderr.contains(&said), "{stderr}");
+    assert_eq!(bytes(&old, "observables.csv"), older.as_bytes());
+    assert_eq!(listing(&old), before);
+}

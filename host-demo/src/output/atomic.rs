@@ -15,6 +15,16 @@ pub fn tmp_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
+/// The file [`AtomicFile::continue_from`] continues `path` from: the `NAME.tmp` a
+/// stopped run left when it holds at least `keep` bytes, else `NAME`.
+pub fn continued_source(path: &Path, keep: u64) -> PathBuf {
+    let tmp = tmp_path(path);
+    match std::fs::metadata(&tmp) {
+        Ok(m) if m.is_file() && m.len() >= keep => tmp,
+        _ => path.to_path_buf(),
+    }
+}
+
 /// `e` with `path` in front of its message (the kind kept), so that a full disk or a
 /// read-only folder says which file it stopped.
 pub fn name_error(path: &Path, e: io::Error) -> io::Error {
@@ -47,18 +57,19 @@ impl AtomicFile {
     /// else a copy of the first `keep` bytes of `NAME`. Stands at the end.
     pub fn continue_from(path: &Path, keep: u64) -> io::Result<AtomicFile> {
         let tmp = tmp_path(path);
-        let left = std::fs::OpenOptions::new().write(true).open(&tmp);
-        if let Ok(mut file) = left {
-            if file.metadata().is_ok_and(|m| m.len() >= keep) {
-                file.set_len(keep)
-                    .and_then(|()| file.seek(SeekFrom::End(0)))
-                    .map_err(|e| name_error(path, e))?;
-                return Ok(AtomicFile {
-                    path: path.to_path_buf(),
-                    tmp,
-                    writer: Some(BufWriter::new(file)),
-                });
-            }
+        if continued_source(path, keep) == tmp {
+            let mut file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&tmp)
+                .map_err(|e| name_error(path, e))?;
+            file.set_len(keep)
+                .and_then(|()| file.seek(SeekFrom::End(0)))
+                .map_err(|e| name_error(path, e))?;
+            return Ok(AtomicFile {
+                path: path.to_path_buf(),
+                tmp,
+                writer: Some(BufWriter::new(file)),
+            });
         }
         let mut file = AtomicFile::create(path)?;
         let copied = File::open(path)

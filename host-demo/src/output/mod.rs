@@ -13,7 +13,7 @@ mod csv;
 pub mod gsd;
 mod xyz;
 
-pub use atomic::{AtomicFile, name_error, tmp_path, write_atomic, write_json};
+pub use atomic::{AtomicFile, continued_source, name_error, tmp_path, write_atomic, write_json};
 pub use csv::{CsvWriter, csv_field};
 pub use xyz::{Frame, XYZ_PROPERTIES, XyzError, XyzWriter, read_xyz, read_xyz_file};
 

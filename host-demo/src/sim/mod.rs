@@ -34,8 +34,8 @@ pub use engine::{Engine, Extra};
 pub use frames::{KeepFrames, MAX_FRAME_BEADS, MAX_FRAMES, step_at_or_after};
 pub use lanczos::{LanczosTally, NoiseIterations};
 pub use record::{
-    COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
-    TRAJECTORY_XYZ,
+    COLUMNS, ColumnsMismatch, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables,
+    TRAJECTORY_GSD, TRAJECTORY_XYZ, check_columns,
 };
 
 use std::path::{Path, PathBuf};
@@ -341,9 +341,16 @@ pub fn scene_name(path: &Path) -> String {
 
 /// Continues the run whose files are in `dir` from its checkpoint to simulated time
 /// `until`, under `limits`: the files are cut back to the checkpoint and continued, the
-/// summary and `scene.toml` rewritten (with the new duration).
+/// summary and `scene.toml` rewritten (with the new duration). A run whose
+/// `observables.csv` has other columns than this program's (another version's) is
+/// refused with a [`ColumnsMismatch`] before anything is written.
 pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Result<RunResult> {
     let checkpoint = Checkpoint::load(dir)?;
+    let rows = dir.join(OBSERVABLES_CSV);
+    check_columns(&crate::output::continued_source(
+        &rows,
+        checkpoint.marks.csv_bytes,
+    ))?;
     let scene_path = dir.join(SCENE_TOML);
     let mut scene = Scene::from_path_limited(&scene_path, limits)?;
     let at = checkpoint.time();
