@@ -146,6 +146,7 @@ fn drawing_is_deterministic() {
                 .map(|p| [p[0] + 0.3 * f64::from(k), p[1], p[2] - 2.0 * f64::from(k)])
                 .collect(),
             radii: scene.radii(),
+            wall: None,
         })
         .collect();
     let colors = chain_colors(frames[0].positions.len());
@@ -173,4 +174,48 @@ fn drawing_is_deterministic() {
     }
     assert!(bytes[0] == bytes[1], "drawing twice gave different bytes");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A sphere 1.5 radii above a wall at `z = -2.5`, free draining: it lands.
+const WALL_SCENE: &str = "[wall]\nheight = -2.5\n\n\
+    [[particle]]\nposition = [0.0, 0.0, 0.0]\nradius = 1.0\n\n\
+    [model]\nhydrodynamics = \"free-draining\"\n\n\
+    [integrator]\nmethod = \"overdamped\"\ndt = 0.1\nduration = 6.0\n";
+
+/// A wall scene's pictures draw the wall: `run` writes them, its configurations carry
+/// the wall's height, and a configuration drawn with its wall is not the one drawn
+/// without (the geometry is `render::panel`'s unit test).
+#[test]
+fn a_wall_scene_s_pictures_draw_the_wall() {
+    let out = scratch("wall");
+    std::fs::create_dir_all(&out).unwrap();
+    let path = out.join("landing.toml");
+    std::fs::write(&path, WALL_SCENE).unwrap();
+    let dir = out.join("run");
+    let o = cli(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["initial.png", "final.png"] {
+        assert_eq!(png_size(&dir.join(f)), (900, 500), "{f}");
+    }
+    let scene = Scene::from_path(&path).unwrap();
+    let r = host_demo::sim::run(&scene, "landing", None, Default::default()).unwrap();
+    assert!(r.summary.landing_time.is_some());
+    assert_eq!((r.initial.wall, r.last.wall), (Some(-2.5), Some(-2.5)));
+    let draw = |s: &Snapshot, name: &str| {
+        let p = out.join(name);
+        let colors = chain_colors(1);
+        host_demo::render::draw_configuration(&p, s, &colors, "landed", (600, 300)).unwrap();
+        std::fs::read(p).unwrap()
+    };
+    let without = Snapshot {
+        wall: None,
+        ..r.last.clone()
+    };
+    assert!(draw(&r.last, "with.png") != draw(&without, "without.png"));
+    std::fs::remove_dir_all(&out).unwrap();
 }

@@ -34,6 +34,7 @@ fn snapshot(scene: &Scene, time: f64) -> Snapshot {
         time,
         positions: scene.positions(),
         radii: scene.radii(),
+        wall: None,
     }
 }
 
@@ -53,6 +54,7 @@ fn stretched(helix: &Helix, wiggle: f64, drop: f64) -> Snapshot {
         time: 400.0,
         positions,
         radii: chain.radii,
+        wall: None,
     }
 }
 

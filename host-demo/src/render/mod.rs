@@ -7,7 +7,7 @@
 //! right is `+x` and screen up is `+y`. Spheres are drawn as filled discs of their
 //! true radius with a thin dark outline, farthest first, so nearer spheres cover
 //! farther ones. Colours follow the paper: the head (particle 0) red, tails blue, the
-//! last particle green.
+//! last particle green. A scene's wall is a dark line on a grey band in side views.
 //!
 //! * [`panel`]: projections and one sphere panel, a configuration's picture;
 //! * [`figure1`]: the Figure 1 layout (own or common scale) and snapshot grids;
@@ -41,6 +41,10 @@ pub const TAIL_COLOR: RGBColor = RGBColor(52, 101, 164);
 pub const LAST_COLOR: RGBColor = RGBColor(44, 160, 44);
 /// Outline of every sphere.
 pub const OUTLINE_COLOR: RGBColor = RGBColor(30, 30, 30);
+/// The wall's plane (side views).
+pub const WALL_COLOR: RGBColor = RGBColor(90, 90, 90);
+/// The solid below the wall.
+pub const WALL_FILL: RGBColor = RGBColor(215, 215, 215);
 
 /// Series colours of the line chart, in order.
 pub const SERIES_COLORS: [RGBColor; 8] = [
@@ -80,6 +84,9 @@ pub struct Snapshot {
     pub positions: Vec<[f64; 3]>,
     /// Radii.
     pub radii: Vec<f64>,
+    /// The height of the scene's wall, the plane `z = wall` below the spheres (side
+    /// views draw it; [`wall_in_view`]).
+    pub wall: Option<f64>,
 }
 
 /// Pictures are drawn this many times larger and averaged down to their final size,

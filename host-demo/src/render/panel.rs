@@ -6,7 +6,10 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
-use super::{FONT, OUTLINE_COLOR, Snapshot, TAIL_COLOR, drawing, nice_length, px, save_png, short};
+use super::{
+    FONT, OUTLINE_COLOR, Snapshot, TAIL_COLOR, WALL_COLOR, WALL_FILL, drawing, nice_length, px,
+    save_png, short,
+};
 
 /// A projection of 3-D space onto a picture.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -37,8 +40,32 @@ impl View {
 }
 
 /// Screen-space bounding box `(min_right, min_up, max_right, max_up)` of the spheres
-/// in a view, radii included.
+/// in a view, radii included, and of the wall where the view shows it
+/// ([`wall_in_view`]).
 pub fn extent(snapshot: &Snapshot, view: View) -> (f64, f64, f64, f64) {
+    let b = spheres_extent(snapshot, view);
+    match wall_in_view(snapshot, view) {
+        Some(h) => (b.0, b.1.min(h), b.2, b.3.max(h)),
+        None => b,
+    }
+}
+
+/// The height at which a side view draws the snapshot's wall: the wall's, when it lies
+/// within the spheres' larger extent below their lowest point (so that a wall far
+/// below does not shrink the spheres to dots; the panel then names it in words).
+/// `None` for top views (the wall is the whole picture plane) and without a wall.
+pub fn wall_in_view(snapshot: &Snapshot, view: View) -> Option<f64> {
+    let h = snapshot.wall.filter(|h| h.is_finite())?;
+    if view != View::Side {
+        return None;
+    }
+    let b = spheres_extent(snapshot, view);
+    let reach = (b.2 - b.0).max(b.3 - b.1);
+    (b.1 - h <= reach).then_some(h)
+}
+
+/// [`extent`] of the spheres alone.
+fn spheres_extent(snapshot: &Snapshot, view: View) -> (f64, f64, f64, f64) {
     let mut b = (f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY);
     for (p, &r) in snapshot.positions.iter().zip(&snapshot.radii) {
         let (u, v, _) = view.project(*p);
@@ -112,6 +139,21 @@ pub fn draw_panel<DB: DrawingBackend>(
     let b = extent(snapshot, view);
     let (uc, vc) = (0.5 * (b.0 + b.2), 0.5 * (b.1 + b.3));
     let (xc, yc) = (0.5 * w, PANEL_TITLE + 0.5 * (h - PANEL_TITLE - PANEL_FOOT));
+    if let Some(z) = wall_in_view(snapshot, view) {
+        // The solid below the wall down to the foot, then the plane, under the spheres.
+        let y = yc - (z - vc) * scale;
+        let foot = (h - PANEL_FOOT).max(y + 4.0);
+        area.draw(&Rectangle::new(
+            [(px(k, 1.0), px(k, y)), (px(k, w - 1.0), px(k, foot))],
+            WALL_FILL.filled(),
+        ))
+        .map_err(drawing)?;
+        area.draw(&PathElement::new(
+            vec![(px(k, 1.0), px(k, y)), (px(k, w - 1.0), px(k, y))],
+            WALL_COLOR.stroke_width(px(k, 2.0).max(1) as u32),
+        ))
+        .map_err(drawing)?;
+    }
     let outline = snapshot.positions.len() <= OUTLINE_MAX;
     let mut order: Vec<usize> = (0..snapshot.positions.len()).collect();
     let nearness = |i: usize| view.project(snapshot.positions[i]).2;
@@ -155,6 +197,18 @@ pub fn draw_panel<DB: DrawingBackend>(
         font(13.0),
     ))
     .map_err(drawing)?;
+
+    if let (View::Side, Some(z)) = (view, snapshot.wall) {
+        let shown = wall_in_view(snapshot, view).is_some();
+        let label = format!(
+            "wall z = {}{}",
+            short(z),
+            if shown { "" } else { ", below" }
+        );
+        let x = w - 8.0 - 7.0 * label.chars().count() as f64;
+        area.draw(&Text::new(label, (px(k, x), px(k, h - 18.0)), font(13.0)))
+            .map_err(drawing)?;
+    }
 
     if view == View::Side {
         let x = w - 16.0;
@@ -233,9 +287,32 @@ mod tests {
             time: 0.0,
             positions: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 1.0]],
             radii: vec![1.0, 2.0],
+            wall: None,
         };
         assert_eq!(extent(&s, View::Side), (-1.0, -1.0, 6.0, 3.0));
         let scale = fit_scale(&[(&s, View::Side)], (116, 200));
         assert!((scale - 100.0 / 7.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn side_views_hold_a_wall_near_the_spheres() {
+        // Spheres spanning x -1..6, z -1..3 (larger extent 7).
+        let at = |wall| Snapshot {
+            time: 0.0,
+            positions: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 1.0]],
+            radii: vec![1.0, 2.0],
+            wall: Some(wall),
+        };
+        // Touching, and a little below: drawn, and the extent reaches down to it.
+        assert_eq!(wall_in_view(&at(-1.0), View::Side), Some(-1.0));
+        assert_eq!(extent(&at(-1.0), View::Side), (-1.0, -1.0, 6.0, 3.0));
+        assert_eq!(wall_in_view(&at(-8.0), View::Side), Some(-8.0));
+        assert_eq!(extent(&at(-8.0), View::Side), (-1.0, -8.0, 6.0, 3.0));
+        // Far below: named, not drawn; never in top views.
+        assert_eq!(wall_in_view(&at(-8.5), View::Side), None);
+        assert_eq!(extent(&at(-8.5), View::Side), (-1.0, -1.0, 6.0, 3.0));
+        assert_eq!(wall_in_view(&at(-1.0), View::Top), None);
+        assert_eq!(extent(&at(-5.0), View::Top), (-1.0, -2.0, 6.0, 2.0));
+        assert_eq!(wall_in_view(&at(f64::NAN), View::Side), None);
     }
 }

@@ -433,6 +433,7 @@ fn snapshot<T: Real>(ps: &[T::V3], radius: &[T], time: T) -> Snapshot {
         time: time.to_f64(),
         positions: ps.iter().map(|&v| T::v3_to_f64(v)).collect(),
         radii: radius.iter().map(|r| r.to_f64()).collect(),
+        wall: None,
     }
 }
 

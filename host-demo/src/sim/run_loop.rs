@@ -371,11 +371,21 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             write_atomic(&dir.join(SCENE_TOML), resolved.to_toml().as_bytes())?;
             write_json(&dir.join(SUMMARY_JSON), &summary)?;
         }
-        let (frames, at) = self.keeper.finish(done, beads);
+        let (mut frames, mut at) = self.keeper.finish(done, beads);
+        let (mut initial, mut last) = (
+            self.initial,
+            snapshot::<T>(&beads.pos, &beads.radius, beads.time),
+        );
+        // The pictures draw the wall.
+        let wall = self.wall.map(|w| w.height.to_f64());
+        let kept = frames.iter_mut().chain(at.iter_mut().flatten());
+        for s in kept.chain([&mut initial, &mut last]) {
+            s.wall = wall;
+        }
         Ok(RunResult {
             summary,
-            initial: self.initial,
-            last: snapshot::<T>(&beads.pos, &beads.radius, beads.time),
+            initial,
+            last,
             series: self.series,
             frames,
             at,
