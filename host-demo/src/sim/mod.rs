@@ -20,6 +20,7 @@
 
 mod beads;
 mod checkpoint;
+mod columns;
 mod engine;
 mod frames;
 mod lanczos;
@@ -30,12 +31,13 @@ mod tail;
 
 pub use beads::{Beads, BuildError, bonds};
 pub use checkpoint::{CHECKPOINT, Checkpoint};
+pub use columns::{ColumnsMismatch, check_columns};
 pub use engine::{Engine, Extra};
 pub use frames::{KeepFrames, MAX_FRAME_BEADS, MAX_FRAMES, step_at_or_after};
 pub use lanczos::{LanczosTally, NoiseIterations};
 pub use record::{
-    COLUMNS, ColumnsMismatch, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables,
-    TRAJECTORY_GSD, TRAJECTORY_XYZ, check_columns,
+    COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
+    TRAJECTORY_XYZ,
 };
 
 use std::path::{Path, PathBuf};
