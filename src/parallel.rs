@@ -399,11 +399,11 @@ pub fn assemble_apply<T: Real>(
         pos,
         radius,
     };
-    let fused = |b0: usize, rows: &mut [T::M3], yt: &mut [T::V3], zt: &mut [T::V3]| {
-        band_fused::<T>(src, rows, b0, x, yt, zt)
-    };
+    if n < blocked::RUNS_MIN {
+        return band_fused::<T>(src, out, 0, x, &mut y[..n], &mut []);
+    }
     if bands(n) == 1 {
-        return fused(0, out, &mut y[..n], &mut []);
+        return blocked::fused_rows::<T>(src, out, 0, x, &mut y[..n], &mut []);
     }
     by_bands::<T, _, _>(par, n, out, y, z, |t, rows_t, yt, zt| {
         blocked::fused_rows::<T>(src, rows_t, band_start(n, t), x, yt, zt)

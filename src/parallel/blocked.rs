@@ -1,7 +1,9 @@
-//! The banded product walking [`ROWS`] block rows at once: the same arithmetic, in the
-//! same order for every entry of the result, as the row-by-row [`band`](super::band), so
-//! the same bits; used from [`BANDED_MIN`](super::BANDED_MIN) rows on, where the packed
-//! mobility no longer fits in cache.
+//! The banded product walking [`ROWS`] block rows at once, and the fused assembly taking
+//! its square roots in runs of [`RUN`] pairs: the same arithmetic, in the same order for
+//! every entry of the result, as the row-by-row [`band`](super::band) and
+//! [`band_fused`](super::band_fused), so the same bits. The product is used from
+//! [`BANDED_MIN`](super::BANDED_MIN) rows on, where the packed mobility no longer fits in
+//! cache; the runs from [`RUNS_MIN`] beads on.
 //!
 //! Why: out of cache the row-by-row product waits on one stream of blocks at a time
 //! (N = 1024, 38 MB: 6.2 ns per block against 2.9 ns in cache). Walking [`ROWS`] rows
@@ -88,6 +90,11 @@ pub(super) fn band_rows<T: Real>(
         super::row::<T>(a, b0, k, x, y, z);
     }
 }
+
+/// Beads from which the fused assembly takes its square roots in runs ([`fused_rows`];
+/// 14.0 -> 10.7 ns per block from N = 64 to 256). Below, the row-by-row
+/// [`super::band_fused`]: the firmware's N = 25 keeps its code and instruction count.
+pub(super) const RUNS_MIN: usize = 64;
 
 /// Columns a fused row evaluates together: their square roots and divisions first, then
 /// their blocks (see [`pair_norm2`]).
