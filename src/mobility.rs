@@ -71,15 +71,20 @@ impl<T: Real> Geometry<T> {
         if s2 <= dif * dif {
             return None;
         }
-        let (s, inv_s) = s2.root_and_inverse();
+        Some(Self::from_roots(r, s2, s2.root_and_inverse()))
+    }
+
+    /// From `s2 = |r|^2` and `s2.root_and_inverse()`.
+    #[inline(always)]
+    fn from_roots(r: T::V3, s2: T, (s, inv_s): (T, T)) -> Self {
         let e = r * inv_s;
-        Some(Self {
+        Self {
             s2,
             s,
             inv_s,
             e,
             ee: T::outer(e, e),
-        })
+        }
     }
 }
 
@@ -94,6 +99,41 @@ pub fn pair_tt<T: Real>(level: Hydro, eta: T, ai: T, aj: T, r: T::V3) -> Option<
         return (T::norm2(r) > dif * dif).then_some(T::M3_ZERO);
     }
     Geometry::new(ai, aj, r).map(|g| tt_block(level, eta, ai, aj, &g))
+}
+
+/// [`pair_tt`] in two stages, for loops that take every square root of a run of pairs
+/// before building their blocks (the roots and divisions then overlap instead of forming
+/// one latency chain per pair): stage one, `|r|^2`, or `None` where [`pair_tt`] is
+/// `None`.
+#[inline(always)]
+pub(crate) fn pair_norm2<T: Real>(level: Hydro, ai: T, aj: T, r: T::V3) -> Option<T> {
+    let (s2, dif) = (T::norm2(r), ai - aj);
+    // As in `pair_tt`: `>` for free draining, not `<=` otherwise (NaN passes there).
+    let nested = s2 <= dif * dif;
+    let apart = if level == Hydro::FreeDraining {
+        s2 > dif * dif
+    } else {
+        !nested
+    };
+    apart.then_some(s2)
+}
+
+/// Stage two of [`pair_norm2`]: the block of [`pair_tt`], bit for bit, from `s2` and
+/// `s2.root_and_inverse()`.
+#[inline(always)]
+pub(crate) fn pair_tt_from<T: Real>(
+    level: Hydro,
+    eta: T,
+    ai: T,
+    aj: T,
+    r: T::V3,
+    s2: T,
+    roots: (T, T),
+) -> T::M3 {
+    if level == Hydro::FreeDraining {
+        return T::M3_ZERO;
+    }
+    tt_block(level, eta, ai, aj, &Geometry::from_roots(r, s2, roots))
 }
 
 /// The `tt` block of an interacting level (Oseen or RPY) from the pair geometry.

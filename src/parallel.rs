@@ -19,6 +19,8 @@
 //! the one place where the stored mobility meets a vector (the integrators, the Krylov
 //! metric).
 
+mod blocked;
+
 use crate::error::ParticleError;
 use crate::linalg::tri;
 use crate::mobility::{Hydro, pair_tt, self_tt};
@@ -119,81 +121,118 @@ pub(crate) fn band<T: Real>(a: &[T::M3], b0: usize, x: &[T::V3], y: &mut [T::V3]
         *yk = a[tri(i) + i] * x[i];
     }
     for k in 0..y.len() {
-        let i = b0 + k;
-        let (left, inside) = a[tri(i)..tri(i) + i].split_at(b0);
-        let xi = x[i];
-        let mut acc = T::V3_ZERO;
-        for ((&b, zj), &xj) in left.iter().zip(z.iter_mut()).zip(x) {
-            acc += b * xj;
-            *zj += T::m3_tmul(b, xi);
+        row::<T>(a, b0, k, x, y, z);
+    }
+}
+
+/// Row `b0 + k` of a [`band`]: its lower blocks' products summed in order into `y_k`,
+/// their transposed products added to `z` (left of the band) and `y` (inside it).
+#[inline(always)]
+fn row<T: Real>(a: &[T::M3], b0: usize, k: usize, x: &[T::V3], y: &mut [T::V3], z: &mut [T::V3]) {
+    let i = b0 + k;
+    let (left, inside) = a[tri(i)..tri(i) + i].split_at(b0);
+    let xi = x[i];
+    let mut acc = T::V3_ZERO;
+    for ((&b, zj), &xj) in left.iter().zip(z.iter_mut()).zip(x) {
+        acc += b * xj;
+        *zj += T::m3_tmul(b, xi);
+    }
+    let (ys, yi) = y[..=k].split_at_mut(k);
+    for ((&b, yj), &xj) in inside.iter().zip(ys).zip(&x[b0..]) {
+        acc += b * xj;
+        *yj += T::m3_tmul(b, xi);
+    }
+    yi[0] += acc;
+}
+
+/// The pairs a fused band evaluates its blocks from.
+#[derive(Clone, Copy)]
+struct Pairs<'a, T: Real> {
+    level: Hydro,
+    eta: T,
+    pos: &'a [T::V3],
+    radius: &'a [T],
+}
+
+impl<T: Real> Pairs<'_, T> {
+    /// The diagonal blocks of rows `b0..b0 + y.len()` into `rows` (the packed rows from
+    /// `b0` on), `y` started from their products, `z` zeroed: a fused band's first step.
+    #[inline(always)]
+    fn start(&self, rows: &mut [T::M3], b0: usize, x: &[T::V3], y: &mut [T::V3], z: &mut [T::V3]) {
+        let base = tri(b0);
+        z.fill(T::V3_ZERO);
+        for (k, yk) in y.iter_mut().enumerate() {
+            let i = b0 + k;
+            let diag = T::m3_diag(self_tt(self.eta, self.radius[i]));
+            rows[tri(i) - base + i] = diag;
+            *yk = diag * x[i];
         }
-        let (ys, yi) = y[..=k].split_at_mut(k);
-        for ((&b, yj), &xj) in inside.iter().zip(ys).zip(&x[b0..]) {
-            acc += b * xj;
-            *yj += T::m3_tmul(b, xi);
-        }
-        yi[0] += acc;
     }
 }
 
 /// [`band`] while assembling: each block is evaluated, stored into `rows` (the packed
 /// rows from `b0` on) and applied at once, in the same order, so the product's bits are
 /// those of [`band`] on the stored blocks.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn band_fused<T: Real>(
-    level: Hydro,
-    eta: T,
-    pos: &[T::V3],
-    radius: &[T],
+    src: Pairs<'_, T>,
     rows: &mut [T::M3],
     b0: usize,
     x: &[T::V3],
     y: &mut [T::V3],
     z: &mut [T::V3],
 ) -> Result<(), ParticleError> {
-    let base = tri(b0);
-    z.fill(T::V3_ZERO);
-    for (k, yk) in y.iter_mut().enumerate() {
-        let i = b0 + k;
-        let diag = T::m3_diag(self_tt(eta, radius[i]));
-        rows[tri(i) - base + i] = diag;
-        *yk = diag * x[i];
-    }
+    src.start(rows, b0, x, y, z);
     for k in 0..y.len() {
-        let i = b0 + k;
-        let (pi, ai, xi) = (pos[i], radius[i], x[i]);
-        #[inline(always)]
-        fn pair<T: Real>(
-            l: Hydro,
-            eta: T,
-            ai: T,
-            aj: T,
-            r: T::V3,
-            i: usize,
-            j: usize,
-        ) -> Result<T::M3, ParticleError> {
-            pair_tt(l, eta, ai, aj, r).ok_or(ParticleError::Nested { i: j, j: i })
-        }
-        let (left, inside) = rows[tri(i) - base..tri(i) - base + i].split_at_mut(b0);
-        let mut acc = T::V3_ZERO;
-        let others = left.iter_mut().zip(z.iter_mut()).zip(pos).zip(radius);
-        for (j, (((o, zj), &pj), &aj)) in others.enumerate() {
-            let b = pair::<T>(level, eta, ai, aj, pi - pj, i, j)?;
-            *o = b;
-            acc += b * x[j];
-            *zj += T::m3_tmul(b, xi);
-        }
-        let (ys, yi) = y[..=k].split_at_mut(k);
-        let others = inside.iter_mut().zip(ys).zip(&pos[b0..]).zip(&radius[b0..]);
-        for (j, (((o, yj), &pj), &aj)) in others.enumerate() {
-            let b = pair::<T>(level, eta, ai, aj, pi - pj, i, b0 + j)?;
-            *o = b;
-            acc += b * x[b0 + j];
-            *yj += T::m3_tmul(b, xi);
-        }
-        yi[0] += acc;
+        row_fused(src, rows, b0, k, x, y, z)?;
     }
+    Ok(())
+}
+
+/// Row `b0 + k` of a [`band_fused`]: [`row`] on blocks evaluated and stored on the way.
+#[inline(always)]
+fn row_fused<T: Real>(
+    src: Pairs<'_, T>,
+    rows: &mut [T::M3],
+    b0: usize,
+    k: usize,
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) -> Result<(), ParticleError> {
+    let (base, i) = (tri(b0), b0 + k);
+    let (level, eta, pos, radius) = (src.level, src.eta, src.pos, src.radius);
+    let (pi, ai, xi) = (pos[i], radius[i], x[i]);
+    #[inline(always)]
+    fn pair<T: Real>(
+        l: Hydro,
+        eta: T,
+        ai: T,
+        aj: T,
+        r: T::V3,
+        i: usize,
+        j: usize,
+    ) -> Result<T::M3, ParticleError> {
+        pair_tt(l, eta, ai, aj, r).ok_or(ParticleError::Nested { i: j, j: i })
+    }
+    let (left, inside) = rows[tri(i) - base..tri(i) - base + i].split_at_mut(b0);
+    let mut acc = T::V3_ZERO;
+    let others = left.iter_mut().zip(z.iter_mut()).zip(pos).zip(radius);
+    for (j, (((o, zj), &pj), &aj)) in others.enumerate() {
+        let b = pair::<T>(level, eta, ai, aj, pi - pj, i, j)?;
+        *o = b;
+        acc += b * x[j];
+        *zj += T::m3_tmul(b, xi);
+    }
+    let (ys, yi) = y[..=k].split_at_mut(k);
+    let others = inside.iter_mut().zip(ys).zip(&pos[b0..]).zip(&radius[b0..]);
+    for (j, (((o, yj), &pj), &aj)) in others.enumerate() {
+        let b = pair::<T>(level, eta, ai, aj, pi - pj, i, b0 + j)?;
+        *o = b;
+        acc += b * x[b0 + j];
+        *yj += T::m3_tmul(b, xi);
+    }
+    yi[0] += acc;
     Ok(())
 }
 
@@ -289,7 +328,7 @@ pub fn product<T: Real>(
         return;
     }
     let _ = by_bands::<T, (), _>(par, n, &mut [], y, z, |t, _, yt, zt| {
-        band::<T>(a, band_start(n, t), x, yt, zt);
+        blocked::band_rows::<T>(a, band_start(n, t), x, yt, zt);
         Ok(())
     });
     reduce::<T>(n, y, z, par);
@@ -354,14 +393,20 @@ pub fn assemble_apply<T: Real>(
 ) -> Result<(), ParticleError> {
     let n = pos.len();
     let out = &mut out[..tri(n)];
-    let fused = |b0: usize, rows: &mut [T::M3], yt: &mut [T::V3], zt: &mut [T::V3]| {
-        band_fused::<T>(level, eta, pos, radius, rows, b0, x, yt, zt)
+    let src = Pairs {
+        level,
+        eta,
+        pos,
+        radius,
     };
+    if n < blocked::RUNS_MIN {
+        return band_fused::<T>(src, out, 0, x, &mut y[..n], &mut []);
+    }
     if bands(n) == 1 {
-        return fused(0, out, &mut y[..n], &mut []);
+        return blocked::fused_rows::<T>(src, out, 0, x, &mut y[..n], &mut []);
     }
     by_bands::<T, _, _>(par, n, out, y, z, |t, rows_t, yt, zt| {
-        fused(band_start(n, t), rows_t, yt, zt)
+        blocked::fused_rows::<T>(src, rows_t, band_start(n, t), x, yt, zt)
     })?;
     reduce::<T>(n, y, z, par);
     Ok(())

@@ -1,0 +1,260 @@
+//! The banded product walking [`ROWS`] block rows at once, and the fused assembly taking
+//! its square roots in runs of [`RUN`] pairs: the same arithmetic, in the same order for
+//! every entry of the result, as the row-by-row [`band`](super::band) and
+//! [`band_fused`](super::band_fused), so the same bits. The product is used from
+//! [`BANDED_MIN`](super::BANDED_MIN) rows on, where the packed mobility no longer fits in
+//! cache; the runs from [`RUNS_MIN`] beads on.
+//!
+//! Why: out of cache the row-by-row product waits on one stream of blocks at a time
+//! (N = 1024, 38 MB: 6.2 ns per block against 2.9 ns in cache). Walking [`ROWS`] rows
+//! column by column reads [`ROWS`] streams at once, and each `x_j` and each partial sum
+//! `y_j` (or `z_j`) is loaded and stored once per [`ROWS`] blocks instead of once per
+//! block: 4.0 ns per block at N = 1024 (see docs/BENCHMARKS.md).
+//!
+//! Entry by entry nothing moves: row `i`'s own sum `acc_i` still adds its blocks in
+//! column order, and `y_j` still receives the transposed products of the rows below it
+//! in row order (row `i`, then `i + 1`, ...), because a column visits the rows of a
+//! group in order.
+
+use super::Pairs;
+use crate::error::ParticleError;
+use crate::linalg::tri;
+use crate::mobility::{pair_norm2, pair_tt_from};
+use crate::real::Real;
+
+/// Block rows walked together: 8 measured best at N = 1024 and 2048 (4: 4.7, 8: 4.0,
+/// 12: 4.3, 16: 5.3 ns per block at N = 1024).
+pub(super) const ROWS: usize = 8;
+
+/// Column `j` for a group of rows: `acc_r += B_rj x_j` for every row `r` of the group,
+/// then `out += B_rj^T x_r` in row order.
+#[inline(always)]
+fn column<T: Real>(
+    rows: &[&[T::M3]; ROWS],
+    j: usize,
+    xj: T::V3,
+    xs: &[T::V3; ROWS],
+    acc: &mut [T::V3; ROWS],
+    out: &mut T::V3,
+) {
+    let mut o = *out;
+    for r in 0..ROWS {
+        let b = rows[r][j];
+        acc[r] += b * xj;
+        o += T::m3_tmul(b, xs[r]);
+    }
+    *out = o;
+}
+
+/// Rows `b0..b0 + y.len()` of `y = A x` as [`band`](super::band) computes them (the same
+/// bits), [`ROWS`] rows at a time, the rows left over at the band's end one by one.
+#[inline(always)]
+pub(super) fn band_rows<T: Real>(
+    a: &[T::M3],
+    b0: usize,
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) {
+    z.fill(T::V3_ZERO);
+    for (k, yk) in y.iter_mut().enumerate() {
+        let i = b0 + k;
+        *yk = a[tri(i) + i] * x[i];
+    }
+    let m = y.len();
+    let mut k = 0;
+    while k + ROWS <= m {
+        let i = b0 + k;
+        let rows: [&[T::M3]; ROWS] = core::array::from_fn(|r| &a[tri(i + r)..tri(i + r) + i]);
+        let xs: [T::V3; ROWS] = core::array::from_fn(|r| x[i + r]);
+        let mut acc = [T::V3_ZERO; ROWS];
+        for (j, (zj, &xj)) in z.iter_mut().zip(x).enumerate() {
+            column::<T>(&rows, j, xj, &xs, &mut acc, zj);
+        }
+        for (j, (yj, &xj)) in y[..k].iter_mut().zip(&x[b0..]).enumerate() {
+            column::<T>(&rows, b0 + j, xj, &xs, &mut acc, yj);
+        }
+        // The group's own triangle, row by row: row `i + r` meets columns `i..i + r`,
+        // whose sums are complete before it adds to them.
+        for (r, (&xr, acc_r)) in xs.iter().zip(&mut acc).enumerate() {
+            let row = &a[tri(i + r) + i..tri(i + r) + i + r];
+            for (c, &b) in row.iter().enumerate() {
+                *acc_r += b * x[i + c];
+                y[k + c] += T::m3_tmul(b, xr);
+            }
+            y[k + r] += *acc_r;
+        }
+        k += ROWS;
+    }
+    for k in k..m {
+        super::row::<T>(a, b0, k, x, y, z);
+    }
+}
+
+/// Beads from which the fused assembly takes its square roots in runs ([`fused_rows`];
+/// 14.0 -> 10.7 ns per block from N = 64 to 256). Below, the row-by-row
+/// [`super::band_fused`]: the firmware's N = 25 keeps its code and instruction count.
+pub(super) const RUNS_MIN: usize = 64;
+
+/// Columns a fused row evaluates together: their square roots and divisions first, then
+/// their blocks (see [`pair_norm2`]).
+const RUN: usize = 8;
+
+/// [`super::band_fused`] with the same blocks and bits, each row taking the square roots
+/// of [`RUN`] pairs before building their blocks. The assembly is bound by those roots'
+/// latency, not by memory, so rows are taken one at a time (walking [`ROWS`] at once did
+/// not pay here: 15.0 -> 16.3 ns per block at N = 1024).
+#[inline(always)]
+pub(super) fn fused_rows<T: Real>(
+    src: Pairs<'_, T>,
+    out: &mut [T::M3],
+    b0: usize,
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) -> Result<(), ParticleError> {
+    src.start(out, b0, x, y, z);
+    let base = tri(b0);
+    for k in 0..y.len() {
+        let i = b0 + k;
+        let (left, inside) = out[tri(i) - base..tri(i) - base + i].split_at_mut(b0);
+        let mut acc = T::V3_ZERO;
+        runs(src, i, 0, left, z, x, &mut acc)?;
+        let (ys, yi) = y[..=k].split_at_mut(k);
+        runs(src, i, b0, inside, ys, &x[b0..], &mut acc)?;
+        yi[0] += acc;
+    }
+    Ok(())
+}
+
+/// Row `i`'s blocks for the columns from `j0` into `blocks`, their products with `x`
+/// (which starts at column `j0`) summed into `acc` in column order, their transposed
+/// products with `x_i` added to `outs`.
+#[inline(always)]
+fn runs<T: Real>(
+    src: Pairs<'_, T>,
+    i: usize,
+    j0: usize,
+    blocks: &mut [T::M3],
+    outs: &mut [T::V3],
+    x: &[T::V3],
+    acc: &mut T::V3,
+) -> Result<(), ParticleError> {
+    let (level, eta, pi, ai) = (src.level, src.eta, src.pos[i], src.radius[i]);
+    let xi = x[i - j0];
+    let runs = blocks
+        .chunks_mut(RUN)
+        .zip(outs.chunks_mut(RUN))
+        .zip(x.chunks(RUN));
+    for (c, ((bs, os), xs)) in runs.enumerate() {
+        let j = j0 + c * RUN;
+        let pos = &src.pos[j..j + bs.len()];
+        let radius = &src.radius[j..j + bs.len()];
+        let mut s2 = [T::ZERO; RUN];
+        for (k, (&pj, &aj)) in pos.iter().zip(radius).enumerate() {
+            s2[k] = pair_norm2(level, ai, aj, pi - pj)
+                .ok_or(ParticleError::Nested { i: j + k, j: i })?;
+        }
+        let roots: [(T, T); RUN] = core::array::from_fn(|k| s2[k].root_and_inverse());
+        let cols = bs.iter_mut().zip(os).zip(xs).zip(pos.iter().zip(radius));
+        for (k, (((b, o), &xj), (&pj, &aj))) in cols.enumerate() {
+            *b = pair_tt_from(level, eta, ai, aj, pi - pj, s2[k], roots[k]);
+            *acc += *b * xj;
+            *o += T::m3_tmul(*b, xi);
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::mobility::Hydro;
+    use glam::{DMat3, DVec3};
+    use std::{vec, vec::Vec};
+
+    /// Deterministic values in [-0.5, 0.5).
+    fn values(seed: u64) -> impl FnMut() -> f64 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        }
+    }
+
+    fn bits(v: &[DVec3]) -> Vec<[u64; 3]> {
+        v.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+    }
+
+    /// Rows `b0..n` of general (non-symmetric, as above a wall) blocks: the grouped band
+    /// gives the row-by-row band's bits, with groups left over or none.
+    #[test]
+    fn grouped_rows_give_the_bits_of_the_row_by_row_band() {
+        let n = 45;
+        let mut v = values(7);
+        let a: Vec<DMat3> = (0..tri(n))
+            .map(|_| DMat3::from_cols_array(&core::array::from_fn(|_| v())))
+            .collect();
+        let x: Vec<DVec3> = (0..n).map(|_| DVec3::new(v(), v(), v())).collect();
+        for (b0, b1) in [(0, n), (13, n), (20, 25), (37, 44), (30, 30 + ROWS)] {
+            let (mut y0, mut y1) = (vec![DVec3::ZERO; b1 - b0], vec![DVec3::ZERO; b1 - b0]);
+            let (mut z0, mut z1) = (vec![DVec3::ONE; b0], vec![DVec3::ONE; b0]);
+            super::super::band::<f64>(&a, b0, &x, &mut y0, &mut z0);
+            band_rows::<f64>(&a, b0, &x, &mut y1, &mut z1);
+            assert_eq!(bits(&y0), bits(&y1), "rows {b0}..{b1}");
+            assert_eq!(bits(&z0), bits(&z1), "rows {b0}..{b1}");
+        }
+    }
+
+    /// The fused band in runs: the blocks, products and first error of the row-by-row
+    /// fused band, at every level of hydrodynamics.
+    #[test]
+    fn runs_give_the_blocks_bits_and_error_of_the_fused_band() {
+        let n = 43;
+        let mut v = values(11);
+        let mut pos: Vec<DVec3> = (0..n)
+            .map(|k| DVec3::new(3.0 * v(), 3.0 * v(), 0.7 * k as f64))
+            .collect();
+        let radius: Vec<f64> = (0..n).map(|_| 0.3 + 0.5 * (v() + 0.5)).collect();
+        let x: Vec<DVec3> = (0..n).map(|_| DVec3::new(v(), v(), v())).collect();
+        for nested in [false, true] {
+            if nested {
+                // Two nested pairs in one band, the later row's at a lower column.
+                pos[33] = pos[30];
+                pos[35] = pos[2];
+            }
+            for level in [Hydro::Rpy, Hydro::Oseen, Hydro::FreeDraining] {
+                let src = Pairs {
+                    level,
+                    eta: 0.7,
+                    pos: &pos,
+                    radius: &radius,
+                };
+                for (b0, b1) in [(0, n), (11, n), (29, 40)] {
+                    let rows = tri(b1) - tri(b0);
+                    let (mut o0, mut o1) = (vec![DMat3::ZERO; rows], vec![DMat3::ZERO; rows]);
+                    let (mut y0, mut y1) = (vec![DVec3::ZERO; b1 - b0], vec![DVec3::ZERO; b1 - b0]);
+                    let (mut z0, mut z1) = (vec![DVec3::ONE; b0], vec![DVec3::ONE; b0]);
+                    let r0 =
+                        super::super::band_fused::<f64>(src, &mut o0, b0, &x, &mut y0, &mut z0);
+                    let r1 = fused_rows::<f64>(src, &mut o1, b0, &x, &mut y1, &mut z1);
+                    assert_eq!(r0, r1, "{level:?} rows {b0}..{b1}");
+                    assert_eq!(r0.is_err(), nested && b1 > 33, "{level:?} rows {b0}..{b1}");
+                    if r0.is_ok() {
+                        let m = |o: &[DMat3]| -> Vec<u64> {
+                            o.iter()
+                                .flat_map(|b| b.to_cols_array().map(f64::to_bits))
+                                .collect()
+                        };
+                        assert_eq!(m(&o0), m(&o1), "{level:?} rows {b0}..{b1}");
+                        assert_eq!(bits(&y0), bits(&y1), "{level:?} rows {b0}..{b1}");
+                        assert_eq!(bits(&z0), bits(&z1), "{level:?} rows {b0}..{b1}");
+                    }
+                }
+            }
+        }
+    }
+}
