@@ -10,6 +10,8 @@
 //! the other) by Lanczos (`LTOL=x` its tolerance), and prints its iterations too. For
 //! instruction counts: `valgrind --tool=callgrind --collect-atstart=no
 //! --toggle-collect='*step_slices*' target/release/examples/scale o auto 1024`.
+//! `CHAIN=1` takes the kernel bench's chain (`benches/kernel.rs`, `brownian/...`)
+//! instead of the helix.
 
 use hydrorattle::*;
 use hydrorattle_heap::Buffers;
@@ -27,6 +29,24 @@ fn helix(n: usize) -> (Vec<glam::DVec3>, Vec<f64>) {
             0.8 * k as f64,
         ));
         rad.push(a);
+    }
+    (pos, rad)
+}
+
+/// The chain of `benches/kernel.rs` (`chain_geometry`): turning 0.6 rad per bead,
+/// rising 0.8, bonds 1.5 (a_i + a_j).
+fn chain(n: usize) -> (Vec<glam::DVec3>, Vec<f64>) {
+    let (mut pos, mut rad) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut at, mut prev) = (glam::DVec3::ZERO, 0.0);
+    for k in 0..n {
+        let a = if k == 0 { 2f64.cbrt() } else { 1.0 };
+        if k > 0 {
+            let t = 0.6 * k as f64;
+            at += glam::DVec3::new(t.cos(), t.sin(), 0.8).normalize() * 1.5 * (a + prev);
+        }
+        pos.push(at);
+        rad.push(a);
+        prev = a;
     }
     (pos, rad)
 }
@@ -51,7 +71,10 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(5);
     for n in args[3..].iter().map(|s| s.parse::<usize>().unwrap()) {
-        let (mut pos, radius) = helix(n);
+        let (mut pos, radius) = match std::env::var("CHAIN").is_ok() {
+            true => chain(n),
+            false => helix(n),
+        };
         let bonds: Vec<Bond<f64>> = (1..n)
             .map(|i| Bond {
                 i: i - 1,

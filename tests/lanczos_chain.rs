@@ -3,6 +3,10 @@
 //!   from a dense eigen-decomposition of `M` done here (cyclic Jacobi on the `3N x 3N`
 //!   matrix, nothing from the kernel but the assembled mobility), below the stated
 //!   tolerance, on a 10-bead cluster and a 64-bead helix;
+//! * the reduced copy of a large mobility the noise's products read
+//!   (`noise::reduced`): its products against the mobility's, the noise through them
+//!   against a converged root, and a thermal step through it against the matrix-free
+//!   one (which reads no copy), on a 768-bead helix;
 //! * a freely jointed chain of 64 beads with RPY and stiff constraints, through the
 //!   Lanczos path with the midpoint drift: the stiff-bond equilibrium has independent
 //!   bond directions, uniform on the sphere, so `<R_ee^2> = B b^2` and consecutive bonds
@@ -19,9 +23,10 @@ use common::*;
 use hydrorattle::linalg::{self, tri};
 use hydrorattle::mobility::assemble_tt;
 use hydrorattle::noise::lanczos::{self, Lanczos};
+use hydrorattle::noise::reduced;
 use hydrorattle::{
-    BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Particle,
-    ParticleSet, SolverKind, step,
+    Bond, BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Particle,
+    ParticleSet, SolverKind, State, step, step_slices,
 };
 use hydrorattle_heap::Buffers;
 
@@ -162,6 +167,98 @@ fn lanczos_truncation_error_is_below_the_stated_tolerance() {
             assert!(worst_inv < tolerance, "M^-1/2 z off by {worst_inv:e}");
         }
     }
+}
+
+#[test]
+fn reduced_copy_keeps_the_noise_within_the_tolerance() {
+    use glam::DVec3;
+    let n = reduced::REDUCED_MIN + 68;
+    let spheres = helix(n, 2f64.cbrt(), 3.0, 0.5, 1.5);
+    let pos: Vec<DVec3> = spheres.iter().map(|s| s.pos.into()).collect();
+    let radius: Vec<f64> = spheres.iter().map(|s| s.radius).collect();
+    let mut mu = vec![glam::DMat3::ZERO; tri(n)];
+    assemble_tt(Hydro::Rpy, 1.0, &pos, &radius, &mut mu).unwrap();
+    // The copy's products: the same bits whether written on the way or read back, and
+    // the mobility's to the rounding of its entries.
+    let mut packed = vec![glam::DMat3::ZERO; reduced::slots(n)];
+    let mut z = vec![DVec3::ZERO; n];
+    Noise::new(3).fill::<f64>(&mut z);
+    let (mut a, mut b, mut exact) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n], vec![]);
+    exact.resize(n, DVec3::ZERO);
+    reduced::copy_apply::<f64>(&mu, n, &mut packed, &z, &mut a);
+    reduced::apply::<f64>(&packed, n, &z, &mut b);
+    assert_eq!(a, b);
+    linalg::sym_matvec::<f64>(&mu, n, &z, &mut exact);
+    let flat = |a: &[DVec3]| -> Vec<f64> { a.iter().flat_map(|p| p.to_array()).collect() };
+    let off = rel(&flat(&a), &flat(&exact));
+    assert!(off < 1e-6, "reduced product off by {off:e}");
+    // The noise through the copy against a converged root from the mobility itself.
+    let mut basis = vec![DVec3::ZERO; lanczos::vectors(64, n)];
+    let mut work = vec![0.0; lanczos::scalars(64)];
+    let (mut root, mut inv) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+    let (mut root_ref, mut inv_ref) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+    let full = |x: &[DVec3], o: &mut [DVec3]| linalg::sym_matvec::<f64>(&mu, n, x, o);
+    let tight = Lanczos {
+        tolerance: 1e-7,
+        max_iterations: 64,
+    };
+    let (w, r) = (&mut basis, &mut work);
+    lanczos::sqrt(tight, full, &z, w, r, &mut root_ref, Some(&mut inv_ref)).unwrap();
+    let mut first = true;
+    let copy = |x: &[DVec3], o: &mut [DVec3]| match std::mem::take(&mut first) {
+        true => reduced::copy_apply::<f64>(&mu, n, &mut packed, x, o),
+        false => reduced::apply::<f64>(&packed, n, x, o),
+    };
+    let s = Lanczos::default();
+    let m = lanczos::sqrt(s, copy, &z, w, r, &mut root, Some(&mut inv)).unwrap();
+    let (e_root, e_inv) = (
+        rel(&flat(&root), &flat(&root_ref)),
+        rel(&flat(&inv), &flat(&inv_ref)),
+    );
+    println!("N = {n}: {m} iterations, relative error M^1/2 z {e_root:.2e}, M^-1/2 z {e_inv:.2e}");
+    assert!(e_root < s.tolerance && e_inv < s.tolerance);
+    // A thermal step through the copy against the matrix-free one (no copy): the same
+    // step but for the noise's error, and the bonds held.
+    let bonds: Vec<Bond<f64>> = (1..n)
+        .map(|i| Bond {
+            i: i - 1,
+            j: i,
+            length: (pos[i] - pos[i - 1]).length(),
+        })
+        .collect();
+    let run = |matrix_free: bool| {
+        let mut p = params::<f64>(0.01, Method::Overdamped, SolverKind::Krylov);
+        p.allow_overlap = true;
+        p.brownian = Some(Brownian::new(1.0));
+        p.noise_sqrt = NoiseSqrt::Lanczos;
+        p.matrix_free = matrix_free;
+        let mut store = Buffers::<f64>::new(Layout::for_params(&p, n, n - 1));
+        let (mut x, mut vel, mut omega) = (pos.clone(), vec![DVec3::ZERO; n], vec![]);
+        omega.resize(n, DVec3::ZERO);
+        let (mut time, mut noise, density) = (0.0, Noise::new(7), vec![RHO; n]);
+        let state = State {
+            pos: &mut x,
+            vel: &mut vel,
+            omega: &mut omega,
+            radius: &radius,
+            density: &density,
+            time: &mut time,
+            noise: Some(&mut noise),
+        };
+        let r = step_slices(state, &bonds, &p, &mut store.workspace(), &mut NoForce).unwrap();
+        (x, r)
+    };
+    let ((x, r), (x_free, r_free)) = (run(false), run(true));
+    assert!(r.noise_iterations > 2 && r.residual < 1e-6, "{r:?}");
+    let size = |d: &mut dyn Iterator<Item = DVec3>| d.map(|v| v.length_squared()).sum::<f64>();
+    let moved = size(&mut x_free.iter().zip(&pos).map(|(a, b)| *a - *b));
+    let apart = size(&mut x.iter().zip(&x_free).map(|(a, b)| *a - *b));
+    let gap = (apart / moved).sqrt(); // the entries rounding, 6e-8, not 1e-3
+    println!("step: {r:?}\nmatrix-free: {r_free:?}\nrelative gap {gap:.2e}");
+    assert!(
+        gap < 1e-5,
+        "step through the copy off by {gap:e} of the move"
+    );
 }
 
 const N: usize = 64;

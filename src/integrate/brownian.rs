@@ -21,6 +21,7 @@
 use super::{
     Projection, Start, StepReport, add_constraint_forces, add_flow, bond_vectors, free_product,
     mobility_metric, mobility_product, project_overdamped, report, spin, step_velocity,
+    wall_height,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch};
@@ -30,6 +31,7 @@ use crate::linalg;
 use crate::mobility::Hydro;
 use crate::noise::Noise;
 use crate::noise::lanczos::{self, LanczosError};
+use crate::noise::reduced;
 use crate::parallel::{self, Parallel};
 use crate::params::{Brownian, Drift, Params};
 use crate::real::Real;
@@ -179,10 +181,23 @@ pub(super) fn kick<T: Real>(
         bands,
     } = krylov;
     // `w = mu v` at the start: the stored mobility in bands, or matrix-free (the start
-    // has passed a product at these positions already, so no pair is nested).
+    // has passed a product at these positions already, so no pair is nested). In free
+    // space (symmetric blocks) a large f64 mobility is read from a reduced copy instead
+    // (`noise::reduced`), written into the factor's storage by the first product.
+    let reduced = lanczos
+        && !p.matrix_free
+        && wall_height(p).is_none()
+        && reduced::usable::<T>(n)
+        && fac.len() >= reduced::slots(n);
+    let mut copied = false;
     let product = |v: &[T::V3], w: &mut [T::V3]| {
         if p.matrix_free {
             let _ = free_product(p, s.pos, s.radius, v, w);
+        } else if reduced && copied {
+            reduced::apply::<T>(fac, n, v, w);
+        } else if reduced {
+            reduced::copy_apply::<T>(mu, n, fac, v, w);
+            copied = true;
         } else {
             parallel::product::<T>(par, mu, n, v, w, bands);
         }

@@ -15,7 +15,9 @@
 //! `M^(-1/2) z` (the Fixman midpoint's `L^-T xi`), converged to the same tolerance.
 //!
 //! Storage: `(cap + 1) n` vectors for the basis and one product, and
-//! [`scalars`]`(cap)` scalars for `T_m`, its eigenvectors and the coefficients.
+//! [`scalars`]`(cap)` scalars for `T_m`, its eigenvectors and the coefficients. A
+//! step's products read a large stored mobility through its reduced copy
+//! ([`super::reduced`]): the noise is then `M~^(1/2) z`, `M~` within `6e-8` of `M`.
 
 use crate::real::Real;
 use core::fmt;

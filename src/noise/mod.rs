@@ -15,6 +15,7 @@
 //! the run against the large kicks that made the step fail.
 
 pub mod lanczos;
+pub mod reduced;
 
 use crate::real::Real;
 
