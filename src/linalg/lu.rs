@@ -126,11 +126,7 @@ pub fn cholesky_dense_solve<T: Real>(a: &[T], n: usize, x: &mut [T]) {
     // L y = b, row by row.
     for r in 0..n {
         let row = &a[r * n..r * n + r + 1];
-        let acc = row[..r]
-            .iter()
-            .zip(&x[..r])
-            .fold(x[r], |acc, (&l, &y)| acc - l * y);
-        x[r] = acc * row[r];
+        x[r] = sub_dot(x[r], &row[..r], &x[..r]) * row[r];
     }
     // L^T x = y, column by column of L^T (rows of L): x_r final, then taken off the rest.
     for r in (0..n).rev() {
@@ -158,6 +154,21 @@ fn dot<T: Real>(a: &[T], b: &[T]) -> T {
         s += x[3] * y[3];
     }
     ra.iter().zip(rb).fold(s, |s, (&x, &y)| s + x * y)
+}
+
+/// `s - a_0 b_0 - a_1 b_1 - ...` in index order, four terms per loop pass (the bits of
+/// the plain loop).
+#[inline(always)]
+fn sub_dot<T: Real>(mut s: T, a: &[T], b: &[T]) -> T {
+    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (a4.remainder(), b4.remainder());
+    for (x, y) in a4.zip(b4) {
+        s -= x[0] * y[0];
+        s -= x[1] * y[1];
+        s -= x[2] * y[2];
+        s -= x[3] * y[3];
+    }
+    ra.iter().zip(rb).fold(s, |s, (&x, &y)| s - x * y)
 }
 
 /// `(sum a_i c_i, sum b_i c_i)`, each from zero in index order (the bits of [`dot`]).
