@@ -477,29 +477,28 @@ fn table<T: Real, const SYM: bool>(
         // rows `i` and `j` (contiguous); up to `hi` one is in row `hi`, the other in
         // column `lo`; beyond, both in columns `i` and `j` of the rows below.
         let (ri, rj) = (tri(i), tri(j));
-        let (first, rest) = out.split_at_mut(lo + 1);
-        let (middle, last) = rest.split_at_mut(hi - lo);
-        let pairs = mu[ri..=ri + lo].iter().zip(&mu[rj..=rj + lo]);
-        for (o, (&a, &c)) in first.iter_mut().zip(pairs) {
-            *o = sym_diff_mul::<T>(a, c, g, sym);
+        let mut at = 0;
+        for (&a, &c) in mu[ri..=ri + lo].iter().zip(&mu[rj..=rj + lo]) {
+            out[at] = sym_diff_mul::<T>(a, c, g, sym);
+            at += 1;
         }
-        // The packed rows below `lo`, split off one by one (row `q` holds `q + 1` blocks).
         let row_hi = &mu[tri(hi)..tri(hi) + hi + 1];
-        let (mut rows, mut len) = (&mu[tri(lo + 1)..], lo + 2);
-        for (o, &on_row) in middle.iter_mut().zip(&row_hi[lo + 1..]) {
-            let (row, below) = rows.split_at(len);
-            (rows, len) = (below, len + 1);
-            let on_col = tr(row[lo]);
-            *o = if i == hi {
+        let mut rq = tri(lo + 1);
+        for q in lo + 1..=hi {
+            let (on_row, on_col) = (row_hi[q], mu[rq + lo]);
+            let on_col = tr(on_col);
+            out[at] = if i == hi {
                 sym_diff_mul::<T>(on_row, on_col, g, sym)
             } else {
                 sym_diff_mul::<T>(on_col, on_row, g, sym)
             };
+            rq += q + 1;
+            at += 1;
         }
-        for o in last.iter_mut() {
-            let (row, below) = rows.split_at(len);
-            (rows, len) = (below, len + 1);
-            *o = sym_diff_mul::<T>(tr(row[i]), tr(row[j]), g, sym);
+        for q in hi + 1..n {
+            out[at] = sym_diff_mul::<T>(tr(mu[rq + i]), tr(mu[rq + j]), g, sym);
+            rq += q + 1;
+            at += 1;
         }
     }
 }

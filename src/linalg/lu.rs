@@ -71,69 +71,53 @@ pub fn lu_solve<T: Real>(a: &[T], n: usize, piv: &[usize], x: &mut [T]) {
 /// In-place Cholesky factorisation `A = L L^T` of the symmetric positive definite
 /// `n x n` row-major `a`, reading and writing only the lower triangle (the upper one is
 /// never touched, so the caller fills only `l <= k`). Row by row, each entry one
-/// contiguous dot product, four rows at a time: their entries left of the block are
-/// independent, so four dot products' addition chains overlap (each entry's arithmetic
-/// is that of one row at a time: the same bits). The diagonal holds
+/// contiguous dot product, two rows at a time: their entries are independent up to the
+/// first row's diagonal, so the two dot products' addition chains overlap (each entry's
+/// arithmetic is that of one row at a time: the same bits). The diagonal holds
 /// `1 / L_kk`, so solves only multiply. A pivot that is not positive and finite is
 /// [`LinalgError::NotPositiveDefinite`]. Cost: about `n^3 / 6` multiply-adds, half of
 /// [`lu`]'s, and no pivot search.
 pub fn cholesky_dense<T: Real>(a: &mut [T], n: usize) -> Result<(), LinalgError> {
     let a = &mut a[..n * n];
     let mut k = 0;
-    while k < n {
-        let rows = if k + 4 <= n { 4 } else { (n - k).min(2) };
+    while k + 1 < n {
         let (done, rest) = a.split_at_mut(k * n);
-        // Every row's entries j < k, from the finished rows j, block by block.
-        if rows == 4 {
-            let (r0, t) = rest.split_at_mut(n);
-            let (r1, t) = t.split_at_mut(n);
-            let (r2, r3) = t.split_at_mut(n);
-            for (j, row_j) in done.chunks_exact(n).enumerate() {
-                let (c, d) = (&row_j[..j], row_j[j]);
-                let (s0, s1) = dot2(&r0[..j], &r1[..j], c);
-                let (s2, s3) = dot2(&r2[..j], &r3[..j], c);
-                r0[j] = (r0[j] - s0) * d;
-                r1[j] = (r1[j] - s1) * d;
-                r2[j] = (r2[j] - s2) * d;
-                r3[j] = (r3[j] - s3) * d;
-            }
-        } else if rows == 2 {
-            let (r0, r1) = rest.split_at_mut(n);
-            for (j, row_j) in done.chunks_exact(n).enumerate() {
-                let (s0, s1) = dot2(&r0[..j], &r1[..j], &row_j[..j]);
-                r0[j] = (r0[j] - s0) * row_j[j];
-                r1[j] = (r1[j] - s1) * row_j[j];
-            }
-        } else {
-            for (j, row_j) in done.chunks_exact(n).enumerate() {
-                rest[j] = (rest[j] - dot(&rest[..j], &row_j[..j])) * row_j[j];
-            }
+        let (row_k, row_m) = rest.split_at_mut(n);
+        let (row_k, row_m) = (&mut row_k[..=k], &mut row_m[..=k + 1]);
+        // L_kj and L_(k+1)j for j < k, both from row j.
+        for (j, row_j) in done.chunks_exact(n).enumerate() {
+            let (s, t) = dot2(&row_k[..j], &row_m[..j], &row_j[..j]);
+            row_k[j] = (row_k[j] - s) * row_j[j];
+            row_m[j] = (row_m[j] - t) * row_j[j];
         }
-        // Then, in order, each row's entries inside the block and its pivot.
-        for i in k..k + rows {
-            let (done, rest) = a.split_at_mut(i * n);
-            let row = &mut rest[..=i];
-            for (j, row_j) in done.chunks_exact(n).enumerate().skip(k) {
-                row[j] = (row[j] - dot(&row[..j], &row_j[..j])) * row_j[j];
-            }
-            pivot(row, i)?;
+        let inv = pivot(row_k, k)?;
+        row_m[k] = (row_m[k] - dot(&row_m[..k], &row_k[..k])) * inv;
+        pivot(row_m, k + 1)?;
+        k += 2;
+    }
+    if k < n {
+        let (done, rest) = a.split_at_mut(k * n);
+        let row_k = &mut rest[..=k];
+        for (j, row_j) in done.chunks_exact(n).enumerate() {
+            let (head, tail) = row_k.split_at_mut(j);
+            tail[0] = (tail[0] - dot(head, &row_j[..j])) * row_j[j];
         }
-        k += rows;
+        pivot(row_k, k)?;
     }
     Ok(())
 }
 
-/// `L_kk = sqrt(A_kk - sum_j L_kj^2)` for `row = [L_k0, .., L_k(k-1), A_kk]`; stores
-/// `1 / L_kk`.
+/// `L_kk = sqrt(A_kk - sum_j L_kj^2)` for `row = [L_k0, .., L_k(k-1), A_kk]`; stores and
+/// returns `1 / L_kk`.
 #[inline(always)]
-fn pivot<T: Real>(row: &mut [T], k: usize) -> Result<(), LinalgError> {
+fn pivot<T: Real>(row: &mut [T], k: usize) -> Result<T, LinalgError> {
     let (head, last) = row.split_at_mut(k);
     let d = head.iter().fold(last[0], |s, &x| s - x * x);
     if !(d > T::ZERO && d.is_finite()) {
         return Err(LinalgError::NotPositiveDefinite { row: k });
     }
     last[0] = T::ONE / d.sqrt();
-    Ok(())
+    Ok(last[0])
 }
 
 /// Solves `A x = b` in place with the factor from [`cholesky_dense`].
