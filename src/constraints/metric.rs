@@ -61,12 +61,12 @@ pub enum Metric<'a, T: Real> {
         /// The wall's height when there is one ([`wall`]).
         wall: Option<T>,
     },
-    /// Precomputed displacements `disp[p * bonds + l]` (`beads x bonds`, bead-major: a
-    /// bead's displacements by every multiplier are contiguous, so an update of all
-    /// multipliers sums each bead's moves in registers, and a Jacobian row reads two
-    /// contiguous runs).
+    /// Precomputed displacements `disp[l * beads + p]` (`bonds x beads`, bond-major: a
+    /// multiplier's moves of all beads are contiguous, so the table is written in order
+    /// and an update of all multipliers keeps a few beads' running sums in registers,
+    /// adjacent beads' coordinates side by side, [`Metric::apply_each`]).
     Dense {
-        /// Displacements, bead-major.
+        /// Displacements, bond-major.
         disp: &'a [T::V3],
         /// Beads.
         n: usize,
@@ -114,11 +114,13 @@ fn sym_block<T: Real>(mu: &[T::M3], p: usize, q: usize) -> T::M3 {
 /// pair blocks are not symmetric). For symmetric blocks these are the bits of
 /// `(a - c) * g` (the same products summed in glam's order, the entries equal to their
 /// transposes).
+/// `sym` says the blocks are known symmetric (no wall in this step): then, as without
+/// the `wall` feature, only their lower triangles are read.
 #[inline(always)]
-fn sym_diff_mul<T: Real>(a: T::M3, c: T::M3, g: T::V3) -> T::V3 {
+fn sym_diff_mul<T: Real>(a: T::M3, c: T::M3, g: T::V3, sym: bool) -> T::V3 {
     let d = |r, col| T::m3_get(a, r, col) - T::m3_get(c, r, col);
     let [x, y, z] = T::xyz(g);
-    if !cfg!(feature = "wall") {
+    if !cfg!(feature = "wall") || sym {
         // Symmetric blocks only: the lower triangles suffice (12 loads and 6
         // subtractions instead of 18 and 9), the same bits (M4 firmware's hot loop).
         let (d00, d10, d20) = (d(0, 0), d(1, 0), d(2, 0));
@@ -189,7 +191,7 @@ impl<T: Real> Metric<'_, T> {
                     true => T::M3_ZERO,
                     false => sym_block::<T>(mu, p, b.j),
                 };
-                sym_diff_mul::<T>(sym_block::<T>(mu, p, b.i), mu_pj, g)
+                sym_diff_mul::<T>(sym_block::<T>(mu, p, b.i), mu_pj, g, false)
             }
             Metric::Free {
                 level,
@@ -210,9 +212,9 @@ impl<T: Real> Metric<'_, T> {
                 };
                 let block = |q| block(q).unwrap_or(T::M3_ZERO);
                 let mu_pj = if b.is_wall() { T::M3_ZERO } else { block(b.j) };
-                sym_diff_mul::<T>(block(b.i), mu_pj, grad[l] * scale)
+                sym_diff_mul::<T>(block(b.i), mu_pj, grad[l] * scale, false)
             }
-            Metric::Dense { disp, n, .. } => disp[p * (disp.len() / n) + l],
+            Metric::Dense { disp, n, .. } => disp[l * n + p],
             Metric::Drag {
                 mu, sq, dt, grad, ..
             } => {
@@ -253,17 +255,15 @@ impl<T: Real> Metric<'_, T> {
         let b = bonds[k];
         match *self {
             Metric::Dense { disp, n, .. } => {
-                let nb = disp.len() / n;
-                let di = &disp[b.i * nb + first..];
+                let rows = disp[first * n..].chunks_exact(n);
                 if b.is_wall() {
                     // A wall link moves its sphere alone.
-                    for (r, &a) in row.iter_mut().zip(di) {
-                        *r = T::dot(dir, a);
+                    for (r, d) in row.iter_mut().zip(rows) {
+                        *r = T::dot(dir, d[b.i]);
                     }
                 } else {
-                    let dj = &disp[b.j * nb + first..];
-                    for ((r, &a), &c) in row.iter_mut().zip(di).zip(dj) {
-                        *r = T::dot(dir, a - c);
+                    for (r, d) in row.iter_mut().zip(rows) {
+                        *r = T::dot(dir, d[b.i] - d[b.j]);
                     }
                 }
             }
@@ -286,9 +286,8 @@ impl<T: Real> Metric<'_, T> {
                 }
             }
             Metric::Dense { disp, n, .. } => {
-                let nb = disp.len() / n;
-                for (xp, row) in x.iter_mut().zip(disp.chunks_exact(nb)) {
-                    *xp += row[l] * c;
+                for (xp, &d) in x.iter_mut().zip(&disp[l * n..(l + 1) * n]) {
+                    *xp += d * c;
                 }
             }
             Metric::Mobility { .. } | Metric::Free { .. } | Metric::Drag { .. } => {
@@ -300,16 +299,31 @@ impl<T: Real> Metric<'_, T> {
     }
 
     /// `x += sum_l c_l D_l`, the multipliers' moves added bond after bond (the bits of
-    /// [`Metric::apply_one`] for `l = 0, 1, ...`; the dense Newton update). The
-    /// bead-major table sums each bead's moves in a register.
+    /// [`Metric::apply_one`] for `l = 0, 1, ...`; the dense Newton update). The table
+    /// is read four beads at a time: their twelve running sums stay in registers and
+    /// adjacent beads' coordinates are adjacent in memory, so the compiler pairs them
+    /// into packed SIMD operations (no reordering: the same bits).
     pub fn apply_each(&self, bonds: &[Bond<T>], c: &[T], x: &mut [T::V3]) {
         match *self {
             Metric::Dense { disp, n, .. } => {
-                let nb = disp.len() / n;
-                for (xp, row) in x.iter_mut().zip(disp.chunks_exact(nb)) {
+                const W: usize = 4;
+                let rows = || disp.chunks_exact(n).zip(c);
+                let mut chunks = x.chunks_exact_mut(W);
+                for (k, xs) in (&mut chunks).enumerate() {
+                    let mut acc = [xs[0], xs[1], xs[2], xs[3]];
+                    for (row, &cl) in rows() {
+                        let d = &row[k * W..k * W + W];
+                        for (a, &dp) in acc.iter_mut().zip(d) {
+                            *a += dp * cl;
+                        }
+                    }
+                    xs.copy_from_slice(&acc);
+                }
+                let first = x.len() - x.len() % W;
+                for (p, xp) in x.iter_mut().enumerate().skip(first) {
                     let mut acc = *xp;
-                    for (&d, &cl) in row.iter().zip(c) {
-                        acc += d * cl;
+                    for (row, &cl) in rows() {
+                        acc += row[p] * cl;
                     }
                     *xp = acc;
                 }
@@ -400,11 +414,12 @@ impl<T: Real> Metric<'_, T> {
     }
 }
 
-/// Tabulates `disp[q * bonds + l] = (mu_qi - mu_qj) (scale g_l)` from the packed mobility:
+/// Tabulates `disp[l * n + q] = (mu_qi - mu_qj) (scale g_l)` from the packed mobility:
 /// the values [`Metric::Mobility`] gives (one block difference and one block product per
 /// entry, not two products). Blocks stored as `mu_qi` are transposed for
 /// [`sym_diff_mul`] (exact: the same bits for symmetric blocks; only a wall's blocks
-/// are not symmetric, so without the `wall` feature nothing is transposed). Never
+/// are not symmetric, so without the `wall` feature, or with `sym` (no wall in this
+/// step), nothing is transposed and only lower triangles are read). Never
 /// inlined: the metric's constructor is inlined at every call site
 /// (`mobility_metric`), the table is the same code at each.
 #[inline(never)]
@@ -414,12 +429,32 @@ pub(crate) fn tabulate<T: Real>(
     grad: &[T::V3],
     scale: T,
     n: usize,
+    sym: bool,
+    disp: &mut [T::V3],
+) {
+    // One body per case, so that the block reads branch on nothing at run time.
+    if sym || !cfg!(feature = "wall") {
+        table::<T, true>(mu, bonds, grad, scale, n, disp);
+    } else {
+        table::<T, false>(mu, bonds, grad, scale, n, disp);
+    }
+}
+
+/// [`tabulate`] with the blocks known symmetric (`SYM`) or not.
+#[inline(always)]
+fn table<T: Real, const SYM: bool>(
+    mu: &[T::M3],
+    bonds: &[Bond<T>],
+    grad: &[T::V3],
+    scale: T,
+    n: usize,
     disp: &mut [T::V3],
 ) {
     let nb = bonds.len();
     let disp = &mut disp[..n * nb];
+    let sym = SYM;
     let tr = |m: T::M3| {
-        if cfg!(feature = "wall") {
+        if cfg!(feature = "wall") && !sym {
             T::transpose(m)
         } else {
             m
@@ -427,10 +462,11 @@ pub(crate) fn tabulate<T: Real>(
     };
     for (l, b) in bonds.iter().enumerate() {
         let g = grad[l] * scale;
-        // Bead `q`'s entry of this bond is `disp[q * nb + l]` (bead-major).
+        // Bead `q`'s entry of this bond is `disp[l * n + q]` (bond-major).
+        let out = &mut disp[l * n..(l + 1) * n];
         if b.is_wall() {
-            for q in 0..n {
-                disp[q * nb + l] = sym_diff_mul::<T>(sym_block::<T>(mu, q, b.i), T::M3_ZERO, g);
+            for (q, o) in out.iter_mut().enumerate() {
+                *o = sym_diff_mul::<T>(sym_block::<T>(mu, q, b.i), T::M3_ZERO, g, false);
             }
             continue;
         }
@@ -441,28 +477,28 @@ pub(crate) fn tabulate<T: Real>(
         // rows `i` and `j` (contiguous); up to `hi` one is in row `hi`, the other in
         // column `lo`; beyond, both in columns `i` and `j` of the rows below.
         let (ri, rj) = (tri(i), tri(j));
-        let mut at = l;
+        let mut at = 0;
         for (&a, &c) in mu[ri..=ri + lo].iter().zip(&mu[rj..=rj + lo]) {
-            disp[at] = sym_diff_mul::<T>(a, c, g);
-            at += nb;
+            out[at] = sym_diff_mul::<T>(a, c, g, sym);
+            at += 1;
         }
         let row_hi = &mu[tri(hi)..tri(hi) + hi + 1];
         let mut rq = tri(lo + 1);
         for q in lo + 1..=hi {
             let (on_row, on_col) = (row_hi[q], mu[rq + lo]);
             let on_col = tr(on_col);
-            disp[at] = if i == hi {
-                sym_diff_mul::<T>(on_row, on_col, g)
+            out[at] = if i == hi {
+                sym_diff_mul::<T>(on_row, on_col, g, sym)
             } else {
-                sym_diff_mul::<T>(on_col, on_row, g)
+                sym_diff_mul::<T>(on_col, on_row, g, sym)
             };
             rq += q + 1;
-            at += nb;
+            at += 1;
         }
         for q in hi + 1..n {
-            disp[at] = sym_diff_mul::<T>(tr(mu[rq + i]), tr(mu[rq + j]), g);
+            out[at] = sym_diff_mul::<T>(tr(mu[rq + i]), tr(mu[rq + j]), g, sym);
             rq += q + 1;
-            at += nb;
+            at += 1;
         }
     }
 }

@@ -158,9 +158,8 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
                 t[q] = (block(b.i) - block(b.j)) * grad[l];
             }
             apply_drag(fac, sq, dt, t);
-            let nb = bonds.len();
-            for q in 0..n {
-                disp[q * nb + l] = t[q] * dt;
+            for (d, &tq) in disp[l * n..(l + 1) * n].iter_mut().zip(t.iter()) {
+                *d = tq * dt;
             }
         }
         let disp = &disp[..n * bonds.len()];

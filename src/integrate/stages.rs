@@ -77,7 +77,9 @@ pub(super) fn mobility_metric<'a, T: Real>(
         };
     }
     let n = pos.len();
-    constraints::tabulate(mu, bonds, grad, scale, n, disp);
+    // Without a wall every block is symmetric: the table reads lower triangles only.
+    let sym = wall_height(p).is_none();
+    constraints::tabulate(mu, bonds, grad, scale, n, sym, disp);
     let disp = &disp[..n * bonds.len()];
     Metric::Dense { disp, n, grad }
 }
