@@ -315,7 +315,7 @@ impl_real!(
     f32,
     glam::Vec3,
     glam::Mat3,
-    libm::sqrtf,
+    sqrt_f32,
     root_and_inverse_f32,
     libm::sinf,
     libm::cosf,
@@ -342,12 +342,21 @@ fn root_and_inverse_f64(x: f64) -> (f64, f64) {
     (s, 1.0 / s)
 }
 
+/// libm's `sqrtf`, called rather than inlined on 32-bit Arm: there it is ~220 bytes of
+/// software (no hardware path from safe stable Rust, see `root_and_inverse`) that
+/// inlining copied into every call site (~1 kB of flash); elsewhere it is one instruction.
+#[cfg_attr(target_arch = "arm", inline(never))]
+#[cfg_attr(not(target_arch = "arm"), inline)]
+fn sqrt_f32(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
+
 #[inline]
 fn root_and_inverse_f32(x: f32) -> (f32, f32) {
     let bits = x.to_bits();
     // Positive normal numbers only: [2^-126, f32::MAX].
     if bits.wrapping_sub(0x0080_0000) >= 0x7f00_0000 {
-        let s = libm::sqrtf(x);
+        let s = sqrt_f32(x);
         return (s, 1.0 / s);
     }
     // A 3.4 % estimate from the bits, then y <- y (3/2 - x y^2 / 2): 1.8e-3, 4.6e-6,
