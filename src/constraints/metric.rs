@@ -183,6 +183,23 @@ impl<T: Real> Metric<'_, T> {
                     T::V3_ZERO
                 }
             }
+            Metric::Dense { disp, n, .. } => disp[l * n + p],
+            _ => self.at_far(bonds, l, p),
+        }
+    }
+
+    /// [`Metric::at`] for the metrics that compute it (mobility blocks, matrix-free
+    /// blocks, the drag model). Called, not inlined, on 32-bit Arm: `at` is inlined at
+    /// every call site (the Jacobian rows, the moves) and these arms would be copied
+    /// into each (~2 kB of firmware flash); the firmware's dense solves read
+    /// [`Metric::Dense`] or [`Metric::Mass`], which stay inline.
+    #[cfg_attr(target_arch = "arm", inline(never))]
+    #[cfg_attr(not(target_arch = "arm"), inline(always))]
+    fn at_far(&self, bonds: &[Bond<T>], l: usize, p: usize) -> T::V3 {
+        let b = bonds[l];
+        match *self {
+            // Read inline by `at`, which never calls this for them.
+            Metric::Mass { .. } | Metric::Dense { .. } => T::V3_ZERO,
             Metric::Mobility {
                 mu, grad, scale, ..
             } => {
@@ -214,7 +231,6 @@ impl<T: Real> Metric<'_, T> {
                 let mu_pj = if b.is_wall() { T::M3_ZERO } else { block(b.j) };
                 sym_diff_mul::<T>(block(b.i), mu_pj, grad[l] * scale, false)
             }
-            Metric::Dense { disp, n, .. } => disp[l * n + p],
             Metric::Drag {
                 mu, sq, dt, grad, ..
             } => {
