@@ -21,6 +21,8 @@
 
 mod blocked;
 
+pub(crate) use blocked::{Blocks, band_rows};
+
 use crate::error::ParticleError;
 use crate::linalg::tri;
 use crate::mobility::{Hydro, pair_tt, self_tt};
@@ -238,7 +240,7 @@ fn row_fused<T: Real>(
 
 /// The second round: band `s`'s rows of `y` gain the partial sums of the bands below it,
 /// in band order.
-fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn Parallel) {
+pub(crate) fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn Parallel) {
     let k = bands(n);
     if k == 1 {
         return;
@@ -281,6 +283,22 @@ pub(crate) fn by_bands<T: Real, E: Send, J>(
 where
     J: Fn(usize, &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
 {
+    by_bands_in::<T, E, J>(par, n, out, tri, y, z, job)
+}
+
+/// [`by_bands`] for an `out` whose first `start(i)` entries hold rows `0..i`.
+pub(crate) fn by_bands_in<T: Real, E: Send, J>(
+    par: &dyn Parallel,
+    n: usize,
+    out: &mut [T::M3],
+    start: fn(usize) -> usize,
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+    job: J,
+) -> Result<(), E>
+where
+    J: Fn(usize, &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
+{
     let k = bands(n);
     let mut results: [Option<Result<(), E>>; BANDS] = core::array::from_fn(|_| None);
     {
@@ -291,7 +309,11 @@ where
             let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
             // Slices given empty stay empty for every band.
             let (lo, ly, lz) = (
-                if os.is_empty() { 0 } else { tri(b1) - tri(b0) },
+                if os.is_empty() {
+                    0
+                } else {
+                    start(b1) - start(b0)
+                },
                 if ys.is_empty() { 0 } else { b1 - b0 },
                 if zs.is_empty() { 0 } else { b0 },
             );
@@ -328,7 +350,7 @@ pub fn product<T: Real>(
         return;
     }
     let _ = by_bands::<T, (), _>(par, n, &mut [], y, z, |t, _, yt, zt| {
-        blocked::band_rows::<T>(a, band_start(n, t), x, yt, zt);
+        band_rows::<T, _>(blocked::Full(a), band_start(n, t), x, yt, zt);
         Ok(())
     });
     reduce::<T>(n, y, z, par);
