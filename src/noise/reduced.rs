@@ -103,7 +103,7 @@ impl<'a, T: Real> Blocks<'a, T> for Reduced<'a, T> {
     }
     #[inline(always)]
     fn apply(row: &[T::M3], j: usize, x: T::V3, xr: T::V3) -> (T::V3, T::V3) {
-        let e = entries::<T>(T::m3_col(row[j / 3], j % 3));
+        let e = entries::<T>(T::m3_col_at(&row[j / 3], j));
         (sym_mul(e, x), sym_mul(e, xr))
     }
 }
