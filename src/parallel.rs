@@ -268,26 +268,12 @@ pub(crate) fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn 
     run_all(par, &mut jobs);
 }
 
-/// Hands every band its rows of `out` (packed blocks, or nothing when `out` is empty),
+/// Hands every band its rows of `out` (packed, the first `start(i)` entries holding
+/// rows `0..i`; or nothing when `out` is empty),
 /// of `y` (or nothing) and its partial-sum slice of `z` (or nothing), runs
 /// `job(t, rows, y_t, z_t)` for every band through `par`, and returns the first error
 /// in band order (the one a single pass in row order meets first).
 pub(crate) fn by_bands<T: Real, E: Send, J>(
-    par: &dyn Parallel,
-    n: usize,
-    out: &mut [T::M3],
-    y: &mut [T::V3],
-    z: &mut [T::V3],
-    job: J,
-) -> Result<(), E>
-where
-    J: Fn(usize, &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
-{
-    by_bands_in::<T, E, J>(par, n, out, tri, y, z, job)
-}
-
-/// [`by_bands`] for an `out` whose first `start(i)` entries hold rows `0..i`.
-pub(crate) fn by_bands_in<T: Real, E: Send, J>(
     par: &dyn Parallel,
     n: usize,
     out: &mut [T::M3],
@@ -349,7 +335,7 @@ pub fn product<T: Real>(
         band::<T>(a, 0, x, &mut y[..n], &mut []);
         return;
     }
-    let _ = by_bands::<T, (), _>(par, n, &mut [], y, z, |t, _, yt, zt| {
+    let _ = by_bands::<T, (), _>(par, n, &mut [], tri, y, z, |t, _, yt, zt| {
         band_rows::<T, _>(blocked::Full(a), band_start(n, t), x, yt, zt);
         Ok(())
     });
@@ -371,7 +357,7 @@ pub fn assemble<T: Real>(
     if bands(n) == 1 {
         return rows::<T>(level, eta, pos, radius, 0..n, out);
     }
-    by_bands::<T, _, _>(par, n, out, &mut [], &mut [], |t, rows_t, _, _| {
+    by_bands::<T, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
         let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
         rows::<T>(level, eta, pos, radius, b0..b1, rows_t)
     })
@@ -427,7 +413,7 @@ pub fn assemble_apply<T: Real>(
     if bands(n) == 1 {
         return blocked::fused_rows::<T>(src, out, 0, x, &mut y[..n], &mut []);
     }
-    by_bands::<T, _, _>(par, n, out, y, z, |t, rows_t, yt, zt| {
+    by_bands::<T, _, _>(par, n, out, tri, y, z, |t, rows_t, yt, zt| {
         blocked::fused_rows::<T>(src, rows_t, band_start(n, t), x, yt, zt)
     })?;
     reduce::<T>(n, y, z, par);

@@ -15,6 +15,10 @@
 //! column order, and `y_j` still receives the transposed products of the rows below it
 //! in row order (row `i`, then `i + 1`, ...), because a column visits the rows of a
 //! group in order.
+//!
+//! The walk is generic over how a block is read and applied ([`Blocks`]): the stored
+//! mobility ([`Full`]) and the Lanczos noise's reduced copy of it
+//! ([`crate::noise::reduced`]) share it.
 
 use super::Pairs;
 use crate::error::ParticleError;
