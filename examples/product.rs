@@ -1,11 +1,13 @@
 //! Nanoseconds per packed block of the stored product `y = mu_tt x` and of the fused
-//! assembly + product, at the bead counts given (issue 20, item 4).
+//! assembly + product, and of the noise's products on the reduced copy (written on the
+//! way, and read back), at the bead counts given (issue 20, item 4; issue 19, item 9).
 //!
 //! `cargo run --release --example product -- N [REPS]`: the helix of `scale`, the best of
 //! `REPS` (default 20) single-thread passes, and a digest of `y` (the same on every
 //! build that keeps the arithmetic).
 use hydrorattle::linalg::tri;
 use hydrorattle::mobility::Hydro;
+use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{assemble, assemble_apply, band_scratch, product};
 use hydrorattle::*;
 use std::time::Instant;
@@ -59,6 +61,13 @@ fn main() {
     };
     report("product", &mut |y| {
         product::<f64>(&par, &mu, n, &x, y, &mut z)
+    });
+    let mut packed = vec![glam::DMat3::ZERO; reduced::slots(n)];
+    report("reduced copy_apply", &mut |y| {
+        reduced::copy_apply::<f64>(&par, &mu, n, &mut packed, &x, y, &mut z)
+    });
+    report("reduced apply", &mut |y| {
+        reduced::apply::<f64>(&par, &packed, n, &x, y, &mut z)
     });
     let mut z = vec![glam::DVec3::ZERO; band_scratch(n).max(1)];
     report("assemble_apply", &mut |y| {

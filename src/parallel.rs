@@ -21,6 +21,8 @@
 
 mod blocked;
 
+pub(crate) use blocked::{Blocks, band_rows};
+
 use crate::error::ParticleError;
 use crate::linalg::tri;
 use crate::mobility::{Hydro, pair_tt, self_tt};
@@ -238,7 +240,7 @@ fn row_fused<T: Real>(
 
 /// The second round: band `s`'s rows of `y` gain the partial sums of the bands below it,
 /// in band order.
-fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn Parallel) {
+pub(crate) fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn Parallel) {
     let k = bands(n);
     if k == 1 {
         return;
@@ -266,7 +268,8 @@ fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn Parallel) {
     run_all(par, &mut jobs);
 }
 
-/// Hands every band its rows of `out` (packed blocks, or nothing when `out` is empty),
+/// Hands every band its rows of `out` (packed, the first `start(i)` entries holding
+/// rows `0..i`; or nothing when `out` is empty),
 /// of `y` (or nothing) and its partial-sum slice of `z` (or nothing), runs
 /// `job(t, rows, y_t, z_t)` for every band through `par`, and returns the first error
 /// in band order (the one a single pass in row order meets first).
@@ -274,6 +277,7 @@ pub(crate) fn by_bands<T: Real, E: Send, J>(
     par: &dyn Parallel,
     n: usize,
     out: &mut [T::M3],
+    start: fn(usize) -> usize,
     y: &mut [T::V3],
     z: &mut [T::V3],
     job: J,
@@ -291,7 +295,11 @@ where
             let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
             // Slices given empty stay empty for every band.
             let (lo, ly, lz) = (
-                if os.is_empty() { 0 } else { tri(b1) - tri(b0) },
+                if os.is_empty() {
+                    0
+                } else {
+                    start(b1) - start(b0)
+                },
                 if ys.is_empty() { 0 } else { b1 - b0 },
                 if zs.is_empty() { 0 } else { b0 },
             );
@@ -327,8 +335,8 @@ pub fn product<T: Real>(
         band::<T>(a, 0, x, &mut y[..n], &mut []);
         return;
     }
-    let _ = by_bands::<T, (), _>(par, n, &mut [], y, z, |t, _, yt, zt| {
-        blocked::band_rows::<T>(a, band_start(n, t), x, yt, zt);
+    let _ = by_bands::<T, (), _>(par, n, &mut [], tri, y, z, |t, _, yt, zt| {
+        band_rows::<T, _>(blocked::Full(a), band_start(n, t), x, yt, zt);
         Ok(())
     });
     reduce::<T>(n, y, z, par);
@@ -349,7 +357,7 @@ pub fn assemble<T: Real>(
     if bands(n) == 1 {
         return rows::<T>(level, eta, pos, radius, 0..n, out);
     }
-    by_bands::<T, _, _>(par, n, out, &mut [], &mut [], |t, rows_t, _, _| {
+    by_bands::<T, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
         let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
         rows::<T>(level, eta, pos, radius, b0..b1, rows_t)
     })
@@ -405,7 +413,7 @@ pub fn assemble_apply<T: Real>(
     if bands(n) == 1 {
         return blocked::fused_rows::<T>(src, out, 0, x, &mut y[..n], &mut []);
     }
-    by_bands::<T, _, _>(par, n, out, y, z, |t, rows_t, yt, zt| {
+    by_bands::<T, _, _>(par, n, out, tri, y, z, |t, rows_t, yt, zt| {
         blocked::fused_rows::<T>(src, rows_t, band_start(n, t), x, yt, zt)
     })?;
     reduce::<T>(n, y, z, par);

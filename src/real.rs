@@ -125,6 +125,8 @@ pub trait Real:
     fn m3_cols(c0: Self::V3, c1: Self::V3, c2: Self::V3) -> Self::M3;
     /// Column `i` of a matrix.
     fn m3_col(m: Self::M3, i: usize) -> Self::V3;
+    /// Column `i % 3` of a matrix in memory, read at its offset (no branch on `i`).
+    fn m3_col_at(m: &Self::M3, i: usize) -> Self::V3;
     /// Transpose.
     fn transpose(m: Self::M3) -> Self::M3;
 
@@ -295,6 +297,12 @@ macro_rules! impl_real {
             #[inline]
             fn m3_col(m: $m, i: usize) -> $v {
                 m.col(i)
+            }
+            #[inline]
+            fn m3_col_at(m: &$m, i: usize) -> $v {
+                let a: &[Self; 9] = m.as_ref();
+                let k = 3 * (i % 3);
+                <$v>::new(a[k], a[k + 1], a[k + 2])
             }
             #[inline]
             fn transpose(m: $m) -> $m {
