@@ -21,7 +21,7 @@
 
 mod blocked;
 
-pub(crate) use blocked::{Blocks, band_rows};
+pub(crate) use blocked::band_rows;
 
 use crate::error::ParticleError;
 use crate::linalg::tri;
@@ -98,10 +98,10 @@ pub const fn band_scratch(n: usize) -> usize {
 }
 
 /// The job list of one round (at most [`BANDS`] jobs, on the stack).
-type Jobs<F> = heapless::Vec<F, BANDS>;
+pub(crate) type Jobs<F> = heapless::Vec<F, BANDS>;
 
 /// Runs one round of jobs through `par`.
-fn run_all<F: FnMut() + Send>(par: &dyn Parallel, jobs: &mut Jobs<F>) {
+pub(crate) fn run_all<F: FnMut() + Send>(par: &dyn Parallel, jobs: &mut Jobs<F>) {
     let mut refs: heapless::Vec<&mut (dyn FnMut() + Send), BANDS> = heapless::Vec::new();
     for job in jobs.iter_mut() {
         let _ = refs.push(job);
@@ -336,7 +336,7 @@ pub fn product<T: Real>(
         return;
     }
     let _ = by_bands::<T, (), _>(par, n, &mut [], tri, y, z, |t, _, yt, zt| {
-        band_rows::<T, _>(blocked::Full(a), band_start(n, t), x, yt, zt);
+        band_rows::<T>(a, band_start(n, t), x, yt, zt);
         Ok(())
     });
     reduce::<T>(n, y, z, par);

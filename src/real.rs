@@ -125,10 +125,12 @@ pub trait Real:
     fn m3_cols(c0: Self::V3, c1: Self::V3, c2: Self::V3) -> Self::M3;
     /// Column `i` of a matrix.
     fn m3_col(m: Self::M3, i: usize) -> Self::V3;
-    /// Column `i % 3` of a matrix in memory, read at its offset (no branch on `i`).
-    fn m3_col_at(m: &Self::M3, i: usize) -> Self::V3;
     /// Transpose.
     fn transpose(m: Self::M3) -> Self::M3;
+    /// The nine entries of a matrix in memory, column by column.
+    fn m3_entries(m: &Self::M3) -> &[Self; 9];
+    /// The nine entries of a matrix in memory, column by column, to write.
+    fn m3_entries_mut(m: &mut Self::M3) -> &mut [Self; 9];
 
     /// Converts from an `f64` triple.
     fn v3_from(a: [f64; 3]) -> Self::V3 {
@@ -299,14 +301,16 @@ macro_rules! impl_real {
                 m.col(i)
             }
             #[inline]
-            fn m3_col_at(m: &$m, i: usize) -> $v {
-                let a: &[Self; 9] = m.as_ref();
-                let k = 3 * (i % 3);
-                <$v>::new(a[k], a[k + 1], a[k + 2])
-            }
-            #[inline]
             fn transpose(m: $m) -> $m {
                 m.transpose()
+            }
+            #[inline(always)]
+            fn m3_entries(m: &$m) -> &[Self; 9] {
+                m.as_ref()
+            }
+            #[inline(always)]
+            fn m3_entries_mut(m: &mut $m) -> &mut [Self; 9] {
+                m.as_mut()
             }
             #[inline]
             fn m3_add_diag(mut m: $m, s: Self) -> $m {

@@ -1,32 +1,48 @@
-//! The Lanczos noise's products on a reduced copy of the stored mobility.
+//! The Lanczos noise's products on a reduced copy of the stored mobility, in `f32`
+//! SIMD lanes.
 //!
 //! The noise is right only to the Lanczos tolerance (`1e-3` by default), so its
-//! products need not read the full `f64` mobility: each free-space block is symmetric
-//! (`a I + b r r^T` for RPY and Oseen, scalar on the diagonal), and its six distinct
-//! entries rounded to `f32` (relative `6e-8`) take 24 bytes instead of 72. Lanczos then
-//! computes `M~^(1/2) z`, `M~` the rounded mobility (symmetric, positive definite with
-//! `M` to `6e-8` relative), the arithmetic still in `T`. The products run in the bands
-//! of [`parallel::product`], eight block rows at a time (the same walk, generic over
-//! how a block is read): 3.4-3.6 ns per block at N = 1024 and 2048 against 3.9-4.4
-//! for the full product, which is memory bound there. The copy's products are compute
-//! bound (the entries are widened on the fly), so in cache they gain nothing, hence
-//! [`REDUCED_MIN`].
+//! products need neither the full `f64` mobility nor `f64` arithmetic. Each free-space
+//! block is symmetric (`a I + b r r^T` for RPY and Oseen, scalar on the diagonal), so
+//! the copy keeps its six distinct entries rounded to `f32` (24 bytes instead of 72),
+//! and the products run in `f32`, four blocks of a row at once (`glam::Vec4`: SSE2
+//! does four `f32` operations where it does two `f64`, and the `f64` walk was compute
+//! bound at 3.4 ns a block; this one takes 1.3 at N = 1024). Lanczos then computes
+//! `M~^(1/2) z` with `M~` the rounded mobility; each product is right to about `1e-6`
+//! relative (`f32` sums, `tests/lanczos_chain.rs` measures it), far below the
+//! tolerance. Bits: the same on any number of threads (fixed bands,
+//! [`parallel::bands`], each summing its transposed blocks into a partial vector of its
+//! own, added in band order), and on any target (`Vec4` is IEEE `f32` lane by lane,
+//! with no fused multiply-add).
 //!
-//! Storage: the blocks are read from and written to `T::M3` slots, three blocks per
-//! slot (one per column), each block's six `f32` as three `f64` bit patterns (pairs of
-//! `f32`). Row `i` (blocks `j = 0 ..= i`) starts at a slot of its own ([`slots`]`(i)`),
-//! block `j` in its slot `j / 3`. This needs `T` to be `f64` ([`usable`]); an `f32`
-//! kernel reads the mobility itself. The copy lives in the Cholesky factor's storage, free until the
-//! midpoint's mobility is assembled there after the noise is drawn.
+//! **Layout.** `f32` values are held in pairs as the bit patterns of the `T` (`f64`)
+//! entries of `T::M3` slots, eight entries a slot (no `unsafe` view of the memory is
+//! needed). Row `i` holds blocks `j = 0 ..= i` in groups of [`GROUP`] blocks, three
+//! slots a group: two chunks of four blocks, each chunk the six entries `[xx, yy, zz,
+//! xy, xz, yz]` of its four blocks as four lanes apiece. The diagonal block is stored
+//! halved (it is met twice: in the row's own sum and as its transposed block), the
+//! blocks past the diagonal as zeros. A band walks its rows one column tile
+//! ([`TILE`]) at a time, the tile's `x` and partial sums in lanes on the stack; its
+//! partial sums over all columns are kept in `f64`. The storage, [`slots`]`(n)`, is
+//! the Cholesky factor's (a third of it), free until the midpoint's mobility is
+//! assembled there after the noise is drawn. `T` must be `f64` ([`usable`]); an `f32`
+//! kernel reads the mobility itself.
 
 use crate::linalg::tri;
-use crate::parallel::{self, Blocks, Parallel, band_start};
+use crate::parallel::{self, Jobs, Parallel, band_start, bands};
 use crate::real::Real;
+use glam::Vec4;
 
 /// Fewest block rows the copy is used at: the mobility then takes 17.6 MB and more,
 /// beyond what a step keeps in a shared last-level cache (32 MB here, two mobilities
 /// and other processes' data in it). Below it the products read the mobility itself.
 pub const REDUCED_MIN: usize = 700;
+
+/// Blocks of a group: two chunks of four lanes.
+const GROUP: usize = 8;
+
+/// Slots of a group of blocks (twelve lane quadruples, four a slot).
+const BLOCK_SLOTS: usize = 3;
 
 /// Whether the reduced copy applies to `n` block rows: an `f64` kernel (two `f32` per
 /// slot entry) and at least [`REDUCED_MIN`] rows.
@@ -34,151 +50,264 @@ pub fn usable<T: Real>(n: usize) -> bool {
     core::mem::size_of::<T>() == 8 && n >= REDUCED_MIN
 }
 
-/// Slots (`T::M3`) the copy of `n` block rows takes: `ceil((i + 1) / 3)` for row `i`,
-/// so also the slot row `n` starts at.
+/// Groups of row `i` (blocks `0 ..= i`).
+const fn groups(i: usize) -> usize {
+    i / GROUP + 1
+}
+
+/// Groups of rows `0..i`: the sum of [`groups`], in closed form.
+const fn row_start(i: usize) -> usize {
+    let q = i / GROUP;
+    i + GROUP * q * q.saturating_sub(1) / 2 + (i % GROUP) * q
+}
+
+/// Slots of an `f64` vector of `n` beads (nine entries a slot).
+const fn vector_slots(n: usize) -> usize {
+    (3 * n).div_ceil(9)
+}
+
+/// Slots the copy of `n` block rows and its products' scratch take: the copy and a
+/// partial sum for each band (rows `0..` its end).
 pub const fn slots(n: usize) -> usize {
-    // sum over i < n of (i / 3 + 1), in closed form.
-    let q = n / 3;
-    n + 3 * q * q.saturating_sub(1) / 2 + (n % 3) * q
-}
-
-/// Two `f32` (rounded from `a` and `b`) in one `f64` bit pattern, as `T`.
-#[inline(always)]
-fn pack<T: Real>(a: T, b: T) -> T {
-    let (a, b) = ((a.to_f64() as f32).to_bits(), (b.to_f64() as f32).to_bits());
-    T::from_f64(f64::from_bits(u64::from(a) | (u64::from(b) << 32)))
-}
-
-/// The two `f32` of [`pack`], as `T`.
-#[inline(always)]
-fn unpack<T: Real>(x: T) -> (T, T) {
-    let bits = x.to_f64().to_bits();
-    let (a, b) = (
-        f32::from_bits(bits as u32),
-        f32::from_bits((bits >> 32) as u32),
-    );
-    (T::from_f64(f64::from(a)), T::from_f64(f64::from(b)))
-}
-
-/// The symmetric block's six entries (lower triangle of `m`), packed into a column.
-#[inline(always)]
-fn pack_block<T: Real>(m: T::M3) -> T::V3 {
-    let g = |r, c| T::m3_get(m, r, c);
-    T::v3(
-        pack(g(0, 0), g(1, 1)),
-        pack(g(2, 2), g(1, 0)),
-        pack(g(2, 0), g(2, 1)),
-    )
-}
-
-/// The six entries of a packed column: `[xx, yy, zz, xy, xz, yz]`.
-#[inline(always)]
-fn entries<T: Real>(v: T::V3) -> [T; 6] {
-    let [p, q, r] = T::xyz(v);
-    let ((xx, yy), (zz, xy), (xz, yz)) = (unpack(p), unpack(q), unpack(r));
-    [xx, yy, zz, xy, xz, yz]
-}
-
-/// `b v` for the symmetric block of `entries`.
-#[inline(always)]
-fn sym_mul<T: Real>(e: [T; 6], v: T::V3) -> T::V3 {
-    let [xx, yy, zz, xy, xz, yz] = e;
-    let [a, b, c] = T::xyz(v);
-    T::v3(
-        xx * a + xy * b + xz * c,
-        xy * a + yy * b + yz * c,
-        xz * a + yz * b + zz * c,
-    )
-}
-
-/// The copy's slots from row `base` on, read by the banded walk
-/// ([`parallel::band_rows`]): block `j` of a row is column `j % 3` of its slot `j / 3`.
-#[derive(Clone, Copy)]
-struct Reduced<'a, T: Real> {
-    slots: &'a [T::M3],
-    base: usize,
-}
-
-impl<'a, T: Real> Blocks<'a, T> for Reduced<'a, T> {
-    #[inline(always)]
-    fn row(self, i: usize) -> &'a [T::M3] {
-        &self.slots[slots(i) - self.base..][..i / 3 + 1]
+    let mut s = BLOCK_SLOTS * row_start(n);
+    let mut t = 0;
+    while t < bands(n) {
+        s += vector_slots(band_start(n, t + 1));
+        t += 1;
     }
-    #[inline(always)]
-    fn apply(row: &[T::M3], j: usize, x: T::V3, xr: T::V3) -> (T::V3, T::V3) {
-        let e = entries::<T>(T::m3_col_at(&row[j / 3], j));
-        (sym_mul(e, x), sym_mul(e, xr))
+    s
+}
+
+/// The bits of entry `p` of a run of slots: eight of a slot's nine entries are used,
+/// so that the two entries of a lane quadruple are always in one slot.
+#[inline(always)]
+fn bits<T: Real>(s: &[T::M3], p: usize) -> u64 {
+    T::m3_entries(&s[p / 8])[p % 8].to_f64().to_bits()
+}
+
+/// Lane quadruple `q`: the `f32` pairs of entries `2 q` and `2 q + 1`, lanes 0 and 1
+/// in their low halves (so the compiler loads them with one instruction and one
+/// shuffle).
+#[inline(always)]
+fn get4<T: Real>(s: &[T::M3], q: usize) -> [f32; 4] {
+    let (a, b) = (bits::<T>(s, 2 * q), bits::<T>(s, 2 * q + 1));
+    let f = |x: u64| f32::from_bits(x as u32);
+    [f(a), f(b), f(a >> 32), f(b >> 32)]
+}
+
+/// Writes lane quadruple `q`.
+#[inline(always)]
+fn put4<T: Real>(s: &mut [T::M3], q: usize, v: [f32; 4]) {
+    let pair = |a: f32, b: f32| {
+        T::from_f64(f64::from_bits(
+            u64::from(a.to_bits()) | (u64::from(b.to_bits()) << 32),
+        ))
+    };
+    let e = T::m3_entries_mut(&mut s[q / 4]);
+    e[2 * (q % 4)] = pair(v[0], v[2]);
+    e[2 * (q % 4) + 1] = pair(v[1], v[3]);
+}
+
+/// Adds `v` to component `k` of bead `j` of an `f64` vector in slots.
+#[inline(always)]
+fn add1<T: Real>(s: &mut [T::M3], j: usize, k: usize, v: f32) {
+    let p = 3 * j + k;
+    let e = &mut T::m3_entries_mut(&mut s[p / 9])[p % 9];
+    *e += T::from_f64(f64::from(v));
+}
+
+/// Component `k` of bead `j` of an `f64` vector in slots.
+#[inline(always)]
+fn get1<T: Real>(s: &[T::M3], j: usize, k: usize) -> T {
+    let p = 3 * j + k;
+    T::m3_entries(&s[p / 9])[p % 9]
+}
+
+/// Packs rows `b0..b1` of the packed mobility `mu` into `out` (their groups).
+fn pack_rows<T: Real>(mu: &[T::M3], b0: usize, b1: usize, out: &mut [T::M3]) {
+    let base = BLOCK_SLOTS * row_start(b0);
+    for i in b0..b1 {
+        let row = &mu[tri(i)..=tri(i) + i];
+        let slots = &mut out[BLOCK_SLOTS * row_start(i) - base..][..BLOCK_SLOTS * groups(i)];
+        for (g, group) in slots.chunks_exact_mut(BLOCK_SLOTS).enumerate() {
+            for c in 0..2 {
+                let j0 = GROUP * g + 4 * c;
+                // The six entries of the chunk's four blocks (halved on the diagonal,
+                // zero past it).
+                let mut e = [[0.0f32; 4]; 6];
+                for l in 0..4 {
+                    let j = j0 + l;
+                    if j > i {
+                        break;
+                    }
+                    let a = T::m3_entries(&row[j]);
+                    let half = if j == i { 0.5 } else { 1.0 };
+                    // Column-major: xx, yy, zz, then xy (row 1, col 0), xz, yz.
+                    for (k, &at) in [0, 4, 8, 1, 2, 5].iter().enumerate() {
+                        e[k][l] = half * a[at].to_f64() as f32;
+                    }
+                }
+                for (k, v) in e.into_iter().enumerate() {
+                    put4::<T>(group, 6 * c + k, v);
+                }
+            }
+        }
     }
 }
 
-/// `y = M~ x` from the copy `packed` of `n` block rows ([`copy_apply`]), in the bands of
-/// [`parallel::product`] through `par` (`z`: [`parallel::band_scratch`]`(n)` vectors).
+/// Beads of a column tile: a band's rows are walked tile by tile, with the tile's `x`
+/// and partial sums `y` in lanes on the stack (12 kB; 1024 measured 1.30 against 1.36
+/// ns a block at N = 1024, 2.7 against 3.0 at 2048, for twice the stack).
+const TILE: usize = 512;
+
+/// A tile's vector: per chunk of four beads, `x`, `y` and `z` as four lanes each.
+type Lanes = [[Vec4; 3]; TILE / 4];
+
+/// Row `i`'s blocks in one tile (`row`, whole groups): `sum_j B_ij x_j` (returned, from
+/// four lane sums in a fixed order) while `y_j += B_ij x_i`. (Written with `Vec4`:
+/// left to the vectoriser, the same loop on `[f32; 4]` took twice as long, shuffling.)
+#[inline(always)]
+fn walk_row<T: Real>(row: &[T::M3], x: &Lanes, y: &mut Lanes, xi: [f32; 3]) -> [f32; 3] {
+    let xi = xi.map(Vec4::splat);
+    let mut acc = [Vec4::ZERO; 3];
+    let chunks = x.chunks_exact(2).zip(y.chunks_exact_mut(2));
+    for (b, (xg, yg)) in row.chunks_exact(BLOCK_SLOTS).zip(chunks) {
+        for c in 0..2 {
+            let [xx, yy, zz, xy, xz, yz]: [Vec4; 6] =
+                core::array::from_fn(|q| Vec4::from_array(get4::<T>(b, 6 * c + q)));
+            let (xl, yl) = (&xg[c], &mut yg[c]);
+            for (k, r) in [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
+                .iter()
+                .enumerate()
+            {
+                acc[k] += r[0] * xl[0] + r[1] * xl[1] + r[2] * xl[2];
+                yl[k] += r[0] * xi[0] + r[1] * xi[1] + r[2] * xi[2];
+            }
+        }
+    }
+    acc.map(|a| (a.x + a.y) + (a.z + a.w))
+}
+
+/// Rows `b0..b1` from their groups `rows` into the band's partial sum `part` (rows
+/// `0..b1`, from zero, in `f64`), one column tile at a time.
+fn band<T: Real>(rows: &[T::M3], b0: usize, b1: usize, x: &[T::V3], part: &mut [T::M3]) {
+    part.fill(T::m3_diag(T::ZERO));
+    let base = BLOCK_SLOTS * row_start(b0);
+    let lane = |j: usize, k: usize| match x.get(j) {
+        Some(&v) => T::xyz(v)[k].to_f64() as f32,
+        None => 0.0,
+    };
+    for t0 in (0..b1).step_by(TILE) {
+        let mut xt: Lanes = [[Vec4::ZERO; 3]; TILE / 4];
+        let mut yt: Lanes = [[Vec4::ZERO; 3]; TILE / 4];
+        for (h, chunk) in xt.iter_mut().enumerate() {
+            let lanes = |k| Vec4::from_array(core::array::from_fn(|l| lane(t0 + 4 * h + l, k)));
+            *chunk = core::array::from_fn(lanes);
+        }
+        for i in b0.max(t0)..b1 {
+            // The row's groups from the tile's first to its last or the row's end.
+            let g = (groups(i) - t0 / GROUP).min(TILE / GROUP);
+            let start = BLOCK_SLOTS * (row_start(i) + t0 / GROUP) - base;
+            let row = &rows[start..][..BLOCK_SLOTS * g];
+            let xi = core::array::from_fn(|k| lane(i, k));
+            let own = walk_row::<T>(row, &xt, &mut yt, xi);
+            for (k, v) in own.into_iter().enumerate() {
+                add1::<T>(part, i, k, v);
+            }
+        }
+        for j in t0..(t0 + TILE).min(b1) {
+            let r = j - t0;
+            for k in 0..3 {
+                add1::<T>(part, j, k, yt[r / 4][k][r % 4]);
+            }
+        }
+    }
+}
+
+/// `y = M~ x` with the copy in `store` (written first from `mu` if given), in bands
+/// through `par`, then the bands' partial sums added in band order.
+fn run<T: Real>(
+    par: &dyn Parallel,
+    mu: Option<&[T::M3]>,
+    n: usize,
+    store: &mut [T::M3],
+    x: &[T::V3],
+    y: &mut [T::V3],
+) {
+    let (copy, parts) = store[..slots(n)].split_at_mut(BLOCK_SLOTS * row_start(n));
+    let x = &x[..n];
+    let mut jobs = Jobs::new();
+    let (mut copy, mut parts) = (copy, &mut *parts);
+    for t in 0..bands(n) {
+        let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
+        let rows = BLOCK_SLOTS * (row_start(b1) - row_start(b0));
+        let (rows, rest) = core::mem::take(&mut copy).split_at_mut(rows);
+        copy = rest;
+        let (part, rest) = core::mem::take(&mut parts).split_at_mut(vector_slots(b1));
+        parts = rest;
+        let _ = jobs.push(move || {
+            if let Some(mu) = mu {
+                pack_rows::<T>(mu, b0, b1, rows);
+            }
+            band::<T>(rows, b0, b1, x, part);
+        });
+    }
+    parallel::run_all(par, &mut jobs);
+    drop(jobs);
+    for yi in y[..n].iter_mut() {
+        *yi = T::V3_ZERO;
+    }
+    let mut offset = 0;
+    let parts = &store[BLOCK_SLOTS * row_start(n)..slots(n)];
+    for t in 0..bands(n) {
+        let b1 = band_start(n, t + 1);
+        let part = &parts[offset..offset + vector_slots(b1)];
+        for (i, yi) in y[..b1].iter_mut().enumerate() {
+            *yi += T::v3(
+                get1::<T>(part, i, 0),
+                get1::<T>(part, i, 1),
+                get1::<T>(part, i, 2),
+            );
+        }
+        offset += vector_slots(b1);
+    }
+}
+
+/// `y = M~ x` from the copy in `store` ([`slots`]`(n)` slots, written by
+/// [`copy_apply`]), through `par`.
 pub fn apply<T: Real>(
     par: &dyn Parallel,
-    packed: &[T::M3],
+    store: &mut [T::M3],
     n: usize,
     x: &[T::V3],
     y: &mut [T::V3],
-    z: &mut [T::V3],
 ) {
-    let _ = parallel::by_bands::<T, (), _>(par, n, &mut [], tri, y, z, |t, _, yt, zt| {
-        let b0 = band_start(n, t);
-        let blocks = Reduced::<T> {
-            slots: &packed[slots(b0)..],
-            base: slots(b0),
-        };
-        parallel::band_rows::<T, _>(blocks, b0, x, yt, zt);
-        Ok(())
-    });
-    parallel::reduce::<T>(n, y, z, par);
+    run::<T>(par, None, n, store, x, y);
 }
 
 /// [`apply`] while writing the copy of the packed mobility `mu` (`n` block rows) into
-/// `packed` ([`slots`]`(n)` slots): each band packs its rows, then applies them from
-/// the copy (so the product is the copy's, bit for bit).
-#[allow(clippy::too_many_arguments)]
+/// `store`: each band packs its rows, then applies them from the copy (so the product
+/// is the copy's, bit for bit).
 pub fn copy_apply<T: Real>(
     par: &dyn Parallel,
     mu: &[T::M3],
     n: usize,
-    packed: &mut [T::M3],
+    store: &mut [T::M3],
     x: &[T::V3],
     y: &mut [T::V3],
-    z: &mut [T::V3],
 ) {
-    let packed = &mut packed[..slots(n)];
-    let _ = parallel::by_bands::<T, (), _>(par, n, packed, slots, y, z, |t, out, yt, zt| {
-        let b0 = band_start(n, t);
-        for i in b0..b0 + yt.len() {
-            let row = &mu[tri(i)..=tri(i) + i];
-            let start = slots(i) - slots(b0);
-            for (q, slot) in out[start..slots(i + 1) - slots(b0)].iter_mut().enumerate() {
-                let col = |c: usize| match row.get(3 * q + c) {
-                    Some(&m) => pack_block::<T>(m),
-                    None => T::V3_ZERO,
-                };
-                *slot = T::m3_cols(col(0), col(1), col(2));
-            }
-        }
-        let blocks = Reduced::<T> {
-            slots: &*out,
-            base: slots(b0),
-        };
-        parallel::band_rows::<T, _>(blocks, b0, x, yt, zt);
-        Ok(())
-    });
-    parallel::reduce::<T>(n, y, z, par);
+    run::<T>(par, Some(mu), n, store, x, y);
 }
 
 #[cfg(test)]
 mod tests {
-    /// The closed form of [`super::slots`] against the sum it stands for.
+    /// The closed form of [`super::row_start`] against the sum it stands for.
     #[test]
-    fn slots_sum_the_rows() {
+    fn row_starts_sum_the_groups() {
         let mut sum = 0;
-        for n in 0..100 {
-            assert_eq!(super::slots(n), sum, "n = {n}");
-            sum += n / 3 + 1;
+        for i in 0..200 {
+            assert_eq!(super::row_start(i), sum, "i = {i}");
+            sum += super::groups(i);
         }
     }
 }

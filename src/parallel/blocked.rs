@@ -15,10 +15,6 @@
 //! column order, and `y_j` still receives the transposed products of the rows below it
 //! in row order (row `i`, then `i + 1`, ...), because a column visits the rows of a
 //! group in order.
-//!
-//! The walk is generic over how a block is read and applied ([`Blocks`]): the stored
-//! mobility ([`Full`]) and the Lanczos noise's reduced copy of it
-//! ([`crate::noise::reduced`]) share it.
 
 use super::Pairs;
 use crate::error::ParticleError;
@@ -30,35 +26,10 @@ use crate::real::Real;
 /// 12: 4.3, 16: 5.3 ns per block at N = 1024).
 pub(super) const ROWS: usize = 8;
 
-/// How a band walk reads a packed symmetric matrix: the stored mobility ([`Full`]), or
-/// the noise's reduced copy of it ([`crate::noise::reduced`]).
-pub(crate) trait Blocks<'a, T: Real>: Copy {
-    /// Row `i`'s storage, holding its blocks `0..=i`.
-    fn row(self, i: usize) -> &'a [T::M3];
-    /// `(b x, b^T xr)` for block `j` of `row`.
-    fn apply(row: &[T::M3], j: usize, x: T::V3, xr: T::V3) -> (T::V3, T::V3);
-}
-
-/// The packed blocks themselves, one `T::M3` each.
-#[derive(Clone, Copy)]
-pub(super) struct Full<'a, T: Real>(pub &'a [T::M3]);
-
-impl<'a, T: Real> Blocks<'a, T> for Full<'a, T> {
-    #[inline(always)]
-    fn row(self, i: usize) -> &'a [T::M3] {
-        &self.0[tri(i)..=tri(i) + i]
-    }
-    #[inline(always)]
-    fn apply(row: &[T::M3], j: usize, x: T::V3, xr: T::V3) -> (T::V3, T::V3) {
-        let b = row[j];
-        (b * x, T::m3_tmul(b, xr))
-    }
-}
-
 /// Column `j` for a group of rows: `acc_r += B_rj x_j` for every row `r` of the group,
 /// then `out += B_rj^T x_r` in row order.
 #[inline(always)]
-fn column<'a, T: Real, W: Blocks<'a, T>, const R: usize>(
+fn column<T: Real, const R: usize>(
     rows: &[&[T::M3]; R],
     j: usize,
     xj: T::V3,
@@ -68,9 +39,9 @@ fn column<'a, T: Real, W: Blocks<'a, T>, const R: usize>(
 ) {
     let mut o = *out;
     for r in 0..R {
-        let (p, q) = W::apply(rows[r], j, xj, xs[r]);
-        acc[r] += p;
-        o += q;
+        let b = rows[r][j];
+        acc[r] += b * xj;
+        o += T::m3_tmul(b, xs[r]);
     }
     *out = o;
 }
@@ -78,8 +49,8 @@ fn column<'a, T: Real, W: Blocks<'a, T>, const R: usize>(
 /// Rows `b0..b0 + y.len()` of `y = A x` as [`band`](super::band) computes them (the same
 /// bits), [`ROWS`] rows at a time, the rows left over at the band's end one by one.
 #[inline(always)]
-pub(crate) fn band_rows<'a, T: Real, W: Blocks<'a, T>>(
-    a: W,
+pub(crate) fn band_rows<T: Real>(
+    a: &[T::M3],
     b0: usize,
     x: &[T::V3],
     y: &mut [T::V3],
@@ -88,23 +59,23 @@ pub(crate) fn band_rows<'a, T: Real, W: Blocks<'a, T>>(
     z.fill(T::V3_ZERO);
     for (k, yk) in y.iter_mut().enumerate() {
         let i = b0 + k;
-        *yk = W::apply(a.row(i), i, x[i], x[i]).0;
+        *yk = a[tri(i) + i] * x[i];
     }
     let m = y.len();
     let mut k = 0;
     while k + ROWS <= m {
-        group::<T, W, ROWS>(a, b0, k, x, y, z);
+        group::<T, ROWS>(a, b0, k, x, y, z);
         k += ROWS;
     }
     for k in k..m {
-        group::<T, W, 1>(a, b0, k, x, y, z);
+        group::<T, 1>(a, b0, k, x, y, z);
     }
 }
 
 /// Rows `b0 + k..b0 + k + R` of a [`band_rows`], walked column by column.
 #[inline(always)]
-fn group<'a, T: Real, W: Blocks<'a, T>, const R: usize>(
-    a: W,
+fn group<T: Real, const R: usize>(
+    a: &[T::M3],
     b0: usize,
     k: usize,
     x: &[T::V3],
@@ -112,22 +83,22 @@ fn group<'a, T: Real, W: Blocks<'a, T>, const R: usize>(
     z: &mut [T::V3],
 ) {
     let i = b0 + k;
-    let rows: [&[T::M3]; R] = core::array::from_fn(|r| a.row(i + r));
+    let rows: [&[T::M3]; R] = core::array::from_fn(|r| &a[tri(i + r)..=tri(i + r) + i + r]);
     let xs: [T::V3; R] = core::array::from_fn(|r| x[i + r]);
     let mut acc = [T::V3_ZERO; R];
     for (j, (zj, &xj)) in z.iter_mut().zip(x).enumerate() {
-        column::<T, W, R>(&rows, j, xj, &xs, &mut acc, zj);
+        column::<T, R>(&rows, j, xj, &xs, &mut acc, zj);
     }
     for (j, (yj, &xj)) in y[..k].iter_mut().zip(&x[b0..]).enumerate() {
-        column::<T, W, R>(&rows, b0 + j, xj, &xs, &mut acc, yj);
+        column::<T, R>(&rows, b0 + j, xj, &xs, &mut acc, yj);
     }
     // The group's own triangle, row by row: row `i + r` meets columns `i..i + r`,
     // whose sums are complete before it adds to them.
     for (r, (&xr, acc_r)) in xs.iter().zip(&mut acc).enumerate() {
         for c in 0..r {
-            let (p, q) = W::apply(rows[r], i + c, x[i + c], xr);
-            *acc_r += p;
-            y[k + c] += q;
+            let b = rows[r][i + c];
+            *acc_r += b * x[i + c];
+            y[k + c] += T::m3_tmul(b, xr);
         }
         y[k + r] += *acc_r;
     }
@@ -245,7 +216,7 @@ mod tests {
             let (mut y0, mut y1) = (vec![DVec3::ZERO; b1 - b0], vec![DVec3::ZERO; b1 - b0]);
             let (mut z0, mut z1) = (vec![DVec3::ONE; b0], vec![DVec3::ONE; b0]);
             super::super::band::<f64>(&a, b0, &x, &mut y0, &mut z0);
-            band_rows::<f64, _>(Full(&a), b0, &x, &mut y1, &mut z1);
+            band_rows::<f64>(&a, b0, &x, &mut y1, &mut z1);
             assert_eq!(bits(&y0), bits(&y1), "rows {b0}..{b1}");
             assert_eq!(bits(&z0), bits(&z1), "rows {b0}..{b1}");
         }
