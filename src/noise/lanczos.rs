@@ -17,7 +17,8 @@
 //! Storage: `(cap + 1) n` vectors for the basis and one product, and
 //! [`scalars`]`(cap)` scalars for `T_m`, its eigenvectors and the coefficients. A
 //! step's products read a large stored mobility through its reduced copy
-//! ([`super::reduced`]): the noise is then `M~^(1/2) z`, `M~` within `6e-8` of `M`.
+//! ([`super::reduced`], `f32` entries and sums): the noise is then `M~^(1/2) z`, each
+//! product `M~ v` within about `1e-7` of `M v`.
 
 use crate::real::Real;
 use core::fmt;

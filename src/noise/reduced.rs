@@ -17,12 +17,12 @@
 //!
 //! **Layout.** `f32` values are held in pairs as the bit patterns of the `T` (`f64`)
 //! entries of `T::M3` slots, eight entries a slot (no `unsafe` view of the memory is
-//! needed). Row `i` holds blocks `j = 0 ..= i` in groups of [`GROUP`] blocks, three
+//! needed). Row `i` holds blocks `j = 0 ..= i` in groups of eight blocks, three
 //! slots a group: two chunks of four blocks, each chunk the six entries `[xx, yy, zz,
 //! xy, xz, yz]` of its four blocks as four lanes apiece. The diagonal block is stored
 //! halved (it is met twice: in the row's own sum and as its transposed block), the
 //! blocks past the diagonal as zeros. A band walks its rows one column tile
-//! ([`TILE`]) at a time, the tile's `x` and partial sums in lanes on the stack; its
+//! (512 beads) at a time, the tile's `x` and partial sums in lanes on the stack; its
 //! partial sums over all columns are kept in `f64`. The storage, [`slots`]`(n)`, is
 //! the Cholesky factor's (a third of it), free until the midpoint's mobility is
 //! assembled there after the noise is drawn. `T` must be `f64` ([`usable`]); an `f32`
