@@ -21,7 +21,7 @@
 
 mod blocked;
 
-pub(crate) use blocked::band_rows;
+pub(crate) use blocked::{assemble_apply_then, band_rows};
 
 use crate::error::ParticleError;
 use crate::linalg::tri;

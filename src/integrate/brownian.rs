@@ -72,9 +72,21 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         links,
         ..
     } = v;
-    // Deterministic velocity at the start: U_inf + mu F.
+    // Deterministic velocity at the start: U_inf + mu F. When the noise's products will
+    // read the reduced copy of `mu`, each band of the assembly writes its part of the
+    // copy while its blocks are in cache.
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
+    let copied = reads_copy(p, n, fac.len());
+    if copied {
+        let (level, eta) = (p.hydro, p.viscosity);
+        let (start, pack) = (reduced::copy_start, reduced::pack_rows::<T>);
+        parallel::assemble_apply_then(
+            par, level, eta, s.pos, s.radius, mu, force, u, bands, fac, start, pack,
+        )
+        .map_err(StepError::from)?;
+    } else {
+        mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
+    }
     add_flow(p, s.pos, u);
     let held = Held {
         bonds,
@@ -88,6 +100,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         work: krylov_t,
         par,
         bands,
+        copied,
     };
     let (noise_iterations, midpoint) =
         kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held), krylov)?;
@@ -128,13 +141,27 @@ pub(super) struct Held<'a, 'b, T: Real> {
 }
 
 /// The Lanczos basis and its scalars ([`Views::basis`], [`Views::krylov_t`]; empty with
-/// the Cholesky factor), and how the stored mobility's products run ([`Views::par`],
-/// [`Views::bands`]; the start's product is done with them when the noise is drawn).
+/// the Cholesky factor), how the stored mobility's products run ([`Views::par`],
+/// [`Views::bands`]; the start's product is done with them when the noise is drawn),
+/// and whether the factor's storage already holds the reduced copy of `mu`
+/// ([`reads_copy`]).
 pub(super) struct Krylov<'a, T: Real> {
     pub(super) basis: &'a mut [T::V3],
     pub(super) work: &'a mut [T],
     pub(super) par: &'a dyn Parallel,
     pub(super) bands: &'a mut [T::V3],
+    pub(super) copied: bool,
+}
+
+/// Whether the noise's products read the reduced copy of the stored mobility
+/// (`noise::reduced`), kept in the factor's storage of `fac` slots: Lanczos, a stored
+/// free-space mobility (symmetric blocks), an `f64` kernel of enough beads.
+fn reads_copy<T: Real>(p: &Params<T>, n: usize, fac: usize) -> bool {
+    p.lanczos_noise(n)
+        && !p.matrix_free
+        && wall_height(p).is_none()
+        && reduced::usable::<T>(n)
+        && fac >= reduced::slots(n)
 }
 
 /// The thermal displacement `dx` of one step from the packed mobility `mu` at the
@@ -179,17 +206,15 @@ pub(super) fn kick<T: Real>(
         work,
         par,
         bands,
+        copied,
     } = krylov;
     // `w = mu v` at the start: the stored mobility in bands, or matrix-free (the start
     // has passed a product at these positions already, so no pair is nested). In free
     // space (symmetric blocks) a large f64 mobility is read from a reduced copy instead
-    // (`noise::reduced`), written into the factor's storage by the first product.
-    let reduced = lanczos
-        && !p.matrix_free
-        && wall_height(p).is_none()
-        && reduced::usable::<T>(n)
-        && fac.len() >= reduced::slots(n);
-    let mut copied = false;
+    // (`noise::reduced`) in the factor's storage, written there by the start's assembly
+    // (`krylov.copied`) or else by the first product.
+    let reduced = reads_copy(p, n, fac.len());
+    let mut copied = reduced && copied;
     let product = |v: &[T::V3], w: &mut [T::V3]| {
         if p.matrix_free {
             let _ = free_product(p, s.pos, s.radius, v, w);

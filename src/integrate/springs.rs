@@ -59,6 +59,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
                 work: krylov_t,
                 par,
                 bands,
+                copied: false,
             };
             (noise_iterations, _) = kick(
                 p, b, s, mu, fac, new_vel, new_omega, dx, noise, None, krylov,

@@ -123,11 +123,17 @@ fn get1<T: Real>(s: &[T::M3], j: usize, k: usize) -> T {
     T::m3_entries(&s[p / 9])[p % 9]
 }
 
-/// Packs rows `b0..b1` of the packed mobility `mu` into `out` (their groups).
-fn pack_rows<T: Real>(mu: &[T::M3], b0: usize, b1: usize, out: &mut [T::M3]) {
+/// First slot of row `i` in the copy.
+pub(crate) const fn copy_start(i: usize) -> usize {
+    BLOCK_SLOTS * row_start(i)
+}
+
+/// Packs rows `b0..b1` of the packed mobility (`mu`: those rows, from `tri(b0)`) into
+/// `out` (their groups, from [`copy_start`]`(b0)`).
+pub(crate) fn pack_rows<T: Real>(b0: usize, b1: usize, mu: &[T::M3], out: &mut [T::M3]) {
     let base = BLOCK_SLOTS * row_start(b0);
     for i in b0..b1 {
-        let row = &mu[tri(i)..=tri(i) + i];
+        let row = &mu[tri(i) - tri(b0)..=tri(i) - tri(b0) + i];
         let slots = &mut out[BLOCK_SLOTS * row_start(i) - base..][..BLOCK_SLOTS * groups(i)];
         for (g, group) in slots.chunks_exact_mut(BLOCK_SLOTS).enumerate() {
             for c in 0..2 {
@@ -247,7 +253,7 @@ fn run<T: Real>(
         parts = rest;
         let _ = jobs.push(move || {
             if let Some(mu) = mu {
-                pack_rows::<T>(mu, b0, b1, rows);
+                pack_rows::<T>(b0, b1, &mu[tri(b0)..tri(b1)], rows);
             }
             band::<T>(rows, b0, b1, x, part);
         });
