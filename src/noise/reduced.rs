@@ -16,17 +16,18 @@
 //! with no fused multiply-add).
 //!
 //! **Layout.** `f32` values are held in pairs as the bit patterns of the `T` (`f64`)
-//! entries of `T::M3` slots, eight entries a slot (no `unsafe` view of the memory is
-//! needed). Row `i` holds blocks `j = 0 ..= i` in groups of eight blocks, three
-//! slots a group: two chunks of four blocks, each chunk the six entries `[xx, yy, zz,
-//! xy, xz, yz]` of its four blocks as four lanes apiece. The diagonal block is stored
-//! halved (it is met twice: in the row's own sum and as its transposed block), the
-//! blocks past the diagonal as zeros. A band walks its rows one column tile
-//! (512 beads) at a time, the tile's `x` and partial sums in lanes on the stack; its
-//! partial sums over all columns are kept in `f64`. The storage, [`slots`]`(n)`, is
-//! the Cholesky factor's (a third of it), free until the midpoint's mobility is
-//! assembled there after the noise is drawn. `T` must be `f64` ([`usable`]); an `f32`
-//! kernel reads the mobility itself.
+//! entries of `T::M3` slots (no `unsafe` view of the memory is needed). Row `i` holds
+//! blocks `j = 0 ..= i` in groups of twelve blocks, four slots (36 entries) a group:
+//! three chunks of four blocks, each chunk the six entries `[xx, yy, zz, xy, xz, yz]`
+//! of its four blocks as a lane quadruple apiece (two `f64` entries). The diagonal
+//! block is stored halved (it is met twice: in the row's own sum and as its transposed
+//! block), the blocks past the diagonal as zeros: 24 bytes a block and at most eleven
+//! blocks of padding a row. A band walks its rows one column tile (480 beads) at a
+//! time, the tile's `x` and partial sums in lanes on the stack; its partial sums over
+//! all columns are kept in `f64`. The storage, [`slots`]`(n)`, is the Cholesky
+//! factor's (a third of it), free until the midpoint's mobility is assembled there
+//! after the noise is drawn. `T` must be `f64` ([`usable`]); an `f32` kernel reads the
+//! mobility itself.
 
 use crate::linalg::tri;
 use crate::parallel::{self, Jobs, Parallel, band_start, bands};
@@ -38,11 +39,14 @@ use glam::Vec4;
 /// and other processes' data in it). Below it the products read the mobility itself.
 pub const REDUCED_MIN: usize = 700;
 
-/// Blocks of a group: two chunks of four lanes.
-const GROUP: usize = 8;
+/// Blocks of a group: three chunks of four lanes (36 entries, four slots).
+const GROUP: usize = 12;
 
-/// Slots of a group of blocks (twelve lane quadruples, four a slot).
-const BLOCK_SLOTS: usize = 3;
+/// Chunks of four blocks a group.
+const CHUNKS: usize = GROUP / 4;
+
+/// Slots of a group of blocks (eighteen lane quadruples).
+const BLOCK_SLOTS: usize = 4;
 
 /// Whether the reduced copy applies to `n` block rows: an `f64` kernel (two `f32` per
 /// slot entry) and at least [`REDUCED_MIN`] rows.
@@ -78,11 +82,11 @@ pub const fn slots(n: usize) -> usize {
     s
 }
 
-/// The bits of entry `p` of a run of slots: eight of a slot's nine entries are used,
-/// so that the two entries of a lane quadruple are always in one slot.
+/// The bits of entry `p` of a run of slots (nine entries a slot; a quadruple's two
+/// entries may straddle two slots, which costs a second load, not a shuffle).
 #[inline(always)]
 fn bits<T: Real>(s: &[T::M3], p: usize) -> u64 {
-    T::m3_entries(&s[p / 8])[p % 8].to_f64().to_bits()
+    T::m3_entries(&s[p / 9])[p % 9].to_f64().to_bits()
 }
 
 /// Lane quadruple `q`: the `f32` pairs of entries `2 q` and `2 q + 1`, lanes 0 and 1
@@ -103,9 +107,9 @@ fn put4<T: Real>(s: &mut [T::M3], q: usize, v: [f32; 4]) {
             u64::from(a.to_bits()) | (u64::from(b.to_bits()) << 32),
         ))
     };
-    let e = T::m3_entries_mut(&mut s[q / 4]);
-    e[2 * (q % 4)] = pair(v[0], v[2]);
-    e[2 * (q % 4) + 1] = pair(v[1], v[3]);
+    let (p, r) = (2 * q, 2 * q + 1);
+    T::m3_entries_mut(&mut s[p / 9])[p % 9] = pair(v[0], v[2]);
+    T::m3_entries_mut(&mut s[r / 9])[r % 9] = pair(v[1], v[3]);
 }
 
 /// Adds `v` to component `k` of bead `j` of an `f64` vector in slots.
@@ -136,7 +140,7 @@ pub(crate) fn pack_rows<T: Real>(b0: usize, b1: usize, mu: &[T::M3], out: &mut [
         let row = &mu[tri(i) - tri(b0)..=tri(i) - tri(b0) + i];
         let slots = &mut out[BLOCK_SLOTS * row_start(i) - base..][..BLOCK_SLOTS * groups(i)];
         for (g, group) in slots.chunks_exact_mut(BLOCK_SLOTS).enumerate() {
-            for c in 0..2 {
+            for c in 0..CHUNKS {
                 let j0 = GROUP * g + 4 * c;
                 // The six entries of the chunk's four blocks (halved on the diagonal,
                 // zero past it).
@@ -161,10 +165,11 @@ pub(crate) fn pack_rows<T: Real>(b0: usize, b1: usize, mu: &[T::M3], out: &mut [
     }
 }
 
-/// Beads of a column tile: a band's rows are walked tile by tile, with the tile's `x`
-/// and partial sums `y` in lanes on the stack (12 kB; 1024 measured 1.30 against 1.36
-/// ns a block at N = 1024, 2.7 against 3.0 at 2048, for twice the stack).
-const TILE: usize = 512;
+/// Beads of a column tile (whole groups): a band's rows are walked tile by tile, with
+/// the tile's `x` and partial sums `y` in lanes on the stack (11.5 kB; a tile twice as
+/// long measured 1.30 against 1.36 ns a block at N = 1024 and 2.7 against 3.0 at 2048,
+/// for twice the stack).
+const TILE: usize = 40 * GROUP;
 
 /// A tile's vector: per chunk of four beads, `x`, `y` and `z` as four lanes each.
 type Lanes = [[Vec4; 3]; TILE / 4];
@@ -176,9 +181,9 @@ type Lanes = [[Vec4; 3]; TILE / 4];
 fn walk_row<T: Real>(row: &[T::M3], x: &Lanes, y: &mut Lanes, xi: [f32; 3]) -> [f32; 3] {
     let xi = xi.map(Vec4::splat);
     let mut acc = [Vec4::ZERO; 3];
-    let chunks = x.chunks_exact(2).zip(y.chunks_exact_mut(2));
+    let chunks = x.chunks_exact(CHUNKS).zip(y.chunks_exact_mut(CHUNKS));
     for (b, (xg, yg)) in row.chunks_exact(BLOCK_SLOTS).zip(chunks) {
-        for c in 0..2 {
+        for c in 0..CHUNKS {
             let [xx, yy, zz, xy, xz, yz]: [Vec4; 6] =
                 core::array::from_fn(|q| Vec4::from_array(get4::<T>(b, 6 * c + q)));
             let (xl, yl) = (&xg[c], &mut yg[c]);
