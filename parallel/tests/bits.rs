@@ -184,6 +184,22 @@ fn overdamped_steps_are_the_same_bits_on_any_thread_count_f32() {
     steps_agree::<f32>();
 }
 
+/// From `REDUCED_MIN` beads on (f64) the Lanczos products read the reduced copy in
+/// `f32` lanes, written by the start's assembly band by band: the same bits on any
+/// thread count too.
+#[test]
+fn brownian_reduced_copy_steps_are_the_same_bits_on_any_thread_count() {
+    let n = hydrorattle::noise::reduced::REDUCED_MIN + 40;
+    let serial = steps_at::<f64>(n, &Serial, Some(1.0));
+    for pool in pools().into_iter().skip(1).take(1) {
+        assert!(
+            steps_at::<f64>(n, &pool, Some(1.0)) == serial,
+            "{} threads: different bits through the reduced copy",
+            pool.threads()
+        );
+    }
+}
+
 #[test]
 fn brownian_lanczos_steps_are_the_same_bits_on_any_thread_count() {
     let n = BANDED_MIN + 88;
