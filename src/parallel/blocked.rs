@@ -19,8 +19,7 @@
 use super::{BANDS, Jobs, Pairs, Parallel, band_start, bands, reduce, run_all};
 use crate::error::ParticleError;
 use crate::linalg::tri;
-use crate::mobility::Hydro;
-use crate::mobility::{pair_norm2, pair_tt_from};
+use crate::mobility::{Hydro, pair_norm2, pair_tt_from};
 use crate::real::Real;
 
 /// Block rows walked together: 8 measured best at N = 1024 and 2048 (4: 4.7, 8: 4.0,
