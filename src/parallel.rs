@@ -5,7 +5,7 @@
 //! `y = mu_tt x` into independent jobs and hands them to the workspace's [`Parallel`]
 //! ([`Workspace::with_parallel`](crate::Workspace::with_parallel); [`Serial`], one job
 //! after the other, by default). A host implements [`Parallel`] with a thread pool (the
-//! std crate `hydrorattle-parallel` does, with rayon).
+//! host crate `hydrorattle-parallel` does, with rayon).
 //!
 //! **Same bits on any number of threads.** The bands depend on the row count alone
 //! ([`band_start`]): below [`BANDED_MIN`] rows there is one band and the arithmetic is

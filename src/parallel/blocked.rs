@@ -248,11 +248,8 @@ fn runs<T: Real>(
 
 #[cfg(test)]
 mod tests {
-    extern crate std;
     use super::*;
-    use crate::mobility::Hydro;
     use glam::{DMat3, DVec3};
-    use std::{vec, vec::Vec};
 
     /// Deterministic values in [-0.5, 0.5).
     fn values(seed: u64) -> impl FnMut() -> f64 {
@@ -265,27 +262,30 @@ mod tests {
         }
     }
 
-    fn bits(v: &[DVec3]) -> Vec<[u64; 3]> {
-        v.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+    /// Whether two runs of vectors (or blocks) hold the same bits.
+    fn same<V, const K: usize>(a: &[V], b: &[V], bits: fn(&V) -> [f64; K]) -> bool {
+        let eq = |(x, y): (&V, &V)| bits(x).map(f64::to_bits) == bits(y).map(f64::to_bits);
+        a.len() == b.len() && a.iter().zip(b).all(eq)
     }
 
     /// Rows `b0..n` of general (non-symmetric, as above a wall) blocks: the grouped band
     /// gives the row-by-row band's bits, with groups left over or none.
     #[test]
     fn grouped_rows_give_the_bits_of_the_row_by_row_band() {
-        let n = 45;
+        const N: usize = 45;
         let mut v = values(7);
-        let a: Vec<DMat3> = (0..tri(n))
-            .map(|_| DMat3::from_cols_array(&core::array::from_fn(|_| v())))
-            .collect();
-        let x: Vec<DVec3> = (0..n).map(|_| DVec3::new(v(), v(), v())).collect();
-        for (b0, b1) in [(0, n), (13, n), (20, 25), (37, 44), (30, 30 + ROWS)] {
-            let (mut y0, mut y1) = (vec![DVec3::ZERO; b1 - b0], vec![DVec3::ZERO; b1 - b0]);
-            let (mut z0, mut z1) = (vec![DVec3::ONE; b0], vec![DVec3::ONE; b0]);
-            super::super::band::<f64>(&a, b0, &x, &mut y0, &mut z0);
-            band_rows::<f64>(&a, b0, &x, &mut y1, &mut z1);
-            assert_eq!(bits(&y0), bits(&y1), "rows {b0}..{b1}");
-            assert_eq!(bits(&z0), bits(&z1), "rows {b0}..{b1}");
+        let a: [DMat3; tri(N)] =
+            core::array::from_fn(|_| DMat3::from_cols_array(&core::array::from_fn(|_| v())));
+        let x: [DVec3; N] = core::array::from_fn(|_| DVec3::new(v(), v(), v()));
+        for (b0, b1) in [(0, N), (13, N), (20, 25), (37, 44), (30, 30 + ROWS)] {
+            let (mut y0, mut y1) = ([DVec3::ZERO; N], [DVec3::ZERO; N]);
+            let (mut z0, mut z1) = ([DVec3::ONE; N], [DVec3::ONE; N]);
+            let (y0, y1) = (&mut y0[..b1 - b0], &mut y1[..b1 - b0]);
+            let (z0, z1) = (&mut z0[..b0], &mut z1[..b0]);
+            super::super::band::<f64>(&a, b0, &x, y0, z0);
+            band_rows::<f64>(&a, b0, &x, y1, z1);
+            assert!(same(y0, y1, DVec3::to_array), "rows {b0}..{b1}");
+            assert!(same(z0, z1, DVec3::to_array), "rows {b0}..{b1}");
         }
     }
 
@@ -293,13 +293,12 @@ mod tests {
     /// fused band, at every level of hydrodynamics.
     #[test]
     fn runs_give_the_blocks_bits_and_error_of_the_fused_band() {
-        let n = 43;
+        const N: usize = 43;
         let mut v = values(11);
-        let mut pos: Vec<DVec3> = (0..n)
-            .map(|k| DVec3::new(3.0 * v(), 3.0 * v(), 0.7 * k as f64))
-            .collect();
-        let radius: Vec<f64> = (0..n).map(|_| 0.3 + 0.5 * (v() + 0.5)).collect();
-        let x: Vec<DVec3> = (0..n).map(|_| DVec3::new(v(), v(), v())).collect();
+        let mut pos: [DVec3; N] =
+            core::array::from_fn(|k| DVec3::new(3.0 * v(), 3.0 * v(), 0.7 * k as f64));
+        let radius: [f64; N] = core::array::from_fn(|_| 0.3 + 0.5 * (v() + 0.5));
+        let x: [DVec3; N] = core::array::from_fn(|_| DVec3::new(v(), v(), v()));
         for nested in [false, true] {
             if nested {
                 // Two nested pairs in one band, the later row's at a lower column.
@@ -313,25 +312,25 @@ mod tests {
                     pos: &pos,
                     radius: &radius,
                 };
-                for (b0, b1) in [(0, n), (11, n), (29, 40)] {
+                for (b0, b1) in [(0, N), (11, N), (29, 40)] {
                     let rows = tri(b1) - tri(b0);
-                    let (mut o0, mut o1) = (vec![DMat3::ZERO; rows], vec![DMat3::ZERO; rows]);
-                    let (mut y0, mut y1) = (vec![DVec3::ZERO; b1 - b0], vec![DVec3::ZERO; b1 - b0]);
-                    let (mut z0, mut z1) = (vec![DVec3::ONE; b0], vec![DVec3::ONE; b0]);
-                    let r0 =
-                        super::super::band_fused::<f64>(src, &mut o0, b0, &x, &mut y0, &mut z0);
-                    let r1 = fused_rows::<f64>(src, &mut o1, b0, &x, &mut y1, &mut z1);
+                    let (mut o0, mut o1) = ([DMat3::ZERO; tri(N)], [DMat3::ZERO; tri(N)]);
+                    let (mut y0, mut y1) = ([DVec3::ZERO; N], [DVec3::ZERO; N]);
+                    let (mut z0, mut z1) = ([DVec3::ONE; N], [DVec3::ONE; N]);
+                    let (o0, o1) = (&mut o0[..rows], &mut o1[..rows]);
+                    let (y0, y1) = (&mut y0[..b1 - b0], &mut y1[..b1 - b0]);
+                    let (z0, z1) = (&mut z0[..b0], &mut z1[..b0]);
+                    let r0 = super::super::band_fused::<f64>(src, o0, b0, &x, y0, z0);
+                    let r1 = fused_rows::<f64>(src, o1, b0, &x, y1, z1);
                     assert_eq!(r0, r1, "{level:?} rows {b0}..{b1}");
                     assert_eq!(r0.is_err(), nested && b1 > 33, "{level:?} rows {b0}..{b1}");
                     if r0.is_ok() {
-                        let m = |o: &[DMat3]| -> Vec<u64> {
-                            o.iter()
-                                .flat_map(|b| b.to_cols_array().map(f64::to_bits))
-                                .collect()
-                        };
-                        assert_eq!(m(&o0), m(&o1), "{level:?} rows {b0}..{b1}");
-                        assert_eq!(bits(&y0), bits(&y1), "{level:?} rows {b0}..{b1}");
-                        assert_eq!(bits(&z0), bits(&z1), "{level:?} rows {b0}..{b1}");
+                        assert!(
+                            same(o0, o1, DMat3::to_cols_array),
+                            "{level:?} rows {b0}..{b1}"
+                        );
+                        assert!(same(y0, y1, DVec3::to_array), "{level:?} rows {b0}..{b1}");
+                        assert!(same(z0, z1, DVec3::to_array), "{level:?} rows {b0}..{b1}");
                     }
                 }
             }
