@@ -64,10 +64,10 @@ fn main() {
     });
     let mut packed = vec![glam::DMat3::ZERO; reduced::slots(n)];
     report("reduced copy_apply", &mut |y| {
-        reduced::copy_apply::<f64>(&par, &mu, n, &mut packed, &x, y)
+        reduced::copy_apply::<f64>(&par, &mu, n, &mut packed, &x, y, &mut z)
     });
     report("reduced apply", &mut |y| {
-        reduced::apply::<f64>(&par, &mut packed, n, &x, y)
+        reduced::apply::<f64>(&par, &packed, n, &x, y, &mut z)
     });
     let mut z = vec![glam::DVec3::ZERO; band_scratch(n).max(1)];
     report("assemble_apply", &mut |y| {

@@ -24,6 +24,7 @@ use hydrorattle::linalg::{self, tri};
 use hydrorattle::mobility::assemble_tt;
 use hydrorattle::noise::lanczos::{self, Lanczos};
 use hydrorattle::noise::reduced;
+use hydrorattle::parallel::band_scratch;
 use hydrorattle::{
     Bond, BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Particle,
     ParticleSet, Serial, SolverKind, State, step, step_slices,
@@ -187,7 +188,8 @@ fn reduced_product_matches_the_mobility() {
             .collect();
         let (mut y, mut exact) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
         let mut store = vec![DMat3::ZERO; reduced::slots(n)];
-        reduced::copy_apply::<f64>(&Serial, &mu, n, &mut store, &x, &mut y);
+        let mut sc = vec![DVec3::ZERO; band_scratch(n)];
+        reduced::copy_apply::<f64>(&Serial, &mu, n, &mut store, &x, &mut y, &mut sc);
         linalg::sym_matvec::<f64>(&mu, n, &x, &mut exact);
         let scale = (n as f64).sqrt() * 1e-6;
         for (i, (a, b)) in y.iter().zip(&exact).enumerate() {
@@ -212,12 +214,13 @@ fn reduced_copy_keeps_the_noise_within_the_tolerance() {
     // The copy's products: the same bits whether written on the way or read back, and
     // the mobility's to the rounding of its entries to `f32` and the `f32` sums.
     let mut packed = vec![glam::DMat3::ZERO; reduced::slots(n)];
+    let mut sc = vec![DVec3::ZERO; band_scratch(n)];
     let mut z = vec![DVec3::ZERO; n];
     Noise::new(3).fill::<f64>(&mut z);
     let (mut a, mut b, mut exact) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n], vec![]);
     exact.resize(n, DVec3::ZERO);
-    reduced::copy_apply::<f64>(&Serial, &mu, n, &mut packed, &z, &mut a);
-    reduced::apply::<f64>(&Serial, &mut packed, n, &z, &mut b);
+    reduced::copy_apply::<f64>(&Serial, &mu, n, &mut packed, &z, &mut a, &mut sc);
+    reduced::apply::<f64>(&Serial, &packed, n, &z, &mut b, &mut sc);
     assert_eq!(a, b);
     linalg::sym_matvec::<f64>(&mu, n, &z, &mut exact);
     let flat = |a: &[DVec3]| -> Vec<f64> { a.iter().flat_map(|p| p.to_array()).collect() };
@@ -238,8 +241,8 @@ fn reduced_copy_keeps_the_noise_within_the_tolerance() {
     lanczos::sqrt(tight, full, &z, w, r, &mut root_ref, Some(&mut inv_ref)).unwrap();
     let mut first = true;
     let copy = |x: &[DVec3], o: &mut [DVec3]| match std::mem::take(&mut first) {
-        true => reduced::copy_apply::<f64>(&Serial, &mu, n, &mut packed, x, o),
-        false => reduced::apply::<f64>(&Serial, &mut packed, n, x, o),
+        true => reduced::copy_apply::<f64>(&Serial, &mu, n, &mut packed, x, o, &mut sc),
+        false => reduced::apply::<f64>(&Serial, &packed, n, x, o, &mut sc),
     };
     let s = Lanczos::default();
     let m = lanczos::sqrt(s, copy, &z, w, r, &mut root, Some(&mut inv)).unwrap();

@@ -219,9 +219,9 @@ pub(super) fn kick<T: Real>(
         if p.matrix_free {
             let _ = free_product(p, s.pos, s.radius, v, w);
         } else if reduced && copied {
-            reduced::apply::<T>(par, fac, n, v, w);
+            reduced::apply::<T>(par, fac, n, v, w, bands);
         } else if reduced {
-            reduced::copy_apply::<T>(par, mu, n, fac, v, w);
+            reduced::copy_apply::<T>(par, mu, n, fac, v, w, bands);
             copied = true;
         } else {
             parallel::product::<T>(par, mu, n, v, w, bands);

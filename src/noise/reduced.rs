@@ -10,9 +10,9 @@
 //! bound at 3.4 ns a block; this one takes 1.3 at N = 1024). Lanczos then computes
 //! `M~^(1/2) z` with `M~` the rounded mobility; each product is right to about `1e-6`
 //! relative (`f32` sums, `tests/lanczos_chain.rs` measures it), far below the
-//! tolerance. Bits: the same on any number of threads (fixed bands,
-//! [`parallel::bands`], each summing its transposed blocks into a partial vector of its
-//! own, added in band order), and on any target (`Vec4` is IEEE `f32` lane by lane,
+//! tolerance. Bits: the same on any number of threads (the bands of
+//! [`parallel::product`], each summing its rows and transposed blocks in `f64`, added
+//! in band order), and on any target (`Vec4` is IEEE `f32` lane by lane,
 //! with no fused multiply-add).
 //!
 //! **Layout.** `f32` values are held in pairs as the bit patterns of the `T` (`f64`)
@@ -30,7 +30,7 @@
 //! mobility itself.
 
 use crate::linalg::tri;
-use crate::parallel::{self, Jobs, Parallel, band_start, bands};
+use crate::parallel::{self, Parallel, band_start};
 use crate::real::Real;
 use glam::Vec4;
 
@@ -65,21 +65,9 @@ const fn row_start(i: usize) -> usize {
     i + GROUP * q * q.saturating_sub(1) / 2 + (i % GROUP) * q
 }
 
-/// Slots of an `f64` vector of `n` beads (nine entries a slot).
-const fn vector_slots(n: usize) -> usize {
-    (3 * n).div_ceil(9)
-}
-
-/// Slots the copy of `n` block rows and its products' scratch take: the copy and a
-/// partial sum for each band (rows `0..` its end).
+/// Slots the copy of `n` block rows takes.
 pub const fn slots(n: usize) -> usize {
-    let mut s = BLOCK_SLOTS * row_start(n);
-    let mut t = 0;
-    while t < bands(n) {
-        s += vector_slots(band_start(n, t + 1));
-        t += 1;
-    }
-    s
+    copy_start(n)
 }
 
 /// The bits of entry `p` of a run of slots (nine entries a slot; a quadruple's two
@@ -110,21 +98,6 @@ fn put4<T: Real>(s: &mut [T::M3], q: usize, v: [f32; 4]) {
     let (p, r) = (2 * q, 2 * q + 1);
     T::m3_entries_mut(&mut s[p / 9])[p % 9] = pair(v[0], v[2]);
     T::m3_entries_mut(&mut s[r / 9])[r % 9] = pair(v[1], v[3]);
-}
-
-/// Adds `v` to component `k` of bead `j` of an `f64` vector in slots.
-#[inline(always)]
-fn add1<T: Real>(s: &mut [T::M3], j: usize, k: usize, v: f32) {
-    let p = 3 * j + k;
-    let e = &mut T::m3_entries_mut(&mut s[p / 9])[p % 9];
-    *e += T::from_f64(f64::from(v));
-}
-
-/// Component `k` of bead `j` of an `f64` vector in slots.
-#[inline(always)]
-fn get1<T: Real>(s: &[T::M3], j: usize, k: usize) -> T {
-    let p = 3 * j + k;
-    T::m3_entries(&s[p / 9])[p % 9]
 }
 
 /// First slot of row `i` in the copy.
@@ -199,14 +172,22 @@ fn walk_row<T: Real>(row: &[T::M3], x: &Lanes, y: &mut Lanes, xi: [f32; 3]) -> [
     acc.map(|a| (a.x + a.y) + (a.z + a.w))
 }
 
-/// Rows `b0..b1` from their groups `rows` into the band's partial sum `part` (rows
-/// `0..b1`, from zero, in `f64`), one column tile at a time.
-fn band<T: Real>(rows: &[T::M3], b0: usize, b1: usize, x: &[T::V3], part: &mut [T::M3]) {
-    part.fill(T::m3_diag(T::ZERO));
+/// Rows `b0..b0 + y.len()` from their groups `rows` into `y`, the transposed blocks
+/// left of the band into `z` (both from zero, in `f64`, as in [`parallel::product`]'s
+/// bands), one column tile at a time.
+fn band<T: Real>(rows: &[T::M3], b0: usize, x: &[T::V3], y: &mut [T::V3], z: &mut [T::V3]) {
+    let b1 = b0 + y.len();
+    y.fill(T::V3_ZERO);
+    z.fill(T::V3_ZERO);
     let base = BLOCK_SLOTS * row_start(b0);
     let lane = |j: usize, k: usize| match x.get(j) {
         Some(&v) => T::xyz(v)[k].to_f64() as f32,
         None => 0.0,
+    };
+    // Adds `f32` sums to row `j` of the band's partial sum (`z` above the band).
+    let mut add = |j: usize, v: [f32; 3]| {
+        let out = if j < b0 { &mut z[j] } else { &mut y[j - b0] };
+        *out += T::v3_from(v.map(f64::from));
     };
     for t0 in (0..b1).step_by(TILE) {
         let mut xt: Lanes = [[Vec4::ZERO; 3]; TILE / 4];
@@ -221,93 +202,56 @@ fn band<T: Real>(rows: &[T::M3], b0: usize, b1: usize, x: &[T::V3], part: &mut [
             let start = BLOCK_SLOTS * (row_start(i) + t0 / GROUP) - base;
             let row = &rows[start..][..BLOCK_SLOTS * g];
             let xi = core::array::from_fn(|k| lane(i, k));
-            let own = walk_row::<T>(row, &xt, &mut yt, xi);
-            for (k, v) in own.into_iter().enumerate() {
-                add1::<T>(part, i, k, v);
-            }
+            add(i, walk_row::<T>(row, &xt, &mut yt, xi));
         }
         for j in t0..(t0 + TILE).min(b1) {
             let r = j - t0;
-            for k in 0..3 {
-                add1::<T>(part, j, k, yt[r / 4][k][r % 4]);
-            }
+            add(j, core::array::from_fn(|k| yt[r / 4][k][r % 4]));
         }
     }
 }
 
-/// `y = M~ x` with the copy in `store` (written first from `mu` if given), in bands
-/// through `par`, then the bands' partial sums added in band order.
-fn run<T: Real>(
-    par: &dyn Parallel,
-    mu: Option<&[T::M3]>,
-    n: usize,
-    store: &mut [T::M3],
-    x: &[T::V3],
-    y: &mut [T::V3],
-) {
-    let (copy, parts) = store[..slots(n)].split_at_mut(BLOCK_SLOTS * row_start(n));
-    let x = &x[..n];
-    let mut jobs = Jobs::new();
-    let (mut copy, mut parts) = (copy, &mut *parts);
-    for t in 0..bands(n) {
-        let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-        let rows = BLOCK_SLOTS * (row_start(b1) - row_start(b0));
-        let (rows, rest) = core::mem::take(&mut copy).split_at_mut(rows);
-        copy = rest;
-        let (part, rest) = core::mem::take(&mut parts).split_at_mut(vector_slots(b1));
-        parts = rest;
-        let _ = jobs.push(move || {
-            if let Some(mu) = mu {
-                pack_rows::<T>(b0, b1, &mu[tri(b0)..tri(b1)], rows);
-            }
-            band::<T>(rows, b0, b1, x, part);
-        });
-    }
-    parallel::run_all(par, &mut jobs);
-    drop(jobs);
-    for yi in y[..n].iter_mut() {
-        *yi = T::V3_ZERO;
-    }
-    let mut offset = 0;
-    let parts = &store[BLOCK_SLOTS * row_start(n)..slots(n)];
-    for t in 0..bands(n) {
-        let b1 = band_start(n, t + 1);
-        let part = &parts[offset..offset + vector_slots(b1)];
-        for (i, yi) in y[..b1].iter_mut().enumerate() {
-            *yi += T::v3(
-                get1::<T>(part, i, 0),
-                get1::<T>(part, i, 1),
-                get1::<T>(part, i, 2),
-            );
-        }
-        offset += vector_slots(b1);
-    }
-}
-
-/// `y = M~ x` from the copy in `store` ([`slots`]`(n)` slots, written by
-/// [`copy_apply`]), through `par`.
+/// `y = M~ x` from the copy `copy` of `n` block rows ([`copy_apply`] writes it), in the
+/// bands of [`parallel::product`] through `par` (`z`:
+/// [`parallel::band_scratch`]`(n)` vectors): each band's partial sums are kept in
+/// `f64`, added in band order.
 pub fn apply<T: Real>(
     par: &dyn Parallel,
-    store: &mut [T::M3],
+    copy: &[T::M3],
     n: usize,
     x: &[T::V3],
     y: &mut [T::V3],
+    z: &mut [T::V3],
 ) {
-    run::<T>(par, None, n, store, x, y);
+    let x = &x[..n];
+    let _ = parallel::by_bands::<T, (), _>(par, n, &mut [], tri, y, z, |t, _, yt, zt| {
+        let b0 = band_start(n, t);
+        band::<T>(&copy[copy_start(b0)..], b0, x, yt, zt);
+        Ok(())
+    });
+    parallel::reduce::<T>(n, y, z, par);
 }
 
 /// [`apply`] while writing the copy of the packed mobility `mu` (`n` block rows) into
-/// `store`: each band packs its rows, then applies them from the copy (so the product
-/// is the copy's, bit for bit).
+/// `copy` ([`slots`]`(n)` slots): each band packs its rows, then applies them from the
+/// copy (so the product is the copy's, bit for bit).
 pub fn copy_apply<T: Real>(
     par: &dyn Parallel,
     mu: &[T::M3],
     n: usize,
-    store: &mut [T::M3],
+    copy: &mut [T::M3],
     x: &[T::V3],
     y: &mut [T::V3],
+    z: &mut [T::V3],
 ) {
-    run::<T>(par, Some(mu), n, store, x, y);
+    let (x, copy) = (&x[..n], &mut copy[..slots(n)]);
+    let _ = parallel::by_bands::<T, (), _>(par, n, copy, copy_start, y, z, |t, rows, yt, zt| {
+        let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
+        pack_rows::<T>(b0, b1, &mu[tri(b0)..tri(b1)], rows);
+        band::<T>(rows, b0, x, yt, zt);
+        Ok(())
+    });
+    parallel::reduce::<T>(n, y, z, par);
 }
 
 #[cfg(test)]
