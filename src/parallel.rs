@@ -98,10 +98,10 @@ pub const fn band_scratch(n: usize) -> usize {
 }
 
 /// The job list of one round (at most [`BANDS`] jobs, on the stack).
-pub(crate) type Jobs<F> = heapless::Vec<F, BANDS>;
+type Jobs<F> = heapless::Vec<F, BANDS>;
 
 /// Runs one round of jobs through `par`.
-pub(crate) fn run_all<F: FnMut() + Send>(par: &dyn Parallel, jobs: &mut Jobs<F>) {
+fn run_all<F: FnMut() + Send>(par: &dyn Parallel, jobs: &mut Jobs<F>) {
     let mut refs: heapless::Vec<&mut (dyn FnMut() + Send), BANDS> = heapless::Vec::new();
     for job in jobs.iter_mut() {
         let _ = refs.push(job);
@@ -285,31 +285,56 @@ pub(crate) fn by_bands<T: Real, E: Send, J>(
 where
     J: Fn(usize, &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
 {
+    let job = |t, rows: &mut [T::M3], _: &mut [T::M3], yt: &mut [T::V3], zt: &mut [T::V3]| {
+        job(t, rows, yt, zt)
+    };
+    by_bands_and::<T, E, _>(par, n, (out, start), (&mut [], start), y, z, job)
+}
+
+/// A packed output and the entry its row `i` starts at.
+pub(crate) type Packed<'a, T> = (&'a mut [<T as Real>::M3], fn(usize) -> usize);
+
+/// [`by_bands`] with a second packed output, `side`, of which each band gets its rows
+/// too: `job(t, rows, side_rows, y_t, z_t)`.
+pub(crate) fn by_bands_and<T: Real, E: Send, J>(
+    par: &dyn Parallel,
+    n: usize,
+    (out, start): Packed<'_, T>,
+    (side, side_start): Packed<'_, T>,
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+    job: J,
+) -> Result<(), E>
+where
+    J: Fn(usize, &mut [T::M3], &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
+{
     let k = bands(n);
     let mut results: [Option<Result<(), E>>; BANDS] = core::array::from_fn(|_| None);
     {
         let mut jobs = Jobs::new();
-        let (mut os, mut ys, mut zs) = (out, y, z);
+        let (mut os, mut ss, mut ys, mut zs) = (out, side, y, z);
         let job = &job;
         for (t, result) in results.iter_mut().take(k).enumerate() {
             let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
             // Slices given empty stay empty for every band.
-            let (lo, ly, lz) = (
-                if os.is_empty() {
-                    0
-                } else {
-                    start(b1) - start(b0)
-                },
+            let rows = |s: &[T::M3], f: fn(usize) -> usize| match s.is_empty() {
+                true => 0,
+                false => f(b1) - f(b0),
+            };
+            let (lo, ls) = (rows(os, start), rows(ss, side_start));
+            let (ly, lz) = (
                 if ys.is_empty() { 0 } else { b1 - b0 },
                 if zs.is_empty() { 0 } else { b0 },
             );
             let (ot, rest) = core::mem::take(&mut os).split_at_mut(lo);
             os = rest;
+            let (st, rest) = core::mem::take(&mut ss).split_at_mut(ls);
+            ss = rest;
             let (yt, rest) = core::mem::take(&mut ys).split_at_mut(ly);
             ys = rest;
             let (zt, rest) = core::mem::take(&mut zs).split_at_mut(lz);
             zs = rest;
-            let _ = jobs.push(move || *result = Some(job(t, ot, yt, zt)));
+            let _ = jobs.push(move || *result = Some(job(t, ot, st, yt, zt)));
         }
         run_all(par, &mut jobs);
     }
@@ -399,23 +424,10 @@ pub fn assemble_apply<T: Real>(
     y: &mut [T::V3],
     z: &mut [T::V3],
 ) -> Result<(), ParticleError> {
-    let n = pos.len();
-    let out = &mut out[..tri(n)];
-    let src = Pairs {
-        level,
-        eta,
-        pos,
-        radius,
-    };
-    if n < blocked::RUNS_MIN {
-        return band_fused::<T>(src, out, 0, x, &mut y[..n], &mut []);
-    }
-    if bands(n) == 1 {
-        return blocked::fused_rows::<T>(src, out, 0, x, &mut y[..n], &mut []);
-    }
-    by_bands::<T, _, _>(par, n, out, tri, y, z, |t, rows_t, yt, zt| {
-        blocked::fused_rows::<T>(src, rows_t, band_start(n, t), x, yt, zt)
-    })?;
-    reduce::<T>(n, y, z, par);
-    Ok(())
+    let none = |_, _, _: &[T::M3], _: &mut [T::M3]| {};
+    let (pairs, side) = (
+        (level, eta, pos, radius),
+        (&mut [][..], tri as fn(usize) -> usize),
+    );
+    assemble_apply_then::<T, _>(par, pairs, out, x, y, z, side, none)
 }

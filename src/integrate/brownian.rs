@@ -78,12 +78,11 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     let copied = reads_copy(p, n, fac.len());
     if copied {
-        let (level, eta) = (p.hydro, p.viscosity);
-        let (start, pack) = (reduced::copy_start, reduced::pack_rows::<T>);
-        parallel::assemble_apply_then(
-            par, level, eta, s.pos, s.radius, mu, force, u, bands, fac, start, pack,
-        )
-        .map_err(StepError::from)?;
+        let pairs = (p.hydro, p.viscosity, s.pos, s.radius);
+        let copy = (&mut *fac, reduced::copy_start as fn(usize) -> usize);
+        let pack = reduced::pack_rows::<T>;
+        parallel::assemble_apply_then(par, pairs, mu, force, u, bands, copy, pack)
+            .map_err(StepError::from)?;
     } else {
         mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
     }

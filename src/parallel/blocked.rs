@@ -16,7 +16,7 @@
 //! in row order (row `i`, then `i + 1`, ...), because a column visits the rows of a
 //! group in order.
 
-use super::{BANDS, Jobs, Pairs, Parallel, band_start, bands, reduce, run_all};
+use super::{Packed, Pairs, Parallel, band_start, bands, by_bands_and, reduce};
 use crate::error::ParticleError;
 use crate::linalg::tri;
 use crate::mobility::{Hydro, pair_norm2, pair_tt_from};
@@ -141,68 +141,56 @@ pub(super) fn fused_rows<T: Real>(
 }
 
 /// [`assemble_apply`](super::assemble_apply), each band then handing its rows of the
-/// mobility, just written and still in cache, to `then(b0, b1, rows, side_t)` with its
-/// part of `side` (from `side_start(b0)` to `side_start(b1)`): a second use of the
-/// blocks without a second pass over memory (the Lanczos noise's reduced copy). The
-/// same blocks and product bits as `assemble_apply`.
+/// mobility, just written and still in cache, to `then(b0, b1, rows, side_rows)` with
+/// its rows of `side`: a second use of the blocks without a second pass over memory
+/// (the Lanczos noise's reduced copy). The same blocks and product bits either way.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn assemble_apply_then<T: Real, F>(
     par: &dyn Parallel,
-    level: Hydro,
-    eta: T,
-    pos: &[T::V3],
-    radius: &[T],
+    (level, eta, pos, radius): (Hydro, T, &[T::V3], &[T]),
     out: &mut [T::M3],
     x: &[T::V3],
     y: &mut [T::V3],
     z: &mut [T::V3],
-    side: &mut [T::M3],
-    side_start: fn(usize) -> usize,
+    (side, side_start): Packed<'_, T>,
     then: F,
 ) -> Result<(), ParticleError>
 where
     F: Fn(usize, usize, &[T::M3], &mut [T::M3]) + Sync,
 {
     let n = pos.len();
+    let out = &mut out[..tri(n)];
     let src = Pairs {
         level,
         eta,
         pos,
         radius,
     };
-    let k = bands(n);
-    let mut results: [Option<Result<(), ParticleError>>; BANDS] = core::array::from_fn(|_| None);
-    {
-        let mut jobs = Jobs::new();
-        let (mut os, mut ss, mut ys, mut zs) = (&mut out[..tri(n)], side, &mut *y, &mut *z);
-        let then = &then;
-        for (t, result) in results.iter_mut().take(k).enumerate() {
-            let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-            let (ot, rest) = core::mem::take(&mut os).split_at_mut(tri(b1) - tri(b0));
-            os = rest;
-            let (st, rest) = core::mem::take(&mut ss).split_at_mut(side_start(b1) - side_start(b0));
-            ss = rest;
-            let (yt, rest) = core::mem::take(&mut ys).split_at_mut(b1 - b0);
-            ys = rest;
-            let (zt, rest) = core::mem::take(&mut zs).split_at_mut(if k == 1 { 0 } else { b0 });
-            zs = rest;
-            let _ = jobs.push(move || {
-                let r = if n < RUNS_MIN {
-                    super::band_fused::<T>(src, ot, b0, x, yt, zt)
-                } else {
-                    fused_rows::<T>(src, ot, b0, x, yt, zt)
-                };
-                if r.is_ok() {
-                    then(b0, b1, ot, st);
-                }
-                *result = Some(r);
-            });
+    if bands(n) == 1 {
+        // One band: no jobs, and below RUNS_MIN the row-by-row fused band.
+        let y = &mut y[..n];
+        match n < RUNS_MIN {
+            true => super::band_fused::<T>(src, out, 0, x, y, &mut [])?,
+            false => fused_rows::<T>(src, out, 0, x, y, &mut [])?,
         }
-        run_all(par, &mut jobs);
+        then(0, n, out, side);
+        return Ok(());
     }
-    for r in results.into_iter().take(k) {
-        r.unwrap_or(Ok(()))?;
-    }
+    let bands = (out, tri as fn(usize) -> usize);
+    by_bands_and::<T, _, _>(
+        par,
+        n,
+        bands,
+        (side, side_start),
+        y,
+        z,
+        |t, rows, st, yt, zt| {
+            let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
+            fused_rows::<T>(src, rows, b0, x, yt, zt)?;
+            then(b0, b1, rows, st);
+            Ok(())
+        },
+    )?;
     reduce::<T>(n, y, z, par);
     Ok(())
 }
