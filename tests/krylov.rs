@@ -148,19 +148,13 @@ both_precisions! {
 /// bonds hold to the tolerance.
 #[test]
 fn thousands_of_beads_matrix_free() {
-    use hydrorattle::{Bond, State, step_slices};
+    use hydrorattle::{State, step_slices};
     let n = 4096;
     let scene = helix(n, 2f64.cbrt(), 3.0, 0.5, 1.5);
     let mut pos: Vec<glam::DVec3> = scene.iter().map(|s| f64::v3_from(s.pos)).collect();
     let radius: Vec<f64> = scene.iter().map(|s| s.radius).collect();
     let density = vec![RHO; n];
-    let bonds: Vec<Bond<f64>> = (1..n)
-        .map(|i| Bond {
-            i: i - 1,
-            j: i,
-            length: (pos[i] - pos[i - 1]).length(),
-        })
-        .collect();
+    let bonds = chain_bonds(&pos);
     hydrorattle::bonds::validate(&bonds, n).unwrap();
     let (mut vel, mut omega, mut time) =
         (vec![glam::DVec3::ZERO; n], vec![glam::DVec3::ZERO; n], 0.0);

@@ -26,7 +26,7 @@ use hydrorattle::noise::lanczos::{self, Lanczos};
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::band_scratch;
 use hydrorattle::{
-    Bond, BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Particle,
+    BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Particle,
     ParticleSet, Serial, SolverKind, State, step, step_slices,
 };
 use hydrorattle_heap::Buffers;
@@ -254,13 +254,7 @@ fn reduced_copy_keeps_the_noise_within_the_tolerance() {
     assert!(e_root < s.tolerance && e_inv < s.tolerance);
     // A thermal step through the copy against the matrix-free one (no copy): the same
     // step but for the noise's error, and the bonds held.
-    let bonds: Vec<Bond<f64>> = (1..n)
-        .map(|i| Bond {
-            i: i - 1,
-            j: i,
-            length: (pos[i] - pos[i - 1]).length(),
-        })
-        .collect();
+    let bonds = chain_bonds(&pos);
     let run = |matrix_free: bool| {
         let mut p = params::<f64>(0.01, Method::Overdamped, SolverKind::Krylov);
         p.allow_overlap = true;
@@ -298,15 +292,7 @@ fn reduced_copy_keeps_the_noise_within_the_tolerance() {
     // f32 lanes' arithmetic is fixed (`glam::Vec4`, no fused multiply-add), so it is the
     // same on every target and thread count. It moves only when that arithmetic changes
     // on purpose; then re-pin from the printed value.
-    let digest = x
-        .iter()
-        .flat_map(|v| v.to_array())
-        .fold(0xcbf2_9ce4_8422_2325u64, |h, c| {
-            c.to_bits()
-                .to_le_bytes()
-                .iter()
-                .fold(h, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
-        });
+    let digest = fnv1a(x.iter().flat_map(|v| v.to_array().map(f64::to_bits)));
     println!("golden reduced-copy step: got {digest:#018x}");
     assert_eq!(
         digest, REDUCED_STEP,

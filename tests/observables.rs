@@ -1,20 +1,12 @@
 //! Outcome metrics and the named states on synthetic shapes whose answers are known.
 
-use hydrorattle::Bond;
+mod common;
+
+use common::chain_bonds;
 use hydrorattle::glam::DVec3;
 use hydrorattle::observables::{Twist, centre_of_mass, extension, settling_speed, verticality};
 
 const DOWN: DVec3 = DVec3::new(0.0, 0.0, -1.0);
-
-fn chain_bonds(pos: &[DVec3]) -> Vec<Bond<f64>> {
-    (1..pos.len())
-        .map(|i| Bond {
-            i: i - 1,
-            j: i,
-            length: (pos[i] - pos[i - 1]).length(),
-        })
-        .collect()
-}
 
 #[test]
 fn a_straight_vertical_chain_has_full_extension_and_verticality() {

@@ -165,6 +165,18 @@ pub fn snapshot<T: Real, const N: usize>(ps: &ParticleSet<T, N>) -> Vec<u64> {
     out
 }
 
+/// The bonds of a chain `0-1-...-(n-1)` at its current lengths, of any length (the
+/// runtime-sized counterpart of `BondSet::chain`).
+pub fn chain_bonds(pos: &[hydrorattle::glam::DVec3]) -> Vec<hydrorattle::Bond<f64>> {
+    (1..pos.len())
+        .map(|i| hydrorattle::Bond {
+            i: i - 1,
+            j: i,
+            length: (pos[i] - pos[i - 1]).length(),
+        })
+        .collect()
+}
+
 /// FNV-1a (64 bit) over the little-endian bytes of a sequence of words.
 pub fn fnv1a(words: impl IntoIterator<Item = u64>) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
