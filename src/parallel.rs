@@ -424,10 +424,23 @@ pub fn assemble_apply<T: Real>(
     y: &mut [T::V3],
     z: &mut [T::V3],
 ) -> Result<(), ParticleError> {
-    let none = |_, _, _: &[T::M3], _: &mut [T::M3]| {};
-    let (pairs, side) = (
-        (level, eta, pos, radius),
-        (&mut [][..], tri as fn(usize) -> usize),
-    );
-    assemble_apply_then::<T, _>(par, pairs, out, x, y, z, side, none)
+    let n = pos.len();
+    let out = &mut out[..tri(n)];
+    let src = Pairs {
+        level,
+        eta,
+        pos,
+        radius,
+    };
+    if n < blocked::RUNS_MIN {
+        return band_fused::<T>(src, out, 0, x, &mut y[..n], &mut []);
+    }
+    if bands(n) == 1 {
+        return blocked::fused_rows::<T>(src, out, 0, x, &mut y[..n], &mut []);
+    }
+    by_bands::<T, _, _>(par, n, out, tri, y, z, |t, rows_t, yt, zt| {
+        blocked::fused_rows::<T>(src, rows_t, band_start(n, t), x, yt, zt)
+    })?;
+    reduce::<T>(n, y, z, par);
+    Ok(())
 }

@@ -154,12 +154,14 @@ pub(super) struct Krylov<'a, T: Real> {
 
 /// Whether the noise's products read the reduced copy of the stored mobility
 /// (`noise::reduced`), kept in the factor's storage of `fac` slots: Lanczos, a stored
-/// free-space mobility (symmetric blocks), an `f64` kernel of enough beads.
+/// free-space mobility (symmetric blocks), an `f64` kernel of enough beads. Inlined,
+/// with the precision tested first, so that an `f32` kernel (firmware) links no copy.
+#[inline(always)]
 fn reads_copy<T: Real>(p: &Params<T>, n: usize, fac: usize) -> bool {
-    p.lanczos_noise(n)
+    reduced::usable::<T>(n)
+        && p.lanczos_noise(n)
         && !p.matrix_free
         && wall_height(p).is_none()
-        && reduced::usable::<T>(n)
         && fac >= reduced::slots(n)
 }
 

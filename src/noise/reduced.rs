@@ -50,6 +50,7 @@ const BLOCK_SLOTS: usize = 4;
 
 /// Whether the reduced copy applies to `n` block rows: an `f64` kernel (two `f32` per
 /// slot entry) and at least [`REDUCED_MIN`] rows.
+#[inline(always)]
 pub fn usable<T: Real>(n: usize) -> bool {
     core::mem::size_of::<T>() == 8 && n >= REDUCED_MIN
 }
