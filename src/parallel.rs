@@ -20,8 +20,10 @@
 //! metric).
 
 mod blocked;
+mod jobs;
 
 pub(crate) use blocked::{assemble_apply_then, band_rows};
+pub(crate) use jobs::{Packed, by_bands, by_bands_and, reduce};
 
 use crate::error::ParticleError;
 use crate::linalg::tri;
@@ -95,18 +97,6 @@ pub const fn band_scratch(n: usize) -> usize {
         t += 1;
     }
     s
-}
-
-/// The job list of one round (at most [`BANDS`] jobs, on the stack).
-type Jobs<F> = heapless::Vec<F, BANDS>;
-
-/// Runs one round of jobs through `par`.
-fn run_all<F: FnMut() + Send>(par: &dyn Parallel, jobs: &mut Jobs<F>) {
-    let mut refs: heapless::Vec<&mut (dyn FnMut() + Send), BANDS> = heapless::Vec::new();
-    for job in jobs.iter_mut() {
-        let _ = refs.push(job);
-    }
-    par.run(&mut refs);
 }
 
 /// One band of the product: rows `b0..b0 + y.len()` of `y = A x` from the packed `a`,
@@ -235,112 +225,6 @@ fn row_fused<T: Real>(
         *yj += T::m3_tmul(b, xi);
     }
     yi[0] += acc;
-    Ok(())
-}
-
-/// The second round: band `s`'s rows of `y` gain the partial sums of the bands below it,
-/// in band order.
-pub(crate) fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn Parallel) {
-    let k = bands(n);
-    if k == 1 {
-        return;
-    }
-    let mut jobs = Jobs::new();
-    let mut rest = y;
-    for s in 0..k {
-        let (b0, b1) = (band_start(n, s), band_start(n, s + 1));
-        let (ys, tail) = rest.split_at_mut(b1 - b0);
-        rest = tail;
-        let _ = jobs.push(move || {
-            let mut offset = 0;
-            for t in 1..k {
-                let len = band_start(n, t);
-                if t > s {
-                    let zt = &z[offset + b0..offset + b1];
-                    for (yk, &zk) in ys.iter_mut().zip(zt) {
-                        *yk += zk;
-                    }
-                }
-                offset += len;
-            }
-        });
-    }
-    run_all(par, &mut jobs);
-}
-
-/// Hands every band its rows of `out` (packed, the first `start(i)` entries holding
-/// rows `0..i`; or nothing when `out` is empty),
-/// of `y` (or nothing) and its partial-sum slice of `z` (or nothing), runs
-/// `job(t, rows, y_t, z_t)` for every band through `par`, and returns the first error
-/// in band order (the one a single pass in row order meets first).
-pub(crate) fn by_bands<T: Real, E: Send, J>(
-    par: &dyn Parallel,
-    n: usize,
-    out: &mut [T::M3],
-    start: fn(usize) -> usize,
-    y: &mut [T::V3],
-    z: &mut [T::V3],
-    job: J,
-) -> Result<(), E>
-where
-    J: Fn(usize, &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
-{
-    let job = |t, rows: &mut [T::M3], _: &mut [T::M3], yt: &mut [T::V3], zt: &mut [T::V3]| {
-        job(t, rows, yt, zt)
-    };
-    by_bands_and::<T, E, _>(par, n, (out, start), (&mut [], start), y, z, job)
-}
-
-/// A packed output and the entry its row `i` starts at.
-pub(crate) type Packed<'a, T> = (&'a mut [<T as Real>::M3], fn(usize) -> usize);
-
-/// [`by_bands`] with a second packed output, `side`, of which each band gets its rows
-/// too: `job(t, rows, side_rows, y_t, z_t)`.
-pub(crate) fn by_bands_and<T: Real, E: Send, J>(
-    par: &dyn Parallel,
-    n: usize,
-    (out, start): Packed<'_, T>,
-    (side, side_start): Packed<'_, T>,
-    y: &mut [T::V3],
-    z: &mut [T::V3],
-    job: J,
-) -> Result<(), E>
-where
-    J: Fn(usize, &mut [T::M3], &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
-{
-    let k = bands(n);
-    let mut results: [Option<Result<(), E>>; BANDS] = core::array::from_fn(|_| None);
-    {
-        let mut jobs = Jobs::new();
-        let (mut os, mut ss, mut ys, mut zs) = (out, side, y, z);
-        let job = &job;
-        for (t, result) in results.iter_mut().take(k).enumerate() {
-            let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-            // Slices given empty stay empty for every band.
-            let rows = |s: &[T::M3], f: fn(usize) -> usize| match s.is_empty() {
-                true => 0,
-                false => f(b1) - f(b0),
-            };
-            let (lo, ls) = (rows(os, start), rows(ss, side_start));
-            let (ly, lz) = (
-                if ys.is_empty() { 0 } else { b1 - b0 },
-                if zs.is_empty() { 0 } else { b0 },
-            );
-            let (ot, rest) = core::mem::take(&mut os).split_at_mut(lo);
-            os = rest;
-            let (st, rest) = core::mem::take(&mut ss).split_at_mut(ls);
-            ss = rest;
-            let (yt, rest) = core::mem::take(&mut ys).split_at_mut(ly);
-            ys = rest;
-            let (zt, rest) = core::mem::take(&mut zs).split_at_mut(lz);
-            zs = rest;
-            let _ = jobs.push(move || *result = Some(job(t, ot, st, yt, zt)));
-        }
-        run_all(par, &mut jobs);
-    }
-    for r in results.into_iter().take(k) {
-        r.unwrap_or(Ok(()))?;
-    }
     Ok(())
 }
 
