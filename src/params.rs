@@ -310,4 +310,14 @@ impl<T: Real> Params<T> {
         };
         bonds + contacts + wall
     }
+
+    /// The solver that runs for `n` spheres and `bonds` bonds: [`SolverKind::Auto`]
+    /// resolved once, from every constraint row the step may solve
+    /// ([`Params::constraints`]: bonds, contact capacity, wall links), not from the rows
+    /// held in one round. [`Layout::for_params`](crate::Layout::for_params) sizes the
+    /// storage from this same choice, and every stage of the step runs it, so the two
+    /// cannot disagree.
+    pub const fn solver_kind(&self, n: usize, bonds: usize) -> SolverKind {
+        self.solver.kind.resolve(self.constraints(n, bonds))
+    }
 }

@@ -2,8 +2,11 @@
 //! subnormal, zero and negative radii, nested and overlapping spheres), hostile bonds
 //! (out of range, self, duplicate, lengths whose square overflows), hostile parameters
 //! (every method, solver and mobility; NaN, negative and huge time steps, tolerances,
-//! viscosities, gravity, time) and mismatched or undersized storage. Every call must
-//! return without a panic; a refused step must leave the state bit-identical; an
+//! viscosities, gravity, time; rest length zero), every table of the step (rotation,
+//! matrix-free products, hard contacts with capacities past `DENSE_BONDS_MAX` rows, a
+//! wall, FENE springs, thermal noise by Cholesky, Lanczos or `Auto` with either drift)
+//! and mismatched or undersized storage. Every call must return without a panic; a
+//! refused step must leave the state and the noise generator bit-identical; an
 //! accepted one must leave it finite with the time advanced.
 //!
 //! 100 000 cases per precision by default (`FUZZ_CASES`, `FUZZ_SEED` to change; a longer run is
@@ -14,7 +17,8 @@ mod common;
 use common::fuzz::{Rng, report, settings};
 use common::*;
 use hydrorattle::{
-    Bond, Contacts, Hydro, Layout, Method, NoForce, Params, Real, SolverKind, State, step_slices,
+    Bond, Brownian, Contacts, Drift, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Params,
+    Real, SolverKind, State, Wall, step_slices,
 };
 use hydrorattle_heap::Buffers;
 
@@ -84,6 +88,7 @@ const SOLVERS: [SolverKind; 4] = [
     SolverKind::Newton,
     SolverKind::Krylov,
 ];
+const NOISE_SQRT: [NoiseSqrt; 3] = [NoiseSqrt::Auto, NoiseSqrt::Cholesky, NoiseSqrt::Lanczos];
 const HYDRO: [Hydro; 3] = [Hydro::Rpy, Hydro::Oseen, Hydro::FreeDraining];
 
 fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
@@ -96,7 +101,12 @@ fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
 /// One fuzz case in precision `T`: whether the step was accepted, or `Err` describing
 /// a broken promise.
 fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
-    let n = 1 + rng.below(6) as usize;
+    // Mostly small; one case in eight long enough for more than `DENSE_BONDS_MAX` rows.
+    let n = if rng.below(8) == 0 {
+        1 + rng.below(40) as usize
+    } else {
+        1 + rng.below(6) as usize
+    };
     // Mostly a chain along x with gaps, so that many cases are valid and step.
     let mut pos = Vec::with_capacity(n);
     let mut radius = Vec::with_capacity(n);
@@ -136,6 +146,9 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
             };
             let length = if rng.1 && rng.below(8) == 0 {
                 rng.value(3.0)
+            } else if rng.below(16) == 0 {
+                // Rest length zero: a spring's (Springs, FENE) or a refused bond.
+                0.0
             } else {
                 // The current distance, so that a clean case starts on its constraints.
                 let d = sub(f64s::<T>(pos[i % n]), f64s::<T>(pos[j % n]));
@@ -175,12 +188,58 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
     if rng.below(10) == 0 {
         p.spring_stiffness = T::from_f64(rng.value(1e3));
     }
-    // Hard contacts on a quarter of the cases: any capacity (zero included), any rounds.
-    if rng.below(4) == 0 {
+    // A clean case takes only the tables its method supports (so that it mostly steps);
+    // a hostile one takes any.
+    let hostile = rng.1;
+    let fits = |ok: bool| hostile || ok;
+    let overdamped = matches!(p.method, Method::Overdamped | Method::Overdamped2);
+    let free_ok = fits(matches!(p.method, Method::Overdamped | Method::Springs));
+    let noise_ok = fits(matches!(
+        p.method,
+        Method::Overdamped | Method::Springs | Method::RattleStable
+    ));
+    let one_sided_ok = fits(overdamped);
+    // Hard contacts on a quarter of the cases: any capacity (zero included, and past
+    // `DENSE_BONDS_MAX` rows), any rounds.
+    if one_sided_ok && rng.below(4) == 0 {
         p.contacts = Some(Contacts {
-            capacity: rng.below(2 * n as u64 + 2) as usize,
+            capacity: rng.below(2 * n as u64 + 40) as usize,
             max_rounds: rng.below(20) as u32,
         });
+    }
+    // A wall on a quarter: below the chain, or anywhere (a sphere under it is refused).
+    if one_sided_ok && rng.below(4) == 0 {
+        let height = if rng.below(4) == 0 {
+            rng.value(-2.0)
+        } else {
+            -2.0 - rng.unit()
+        };
+        p.wall = Some(Wall::new(T::from_f64(height)));
+    }
+    p.matrix_free = free_ok && rng.below(6) == 0;
+    // FENE springs on a sixth: a limit beyond the bonds, or a hostile one.
+    if rng.below(6) == 0 {
+        p.fene = Some(T::from_f64(rng.value(6.0)));
+    }
+    // Thermal noise on a quarter, drawn by either square root (or the default's pick).
+    let one_sided = p.contacts.is_some() || p.wall.is_some();
+    if noise_ok && fits(!one_sided) && rng.below(4) == 0 {
+        let mut b = Brownian::new(T::from_f64(rng.value(0.05)));
+        if rng.below(2) == 0 {
+            b.drift = Drift::Uncorrected;
+        }
+        p.brownian = Some(b);
+        p.noise_sqrt = NOISE_SQRT[rng.below(3) as usize];
+        if !hostile && p.method == Method::RattleStable {
+            p.noise_sqrt = NoiseSqrt::Cholesky;
+        }
+        if !hostile && p.matrix_free {
+            p.noise_sqrt = NoiseSqrt::Lanczos;
+        }
+        if rng.1 && rng.below(4) == 0 {
+            p.lanczos.max_iterations = rng.below(4) as u32;
+            p.lanczos.tolerance = T::from_f64(rng.value(1e-6));
+        }
     }
     // Storage: usually what the step needs, sometimes too little.
     let (ln, lb) = match (rng.1, rng.below(16)) {
@@ -192,6 +251,8 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
     let mut ws = store.workspace();
     // Sometimes a slice of the wrong length.
     let short = rng.below(40) == 0 && n > 1;
+    let mut noise = Noise::new(rng.next());
+    let noise0 = noise.save();
     let (pos0, vel0, omega0, time0) = (
         bits::<T>(&pos),
         bits::<T>(&vel),
@@ -205,7 +266,7 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
         radius: &radius,
         density: &density,
         time: &mut time,
-        noise: None,
+        noise: Some(&mut noise),
     };
     let result = step_slices(state, &bonds, &p, &mut ws, &mut NoForce);
     let accepted = result.is_ok();
@@ -214,7 +275,8 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
             let same = bits::<T>(&pos) == pos0
                 && bits::<T>(&vel) == vel0
                 && bits::<T>(&omega) == omega0
-                && time.to_f64().to_bits() == time0;
+                && time.to_f64().to_bits() == time0
+                && noise.save() == noise0;
             if !same {
                 return Err(format!("refused ({e}) but changed the state"));
             }

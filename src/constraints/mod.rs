@@ -34,7 +34,8 @@ use crate::error::{Stage, StepError};
 use crate::real::Real;
 
 /// [`SolverKind::Auto`] picks the dense [`SolverKind::Newton`] solve up to this many
-/// bonds and [`SolverKind::Krylov`] above. Measured crossover (`cargo bench --bench
+/// constraint rows (bonds, contact capacity and wall links:
+/// [`Params::solver_kind`](crate::Params::solver_kind)) and [`SolverKind::Krylov`] above. Measured crossover (`cargo bench --bench
 /// kernel -- solver`): see `docs/BENCHMARKS.md`.
 pub const DENSE_BONDS_MAX: usize = 32;
 
@@ -49,17 +50,19 @@ pub enum SolverKind {
     /// Chord Newton with banded-preconditioned conjugate gradients: `O(B)` storage,
     /// one mobility product per iteration.
     Krylov,
-    /// [`SolverKind::Newton`] up to [`DENSE_BONDS_MAX`] bonds, [`SolverKind::Krylov`]
-    /// above (the default).
+    /// [`SolverKind::Newton`] up to [`DENSE_BONDS_MAX`] constraint rows,
+    /// [`SolverKind::Krylov`] above (the default). A step resolves it once, from every
+    /// row it may solve ([`Params::solver_kind`](crate::Params::solver_kind)).
     #[default]
     Auto,
 }
 
 impl SolverKind {
-    /// The algorithm that runs for `bonds` bonds ([`SolverKind::Auto`] resolved).
-    pub const fn resolve(self, bonds: usize) -> Self {
+    /// The algorithm that runs for `rows` constraint rows ([`SolverKind::Auto`]
+    /// resolved).
+    pub const fn resolve(self, rows: usize) -> Self {
         match self {
-            Self::Auto if bonds <= DENSE_BONDS_MAX => Self::Newton,
+            Self::Auto if rows <= DENSE_BONDS_MAX => Self::Newton,
             Self::Auto => Self::Krylov,
             kind => kind,
         }

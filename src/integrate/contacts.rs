@@ -32,7 +32,6 @@
 
 use super::{bond_vectors, mobility_metric, project_positions};
 use crate::bonds::Bond;
-use crate::constraints::Solver;
 use crate::constraints::{Scratch, SolveStats};
 use crate::error::{Stage, StepError};
 use crate::params::{Contacts, Params, Wall};
@@ -98,23 +97,6 @@ pub(super) fn project_overdamped<'l, T: Real>(
     let one_sided = match (contacts, wall) {
         (None, None) => None,
         (c, _) => Some(c.unwrap_or(Contacts::new(0))),
-    };
-    // With one-sided constraints the solver is resolved once for the bonds plus the
-    // pool, as the storage was ([`Layout::for_params`](crate::Layout::for_params)),
-    // however many a round holds.
-    let resolved;
-    let p = match one_sided {
-        Some(_) => {
-            resolved = Params {
-                solver: Solver {
-                    kind: p.solver.kind.resolve(nb + pool),
-                    ..p.solver
-                },
-                ..*p
-            };
-            &resolved
-        }
-        None => p,
     };
     let tol = p.solver.tolerance;
     let mut nc = 0;

@@ -31,6 +31,7 @@ use checks::{accept, check_contacts, check_inputs, check_thermal, check_wall};
 use contacts::{Projection, project_overdamped};
 
 use crate::bonds::{Bond, BondSet, max_residual};
+use crate::constraints::{Solver, SolverKind};
 use crate::error::StepError;
 use crate::forces::ExternalForce;
 use crate::params::{Method, Params};
@@ -131,6 +132,23 @@ fn advance<T: Real, E: ExternalForce<T>>(
     // compiler, which then links only the method it runs.
     check_contacts(p, thermal.is_some())?;
     check_wall(p, &state)?;
+    // The solver, resolved once from every row the step may solve, as the storage was
+    // sized ([`Params::solver_kind`]): no stage re-resolves `Auto` from the rows it
+    // holds in one round. A concrete kind (firmware's) keeps `p` the caller's reference.
+    let resolved;
+    let p = match p.solver.kind {
+        SolverKind::Auto => {
+            resolved = Params {
+                solver: Solver {
+                    kind: p.solver_kind(n, bonds.len()),
+                    ..p.solver
+                },
+                ..*p
+            };
+            &resolved
+        }
+        _ => p,
+    };
     let s = Start {
         pos: state.pos,
         vel: state.vel,

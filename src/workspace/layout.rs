@@ -124,18 +124,17 @@ impl Layout {
     /// they are solved over.
     pub const fn for_params<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Self {
         let c = p.constraints(n, bonds);
-        let mut l = Self::with_solver(p.method, p.rotation, p.solver.kind, n, c);
+        let mut l = Self::with_solver(p.method, p.rotation, p.solver_kind(n, bonds), n, c);
         if p.contacts.is_some() || p.wall.is_some() {
             l.links = c;
         }
-        let bonds = c;
         let l = if p.brownian.is_some() {
-            l.thermal(p.method, n, bonds).noise_sqrt(p, n)
+            l.thermal(p.method, n, c).noise_sqrt(p, n)
         } else {
             l
         };
         if p.matrix_free {
-            l.matrix_free(p.method, p.solver.kind, n, bonds)
+            l.matrix_free(p.method, p.solver_kind(n, bonds), n, c)
         } else {
             l
         }

@@ -64,7 +64,7 @@ impl<T: Real> Workspace<'_, T> {
         n: usize,
         bonds: usize,
     ) -> Result<Views<'_, T>, StepError> {
-        let (method, rotation, kind) = (p.method, p.rotation, p.solver.kind);
+        let (method, rotation, kind) = (p.method, p.rotation, p.solver_kind(n, bonds));
         let need = Layout::for_params(p, n, bonds);
         let have = self.capacity();
         if !have.holds(&need) {
@@ -73,7 +73,6 @@ impl<T: Real> Workspace<'_, T> {
         let nb = p.constraints(n, bonds);
         let links = Carve(&mut *self.links).take(need.links);
         let m = super::block_rows(method, rotation, n);
-        let kind = kind.resolve(nb);
         let krylov = matches!(kind, SolverKind::Krylov);
         let mut bl = Carve(&mut *self.blocks);
         let mut ve = Carve(&mut *self.vectors);
