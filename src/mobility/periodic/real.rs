@@ -96,7 +96,7 @@ pub(super) fn real_sum<T: Real>(
                 }
                 if same && nx == 0 && ny == 0 && nz == 0 {
                     let (a0, _) = smooth(ew.xi, alpha, beta, T::ZERO);
-                    acc = acc + T::m3_diag(free_self_tt(eta, ai) - a0 * inv_eta);
+                    acc += T::m3_diag(free_self_tt(eta, ai) - a0 * inv_eta);
                     continue;
                 }
                 let rpy = crate::mobility::pair_tt(Hydro::Rpy, eta, ai, aj, rn)?;
@@ -104,7 +104,7 @@ pub(super) fn real_sum<T: Real>(
                 let e = rn * inv_s;
                 let (a, b) = smooth(ew.xi, alpha, beta, s);
                 let w = T::m3_add_diag(T::outer(e, e) * (b * inv_eta), a * inv_eta);
-                acc = acc + (rpy - w);
+                acc += rpy - w;
             }
         }
     }

@@ -8,15 +8,11 @@
 use super::{Ewald, MAX_INDEX};
 use crate::real::Real;
 
-/// `(k, h(k) / k^2-free part)`: the wave vector of index `n`, `k^2`, and the radius-free
-/// factor `(1 + k^2/(4 xi^2)) exp(-k^2/(4 xi^2)) / k^2`; `None` outside the half space,
-/// at `k = 0` or beyond `k_max`.
+/// The wave vector of index `n`, `1/k^2`, and the radius-free factor
+/// `(1 + k^2/(4 xi^2)) exp(-k^2/(4 xi^2)) / k^2`.
 #[inline(always)]
-fn mode<T: Real>(ew: &Ewald<T>, n: [i32; 3]) -> Option<(T::V3, T, T)> {
+fn mode<T: Real>(ew: &Ewald<T>, n: [i32; 3]) -> (T::V3, T, T, T) {
     let [nx, ny, nz] = n;
-    if !(nx > 0 || (nx == 0 && (ny > 0 || (ny == 0 && nz > 0)))) {
-        return None;
-    }
     let [kx, ky, kz] = ew.dk;
     let k = T::v3(
         T::from_f64(nx as f64) * kx,
@@ -24,20 +20,38 @@ fn mode<T: Real>(ew: &Ewald<T>, n: [i32; 3]) -> Option<(T::V3, T, T)> {
         T::from_f64(nz as f64) * kz,
     );
     let k2 = T::norm2(k);
-    if !(k2 <= ew.k_max * ew.k_max) {
-        return None;
-    }
+    let inv_k2 = T::ONE / k2;
     let g = ew.gauss[0][nx.unsigned_abs() as usize]
         * ew.gauss[1][ny.unsigned_abs() as usize]
         * ew.gauss[2][nz.unsigned_abs() as usize];
-    let q = k2 * ew.inv_4xi2;
-    Some((k, k2, (T::ONE + q) * g / k2))
+    (k, k2, inv_k2, (T::ONE + k2 * ew.inv_4xi2) * g * inv_k2)
 }
 
-/// Index ranges of the half space: `n_x` from 0, `n_y`, `n_z` symmetric.
+/// Visits the half space of wave vectors within `k_max` in a fixed order (`n_x`
+/// ascending from 0, then `n_y`, then `n_z`, each ascending), the `n_z` range cut to the
+/// sphere `|k| <= k_max` for each `(n_x, n_y)` so that no index outside it is visited.
 #[inline(always)]
-fn ranges<T: Real>(ew: &Ewald<T>) -> [i32; 3] {
-    ew.waves.map(|m| m as i32)
+fn for_each_mode<T: Real>(ew: &Ewald<T>, mut f: impl FnMut([i32; 3])) {
+    let [mx, my, mz] = ew.waves.map(|m| m as i32);
+    let [kx, ky, kz] = ew.dk;
+    let km2 = ew.k_max * ew.k_max;
+    for nx in 0..=mx {
+        let ax = T::from_f64(nx as f64) * kx;
+        let lo_y = if nx == 0 { 0 } else { -my };
+        for ny in lo_y..=my {
+            let ay = T::from_f64(ny as f64) * ky;
+            let rest = km2 - ax * ax - ay * ay;
+            if !(rest >= T::ZERO) {
+                continue;
+            }
+            // floor(sqrt(rest) / dk_z), clamped to the precomputed bound.
+            let top = libm::floor((rest.sqrt() / kz).to_f64()).min(mz as f64) as i32;
+            let lo_z = if nx == 0 && ny == 0 { 1 } else { -top };
+            for nz in lo_z..=top {
+                f([nx, ny, nz]);
+            }
+        }
+    }
 }
 
 /// `1 - k^2 a^2 / 6`: the sphere's factor of the wave-space kernel.
@@ -65,33 +79,26 @@ pub(super) fn wave_sum<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r0: T::V3) 
         let (c, s) = pw[d][n.unsigned_abs() as usize];
         if n < 0 { (c, -s) } else { (c, s) }
     };
-    let [mx, my, mz] = ranges(ew);
     let (mut diag, mut kk) = (T::ZERO, [T::ZERO; 6]);
-    for nx in 0..=mx {
-        for ny in -my..=my {
-            for nz in -mz..=mz {
-                let Some((k, k2, base)) = mode(ew, [nx, ny, nz]) else {
-                    continue;
-                };
-                let (c1, s1) = phase(0, nx);
-                let (c2, s2) = phase(1, ny);
-                let (c3, s3) = phase(2, nz);
-                let (c12, s12) = (c1 * c2 - s1 * s2, c1 * s2 + s1 * c2);
-                let cos = c12 * c3 - s12 * s3;
-                let f = base * radius_factor(k2, ai) * radius_factor(k2, aj) * cos;
-                diag += f;
-                let g = f / k2;
-                let [x, y, z] = T::xyz(k);
-                let (gx, gy) = (g * x, g * y);
-                kk[0] += gx * x;
-                kk[1] += gx * y;
-                kk[2] += gx * z;
-                kk[3] += gy * y;
-                kk[4] += gy * z;
-                kk[5] += g * z * z;
-            }
-        }
-    }
+    for_each_mode(ew, |[nx, ny, nz]| {
+        let (k, k2, inv_k2, base) = mode(ew, [nx, ny, nz]);
+        let (c1, s1) = phase(0, nx);
+        let (c2, s2) = phase(1, ny);
+        let (c3, s3) = phase(2, nz);
+        let (c12, s12) = (c1 * c2 - s1 * s2, c1 * s2 + s1 * c2);
+        let cos = c12 * c3 - s12 * s3;
+        let f = base * radius_factor(k2, ai) * radius_factor(k2, aj) * cos;
+        diag += f;
+        let g = f * inv_k2;
+        let [x, y, z] = T::xyz(k);
+        let (gx, gy) = (g * x, g * y);
+        kk[0] += gx * x;
+        kk[1] += gx * y;
+        kk[2] += gx * z;
+        kk[3] += gy * y;
+        kk[4] += gy * z;
+        kk[5] += g * z * z;
+    });
     let w = T::TWO / (eta * ew.volume);
     let [xx, xy, xz, yy, yz, zz] = kk.map(|v| -(v * w));
     let d = diag * w;
@@ -115,30 +122,23 @@ pub(super) fn wave_product<T: Real>(
     y: &mut [T::V3],
 ) {
     let w = T::TWO / (eta * ew.volume);
-    let [mx, my, mz] = ranges(ew);
-    for nx in 0..=mx {
-        for ny in -my..=my {
-            for nz in -mz..=mz {
-                let Some((k, k2, base)) = mode(ew, [nx, ny, nz]) else {
-                    continue;
-                };
-                let (mut c, mut s) = (T::V3_ZERO, T::V3_ZERO);
-                for j in 0..pos.len() {
-                    let t = T::dot(k, ew.cell.wrap_into(pos[j]));
-                    let f = radius_factor(k2, radius[j]);
-                    c += x[j] * (f * t.cos());
-                    s += x[j] * (f * t.sin());
-                }
-                // Project across k: P v = v - k (k . v) / k^2.
-                let c = c - k * (T::dot(k, c) / k2);
-                let s = s - k * (T::dot(k, s) / k2);
-                let h = base * w;
-                for i in 0..pos.len() {
-                    let t = T::dot(k, ew.cell.wrap_into(pos[i]));
-                    let f = h * radius_factor(k2, radius[i]);
-                    y[i] += (c * t.cos() + s * t.sin()) * f;
-                }
-            }
+    for_each_mode(ew, |n| {
+        let (k, k2, inv_k2, base) = mode(ew, n);
+        let (mut c, mut s) = (T::V3_ZERO, T::V3_ZERO);
+        for j in 0..pos.len() {
+            let t = T::dot(k, ew.cell.wrap_into(pos[j]));
+            let f = radius_factor(k2, radius[j]);
+            c += x[j] * (f * t.cos());
+            s += x[j] * (f * t.sin());
         }
-    }
+        // Project across k: P v = v - k (k . v) / k^2.
+        let c = c - k * (T::dot(k, c) * inv_k2);
+        let s = s - k * (T::dot(k, s) * inv_k2);
+        let h = base * w;
+        for i in 0..pos.len() {
+            let t = T::dot(k, ew.cell.wrap_into(pos[i]));
+            let f = h * radius_factor(k2, radius[i]);
+            y[i] += (c * t.cos() + s * t.sin()) * f;
+        }
+    });
 }
