@@ -1,16 +1,16 @@
 //! The Rotne-Prager-Yamakawa translational mobility in a rectangular periodic box,
-//! Ewald-summed (Beenakker, J. Chem. Phys. 85, 1581, 1986; Hasimoto's split, as in
-//! Fiore et al., J. Chem. Phys. 146, 124116, 2017), for unequal radii, the overlapping
-//! branch included. The exact reference path: every block is summed to a tolerance near
+//! Ewald-summed for unequal radii, the overlapping branch included: Hasimoto's
+//! splitting function (as in Fiore et al., J. Chem. Phys. 146, 124116, 2017) with
+//! Beenakker's polynomial sphere factors (J. Chem. Phys. 85, 1581, 1986). The exact reference path: every block is summed to a tolerance near
 //! the precision's epsilon. Derivation and measured accuracy in `docs/PERIODIC.md`.
 //!
 //! **What is summed.** In a box of volume `V` the mobility of spheres `i`, `j` at
 //! `r = r_i - r_j` is the Fourier series
 //! `M_ij = 1/(eta V) sum_{k != 0} (I - k k/k^2)/k^2 sinc(k a_i) sinc(k a_j) e^{i k.r}`
 //! (`k = 0`, the mean flow, excluded: the net force is balanced by the mean pressure
-//! gradient). Beenakker's split multiplies the Oseen kernel by
+//! gradient). The split multiplies the Oseen kernel by
 //! `H = (1 + k^2/(4 xi^2)) e^{-k^2/(4 xi^2)}` in wave space, with the sphere factors
-//! `(1 - k^2 a^2/6)` (equal to `sinc` wherever the spheres do not overlap), and leaves
+//! `(1 - k^2 a^2/6)` (whose transform equals `sinc`'s beyond contact), and leaves
 //! the rest in real space: there each image contributes the free-space RPY block
 //! ([`crate::mobility::pair_tt`], both branches, so overlapping pairs need no formulas of
 //! their own) minus the smooth transform `W` of the wave-space kernel. The self block
