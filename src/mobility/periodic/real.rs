@@ -20,11 +20,21 @@ const SERIES_TERMS: usize = 28;
 /// (alternating, largest term `O(1)`: no cancellation to speak of).
 #[inline(always)]
 pub(super) fn smooth<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
+    if xi * s < T::ONE {
+        series(xi, alpha, beta, s)
+    } else {
+        closed(xi, alpha, beta, s)
+    }
+}
+
+/// [`smooth`] by its power series in `(xi s)^2`.
+#[inline(always)]
+fn series<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
     let c = |v: f64| T::from_f64(v);
     let x = xi * s;
     let x2 = x * x;
     let (xi2, xi4) = (xi * xi, xi * xi * xi * xi);
-    if x < T::ONE {
+    {
         // A = k0 sum_n n u_{n-1} c_n, B = -k0 sum_n (n - 1) u_{n-1} c_n with
         // u_m = (-x^2)^m / m!, c_n = 1/(2n-1) - 2 alpha xi^2 (2n+3)/(2n+1) + 4 beta xi^4 (2n+5).
         let (mut a, mut b, mut u) = (T::ZERO, T::ZERO, T::ONE);
@@ -39,8 +49,17 @@ pub(super) fn smooth<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
             u = -u * x2 / nf;
         }
         let k0 = xi / (T::TWO * T::PI * T::PI.sqrt());
-        return (k0 * a, -(k0 * b));
+        (k0 * a, -(k0 * b))
     }
+}
+
+/// [`smooth`] in closed form (accurate from `xi s` about 1 on).
+#[inline(always)]
+fn closed<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
+    let c = |v: f64| T::from_f64(v);
+    let x = xi * s;
+    let x2 = x * x;
+    let (xi2, xi4) = (xi * xi, xi * xi * xi * xi);
     // Phi' = -p1 / (8 pi), Phi'' = -p2 / (8 pi) of the radial potential Phi with
     // eta W = grad grad Phi - I lap Phi; A = -(Phi'' + Phi'/s), B = Phi'' - Phi'/s.
     let cg = c(2.0) * xi / T::PI.sqrt() * (-x2).exp();
@@ -109,4 +128,43 @@ pub(super) fn real_sum<T: Real>(
         }
     }
     Some(acc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{closed, series, smooth};
+
+    /// The series and the closed form agree around the switch at `xi r = 1`, and far
+    /// out `W` is the far-field RPY block `(1 + q/3) I + (1 - q) e e` over `8 pi r`,
+    /// `q = (a_i^2 + a_j^2) / r^2`.
+    #[test]
+    fn series_meets_closed_form_and_far_field() {
+        for (ai, aj, xi) in [
+            (1.0f64, 1.0, 0.3),
+            (1.0, 0.3, 1.0),
+            (2.0, 0.5, 0.5),
+            (0.4, 0.4, 2.4),
+        ] {
+            let (alpha, beta) = ((ai * ai + aj * aj) / 6.0, ai * ai * aj * aj / 36.0);
+            for x in [0.8, 1.0, 1.3] {
+                let (s, c) = (
+                    series(xi, alpha, beta, x / xi),
+                    closed(xi, alpha, beta, x / xi),
+                );
+                let scale = s.0.abs().max(s.1.abs());
+                let d = (s.0 - c.0).abs().max((s.1 - c.1).abs()) / scale;
+                assert!(d < 5e-15, "a {ai} {aj} xi {xi} x {x}: {d:e}");
+            }
+            let r = 9.0 / xi;
+            let (a, b) = smooth(xi, alpha, beta, r);
+            let (q, c) = (
+                (ai * ai + aj * aj) / (r * r),
+                1.0 / (8.0 * core::f64::consts::PI * r),
+            );
+            assert!(
+                (a - c * (1.0 + q / 3.0)).abs() < 1e-15 * c
+                    && (b - c * (1.0 - q)).abs() < 1e-15 * c
+            );
+        }
+    }
 }
