@@ -20,20 +20,47 @@ const SERIES_TERMS: usize = 28;
 /// (alternating, largest term `O(1)`: no cancellation to speak of).
 #[inline(always)]
 pub(super) fn smooth<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
-    if xi * s < T::ONE {
-        series(xi, alpha, beta, s)
-    } else {
-        closed(xi, alpha, beta, s)
+    let v = Scaled::new(xi, alpha, beta, s);
+    if v.x < T::ONE { series(&v) } else { closed(&v) }
+}
+
+/// The arguments of [`smooth`] and the products both its forms read.
+#[derive(Clone, Copy)]
+struct Scaled<T: Real> {
+    xi: T,
+    alpha: T,
+    s: T,
+    /// `xi s` and its square.
+    x: T,
+    x2: T,
+    /// `alpha xi^2`, `beta xi^4`: the sphere factors' dimensionless weights.
+    axi2: T,
+    bxi4: T,
+}
+
+impl<T: Real> Scaled<T> {
+    #[inline(always)]
+    fn new(xi: T, alpha: T, beta: T, s: T) -> Self {
+        let (x, xi2) = (xi * s, xi * xi);
+        Self {
+            xi,
+            alpha,
+            s,
+            x,
+            x2: x * x,
+            axi2: alpha * xi2,
+            bxi4: beta * xi2 * xi2,
+        }
     }
 }
 
 /// [`smooth`] by its power series in `(xi s)^2`.
 #[inline(always)]
-fn series<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
+fn series<T: Real>(v: &Scaled<T>) -> (T, T) {
     let c = |v: f64| T::from_f64(v);
-    let x = xi * s;
-    let x2 = x * x;
-    let (xi2, xi4) = (xi * xi, xi * xi * xi * xi);
+    let Scaled {
+        xi, x2, axi2, bxi4, ..
+    } = *v;
     {
         // A = k0 sum_n n u_{n-1} c_n, B = -k0 sum_n (n - 1) u_{n-1} c_n with
         // u_m = (-x^2)^m / m!, c_n = 1/(2n-1) - 2 alpha xi^2 (2n+3)/(2n+1) + 4 beta xi^4 (2n+5).
@@ -42,8 +69,8 @@ fn series<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
             let nf = c(n as f64);
             let two_n = nf + nf;
             let cn = T::ONE / (two_n - T::ONE)
-                - c(2.0) * alpha * xi2 * (two_n + c(3.0)) / (two_n + T::ONE)
-                + c(4.0) * beta * xi4 * (two_n + c(5.0));
+                - c(2.0) * axi2 * (two_n + c(3.0)) / (two_n + T::ONE)
+                + c(4.0) * bxi4 * (two_n + c(5.0));
             a += nf * u * cn;
             b += (nf - T::ONE) * u * cn;
             u = -u * x2 / nf;
@@ -55,24 +82,31 @@ fn series<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
 
 /// [`smooth`] in closed form (accurate from `xi s` about 1 on).
 #[inline(always)]
-fn closed<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
+fn closed<T: Real>(v: &Scaled<T>) -> (T, T) {
     let c = |v: f64| T::from_f64(v);
-    let x = xi * s;
-    let x2 = x * x;
-    let (xi2, xi4) = (xi * xi, xi * xi * xi * xi);
+    let Scaled {
+        xi,
+        alpha,
+        s,
+        x,
+        x2,
+        axi2,
+        bxi4,
+    } = *v;
+    let xi2 = xi * xi;
     // Phi' = -p1 / (8 pi), Phi'' = -p2 / (8 pi) of the radial potential Phi with
     // eta W = grad grad Phi - I lap Phi; A = -(Phi'' + Phi'/s), B = Phi'' - Phi'/s.
     let cg = c(2.0) * xi / T::PI.sqrt() * (-x2).exp();
     let erf = x.erf();
     let inv = T::ONE / s;
     let inv2 = inv * inv;
-    let t2p = -(c(2.0) * alpha * xi2 * s * cg);
-    let t2pp = -(c(2.0) * alpha * xi2 * (T::ONE - c(2.0) * x2) * cg);
+    let t2p = -(c(2.0) * axi2 * s * cg);
+    let t2pp = -(c(2.0) * axi2 * (T::ONE - c(2.0) * x2) * cg);
     let t3p = c(2.0) * alpha * (cg * inv - erf * inv2);
     let t3pp =
         c(2.0) * alpha * (c(2.0) * erf * inv2 * inv - c(2.0) * cg * inv2 - c(2.0) * xi2 * cg);
-    let t4p = beta * xi4 * s * cg * (c(28.0) - c(8.0) * x2);
-    let t4pp = beta * xi4 * cg * (c(28.0) - c(80.0) * x2 + c(16.0) * x2 * x2);
+    let t4p = bxi4 * s * cg * (c(28.0) - c(8.0) * x2);
+    let t4pp = bxi4 * cg * (c(28.0) - c(80.0) * x2 + c(16.0) * x2 * x2);
     let p1 = erf + t2p + t3p + t4p;
     let p2 = cg + t2pp + t3pp + t4pp;
     let k = T::ONE / (c(8.0) * T::PI);
@@ -132,7 +166,7 @@ pub(super) fn real_sum<T: Real>(
 
 #[cfg(test)]
 mod tests {
-    use super::{closed, series, smooth};
+    use super::{Scaled, closed, series, smooth};
 
     /// The series and the closed form agree around the switch at `xi r = 1`, and far
     /// out `W` is the far-field RPY block `(1 + q/3) I + (1 - q) e e` over `8 pi r`,
@@ -147,10 +181,8 @@ mod tests {
         ] {
             let (alpha, beta) = ((ai * ai + aj * aj) / 6.0, ai * ai * aj * aj / 36.0);
             for x in [0.8, 1.0, 1.3] {
-                let (s, c) = (
-                    series(xi, alpha, beta, x / xi),
-                    closed(xi, alpha, beta, x / xi),
-                );
+                let v = Scaled::new(xi, alpha, beta, x / xi);
+                let (s, c) = (series(&v), closed(&v));
                 let scale = s.0.abs().max(s.1.abs());
                 let d = (s.0 - c.0).abs().max((s.1 - c.1).abs()) / scale;
                 assert!(d < 5e-15, "a {ai} {aj} xi {xi} x {x}: {d:e}");
