@@ -13,6 +13,8 @@ use crate::error::ParticleError;
 use crate::linalg::tri;
 use crate::real::Real;
 
+#[cfg(feature = "periodic")]
+pub mod periodic;
 pub mod wall;
 
 /// How much hydrodynamics to model.

@@ -104,6 +104,8 @@ pub trait Real:
     fn acos(self) -> Self;
     /// Exponential (libm).
     fn exp(self) -> Self;
+    /// Error function (libm; the periodic mobility's Ewald split).
+    fn erf(self) -> Self;
     /// `true` unless NaN or infinite.
     fn is_finite(self) -> bool;
     /// `true` for NaN.
@@ -202,7 +204,7 @@ pub trait Real:
 }
 
 macro_rules! impl_real {
-    ($t:ty, $v:ty, $m:ty, $sqrt:path, $rootinv:path, $sin:path, $cos:path, $atan2:path, $acos:path, $exp:path) => {
+    ($t:ty, $v:ty, $m:ty, $sqrt:path, $rootinv:path, $sin:path, $cos:path, $atan2:path, $acos:path, $exp:path, $erf:path) => {
         impl Real for $t {
             type V3 = $v;
             type M3 = $m;
@@ -255,6 +257,10 @@ macro_rules! impl_real {
             #[inline]
             fn exp(self) -> Self {
                 $exp(self)
+            }
+            #[inline]
+            fn erf(self) -> Self {
+                $erf(self)
             }
             #[inline]
             fn is_finite(self) -> bool {
@@ -333,7 +339,8 @@ impl_real!(
     libm::cosf,
     libm::atan2f,
     libm::acosf,
-    libm::expf
+    libm::expf,
+    libm::erff
 );
 impl_real!(
     f64,
@@ -345,7 +352,8 @@ impl_real!(
     libm::cos,
     libm::atan2,
     libm::acos,
-    libm::exp
+    libm::exp,
+    libm::erf
 );
 
 #[inline]

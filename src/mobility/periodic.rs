@@ -1,0 +1,345 @@
+//! The Rotne-Prager-Yamakawa translational mobility in a rectangular periodic box,
+//! Ewald-summed for unequal radii, the overlapping branch included: Hasimoto's
+//! splitting function (as in Fiore et al., J. Chem. Phys. 146, 124116, 2017) with
+//! Beenakker's polynomial sphere factors (J. Chem. Phys. 85, 1581, 1986). The exact reference path: every block is summed to a tolerance near
+//! the precision's epsilon. Derivation and measured accuracy in `docs/PERIODIC.md`.
+//!
+//! **What is summed.** In a box of volume `V` the mobility of spheres `i`, `j` at
+//! `r = r_i - r_j` is the Fourier series
+//! `M_ij = 1/(eta V) sum_{k != 0} (I - k k/k^2)/k^2 sinc(k a_i) sinc(k a_j) e^{i k.r}`
+//! (`k = 0`, the mean flow, excluded: the net force is balanced by the mean pressure
+//! gradient). The split multiplies the Oseen kernel by
+//! `H = (1 + k^2/(4 xi^2)) e^{-k^2/(4 xi^2)}` in wave space, with the sphere factors
+//! `(1 - k^2 a^2/6)` (whose transform equals `sinc`'s beyond contact), and leaves
+//! the rest in real space: there each image contributes the free-space RPY block
+//! ([`crate::mobility::pair_tt`], both branches, so overlapping pairs need no formulas of
+//! their own) minus the smooth transform `W` of the wave-space kernel. The self block
+//! takes `1/(6 pi eta a) - W(0)` for the sphere itself. The sum does not depend on `xi`.
+//!
+//! **Positive definiteness.** `F^T M F` is the dissipation of the periodic flow driven
+//! by the forces spread uniformly over the sphere surfaces (the `sinc` form is a sum of
+//! Gram terms, `|sum_j sinc(k a_j) e^{-i k.r_j} (I - k k/k^2) F_j|^2 / k^2 >= 0`). It is
+//! zero only when that force density is a periodic pressure gradient plus a constant;
+//! a uniform vector on a patch of sphere surface is normal to it nowhere unless it is
+//! zero, so every `F_j = 0`: positive definite for every configuration accepted (no
+//! sphere nested in another's image, every radius below half the box's smallest edge).
+//!
+//! **Parameters.** [`Ewald::new`] picks `xi` to balance the cost of the two sums and
+//! the cutoffs for a tolerance near epsilon; [`Ewald::with_xi`] takes them from the
+//! caller. Rotation (the `rt`, `rr` blocks) is not here yet.
+
+mod real;
+mod wave;
+
+use core::fmt;
+
+use crate::error::ParticleError;
+use crate::linalg::tri;
+use crate::real::Real;
+
+/// Largest image or wave-vector index per axis that the sums visit (a bound on their
+/// cost: a box too elongated for it is [`PeriodicError::TooElongated`]).
+pub const MAX_INDEX: usize = 40;
+
+/// `xi V^{1/3}` of [`Ewald::new`]: balances the measured cost of a real-space image
+/// (an RPY block, `erf`, `exp`) against that of a wave vector (`docs/PERIODIC.md`).
+pub const XI_BALANCE: f64 = 2.9;
+
+/// The largest `xi a_max` of [`Ewald::new`]: beyond it the sphere factors
+/// `(1 - k^2 a^2 / 6)` make the wave-space terms cancel (a sphere of a third of the box
+/// at `xi a = 2.4` loses two digits), so spheres that large lower `xi` below the balance.
+pub const XI_RADIUS: f64 = 1.0;
+
+/// A rejected periodic box, Ewald parameter or sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PeriodicError {
+    /// A box edge is zero, negative or not finite (axis 0, 1, 2).
+    BadEdge {
+        /// The axis.
+        axis: usize,
+    },
+    /// The splitting parameter, tolerance or largest radius is out of range (named).
+    BadParameter(&'static str),
+    /// The largest radius is not below half the smallest edge: a sphere would overlap
+    /// its own image.
+    SphereTooLarge,
+    /// The cutoffs need more than [`MAX_INDEX`] images or wave vectors along an axis.
+    TooElongated,
+    /// A radius is not finite, not positive, or above the parameters' largest radius.
+    Radius {
+        /// Index of the particle.
+        particle: usize,
+    },
+    /// A position is not finite, or a sphere lies inside another's image.
+    Particle(ParticleError),
+}
+
+impl fmt::Display for PeriodicError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BadEdge { axis } => write!(f, "periodic box edge {axis} must be finite and > 0"),
+            Self::BadParameter(name) => write!(f, "invalid Ewald parameter: {name}"),
+            Self::SphereTooLarge => write!(f, "a sphere is not smaller than half the box"),
+            Self::TooElongated => write!(f, "the box is too elongated for the Ewald sums' bounds"),
+            Self::Radius { particle } => {
+                write!(f, "particle {particle}: radius not in (0, largest radius]")
+            }
+            Self::Particle(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+/// A rectangular periodic box, edges `size` (validated: finite and positive).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Periodic<T: Real> {
+    size: [T; 3],
+}
+
+impl<T: Real> Periodic<T> {
+    /// The box `L_x x L_y x L_z`.
+    pub fn new(size: [T; 3]) -> Result<Self, PeriodicError> {
+        for (axis, l) in size.iter().enumerate() {
+            if !(*l > T::ZERO && l.is_finite()) {
+                return Err(PeriodicError::BadEdge { axis });
+            }
+        }
+        Ok(Self { size })
+    }
+
+    /// The edges.
+    pub fn size(&self) -> [T; 3] {
+        self.size
+    }
+
+    /// `L_x L_y L_z`.
+    pub fn volume(&self) -> T {
+        self.size[0] * self.size[1] * self.size[2]
+    }
+
+    /// The minimum image of a separation: each component reduced by a whole number of
+    /// edges into `[-L/2, L/2]`. A function of `r` alone, so separations that differ by
+    /// exactly a box vector give the same bits.
+    pub fn minimum_image(&self, r: T::V3) -> T::V3 {
+        let v = T::xyz(r);
+        let f = |d: usize| {
+            let l = self.size[d];
+            v[d] - T::from_f64(libm::round((v[d] / l).to_f64())) * l
+        };
+        T::v3(f(0), f(1), f(2))
+    }
+
+    /// A position moved by whole edges into `[0, L)` (for the phases of the wave sums).
+    pub fn wrap_into(&self, p: T::V3) -> T::V3 {
+        let v = T::xyz(p);
+        let f = |d: usize| {
+            let l = self.size[d];
+            v[d] - T::from_f64(libm::floor((v[d] / l).to_f64())) * l
+        };
+        T::v3(f(0), f(1), f(2))
+    }
+}
+
+/// The Ewald parameters for one box and one largest radius: the splitting parameter
+/// `xi`, the real-space cutoff and the wave-space cutoff, with the index bounds and
+/// per-axis Gaussian factors the sums read.
+#[derive(Clone, Copy, Debug)]
+pub struct Ewald<T: Real> {
+    cell: Periodic<T>,
+    a_max: T,
+    xi: T,
+    r_cut: T,
+    k_max: T,
+    volume: T,
+    inv_4xi2: T,
+    /// Real-space index bound per axis.
+    images: [usize; 3],
+    /// Wave-space index bound per axis.
+    waves: [usize; 3],
+    /// `2 pi / L_d`.
+    dk: [T; 3],
+    /// `exp(-(n dk_d)^2 / (4 xi^2))`, `n = 0..=waves[d]`.
+    gauss: [[T; MAX_INDEX + 1]; 3],
+}
+
+impl<T: Real> Ewald<T> {
+    /// Parameters by the documented rule: `xi = XI_BALANCE / V^{1/3}` and a tolerance of
+    /// an eighth of the precision's epsilon.
+    pub fn new(cell: Periodic<T>, a_max: T) -> Result<Self, PeriodicError> {
+        let xi = (XI_BALANCE / libm::cbrt(cell.volume().to_f64())).min(XI_RADIUS / a_max.to_f64());
+        Self::with_xi(cell, a_max, T::from_f64(xi), T::EPSILON / T::from_f64(8.0))
+    }
+
+    /// Parameters for a given splitting parameter `xi` and relative tolerance `tol`
+    /// (`0 < tol < 1`). With `p^2 = ln(1/tol) + 2 ln(1 + (a_max xi p)^2 / 2)` (the
+    /// second term covers the sphere factors' growth, iterated to a fixed point from
+    /// `p^2 = ln(1/tol)`), the cutoffs are `r_cut = max(p / xi, 2 a_max)` and
+    /// `k_max = 2 p xi`: the neglected terms fall like `exp(-p^2)` on both sides.
+    pub fn with_xi(cell: Periodic<T>, a_max: T, xi: T, tol: T) -> Result<Self, PeriodicError> {
+        if !(xi > T::ZERO && xi.is_finite()) {
+            return Err(PeriodicError::BadParameter("xi"));
+        }
+        if !(tol > T::ZERO && tol < T::ONE) {
+            return Err(PeriodicError::BadParameter("tolerance"));
+        }
+        if !(a_max > T::ZERO && a_max.is_finite()) {
+            return Err(PeriodicError::BadParameter("largest radius"));
+        }
+        let size = cell.size();
+        if !(a_max + a_max < size[0].min(size[1]).min(size[2])) {
+            return Err(PeriodicError::SphereTooLarge);
+        }
+        // The rule in f64 whatever T: the parameters are not part of the sums' rounding.
+        let (x, a, base) = (xi.to_f64(), a_max.to_f64(), -libm::log(tol.to_f64()));
+        let mut p2 = base;
+        for _ in 0..4 {
+            let t = a * x * libm::sqrt(p2);
+            p2 = base + 2.0 * libm::log(1.0 + 0.5 * t * t);
+        }
+        let p = libm::sqrt(p2);
+        let r_cut = (p / x).max(2.0 * a);
+        let k_max = 2.0 * p * x;
+        let mut images = [0; 3];
+        let mut waves = [0; 3];
+        let mut dk = [T::ZERO; 3];
+        let mut gauss = [[T::ZERO; MAX_INDEX + 1]; 3];
+        for d in 0..3 {
+            let l = size[d].to_f64();
+            let m = libm::ceil(r_cut / l + 0.5);
+            let w = libm::floor(k_max * l / (2.0 * core::f64::consts::PI));
+            if !(m <= MAX_INDEX as f64 && w <= MAX_INDEX as f64) {
+                return Err(PeriodicError::TooElongated);
+            }
+            (images[d], waves[d]) = (m as usize, w as usize);
+            dk[d] = T::TWO * T::PI / size[d];
+            for n in 0..=waves[d] {
+                let k = T::from_f64(n as f64) * dk[d];
+                gauss[d][n] = (-(k * k) / (T::from_f64(4.0) * xi * xi)).exp();
+            }
+        }
+        Ok(Self {
+            cell,
+            a_max,
+            xi,
+            r_cut: T::from_f64(r_cut),
+            k_max: T::from_f64(k_max),
+            volume: cell.volume(),
+            inv_4xi2: T::ONE / (T::from_f64(4.0) * xi * xi),
+            images,
+            waves,
+            dk,
+            gauss,
+        })
+    }
+
+    /// The box.
+    pub fn cell(&self) -> Periodic<T> {
+        self.cell
+    }
+    /// The splitting parameter `xi`.
+    pub fn xi(&self) -> T {
+        self.xi
+    }
+    /// The real-space cutoff.
+    pub fn r_cut(&self) -> T {
+        self.r_cut
+    }
+    /// The wave-space cutoff.
+    pub fn k_max(&self) -> T {
+        self.k_max
+    }
+    /// The largest radius the cutoffs were chosen for.
+    pub fn a_max(&self) -> T {
+        self.a_max
+    }
+}
+
+/// The block `(i, j)`, `i != j`, for radii `a_i`, `a_j` (at most [`Ewald::a_max`]) and
+/// separation `r = r_i - r_j` (any image: it is reduced to the minimum image first).
+/// Exactly symmetric; `None` when a sphere lies inside an image of the other.
+pub fn pair_tt<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r: T::V3) -> Option<T::M3> {
+    let r0 = ew.cell.minimum_image(r);
+    let real = real::real_sum(ew, eta, ai, aj, r0, false)?;
+    Some(real + wave::wave_sum(ew, eta, ai, aj, r0))
+}
+
+/// The self block of a sphere of radius `a` (at most [`Ewald::a_max`]): its Stokes
+/// mobility corrected for its periodic images (for a cubic box, Hasimoto's
+/// `(1 - 2.837297 a/L + 4 pi/3 (a/L)^3) / (6 pi eta a)`).
+pub fn self_tt<T: Real>(ew: &Ewald<T>, eta: T, a: T) -> T::M3 {
+    // No image of a sphere lies inside it (a < L/2), so the real sum is never `None`.
+    let real = real::real_sum(ew, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
+    real + wave::wave_sum(ew, eta, a, a, T::V3_ZERO)
+}
+
+/// Positions finite, radii in `(0, a_max]`.
+fn check<T: Real>(ew: &Ewald<T>, pos: &[T::V3], radius: &[T]) -> Result<(), PeriodicError> {
+    for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
+        if !T::v3_is_finite(p) {
+            return Err(PeriodicError::Particle(ParticleError::NonFinite {
+                particle: i,
+            }));
+        }
+        if !(a > T::ZERO && a <= ew.a_max) {
+            return Err(PeriodicError::Radius { particle: i });
+        }
+    }
+    Ok(())
+}
+
+/// Assembles the `n x n` periodic `mu_tt`, packed lower triangle ([`tri`]`(n)` blocks
+/// into `out`), in the layout of [`crate::mobility::assemble_tt`].
+pub fn assemble_tt<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    out: &mut [T::M3],
+) -> Result<(), PeriodicError> {
+    check(ew, pos, radius)?;
+    for i in 0..pos.len() {
+        let row = tri(i);
+        out[row + i] = self_tt(ew, eta, radius[i]);
+        for j in 0..i {
+            out[row + j] = pair_tt(ew, eta, radius[i], radius[j], pos[i] - pos[j]).ok_or(
+                PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// `y = mu_tt x` without storing `mu_tt`: the real-space blocks pair by pair (each
+/// evaluated once, used for both rows), the wave-space part through structure factors
+/// (`O(N K)` for `K` wave vectors). Agrees with [`assemble_tt`] followed by
+/// [`sym_matvec`](crate::linalg::sym_matvec) to rounding, not bit for bit.
+pub fn tt_product<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    x: &[T::V3],
+    y: &mut [T::V3],
+) -> Result<(), PeriodicError> {
+    check(ew, pos, radius)?;
+    let n = pos.len();
+    for i in 0..n {
+        let a = radius[i];
+        // The self block's real part (a < L/2: never `None`, see `self_tt`).
+        let b = real::real_sum(ew, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
+        y[i] = b * x[i];
+    }
+    for i in 0..n {
+        let mut acc = T::V3_ZERO;
+        for j in 0..i {
+            let r0 = ew.cell.minimum_image(pos[i] - pos[j]);
+            let b = real::real_sum(ew, eta, radius[i], radius[j], r0, false).ok_or(
+                PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
+            )?;
+            acc += b * x[j];
+            y[j] += T::m3_tmul(b, x[i]);
+        }
+        y[i] += acc;
+    }
+    wave::wave_product(ew, eta, pos, radius, x, y);
+    Ok(())
+}

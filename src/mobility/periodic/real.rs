@@ -1,0 +1,202 @@
+//! The real-space half of the Ewald split: the free-space RPY block of every image
+//! within the cutoff minus the smooth kernel `W` whose lattice sum the wave-space half
+//! takes over (`docs/PERIODIC.md`, eqs. W and W0).
+
+use super::Ewald;
+use crate::mobility::{Hydro, self_tt as free_self_tt};
+use crate::real::Real;
+
+/// Terms of the power series of `W` below `xi r = 1` (the last one is below `1e-22`
+/// relative there, for spheres up to the box's half width).
+const SERIES_TERMS: usize = 28;
+
+/// Coefficients `(A, B)` of `eta W(r) = A I + B e e^T`, the inverse transform of the
+/// wave-space kernel `(I - k k / k^2) / k^2 (1 + k^2 / (4 xi^2)) exp(-k^2 / (4 xi^2))
+/// (1 - k^2 a_i^2 / 6) (1 - k^2 a_j^2 / 6)` over all of `k`-space, at distance `s >= 0`.
+/// `alpha = (a_i^2 + a_j^2) / 6`, `beta = a_i^2 a_j^2 / 36`.
+///
+/// `W` is entire in `s`; its closed form (erf and a Gaussian) cancels like `1/(xi s)^3`
+/// near the origin, so below `xi s = 1` the power series in `(xi s)^2` is summed instead
+/// (alternating, largest term `O(1)`: no cancellation to speak of).
+#[inline(always)]
+pub(super) fn smooth<T: Real>(xi: T, alpha: T, beta: T, s: T) -> (T, T) {
+    let v = Scaled::new(xi, alpha, beta, s);
+    if v.x < T::ONE { series(&v) } else { closed(&v) }
+}
+
+/// The arguments of [`smooth`] and the products both its forms read.
+#[derive(Clone, Copy)]
+struct Scaled<T: Real> {
+    xi: T,
+    alpha: T,
+    s: T,
+    /// `xi s` and its square.
+    x: T,
+    x2: T,
+    /// `alpha xi^2`, `beta xi^4`: the sphere factors' dimensionless weights.
+    axi2: T,
+    bxi4: T,
+}
+
+impl<T: Real> Scaled<T> {
+    #[inline(always)]
+    fn new(xi: T, alpha: T, beta: T, s: T) -> Self {
+        let (x, xi2) = (xi * s, xi * xi);
+        Self {
+            xi,
+            alpha,
+            s,
+            x,
+            x2: x * x,
+            axi2: alpha * xi2,
+            bxi4: beta * xi2 * xi2,
+        }
+    }
+}
+
+/// [`smooth`] by its power series in `(xi s)^2`.
+#[inline(always)]
+fn series<T: Real>(v: &Scaled<T>) -> (T, T) {
+    let c = |v: f64| T::from_f64(v);
+    let Scaled {
+        xi, x2, axi2, bxi4, ..
+    } = *v;
+    {
+        // A = k0 sum_n n u_{n-1} c_n, B = -k0 sum_n (n - 1) u_{n-1} c_n with
+        // u_m = (-x^2)^m / m!, c_n = 1/(2n-1) - 2 alpha xi^2 (2n+3)/(2n+1) + 4 beta xi^4 (2n+5).
+        let (mut a, mut b, mut u) = (T::ZERO, T::ZERO, T::ONE);
+        for n in 1..=SERIES_TERMS {
+            let nf = c(n as f64);
+            let two_n = nf + nf;
+            let cn = T::ONE / (two_n - T::ONE)
+                - c(2.0) * axi2 * (two_n + c(3.0)) / (two_n + T::ONE)
+                + c(4.0) * bxi4 * (two_n + c(5.0));
+            a += nf * u * cn;
+            b += (nf - T::ONE) * u * cn;
+            u = -u * x2 / nf;
+        }
+        let k0 = xi / (T::TWO * T::PI * T::PI.sqrt());
+        (k0 * a, -(k0 * b))
+    }
+}
+
+/// [`smooth`] in closed form (accurate from `xi s` about 1 on).
+#[inline(always)]
+fn closed<T: Real>(v: &Scaled<T>) -> (T, T) {
+    let c = |v: f64| T::from_f64(v);
+    let Scaled {
+        xi,
+        alpha,
+        s,
+        x,
+        x2,
+        axi2,
+        bxi4,
+    } = *v;
+    let xi2 = xi * xi;
+    // Phi' = -p1 / (8 pi), Phi'' = -p2 / (8 pi) of the radial potential Phi with
+    // eta W = grad grad Phi - I lap Phi; A = -(Phi'' + Phi'/s), B = Phi'' - Phi'/s.
+    let cg = c(2.0) * xi / T::PI.sqrt() * (-x2).exp();
+    let erf = x.erf();
+    let inv = T::ONE / s;
+    let inv2 = inv * inv;
+    let t2p = -(c(2.0) * axi2 * s * cg);
+    let t2pp = -(c(2.0) * axi2 * (T::ONE - c(2.0) * x2) * cg);
+    let t3p = c(2.0) * alpha * (cg * inv - erf * inv2);
+    let t3pp =
+        c(2.0) * alpha * (c(2.0) * erf * inv2 * inv - c(2.0) * cg * inv2 - c(2.0) * xi2 * cg);
+    let t4p = bxi4 * s * cg * (c(28.0) - c(8.0) * x2);
+    let t4pp = bxi4 * cg * (c(28.0) - c(80.0) * x2 + c(16.0) * x2 * x2);
+    let p1 = erf + t2p + t3p + t4p;
+    let p2 = cg + t2pp + t3pp + t4pp;
+    let k = T::ONE / (c(8.0) * T::PI);
+    (k * (p2 + p1 * inv), k * (p1 * inv - p2))
+}
+
+/// The real-space sum for the pair `(i, j)` at minimum-image separation `r0` (for
+/// `same`, the self block: `r0` is zero and the image `n = 0` is the sphere itself,
+/// `1/(6 pi eta a) - W(0)`). Images in a fixed order (`n_x`, then `n_y`, then `n_z`,
+/// each ascending), every one with `|r0 + n L| <= r_cut`. `None` when an image of one
+/// sphere lies inside the other (as [`crate::mobility::pair_tt`]).
+pub(super) fn real_sum<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    ai: T,
+    aj: T,
+    r0: T::V3,
+    same: bool,
+) -> Option<T::M3> {
+    let six = T::from_f64(6.0);
+    let alpha = (ai * ai + aj * aj) / six;
+    let beta = ai * ai * aj * aj / (six * six);
+    let inv_eta = T::ONE / eta;
+    let [lx, ly, lz] = ew.cell.size();
+    let [mx, my, mz] = ew.images.map(|m| m as i32);
+    let rc2 = ew.r_cut * ew.r_cut;
+    let mut acc = T::M3_ZERO;
+    for nx in -mx..=mx {
+        for ny in -my..=my {
+            for nz in -mz..=mz {
+                let shift = T::v3(
+                    T::from_f64(nx as f64) * lx,
+                    T::from_f64(ny as f64) * ly,
+                    T::from_f64(nz as f64) * lz,
+                );
+                let rn = r0 + shift;
+                let s2 = T::norm2(rn);
+                if !(s2 <= rc2) {
+                    continue;
+                }
+                if same && nx == 0 && ny == 0 && nz == 0 {
+                    let (a0, _) = smooth(ew.xi, alpha, beta, T::ZERO);
+                    acc += T::m3_diag(free_self_tt(eta, ai) - a0 * inv_eta);
+                    continue;
+                }
+                let rpy = crate::mobility::pair_tt(Hydro::Rpy, eta, ai, aj, rn)?;
+                let (s, inv_s) = s2.root_and_inverse();
+                let e = rn * inv_s;
+                let (a, b) = smooth(ew.xi, alpha, beta, s);
+                let w = T::m3_add_diag(T::outer(e, e) * (b * inv_eta), a * inv_eta);
+                acc += rpy - w;
+            }
+        }
+    }
+    Some(acc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Scaled, closed, series, smooth};
+
+    /// The series and the closed form agree around the switch at `xi r = 1`, and far
+    /// out `W` is the far-field RPY block `(1 + q/3) I + (1 - q) e e` over `8 pi r`,
+    /// `q = (a_i^2 + a_j^2) / r^2`.
+    #[test]
+    fn series_meets_closed_form_and_far_field() {
+        for (ai, aj, xi) in [
+            (1.0f64, 1.0, 0.3),
+            (1.0, 0.3, 1.0),
+            (2.0, 0.5, 0.5),
+            (0.4, 0.4, 2.4),
+        ] {
+            let (alpha, beta) = ((ai * ai + aj * aj) / 6.0, ai * ai * aj * aj / 36.0);
+            for x in [0.8, 1.0, 1.3] {
+                let v = Scaled::new(xi, alpha, beta, x / xi);
+                let (s, c) = (series(&v), closed(&v));
+                let scale = s.0.abs().max(s.1.abs());
+                let d = (s.0 - c.0).abs().max((s.1 - c.1).abs()) / scale;
+                assert!(d < 5e-15, "a {ai} {aj} xi {xi} x {x}: {d:e}");
+            }
+            let r = 9.0 / xi;
+            let (a, b) = smooth(xi, alpha, beta, r);
+            let (q, c) = (
+                (ai * ai + aj * aj) / (r * r),
+                1.0 / (8.0 * core::f64::consts::PI * r),
+            );
+            assert!(
+                (a - c * (1.0 + q / 3.0)).abs() < 1e-15 * c
+                    && (b - c * (1.0 - q)).abs() < 1e-15 * c
+            );
+        }
+    }
+}
