@@ -43,6 +43,7 @@
 mod contact;
 mod error;
 mod helix;
+mod kernel;
 mod model;
 mod precision;
 mod raw;

@@ -210,7 +210,7 @@ impl RawScene {
             }
         }
 
-        Ok(Scene {
+        let scene = Scene {
             fluid,
             gravity,
             flow,
@@ -224,7 +224,10 @@ impl RawScene {
             brownian,
             species,
             wall,
-        })
+        };
+        let keys = super::kernel::KeySpans::of(&self, raw_int.span());
+        super::kernel::check(&scene, &keys, &body_span)?;
+        Ok(scene)
     }
 }
 
