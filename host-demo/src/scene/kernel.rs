@@ -105,10 +105,32 @@ pub(super) fn check(scene: &Scene, keys: &KeySpans, body: &BodySpans) -> Result<
         }
         Level::Manual => scene,
     };
-    let found = match scene.integrator.precision {
-        Precision::F32 => first_step::<f32>(scene),
-        Precision::F64 => first_step::<f64>(scene),
+    let f32 = scene.integrator.precision == Precision::F32;
+    let squares = |v| match f32 {
+        true => squares_finite::<f32>(v),
+        false => squares_finite::<f64>(v),
     };
+    let found = match f32 {
+        true => first_step::<f32>(scene),
+        false => first_step::<f64>(scene),
+    };
+    let precision = match scene.integrator.precision {
+        Precision::F32 => "f32",
+        Precision::F64 => "f64",
+    };
+    // Finite components whose squared length overflows: the step and the observables
+    // square them (a speed along gravity is `v . g / |g|`).
+    let vectors = [
+        ("gravity", scene.gravity),
+        ("flow_velocity", scene.flow.velocity),
+        ("vorticity", scene.flow.vorticity),
+    ];
+    if let Some((name, v)) = vectors.into_iter().find(|(_, v)| !squares(*v)) {
+        return Err(issue(
+            keys.named(name),
+            format!("{name} {v:?}: its squared length overflows {precision}"),
+        ));
+    }
     let Err(e) = found else {
         return Ok(());
     };
@@ -134,10 +156,6 @@ pub(super) fn check(scene: &Scene, keys: &KeySpans, body: &BodySpans) -> Result<
         StepError::BadParameter(name) | StepError::Unsupported(name) => keys.named(name),
         _ => keys.fallback.clone(),
     };
-    let precision = match scene.integrator.precision {
-        Precision::F32 => "f32",
-        Precision::F64 => "f64",
-    };
     Err(issue(
         span,
         format!("{e} in {precision} (the first step would refuse it)"),
@@ -161,4 +179,10 @@ fn first_step<T: Real>(scene: &Scene) -> Result<(), StepError> {
         hydrorattle::forces::springs(&bonds, p.spring_stiffness, p.fene, state.pos, &mut force)?;
     }
     Ok(())
+}
+
+/// `|v|^2` is finite in precision `T`.
+fn squares_finite<T: Real>(v: [f64; 3]) -> bool {
+    let w = T::v3_from(v);
+    T::dot(w, w).is_finite()
 }

@@ -355,8 +355,16 @@ fn resolve_integrator(r: &RawIntegrator) -> Result<Integrator, Issue> {
         Some(m) if *m.get_ref() == 0 => {
             return Err(issue(m.span(), "max_iterations must be >= 1"));
         }
-        // The kernel counts iterations in 32 bits.
-        Some(m) => (*m.get_ref()).min(u32::MAX as usize),
+        Some(m) if *m.get_ref() > super::MAX_ITERATIONS => {
+            return Err(issue(
+                m.span(),
+                format!(
+                    "max_iterations must be at most {} (it bounds one step's constraint work)",
+                    super::MAX_ITERATIONS
+                ),
+            ));
+        }
+        Some(m) => *m.get_ref(),
     };
     Ok(Integrator {
         method: r.method,
