@@ -145,7 +145,9 @@ fn corpus() -> Vec<String> {
 }
 
 /// The features the accepted cases must cover, and whether scene `s` has each.
-const FEATURES: [(&str, fn(&Scene) -> bool); 9] = [
+type Feature = (&'static str, fn(&Scene) -> bool);
+
+const FEATURES: [Feature; 9] = [
     ("wall", |s| s.wall.is_some()),
     ("noise by Cholesky", |s| noise(s, Sqrt::Cholesky)),
     ("noise by Lanczos", |s| noise(s, Sqrt::Lanczos)),
