@@ -43,7 +43,7 @@ pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
 pub use forces::{ExternalForce, NoForce, SoftContact};
 /// The vector crate the kernel is written against (re-exported so callers match versions).
 pub use glam;
-pub use integrate::{StepReport, step, step_slices};
+pub use integrate::{StepReport, check_step, step, step_slices};
 pub use mobility::Hydro;
 pub use noise::Noise;
 pub use noise::lanczos::{Lanczos, LanczosError};

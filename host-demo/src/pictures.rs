@@ -79,9 +79,17 @@ pub fn draw_run(dir: &Path, r: &RunResult, initial: bool) -> Result<()> {
         scene.bonds.len()
     );
     let name = &r.summary.scene;
+    // A picture that cannot be drawn is skipped with a message: the run's data stand.
     let draw = |file: &str, snap, when: &str| {
         let title = format!("{name}: {when} configuration ({what})");
-        draw_configuration(&dir.join(file), snap, &colors, &title, (900, 500))
+        let path = dir.join(file);
+        if let Err(e) = draw_configuration(&path, snap, &colors, &title, (900, 500)) {
+            match e.downcast_ref::<crate::render::Undrawable>() {
+                Some(why) => log::warn!("{}: not drawn: {why}", path.display()),
+                None => return Err(e),
+            }
+        }
+        Ok(())
     };
     let (a, b) = rayon::join(
         || match initial {

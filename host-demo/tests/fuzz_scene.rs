@@ -1,5 +1,7 @@
-//! Fuzzing the scene parser with a fixed seed: mutated copies of every shipped scene and
-//! every bad scene (lines deleted, duplicated, swapped or cut; numbers replaced by
+//! Fuzzing the scene parser with a fixed seed: mutated copies of every shipped scene,
+//! every bad scene and the seeds of `tests/data/fuzz` (which cover every table: the
+//! wall, Brownian noise by Cholesky and by Lanczos, FENE, rest length 0, matrix-free,
+//! rotation, hard contacts, f32; each must be among the accepted cases) (lines deleted, duplicated, swapped or cut; numbers replaced by
 //! hostile ones; keys, tables and bytes, invalid UTF-8 included, inserted). Every case
 //! must return without a panic; a refusal must name the origin and a line inside the
 //! text, in one line; an accepted scene must hold its invariants and write itself
@@ -10,7 +12,7 @@
 
 use std::path::PathBuf;
 
-use host_demo::scene::{Level, Scene};
+use host_demo::scene::{Level, Precision, Scene, Sqrt};
 use host_demo::sizing::Limits;
 
 #[path = "../../tests/common/fuzz.rs"]
@@ -56,7 +58,13 @@ const NUMBERS: [&str; 24] = [
     "true",
 ];
 
-const SNIPPETS: [&str; 16] = [
+const SNIPPETS: [&str; 22] = [
+    "[wall]\nheight = -5\n",
+    "sqrt = \"lanczos\"\n",
+    "sqrt = \"cholesky\"\n",
+    "fene = 4.0\n",
+    "matrix_free = true\n",
+    "rotation = true\n",
     "[helix]\ntails = 3\n",
     "[[particle]]\nposition = [0, 0, 0]\nradius = 1\n",
     "[[particle]]\nposition = [0.5, 0, 0]\nradius = 1\nvelocity = [1, 0, 0]\n",
@@ -124,7 +132,7 @@ fn mutate(rng: &mut Rng, text: &str) -> Vec<u8> {
 fn corpus() -> Vec<String> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let mut texts = Vec::new();
-    for dir in ["scenes", "tests/data/bad"] {
+    for dir in ["scenes", "tests/data/bad", "tests/data/fuzz"] {
         let mut files: Vec<PathBuf> = std::fs::read_dir(root.join(dir))
             .unwrap()
             .map(|e| e.unwrap().path())
@@ -136,8 +144,28 @@ fn corpus() -> Vec<String> {
     texts
 }
 
-/// Checks one case; `Err` describes a broken promise. `Ok(true)` when accepted.
-fn case(bytes: &[u8], limits: Limits) -> Result<bool, String> {
+/// The features the accepted cases must cover, and whether scene `s` has each.
+type Feature = (&'static str, fn(&Scene) -> bool);
+
+const FEATURES: [Feature; 9] = [
+    ("wall", |s| s.wall.is_some()),
+    ("noise by Cholesky", |s| noise(s, Sqrt::Cholesky)),
+    ("noise by Lanczos", |s| noise(s, Sqrt::Lanczos)),
+    ("FENE", |s| s.integrator.fene.is_some()),
+    ("rest length 0", |s| s.bonds.iter().any(|b| b.length == 0.0)),
+    ("matrix-free", |s| s.integrator.matrix_free),
+    ("rotation", |s| s.model.rotation),
+    ("contacts", |s| s.contact.is_some()),
+    ("f32", |s| s.integrator.precision == Precision::F32),
+];
+
+fn noise(s: &Scene, sqrt: Sqrt) -> bool {
+    s.brownian
+        .is_some_and(|b| b.temperature > 0.0 && b.sqrt == sqrt)
+}
+
+/// Checks one case; `Err` describes a broken promise. `Ok(Some(scene))` when accepted.
+fn case(bytes: &[u8], limits: Limits) -> Result<Option<Scene>, String> {
     let lines = bytes.split(|&b| b == b'\n').count();
     match Scene::parse_bytes(bytes, "fuzz.toml", limits) {
         Err(e) => {
@@ -149,7 +177,7 @@ fn case(bytes: &[u8], limits: Limits) -> Result<bool, String> {
                 Some(l) if l == 0 || l > lines + 1 => {
                     Err(format!("line {l} outside the {lines} lines: {shown}"))
                 }
-                _ => Ok(false),
+                _ => Ok(None),
             }
         }
         Ok(s) => {
@@ -173,11 +201,12 @@ fn case(bytes: &[u8], limits: Limits) -> Result<bool, String> {
             if !ok {
                 return Err("accepted a scene that breaks an invariant".into());
             }
-            let mut want = s.clone();
+            // As a run writes its scene.toml: the level's choice applied, then manual.
+            let (mut want, _) = host_demo::sim::resolve_level(&s, "fuzz");
             want.model.level = Level::Manual;
             let text = want.to_toml();
             match Scene::parse_limited(&text, "written.toml", limits) {
-                Ok(back) if back == want => Ok(true),
+                Ok(back) if back == want => Ok(Some(s)),
                 Ok(_) => Err(format!("to_toml does not read back the same:\n{text}")),
                 Err(e) => Err(format!("to_toml writes a refused file: {e}\n{text}")),
             }
@@ -195,18 +224,38 @@ fn the_parser_survives_mutated_scenes() {
         output: 1 << 30,
     };
     let (mut accepted, mut failures) = (0u64, Vec::new());
+    let mut covered = [0u64; FEATURES.len()];
     for k in 0..cases {
         let mut rng = Rng::case(seed, k);
         let text = &texts[rng.below(texts.len())];
         let bytes = mutate(&mut rng, text);
         match std::panic::catch_unwind(|| case(&bytes, limits)) {
-            Ok(Ok(true)) => accepted += 1,
-            Ok(Ok(false)) => {}
+            Ok(Ok(Some(s))) => {
+                accepted += 1;
+                for (c, (_, has)) in covered.iter_mut().zip(FEATURES) {
+                    *c += u64::from(has(&s));
+                }
+            }
+            Ok(Ok(None)) => {}
             Ok(Err(m)) => failures.push(format!("case {k}: {m}")),
             Err(_) => failures.push(format!(
                 "case {k}: panicked on {:?}",
                 String::from_utf8_lossy(&bytes)
             )),
+        }
+    }
+    let tally: Vec<String> = FEATURES
+        .iter()
+        .zip(covered)
+        .map(|((f, _), c)| format!("{f} {c}"))
+        .collect();
+    eprintln!("fuzz_scene: accepted cases with {}", tally.join(", "));
+    // A short run (`FUZZ_CASES`) may miss some; the default run must not.
+    if cases >= 10_000 {
+        for ((f, _), c) in FEATURES.iter().zip(covered) {
+            if c == 0 {
+                failures.push(format!("no accepted case has {f}"));
+            }
         }
     }
     let name = format!("fuzz_scene ({} files)", texts.len());

@@ -219,3 +219,30 @@ fn a_wall_scene_s_pictures_draw_the_wall() {
     assert!(draw(&r.last, "with.png") != draw(&without, "without.png"));
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// A sphere at 1e16 (issue 33, 3): its spread is lost in the rounding of its
+/// coordinates, so its pictures are skipped with a message, promptly, and the run's
+/// data stand (it used to hang while drawing).
+#[test]
+fn a_sphere_far_from_the_origin_is_skipped_not_drawn_forever() {
+    let dir = scratch("far-sphere");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("far.toml");
+    let text = "[[particle]]\nposition = [1e16, 1e16, 1e16]\nradius = 1.0\n\n\
+                [integrator]\nmethod = \"overdamped\"\ndt = 0.01\nduration = 0.1\n";
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.join("out");
+    let t = std::time::Instant::now();
+    let o = cli(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(t.elapsed() < std::time::Duration::from_secs(10));
+    assert!(err.contains("not drawn"), "{err}");
+    assert!(out.join("summary.json").exists() && out.join("observables.csv").exists());
+    assert!(!out.join("final.png").exists());
+}

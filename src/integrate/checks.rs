@@ -93,12 +93,33 @@ pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result
     }
 }
 
-/// The first sphere whose centre is below `height + a_i (1 - 2 tol)`.
+/// The first sphere whose centre is below `height + a_i (1 - 2 tol)`, less the
+/// rounding of the numbers compared (4 epsilons of `|z| + |height| + a_i`): far from
+/// the origin a sphere put or held at contact is off by an ulp of its coordinates,
+/// which can exceed `2 tol a_i`.
 fn below_wall<T: Real>(pos: &[T::V3], radius: &[T], height: T, tol: T) -> Option<usize> {
     let reach = T::ONE - tol * T::TWO;
-    pos.iter()
-        .zip(radius)
-        .position(|(&r, &a)| !(T::xyz(r)[2] - height >= a * reach))
+    let ulps = T::EPSILON * T::from_f64(4.0);
+    pos.iter().zip(radius).position(|(&r, &a)| {
+        let z = T::xyz(r)[2];
+        let rounding = (z.abs() + height.abs() + a) * ulps;
+        !(z - height + rounding >= a * reach)
+    })
+}
+
+/// Stage 1 of a step: every check of its inputs, in order; the thermal settings when
+/// the step has noise.
+pub(super) fn check_all<T: Real>(
+    state: &State<'_, T>,
+    bonds: &[Bond<T>],
+    p: &Params<T>,
+    has_generator: bool,
+) -> Result<Option<crate::params::Brownian<T>>, StepError> {
+    check_inputs(state, bonds, p)?;
+    let thermal = check_thermal(p, has_generator)?;
+    check_contacts(p, thermal.is_some())?;
+    check_wall(p, state)?;
+    Ok(thermal)
 }
 
 /// Refuses contacts where they are not implemented.

@@ -27,7 +27,7 @@ use springs::springs;
 use stable::rattle_stable;
 use stages::*;
 
-use checks::{accept, check_contacts, check_inputs, check_thermal, check_wall};
+use checks::{accept, check_all};
 use contacts::{Projection, project_overdamped};
 
 use crate::bonds::{Bond, BondSet, max_residual};
@@ -115,6 +115,19 @@ pub fn step_slices<T: Real, E: ExternalForce<T>>(
     advance(state, bonds, p, ws, ext)
 }
 
+/// Stage 1 of [`step_slices`] alone: the checks a step makes of its inputs before it
+/// touches anything (parameters, particles, bonds, thermal noise, contacts, wall), with
+/// no integration. A driver asks it before it creates any output, so that an input the
+/// step would refuse is refused with the same predicate up front. `state.noise` stands
+/// for the generator a thermal step needs.
+pub fn check_step<T: Real>(
+    state: &State<'_, T>,
+    bonds: &[Bond<T>],
+    p: &Params<T>,
+) -> Result<(), StepError> {
+    check_all(state, bonds, p, state.noise.is_some()).map(|_| ())
+}
+
 /// The stages of every step; the state's generator feeds a thermal step.
 fn advance<T: Real, E: ExternalForce<T>>(
     mut state: State<'_, T>,
@@ -126,12 +139,9 @@ fn advance<T: Real, E: ExternalForce<T>>(
     let n = state.len();
     let noise = state.noise.take();
     // 1. Inputs and storage.
-    check_inputs(&state, bonds, p)?;
-    let thermal = check_thermal(p, noise.is_some())?;
     // `p` stays the caller's reference: a firmware's `static` must stay visible to the
     // compiler, which then links only the method it runs.
-    check_contacts(p, thermal.is_some())?;
-    check_wall(p, &state)?;
+    let thermal = check_all(&state, bonds, p, noise.is_some())?;
     // The solver, resolved once from every row the step may solve, as the storage was
     // sized ([`Params::solver_kind`]): no stage re-resolves `Auto` from the rows it
     // holds in one round. A concrete kind (firmware's) keeps `p` the caller's reference.

@@ -101,6 +101,38 @@ pub fn fit_scale(items: &[(&Snapshot, View)], size: (u32, u32)) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Refuses a panel whose spheres cannot be placed to a pixel at `scale`: coordinates
+/// so far from the origin, for the spheres' spread, that their rounding (an epsilon of
+/// the largest) is over half a pixel, or a scale that is not a positive number. Such a
+/// picture would be wrong, and drawing it at the scale its rounding implies unbounded.
+pub fn drawable(b: (f64, f64, f64, f64), scale: f64) -> Result<()> {
+    let reach = [b.0, b.1, b.2, b.3]
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let rounding = reach * f64::EPSILON * scale;
+    if scale.is_finite() && scale > 0.0 && rounding <= 0.5 {
+        return Ok(());
+    }
+    Err(Undrawable(format!(
+        "the spheres cannot be drawn to scale: coordinates up to {reach:e} for a spread of {:e} \
+         (their rounding is {rounding:e} pixels)",
+        (b.2 - b.0).max(b.3 - b.1)
+    ))
+    .into())
+}
+
+/// Why a picture was not drawn ([`drawable`]): its caller may skip it.
+#[derive(Debug)]
+pub struct Undrawable(pub String);
+
+impl std::fmt::Display for Undrawable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Undrawable {}
+
 /// Spheres beyond this many are drawn without outlines (a big scene stays fast and
 /// readable).
 pub const OUTLINE_MAX: usize = 2000;
@@ -137,6 +169,7 @@ pub fn draw_panel<DB: DrawingBackend>(
     .map_err(drawing)?;
 
     let b = extent(snapshot, view);
+    drawable(b, scale)?;
     let (uc, vc) = (0.5 * (b.0 + b.2), 0.5 * (b.1 + b.3));
     let (xc, yc) = (0.5 * w, PANEL_TITLE + 0.5 * (h - PANEL_TITLE - PANEL_FOOT));
     if let Some(z) = wall_in_view(snapshot, view) {
@@ -163,7 +196,9 @@ pub fn draw_panel<DB: DrawingBackend>(
         let centre = (px(k, xc + (u - uc) * scale), px(k, yc - (v - vc) * scale));
         // A dark disc with the coloured disc one output pixel smaller on top: the
         // outline, with no gap between fill and outline.
-        let r = (snapshot.radii[i] * scale).max(1.5) * k;
+        // No disc larger than the panel's perimeter is needed to cover it: the work of
+        // one disc stays bounded whatever the scale.
+        let r = (snapshot.radii[i] * scale).clamp(1.5, 2.0 * (w + h)) * k;
         let color = colors.get(i).copied().unwrap_or(TAIL_COLOR);
         if outline {
             area.draw(&Circle::new(centre, r, OUTLINE_COLOR.filled()))

@@ -43,6 +43,7 @@
 mod contact;
 mod error;
 mod helix;
+mod kernel;
 mod model;
 mod precision;
 mod raw;
@@ -91,6 +92,12 @@ pub const DEFAULT_HELIX_RADIUS: f64 = 2.0;
 /// about the head in top view instead of stacking in a few columns, as in the
 /// paper's Figure 1.
 pub const DEFAULT_HELIX_PITCH: f64 = 7.0;
+/// Largest `max_iterations`: it bounds the constraint work of one step (a Newton
+/// iteration is a factorisation of the bonds' Jacobian, a sweep a pass over the bonds).
+/// 10 000 is 20 times the default 500, more than a converging solve takes; past it a
+/// tolerance the solve cannot reach (`tolerance = 1e-16`) would hold one step for
+/// hours instead of ending it with a convergence failure.
+pub const MAX_ITERATIONS: usize = 10_000;
 /// Number of trajectory frames aimed at when `[output] every` is not given.
 pub const TARGET_FRAMES: usize = 200;
 

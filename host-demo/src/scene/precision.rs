@@ -17,8 +17,8 @@ pub(super) fn check(
     spans: &BodySpans,
 ) -> Result<(), Issue> {
     match precision {
-        Precision::F32 => check_t::<f32>(particles, bonds, spans, "f32"),
-        Precision::F64 => check_t::<f64>(particles, bonds, spans, "f64"),
+        Precision::F32 => check_t::<f32>(particles, bonds, spans, "f32", f32::MIN_POSITIVE.into()),
+        Precision::F64 => check_t::<f64>(particles, bonds, spans, "f64", f64::MIN_POSITIVE),
     }
 }
 
@@ -27,6 +27,7 @@ fn check_t<T: Real>(
     bonds: &[Bond],
     spans: &BodySpans,
     name: &str,
+    min_normal: f64,
 ) -> Result<(), Issue> {
     for (k, p) in particles.iter().enumerate() {
         let mut kp = hydrorattle::Particle::new(
@@ -52,11 +53,14 @@ fn check_t<T: Real>(
             j: 1,
             length: T::from_f64(b.length),
         };
-        if hydrorattle::bonds::validate(&[kb], 2).is_err() {
+        // A rest length whose square is subnormal or zero has no relative error to
+        // measure (the residual divides by it): zero (a spring's) or normal only.
+        let tiny = kb.length > T::ZERO && (kb.length * kb.length).to_f64() < min_normal;
+        if tiny || hydrorattle::bonds::validate(&[kb], 2).is_err() {
             return Err(issue(
                 spans.bond(l),
                 format!(
-                    "bond {l} between [{}, {}]: length {} is not usable in {name} (it must be >= 0 and its square finite)",
+                    "bond {l} between [{}, {}]: length {} is not usable in {name} (it must be 0 or > 0 with a normal, finite square)",
                     b.i,
                     b.j,
                     crate::output::format_f64(b.length)

@@ -210,7 +210,7 @@ impl RawScene {
             }
         }
 
-        Ok(Scene {
+        let scene = Scene {
             fluid,
             gravity,
             flow,
@@ -224,7 +224,10 @@ impl RawScene {
             brownian,
             species,
             wall,
-        })
+        };
+        let keys = super::kernel::KeySpans::of(&self, raw_int.span());
+        super::kernel::check(&scene, &keys, &body_span)?;
+        Ok(scene)
     }
 }
 
@@ -352,8 +355,16 @@ fn resolve_integrator(r: &RawIntegrator) -> Result<Integrator, Issue> {
         Some(m) if *m.get_ref() == 0 => {
             return Err(issue(m.span(), "max_iterations must be >= 1"));
         }
-        // The kernel counts iterations in 32 bits.
-        Some(m) => (*m.get_ref()).min(u32::MAX as usize),
+        Some(m) if *m.get_ref() > super::MAX_ITERATIONS => {
+            return Err(issue(
+                m.span(),
+                format!(
+                    "max_iterations must be at most {} (it bounds one step's constraint work)",
+                    super::MAX_ITERATIONS
+                ),
+            ));
+        }
+        Some(m) => *m.get_ref(),
     };
     Ok(Integrator {
         method: r.method,

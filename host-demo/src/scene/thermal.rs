@@ -76,10 +76,23 @@ pub(super) struct RawBrownian {
     temperature: S<f64>,
     seed: Option<Spanned<i64>>,
     drift: Option<Drift>,
-    sqrt: Option<Sqrt>,
+    sqrt: Option<Spanned<Sqrt>>,
 }
 
 impl RawBrownian {
+    /// Where `sqrt` is written, or else `temperature`.
+    pub(super) fn sqrt_span(&self) -> Option<std::ops::Range<usize>> {
+        self.sqrt
+            .as_ref()
+            .map(|s| s.span())
+            .or_else(|| self.temperature_span())
+    }
+
+    /// Where `temperature` is written.
+    pub(super) fn temperature_span(&self) -> Option<std::ops::Range<usize>> {
+        self.temperature.as_ref().map(|t| t.span())
+    }
+
     /// Checks the keys; a positive temperature needs the overdamped, spring or
     /// rattle-stable method chosen by hand (the kernel has noise for those methods
     /// only).
@@ -108,7 +121,10 @@ impl RawBrownian {
             temperature,
             seed,
             drift: self.drift.unwrap_or_default(),
-            sqrt: self.sqrt.unwrap_or_default(),
+            sqrt: self
+                .sqrt
+                .as_ref()
+                .map_or_else(Sqrt::default, |s| *s.get_ref()),
         })
     }
 

@@ -215,8 +215,9 @@ impl Observables {
         }
     }
 
-    fn row(&self) -> Vec<String> {
-        let numbers = [
+    /// The numeric columns before the wall's, in [`COLUMNS`] order.
+    fn numbers(&self) -> [f64; NUMBERS] {
+        [
             self.time,
             self.extension,
             self.verticality,
@@ -237,8 +238,19 @@ impl Observables {
             self.horizontal_extent,
             self.vertical_extent,
             self.com_speed,
-        ];
-        let mut row: Vec<String> = numbers.iter().map(|&x| format_f64(x)).collect();
+        ]
+    }
+
+    /// The first column that is NaN or infinite, and its value: an observable the
+    /// run's precision could not compute (squares of coordinates past its range).
+    pub fn non_finite(&self) -> Option<(&'static str, f64)> {
+        let wall = [self.wall_height, self.wall_gap].into_iter().flatten();
+        let named = COLUMNS.iter().zip(self.numbers().into_iter().chain(wall));
+        named.map(|(c, x)| (*c, x)).find(|(_, x)| !x.is_finite())
+    }
+
+    fn row(&self) -> Vec<String> {
+        let mut row: Vec<String> = self.numbers().iter().map(|&x| format_f64(x)).collect();
         let or_empty = |x: Option<f64>| x.map_or(String::new(), format_f64);
         row.push(or_empty(self.wall_height));
         row.push(or_empty(self.wall_gap));

@@ -247,6 +247,17 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
                 Ok(rep) => {
                     done = s;
                     self.after_step(s, engine, &rep)?;
+                    // A row the precision could not compute ends the run as a failed
+                    // step does: its rows so far are kept, and the run exits non-zero.
+                    if let Some((column, x)) = self.last.non_finite() {
+                        let t = engine.beads.time.to_f64();
+                        let message = format!(
+                            "step {s} (t = {t}): observable {column} is {x}: the state is beyond what the run's precision can measure"
+                        );
+                        log::warn!("{name}: {message}");
+                        failure = Some(message);
+                        break;
+                    }
                 }
                 Err(e) => {
                     let t = engine.beads.time;
