@@ -5,8 +5,13 @@
 //! `f32` values widen exactly), so a resumed run continues bit for bit. The files of
 //! the run are cut back to the marks the checkpoint names and continued: a run to `T`
 //! resumed to `2 T` writes the same bytes as one run to `2 T`.
+//!
+//! A run can be killed at any moment (SIGKILL included) and resumed from its last
+//! checkpoint: [`ready_folder`] writes `scene.toml` before the first step, and every
+//! file is written aside and renamed, so the folder never holds half a checkpoint.
 
-use std::path::Path;
+use std::fmt;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use hydrorattle::Real;
@@ -14,8 +19,9 @@ use serde::{Deserialize, Serialize};
 
 use super::beads::Beads;
 use super::record::{Marks, Observables};
-use crate::output::write_json;
-use crate::scene::Precision;
+use super::{SCENE_TOML, SUMMARY_JSON};
+use crate::output::{tmp_path, write_atomic, write_json};
+use crate::scene::{Precision, Scene};
 
 /// The checkpoint file's name in the output folder.
 pub const CHECKPOINT: &str = "checkpoint.json";
@@ -165,11 +171,13 @@ impl Checkpoint {
         Ok(write_json(&dir.join(CHECKPOINT), self)?)
     }
 
-    /// Reads `DIR/checkpoint.json`.
+    /// Reads `DIR/checkpoint.json`; [`NoCheckpoint`] when there is none.
     pub fn load(dir: &Path) -> Result<Self> {
         let path = dir.join(CHECKPOINT);
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("reading {}", path.display()))?;
+        let text = match std::fs::read_to_string(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(NoCheckpoint { path }),
+            read => read.with_context(|| format!("reading {}", path.display()))?,
+        };
         let c: Checkpoint = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a checkpoint", path.display()))?;
         if c.version != VERSION {
@@ -181,4 +189,53 @@ impl Checkpoint {
         }
         Ok(c)
     }
+}
+
+/// `resume` of a folder without `checkpoint.json`: a run killed before its first
+/// checkpoint, or one run without `--checkpoint-every`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NoCheckpoint {
+    /// The checkpoint's path.
+    pub path: PathBuf,
+}
+
+impl fmt::Display for NoCheckpoint {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}: no checkpoint to resume from (the run stopped before its first one, or ran \
+             without --checkpoint-every); run its scene.toml again",
+            self.path.display()
+        )
+    }
+}
+
+impl std::error::Error for NoCheckpoint {}
+
+/// Readies the output folder `dir` for a run of `scene` (its level applied) that can be
+/// killed at any moment and resumed: the `checkpoint.json.tmp` of a run killed while
+/// saving goes (never read, it would otherwise outlive the run). A run from the start
+/// (`fresh`) writes `scene.toml` before its first step, as `resume` reads it, and
+/// removes the checkpoint and summary a previous run left in the folder: beside the new
+/// `scene.toml` they would describe another run, and resuming from that checkpoint would
+/// mix the two. A resumed run keeps `scene.toml` until it ends, so that a resume that
+/// fails leaves the folder as it was.
+pub(super) fn ready_folder(dir: &Path, scene: &Scene, fresh: bool) -> Result<()> {
+    let checkpoint = dir.join(CHECKPOINT);
+    let mut stale = vec![tmp_path(&checkpoint)];
+    if fresh {
+        stale.extend([checkpoint, dir.join(SUMMARY_JSON)]);
+    }
+    for path in stale {
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(crate::output::name_error(&path, e).into());
+            }
+            _ => {}
+        }
+    }
+    if fresh {
+        write_atomic(&dir.join(SCENE_TOML), scene.to_toml().as_bytes())?;
+    }
+    Ok(())
 }

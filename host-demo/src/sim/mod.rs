@@ -30,7 +30,7 @@ mod run_loop;
 mod tail;
 
 pub use beads::{Beads, BuildError, bonds};
-pub use checkpoint::{CHECKPOINT, Checkpoint};
+pub use checkpoint::{CHECKPOINT, Checkpoint, NoCheckpoint};
 pub use columns::{ColumnsMismatch, check_columns};
 pub use engine::{Engine, Extra};
 pub use frames::{KeepFrames, MAX_FRAME_BEADS, MAX_FRAMES, step_at_or_after};
@@ -343,9 +343,11 @@ pub fn scene_name(path: &Path) -> String {
 
 /// Continues the run whose files are in `dir` from its checkpoint to simulated time
 /// `until`, under `limits`: the files are cut back to the checkpoint and continued, the
-/// summary and `scene.toml` rewritten (with the new duration). A run whose
-/// `observables.csv` has other columns than this program's (another version's) is
-/// refused with a [`ColumnsMismatch`] before anything is written.
+/// summary and `scene.toml` rewritten (with the new duration). The scene to `until` is
+/// read under `limits` as `run` reads a scene file (storage, output size, step count).
+/// A folder without a checkpoint is refused with a [`NoCheckpoint`], and a run whose
+/// `observables.csv` has other columns than this program's (another version's) with a
+/// [`ColumnsMismatch`], both before anything is written.
 pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Result<RunResult> {
     let checkpoint = Checkpoint::load(dir)?;
     let rows = dir.join(OBSERVABLES_CSV);
@@ -354,7 +356,12 @@ pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Resul
         checkpoint.marks.csv_bytes,
     ))?;
     let scene_path = dir.join(SCENE_TOML);
-    let mut scene = Scene::from_path_limited(&scene_path, limits)?;
+    // The output limit is the resumed run's, checked below at its own duration.
+    let unlimited = Limits {
+        output: u64::MAX,
+        ..limits
+    };
+    let mut scene = Scene::from_path_limited(&scene_path, unlimited)?;
     let at = checkpoint.time();
     let dt = scene.integrator.dt;
     if !(until.is_finite() && until > at) {
@@ -368,6 +375,11 @@ pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Resul
         );
     }
     scene.integrator.duration = until;
+    // The scene as `run` would read it (the same checks, by the same reader): the text
+    // is `scene.toml`'s own, as this program writes it, with the new duration.
+    let origin = scene_path.display().to_string();
+    let scene = Scene::parse_limited(&scene.to_toml(), &origin, limits)
+        .with_context(|| format!("resuming to --until {until}"))?;
     if scene.integrator.steps() as u64 <= checkpoint.step {
         bail!("--until {until} is not a whole step (dt = {dt}) after the checkpoint's t = {at}");
     }

@@ -7,7 +7,8 @@
 //! 3. [`Tracks::steps`]: the time loop, a step and what follows it (trackers, frames,
 //!    checkpoints);
 //! 4. [`Tracks::close`]: the closing row, the summary, the files under their final names
-//!    with `scene.toml` and `summary.json`.
+//!    with `summary.json` (and a resumed run's `scene.toml`; a run from the start writes
+//!    it before its first step, so that it can be resumed however it stops).
 
 use std::path::Path;
 use std::time::Instant;
@@ -16,7 +17,7 @@ use anyhow::{Result, bail};
 use hydrorattle::observables::{StateThresholds, Twist, VerticalFront};
 use hydrorattle::{Real, StepReport};
 
-use super::checkpoint::Checkpoint;
+use super::checkpoint::{Checkpoint, ready_folder};
 use super::engine::Engine;
 use super::frames::Keeper;
 use super::record::{NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, WallGauge, each_row};
@@ -62,6 +63,7 @@ pub(super) fn run_t<T: Real>(
     }
     if let Some(dir) = out {
         std::fs::create_dir_all(dir).map_err(|e| crate::output::name_error(dir, e))?;
+        ready_folder(dir, scene, origin.checkpoint.is_none())?;
     }
     let mut twist_prev = vec![T::ZERO; engine.beads.len()];
     let mut front_times = vec![-T::ONE; engine.bonds.len()];
@@ -378,8 +380,12 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         summary.resolved_scene.model.level = Level::Manual;
         self.rec.commit()?;
         if let Some(dir) = self.out {
-            let resolved = &summary.resolved_scene;
-            write_atomic(&dir.join(SCENE_TOML), resolved.to_toml().as_bytes())?;
+            // A resumed run's duration is new; a run from the start wrote its scene
+            // before the first step.
+            if origin.checkpoint.is_some() {
+                let resolved = &summary.resolved_scene;
+                write_atomic(&dir.join(SCENE_TOML), resolved.to_toml().as_bytes())?;
+            }
             write_json(&dir.join(SUMMARY_JSON), &summary)?;
         }
         let (mut frames, mut at) = self.keeper.finish(done, beads);
