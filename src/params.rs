@@ -26,7 +26,7 @@ pub enum Method {
 }
 
 /// How the Brownian step produces the drift that constrained Brownian motion needs
-/// (see the README, "Brownian dynamics").
+/// (see `docs/BROWNIAN.md`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Drift {
     /// Fixman-type midpoint: the noise is applied through the constrained mobility

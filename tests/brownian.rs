@@ -7,7 +7,7 @@
 //! every run the same; the tolerances are several standard errors wide so that a
 //! different seed would pass too.
 //!
-//! Exact values used (derived in the README, "Brownian dynamics"):
+//! Exact values used (derived in docs/BROWNIAN.md):
 //! * lone sphere: `D = kT / (6 pi eta a)`;
 //! * two free spheres: `<dx_1 dx_2^T> = 2 kT dt mu_12` with the far-field RPY pair block
 //!   `mu_12 = [(1 + (a1^2 + a2^2) / 3s^2) I + (1 - (a1^2 + a2^2) / s^2) e e] / (8 pi eta s)`;

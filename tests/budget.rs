@@ -1,6 +1,6 @@
 //! Storage budgets (issue 8): the paper's chain (N = 25, B = 24) in f32, particles +
 //! bonds + workspace, measured with `size_of` and the method's [`Layout`]. The table
-//! for f32 and f64 prints with `--nocapture` and is copied into the README.
+//! for f32 and f64 prints with `--nocapture` and is copied into docs/STORAGE.md.
 //!
 //! Also: a workspace of exactly the layout's size works for every method, rotation
 //! flag and solver; one element short of any count is a typed error that leaves the

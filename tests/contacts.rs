@@ -1,5 +1,5 @@
 //! Hard-sphere contacts as one-sided constraints (`Params::contacts`), checked against
-//! closed forms built from the RPY pair formulas of DESIGN.md 2.1 (not from the kernel):
+//! closed forms built from the RPY pair formulas of docs/MODEL.md#mobility (not from the kernel):
 //!
 //! * two touching spheres, the upper one heavier, pushed along their line of centres:
 //!   the contact force is half the difference of the weights, and the pair settles as

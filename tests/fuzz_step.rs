@@ -10,7 +10,7 @@
 //! accepted one must leave it finite with the time advanced.
 //!
 //! 100 000 cases per precision by default (`FUZZ_CASES`, `FUZZ_SEED` to change; a longer run is
-//! documented in the README).
+//! documented in docs/VALIDATION.md).
 
 mod common;
 

@@ -1,7 +1,7 @@
 //! Validation of the mobility assembly, the linear algebra and the input checks.
 //!
 //! Every expected value is a closed form written out here (Stokes' law, the RPY
-//! two-sphere settling speeds, the far-field formulas of DESIGN.md section 2.1, the
+//! two-sphere settling speeds, the far-field formulas of docs/MODEL.md#far-branch, the
 //! classical equal-sphere overlapping forms, rigid-body limits) or a direct check such
 //! as `A x = b`; nothing is computed by the code under test and then compared with
 //! itself. One generic body per check, instantiated for `f32` and `f64` by
@@ -308,10 +308,10 @@ fn rotation(axis: [f64; 3], angle: f64) -> M {
 }
 
 // ---------------------------------------------------------------------------------
-// Closed forms, written out from DESIGN.md section 2.1 and the classical RPY papers.
+// Closed forms, written out from docs/MODEL.md#far-branch and the classical RPY papers.
 // ---------------------------------------------------------------------------------
 
-/// Far-field (`s > a_i + a_j`) polydisperse RPY blocks of DESIGN.md: `(tt, rr, rt_ij)`
+/// Far-field (`s > a_i + a_j`) polydisperse RPY blocks of `docs/MODEL.md`: `(tt, rr, rt_ij)`
 /// with `r = r_i - r_j`.
 fn far_blocks(eta: f64, ai: f64, aj: f64, r: [f64; 3]) -> (M, M, M) {
     let s = norm(r);
@@ -430,7 +430,7 @@ fn two_equal_spheres_settling<T: Real>(tol: &Tol) {
 }
 
 /// Polydisperse pair: every block of the 12 x 12 grand mobility against the far-field
-/// formulas of DESIGN.md, both orderings of big and small.
+/// formulas of `docs/MODEL.md`, both orderings of big and small.
 fn polydisperse_pair_far<T: Real>(tol: &Tol) {
     let mut worst = 0.0f64;
     let mut rng = Rng(11);
@@ -861,7 +861,7 @@ fn nested_assembly_error<T: Real>(_tol: &Tol) {
     );
 }
 
-/// DESIGN.md: nesting is invalid for the project, whatever the hydrodynamic level.
+/// docs/MODEL.md#nested-spheres: nesting is invalid, whatever the hydrodynamic level.
 /// (Today Oseen and free-draining assemble it; with coincident centres the Oseen
 /// blocks come out NaN while assembly returns `Ok`.)
 fn nested_assembly_error_cheaper_levels<T: Real>(_tol: &Tol) {

@@ -266,7 +266,7 @@ fn variants() -> Vec<Variant> {
     v
 }
 
-/// The same weights with inertia: density `4.5 St`, gravity `1 / St` (DESIGN.md sec. 4),
+/// The same weights with inertia: density `4.5 St`, gravity `1 / St` (docs/MODEL.md#units),
 /// integrated with the stable-drag RATTLE.
 fn stokes(s: &Scene, st: f64) -> Result<Scene> {
     let mut s = s.clone();

@@ -8,7 +8,7 @@
 //! back (`to_toml`) as a file that parses to the same scene.
 //!
 //! 100 000 cases by default (`FUZZ_CASES`, `FUZZ_SEED` to change; a longer run is
-//! documented in the README).
+//! documented in docs/VALIDATION.md).
 
 use std::path::PathBuf;
 

@@ -110,7 +110,7 @@ fn figure1_scenes_are_the_papers_cases() {
         assert_eq!(scene.species()[0], "head");
         assert!(scene.species()[1..].iter().all(|s| *s == "tail"));
         // Hard contacts (no stiffness, so no explicit-stability limit on dt), with the
-        // second-order method at dt = 0.1 (README, "Figure 1 at dt = 0.1").
+        // second-order method at dt = 0.1 (docs/FIGURE1.md#figure-1-at-dt--01).
         assert_eq!(
             scene.contact,
             Some(host_demo::scene::Contact::Hard { capacity: None })

@@ -1,5 +1,5 @@
 """Overhead of the Python package over the Rust step (prints the numbers quoted in the
-README). Usage: python python/bench/overhead.py [path/to/host-demo]
+docs/PYTHON.md). Usage: python python/bench/overhead.py [path/to/host-demo]
 
 * System.step(1000) at N = 25 (the Figure 1 (c) helix) against the CLI's own time loop
   on the same scene (summary.json's wall_time_s, frames every 100000 steps);

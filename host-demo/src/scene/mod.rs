@@ -24,7 +24,7 @@
 //! | `[wall]` | `height` (required, finite): a no-slip plane `z = height` below every sphere (`method = "overdamped"` or `"overdamped2"`, level manual; see [`Wall`]) | no wall |
 //!
 //! A scene gives either a `[helix]` table or explicit `[[particle]]` (and optionally
-//! `[[bond]]`) tables, never both. Units are those of `DESIGN.md` section 4: tail radius
+//! `[[bond]]`) tables, never both. Units are those of `docs/MODEL.md#units`: tail radius
 //! 1, viscosity 1, and the default density 4.5 with gravity `[0, 0, -1]` and fluid
 //! density 0 gives a lone tail a buoyant weight of `6 pi`, so it settles at speed 1.
 //!

@@ -102,7 +102,7 @@ pub struct Model {
     pub overlap: Overlap,
 }
 
-/// Time integration method (`DESIGN.md` section 2.3).
+/// Time integration method (`docs/MODEL.md#integrators`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Method {
     /// First-order overdamped step with constraint projection (HydroSHAKE).

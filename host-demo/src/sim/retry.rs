@@ -3,8 +3,8 @@
 //! At temperature the unconstrained move carries a random kick of size `sqrt(dt)`; on
 //! rare steps it is so large, for the chain's local shape, that the projection along
 //! the start-of-step bond vectors has no solution near the start (the constraint
-//! solvers then fail, each in its own way; issue 19 in the README, "Brownian
-//! dynamics"). Such a step is retried as 2, then 4, ... up to `2^MAX_DEPTH` shorter
+//! solvers then fail, each in its own way; issue 19 in `docs/BROWNIAN.md`, "A refused
+//! step"). Such a step is retried as 2, then 4, ... up to `2^MAX_DEPTH` shorter
 //! steps whose noise refines the refused step's (a Brownian bridge, the kernel's
 //! [`Noise::split`]): the sub-steps' increments add up to the refused one, so the
 //! retry does not bias the run against large kicks. Only when the deepest split fails

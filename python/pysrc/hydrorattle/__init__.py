@@ -421,7 +421,7 @@ class System:
         gravity (and any soft contact). It is called once per force evaluation (once
         per step for the first-order methods, twice for "overdamped2"), with the GIL
         held; its cost is the Python call plus two ``(N, 3)`` array conversions (a few
-        microseconds at N = 25; see the README). An exception it raises aborts the step
+        microseconds at N = 25; see docs/PYTHON.md). An exception it raises aborts the step
         and propagates, leaving the state unchanged.
 
         Raises a :class:`StepError` subclass (``kind``, ``stage``, ``index``,
