@@ -35,27 +35,26 @@ fn ok(args: &[&str]) {
     );
 }
 
-/// A small deterministic generator (SplitMix64): the test draws the same scenes and
-/// kill times on every machine.
-struct Draw(u64);
+#[path = "../../tests/common/fuzz.rs"]
+mod fuzz;
+
+/// The fuzzers' deterministic generator: the test draws the same scenes and kill times
+/// on every machine.
+struct Draw(fuzz::Rng);
 
 impl Draw {
     fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0.next()
     }
 
     /// An integer in `lo..=hi`.
     fn int(&mut self, lo: u64, hi: u64) -> u64 {
-        lo + self.next() % (hi - lo + 1)
+        lo + self.0.below((hi - lo + 1) as usize) as u64
     }
 
     /// A number in `[lo, hi)`.
     fn real(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        lo + (hi - lo) * self.0.unit()
     }
 }
 
@@ -208,7 +207,7 @@ fn a_run_killed_with_sigkill_resumes_to_the_bytes_of_one_run() {
         every: 37,
     };
     // Checkpoints every 999 steps (not on the last one), killed after the sixth.
-    let kill = kill_and_resume(&dir, &spec, &mut Draw(33), 999, 6 * 999);
+    let kill = kill_and_resume(&dir, &spec, &mut Draw(fuzz::Rng(33)), 999, 6 * 999);
     assert_eq!(kill, Kill::Midway, "the run ended before it was killed");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -224,7 +223,7 @@ fn killed_runs_of_random_scenes_resume_to_the_bytes_of_one_run() {
         "rattle-stable",
         "springs",
     ];
-    let mut draw = Draw(0x33);
+    let mut draw = Draw(fuzz::Rng(0x33));
     let mut midway = 0;
     let cases = 8;
     for case in 0..cases {
@@ -265,7 +264,7 @@ fn small_scene(dir: &Path, n: usize, steps: usize) -> PathBuf {
         every: 10,
     };
     let scene = dir.join(format!("scene-{steps}.toml"));
-    std::fs::write(&scene, spec.toml(&mut Draw(1))).unwrap();
+    std::fs::write(&scene, spec.toml(&mut Draw(fuzz::Rng(1)))).unwrap();
     scene
 }
 
