@@ -15,6 +15,8 @@ mod brownian;
 mod checks;
 mod contacts;
 mod overdamped;
+#[cfg(feature = "periodic")]
+mod periodic;
 mod rattle;
 mod springs;
 mod stable;
@@ -27,10 +29,10 @@ use springs::springs;
 use stable::rattle_stable;
 use stages::*;
 
-use checks::{accept, check_contacts, check_inputs, check_thermal, check_wall};
+use checks::{accept, check_contacts, check_inputs, check_periodic, check_thermal, check_wall};
 use contacts::{Projection, project_overdamped};
 
-use crate::bonds::{Bond, BondSet, max_residual};
+use crate::bonds::{Bond, BondSet, max_residual_in};
 use crate::constraints::{Solver, SolverKind};
 use crate::error::StepError;
 use crate::forces::ExternalForce;
@@ -132,6 +134,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
     // compiler, which then links only the method it runs.
     check_contacts(p, thermal.is_some())?;
     check_wall(p, &state)?;
+    check_periodic(p, &state, bonds)?;
     // The solver, resolved once from every row the step may solve, as the storage was
     // sized ([`Params::solver_kind`]): no stage re-resolves `Auto` from the rows it
     // holds in one round. A concrete kind (firmware's) keeps `p` the caller's reference.
@@ -195,7 +198,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
         && p.contacts.is_none()
         && p.wall.is_none();
     if !solved {
-        report.residual = max_residual(bonds, new_pos).1;
+        report.residual = max_residual_in(bonds, new_pos, cell(p).as_ref()).1;
     }
     // 4. Commit (the generator too, if it was drawn from).
     state.pos.copy_from_slice(new_pos);
