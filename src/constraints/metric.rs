@@ -228,9 +228,9 @@ impl<T: Real> Metric<'_, T> {
             } => {
                 #[cfg(feature = "periodic")]
                 if let Some((c, a_max)) = cell {
-                    return periodic_at(level, eta, pos, radius, (c, a_max), b, grad[l] * scale, p);
+                    return periodic_at(eta, pos, radius, (c, a_max), b, grad[l] * scale, p);
                 }
-                let _ = cell;
+                let _ = cell; // Read above only with the `periodic` feature.
                 // Nested pairs were refused by the product at these positions. The block
                 // (q, p), as `sym_block` reads it.
                 let block = |q| match wall {
@@ -421,7 +421,7 @@ impl<T: Real> Metric<'_, T> {
                     }
                     return;
                 }
-                let _ = cell;
+                let _ = cell; // Read above only with the `periodic` feature.
                 let done = match wall {
                     Some(h) if cfg!(feature = "wall") => {
                         wall::tt_product(level, eta, h, pos, radius, f, out)
@@ -558,9 +558,7 @@ fn spread<T: Real>(bonds: &[Bond<T>], grad: &[T::V3], c: &[T], scale: T, f: &mut
 /// blocks (exactly symmetric, so read in either orientation), the parameters derived
 /// for this block (the product at these positions refused nested spheres and a bad box).
 #[cfg(feature = "periodic")]
-#[allow(clippy::too_many_arguments)]
 fn periodic_at<T: Real>(
-    level: Hydro,
     eta: T,
     pos: &[T::V3],
     radius: &[T],
@@ -569,7 +567,6 @@ fn periodic_at<T: Real>(
     g: T::V3,
     p: usize,
 ) -> T::V3 {
-    let _ = level;
     let Ok(ew) = periodic::Ewald::new(cell, a_max) else {
         return T::V3_ZERO;
     };
