@@ -13,6 +13,7 @@
 //! is `z = 0` there), so the link's relative vector is the normal component
 //! `(0, 0, z_i)` ([`Bond::relative`]); its length is the sphere's radius (touching).
 
+use crate::cell::Periodic;
 use crate::error::BondError;
 use crate::real::Real;
 use heapless::Vec;
@@ -58,6 +59,18 @@ impl<T: Real> Bond<T> {
             normal::<T>(v[self.i])
         } else {
             v[self.i] - v[self.j]
+        }
+    }
+}
+
+impl<T: Real> Bond<T> {
+    /// The link's relative position `x_i - x_j` ([`Bond::relative`]), in a periodic box
+    /// its minimum image ([`crate::cell::image`]; a wall link has none to take).
+    #[inline(always)]
+    pub fn separation(&self, pos: &[T::V3], cell: Option<&Periodic<T>>) -> T::V3 {
+        match self.is_wall() {
+            true => self.relative(pos),
+            false => crate::cell::image(cell, pos[self.i] - pos[self.j]),
         }
     }
 }
@@ -217,16 +230,26 @@ pub fn validate<T: Real>(bonds: &[Bond<T>], n: usize) -> Result<(), BondError> {
 /// (exactly so in exact arithmetic; where two bonds' errors agree to rounding, either
 /// may be named).
 pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
+    max_residual_in(bonds, pos, None)
+}
+
+/// [`max_residual`] in a periodic box: each bond's length is that of its minimum image
+/// ([`Bond::separation`]).
+pub fn max_residual_in<T: Real>(
+    bonds: &[Bond<T>],
+    pos: &[T::V3],
+    cell: Option<&Periodic<T>>,
+) -> (usize, T) {
     let (mut hi, mut lo) = ((0, T::ZERO), (0, T::ZERO));
     let mut first = true;
     for (k, b) in bonds.iter().enumerate() {
         if b.i >= pos.len() || b.j >= pos.len() {
-            return max_residual_each(bonds, pos);
+            return max_residual_each(bonds, pos, cell);
         }
         if b.length == T::ZERO {
             continue;
         }
-        let r = b.relative(pos);
+        let r = b.separation(pos, cell);
         let mut ratio = T::norm2(r) / (b.length * b.length);
         // A wall link's centre at or below the plane has the error of a bond stretched
         // to `(2 - z/a) d`: the ratio that orders it with the others.
@@ -235,7 +258,7 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
             ratio = (T::TWO - h) * (T::TWO - h);
         }
         if ratio.is_nan() {
-            return max_residual_each(bonds, pos);
+            return max_residual_each(bonds, pos, cell);
         }
         if first || ratio > hi.1 {
             hi = (k, ratio);
@@ -247,7 +270,7 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
     }
     let at = |k: usize| {
         let b = &bonds[k];
-        (k, link_error(b, b.relative(pos)))
+        (k, link_error(b, b.separation(pos, cell)))
     };
     if first {
         return (0, T::ZERO);
@@ -261,12 +284,16 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
 }
 
 /// [`max_residual`] bond by bond, for the rare lists with a NaN or a bond out of range.
-fn max_residual_each<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
+fn max_residual_each<T: Real>(
+    bonds: &[Bond<T>],
+    pos: &[T::V3],
+    cell: Option<&Periodic<T>>,
+) -> (usize, T) {
     let mut worst = (0, T::ZERO);
     for (k, b) in bonds.iter().enumerate() {
         let r = match b.i < pos.len() && b.j < pos.len() {
             true if b.length == T::ZERO => continue,
-            true => link_error(b, b.relative(pos)),
+            true => link_error(b, b.separation(pos, cell)),
             false => T::ONE / T::ZERO,
         };
         if !worst.1.is_nan() && (r.is_nan() || r > worst.1) {

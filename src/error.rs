@@ -82,7 +82,9 @@ pub enum BondError {
     },
     /// Length is negative, not finite, or so large that its square overflows; or zero
     /// in a step of a method other than [`Method::Springs`](crate::Method::Springs)
-    /// (only a spring may have rest length zero).
+    /// (only a spring may have rest length zero); or, in a periodic box
+    /// ([`Params::periodic`](crate::Params::periodic)), not below half the box's
+    /// smallest edge (its minimum image would be ambiguous).
     BadLength {
         /// Index of the bond.
         bond: usize,
@@ -251,7 +253,7 @@ impl fmt::Display for BondError {
             Self::Duplicate { bond, other } => write!(f, "bond {bond} duplicates bond {other}"),
             Self::BadLength { bond } => write!(
                 f,
-                "bond {bond}: length must be finite and > 0 (0 only for springs)"
+                "bond {bond}: length must be finite and > 0 (0 only for springs; below half the smallest edge of a periodic box)"
             ),
             Self::Violated { bond, residual } => {
                 write!(f, "bond {bond}: configuration off by relative {residual:e}")
@@ -343,6 +345,28 @@ impl core::error::Error for StepError {}
 impl From<ParticleError> for StepError {
     fn from(e: ParticleError) -> Self {
         Self::Particle(e)
+    }
+}
+
+/// A box or Ewald parameter the step cannot use: typed as the step's own errors (a
+/// radius or particle as [`StepError::Particle`], a parameter as
+/// [`StepError::BadParameter`], a box beyond the sums' bounds as
+/// [`StepError::Unsupported`]), so that no new variant reaches callers' matches.
+impl From<crate::cell::PeriodicError> for StepError {
+    fn from(e: crate::cell::PeriodicError) -> Self {
+        use crate::cell::PeriodicError as E;
+        match e {
+            E::BadEdge { .. } => Self::BadParameter("periodic (every edge finite and > 0)"),
+            E::BadParameter(name) => Self::BadParameter(name),
+            E::SphereTooLarge => {
+                Self::BadParameter("periodic (every radius below half the smallest edge)")
+            }
+            E::TooElongated => Self::Unsupported(
+                "a periodic box too elongated for the Ewald sums (mobility::periodic::MAX_INDEX)",
+            ),
+            E::Radius { particle } => Self::Particle(ParticleError::BadRadius { particle }),
+            E::Particle(e) => Self::Particle(e),
+        }
     }
 }
 

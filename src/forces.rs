@@ -57,8 +57,20 @@ pub fn springs<T: Real>(
     pos: &[T::V3],
     out: &mut [T::V3],
 ) -> Result<(), crate::BondError> {
+    springs_in(bonds, stiffness, fene, pos, None, out)
+}
+
+/// [`springs`] in a periodic box `cell`: each bond vector is its minimum image.
+pub fn springs_in<T: Real>(
+    bonds: &[crate::bonds::Bond<T>],
+    stiffness: T,
+    fene: Option<T>,
+    pos: &[T::V3],
+    cell: Option<crate::cell::Periodic<T>>,
+    out: &mut [T::V3],
+) -> Result<(), crate::BondError> {
     for (k, b) in bonds.iter().enumerate() {
-        let r = pos[b.i] - pos[b.j];
+        let r = crate::cell::image(cell.as_ref(), pos[b.i] - pos[b.j]);
         let f = match fene {
             // Rest length zero: -k r, defined at r = 0 too.
             None if b.length == T::ZERO => r * -stiffness,

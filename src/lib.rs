@@ -23,6 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod bonds;
+pub mod cell;
 pub mod constraints;
 pub mod error;
 pub mod forces;
@@ -38,6 +39,7 @@ pub mod real;
 pub mod workspace;
 
 pub use bonds::{Bond, BondSet};
+pub use cell::{Periodic, PeriodicError};
 pub use constraints::{DENSE_BONDS_MAX, Solver, SolverKind};
 pub use error::{BondError, LinalgError, ParticleError, Stage, StepError};
 pub use forces::{ExternalForce, NoForce, SoftContact};

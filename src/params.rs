@@ -1,5 +1,6 @@
 //! Step parameters: one plain `Copy` struct with documented defaults.
 
+use crate::cell::Periodic;
 use crate::constraints::{Solver, SolverKind};
 use crate::mobility::Hydro;
 use crate::noise::lanczos::Lanczos;
@@ -245,6 +246,14 @@ pub struct Params<T: Real> {
     pub contacts: Option<Contacts>,
     /// A no-slip plane wall below the spheres ([`Wall`]). Default `None`: unbounded fluid.
     pub wall: Option<Wall<T>>,
+    /// A rectangular periodic box ([`Periodic`]; the kernel's `periodic` feature): the
+    /// mobility is the Ewald-summed RPY tensor of the box (`docs/PERIODIC.md`), and
+    /// every pair geometry (bonds, contacts, springs, overlap checks) takes the
+    /// minimum image. Positions are kept as given, not wrapped. Refused with a wall,
+    /// with [`Params::rotation`] and with [`Hydro::Oseen`]; a bond not shorter than
+    /// half the box's smallest edge is refused with its index
+    /// ([`BondError::BadLength`](crate::BondError::BadLength)). Default `None`.
+    pub periodic: Option<Periodic<T>>,
 }
 
 impl<T: Real> Params<T> {
@@ -280,6 +289,7 @@ impl<T: Real> Params<T> {
             lanczos: Lanczos::default(),
             contacts: None,
             wall: None,
+            periodic: None,
         }
     }
 

@@ -4,7 +4,7 @@
 //! (every method, solver and mobility; NaN, negative and huge time steps, tolerances,
 //! viscosities, gravity, time; rest length zero), every table of the step (rotation,
 //! matrix-free products, hard contacts with capacities past `DENSE_BONDS_MAX` rows, a
-//! wall, FENE springs, thermal noise by Cholesky, Lanczos or `Auto` with either drift)
+//! wall, a periodic box, FENE springs, thermal noise by Cholesky, Lanczos or `Auto` with either drift)
 //! and mismatched or undersized storage. Every call must return without a panic; a
 //! refused step must leave the state and the noise generator bit-identical; an
 //! accepted one must leave it finite with the time advanced.
@@ -18,7 +18,7 @@ use common::fuzz::{Rng, report, settings};
 use common::*;
 use hydrorattle::{
     Bond, Brownian, Contacts, Drift, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Params,
-    Real, SolverKind, State, Wall, step_slices,
+    Periodic, Real, SolverKind, State, Wall, step_slices,
 };
 use hydrorattle_heap::Buffers;
 
@@ -215,6 +215,25 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
             -2.0 - rng.unit()
         };
         p.wall = Some(Wall::new(T::from_f64(height)));
+    }
+    // A periodic box on an eighth: edges around the chain's extent (so that it may wrap
+    // and meet its own images), or hostile ones; a clean case drops what a box
+    // refuses (a wall, rotation, the Oseen level).
+    if rng.below(8) == 0 {
+        let mut edge = |typical: f64| match rng.1 && rng.below(4) == 0 {
+            true => rng.value(typical),
+            false => typical * (0.5 + rng.unit()),
+        };
+        let size = [edge(3.0 * n as f64 + 6.0), edge(12.0), edge(12.0)];
+        if let Ok(c) = Periodic::new(size.map(T::from_f64)) {
+            p.periodic = Some(c);
+            if !hostile {
+                (p.wall, p.rotation) = (None, false);
+                if p.hydro == Hydro::Oseen {
+                    p.hydro = Hydro::Rpy;
+                }
+            }
+        }
     }
     p.matrix_free = free_ok && rng.below(6) == 0;
     // FENE springs on a sixth: a limit beyond the bonds, or a hostile one.

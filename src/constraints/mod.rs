@@ -30,6 +30,7 @@ pub use newton::newton;
 pub use sweep::sweep;
 
 use crate::bonds::Bond;
+use crate::cell::Periodic;
 use crate::error::{Stage, StepError};
 use crate::real::Real;
 
@@ -96,8 +97,12 @@ impl<T: Real> Solver<T> {
 /// Which condition to enforce.
 #[derive(Clone, Copy, Debug)]
 pub enum Problem<'a, T: Real> {
-    /// `|x_i - x_j|^2 - d^2 = 0` (SHAKE).
-    Positions,
+    /// `|x_i - x_j|^2 - d^2 = 0` (SHAKE), `x_i - x_j` the minimum image in a periodic
+    /// box.
+    Positions {
+        /// The periodic box, if any ([`Params::periodic`](crate::Params::periodic)).
+        cell: Option<Periodic<T>>,
+    },
     /// `b_k . (x_i - x_j) = 0` with `b_k` the new bond vectors (RATTLE); `dt` scales the
     /// residual to a relative length change per step.
     Velocities {
@@ -113,12 +118,15 @@ impl<T: Real> Problem<'_, T> {
     /// normalised magnitude compared with the tolerance.
     #[inline]
     fn eval(&self, b: &Bond<T>, k: usize, x: &[T::V3]) -> (T, T::V3, T) {
-        let rel = b.relative(x);
+        let rel = match *self {
+            Problem::Positions { cell } => b.separation(x, cell.as_ref()),
+            Problem::Velocities { .. } => b.relative(x),
+        };
         let d2 = b.length * b.length;
         match *self {
             // A wall link's linear constraint `2 d (z - d)` (see [`Bond::wall`]); its
             // gradient `(0, 0, 2 d)` is the chord's `c g` (`g = (0, 0, d)`).
-            Problem::Positions if b.is_wall() => {
+            Problem::Positions { .. } if b.is_wall() => {
                 let z = T::xyz(rel)[2];
                 let two_d = T::TWO * b.length;
                 (
@@ -127,7 +135,7 @@ impl<T: Real> Problem<'_, T> {
                     ((z - b.length) / b.length).abs(),
                 )
             }
-            Problem::Positions => {
+            Problem::Positions { .. } => {
                 let r2 = T::norm2(rel);
                 // The relative length error `| |r| - d | / d` the tolerance is stated in
                 // (`|r^2 - d^2| / (2 d^2)` would understate a compressed bond's error).
@@ -149,7 +157,7 @@ impl<T: Real> Problem<'_, T> {
     fn normalise(&self, b: &Bond<T>, value: T) -> T {
         let d2 = b.length * b.length;
         match *self {
-            Problem::Positions => value.abs() / (T::TWO * d2),
+            Problem::Positions { .. } => value.abs() / (T::TWO * d2),
             Problem::Velocities { dt, .. } => (value * dt).abs() / d2,
         }
     }
@@ -157,14 +165,14 @@ impl<T: Real> Problem<'_, T> {
     /// `c` in the chord matrix `A = c G D`: the derivative of the residual along `g`.
     fn chord_factor(&self) -> T {
         match self {
-            Problem::Positions => T::TWO,
+            Problem::Positions { .. } => T::TWO,
             Problem::Velocities { .. } => T::ONE,
         }
     }
 
     fn stage(&self) -> Stage {
         match self {
-            Problem::Positions => Stage::Positions,
+            Problem::Positions { .. } => Stage::Positions,
             Problem::Velocities { .. } => Stage::Velocities,
         }
     }
@@ -221,8 +229,8 @@ pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) ->
 /// Largest normalised residual over all bonds (positions: two square roots, see
 /// [`max_residual`](crate::bonds::max_residual)).
 fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T {
-    if let Problem::Positions = problem {
-        return crate::bonds::max_residual(bonds, x).1;
+    if let Problem::Positions { cell } = problem {
+        return crate::bonds::max_residual_in(bonds, x, cell.as_ref()).1;
     }
     let mut w = T::ZERO;
     for (k, b) in bonds.iter().enumerate() {

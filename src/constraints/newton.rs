@@ -37,7 +37,7 @@ pub fn newton<T: Real>(
     );
     // Positions start on the chord; every solve falls back to the Jacobian at the
     // iterate, refreshed whenever the residual falls less than tenfold.
-    let mut chord = matches!(problem, Problem::Positions);
+    let mut chord = matches!(problem, Problem::Positions { .. });
     let mut previous: Option<T> = None;
     for it in 0..=solver.max_iterations {
         let residual = worst(&problem, bonds, x);

@@ -162,6 +162,7 @@ fn reads_copy<T: Real>(p: &Params<T>, n: usize, fac: usize) -> bool {
         && p.lanczos_noise(n)
         && !p.matrix_free
         && wall_height(p).is_none()
+        && super::ewald_cell(p).is_none()
         && fac >= reduced::slots(n)
 }
 
@@ -273,7 +274,7 @@ pub(super) fn kick<T: Real>(
                 if p.matrix_free { &[] } else { fac }
             };
             if let Some(h) = held {
-                bond_vectors(h.bonds, mid, h.grad_mid);
+                bond_vectors(h.bonds, mid, super::cell(p), h.grad_mid);
                 h.kappa.fill(T::ZERO);
                 let par = h.scratch.par;
                 let metric = mobility_metric(

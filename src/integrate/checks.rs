@@ -3,8 +3,10 @@
 //! candidate state before it is committed.
 
 use crate::bonds::Bond;
+use crate::cell::image;
 use crate::constraints::Solver;
 use crate::error::{ParticleError, StepError};
+use crate::mobility::Hydro;
 use crate::params::{Method, Params};
 use crate::particles::{State, sphere_volume};
 use crate::real::Real;
@@ -93,6 +95,59 @@ pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result
     }
 }
 
+/// Checks the periodic box: the kernel built with its `periodic` feature; no wall (its
+/// image system is free space's) and no rotation (the box's `rt`, `rr` blocks are not
+/// summed yet); not the Oseen level (the Ewald sum is RPY's; free draining has no pair
+/// blocks and needs none); every radius below half the smallest edge, every bond (and
+/// FENE's maximum extension) shorter than half of it, so that the minimum image of a
+/// bond at its length is the bond; and Ewald parameters the sums' bounds allow.
+pub(super) fn check_periodic<T: Real>(
+    p: &Params<T>,
+    state: &State<'_, T>,
+    bonds: &[Bond<T>],
+) -> Result<(), StepError> {
+    let Some(c) = p.periodic else {
+        return Ok(());
+    };
+    if !cfg!(feature = "periodic") {
+        return Err(StepError::Unsupported(
+            "a periodic box: the kernel was built without its `periodic` feature",
+        ));
+    }
+    if p.wall.is_some() {
+        return Err(StepError::Unsupported("a periodic box with a wall"));
+    }
+    if p.rotation {
+        return Err(StepError::Unsupported(
+            "a periodic box with rotation (the box's rt and rr blocks are not summed yet)",
+        ));
+    }
+    if p.hydro == Hydro::Oseen {
+        return Err(StepError::Unsupported(
+            "a periodic box with Hydro::Oseen (the Ewald sum is RPY's)",
+        ));
+    }
+    let [x, y, z] = c.size();
+    let half = x.min(y).min(z) * T::HALF;
+    if let Some(particle) = state.radius.iter().position(|&a| !(a < half)) {
+        return Err(StepError::Particle(ParticleError::BadRadius { particle }));
+    }
+    if let Some(bond) = bonds.iter().position(|b| !(b.length < half)) {
+        return Err(crate::error::BondError::BadLength { bond }.into());
+    }
+    if p.method == Method::Springs && p.fene.is_some_and(|q| !(q < half)) {
+        return Err(StepError::BadParameter(
+            "fene (maximum extension below half the periodic box's smallest edge)",
+        ));
+    }
+    #[cfg(feature = "periodic")]
+    if p.hydro != Hydro::FreeDraining {
+        let a_max = state.radius.iter().fold(T::ZERO, |m, &a| m.max(a));
+        crate::mobility::periodic::Ewald::new(c, a_max)?;
+    }
+    Ok(())
+}
+
 /// The first sphere whose centre is below `height + a_i (1 - 2 tol)`, less the
 /// rounding of the numbers compared (4 epsilons of `|z| + |height| + a_i`): far from
 /// the origin a sphere put or held at contact is off by an ulp of its coordinates,
@@ -119,6 +174,7 @@ pub(super) fn check_all<T: Real>(
     let thermal = check_thermal(p, has_generator)?;
     check_contacts(p, thermal.is_some())?;
     check_wall(p, state)?;
+    check_periodic(p, state, bonds)?;
     Ok(thermal)
 }
 
@@ -237,8 +293,8 @@ pub(super) fn check_inputs<T: Real>(
     Ok(())
 }
 
-/// Finite, no nested spheres, no overlap unless allowed (squared distances: no sqrt),
-/// no sphere below the wall. With contacts, spheres touch to within the solver's
+/// Finite, no nested spheres, no overlap unless allowed (squared distances: no sqrt;
+/// the minimum image in a periodic box), no sphere below the wall. With contacts, spheres touch to within the solver's
 /// tolerance, which is accepted; so do spheres on the wall.
 pub(super) fn accept<T: Real>(
     pos: &[T::V3],
@@ -248,6 +304,7 @@ pub(super) fn accept<T: Real>(
     p: &Params<T>,
 ) -> Result<(), StepError> {
     let allow_overlap = p.allow_overlap;
+    let cell = super::cell(p);
     let reach = match p.contacts {
         Some(_) => T::ONE - p.solver.tolerance * T::TWO,
         None => T::ONE,
@@ -265,7 +322,7 @@ pub(super) fn accept<T: Real>(
     for (i, (&pi, &ai)) in pos.iter().zip(radius).enumerate() {
         let others = pos[i + 1..].iter().zip(&radius[i + 1..]);
         for (k, (&pj, &aj)) in others.enumerate() {
-            let s2 = T::norm2(pi - pj);
+            let s2 = T::norm2(image(cell.as_ref(), pi - pj));
             let (dif, sum) = (ai - aj, (ai + aj) * reach);
             if s2 <= dif * dif || (!allow_overlap && s2 < sum * sum) {
                 return Err(StepError::Overlap { i, j: i + 1 + k });

@@ -32,6 +32,7 @@
 
 use super::{bond_vectors, mobility_metric, project_positions};
 use crate::bonds::Bond;
+use crate::cell::{Periodic, image};
 use crate::constraints::{Scratch, SolveStats};
 use crate::error::{Stage, StepError};
 use crate::params::{Contacts, Params, Wall};
@@ -91,6 +92,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
     let wall = p.wall.filter(|_| cfg!(feature = "contacts"));
     let nb = bonds.len();
+    let cell = super::cell(p);
     // The pool of one-sided constraints: the contacts' capacity, one wall link per
     // sphere ([`Params::constraints`]).
     let pool = p.constraints(start.len(), nb) - nb;
@@ -105,7 +107,9 @@ pub(super) fn project_overdamped<'l, T: Real>(
         // The last step's contacts end within the tolerance of touching.
         let reach = T::ONE + tol * T::TWO;
         if contacts.is_some() {
-            add_pairs(bonds, start, start, radius, reach, pool, links, &mut nc)?;
+            add_pairs(
+                bonds, start, start, radius, cell, reach, pool, links, &mut nc,
+            )?;
         }
         if let Some(w) = wall {
             add_wall(nb, start, w.height, radius, reach, pool, links, &mut nc)?;
@@ -118,7 +122,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
             Some(_) => &links[..nb + nc],
             None => bonds,
         };
-        bond_vectors(active, start, grad);
+        bond_vectors(active, start, super::cell(p), grad);
         let par = scratch.par;
         let metric = mobility_metric(p, active, start, radius, mu, grad, p.dt, disp, par);
         free(x);
@@ -136,7 +140,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         let reach = T::ONE - tol;
         let mut added = 0;
         if contacts.is_some() {
-            added += add_pairs(bonds, start, x, radius, reach, pool, links, &mut nc)?;
+            added += add_pairs(bonds, start, x, radius, cell, reach, pool, links, &mut nc)?;
         }
         if wall.is_some() {
             added += add_wall(nb, x, T::ZERO, radius, reach, pool, links, &mut nc)?;
@@ -145,7 +149,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
             // Every contact must end on the side it started from (a sphere above the
             // wall: `grad = (0, 0, a)`, its relative vector `(0, 0, z)`).
             for (k, l) in links[nb..nb + nc].iter().enumerate() {
-                if !(T::dot(l.relative(x), grad[nb + k]) > T::ZERO) {
+                if !(T::dot(l.separation(x, cell.as_ref()), grad[nb + k]) > T::ZERO) {
                     return Err(StepError::Degenerate { bond: nb + k });
                 }
             }
@@ -165,7 +169,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
             return Err(StepError::NoConvergence {
                 stage: Stage::Contacts,
                 iterations: round,
-                residual: deepest_overlap(x, radius, wall.is_some()).to_f64(),
+                residual: deepest_overlap(x, radius, cell, wall.is_some()).to_f64(),
             });
         }
     }
@@ -229,13 +233,18 @@ fn push<T: Real>(
 
 /// Appends every unbonded pair that ends closer than `reach` times its contact distance
 /// or crossed within it on the straight path from `from` to `to`, and is not yet a
-/// contact; returns how many were added.
+/// contact; returns how many were added. In a periodic box the path starts at the
+/// minimum image of the pair's separation and moves with the pair's relative
+/// displacement (the image is not taken again at its end, where a pair near half the
+/// box apart would jump across the box and seem to pass through contact); the end
+/// is compared by its minimum image.
 #[allow(clippy::too_many_arguments)]
 fn add_pairs<T: Real>(
     bonds: &[Bond<T>],
     from: &[T::V3],
     to: &[T::V3],
     radius: &[T],
+    cell: Option<Periodic<T>>,
     reach: T,
     pool: usize,
     links: &mut [Bond<T>],
@@ -247,8 +256,14 @@ fn add_pairs<T: Real>(
         for j in 0..i {
             let sigma = radius[i] + radius[j];
             let far = sigma * reach;
-            let (d0, d1) = (from[i] - from[j], to[i] - to[j]);
-            let ends = T::norm2(d1) < far * far;
+            let (d0, d1) = match cell {
+                Some(c) if cfg!(feature = "periodic") => {
+                    let d0 = c.minimum_image(from[i] - from[j]);
+                    (d0, d0 + ((to[i] - from[i]) - (to[j] - from[j])))
+                }
+                _ => (from[i] - from[j], to[i] - to[j]),
+            };
+            let ends = T::norm2(image(cell.as_ref(), d1)) < far * far;
             let crossed = !(T::dot(d0, d1) > T::ZERO) && closest2::<T>(d0, d1) < far * far;
             if !(ends || crossed) {
                 continue;
@@ -304,9 +319,14 @@ fn release_pulling<T: Real>(
     true
 }
 
-/// Largest relative overlap `1 - |r_ij| / (a_i + a_j)`, and with a wall `1 - z_i / a_i`
-/// (positions in the wall's frame), for the error report.
-fn deepest_overlap<T: Real>(pos: &[T::V3], radius: &[T], wall: bool) -> T {
+/// Largest relative overlap `1 - |r_ij| / (a_i + a_j)` (the minimum image in a box), and
+/// with a wall `1 - z_i / a_i` (positions in the wall's frame), for the error report.
+fn deepest_overlap<T: Real>(
+    pos: &[T::V3],
+    radius: &[T],
+    cell: Option<Periodic<T>>,
+    wall: bool,
+) -> T {
     let mut worst = T::ZERO;
     for i in 0..pos.len() {
         if wall {
@@ -314,7 +334,7 @@ fn deepest_overlap<T: Real>(pos: &[T::V3], radius: &[T], wall: bool) -> T {
         }
         for j in 0..i {
             let sigma = radius[i] + radius[j];
-            worst = worst.max(T::ONE - T::norm(pos[i] - pos[j]) / sigma);
+            worst = worst.max(T::ONE - T::norm(image(cell.as_ref(), pos[i] - pos[j])) / sigma);
         }
     }
     worst

@@ -15,6 +15,8 @@ mod brownian;
 mod checks;
 mod contacts;
 mod overdamped;
+#[cfg(feature = "periodic")]
+mod periodic;
 mod rattle;
 mod springs;
 mod stable;
@@ -30,7 +32,7 @@ use stages::*;
 use checks::{accept, check_all};
 use contacts::{Projection, project_overdamped};
 
-use crate::bonds::{Bond, BondSet, max_residual};
+use crate::bonds::{Bond, BondSet, max_residual_in};
 use crate::constraints::{Solver, SolverKind};
 use crate::error::StepError;
 use crate::forces::ExternalForce;
@@ -205,7 +207,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
         && p.contacts.is_none()
         && p.wall.is_none();
     if !solved {
-        report.residual = max_residual(bonds, new_pos).1;
+        report.residual = max_residual_in(bonds, new_pos, cell(p).as_ref()).1;
     }
     // 4. Commit (the generator too, if it was drawn from).
     state.pos.copy_from_slice(new_pos);

@@ -93,7 +93,7 @@ fn projected_velocity<T: Real>(
     let n = pos.len();
     linalg::sym_matvec::<T>(mu, n, force, u);
     add_flow(p, pos, u);
-    bond_vectors(bonds, pos, grad);
+    bond_vectors(bonds, pos, super::cell(p), grad);
     kappa.fill(T::ZERO);
     let problem = Problem::Velocities {
         bond: grad,

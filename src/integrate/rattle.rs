@@ -4,7 +4,7 @@
 //! SHAKE with the mass metric (eq. 3) fixes the positions and RATTLE (eq. 4) the
 //! velocities. Stable only for `dt` below about `2 m / zeta`.
 
-use super::{Start, StepReport, assemble_tt, bond_vectors, report, spin};
+use super::{Start, StepReport, assemble_tt, bond_vectors, cell, report, spin};
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem};
 use crate::error::{Stage, StepError};
@@ -79,7 +79,7 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
         new_pos[i] = r_star[i];
     }
     // SHAKE with the mass metric (eq. 3).
-    bond_vectors(bonds, s.pos, grad);
+    bond_vectors(bonds, s.pos, cell(p), grad);
     lambda.fill(T::ZERO);
     let metric = Metric::Mass {
         inv_mass,
@@ -87,7 +87,7 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
         scale: half_dt2,
     };
     let stats = constraints::solve(
-        Problem::Positions,
+        Problem::Positions { cell: cell(p) },
         &metric,
         bonds,
         &p.solver,
@@ -99,7 +99,7 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
     for i in 0..n {
         new_vel[i] = s.vel[i] + acc[i] * dt + (new_pos[i] - r_star[i]) / dt;
     }
-    bond_vectors(bonds, new_pos, grad_new);
+    bond_vectors(bonds, new_pos, cell(p), grad_new);
     kappa.fill(T::ZERO);
     let metric = Metric::Mass {
         inv_mass,

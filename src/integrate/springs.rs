@@ -5,7 +5,7 @@
 
 use super::brownian::{Krylov, kick};
 use super::{Start, StepReport, add_flow, mobility_product, spin, step_velocity};
-use crate::bonds::{Bond, max_residual};
+use crate::bonds::{Bond, max_residual_in};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
 use crate::noise::Noise;
@@ -42,7 +42,14 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         ..
     } = v;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    forces::springs(bonds, p.spring_stiffness, p.fene, s.pos, force)?;
+    forces::springs_in(
+        bonds,
+        p.spring_stiffness,
+        p.fene,
+        s.pos,
+        super::cell(p),
+        force,
+    )?;
     mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
     add_flow(p, s.pos, u);
     let mut noise_iterations = 0;
@@ -86,7 +93,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
 /// nonzero rest length) and the largest spring force, Hookean `k | |r_ij| - d |` or
 /// FENE `k |r_ij| / (1 - |r_ij|^2 / Q0^2)`.
 fn spring_report<T: Real>(p: &Params<T>, bonds: &[Bond<T>], new_pos: &[T::V3]) -> StepReport<T> {
-    let (_, worst) = max_residual(bonds, new_pos);
+    let (_, worst) = max_residual_in(bonds, new_pos, super::cell(p).as_ref());
     let k = p.spring_stiffness;
     let tension = bonds.iter().fold(T::ZERO, |a, b| {
         let r2 = T::norm2(new_pos[b.i] - new_pos[b.j]);

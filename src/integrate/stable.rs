@@ -135,7 +135,7 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     }
     // Constraint displacements D_l = dt S^-1 dt K^-1 S mu g_l (every bead moves):
     // for the dense solves one drag solve per bond, for Krylov one per iteration.
-    bond_vectors(bonds, s.pos, grad);
+    bond_vectors(bonds, s.pos, super::cell(p), grad);
     let metric = if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
         Metric::Drag {
             mu,
@@ -176,7 +176,7 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
         new_omega.fill(p.vorticity);
     }
     // RATTLE: make the velocities tangent to the bonds at the new positions.
-    bond_vectors(bonds, new_pos, grad_new);
+    bond_vectors(bonds, new_pos, super::cell(p), grad_new);
     kappa.fill(T::ZERO);
     let problem = Problem::Velocities { bond: grad_new, dt };
     let vstats = constraints::solve(problem, &metric, bonds, &p.solver, new_vel, kappa, &mut sc)?;

@@ -4,6 +4,7 @@
 
 use super::StepReport;
 use crate::bonds::Bond;
+use crate::cell::Periodic;
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind};
 use crate::error::{ParticleError, StepError};
 use crate::mobility::{self, Hydro};
@@ -27,6 +28,13 @@ pub(super) fn mobility_product<T: Real>(
 ) -> Result<(), StepError> {
     if p.matrix_free {
         return free_product(p, pos, radius, f, u);
+    }
+    #[cfg(feature = "periodic")]
+    if let Some(c) = ewald_cell(p) {
+        // In a box: assembled serially, then applied in bands (`integrate/periodic.rs`).
+        super::periodic::assemble(p, c, pos, radius, mu)?;
+        crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
+        return Ok(());
     }
     if let Some(h) = wall_height(p) {
         // Above a wall: assembled, then applied (`mobility::wall`).
@@ -66,6 +74,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
             grad,
             scale,
             wall: wall_height(p),
+            cell: ewald_cell(p).map(|c| (c, radius.iter().fold(T::ZERO, |m, &a| m.max(a)))),
         };
     }
     if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
@@ -93,6 +102,10 @@ pub(super) fn free_product<T: Real>(
     f: &[T::V3],
     u: &mut [T::V3],
 ) -> Result<(), StepError> {
+    #[cfg(feature = "periodic")]
+    if let Some(c) = ewald_cell(p) {
+        return super::periodic::product(p, c, pos, radius, f, u);
+    }
     let (level, eta) = (p.hydro, p.viscosity);
     match wall_height(p) {
         Some(h) => mobility::wall::tt_product(level, eta, h, pos, radius, f, u)?,
@@ -111,12 +124,35 @@ pub(super) fn wall_height<T: Real>(p: &Params<T>) -> Option<T> {
     }
 }
 
+/// The periodic box when the step has one and the kernel its `periodic` feature
+/// (without it the box's code compiles away; `check_periodic` refuses the box then).
+#[inline(always)]
+pub(super) fn cell<T: Real>(p: &Params<T>) -> Option<Periodic<T>> {
+    match p.periodic {
+        Some(c) if cfg!(feature = "periodic") => Some(c),
+        _ => None,
+    }
+}
+
+/// The box when its images interact through the mobility: not with free draining,
+/// whose mobility has self blocks only (the same in a box as outside it).
+#[inline(always)]
+pub(super) fn ewald_cell<T: Real>(p: &Params<T>) -> Option<Periodic<T>> {
+    cell(p).filter(|_| p.hydro != Hydro::FreeDraining)
+}
+
+/// `mu_tt(pos)` into the packed lower triangle `mu`: free space, above the wall, or in
+/// the periodic box.
 pub(super) fn assemble_tt<T: Real>(
     p: &Params<T>,
     pos: &[T::V3],
     radius: &[T],
     mu: &mut [T::M3],
 ) -> Result<(), StepError> {
+    #[cfg(feature = "periodic")]
+    if let Some(c) = ewald_cell(p) {
+        return super::periodic::assemble(p, c, pos, radius, mu);
+    }
     if let Some(h) = wall_height(p) {
         let (level, eta, serial) = (p.hydro, p.viscosity, &crate::parallel::Serial);
         return Ok(mobility::wall::assemble(
@@ -126,13 +162,19 @@ pub(super) fn assemble_tt<T: Real>(
     mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
 }
 
-/// `g_l = r_i - r_j` for every bond; `(0, 0, a)` for a wall link (the wall's normal,
-/// scaled as the link's relative vector at contact: [`Bond::wall`]).
-pub(super) fn bond_vectors<T: Real>(bonds: &[Bond<T>], pos: &[T::V3], out: &mut [T::V3]) {
+/// `g_l = r_i - r_j` for every bond (its minimum image in a periodic box `cell`);
+/// `(0, 0, a)` for a wall link (the wall's normal, scaled as the link's relative vector
+/// at contact: [`Bond::wall`]).
+pub(super) fn bond_vectors<T: Real>(
+    bonds: &[Bond<T>],
+    pos: &[T::V3],
+    cell: Option<Periodic<T>>,
+    out: &mut [T::V3],
+) {
     for (g, b) in out.iter_mut().zip(bonds) {
         *g = match b.is_wall() {
             true => T::v3(T::ZERO, T::ZERO, b.length),
-            false => pos[b.i] - pos[b.j],
+            false => crate::cell::image(cell.as_ref(), pos[b.i] - pos[b.j]),
         };
     }
 }
@@ -212,7 +254,7 @@ pub(super) fn project_positions<T: Real>(
 ) -> Result<SolveStats<T>, StepError> {
     lambda.fill(T::ZERO);
     constraints::solve(
-        Problem::Positions,
+        Problem::Positions { cell: cell(p) },
         metric,
         bonds,
         &p.solver,

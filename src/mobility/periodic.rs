@@ -31,8 +31,7 @@
 mod real;
 mod wave;
 
-use core::fmt;
-
+pub use crate::cell::{Periodic, PeriodicError};
 use crate::error::ParticleError;
 use crate::linalg::tri;
 use crate::real::Real;
@@ -49,95 +48,6 @@ pub const XI_BALANCE: f64 = 2.9;
 /// `(1 - k^2 a^2 / 6)` make the wave-space terms cancel (a sphere of a third of the box
 /// at `xi a = 2.4` loses two digits), so spheres that large lower `xi` below the balance.
 pub const XI_RADIUS: f64 = 1.0;
-
-/// A rejected periodic box, Ewald parameter or sphere.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum PeriodicError {
-    /// A box edge is zero, negative or not finite (axis 0, 1, 2).
-    BadEdge {
-        /// The axis.
-        axis: usize,
-    },
-    /// The splitting parameter, tolerance or largest radius is out of range (named).
-    BadParameter(&'static str),
-    /// The largest radius is not below half the smallest edge: a sphere would overlap
-    /// its own image.
-    SphereTooLarge,
-    /// The cutoffs need more than [`MAX_INDEX`] images or wave vectors along an axis.
-    TooElongated,
-    /// A radius is not finite, not positive, or above the parameters' largest radius.
-    Radius {
-        /// Index of the particle.
-        particle: usize,
-    },
-    /// A position is not finite, or a sphere lies inside another's image.
-    Particle(ParticleError),
-}
-
-impl fmt::Display for PeriodicError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::BadEdge { axis } => write!(f, "periodic box edge {axis} must be finite and > 0"),
-            Self::BadParameter(name) => write!(f, "invalid Ewald parameter: {name}"),
-            Self::SphereTooLarge => write!(f, "a sphere is not smaller than half the box"),
-            Self::TooElongated => write!(f, "the box is too elongated for the Ewald sums' bounds"),
-            Self::Radius { particle } => {
-                write!(f, "particle {particle}: radius not in (0, largest radius]")
-            }
-            Self::Particle(e) => write!(f, "{e}"),
-        }
-    }
-}
-
-/// A rectangular periodic box, edges `size` (validated: finite and positive).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Periodic<T: Real> {
-    size: [T; 3],
-}
-
-impl<T: Real> Periodic<T> {
-    /// The box `L_x x L_y x L_z`.
-    pub fn new(size: [T; 3]) -> Result<Self, PeriodicError> {
-        for (axis, l) in size.iter().enumerate() {
-            if !(*l > T::ZERO && l.is_finite()) {
-                return Err(PeriodicError::BadEdge { axis });
-            }
-        }
-        Ok(Self { size })
-    }
-
-    /// The edges.
-    pub fn size(&self) -> [T; 3] {
-        self.size
-    }
-
-    /// `L_x L_y L_z`.
-    pub fn volume(&self) -> T {
-        self.size[0] * self.size[1] * self.size[2]
-    }
-
-    /// The minimum image of a separation: each component reduced by a whole number of
-    /// edges into `[-L/2, L/2]`. A function of `r` alone, so separations that differ by
-    /// exactly a box vector give the same bits.
-    pub fn minimum_image(&self, r: T::V3) -> T::V3 {
-        let v = T::xyz(r);
-        let f = |d: usize| {
-            let l = self.size[d];
-            v[d] - T::from_f64(libm::round((v[d] / l).to_f64())) * l
-        };
-        T::v3(f(0), f(1), f(2))
-    }
-
-    /// A position moved by whole edges into `[0, L)` (for the phases of the wave sums).
-    pub fn wrap_into(&self, p: T::V3) -> T::V3 {
-        let v = T::xyz(p);
-        let f = |d: usize| {
-            let l = self.size[d];
-            v[d] - T::from_f64(libm::floor((v[d] / l).to_f64())) * l
-        };
-        T::v3(f(0), f(1), f(2))
-    }
-}
 
 /// The Ewald parameters for one box and one largest radius: the splitting parameter
 /// `xi`, the real-space cutoff and the wave-space cutoff, with the index bounds and
@@ -342,4 +252,22 @@ pub fn tt_product<T: Real>(
     }
     wave::wave_product(ew, eta, pos, radius, x, y);
     Ok(())
+}
+
+/// Block `(p, q)` of the matrix [`assemble_tt`] stores (the pair evaluated from the
+/// higher index, as there), `None` for a sphere inside another's image: the
+/// matrix-free constraint metric's block.
+pub fn tt_block_at<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    p: usize,
+    q: usize,
+) -> Option<T::M3> {
+    let (hi, lo) = (p.max(q), p.min(q));
+    match hi == lo {
+        true => Some(self_tt(ew, eta, radius[hi])),
+        false => pair_tt(ew, eta, radius[hi], radius[lo], pos[hi] - pos[lo]),
+    }
 }

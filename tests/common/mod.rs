@@ -218,6 +218,15 @@ pub fn run<T: Real, const N: usize, const B: usize, E: ExternalForce<T>>(
         .collect()
 }
 
+/// Every integrator, in declaration order.
+pub const ALL_METHODS: [Method; 5] = [
+    Method::Overdamped,
+    Method::Overdamped2,
+    Method::Rattle,
+    Method::RattleStable,
+    Method::Springs,
+];
+
 /// Parameters with the method and solver kind set.
 pub fn params<T: Real>(dt: f64, method: Method, kind: SolverKind) -> Params<T> {
     let mut p = Params::new(T::from_f64(dt));

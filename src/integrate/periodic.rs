@@ -1,0 +1,47 @@
+//! The mobility of a step in a periodic box (feature `periodic`): the Ewald sums of
+//! `mobility::periodic` with parameters derived per step.
+//!
+//! `xi` and the cutoffs come from the box and the step's largest radius by
+//! [`Ewald::new`] on every call, not from the parameters: the largest radius is the
+//! state's (a radius above a stored one would be refused), deriving them costs about
+//! a hundred `exp` (nothing beside one pair block's sums), and `Params` stays small and
+//! `Copy`. The assembly is serial (the banded assembly of [`crate::parallel`] is free
+//! space's); the products over the assembled matrix still run in bands.
+
+use crate::cell::Periodic;
+use crate::error::StepError;
+use crate::mobility::periodic::{self, Ewald};
+use crate::params::Params;
+use crate::real::Real;
+
+/// The Ewald parameters for this box and these spheres (every radius at most the
+/// largest, so the sums accept each one).
+pub(super) fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>, StepError> {
+    let a_max = radius.iter().fold(T::ZERO, |m, &a| m.max(a));
+    Ok(Ewald::new(cell, a_max)?)
+}
+
+/// `mu_tt` of the box into the packed lower triangle `mu` ([`periodic::assemble_tt`]).
+pub(super) fn assemble<T: Real>(
+    p: &Params<T>,
+    cell: Periodic<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    mu: &mut [T::M3],
+) -> Result<(), StepError> {
+    let ew = ewald(cell, radius)?;
+    Ok(periodic::assemble_tt(&ew, p.viscosity, pos, radius, mu)?)
+}
+
+/// `u = mu_tt f` in the box without storing `mu_tt` ([`periodic::tt_product`]).
+pub(super) fn product<T: Real>(
+    p: &Params<T>,
+    cell: Periodic<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    f: &[T::V3],
+    u: &mut [T::V3],
+) -> Result<(), StepError> {
+    let ew = ewald(cell, radius)?;
+    Ok(periodic::tt_product(&ew, p.viscosity, pos, radius, f, u)?)
+}
