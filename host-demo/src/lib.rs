@@ -16,6 +16,7 @@ pub mod auto;
 pub mod charts;
 pub mod claims;
 pub mod figure1;
+pub mod fonts;
 pub mod output;
 pub mod phase;
 pub mod pictures;

@@ -123,6 +123,7 @@ fn quantise(rgb: &[u8]) -> Vec<u8> {
 
 /// Draws one frame (side view, `scale` pixels per length unit) as palette indices.
 fn frame_indices(a: &Animation<'_>, snapshot: &Snapshot, scale: f64) -> Result<Vec<u8>> {
+    crate::fonts::register();
     let (w, h) = a.size;
     let mut rgb = vec![255u8; w as usize * h as usize * 3];
     {

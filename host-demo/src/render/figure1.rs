@@ -94,10 +94,7 @@ fn draw_figure1_scaled(path: &Path, cases: &[Figure1Case], common: bool) -> Resu
             root.draw(&Text::new(
                 case.title.clone(),
                 (px(k, x0), px(k, FIG1_HEADING + 4.0)),
-                (FONT, 21.0 * k)
-                    .into_font()
-                    .style(FontStyle::Bold)
-                    .color(&BLACK),
+                (FONT, 21.0 * k, FontStyle::Bold).into_font().color(&BLACK),
             ))
             .map_err(drawing)?;
             let scale = if common { smallest } else { scales[c] };
@@ -178,10 +175,7 @@ pub fn draw_snapshots(path: &Path, rows: &[SnapshotRow], times: &[f64]) -> Resul
             root.draw(&Text::new(
                 row.title.clone(),
                 (px(k, FIG1_GAP), px(k, top + 4.0)),
-                (FONT, 20.0 * k)
-                    .into_font()
-                    .style(FontStyle::Bold)
-                    .color(&BLACK),
+                (FONT, 20.0 * k, FontStyle::Bold).into_font().color(&BLACK),
             ))
             .map_err(drawing)?;
             for (c, (snap, &asked)) in row.snapshots.iter().zip(times).enumerate() {

@@ -151,10 +151,7 @@ fn draw_category_map<DB: DrawingBackend>(
             + Text::new(
                 m.label.clone(),
                 (px(k, 10.0), px(k, -20.0)),
-                (FONT, 17.0 * k)
-                    .into_font()
-                    .style(FontStyle::Bold)
-                    .color(&BLACK),
+                (FONT, 17.0 * k, FontStyle::Bold).into_font().color(&BLACK),
             )])
         .map_err(drawing)?;
     }

@@ -58,7 +58,7 @@ pub const SERIES_COLORS: [RGBColor; 8] = [
     RGBColor(127, 127, 127),
 ];
 
-const FONT: &str = "sans-serif";
+const FONT: &str = crate::fonts::FAMILY;
 
 fn drawing<E: std::fmt::Display>(e: E) -> anyhow::Error {
     anyhow!("drawing failed: {e}")
@@ -117,6 +117,7 @@ fn save_png<F>(path: &Path, size: (u32, u32), draw: F) -> Result<()>
 where
     F: FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>, f64) -> Result<()>,
 {
+    crate::fonts::register();
     let k = SUPERSAMPLE;
     let (w, h) = size;
     let (bw, bh) = (w * k, h * k);

@@ -166,10 +166,7 @@ fn draw_strips<DB: DrawingBackend>(
             root.draw(&Text::new(
                 strip.label.clone(),
                 (px(k, 16.0), y(0.5 * BAND - 9.0)),
-                (FONT, 16.0 * k)
-                    .into_font()
-                    .style(FontStyle::Bold)
-                    .color(&BLACK),
+                (FONT, 16.0 * k, FontStyle::Bold).into_font().color(&BLACK),
             ))
             .map_err(drawing)?;
         }
