@@ -1,7 +1,7 @@
 //! `level = "auto"` picks the cheapest adequate model from the scene's numbers.
 
-use host_demo::auto::{choose, interaction, stokes_number};
-use host_demo::scene::{Hydrodynamics, Method, Scene};
+use hydrorattle_host::auto::{choose, interaction, stokes_number};
+use hydrorattle_host::scene::{Hydrodynamics, Method, Scene};
 
 fn dimer(density: f64, gravity: f64, separation: f64, vorticity: f64) -> Scene {
     let text = format!(
@@ -76,12 +76,12 @@ fn far_apart_spheres_are_free_draining() {
 #[test]
 fn the_run_records_the_choice() {
     let scene = dimer(0.0045, 1000.0, 3.0, 0.0);
-    let opts = host_demo::sim::RunOptions {
+    let opts = hydrorattle_host::sim::RunOptions {
         progress: false,
         max_steps: Some(5),
         ..Default::default()
     };
-    let r = host_demo::sim::run(&scene, "auto", None, opts).unwrap();
+    let r = hydrorattle_host::sim::run(&scene, "auto", None, opts).unwrap();
     let c = r
         .summary
         .level_choice

@@ -2,8 +2,8 @@
 //! its seed (same seed same bits in f32 and f64; another seed another run; `kT = 0` the
 //! deterministic run).
 
-use host_demo::scene::{Drift, Precision, Scene, Sqrt, Thermal};
-use host_demo::sim::{RunOptions, run};
+use hydrorattle_host::scene::{Drift, Precision, Scene, Sqrt, Thermal};
+use hydrorattle_host::sim::{RunOptions, run};
 
 const SHIPPED: &str = include_str!("../scenes/brownian_chain.toml");
 
@@ -241,7 +241,7 @@ fn fene_dumbbell_scene() {
     assert_eq!(r.summary.failure, None);
     // One frame every 500 steps (1 time unit, 2 relaxation times apart): nearly
     // independent samples; blocks of 10.
-    let frames = host_demo::output::read_xyz_file(&out.join("trajectory.xyz")).unwrap();
+    let frames = hydrorattle_host::output::read_xyz_file(&out.join("trajectory.xyz")).unwrap();
     std::fs::remove_dir_all(&out).unwrap();
     let q2: Vec<f64> = frames[1..]
         .iter()

@@ -1,11 +1,11 @@
 //! The claims' verdicts on made-up series whose verdicts are known, and the same
 //! verdicts from two runs of the Figure 1 cases.
 
-use host_demo::claims::{CaseRun, Claim, Verdict, claims};
-use host_demo::figure1::claims_of;
-use host_demo::scene::Scene;
-use host_demo::sim::{Front, Label, Observables, RunOptions, run};
 use hydrorattle::observables::State;
+use hydrorattle_host::scene::Scene;
+use hydrorattle_host::sim::{Front, Label, Observables, RunOptions, run};
+use hydrorattle_study::claims::{CaseRun, Claim, Verdict, claims};
+use hydrorattle_study::figure1::claims_of;
 
 /// 41 frames at t = 0, 10, ..., 400: state `state(t)`, spin `(rate, coherence)` from
 /// `spin(t)`, centre of mass falling at `speed(t)`.

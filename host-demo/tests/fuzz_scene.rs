@@ -12,8 +12,8 @@
 
 use std::path::PathBuf;
 
-use host_demo::scene::{Level, Precision, Scene, Sqrt};
-use host_demo::sizing::Limits;
+use hydrorattle_host::scene::{Level, Precision, Scene, Sqrt};
+use hydrorattle_host::sizing::Limits;
 
 #[path = "../../tests/common/fuzz.rs"]
 mod fuzz;
@@ -183,7 +183,7 @@ fn case(bytes: &[u8], limits: Limits) -> Result<Option<Scene>, String> {
         Ok(s) => {
             let n = s.particles.len();
             // Springs may rest at length zero; rigid bonds may not.
-            let springs = s.integrator.method == host_demo::scene::Method::Springs;
+            let springs = s.integrator.method == hydrorattle_host::scene::Method::Springs;
             let ok = n > 0
                 && s.species.len() == n
                 && s.particles
@@ -202,7 +202,7 @@ fn case(bytes: &[u8], limits: Limits) -> Result<Option<Scene>, String> {
                 return Err("accepted a scene that breaks an invariant".into());
             }
             // As a run writes its scene.toml: the level's choice applied, then manual.
-            let (mut want, _) = host_demo::sim::resolve_level(&s, "fuzz");
+            let (mut want, _) = hydrorattle_host::sim::resolve_level(&s, "fuzz");
             want.model.level = Level::Manual;
             let text = want.to_toml();
             match Scene::parse_limited(&text, "written.toml", limits) {

@@ -6,9 +6,9 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use host_demo::output::read_xyz_file;
-use host_demo::scene::Scene;
-use host_demo::sim::{BuildError, RunOptions, run};
+use hydrorattle_host::output::read_xyz_file;
+use hydrorattle_host::scene::Scene;
+use hydrorattle_host::sim::{BuildError, RunOptions, run};
 
 fn manifest() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -171,7 +171,9 @@ fn a_matrix_free_brownian_chain_runs_with_the_same_bits_on_any_threads() {
     // No stored mobility: the plan's storage is O(N) (the 256-bead stored thermal
     // layout would hold two packed mobilities, 2 x 2.4 MB).
     let s = Scene::from_path(&scene).unwrap();
-    let bytes = host_demo::sizing::Plan::of(&s).bytes(256, 255).unwrap();
+    let bytes = hydrorattle_host::sizing::Plan::of(&s)
+        .bytes(256, 255)
+        .unwrap();
     assert!(bytes < 1_000_000, "{bytes} bytes of step storage");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -6,10 +6,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use host_demo::pictures::{ANIMATION_FRAMES, ANIMATION_SIZE};
-use host_demo::render::{Animation, Snapshot, chain_colors, draw_timeline, write_gif};
-use host_demo::scene::Scene;
 use hydrorattle::observables::State;
+use hydrorattle_host::scene::Scene;
+use hydrorattle_study::pictures::{ANIMATION_FRAMES, ANIMATION_SIZE};
+use hydrorattle_study::render::{Animation, Snapshot, chain_colors, draw_timeline, write_gif};
 
 fn manifest() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -203,13 +203,14 @@ fn a_wall_scene_s_pictures_draw_the_wall() {
         assert_eq!(png_size(&dir.join(f)), (900, 500), "{f}");
     }
     let scene = Scene::from_path(&path).unwrap();
-    let r = host_demo::sim::run(&scene, "landing", None, Default::default()).unwrap();
+    let r = hydrorattle_host::sim::run(&scene, "landing", None, Default::default()).unwrap();
     assert!(r.summary.landing_time.is_some());
     assert_eq!((r.initial.wall, r.last.wall), (Some(-2.5), Some(-2.5)));
     let draw = |s: &Snapshot, name: &str| {
         let p = out.join(name);
         let colors = chain_colors(1);
-        host_demo::render::draw_configuration(&p, s, &colors, "landed", (600, 300)).unwrap();
+        hydrorattle_study::render::draw_configuration(&p, s, &colors, "landed", (600, 300))
+            .unwrap();
         std::fs::read(p).unwrap()
     };
     let without = Snapshot {

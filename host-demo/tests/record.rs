@@ -252,11 +252,11 @@ fn a_run_of_an_older_version_is_refused_with_the_columns_named() {
     };
     let before = listing(&old);
 
-    let opts = host_demo::sim::RunOptions::default();
-    let limits = host_demo::sizing::Limits::default();
-    let e = host_demo::sim::resume(&old, 40.0, limits, opts).unwrap_err();
+    let opts = hydrorattle_host::sim::RunOptions::default();
+    let limits = hydrorattle_host::sizing::Limits::default();
+    let e = hydrorattle_host::sim::resume(&old, 40.0, limits, opts).unwrap_err();
     let m = e
-        .downcast_ref::<host_demo::sim::ColumnsMismatch>()
+        .downcast_ref::<hydrorattle_host::sim::ColumnsMismatch>()
         .unwrap_or_else(|| panic!("not a ColumnsMismatch: {e:#}"));
     assert_eq!(m.path, csv);
     assert_eq!(m.missing, ["wall_height", "wall_gap", "wall_contacts"]);

@@ -1,11 +1,11 @@
 //! Pictures: each drawing function writes a valid PNG of the expected size. The files
 //! stay in the target's temporary directory (`render/`) for a look by eye.
 
-use host_demo::render::{
+use hydrorattle_host::scene::{Helix, Scene};
+use hydrorattle_study::render::{
     CategoryMap, Figure1Case, LineChart, Mark, Series, Snapshot, category_map, chain_colors,
     draw_configuration, draw_figure1, line_chart,
 };
-use host_demo::scene::{Helix, Scene};
 use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
 

@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use host_demo::output::read_xyz_file;
-use host_demo::scene::Scene;
-use host_demo::sim::{COLUMNS, RunOptions, run};
+use hydrorattle_host::output::read_xyz_file;
+use hydrorattle_host::scene::Scene;
+use hydrorattle_host::sim::{COLUMNS, RunOptions, run};
 
 fn manifest() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -59,7 +59,7 @@ fn every_shipped_scene_runs_and_writes_whole_files() {
         }
         // Bonds held to the tolerance the run used.
         let worst = r.series.iter().map(|o| o.bond_residual).fold(0.0, f64::max);
-        if scene.integrator.method != host_demo::scene::Method::Springs {
+        if scene.integrator.method != hydrorattle_host::scene::Method::Springs {
             assert!(
                 worst <= 10.0 * r.summary.tolerance_used,
                 "{name}: {worst:e}"

@@ -1,7 +1,7 @@
 //! Scene files: every shipped scene parses; the helix generator is exact; every bad
 //! file under `tests/data/bad/` is refused with the line its `# expect-line:` names.
 
-use host_demo::scene::{FIGURE1_SCENES, HeadEnd, Helix, Scene};
+use hydrorattle_host::scene::{FIGURE1_SCENES, HeadEnd, Helix, Scene};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -63,7 +63,7 @@ fn every_shipped_scene_parses() {
         let scene = Scene::from_path(&path).unwrap_or_else(|e| panic!("{e}"));
         assert!(!scene.particles.is_empty(), "{}", path.display());
         // Constrained bonds start at their length (a spring may start stretched).
-        let springs = scene.integrator.method == host_demo::scene::Method::Springs;
+        let springs = scene.integrator.method == hydrorattle_host::scene::Method::Springs;
         for b in scene.bonds.iter().filter(|_| !springs) {
             let s = distance(scene.particles[b.i].position, scene.particles[b.j].position);
             assert!(
@@ -113,11 +113,11 @@ fn figure1_scenes_are_the_papers_cases() {
         // second-order method at dt = 0.1 (docs/FIGURE1.md#figure-1-at-dt--01).
         assert_eq!(
             scene.contact,
-            Some(host_demo::scene::Contact::Hard { capacity: None })
+            Some(hydrorattle_host::scene::Contact::Hard { capacity: None })
         );
         assert_eq!(
             scene.integrator.method,
-            host_demo::scene::Method::Overdamped2
+            hydrorattle_host::scene::Method::Overdamped2
         );
         assert_eq!(scene.integrator.dt, 0.1);
         assert!(scene.integrator.duration >= 400.0);

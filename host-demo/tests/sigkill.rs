@@ -43,10 +43,6 @@ mod fuzz;
 struct Draw(fuzz::Rng);
 
 impl Draw {
-    fn next(&mut self) -> u64 {
-        self.0.next()
-    }
-
     /// An integer in `lo..=hi`.
     fn int(&mut self, lo: u64, hi: u64) -> u64 {
         lo + self.0.below((hi - lo + 1) as usize) as u64
@@ -349,8 +345,9 @@ fn resume_applies_the_output_limits_of_run() {
 fn a_run_without_a_checkpoint_is_refused_by_name() {
     let dir = scratch("none");
     let out = small_run(&dir, 2, 100, &[]);
-    let e = host_demo::sim::resume(&out, 2.0, Default::default(), Default::default()).unwrap_err();
-    let none = e.downcast_ref::<host_demo::sim::NoCheckpoint>();
+    let e = hydrorattle_host::sim::resume(&out, 2.0, Default::default(), Default::default())
+        .unwrap_err();
+    let none = e.downcast_ref::<hydrorattle_host::sim::NoCheckpoint>();
     assert_eq!(
         none.map(|n| n.path.clone()),
         Some(out.join("checkpoint.json"))

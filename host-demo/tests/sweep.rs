@@ -6,8 +6,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use host_demo::scene::{Helix, Scene};
-use host_demo::sweep::Sweep;
+use hydrorattle_host::scene::{Helix, Scene};
+use hydrorattle_host::sweep::Sweep;
 
 const BIN: &str = env!("CARGO_BIN_EXE_host-demo");
 
@@ -332,8 +332,8 @@ fn the_phase_sweep_is_the_phase_grid() {
     let template = Scene::figure1().unwrap().remove(0).1;
     let base = template.helix.unwrap();
     let (ds, hs) = (
-        host_demo::phase::linspace(1.05, 2.0, 6),
-        host_demo::phase::linspace(1.0, 2.5, 6),
+        hydrorattle_host::sweep::linspace(1.05, 2.0, 6),
+        hydrorattle_host::sweep::linspace(1.0, 2.5, 6),
     );
     let cells: Vec<(f64, f64)> = hs
         .iter()
@@ -346,7 +346,7 @@ fn the_phase_sweep_is_the_phase_grid() {
             head_ratio: h,
             ..base
         };
-        let cell = host_demo::phase::with_helix(&template, helix).unwrap();
+        let cell = hydrorattle_study::phase::with_helix(&template, helix).unwrap();
         assert_eq!(
             p.scene, cell,
             "point {} is not the cell D = {d}, head = {h}",
@@ -358,7 +358,7 @@ fn the_phase_sweep_is_the_phase_grid() {
 #[test]
 fn sweep_and_collect_reproduce_the_phase_outcomes() {
     let dir = scratch("phase");
-    host_demo::phase::phase(&dir.join("phase"), 6, None).unwrap();
+    hydrorattle_study::phase::phase(&dir.join("phase"), 6, None).unwrap();
     let file = sweeps().join("phase.toml");
     let out = dir.join("sweep");
     let o = host_demo(&[

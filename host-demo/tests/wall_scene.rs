@@ -4,8 +4,8 @@
 //! and the observables gain the height above the wall and the contacts with it. Bad
 //! `[wall]` tables are in `tests/data/bad/wall_*.toml` (file:line, `scenes.rs`).
 
-use host_demo::scene::{Scene, Wall};
-use host_demo::sim::{OBSERVABLES_CSV, RunOptions, SUMMARY_JSON, run};
+use hydrorattle_host::scene::{Scene, Wall};
+use hydrorattle_host::sim::{OBSERVABLES_CSV, RunOptions, SUMMARY_JSON, run};
 
 /// A sphere `gap` above a wall at `height`, and a tilted dimer beside it, 3 radii
 /// higher, free draining (each sphere falls at Stokes' speed 1 at most: the wall only

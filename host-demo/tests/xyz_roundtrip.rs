@@ -1,7 +1,9 @@
 //! Extended XYZ trajectories: written through an atomic file and read back bit-exact.
 
-use host_demo::output::{AtomicFile, Frame, XYZ_PROPERTIES, XyzWriter, read_xyz_file, tmp_path};
-use host_demo::scene::Scene;
+use hydrorattle_host::output::{
+    AtomicFile, Frame, XYZ_PROPERTIES, XyzWriter, read_xyz_file, tmp_path,
+};
+use hydrorattle_host::scene::Scene;
 
 /// A small deterministic generator (xorshift64*) of awkward doubles.
 struct Numbers(u64);

@@ -292,7 +292,7 @@ pub fn bond_error(e: BondError) -> PyErr {
 }
 
 /// A scene error as `SceneError` with `file`, `line` and `column`.
-pub fn scene_error(py: Python<'_>, e: &host_demo::scene::SceneError) -> PyErr {
+pub fn scene_error(py: Python<'_>, e: &hydrorattle_host::scene::SceneError) -> PyErr {
     let text = |s: &str| {
         s.into_pyobject(py)
             .map_or_else(|_| py.None(), |x| x.into_any().unbind())

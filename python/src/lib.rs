@@ -3,7 +3,7 @@
 //!
 //! * [`mobility`]: the dense RPY / Oseen / free-draining mobility and its product;
 //! * [`system`]: a system stepped by the kernel through the host library's
-//!   [`Engine`](host_demo::sim::Engine);
+//!   [`Engine`](hydrorattle_host::sim::Engine);
 //! * [`runs`]: scene files and runs, through the CLI's own library code;
 //! * [`errors`]: the exception hierarchy mirroring the kernel's typed errors.
 #![forbid(unsafe_code)]

@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use host_demo::output::read_xyz_file;
-use host_demo::scene::{Scene, SceneError};
-use host_demo::sizing::{DEFAULT_LIMIT, DEFAULT_OUTPUT_LIMIT, Limits};
+use hydrorattle_host::output::read_xyz_file;
+use hydrorattle_host::scene::{Scene, SceneError};
+use hydrorattle_host::sizing::{DEFAULT_LIMIT, DEFAULT_OUTPUT_LIMIT, Limits};
 use numpy::IntoPyArray;
 use numpy::ndarray::{Array1, Array3};
 use pyo3::exceptions::{PyOSError, PyRuntimeError};
@@ -30,7 +30,8 @@ pub fn load_scene_json(py: Python<'_>, path: PathBuf) -> PyResult<String> {
     serde_json::to_string(&scene).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
-/// Runs a scene file into `out` as `host-demo run` does, with the GIL released;
+/// Runs a scene file into `out` as `host-demo run` does (its data files; the CLI also
+/// draws pictures after the run), with the GIL released;
 /// returns `summary.json`'s text.
 #[pyfunction]
 #[pyo3(signature = (path, out, checkpoint_every=None, max_storage=None))]
@@ -46,7 +47,7 @@ pub fn run_scene(
         output: DEFAULT_OUTPUT_LIMIT,
     };
     let r = py
-        .detach(|| host_demo::sim::run_scene_file(&path, &out, limits, checkpoint_every, false, 0))
+        .detach(|| hydrorattle_host::sim::run_scene_file(&path, &out, limits, checkpoint_every, false, 0))
         .map_err(|e| host_error(py, e))?;
     if let Some(f) = &r.summary.failure {
         return Err(PyRuntimeError::new_err(format!(
@@ -60,7 +61,7 @@ pub fn run_scene(
 /// `(F, N, 3)`, radii and masses `(N,)` (of the first frame), species.
 #[pyfunction]
 pub fn read_trajectory<'py>(py: Python<'py>, dir: PathBuf) -> PyResult<Bound<'py, PyDict>> {
-    let path = dir.join(host_demo::sim::TRAJECTORY_XYZ);
+    let path = dir.join(hydrorattle_host::sim::TRAJECTORY_XYZ);
     let frames = py
         .detach(|| read_xyz_file(&path))
         .map_err(|e| PyOSError::new_err(format!("{e:#}")))?;
@@ -72,7 +73,7 @@ pub fn read_trajectory<'py>(py: Python<'py>, dir: PathBuf) -> PyResult<Bound<'py
             frames[k].positions.len()
         )));
     }
-    let stack = |get: fn(&host_demo::output::Frame) -> &Vec<[f64; 3]>| {
+    let stack = |get: fn(&hydrorattle_host::output::Frame) -> &Vec<[f64; 3]>| {
         let flat: Vec<f64> = frames
             .iter()
             .flat_map(|f| get(f).iter().flatten().copied())

@@ -3,9 +3,9 @@
 
 use std::time::{Duration, Instant};
 
-use host_demo::scene::Scene;
-use host_demo::sim::{Beads, Engine, resolve_level};
-use host_demo::sizing::DEFAULT_LIMIT;
+use hydrorattle_host::scene::Scene;
+use hydrorattle_host::sim::{Beads, Engine, resolve_level};
+use hydrorattle_host::sizing::DEFAULT_LIMIT;
 use hydrorattle::{Bond, Noise, Real, StepReport};
 use numpy::ndarray::{Array1, Array2};
 use numpy::{
@@ -166,12 +166,12 @@ fn engine_from<T: Real>(
 /// The engine of a scene (its level resolved), in the scene's precision.
 fn engine_of_scene(scene: &Scene) -> PyResult<Inner> {
     let (scene, _) = resolve_level(scene, "scene");
-    let fail = |e: host_demo::sim::BuildError| PyValueError::new_err(e.to_string());
+    let fail = |e: hydrorattle_host::sim::BuildError| PyValueError::new_err(e.to_string());
     Ok(match scene.integrator.precision {
-        host_demo::scene::Precision::F64 => {
+        hydrorattle_host::scene::Precision::F64 => {
             Inner::F64(Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?)
         }
-        host_demo::scene::Precision::F32 => {
+        hydrorattle_host::scene::Precision::F32 => {
             Inner::F32(Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?)
         }
     })

@@ -1,0 +1,22 @@
+//! The host library of hydrorattle, shared by the CLI (`host-demo`), the Python package
+//! and the sweeps. It draws nothing and links no CLI, terminal or plotting crate.
+//!
+//! * [`scene`]: TOML scene files parsed and validated into a plain [`scene::Scene`]
+//!   (errors at file and line), and written back;
+//! * [`sim`]: the run: the [`sim::Engine`] (the host's one call of the kernel step),
+//!   the run's stages, records, checkpoints and resume;
+//! * [`output`]: atomic file writes, trajectories (extended XYZ, GSD), CSV and JSON;
+//! * [`sweep`]: parameter sweeps (sweep files, point folders with signac ids, SLURM and
+//!   GNU parallel engines, the collected table);
+//! * [`auto`], [`sizing`]: the level a scene models and the storage it needs;
+//! * [`progress`]: progress of long jobs, shown by whatever display a front end installs;
+//! * [`provenance`]: the code version and machine a record names.
+
+pub mod auto;
+pub mod output;
+pub mod progress;
+pub mod provenance;
+pub mod scene;
+pub mod sim;
+pub mod sizing;
+pub mod sweep;

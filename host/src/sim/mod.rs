@@ -1,0 +1,527 @@
+//! Runs a scene on the kernel: the precision dispatch, the time loop, observables,
+//! outcome, checkpoints, and the files of a run, each written to a temporary name and
+//! renamed:
+//!
+//! * `trajectory.xyz` (extended XYZ, exact) and `trajectory.gsd` (GSD, HOOMD's format,
+//!   with types and bonds), one frame every `output.every` steps;
+//! * `observables.csv`, one row per frame; its last row is `summary.json`'s
+//!   `final_observables`;
+//! * `summary.json`: the run's record (resolved scene, code version, machine, results);
+//! * `scene.toml`: the resolved scene, which re-runs to the same result;
+//! * `checkpoint.json` with `--checkpoint-every` ([`Checkpoint`]).
+//!
+//! Everything is streamed: memory does not grow with the duration. The state lives in
+//! vectors of any length ([`Beads`]), held with the bonds, parameters and storage by an
+//! [`Engine`], whose `step` is the one call of the kernel's step in the host code
+//! (storage sized for the scene's method, rotation flag, solver and bead count by
+//! [`Plan`](crate::sizing::Plan), under a storage limit checked before anything is
+//! built). The run itself is a short list of stages (`run_loop.rs`); the CLI's `run`
+//! and the Python package call it through [`run_scene_file`].
+
+mod beads;
+mod checkpoint;
+mod columns;
+mod engine;
+mod frames;
+mod lanczos;
+mod record;
+pub mod retry;
+mod run_loop;
+mod tail;
+
+pub use beads::{Beads, BuildError, bonds};
+pub use checkpoint::{CHECKPOINT, Checkpoint, NoCheckpoint};
+pub use columns::{ColumnsMismatch, check_columns};
+pub use engine::{Engine, Extra};
+pub use frames::{KeepFrames, MAX_FRAME_BEADS, MAX_FRAMES, step_at_or_after};
+pub use lanczos::{LanczosTally, NoiseIterations};
+pub use record::{
+    COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
+    TRAJECTORY_XYZ,
+};
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use hydrorattle::{Hydro, Params, Real, Solver as KSolver};
+use serde::Serialize;
+
+use crate::provenance::{CODE_VERSION, Machine};
+use crate::scene::{Flow, Fluid, Hydrodynamics, Precision, Scene};
+use crate::sizing::{DEFAULT_LIMIT, Limits};
+pub use frames::Snapshot;
+
+/// The resolved scene's copy in the output folder.
+pub const SCENE_TOML: &str = "scene.toml";
+/// The run's record in the output folder.
+pub const SUMMARY_JSON: &str = "summary.json";
+
+/// What `summary.json` holds: everything needed to rerun, and the results.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// Scene name (file stem or case).
+    pub scene: String,
+    /// The scene file's path as given, when the run came from a file.
+    pub scene_path: Option<String>,
+    /// The code version (`git describe` at build time).
+    pub code_version: String,
+    /// The machine the run ran on.
+    pub machine: Machine,
+    /// Kernel precision.
+    pub precision: Precision,
+    /// The fluid.
+    pub fluid: Fluid,
+    /// Gravitational acceleration.
+    pub gravity: [f64; 3],
+    /// The ambient flow.
+    pub flow: Flow,
+    /// Number of particles.
+    pub particles: usize,
+    /// Number of bonds.
+    pub bonds: usize,
+    /// The model as run.
+    pub model: crate::scene::Model,
+    /// The integrator as run.
+    pub integrator: crate::scene::Integrator,
+    /// Constraint tolerance actually used (raised to what the precision can reach).
+    pub tolerance_used: f64,
+    /// Contact stiffness (0 when off).
+    pub contact_stiffness: f64,
+    /// Steps asked for.
+    pub steps: usize,
+    /// Steps completed (fewer than `steps` when the run failed).
+    pub steps_done: usize,
+    /// The simulated time the run was resumed from, if it was.
+    pub resumed_from: Option<f64>,
+    /// Wall time of the time loop, seconds.
+    pub wall_time_s: f64,
+    /// Steps per second (of the steps this invocation made).
+    pub steps_per_second: f64,
+    /// Mean constraint iterations per step.
+    pub mean_iterations: f64,
+    /// Observables at the end: the last row of `observables.csv`.
+    pub final_observables: Observables,
+    /// Late-time twist rate (slope over the last quarter of the run's time), rad per
+    /// time unit.
+    pub twist_rate: f64,
+    /// Late state: the named state of most frames in the last quarter of the run's time
+    /// (`observables::State` names), or "failed".
+    pub outcome: String,
+    /// The order in which the bonds first turned near-vertical (the stretching front).
+    pub front: Front,
+    /// Why the run stopped early, if it did.
+    pub failure: Option<String>,
+    /// Brownian steps the kernel refused and the run completed as split steps.
+    pub retries: retry::Retries,
+    /// At temperature: the Lanczos iterations of the noise's square root per kernel
+    /// step (absent for a run without noise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_iterations: Option<NoiseIterations>,
+    /// With a wall: the landing time, the end of the first step after which a sphere
+    /// is held on the wall (`StepReport::wall_contacts > 0`: the first contact);
+    /// `None` without a wall or before any sphere touches it.
+    pub landing_time: Option<f64>,
+    /// What `level = "auto"` chose and why (None for a manual level).
+    pub level_choice: Option<crate::auto::Choice>,
+    /// The scene as run: every default filled in and the `auto` choice applied
+    /// (`scene.toml` holds the same as a scene file).
+    pub resolved_scene: Scene,
+}
+
+impl Summary {
+    /// The record of `scene` before any step: results empty.
+    pub fn for_scene(scene: &Scene, name: &str) -> Summary {
+        Summary {
+            scene: name.to_string(),
+            scene_path: None,
+            code_version: CODE_VERSION.to_string(),
+            machine: Machine::this(),
+            precision: scene.integrator.precision,
+            fluid: scene.fluid,
+            gravity: scene.gravity,
+            flow: scene.flow,
+            particles: scene.particles.len(),
+            bonds: scene.bonds.len(),
+            model: scene.model,
+            integrator: scene.integrator,
+            tolerance_used: scene.integrator.tolerance,
+            contact_stiffness: scene.contact.map_or(0.0, |c| c.stiffness()),
+            steps: scene.integrator.steps(),
+            steps_done: 0,
+            resumed_from: None,
+            wall_time_s: 0.0,
+            steps_per_second: 0.0,
+            mean_iterations: 0.0,
+            final_observables: Observables::default(),
+            twist_rate: 0.0,
+            outcome: String::new(),
+            front: Front::default(),
+            failure: None,
+            retries: retry::Retries::default(),
+            noise_iterations: None,
+            landing_time: None,
+            level_choice: None,
+            resolved_scene: scene.clone(),
+        }
+    }
+}
+
+/// The order in which bonds first turned near-vertical (checked after every step).
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct Front {
+    /// A bond is near-vertical when `|cos|` of its angle with gravity is at least this.
+    pub cos_min: f64,
+    /// Bonds that turned near-vertical at some time.
+    pub count: usize,
+    /// Correlation between bond index (bond 0 at the head) and first-vertical time:
+    /// +1 for a front from the head to the end, -1 the other way, 0 without order.
+    pub correlation: f64,
+    /// Per bond, in bond order, the first time it was near-vertical (None: never).
+    pub first_vertical: Vec<Option<f64>>,
+}
+
+/// A finished run: summary, first and last configurations, the observables series.
+#[derive(Debug, Clone)]
+pub struct RunResult {
+    /// Summary.
+    pub summary: Summary,
+    /// Initial configuration (of this invocation: the checkpoint's for a resumed run).
+    pub initial: Snapshot,
+    /// Final configuration.
+    pub last: Snapshot,
+    /// Observables every `output.every` steps (empty unless
+    /// [`RunOptions::keep_series`]).
+    pub series: Vec<Observables>,
+    /// Configurations at the cadence of [`RunOptions::keep`] (empty by default).
+    pub frames: Vec<Snapshot>,
+    /// Configurations at the times of [`RunOptions::keep`], in the order asked (None
+    /// for a time past the run's last step).
+    pub at: Vec<Option<Snapshot>>,
+}
+
+/// Options of a run.
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions<'a> {
+    /// Show a progress bar (on a terminal, after a second).
+    pub progress: bool,
+    /// Stop after at most this many steps (smoke runs); None: the whole duration.
+    pub max_steps: Option<usize>,
+    /// Largest step storage allowed, bytes.
+    pub max_storage: usize,
+    /// Keep the observables series in memory ([`RunResult::series`]); off, memory does
+    /// not grow with the duration (the files have every row).
+    pub keep_series: bool,
+    /// Write a checkpoint every this much simulated time (rounded to whole steps), when
+    /// the run writes files.
+    pub checkpoint_every: Option<f64>,
+    /// Configurations to keep in memory for pictures (none by default).
+    pub keep: KeepFrames<'a>,
+    /// Threads for the mobility's bands from [`hydrorattle::parallel::BANDED_MIN`] beads
+    /// on (smaller scenes run on the calling thread); 0: every core. The bits do not
+    /// depend on it.
+    pub threads: usize,
+}
+
+impl Default for RunOptions<'_> {
+    fn default() -> Self {
+        RunOptions {
+            progress: false,
+            max_steps: None,
+            max_storage: DEFAULT_LIMIT,
+            keep_series: true,
+            checkpoint_every: None,
+            keep: KeepFrames::default(),
+            threads: 0,
+        }
+    }
+}
+
+impl RunOptions<'static> {
+    /// The options of a run into files, as the CLI makes them: nothing kept in memory.
+    pub fn files(limits: Limits, checkpoint_every: Option<f64>, progress: bool) -> Self {
+        RunOptions {
+            progress,
+            max_storage: limits.storage,
+            keep_series: false,
+            checkpoint_every,
+            ..RunOptions::default()
+        }
+    }
+}
+
+/// Runs `scene`, writing the run's files into `out` when given. Refuses (before
+/// writing anything) a scene whose step storage would exceed `opts.max_storage`.
+pub fn run(scene: &Scene, name: &str, out: Option<&Path>, opts: RunOptions) -> Result<RunResult> {
+    run_from(scene, name, out, opts, Start::default())
+}
+
+/// Where a run comes from, for its record, and where it starts.
+#[derive(Debug, Clone, Default)]
+pub struct Start {
+    /// The scene file, when the run came from one.
+    pub scene_path: Option<PathBuf>,
+    /// The checkpoint to continue from.
+    pub checkpoint: Option<Checkpoint>,
+}
+
+/// [`run`] from `start`. A run that fails before its files are complete removes the
+/// output folder if it created it (and leaves no `*.tmp` in any case).
+pub fn run_from(
+    scene: &Scene,
+    name: &str,
+    out: Option<&Path>,
+    opts: RunOptions,
+    start: Start,
+) -> Result<RunResult> {
+    let (scene, choice) = resolve_level(scene, name);
+    let fresh = out.filter(|d| !d.exists());
+    let origin = run_loop::Origin {
+        scene_path: start.scene_path.map(|p| p.display().to_string()),
+        level_choice: choice,
+        checkpoint: start.checkpoint.as_ref(),
+    };
+    let result = match scene.integrator.precision {
+        Precision::F64 => run_loop::run_t::<f64>(&scene, name, out, opts, origin),
+        Precision::F32 => run_loop::run_t::<f32>(&scene, name, out, opts, origin),
+    };
+    if result.is_err() {
+        if let Some(dir) = fresh.filter(|d| d.exists()) {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+    result
+}
+
+/// `scene` with `level = "auto"` applied (and what was chosen), or as it is.
+pub fn resolve_level(scene: &Scene, name: &str) -> (Scene, Option<crate::auto::Choice>) {
+    if scene.model.level != crate::scene::Level::Auto {
+        return (scene.clone(), None);
+    }
+    let c = crate::auto::choose(scene);
+    log::info!("{name}: level auto: {}", c.reason);
+    (crate::auto::apply(scene, &c), Some(c))
+}
+
+/// What `host-demo run SCENE --out OUT` does: reads the scene file under `limits` and
+/// runs it into `out` (named after the file). The CLI and the Python package
+/// (`hydrorattle.run_scene`) both call this; the run draws nothing (the CLI draws the
+/// pictures after it, from the result).
+pub fn run_scene_file(
+    scene_path: &Path,
+    out: &Path,
+    limits: Limits,
+    checkpoint_every: Option<f64>,
+    progress: bool,
+    threads: usize,
+) -> Result<RunResult> {
+    let scene = Scene::from_path_limited(scene_path, limits)?;
+    log::info!(
+        "scene: {} particles, {} bonds, {:?}, {} steps",
+        scene.particles.len(),
+        scene.bonds.len(),
+        scene.integrator.method,
+        scene.integrator.steps()
+    );
+    let name = scene_name(scene_path);
+    let opts = RunOptions {
+        threads,
+        ..RunOptions::files(limits, checkpoint_every, progress)
+    };
+    let start = Start {
+        scene_path: Some(scene_path.to_path_buf()),
+        checkpoint: None,
+    };
+    run_from(&scene, &name, Some(out), opts, start)
+}
+
+/// A run's name from its scene file: the file stem.
+pub fn scene_name(path: &Path) -> String {
+    path.file_stem()
+        .map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Continues the run whose files are in `dir` from its checkpoint to simulated time
+/// `until`, under `limits`: the files are cut back to the checkpoint and continued, the
+/// summary and `scene.toml` rewritten (with the new duration). The scene to `until` is
+/// read under `limits` as `run` reads a scene file (storage, output size, step count).
+/// A folder without a checkpoint is refused with a [`NoCheckpoint`], and a run whose
+/// `observables.csv` has other columns than this program's (another version's) with a
+/// [`ColumnsMismatch`], both before anything is written.
+pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Result<RunResult> {
+    let checkpoint = Checkpoint::load(dir)?;
+    let rows = dir.join(OBSERVABLES_CSV);
+    check_columns(&crate::output::continued_source(
+        &rows,
+        checkpoint.marks.csv_bytes,
+    ))?;
+    let scene_path = dir.join(SCENE_TOML);
+    // The output limit is the resumed run's, checked below at its own duration.
+    let unlimited = Limits {
+        output: u64::MAX,
+        ..limits
+    };
+    let mut scene = Scene::from_path_limited(&scene_path, unlimited)?;
+    let at = checkpoint.time();
+    let dt = scene.integrator.dt;
+    if !(until.is_finite() && until > at) {
+        bail!("--until {until} must be a time after the checkpoint's t = {at}");
+    }
+    if checkpoint.precision != scene.integrator.precision {
+        bail!(
+            "{}: the checkpoint's precision differs from {}",
+            dir.join(CHECKPOINT).display(),
+            scene_path.display()
+        );
+    }
+    scene.integrator.duration = until;
+    // The scene as `run` would read it (the same checks, by the same reader): the text
+    // is `scene.toml`'s own, as this program writes it, with the new duration.
+    let origin = scene_path.display().to_string();
+    let scene = Scene::parse_limited(&scene.to_toml(), &origin, limits)
+        .with_context(|| format!("resuming to --until {until}"))?;
+    if scene.integrator.steps() as u64 <= checkpoint.step {
+        bail!("--until {until} is not a whole step (dt = {dt}) after the checkpoint's t = {at}");
+    }
+    let name = dir
+        .file_name()
+        .map_or_else(|| "run".to_string(), |s| s.to_string_lossy().into_owned());
+    let start = Start {
+        scene_path: Some(scene_path),
+        checkpoint: Some(checkpoint),
+    };
+    run_from(&scene, &name, Some(dir), opts, start).context("resuming")
+}
+
+/// Kernel parameters for a scene in precision `T`.
+pub fn params<T: Real>(scene: &Scene) -> Params<T> {
+    let i = &scene.integrator;
+    let mut p = Params::new(T::from_f64(i.dt));
+    p.viscosity = T::from_f64(scene.fluid.viscosity);
+    p.fluid_density = T::from_f64(scene.fluid.density);
+    p.gravity = T::v3_from(scene.gravity);
+    p.flow_velocity = T::v3_from(scene.flow.velocity);
+    p.vorticity = T::v3_from(scene.flow.vorticity);
+    p.hydro = match scene.model.hydrodynamics {
+        Hydrodynamics::Rpy => Hydro::Rpy,
+        Hydrodynamics::Oseen => Hydro::Oseen,
+        Hydrodynamics::FreeDraining => Hydro::FreeDraining,
+    };
+    p.method = i.method.kernel();
+    p.rotation = scene.model.rotation;
+    p.matrix_free = i.matrix_free;
+    // f32 cannot reach 1e-10: floor the tolerance at a few hundred ulps.
+    let floor = 256.0 * T::EPSILON.to_f64();
+    p.solver = KSolver {
+        kind: i.solver.kind(),
+        tolerance: T::from_f64(i.tolerance.max(floor)),
+        max_iterations: u32::try_from(i.max_iterations).unwrap_or(u32::MAX),
+    };
+    // `overlap` is about t = 0 (checked when the scene is read and when the run is
+    // prepared); during the run spheres may come to overlap, as in the paper.
+    p.allow_overlap = true;
+    p.spring_stiffness = T::from_f64(i.stiffness);
+    p.fene = i.fene.map(T::from_f64);
+    // The paper's explicit drag can shiver silently (bounded, wrong) beyond its limit:
+    // the demo refuses such steps up front.
+    p.stability_guard = true;
+    p.contacts = scene
+        .contact
+        .and_then(|c| c.hard_capacity(scene.particles.len()))
+        .map(hydrorattle::Contacts::new);
+    p.brownian = scene.brownian.map(|b| hydrorattle::Brownian {
+        temperature: T::from_f64(b.temperature),
+        drift: b.drift.kernel(),
+    });
+    if let Some(b) = scene.brownian {
+        p.noise_sqrt = b.sqrt.kernel();
+    }
+    p.wall = scene
+        .wall
+        .map(|w| hydrorattle::Wall::new(T::from_f64(w.height)));
+    p
+}
+
+fn snapshot<T: Real>(ps: &[T::V3], radius: &[T], time: T) -> Snapshot {
+    Snapshot {
+        time: time.to_f64(),
+        positions: ps.iter().map(|&v| T::v3_to_f64(v)).collect(),
+        radii: radius.iter().map(|r| r.to_f64()).collect(),
+        wall: None,
+    }
+}
+
+/// Least-squares slope of `y` against `x`.
+pub fn slope(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    if points.len() < 2 {
+        return 0.0;
+    }
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+    let (mx, my) = (sx / n, sy / n);
+    let (num, den) = points.iter().fold((0.0, 0.0), |a, p| {
+        (a.0 + (p.0 - mx) * (p.1 - my), a.1 + (p.0 - mx) * (p.0 - mx))
+    });
+    if den > 0.0 { num / den } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Method, Solver};
+    use crate::sizing::Plan;
+    use hydrorattle::Layout;
+
+    #[test]
+    fn the_storage_checked_is_the_storage_the_kernel_asks_for() {
+        let mut scene = Scene::figure1().unwrap().remove(0).1;
+        for method in Method::ALL {
+            for solver in [Solver::Auto, Solver::Sweep, Solver::Newton, Solver::Krylov] {
+                for rotation in [false, true] {
+                    scene.integrator.method = method;
+                    scene.integrator.solver = solver;
+                    scene.model.rotation = rotation;
+                    let (n, b) = (scene.particles.len(), scene.bonds.len());
+                    let want = Layout::for_params(&params::<f64>(&scene), n, b);
+                    assert_eq!(Plan::of(&scene).layout(n, b), Some(want));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_storage_checked_counts_the_thermal_noise() {
+        use crate::scene::{Drift, Sqrt, Thermal};
+        let mut scene = Scene::figure1().unwrap().remove(0).1;
+        scene.contact = None;
+        for method in [Method::Overdamped, Method::Springs] {
+            for sqrt in [Sqrt::Auto, Sqrt::Cholesky, Sqrt::Lanczos] {
+                for drift in [Drift::Midpoint, Drift::Uncorrected] {
+                    scene.integrator.method = method;
+                    scene.brownian = Some(Thermal {
+                        temperature: 1.0,
+                        seed: 1,
+                        drift,
+                        sqrt,
+                    });
+                    let (n, b) = (scene.particles.len(), scene.bonds.len());
+                    let want = Layout::for_params(&params::<f64>(&scene), n, b);
+                    let plain = Layout::for_params(
+                        &params::<f64>(&Scene {
+                            brownian: None,
+                            ..scene.clone()
+                        }),
+                        n,
+                        b,
+                    );
+                    assert_ne!(
+                        want, plain,
+                        "{method:?} {sqrt:?} {drift:?}: noise needs storage"
+                    );
+                    assert_eq!(Plan::of(&scene).layout(n, b), Some(want));
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,411 @@
+//! The run of a scene in precision `T`, as a short list of stages ([`run_t`]):
+//!
+//! 1. [`Engine::new`]: the system (particles, bonds, parameters, storage), checked and
+//!    sized before anything is written; a resumed run takes its checkpoint's state;
+//! 2. [`Tracks::open`]: the files and the trackers (twist, stretching front, late-time
+//!    window, kept frames) with the first frame, or the rows replayed from a checkpoint;
+//! 3. [`Tracks::steps`]: the time loop, a step and what follows it (trackers, frames,
+//!    checkpoints);
+//! 4. [`Tracks::close`]: the closing row, the summary, the files under their final names
+//!    with `summary.json` (and a resumed run's `scene.toml`; a run from the start writes
+//!    it before its first step, so that it can be resumed however it stops).
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use hydrorattle::observables::{StateThresholds, Twist, VerticalFront};
+use hydrorattle::{Real, StepReport};
+
+use super::checkpoint::{Checkpoint, ready_folder};
+use super::engine::Engine;
+use super::frames::Keeper;
+use super::record::{NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, WallGauge, each_row};
+use super::tail::TailSlope;
+use super::{
+    Beads, Front, Observables, RunOptions, RunResult, SCENE_TOML, SUMMARY_JSON, Summary, snapshot,
+};
+use crate::output::{write_atomic, write_json};
+use crate::progress::Progress;
+use crate::scene::{Level, Scene};
+
+/// What a run records about where it came from.
+pub(super) struct Origin<'a> {
+    /// The scene file, when the run came from one.
+    pub scene_path: Option<String>,
+    /// What `level = "auto"` chose.
+    pub level_choice: Option<crate::auto::Choice>,
+    /// The checkpoint the run continues from.
+    pub checkpoint: Option<&'a Checkpoint>,
+}
+
+/// Runs `scene` (its level already applied) from the start or from `origin`'s
+/// checkpoint, writing the run's files into `out` when given.
+pub(super) fn run_t<T: Real>(
+    scene: &Scene,
+    name: &str,
+    out: Option<&Path>,
+    opts: RunOptions,
+    origin: Origin,
+) -> Result<RunResult> {
+    let mut engine = Engine::<T>::new(scene, opts.max_storage)?.with_threads(opts.threads)?;
+    if let Some(c) = origin.checkpoint {
+        c.restore(&mut engine.beads)?;
+        // A Brownian run continues its generator and its retry count.
+        let thermal = scene.brownian.is_some_and(|b| b.temperature > 0.0);
+        match c.noise()? {
+            Some(g) => engine.noise = g,
+            None if thermal => bail!("the checkpoint of a Brownian run has no generator state"),
+            None => {}
+        }
+        engine.retries = c.retries;
+        engine.lanczos = c.lanczos.unwrap_or_default();
+    }
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir).map_err(|e| crate::output::name_error(dir, e))?;
+        ready_folder(dir, scene, origin.checkpoint.is_none())?;
+    }
+    let mut twist_prev = vec![T::ZERO; engine.beads.len()];
+    let mut front_times = vec![-T::ONE; engine.bonds.len()];
+    let mut tracks = Tracks::open(
+        scene,
+        &engine,
+        out,
+        opts,
+        origin.checkpoint,
+        &mut twist_prev,
+        &mut front_times,
+    )?;
+    let (done, failure, wall) = tracks.steps(&mut engine, name)?;
+    tracks.close(engine, done, failure, wall, name, origin)
+}
+
+/// The trackers and files of a run, over the caller's storage.
+struct Tracks<'a, 's, T: Real> {
+    scene: &'s Scene,
+    out: Option<&'s Path>,
+    opts: RunOptions<'s>,
+    rec: Recorder,
+    twist: Twist<'a, T>,
+    front: VerticalFront<'a, T>,
+    tail: TailSlope,
+    series: Vec<Observables>,
+    keeper: Keeper,
+    mass: Vec<T>,
+    gravity: T::V3,
+    bonds: Vec<hydrorattle::Bond<T>>,
+    /// The wall, if any, as the observables see it.
+    wall: Option<WallGauge<T>>,
+    /// The end of the first step after which a sphere was held on the wall.
+    landing: Option<T>,
+    initial: super::Snapshot,
+    /// Steps asked for (the scene's, cut by `max_steps`).
+    steps: usize,
+    /// The first step to make (1, or the one after a checkpoint).
+    first: usize,
+    /// The last frame's observables.
+    last: Observables,
+    total_iterations: u64,
+}
+
+impl<'a, 's, T: Real> Tracks<'a, 's, T> {
+    /// Opens the files and starts the trackers at `engine`'s state: records the first
+    /// frame, or (from a checkpoint) replays the rows written so far.
+    fn open(
+        scene: &'s Scene,
+        engine: &Engine<T>,
+        out: Option<&'s Path>,
+        opts: RunOptions<'s>,
+        from: Option<&Checkpoint>,
+        twist_prev: &'a mut [T],
+        front_times: &'a mut [T],
+    ) -> Result<Self> {
+        let beads = &engine.beads;
+        let gravity = engine.params.gravity;
+        let steps = opts.max_steps.map_or(scene.integrator.steps(), |m| {
+            m.min(scene.integrator.steps())
+        });
+        let rec = Recorder::new(out, scene.topology(), from.map(|c| c.marks))?;
+        let mut twist = Twist::new(twist_prev, T::from_f64(0.25));
+        if let Some(c) = from {
+            c.restore_front(front_times)?;
+        }
+        let mut front = VerticalFront::resume(front_times);
+        if from.is_none() {
+            front.update(
+                &engine.bonds,
+                &beads.pos,
+                gravity,
+                T::from_f64(NEAR_VERTICAL_COS),
+                beads.time,
+            );
+        }
+        let initial = snapshot::<T>(&beads.pos, &beads.radius, beads.time);
+        // The twist tracker starts from the current positions; a resumed run carries the
+        // total on.
+        twist.update(&beads.pos, gravity);
+        let mut tracks = Tracks {
+            scene,
+            out,
+            opts,
+            rec,
+            twist,
+            front,
+            tail: TailSlope::new(steps as f64 * scene.integrator.dt),
+            series: Vec::new(),
+            keeper: Keeper::new(&opts.keep, steps, scene.integrator.dt, beads.len()),
+            mass: (0..beads.len()).map(|i| beads.mass(i)).collect(),
+            gravity,
+            bonds: engine.bonds.clone(),
+            wall: engine.params.wall.map(|w| WallGauge {
+                height: w.height,
+                tolerance: engine.params.solver.tolerance,
+            }),
+            landing: None,
+            initial,
+            steps,
+            first: 1,
+            last: Observables::default(),
+            total_iterations: 0,
+        };
+        match from {
+            Some(c) => {
+                tracks.twist.total = T::from_f64(f64::from_bits(c.twist));
+                // The recorder has cut the rows back to the checkpoint, under the
+                // temporary name: replay them into the twist-rate window (and the series).
+                if let Some(dir) = out {
+                    let rows = crate::output::tmp_path(&dir.join(OBSERVABLES_CSV));
+                    each_row(&rows, c.marks.csv_bytes, |o| tracks.keep_row(o))?;
+                }
+                (tracks.first, tracks.last) = (c.step as usize + 1, c.last);
+                tracks.landing = c.landing.map(|t| T::from_f64(f64::from_bits(t)));
+                tracks.total_iterations = c.total_iterations;
+            }
+            None => {
+                tracks.last = tracks.frame(0, beads, T::ZERO, 0, T::ZERO)?;
+            }
+        }
+        tracks.keeper.take(tracks.first - 1, beads);
+        Ok(tracks)
+    }
+
+    /// A run at temperature (its steps draw noise).
+    fn thermal(&self) -> bool {
+        self.scene.brownian.is_some_and(|b| b.temperature > 0.0)
+    }
+
+    /// The observables of `beads` with the twist so far and a step's solve figures.
+    fn observe(&self, beads: &Beads<T>, twist: T, iterations: u32, tension: T) -> Observables {
+        let observer = Observer {
+            bonds: &self.bonds,
+            mass: &self.mass,
+            gravity: self.gravity,
+            thresholds: StateThresholds::default(),
+            wall: self.wall,
+        };
+        Observables::of(beads, &observer, twist, iterations, tension)
+    }
+
+    /// A row into the late-time window and the series.
+    fn keep_row(&mut self, o: Observables) {
+        self.tail.add(&o);
+        if self.opts.keep_series {
+            self.series.push(o);
+        }
+    }
+
+    /// Records a frame reached at step `step` and its row.
+    fn frame(
+        &mut self,
+        step: usize,
+        beads: &Beads<T>,
+        twist: T,
+        iterations: u32,
+        tension: T,
+    ) -> Result<Observables> {
+        let o = self.observe(beads, twist, iterations, tension);
+        self.rec.record(step as u64, beads, &o)?;
+        self.keep_row(o);
+        Ok(o)
+    }
+
+    /// The time loop: steps `first..=steps`, each followed by [`Tracks::after_step`];
+    /// stops at the first failed step. Returns the last step done, the failure and the
+    /// wall time.
+    fn steps(
+        &mut self,
+        engine: &mut Engine<T>,
+        name: &str,
+    ) -> Result<(usize, Option<String>, f64)> {
+        let bar = if self.opts.progress {
+            Progress::new(self.steps as u64, name)
+        } else {
+            Progress::hidden(self.steps as u64)
+        };
+        let start = Instant::now();
+        let (mut done, mut failure) = (self.first - 1, None);
+        for s in self.first..=self.steps {
+            match engine.step() {
+                Ok(rep) => {
+                    done = s;
+                    self.after_step(s, engine, &rep)?;
+                    // A row the precision could not compute ends the run as a failed
+                    // step does: its rows so far are kept, and the run exits non-zero.
+                    if let Some((column, x)) = self.last.non_finite() {
+                        let t = engine.beads.time.to_f64();
+                        let message = format!(
+                            "step {s} (t = {t}): observable {column} is {x}: the state is beyond what the run's precision can measure"
+                        );
+                        log::warn!("{name}: {message}");
+                        failure = Some(message);
+                        break;
+                    }
+                }
+                Err(e) => {
+                    let t = engine.beads.time;
+                    log::warn!("{name}: step {s} failed at t = {t}: {e}");
+                    failure = Some(format!("step {s} (t = {}): {e}", t.to_f64()));
+                    break;
+                }
+            }
+            if s % 256 == 0 {
+                bar.set_position(s as u64);
+            }
+        }
+        bar.finish();
+        Ok((done, failure, start.elapsed().as_secs_f64()))
+    }
+
+    /// What follows step `s`: the trackers, the scheduled frame, a checkpoint, and the
+    /// closing frame of a run that ends between frames.
+    fn after_step(&mut self, s: usize, engine: &Engine<T>, rep: &StepReport<T>) -> Result<()> {
+        let beads = &engine.beads;
+        let gravity = self.gravity;
+        self.keeper.take(s, beads);
+        self.total_iterations += u64::from(rep.iterations);
+        if self.landing.is_none() && rep.wall_contacts > 0 {
+            self.landing = Some(beads.time);
+        }
+        let tw = self.twist.update(&beads.pos, gravity);
+        let cos_vertical = T::from_f64(NEAR_VERTICAL_COS);
+        self.front
+            .update(&self.bonds, &beads.pos, gravity, cos_vertical, beads.time);
+        let scheduled = s % self.scene.output.every.max(1) == 0;
+        if scheduled {
+            self.last = self.frame(s, beads, tw, rep.iterations, rep.max_tension)?;
+        }
+        // A checkpoint marks the files after the scheduled frames only: the closing
+        // frame of a run that ends between frames is not part of a longer run.
+        if let (Some(t), Some(dir)) = (self.opts.checkpoint_every, self.out) {
+            let k = ((t / self.scene.integrator.dt).round() as usize).max(1);
+            if s % k == 0 {
+                let marks = self.rec.marks()?;
+                let precision = self.scene.integrator.precision;
+                let trackers = (tw, self.front.times());
+                let its = self.total_iterations;
+                let mut c =
+                    Checkpoint::of(s as u64, precision, beads, trackers, its, marks, self.last);
+                if self.thermal() {
+                    c.noise = Some(engine.noise.save());
+                    c.retries = engine.retries;
+                    c.lanczos = Some(engine.lanczos);
+                }
+                c.landing = self.landing.map(|t| t.to_f64().to_bits());
+                c.save(dir)?;
+            }
+        }
+        if s == self.steps && !scheduled {
+            self.last = self.frame(s, beads, tw, rep.iterations, rep.max_tension)?;
+        }
+        Ok(())
+    }
+
+    /// Closes the run after step `done`: a final row when it stopped between frames,
+    /// the summary, the files renamed, and the record (`scene.toml`, `summary.json`).
+    fn close(
+        mut self,
+        engine: Engine<T>,
+        done: usize,
+        failure: Option<String>,
+        wall: f64,
+        name: &str,
+        origin: Origin,
+    ) -> Result<RunResult> {
+        let beads = &engine.beads;
+        if self.last.time != beads.time.to_f64() {
+            let total = self.twist.total;
+            self.last = self.frame(done, beads, total, 0, T::ZERO)?;
+        }
+        let outcome = match (&failure, self.tail.late_state()) {
+            (None, Some(s)) => s.name().to_string(),
+            _ => "failed".to_string(),
+        };
+        let order = self.front.order();
+        let front = Front {
+            cos_min: NEAR_VERTICAL_COS,
+            count: order.count,
+            correlation: order.correlation.to_f64(),
+            first_vertical: self
+                .front
+                .times()
+                .iter()
+                .map(|t| (*t >= T::ZERO).then(|| t.to_f64()))
+                .collect(),
+        };
+        let stepped = done + 1 - self.first;
+        let mut summary = Summary {
+            scene_path: origin.scene_path,
+            particles: beads.len(),
+            bonds: self.bonds.len(),
+            tolerance_used: engine.params.solver.tolerance.to_f64(),
+            steps: self.steps,
+            steps_done: done,
+            resumed_from: origin.checkpoint.map(Checkpoint::time),
+            wall_time_s: wall,
+            steps_per_second: stepped as f64 / wall.max(1e-12),
+            mean_iterations: self.total_iterations as f64 / (done.max(1) as f64),
+            final_observables: self.last,
+            twist_rate: self.tail.slope(),
+            outcome,
+            front,
+            failure,
+            retries: engine.retries,
+            noise_iterations: self
+                .thermal()
+                .then(|| engine.lanczos.record(&engine.params, beads.len())),
+            landing_time: self.landing.map(T::to_f64),
+            level_choice: origin.level_choice,
+            ..Summary::for_scene(self.scene, name)
+        };
+        summary.resolved_scene.model.level = Level::Manual;
+        self.rec.commit()?;
+        if let Some(dir) = self.out {
+            // A resumed run's duration is new; a run from the start wrote its scene
+            // before the first step.
+            if origin.checkpoint.is_some() {
+                let resolved = &summary.resolved_scene;
+                write_atomic(&dir.join(SCENE_TOML), resolved.to_toml().as_bytes())?;
+            }
+            write_json(&dir.join(SUMMARY_JSON), &summary)?;
+        }
+        let (mut frames, mut at) = self.keeper.finish(done, beads);
+        let (mut initial, mut last) = (
+            self.initial,
+            snapshot::<T>(&beads.pos, &beads.radius, beads.time),
+        );
+        // The pictures draw the wall.
+        let wall = self.wall.map(|w| w.height.to_f64());
+        let kept = frames.iter_mut().chain(at.iter_mut().flatten());
+        for s in kept.chain([&mut initial, &mut last]) {
+            s.wall = wall;
+        }
+        Ok(RunResult {
+            summary,
+            initial,
+            last,
+            series: self.series,
+            frames,
+            at,
+        })
+    }
+}

@@ -1,0 +1,200 @@
+//! Sweeps: a grid of scene parameters expanded into points, each run in its own folder
+//! by whichever process, shard or cluster task gets it, and collected into one table.
+//!
+//! # The sweep file
+//!
+//! A scene file with a `[sweep]` table added, or a file holding only a `[sweep]` table
+//! with `base = "scene.toml"` (relative to the sweep file):
+//!
+//! ```toml
+//! [sweep]
+//! base = "../scenes/figure1a.toml"
+//! "integrator.dt" = [0.1, 0.05]                  # a list of values
+//! "helix.head_ratio" = { linspace = [1.0, 2.5, 4] }   # first, last, count
+//! replicas = 4                                   # Brownian runs: seeds s, s+1, s+2, s+3
+//!
+//! [[sweep.zip]]                                  # keys that vary together
+//! "helix.dhat" = [1.50, 1.05]
+//! "model.hydrodynamics" = ["rpy", "free-draining"]
+//! ```
+//!
+//! * Keys are dotted scene keys, quoted; a number indexes a list of tables
+//!   (`"particle.1.radius"`). A key may be one the base scene leaves to its default.
+//! * The lists combine as a product, in file order, the last varying fastest; a
+//!   `[[sweep.zip]]` group is one factor whose lists (of one length) vary together.
+//! * `replicas = K` runs every point K times with `brownian.seed` = the base scene's
+//!   seed (default 1) plus 0, 1, ..., K - 1; it needs thermal noise in every point.
+//! * Every point is resolved and validated before anything runs. An unknown key, an
+//!   empty list, a value the scene refuses, a point given twice, or more than
+//!   [`MAX_POINTS`] points is an error at its file, line and column
+//!   (`sweep.toml:4:21: ...`), as for scenes.
+//!
+//! # Points
+//!
+//! A point's *state point* is its parameters nested at their dots
+//! (`{"helix": {"dhat": 1.05}, "integrator": {"dt": 0.1}}`, with `brownian.seed` for a
+//! replica). Its id is the MD5 of the state point's canonical JSON, computed as signac
+//! computes job ids ([`id`]), so `DIR` is a signac project (`.signac/config`,
+//! `workspace -> points`) and a row project (`workflow.toml`) as it is.
+//!
+//! `DIR/points/<id>/` holds `signac_statepoint.json`, `scene.toml` (the point's
+//! resolved scene) and, once run, the files of a run (`summary.json`,
+//! `observables.csv`, `trajectory.xyz`, `trajectory.gsd`, `checkpoint.json`). They are
+//! byte-identical whichever process ran the point, except four fields of
+//! `summary.json` that describe the execution: `wall_time_s`, `steps_per_second`,
+//! `machine`, and `resumed_from` (the time a resumed run continued from).
+
+mod base;
+pub mod emit;
+mod file;
+pub mod id;
+pub mod run;
+
+use std::path::Path;
+
+use serde::Serialize;
+use serde_json::Value as Json;
+use toml::Value;
+
+use crate::scene::{Scene, SceneError};
+use crate::sizing::Limits;
+
+pub use emit::{Engine, SlurmOptions, emit};
+pub use file::linspace;
+pub use run::{RunReport, Selection, run_points, run_sweep};
+
+/// Most points a sweep may have (replicas counted).
+pub const MAX_POINTS: usize = 100_000;
+
+/// The sweep's record in its folder.
+pub const SWEEP_JSON: &str = "sweep.json";
+/// The folder of the points in the sweep's folder.
+pub const POINTS: &str = "points";
+/// A point's parameters in its folder, as signac names it.
+pub const STATEPOINT_JSON: &str = "signac_statepoint.json";
+
+/// One point of a sweep.
+#[derive(Debug, Clone)]
+pub struct Point {
+    /// Position in the sweep (product order, replicas innermost).
+    pub index: usize,
+    /// The id: MD5 of the state point's canonical JSON ([`id::point_id`]).
+    pub id: String,
+    /// The parameters, as dotted keys in the sweep's key order.
+    pub params: Vec<(String, Value)>,
+    /// Which replica, when the sweep has `replicas` > 1.
+    pub replica: Option<usize>,
+    /// The parameters nested at their dots.
+    pub statepoint: Json,
+    /// The resolved scene.
+    pub scene: Scene,
+}
+
+/// An expanded sweep file.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    /// The parameter keys, in order (`brownian.seed` last with replicas).
+    pub keys: Vec<String>,
+    /// Runs per point (1 without replicas).
+    pub replicas: usize,
+    /// Every point.
+    pub points: Vec<Point>,
+}
+
+impl Sweep {
+    /// Reads, expands and validates a sweep file.
+    pub fn from_path(path: &Path) -> Result<Sweep, SceneError> {
+        let origin = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+            origin: origin.clone(),
+            location: None,
+            message: format!("cannot read sweep file: {e}"),
+            too_large: None,
+        })?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Sweep::parse(&text, &origin, dir)
+    }
+
+    /// Expands and validates sweep text; `origin` names it in errors, `dir` is where
+    /// `base` is found.
+    pub fn parse(text: &str, origin: &str, dir: &Path) -> Result<Sweep, SceneError> {
+        let src = file::Source { text, origin, dir };
+        file::parse(&src, Limits::default())
+    }
+
+    /// The point with this id (or a unique prefix of it, at least 4 characters).
+    pub fn find(&self, id: &str) -> Option<&Point> {
+        let exact = self.points.iter().find(|p| p.id == id);
+        exact.or_else(|| {
+            let mut m = self
+                .points
+                .iter()
+                .filter(|p| id.len() >= 4 && p.id.starts_with(id));
+            match (m.next(), m.next()) {
+                (Some(p), None) => Some(p),
+                _ => None,
+            }
+        })
+    }
+
+    /// `sweep.json`: every point, its id, state point and parameters.
+    pub fn record(&self) -> SweepRecord<'_> {
+        SweepRecord {
+            format: "host-demo sweep 1",
+            id: "md5 of json.dumps(statepoint, sort_keys=True), as signac.job.calc_id",
+            keys: &self.keys,
+            replicas: self.replicas,
+            count: self.points.len(),
+            points: self
+                .points
+                .iter()
+                .map(|p| PointRecord {
+                    index: p.index,
+                    id: &p.id,
+                    replica: p.replica,
+                    parameters: p
+                        .params
+                        .iter()
+                        .map(|(k, v)| (k.clone(), serde_json::to_value(v).unwrap_or(Json::Null)))
+                        .collect(),
+                    statepoint: &p.statepoint,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// What `sweep.json` holds.
+#[derive(Debug, Serialize)]
+pub struct SweepRecord<'a> {
+    /// Format name and version.
+    pub format: &'static str,
+    /// How ids are computed.
+    pub id: &'static str,
+    /// Parameter keys.
+    pub keys: &'a [String],
+    /// Runs per point.
+    pub replicas: usize,
+    /// Number of points.
+    pub count: usize,
+    /// The points.
+    pub points: Vec<PointRecord<'a>>,
+}
+
+/// One point in `sweep.json`.
+#[derive(Debug, Serialize)]
+pub struct PointRecord<'a> {
+    /// Position in the sweep.
+    pub index: usize,
+    /// Id (folder name).
+    pub id: &'a str,
+    /// Replica number, with replicas.
+    pub replica: Option<usize>,
+    /// Parameters by dotted key.
+    pub parameters: serde_json::Map<String, Json>,
+    /// The state point.
+    pub statepoint: &'a Json,
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,446 @@
+//! `host-demo collect DIR`: every point of a sweep in one table, `collected.csv`, and
+//! charts of an observable against a parameter with replica means and error bars.
+//!
+//! Columns: `id`, `index`, the parameters (dotted keys, `brownian.seed` with
+//! replicas), `replica`, `status`, `steps`, `steps_done`, `outcome`, the final
+//! observables (`observables.csv`'s last row), `twist_rate`, `front_correlation`,
+//! `mean_iterations`, one column per claim of the paper (`claim_<id>`: holds, transient
+//! or fails, where the point is a Figure 1 case, empty otherwise), `failure`, and last
+//! the two columns that depend on the machine and its load, `wall_time_s` and
+//! `steps_per_second`.
+//!
+//! Status: `done`; `stopped_early` (a step failed: the summary says why); `error` (the
+//! run could not start: `error.txt`); `unfinished` (a checkpoint, no summary); `missing`.
+//!
+//! A point is a Figure 1 case when its helix is one of the paper's three. Its claims
+//! are judged on its own observables; a claim comparing two cases ("settles faster
+//! than (a)") also needs the other case's point with the same parameters apart from
+//! the helix, and is left empty without one.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use serde_json::Value as Json;
+
+use crate::claims::{CaseRun, SPECS, claims};
+use crate::render::{LineChart, Series, line_chart_with_errors};
+use hydrorattle_host::output::{AtomicFile, CsvWriter, format_f64};
+use hydrorattle_host::scene::Scene;
+use hydrorattle_host::sim::{
+    CHECKPOINT, COLUMNS, Front, OBSERVABLES_CSV, Observables, SCENE_TOML, SUMMARY_JSON,
+};
+use hydrorattle_host::sweep::SWEEP_JSON;
+use hydrorattle_host::sweep::run::{ERROR_TXT, point_dir};
+
+/// The collected table's file name.
+pub const COLLECTED_CSV: &str = "collected.csv";
+
+/// One point as collected.
+#[derive(Debug, Clone)]
+struct Row {
+    id: String,
+    params: Vec<(String, Json)>,
+    replica: Option<u64>,
+    status: &'static str,
+    summary: Option<Json>,
+    error: Option<String>,
+    series: Vec<Observables>,
+    case: Option<&'static str>,
+}
+
+/// What `collect` found.
+#[derive(Debug, Clone)]
+pub struct Collected {
+    /// `collected.csv`.
+    pub csv: PathBuf,
+    /// Points.
+    pub points: usize,
+    /// Points not done, with their status and why.
+    pub problems: Vec<(String, String, String)>,
+    /// The chart drawn, if asked.
+    pub chart: Option<PathBuf>,
+}
+
+fn number(v: Option<&Json>) -> String {
+    match v {
+        Some(Json::Number(n)) if n.is_f64() => n.as_f64().map(format_f64).unwrap_or_default(),
+        Some(Json::Number(n)) => n.to_string(),
+        Some(Json::String(s)) => s.clone(),
+        Some(Json::Bool(b)) => b.to_string(),
+        Some(Json::Null) | None => String::new(),
+        Some(other) => other.to_string(),
+    }
+}
+
+fn read_point(dir: &Path, record: &Json, figure1: &[(&'static str, Scene)]) -> Result<Row> {
+    let id = record["id"]
+        .as_str()
+        .context("a point without id in sweep.json")?;
+    let pdir = point_dir(dir, id);
+    let params: Vec<(String, Json)> = record["parameters"]
+        .as_object()
+        .map(|m| m.iter().map(|(k, v)| (k.clone(), v.clone())).collect())
+        .unwrap_or_default();
+    let summary: Option<Json> = std::fs::read_to_string(pdir.join(SUMMARY_JSON))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let error = std::fs::read_to_string(pdir.join(ERROR_TXT)).ok();
+    let status = match (&summary, &error) {
+        (Some(s), _) if s["failure"].is_null() => "done",
+        (Some(_), _) => "stopped_early",
+        (None, Some(_)) => "error",
+        (None, None) if pdir.join(CHECKPOINT).is_file() => "unfinished",
+        _ => "missing",
+    };
+    let mut series = Vec::new();
+    let mut case = None;
+    if summary.is_some() {
+        let scene = Scene::from_path(&pdir.join(SCENE_TOML)).ok();
+        case = scene.and_then(|s| {
+            let h = s.helix?;
+            figure1
+                .iter()
+                .find(|(_, f)| f.helix == Some(h))
+                .map(|(c, _)| *c)
+        });
+        if case.is_some() {
+            let path = pdir.join(OBSERVABLES_CSV);
+            let text = std::fs::read_to_string(&path)
+                .with_context(|| format!("reading {}", path.display()))?;
+            for (k, line) in text.lines().enumerate().skip(1) {
+                series
+                    .push(Observables::from_row(line).with_context(|| {
+                        format!("{}:{}: unreadable row", path.display(), k + 1)
+                    })?);
+            }
+        }
+    }
+    Ok(Row {
+        id: id.to_string(),
+        params,
+        replica: record["replica"].as_u64(),
+        status,
+        summary,
+        error,
+        series,
+        case,
+    })
+}
+
+fn front(summary: &Json) -> Front {
+    let f = &summary["front"];
+    Front {
+        cos_min: f["cos_min"].as_f64().unwrap_or(0.0),
+        count: f["count"].as_u64().unwrap_or(0) as usize,
+        correlation: f["correlation"].as_f64().unwrap_or(0.0),
+        first_vertical: f["first_vertical"]
+            .as_array()
+            .map(|a| a.iter().map(Json::as_f64).collect())
+            .unwrap_or_default(),
+    }
+}
+
+/// The claims of each Figure 1 point, by claim id.
+fn verdicts(rows: &[Row]) -> Vec<BTreeMap<&'static str, &'static str>> {
+    // Points that differ only in their helix are the cases of one setting.
+    let setting = |r: &Row| -> String {
+        let rest: Vec<String> = r
+            .params
+            .iter()
+            .filter(|(k, _)| !k.starts_with("helix."))
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect();
+        rest.join(",")
+    };
+    let fronts: Vec<Option<Front>> = rows.iter().map(|r| r.summary.as_ref().map(front)).collect();
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let mut out = BTreeMap::new();
+            let (Some(case), Some(f)) = (r.case, &fronts[i]) else {
+                return out;
+            };
+            let mine = setting(r);
+            let mut runs = vec![CaseRun {
+                case,
+                series: &r.series,
+                front: f,
+            }];
+            for (j, other) in rows.iter().enumerate() {
+                if let (Some(c), Some(fj)) = (other.case, &fronts[j]) {
+                    if c != case && !runs.iter().any(|x| x.case == c) && setting(other) == mine {
+                        runs.push(CaseRun {
+                            case: c,
+                            series: &other.series,
+                            front: fj,
+                        });
+                    }
+                }
+            }
+            for c in claims(&runs).into_iter().filter(|c| c.case == case) {
+                if let Some(spec) = SPECS.iter().find(|s| s.id == c.id) {
+                    out.insert(spec.id, c.verdict.name());
+                }
+            }
+            out
+        })
+        .collect()
+}
+
+/// Merges the points of the sweep in `dir` into `DIR/collected.csv` and, with
+/// `chart = Some((key, column))`, draws `DIR/<column>_vs_<key>.png`.
+pub fn collect(dir: &Path, chart: Option<(&str, &str)>) -> Result<Collected> {
+    let path = dir.join(SWEEP_JSON);
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("reading {} (run `host-demo sweep` first)", path.display()))?;
+    let record: Json =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let keys: Vec<String> = record["keys"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(|k| k.as_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    let replicas = record["replicas"].as_u64().unwrap_or(1) > 1;
+    let figure1 = Scene::figure1()?;
+    let rows: Vec<Row> = record["points"]
+        .as_array()
+        .context("sweep.json without points")?
+        .iter()
+        .map(|p| read_point(dir, p, &figure1))
+        .collect::<Result<_>>()?;
+    let verdicts = verdicts(&rows);
+    let observables: Vec<&str> = COLUMNS[1..COLUMNS.len() - 1].to_vec();
+    let mut header: Vec<String> = vec!["id".into(), "index".into()];
+    header.extend(keys.iter().cloned());
+    if replicas {
+        header.push("replica".into());
+    }
+    header.extend(["status", "steps", "steps_done", "outcome"].map(String::from));
+    header.extend(observables.iter().map(|c| c.to_string()));
+    header.push("state".into());
+    header.extend(["twist_rate", "front_correlation", "mean_iterations"].map(String::from));
+    header.extend(SPECS.iter().map(|s| format!("claim_{}", s.id)));
+    header.extend(["failure", "wall_time_s", "steps_per_second"].map(String::from));
+    let csv_path = dir.join(COLLECTED_CSV);
+    let mut csv = CsvWriter::new(AtomicFile::create(&csv_path)?, &header)?;
+    let mut table: Vec<Vec<String>> = Vec::new();
+    let mut problems = Vec::new();
+    for (k, (r, v)) in rows.iter().zip(&verdicts).enumerate() {
+        let s = r.summary.as_ref();
+        let get = |key: &str| number(s.and_then(|s| s.get(key)));
+        let fin = |key: &str| number(s.and_then(|s| s["final_observables"].get(key)));
+        let mut row = vec![r.id.clone(), k.to_string()];
+        for key in &keys {
+            let v = r.params.iter().find(|(p, _)| p == key).map(|(_, v)| v);
+            row.push(number(v));
+        }
+        if replicas {
+            row.push(r.replica.map_or(String::new(), |x| x.to_string()));
+        }
+        row.extend([
+            r.status.to_string(),
+            get("steps"),
+            get("steps_done"),
+            get("outcome"),
+        ]);
+        for c in &observables {
+            row.push(match *c {
+                "com_x" | "com_y" | "com_z" => {
+                    let i = usize::from(c.as_bytes()[4] - b'x');
+                    number(s.and_then(|s| s["final_observables"]["com"].get(i)))
+                }
+                c => fin(c),
+            });
+        }
+        row.push(fin("state"));
+        row.push(get("twist_rate"));
+        row.push(number(s.and_then(|s| s["front"].get("correlation"))));
+        row.push(get("mean_iterations"));
+        row.extend(
+            SPECS
+                .iter()
+                .map(|spec| v.get(spec.id).map_or(String::new(), |x| x.to_string())),
+        );
+        let why = match r.status {
+            "error" => r.error.clone().unwrap_or_default().trim().to_string(),
+            _ => get("failure"),
+        };
+        row.extend([why.clone(), get("wall_time_s"), get("steps_per_second")]);
+        if r.status != "done" {
+            problems.push((r.id.clone(), r.status.to_string(), why));
+        }
+        csv.write_record(&row)?;
+        table.push(row);
+    }
+    csv.into_inner().commit()?;
+    let chart = match chart {
+        Some((x, y)) => Some(draw(dir, &header, &table, x, y, replicas)?),
+        None => None,
+    };
+    Ok(Collected {
+        csv: csv_path,
+        points: rows.len(),
+        problems,
+        chart,
+    })
+}
+
+/// A series of the chart: its name (the other parameters' values) and, per value of
+/// the parameter, the mean of the column and the standard error of the mean.
+type Means = (String, Vec<(f64, f64, f64)>);
+
+/// Column `yi` against column `xi` of the done rows: one series per setting of the other
+/// parameters that vary (columns 2 to `params_end`, replicas and their seeds left out),
+/// each point the mean over the rows with that `x` (replicas) with its standard error
+/// (sample standard deviation over the square root of the count; 0 for one row).
+fn replica_means(
+    header: &[String],
+    table: &[Vec<String>],
+    (xi, yi): (usize, usize),
+    params_end: usize,
+) -> Vec<Means> {
+    let varies = |c: usize| table.iter().any(|r| r[c] != table[0][c]);
+    let others: Vec<usize> = (2..params_end)
+        .filter(|&c| c != xi && header[c] != "replica" && header[c] != "brownian.seed")
+        .filter(|&c| varies(c))
+        .collect();
+    let mut groups: Vec<(String, BTreeMap<String, Vec<f64>>)> = Vec::new();
+    for row in table.iter().filter(|r| r[params_end] == "done") {
+        let (Ok(_), Ok(v)) = (row[xi].parse::<f64>(), row[yi].parse::<f64>()) else {
+            continue;
+        };
+        let name: Vec<String> = others
+            .iter()
+            .map(|&c| format!("{}={}", header[c], row[c]))
+            .collect();
+        let name = name.join(" ");
+        let k = match groups.iter().position(|g| g.0 == name) {
+            Some(k) => k,
+            None => {
+                groups.push((name, BTreeMap::new()));
+                groups.len() - 1
+            }
+        };
+        groups[k].1.entry(row[xi].clone()).or_default().push(v);
+    }
+    groups
+        .into_iter()
+        .map(|(name, by_x)| {
+            let mut pts: Vec<(f64, f64, f64)> = by_x
+                .iter()
+                .map(|(xv, vals)| {
+                    let n = vals.len() as f64;
+                    let mean = vals.iter().sum::<f64>() / n;
+                    let sem = if vals.len() > 1 {
+                        let var = vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+                        (var / n).sqrt()
+                    } else {
+                        0.0
+                    };
+                    (xv.parse().unwrap_or(f64::NAN), mean, sem)
+                })
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            (name, pts)
+        })
+        .collect()
+}
+
+/// Draws column `y` against parameter `x` ([`replica_means`]).
+fn draw(
+    dir: &Path,
+    header: &[String],
+    table: &[Vec<String>],
+    x: &str,
+    y: &str,
+    replicas: bool,
+) -> Result<PathBuf> {
+    let col = |name: &str| header.iter().position(|h| h == name);
+    let params_end = col("status").unwrap_or(2);
+    let xi = col(x).filter(|&c| (2..params_end).contains(&c));
+    let Some(xi) = xi else {
+        let params = header[2..params_end].join(", ");
+        bail!("--x {x:?} is not a parameter of this sweep ({params})");
+    };
+    let Some(yi) = col(y) else {
+        bail!(
+            "--y {y:?} is not a column of collected.csv ({})",
+            header.join(", ")
+        );
+    };
+    let means = replica_means(header, table, (xi, yi), params_end);
+    if means.is_empty() {
+        bail!("no finished point has numbers in {x:?} and {y:?}");
+    }
+    let series = means
+        .iter()
+        .map(|(name, pts)| Series {
+            name: name.clone(),
+            points: pts.iter().map(|p| (p.0, p.1)).collect(),
+        })
+        .collect();
+    let errors: Vec<Vec<f64>> = means
+        .iter()
+        .map(|m| m.1.iter().map(|p| p.2).collect())
+        .collect();
+    let chart = LineChart {
+        title: if replicas {
+            format!("{y} against {x} (mean over replicas, bars: standard error)")
+        } else {
+            format!("{y} against {x}")
+        },
+        x_label: x.to_string(),
+        y_label: y.to_string(),
+        series,
+        ..LineChart::default()
+    };
+    let safe = |s: &str| s.replace(|c: char| !c.is_ascii_alphanumeric() && c != '_', "_");
+    let path = dir.join(format!("{}_vs_{}.png", safe(y), safe(x)));
+    line_chart_with_errors(&path, &chart, &errors, (900, 600))?;
+    Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn replica_means_are_means_with_standard_errors() {
+        let header: Vec<String> = [
+            "id",
+            "index",
+            "T",
+            "dt",
+            "brownian.seed",
+            "replica",
+            "status",
+            "y",
+        ]
+        .map(String::from)
+        .to_vec();
+        let row = |t: &str, dt: &str, seed: &str, y: &str| -> Vec<String> {
+            ["x", "0", t, dt, seed, "0", "done", y]
+                .map(String::from)
+                .to_vec()
+        };
+        let table = vec![
+            row("1", "0.1", "1", "1"),
+            row("1", "0.1", "2", "2"),
+            row("1", "0.1", "3", "6"),
+            row("2", "0.1", "1", "4"),
+            row("1", "0.2", "1", "5"),
+        ];
+        let m = replica_means(&header, &table, (2, 7), 6);
+        // dt varies: two series; T = 1 at dt = 0.1 has three replicas 1, 2, 6:
+        // mean 3, sample variance (4 + 1 + 9) / 2 = 7, standard error sqrt(7 / 3).
+        assert_eq!(m.len(), 2);
+        assert_eq!(m[0].0, "dt=0.1");
+        assert_eq!(m[0].1[0], (1.0, 3.0, (7.0f64 / 3.0).sqrt()));
+        assert_eq!(m[0].1[1], (2.0, 4.0, 0.0));
+        assert_eq!(m[1], ("dt=0.2".to_string(), vec![(1.0, 5.0, 0.0)]));
+    }
+}
