@@ -1,6 +1,7 @@
 //! One method's steps on the paper's 25-bead chain in f32, for instruction counting:
 //! `valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*step_slices*'
-//! target/release/examples/icount o newton 100` and divide `Ir` by the step count.
+//! target/profiling/examples/icount o newton 100` (`cargo build --profile profiling
+//! --example icount`: release code with symbols) and divide `Ir` by the step count.
 //! Arguments: method (`o`, `o2`, `r`, `s`, `sp`), solver (`newton`, `krylov`, `sweep`,
 //! `auto`), steps. Case (c) of Figure 1: head radius 2, tails 1, D = 1.05, dt = 0.01.
 

@@ -1,8 +1,8 @@
 //! Times one method's step on a 25-bead chain, for profiling (perf, callgrind).
 //!
-//! `cargo run --release --example prof -- o|o2|r|s|sp [sweep]`, with `STEPS=n` to set
-//! the number of steps (default 20000). Prints microseconds per step and mean
-//! constraint iterations.
+//! `cargo run --profile profiling --example prof -- o|o2|r|s|sp [sweep]` (release
+//! code with line tables for the profiler), with `STEPS=n` to set the number of steps
+//! (default 20000). Prints microseconds per step and mean constraint iterations.
 
 use glam::DVec3;
 use hydrorattle::*;

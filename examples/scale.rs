@@ -9,7 +9,8 @@
 //! thermal noise at `kT = x` (Overdamped, Springs; midpoint drift, `UNCORRECTED=1` for
 //! the other) by Lanczos (`LTOL=x` its tolerance), and prints its iterations too. For
 //! instruction counts: `valgrind --tool=callgrind --collect-atstart=no
-//! --toggle-collect='*step_slices*' target/release/examples/scale o auto 1024`.
+//! --toggle-collect='*step_slices*' target/profiling/examples/scale o auto 1024` (built
+//! with `--profile profiling`: release code with symbols).
 //! `CHAIN=1` takes the kernel bench's chain (`benches/kernel.rs`, `brownian/...`)
 //! instead of the helix.
 

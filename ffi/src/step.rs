@@ -284,85 +284,34 @@ pub unsafe fn step<T: Precision>(
     }
 }
 
-/// The status of a kernel error, with its payload written into `r`.
+/// The status of a kernel error, with its parts ([`StepError::index`], ...) written
+/// into `r`: the first index (or a count: iterations done go to `error_other`, the
+/// contact capacity to `error_index`), the second, the stage, the value and the limit.
 fn describe<T>(e: StepError, r: &mut HrReport<T>) -> HrStatus {
-    use kernel::{BondError as B, ParticleError as P};
-    let stage = |s: kernel::Stage| s as u32 + 1;
+    // `r` starts zeroed (`hr_step_*`), so a part the error lacks stays 0.
+    let wide = |i: Option<usize>| i.map_or(0, |i| i as u64);
+    r.error_stage = e.stage().map_or(0, |s| s as u32 + 1);
+    r.error_value = e.value().unwrap_or(0.0);
+    r.error_limit = e.limit().unwrap_or(0.0);
+    (r.error_index, r.error_other) = match e {
+        StepError::NoConvergence { .. } => (0, wide(e.count())),
+        StepError::ContactsFull { .. } => (wide(e.count()), 0),
+        _ => (wide(e.index()), wide(e.other())),
+    };
     match e {
         StepError::BadTimeStep => HrStatus::BadTimeStep,
         StepError::BadParameter(_) => HrStatus::BadParameter,
-        StepError::Particle(p) => {
-            (r.error_index, r.error_other) = match p {
-                P::Full => (0, 0),
-                P::NonFinite { particle }
-                | P::BadRadius { particle }
-                | P::BadDensity { particle }
-                | P::Massless { particle }
-                | P::BelowWall { particle } => (particle as u64, 0),
-                P::Nested { i, j } | P::Overlap { i, j } => (i as u64, j as u64),
-            };
-            HrStatus::Particle
-        }
-        StepError::Bond(b) => {
-            (r.error_index, r.error_other) = match b {
-                B::Full => (0, 0),
-                B::SelfBond { bond, particle } | B::OutOfRange { bond, particle } => {
-                    (bond as u64, particle as u64)
-                }
-                B::Duplicate { bond, other } => (bond as u64, other as u64),
-                B::BadLength { bond } => (bond as u64, 0),
-                B::Violated { bond, residual } => {
-                    r.error_value = residual;
-                    (bond as u64, 0)
-                }
-                B::BadTree { particle } => (particle as u64, 0),
-                B::Overstretched { bond, ratio } => {
-                    r.error_value = ratio;
-                    (bond as u64, 0)
-                }
-            };
-            HrStatus::Bond
-        }
-        StepError::Linalg { stage: s, error } => {
-            r.error_stage = stage(s);
-            r.error_index = match error {
-                kernel::LinalgError::NotPositiveDefinite { row }
-                | kernel::LinalgError::Singular { row } => row as u64,
-            };
-            HrStatus::Linalg
-        }
-        StepError::NoConvergence {
-            stage: s,
-            iterations,
-            residual,
-        } => {
-            r.error_stage = stage(s);
-            r.error_other = iterations.into();
-            r.error_value = residual;
-            HrStatus::NoConvergence
-        }
-        StepError::Degenerate { bond } => {
-            r.error_index = bond as u64;
-            HrStatus::Degenerate
-        }
-        StepError::NonFinite { particle } => {
-            r.error_index = particle as u64;
-            HrStatus::NonFinite
-        }
-        StepError::Overlap { i, j } => {
-            (r.error_index, r.error_other) = (i as u64, j as u64);
-            HrStatus::Overlap
-        }
+        StepError::Particle(_) => HrStatus::Particle,
+        StepError::Bond(_) => HrStatus::Bond,
+        StepError::Linalg { .. } => HrStatus::Linalg,
+        StepError::NoConvergence { .. } => HrStatus::NoConvergence,
+        StepError::Degenerate { .. } => HrStatus::Degenerate,
+        StepError::NonFinite { .. } => HrStatus::NonFinite,
+        StepError::Overlap { .. } => HrStatus::Overlap,
         StepError::Storage { .. } => HrStatus::Storage,
         StepError::StateLength => HrStatus::StateLength,
-        StepError::Unstable { dt, limit } => {
-            (r.error_value, r.error_limit) = (dt, limit);
-            HrStatus::Unstable
-        }
-        StepError::ContactsFull { capacity } => {
-            r.error_index = capacity as u64;
-            HrStatus::ContactsFull
-        }
+        StepError::Unstable { .. } => HrStatus::Unstable,
+        StepError::ContactsFull { .. } => HrStatus::ContactsFull,
         StepError::Unsupported(_) => HrStatus::Unsupported,
     }
 }

@@ -2,7 +2,7 @@
 //! [`hydrorattle::StepError`], each carrying `stage`, `index` and `value`;
 //! `SceneError` (a `ValueError`) carries `file`, `line` and `column`.
 
-use hydrorattle::{BondError, LinalgError as KLinalg, ParticleError, StepError as KStep};
+use hydrorattle::{BondError, ParticleError, StepError as KStep};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -101,184 +101,69 @@ fn with_attrs(py: Python<'_>, e: PyErr, attrs: &[(&str, Py<PyAny>)]) -> PyErr {
     e
 }
 
-/// The particle index or pair a particle error names.
-fn particle_index(py: Python<'_>, e: ParticleError) -> Py<PyAny> {
-    let one = |i: usize| i.into_pyobject(py).map(|x| x.into_any().unbind()).ok();
-    let pair = |i: usize, j: usize| PyTuple::new(py, [i, j]).map(|t| t.into_any().unbind()).ok();
-    match e {
-        ParticleError::NonFinite { particle }
-        | ParticleError::BadRadius { particle }
-        | ParticleError::BadDensity { particle }
-        | ParticleError::Massless { particle }
-        | ParticleError::BelowWall { particle } => one(particle),
-        ParticleError::Nested { i, j } | ParticleError::Overlap { i, j } => pair(i, j),
-        ParticleError::Full => None,
-    }
-    .unwrap_or_else(|| py.None())
+/// A Python index: the pair of an overlap or nesting, else the one index.
+fn index_of(py: Python<'_>, pair: Option<(usize, usize)>, one: Option<usize>) -> Py<PyAny> {
+    let obj = match (pair, one) {
+        (Some((i, j)), _) => PyTuple::new(py, [i, j]).map(|t| t.into_any().unbind()).ok(),
+        (None, Some(i)) => i.into_pyobject(py).map(|x| x.into_any().unbind()).ok(),
+        (None, None) => None,
+    };
+    obj.unwrap_or_else(|| py.None())
 }
 
-/// The bond index a bond error names.
-fn bond_index(e: BondError) -> Option<usize> {
-    match e {
-        BondError::SelfBond { bond, .. }
-        | BondError::OutOfRange { bond, .. }
-        | BondError::Duplicate { bond, .. }
-        | BondError::BadLength { bond }
-        | BondError::Violated { bond, .. }
-        | BondError::Overstretched { bond, .. } => Some(bond),
-        BondError::BadTree { particle } => Some(particle),
-        BondError::Full => None,
-    }
-}
-
-/// A kernel step error as the matching Python exception, with `kind`, `stage`,
-/// `index` and `value` set (None where the error has none).
+/// A kernel step error as the matching Python exception, with the kernel's parts
+/// ([`KStep::kind`], ...): `kind`, `stage` (the stage's name), `index` (the particle,
+/// bond or row at fault, a pair as a tuple, or the iterations done / the contact
+/// capacity) and `value` (the residual or ratio, or for `UnstableError` the limit);
+/// None where the error has none.
 pub fn step_error(py: Python<'_>, e: KStep) -> PyErr {
     let msg = e.to_string();
-    let none = || py.None();
-    let int = |i: usize| {
-        i.into_pyobject(py)
-            .map_or_else(|_| py.None(), |x| x.into_any().unbind())
+    let err = match e {
+        KStep::Linalg { .. } => LinalgError::new_err(msg),
+        KStep::NoConvergence { .. } => ConvergenceError::new_err(msg),
+        KStep::Degenerate { .. } => DegenerateError::new_err(msg),
+        KStep::NonFinite { .. } => NonFiniteError::new_err(msg),
+        KStep::Overlap { .. } => OverlapError::new_err(msg),
+        KStep::Unstable { .. } => UnstableError::new_err(msg),
+        KStep::ContactsFull { .. } => ContactsFullError::new_err(msg),
+        KStep::Unsupported(_) => UnsupportedError::new_err(msg),
+        KStep::BadTimeStep
+        | KStep::BadParameter(_)
+        | KStep::Particle(_)
+        | KStep::Bond(_)
+        | KStep::Storage { .. }
+        | KStep::StateLength => InvalidStateError::new_err(msg),
     };
-    let float = |x: f64| {
-        x.into_pyobject(py)
-            .map_or_else(|_| py.None(), |x| x.into_any().unbind())
-    };
-    let text = |s: String| {
+    let text = |s: &str| {
         s.into_pyobject(py)
             .map_or_else(|_| py.None(), |x| x.into_any().unbind())
     };
-    let (err, kind, stage, index, value) = match e {
-        KStep::BadTimeStep => (
-            InvalidStateError::new_err(msg),
-            "BadTimeStep",
-            none(),
-            none(),
-            none(),
-        ),
-        KStep::BadParameter(_) => (
-            InvalidStateError::new_err(msg),
-            "BadParameter",
-            none(),
-            none(),
-            none(),
-        ),
-        KStep::Particle(p) => (
-            InvalidStateError::new_err(msg),
-            "Particle",
-            none(),
-            particle_index(py, p),
-            none(),
-        ),
-        KStep::Bond(b) => {
-            let value = match b {
-                BondError::Violated { residual, .. } => float(residual),
-                BondError::Overstretched { ratio, .. } => float(ratio),
-                _ => none(),
-            };
-            (
-                InvalidStateError::new_err(msg),
-                "Bond",
-                none(),
-                bond_index(b).map_or_else(none, int),
-                value,
-            )
-        }
-        KStep::Linalg { stage, error } => {
-            let row = match error {
-                KLinalg::NotPositiveDefinite { row } | KLinalg::Singular { row } => row,
-            };
-            (
-                LinalgError::new_err(msg),
-                "Linalg",
-                text(format!("{stage:?}")),
-                int(row),
-                none(),
-            )
-        }
-        KStep::NoConvergence {
-            stage,
-            iterations,
-            residual,
-        } => (
-            ConvergenceError::new_err(msg),
-            "NoConvergence",
-            text(format!("{stage:?}")),
-            int(iterations as usize),
-            float(residual),
-        ),
-        KStep::Degenerate { bond } => (
-            DegenerateError::new_err(msg),
-            "Degenerate",
-            none(),
-            int(bond),
-            none(),
-        ),
-        KStep::NonFinite { particle } => (
-            NonFiniteError::new_err(msg),
-            "NonFinite",
-            none(),
-            int(particle),
-            none(),
-        ),
-        KStep::Overlap { i, j } => (
-            OverlapError::new_err(msg),
-            "Overlap",
-            none(),
-            particle_index(py, ParticleError::Overlap { i, j }),
-            none(),
-        ),
-        KStep::Storage { .. } => (
-            InvalidStateError::new_err(msg),
-            "Storage",
-            none(),
-            none(),
-            none(),
-        ),
-        KStep::StateLength => (
-            InvalidStateError::new_err(msg),
-            "StateLength",
-            none(),
-            none(),
-            none(),
-        ),
-        KStep::Unstable { dt: _, limit } => (
-            UnstableError::new_err(msg),
-            "Unstable",
-            none(),
-            none(),
-            float(limit),
-        ),
-        KStep::ContactsFull { capacity } => (
-            ContactsFullError::new_err(msg),
-            "ContactsFull",
-            none(),
-            int(capacity),
-            none(),
-        ),
-        KStep::Unsupported(_) => (
-            UnsupportedError::new_err(msg),
-            "Unsupported",
-            none(),
-            none(),
-            none(),
-        ),
+    let float = |x: Option<f64>| {
+        x.and_then(|x| x.into_pyobject(py).ok())
+            .map_or_else(|| py.None(), |x| x.into_any().unbind())
+    };
+    let value = match e {
+        KStep::Unstable { .. } => e.limit(),
+        _ => e.value(),
     };
     with_attrs(
         py,
         err,
         &[
-            ("kind", text(kind.to_string())),
-            ("stage", stage),
-            ("index", index),
-            ("value", value),
+            ("kind", text(e.kind())),
+            (
+                "stage",
+                e.stage().map_or_else(|| py.None(), |s| text(s.name())),
+            ),
+            ("index", index_of(py, e.pair(), e.index().or(e.count()))),
+            ("value", float(value)),
         ],
     )
 }
 
 /// A refused particle as a `ValueError` naming it (`index` set).
 pub fn particle_error(py: Python<'_>, e: ParticleError) -> PyErr {
-    let index = particle_index(py, e);
+    let index = index_of(py, e.pair(), e.index());
     with_attrs(
         py,
         PyValueError::new_err(e.to_string()),

@@ -73,15 +73,12 @@ pub fn viscosity(eta: f64) -> PyResult<f64> {
     }
 }
 
-/// The kernel's hydrodynamic level from its name.
+/// The kernel's hydrodynamic level from its name (the kernel's names; `free_draining`
+/// too, the Python spelling of `free-draining` that earlier releases accepted).
 pub fn hydro(name: &str) -> PyResult<hydrorattle::Hydro> {
     match name {
-        "rpy" => Ok(hydrorattle::Hydro::Rpy),
-        "oseen" => Ok(hydrorattle::Hydro::Oseen),
-        "free-draining" | "free_draining" => Ok(hydrorattle::Hydro::FreeDraining),
-        _ => Err(PyValueError::new_err(format!(
-            "hydro must be 'rpy', 'oseen' or 'free-draining', not {name:?}"
-        ))),
+        "free_draining" => Ok(hydrorattle::Hydro::FreeDraining),
+        _ => crate::params::pick("hydro", name),
     }
 }
 

@@ -1,20 +1,19 @@
 //! Kernel parameters from keyword arguments, with the kernel's names and defaults.
 
-use hydrorattle::{Brownian, Contacts, Drift, Method, NoiseSqrt, Params, Real, SolverKind, Wall};
+use hydrorattle::{
+    Brownian, Contacts, Drift, Method, Named, NoiseSqrt, Params, Real, SolverKind, Wall,
+};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// A named choice, or a `ValueError` listing the names.
-fn pick<X: Copy>(what: &str, name: &str, choices: &[(&str, X)]) -> PyResult<X> {
-    choices
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|&(_, x)| x)
-        .ok_or_else(|| {
-            let names: Vec<&str> = choices.iter().map(|(n, _)| *n).collect();
-            PyValueError::new_err(format!("{what} must be one of {names:?}, not {name:?}"))
-        })
+/// The kernel's value called `name` ([`Named::from_name`]), or a `ValueError` listing
+/// the kernel's names for `what`.
+pub fn pick<X: Named>(what: &str, name: &str) -> PyResult<X> {
+    X::from_name(name).map_err(|e| {
+        let names = e.expected.join("\", \"");
+        PyValueError::new_err(format!("{what} must be one of \"{names}\", not {name:?}"))
+    })
 }
 
 /// Kernel parameters in precision `T` from keyword arguments with the kernel's names
@@ -41,19 +40,7 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
         let k: String = k.extract()?;
         match k.as_str() {
             "dt" => {}
-            "method" => {
-                p.method = pick(
-                    "method",
-                    &x.extract::<String>()?,
-                    &[
-                        ("overdamped", Method::Overdamped),
-                        ("overdamped2", Method::Overdamped2),
-                        ("rattle", Method::Rattle),
-                        ("rattle-stable", Method::RattleStable),
-                        ("springs", Method::Springs),
-                    ],
-                )?
-            }
+            "method" => p.method = pick::<Method>("method", &x.extract::<String>()?)?,
             "viscosity" => p.viscosity = T::from_f64(x.extract()?),
             "fluid_density" => p.fluid_density = T::from_f64(x.extract()?),
             "gravity" => p.gravity = v3(x)?,
@@ -62,18 +49,7 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
             "hydro" => p.hydro = crate::input::hydro(&x.extract::<String>()?)?,
             "rotation" => p.rotation = x.extract()?,
             "matrix_free" => p.matrix_free = x.extract()?,
-            "solver" => {
-                p.solver.kind = pick(
-                    "solver",
-                    &x.extract::<String>()?,
-                    &[
-                        ("auto", SolverKind::Auto),
-                        ("sweep", SolverKind::Sweep),
-                        ("newton", SolverKind::Newton),
-                        ("krylov", SolverKind::Krylov),
-                    ],
-                )?
-            }
+            "solver" => p.solver.kind = pick::<SolverKind>("solver", &x.extract::<String>()?)?,
             "tolerance" => p.solver.tolerance = T::from_f64(x.extract()?),
             "max_iterations" => p.solver.max_iterations = x.extract()?,
             "allow_overlap" => p.allow_overlap = x.extract()?,
@@ -89,27 +65,10 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
                     .map(|h| Wall::new(T::from_f64(h)))
             }
             "temperature" => temperature = x.extract::<Option<f64>>()?,
-            "drift" => {
-                drift = pick(
-                    "drift",
-                    &x.extract::<String>()?,
-                    &[
-                        ("midpoint", Drift::Midpoint),
-                        ("uncorrected", Drift::Uncorrected),
-                    ],
-                )?
-            }
+            "drift" => drift = pick::<Drift>("drift", &x.extract::<String>()?)?,
             "seed" => seed = x.extract()?,
             "noise_sqrt" => {
-                p.noise_sqrt = pick(
-                    "noise_sqrt",
-                    &x.extract::<String>()?,
-                    &[
-                        ("auto", NoiseSqrt::Auto),
-                        ("cholesky", NoiseSqrt::Cholesky),
-                        ("lanczos", NoiseSqrt::Lanczos),
-                    ],
-                )?
+                p.noise_sqrt = pick::<NoiseSqrt>("noise_sqrt", &x.extract::<String>()?)?
             }
             "lanczos_tolerance" => p.lanczos.tolerance = T::from_f64(x.extract()?),
             "lanczos_max_iterations" => p.lanczos.max_iterations = x.extract()?,

@@ -80,7 +80,7 @@ def test_a_failed_step_changes_nothing_and_names_its_stage():
     with pytest.raises(hr.ConvergenceError) as e:
         s.step(10)
     assert isinstance(e.value, hr.StepError)
-    assert e.value.kind == "NoConvergence" and e.value.stage == "Positions"
+    assert e.value.kind == "no_convergence" and e.value.stage == "positions"
     assert e.value.index == 1 and e.value.value > 1e-14
     assert s.state_bits() == before
     with pytest.raises(hr.NonFiniteError) as e:

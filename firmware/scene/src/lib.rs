@@ -71,60 +71,42 @@ pub struct Helix {
     pub length: [f64; B],
 }
 
+/// The scene's helix in the kernel's terms (the host scenes build theirs from the same
+/// function, [`hydrorattle::helix`]).
+pub const SCENE_HELIX: hydrorattle::helix::Helix = hydrorattle::helix::Helix {
+    tails: B,
+    head_ratio: HEAD_RADIUS,
+    dhat: DHAT,
+    radius: HELIX_RADIUS,
+    pitch: HELIX_PITCH,
+    head_end: hydrorattle::helix::HeadEnd::Bottom,
+};
+
 /// The chain with `tails` tails (the unused entries are zero). `None` when the helix
 /// cannot be built (fewer than one tail, or more than `N - 1`).
 pub fn helix(tails: usize) -> Option<Helix> {
-    if tails == 0 || tails > B {
+    if tails > B {
         return None;
     }
-    let tail_bond = DHAT * 2.0;
-    let head_bond = DHAT * (HEAD_RADIUS + 1.0);
-    let dphi = angular_step(HELIX_RADIUS, HELIX_PITCH, tail_bond);
-    // The head sits on the axis, one head bond from the first tail.
-    let lift = libm::sqrt(head_bond * head_bond - HELIX_RADIUS * HELIX_RADIUS);
+    let h = hydrorattle::helix::Helix {
+        tails,
+        ..SCENE_HELIX
+    };
     let mut pos = [[0.0; 3]; N];
     let mut radius = [0.0; N];
     let mut length = [0.0; B];
-    radius[0] = HEAD_RADIUS;
-    for k in 0..tails {
-        let phi = k as f64 * dphi;
-        let z = lift + HELIX_PITCH * phi / (2.0 * core::f64::consts::PI);
-        pos[k + 1] = [
-            HELIX_RADIUS * libm::cos(phi),
-            HELIX_RADIUS * libm::sin(phi),
-            z,
-        ];
-        radius[k + 1] = 1.0;
-        length[k] = DHAT * (radius[k] + radius[k + 1]);
+    for (k, p) in h.positions().ok()?.enumerate() {
+        pos[k] = p;
+        radius[k] = h.bead_radius(k);
+    }
+    for (k, l) in length.iter_mut().enumerate().take(tails) {
+        *l = h.bond_length(k);
     }
     Some(Helix {
         pos,
         radius,
         length,
     })
-}
-
-/// The angle between consecutive tails, in `(0, pi]`: the root of
-/// `(2 R sin(x / 2))^2 + (p x / 2 pi)^2 = d^2` by bisection down to adjacent doubles
-/// (the chord grows with `x` there, and the scene's numbers keep the root inside).
-fn angular_step(r: f64, pitch: f64, d: f64) -> f64 {
-    let chord2 = |x: f64| {
-        let across = 2.0 * r * libm::sin(0.5 * x);
-        let up = pitch * x / (2.0 * core::f64::consts::PI);
-        across * across + up * up
-    };
-    let (mut lo, mut hi) = (0.0_f64, core::f64::consts::PI);
-    loop {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            return mid;
-        }
-        if chord2(mid) < d * d {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
 }
 
 /// Fills `ps` (which must be empty) with the chain and returns its bonds.
@@ -377,7 +359,11 @@ where
         Err(e) => {
             // `write_str`, not `{}`: a `&str` through `{}` links core's padding code.
             write!(w, "failed at step {}: ", e.step)?;
-            w.write_str(error_name(&e.error))?;
+            w.write_str(e.error.kind())?;
+            if let Some(what) = e.error.detail() {
+                w.write_str(" ")?;
+                w.write_str(what)?;
+            }
             w.write_str("\n")
         }
     }
@@ -410,25 +396,4 @@ pub fn host_summaries(only: &[&str]) -> alloc::string::String {
         );
     }
     out
-}
-
-/// The variant of a step error, without its payload (whose floats would need float
-/// formatting).
-pub fn error_name(e: &StepError) -> &'static str {
-    match e {
-        StepError::BadTimeStep => "BadTimeStep",
-        StepError::BadParameter(name) => name,
-        StepError::Particle(_) => "Particle",
-        StepError::Bond(_) => "Bond",
-        StepError::Linalg { .. } => "Linalg",
-        StepError::NoConvergence { .. } => "NoConvergence",
-        StepError::Degenerate { .. } => "Degenerate",
-        StepError::NonFinite { .. } => "NonFinite",
-        StepError::Overlap { .. } => "Overlap",
-        StepError::Storage { .. } => "Storage",
-        StepError::StateLength => "StateLength",
-        StepError::Unstable { .. } => "Unstable",
-        StepError::ContactsFull { .. } => "ContactsFull",
-        StepError::Unsupported(what) => what,
-    }
 }

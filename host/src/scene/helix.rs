@@ -1,10 +1,9 @@
 //! The helix generator: the paper's head-and-tails chain, exact to the last bit.
 
+use hydrorattle::helix::HelixError;
 use serde::{Deserialize, Serialize};
 
-use super::{
-    DEFAULT_DENSITY, DEFAULT_HEAD_RATIO, DEFAULT_HELIX_PITCH, DEFAULT_HELIX_RADIUS, TAIL_RADIUS,
-};
+use super::{DEFAULT_DENSITY, DEFAULT_HEAD_RATIO, DEFAULT_HELIX_PITCH, DEFAULT_HELIX_RADIUS};
 
 /// Which end of the helix the head sits at.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -75,63 +74,63 @@ pub struct Chain {
 }
 
 impl Helix {
-    /// Head radius (tail radius is [`TAIL_RADIUS`]).
+    /// The kernel's helix ([`hydrorattle::helix`]): the one geometry the scenes and the
+    /// firmware build.
+    pub fn geometry(&self) -> hydrorattle::helix::Helix {
+        hydrorattle::helix::Helix {
+            tails: self.tails,
+            head_ratio: self.head_ratio,
+            dhat: self.dhat,
+            radius: self.radius,
+            pitch: self.pitch,
+            head_end: match self.head_end {
+                HeadEnd::Bottom => hydrorattle::helix::HeadEnd::Bottom,
+                HeadEnd::Top => hydrorattle::helix::HeadEnd::Top,
+            },
+        }
+    }
+
+    /// Head radius (tail radius is [`TAIL_RADIUS`](super::TAIL_RADIUS)).
     pub fn head_radius(&self) -> f64 {
-        self.head_ratio * TAIL_RADIUS
+        self.geometry().head_radius()
     }
 
     /// Length of the head-to-first-tail bond.
     pub fn head_bond(&self) -> f64 {
-        self.dhat * (self.head_radius() + TAIL_RADIUS)
+        self.geometry().head_bond()
     }
 
     /// Length of a tail-to-tail bond.
     pub fn tail_bond(&self) -> f64 {
-        self.dhat * 2.0 * TAIL_RADIUS
+        self.geometry().tail_bond()
     }
 
-    /// Angular step between consecutive tails: the `dphi` in `(0, pi]` with
-    /// `(2 R sin(dphi/2))^2 + (p dphi / 2 pi)^2 = d^2`, found by bisection to the last
-    /// bit (the left side increases strictly on that interval).
+    /// Angular step between consecutive tails
+    /// ([`hydrorattle::helix::Helix::angular_step`]).
     pub fn angular_step(&self) -> Result<f64, String> {
-        let (r, p, d) = (self.radius, self.pitch, self.tail_bond());
-        let chord2 = |x: f64| {
-            let h = 2.0 * r * (0.5 * x).sin();
-            let v = p * x / (2.0 * std::f64::consts::PI);
-            h * h + v * v
-        };
-        let pi = std::f64::consts::PI;
-        if chord2(pi) < d * d {
-            return Err(format!(
-                "helix too tight: tail bond length {d} exceeds the largest chord \
-                 {:.6} of a half turn (radius {r}, pitch {p}); increase radius or pitch",
-                chord2(pi).sqrt()
-            ));
+        self.geometry().angular_step().map_err(|e| self.describe(e))
+    }
+
+    /// A kernel refusal in the scene's terms.
+    fn describe(&self, e: HelixError) -> String {
+        let (r, p) = (self.radius, self.pitch);
+        match e {
+            HelixError::NoTails => "helix needs at least one tail".into(),
+            HelixError::TooTight { bond, max_chord } => format!(
+                "helix too tight: tail bond length {bond} exceeds the largest chord \
+                 {max_chord:.6} of a half turn (radius {r}, pitch {p}); increase radius or pitch"
+            ),
+            HelixError::HeadTooShort { head_bond } => format!(
+                "helix radius {r} exceeds the head bond length {head_bond} = dhat (head_ratio + 1): \
+                 the head on the axis cannot reach the first tail; choose radius <= {head_bond}"
+            ),
         }
-        let (mut lo, mut hi) = (0.0_f64, pi);
-        loop {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                break;
-            }
-            if chord2(mid) < d * d {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let best = if (chord2(lo) - d * d).abs() <= (chord2(hi) - d * d).abs() {
-            lo
-        } else {
-            hi
-        };
-        Ok(best)
     }
 
     /// Checks the numbers (ranges, finiteness) and the geometry.
     pub fn check(&self) -> Result<(), String> {
         if self.tails < 1 {
-            return Err("helix needs at least one tail".into());
+            return Err(self.describe(HelixError::NoTails));
         }
         for (name, value, min, strict) in [
             ("head_ratio", self.head_ratio, 0.0, true),
@@ -142,49 +141,26 @@ impl Helix {
         ] {
             check_number(name, value, min, strict)?;
         }
-        if self.radius > self.head_bond() {
-            return Err(format!(
-                "helix radius {} exceeds the head bond length {} = dhat (head_ratio + 1): \
-                 the head on the axis cannot reach the first tail; choose radius <= {}",
-                self.radius,
-                self.head_bond(),
-                self.head_bond()
-            ));
-        }
-        self.angular_step().map(|_| ())
+        self.geometry()
+            .positions()
+            .map(|_| ())
+            .map_err(|e| self.describe(e))
     }
 
     /// Generates the chain: bead 0 is the head, beads `1..=tails` the tails, bonds
     /// `(k, k + 1, dhat (a_k + a_{k+1}))`.
     pub fn generate(&self) -> Result<Chain, String> {
         self.check()?;
-        let dphi = self.angular_step()?;
-        let sign = match self.head_end {
-            HeadEnd::Bottom => 1.0,
-            HeadEnd::Top => -1.0,
-        };
-        let r = self.radius;
-        let lift = (self.head_bond().powi(2) - r * r).max(0.0).sqrt();
+        let h = self.geometry();
         let n = self.tails + 1;
-        let mut chain = Chain {
-            positions: Vec::with_capacity(n),
-            radii: Vec::with_capacity(n),
+        Ok(Chain {
+            positions: h.positions().map_err(|e| self.describe(e))?.collect(),
+            radii: (0..n).map(|k| h.bead_radius(k)).collect(),
             densities: vec![self.density; n],
-            bonds: Vec::with_capacity(self.tails),
-        };
-        chain.positions.push([0.0, 0.0, 0.0]);
-        chain.radii.push(self.head_radius());
-        for k in 0..self.tails {
-            let phi = sign * (k as f64) * dphi;
-            let z = sign * lift + self.pitch * phi / (2.0 * std::f64::consts::PI);
-            chain.positions.push([r * phi.cos(), r * phi.sin(), z]);
-            chain.radii.push(TAIL_RADIUS);
-        }
-        for k in 0..self.tails {
-            let length = self.dhat * (chain.radii[k] + chain.radii[k + 1]);
-            chain.bonds.push((k, k + 1, length));
-        }
-        Ok(chain)
+            bonds: (0..self.tails)
+                .map(|k| (k, k + 1, h.bond_length(k)))
+                .collect(),
+        })
     }
 }
 

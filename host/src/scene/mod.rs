@@ -45,6 +45,7 @@ mod error;
 mod helix;
 mod kernel;
 mod model;
+mod names;
 mod precision;
 mod raw;
 mod resolve;
@@ -72,7 +73,7 @@ use crate::sizing::{DEFAULT_LIMIT, Limits};
 use raw::RawScene;
 
 /// Radius of a tail bead of the helix generator: the length unit of the demo scenes.
-pub const TAIL_RADIUS: f64 = 1.0;
+pub const TAIL_RADIUS: f64 = hydrorattle::helix::TAIL_RADIUS;
 /// Default particle density: with gravity 1 and fluid density 0, a bead of radius 1
 /// has buoyant weight `4/3 pi 4.5 = 6 pi` and settles alone at speed 1 (`eta = 1`).
 pub const DEFAULT_DENSITY: f64 = 4.5;

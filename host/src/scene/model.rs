@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::names::{Kernel, by_kernel_name};
+
 /// The fluid around the particles.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Fluid {
@@ -47,20 +49,37 @@ pub struct Bond {
     pub length: f64,
 }
 
-/// Hydrodynamic interaction model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+/// Hydrodynamic interaction model (named by the kernel's [`hydrorattle::Hydro`] names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Hydrodynamics {
     /// Rotne-Prager-Yamakawa grand mobility (with its overlap regularisation).
     #[default]
-    #[serde(rename = "rpy")]
     Rpy,
     /// Oseen tensor (not positive definite when beads come close).
-    #[serde(rename = "oseen")]
     Oseen,
     /// Self terms only: no hydrodynamic interaction between beads.
-    #[serde(rename = "free-draining")]
     FreeDraining,
 }
+
+impl Hydrodynamics {
+    /// The kernel's model.
+    pub fn kernel(self) -> hydrorattle::Hydro {
+        match self {
+            Self::Rpy => hydrorattle::Hydro::Rpy,
+            Self::Oseen => hydrorattle::Hydro::Oseen,
+            Self::FreeDraining => hydrorattle::Hydro::FreeDraining,
+        }
+    }
+}
+
+impl Kernel for Hydrodynamics {
+    type K = hydrorattle::Hydro;
+    const ALL: &'static [Self] = &[Self::Rpy, Self::Oseen, Self::FreeDraining];
+    fn kernel(self) -> hydrorattle::Hydro {
+        Hydrodynamics::kernel(self)
+    }
+}
+by_kernel_name!(Hydrodynamics);
 
 /// Whether the driver may pick the model level itself.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -102,25 +121,30 @@ pub struct Model {
     pub overlap: Overlap,
 }
 
-/// Time integration method (`docs/MODEL.md#integrators`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// Time integration method (`docs/MODEL.md#integrators`), named by the kernel's
+/// [`hydrorattle::Method`] names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
     /// First-order overdamped step with constraint projection (HydroSHAKE).
-    #[serde(rename = "overdamped")]
     Overdamped,
     /// Second-order (predictor-corrector) overdamped step.
-    #[serde(rename = "overdamped2")]
     Overdamped2,
     /// The paper's inertial HydroRATTLE, explicit drag.
-    #[serde(rename = "rattle")]
     Rattle,
     /// Inertial RATTLE with a drag treatment stable at any `dt`.
-    #[serde(rename = "rattle-stable")]
     RattleStable,
     /// Hookean springs instead of constraints.
-    #[serde(rename = "springs")]
     Springs,
 }
+
+impl Kernel for Method {
+    type K = hydrorattle::Method;
+    const ALL: &'static [Self] = &Method::ALL;
+    fn kernel(self) -> hydrorattle::Method {
+        Method::kernel(self)
+    }
+}
+by_kernel_name!(Method);
 
 impl Method {
     /// Every method, in declaration order.
@@ -149,9 +173,8 @@ impl Method {
     }
 }
 
-/// Constraint solver.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
+/// Constraint solver (named by the kernel's [`hydrorattle::SolverKind`] names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Solver {
     /// The kernel's choice: Newton up to [`hydrorattle::DENSE_BONDS_MAX`] bonds, Krylov
     /// above (the same bits as Newton for the small scenes).
@@ -166,6 +189,15 @@ pub enum Solver {
     /// mobility product per iteration (thousands of beads).
     Krylov,
 }
+
+impl Kernel for Solver {
+    type K = hydrorattle::SolverKind;
+    const ALL: &'static [Self] = &[Self::Auto, Self::Sweep, Self::Newton, Self::Krylov];
+    fn kernel(self) -> hydrorattle::SolverKind {
+        self.kind()
+    }
+}
+by_kernel_name!(Solver);
 
 impl Solver {
     /// The kernel's solver kind.

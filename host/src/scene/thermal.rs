@@ -5,11 +5,11 @@ use toml::Spanned;
 
 use super::error::{Issue, issue};
 use super::model::{Integrator, Level, Method, Model, Precision};
+use super::names::{Kernel, by_kernel_name};
 use super::raw::{Bound, S, number};
 
-/// Drift scheme of a Brownian run (the kernel's [`hydrorattle::Drift`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
+/// Drift scheme of a Brownian run (the kernel's [`hydrorattle::Drift`], by its names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Drift {
     /// Fixman-type midpoint: the stiff-bond (flexible chain) equilibrium.
     #[default]
@@ -29,9 +29,8 @@ impl Drift {
 }
 
 /// Square root of the mobility for the noise (the kernel's [`hydrorattle::NoiseSqrt`]):
-/// `sqrt = "auto" | "cholesky" | "lanczos"`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
+/// `sqrt = "auto" | "cholesky" | "lanczos"` (the kernel's names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Sqrt {
     /// Cholesky up to the kernel's crossover ([`hydrorattle::LANCZOS_CROSSOVER`]
     /// beads), Lanczos above.
@@ -53,6 +52,24 @@ impl Sqrt {
         }
     }
 }
+
+impl Kernel for Drift {
+    type K = hydrorattle::Drift;
+    const ALL: &'static [Self] = &[Self::Midpoint, Self::Uncorrected];
+    fn kernel(self) -> hydrorattle::Drift {
+        Drift::kernel(self)
+    }
+}
+by_kernel_name!(Drift);
+
+impl Kernel for Sqrt {
+    type K = hydrorattle::NoiseSqrt;
+    const ALL: &'static [Self] = &[Self::Auto, Self::Cholesky, Self::Lanczos];
+    fn kernel(self) -> hydrorattle::NoiseSqrt {
+        Sqrt::kernel(self)
+    }
+}
+by_kernel_name!(Sqrt);
 
 /// Thermal noise settings (`[brownian]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

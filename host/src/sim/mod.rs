@@ -43,11 +43,11 @@ pub use record::{
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use hydrorattle::{Hydro, Params, Real, Solver as KSolver};
+use hydrorattle::{Params, Real, Solver as KSolver};
 use serde::Serialize;
 
 use crate::provenance::{CODE_VERSION, Machine};
-use crate::scene::{Flow, Fluid, Hydrodynamics, Precision, Scene};
+use crate::scene::{Flow, Fluid, Precision, Scene};
 use crate::sizing::{DEFAULT_LIMIT, Limits};
 pub use frames::Snapshot;
 
@@ -401,11 +401,7 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     p.gravity = T::v3_from(scene.gravity);
     p.flow_velocity = T::v3_from(scene.flow.velocity);
     p.vorticity = T::v3_from(scene.flow.vorticity);
-    p.hydro = match scene.model.hydrodynamics {
-        Hydrodynamics::Rpy => Hydro::Rpy,
-        Hydrodynamics::Oseen => Hydro::Oseen,
-        Hydrodynamics::FreeDraining => Hydro::FreeDraining,
-    };
+    p.hydro = scene.model.hydrodynamics.kernel();
     p.method = i.method.kernel();
     p.rotation = scene.model.rotation;
     p.matrix_free = i.matrix_free;

@@ -425,7 +425,9 @@ class System:
         and propagates, leaving the state unchanged.
 
         Raises a :class:`StepError` subclass (``kind``, ``stage``, ``index``,
-        ``value``) when a step fails: the state (positions, velocities, spins, time,
+        ``value``; ``kind`` and ``stage`` are the kernel's snake_case names, e.g.
+        ``"no_convergence"``, ``"particle_bad_radius"``, ``"positions"``) when a step
+        fails: the state (positions, velocities, spins, time,
         noise generator) is then exactly as it was before that step; the steps before
         it are kept.
         """
