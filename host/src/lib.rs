@@ -8,15 +8,18 @@
 //! * [`output`]: atomic file writes, trajectories (extended XYZ, GSD), CSV and JSON;
 //! * [`sweep`]: parameter sweeps (sweep files, point folders with signac ids, SLURM and
 //!   GNU parallel engines, the collected table);
-//! * [`auto`], [`sizing`]: the level a scene models and the storage it needs;
+//! * [`auto`], [`sizing`] (in [`scene`]): the level a scene models and the storage it
+//!   needs;
 //! * [`progress`]: progress of long jobs, shown by whatever display a front end installs;
 //! * [`provenance`]: the code version and machine a record names.
 
-pub mod auto;
 pub mod output;
 pub mod progress;
 pub mod provenance;
 pub mod scene;
 pub mod sim;
-pub mod sizing;
 pub mod sweep;
+
+// A scene's level and its storage are the scene's concern (its reader refuses a scene
+// too large at the line that makes it so); their paths stay at the top for callers.
+pub use scene::{auto, sizing};

@@ -8,11 +8,11 @@ use std::ops::Range;
 
 use hydrorattle::{BondError, Noise, ParticleError, Real, StepError};
 
+use super::beads::{Beads, bonds};
 use super::error::{Issue, issue};
 use super::raw::RawScene;
 use super::resolve::BodySpans;
 use super::{Level, Precision, Scene};
-use crate::sim::{Beads, bonds};
 
 /// Where the keys the step checks are written; `fallback` (the `[integrator]` table)
 /// places the rest.
@@ -165,7 +165,7 @@ pub(super) fn check(scene: &Scene, keys: &KeySpans, body: &BodySpans) -> Result<
 /// The first step's input checks of `scene` in precision `T`, and its FENE springs'
 /// extensions at the start.
 fn first_step<T: Real>(scene: &Scene) -> Result<(), StepError> {
-    let p = crate::sim::params::<T>(scene);
+    let p = super::beads::params::<T>(scene);
     let mut beads = Beads::<T>::new(&scene.particles, 1.0)?;
     let bonds = bonds::<T>(&scene.bonds, beads.len())?;
     let mut noise = Noise::new(0);

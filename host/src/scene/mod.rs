@@ -40,6 +40,9 @@
 //! lying wholly inside another is refused either way (the mobility is not defined for
 //! it).
 
+pub mod auto;
+mod beads;
+mod bodies;
 mod contact;
 mod error;
 mod helix;
@@ -49,12 +52,14 @@ mod names;
 mod precision;
 mod raw;
 mod resolve;
+pub mod sizing;
 #[cfg(test)]
 mod tests;
 mod thermal;
 mod wall;
 mod write;
 
+pub use beads::{Beads, BuildError, bonds, params};
 pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE, SOFT_DT, SOFT_STIFFNESS};
 pub use error::{SceneError, line_col};
 pub use helix::{Chain, HeadEnd, Helix};

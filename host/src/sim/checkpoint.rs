@@ -17,10 +17,10 @@ use anyhow::{Context, Result, bail};
 use hydrorattle::Real;
 use serde::{Deserialize, Serialize};
 
-use super::beads::Beads;
 use super::record::{Marks, Observables};
 use super::{SCENE_TOML, SUMMARY_JSON};
 use crate::output::{tmp_path, write_atomic, write_json};
+use crate::scene::Beads;
 use crate::scene::{Precision, Scene};
 
 /// The checkpoint file's name in the output folder.

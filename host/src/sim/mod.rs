@@ -18,7 +18,6 @@
 //! built). The run itself is a short list of stages (`run_loop.rs`); the CLI's `run`
 //! and the Python package call it through [`run_scene_file`].
 
-mod beads;
 mod checkpoint;
 mod columns;
 mod engine;
@@ -29,7 +28,7 @@ pub mod retry;
 mod run_loop;
 mod tail;
 
-pub use beads::{Beads, BuildError, bonds};
+pub use crate::scene::{Beads, BuildError, bonds, params};
 pub use checkpoint::{CHECKPOINT, Checkpoint, NoCheckpoint};
 pub use columns::{ColumnsMismatch, check_columns};
 pub use engine::{Engine, Extra};
@@ -43,7 +42,7 @@ pub use record::{
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use hydrorattle::{Params, Real, Solver as KSolver};
+use hydrorattle::Real;
 use serde::Serialize;
 
 use crate::provenance::{CODE_VERSION, Machine};
@@ -390,51 +389,6 @@ pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Resul
         checkpoint: Some(checkpoint),
     };
     run_from(&scene, &name, Some(dir), opts, start).context("resuming")
-}
-
-/// Kernel parameters for a scene in precision `T`.
-pub fn params<T: Real>(scene: &Scene) -> Params<T> {
-    let i = &scene.integrator;
-    let mut p = Params::new(T::from_f64(i.dt));
-    p.viscosity = T::from_f64(scene.fluid.viscosity);
-    p.fluid_density = T::from_f64(scene.fluid.density);
-    p.gravity = T::v3_from(scene.gravity);
-    p.flow_velocity = T::v3_from(scene.flow.velocity);
-    p.vorticity = T::v3_from(scene.flow.vorticity);
-    p.hydro = scene.model.hydrodynamics.kernel();
-    p.method = i.method.kernel();
-    p.rotation = scene.model.rotation;
-    p.matrix_free = i.matrix_free;
-    // f32 cannot reach 1e-10: floor the tolerance at a few hundred ulps.
-    let floor = 256.0 * T::EPSILON.to_f64();
-    p.solver = KSolver {
-        kind: i.solver.kind(),
-        tolerance: T::from_f64(i.tolerance.max(floor)),
-        max_iterations: u32::try_from(i.max_iterations).unwrap_or(u32::MAX),
-    };
-    // `overlap` is about t = 0 (checked when the scene is read and when the run is
-    // prepared); during the run spheres may come to overlap, as in the paper.
-    p.allow_overlap = true;
-    p.spring_stiffness = T::from_f64(i.stiffness);
-    p.fene = i.fene.map(T::from_f64);
-    // The paper's explicit drag can shiver silently (bounded, wrong) beyond its limit:
-    // the demo refuses such steps up front.
-    p.stability_guard = true;
-    p.contacts = scene
-        .contact
-        .and_then(|c| c.hard_capacity(scene.particles.len()))
-        .map(hydrorattle::Contacts::new);
-    p.brownian = scene.brownian.map(|b| hydrorattle::Brownian {
-        temperature: T::from_f64(b.temperature),
-        drift: b.drift.kernel(),
-    });
-    if let Some(b) = scene.brownian {
-        p.noise_sqrt = b.sqrt.kernel();
-    }
-    p.wall = scene
-        .wall
-        .map(|w| hydrorattle::Wall::new(T::from_f64(w.height)));
-    p
 }
 
 fn snapshot<T: Real>(ps: &[T::V3], radius: &[T], time: T) -> Snapshot {

@@ -10,8 +10,8 @@ use hydrorattle::observables::{self, Shape, State, StateThresholds, state_of};
 use hydrorattle::{Bond, Real};
 use serde::{Deserialize, Serialize};
 
-use super::beads::Beads;
 use crate::output::{AtomicFile, CsvWriter, Topology, XyzWriter, format_f64, gsd::GsdWriter};
+use crate::scene::Beads;
 
 /// Columns of `observables.csv`, in order.
 pub const COLUMNS: [&str; 24] = [

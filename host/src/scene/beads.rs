@@ -1,13 +1,15 @@
-//! Runtime-sized particle state and bonds: what the kernel's `step_slices` advances,
-//! for any number of beads.
+//! A scene in the kernel's terms: runtime-sized particle state and bonds (what the
+//! kernel's `step_slices` advances, for any number of beads) and the step's
+//! parameters, in either precision. The run ([`crate::sim`]) and the scene's own
+//! check against the kernel's first step ([`super::kernel`]) both build from here.
 
 use std::fmt;
 
 use hydrorattle::particles::{check_pairs, sphere_volume};
-use hydrorattle::{Bond, BondError, ParticleError, Real, State};
+use hydrorattle::{Bond, BondError, Params, ParticleError, Real, Solver, State};
 
-use crate::scene;
-use crate::sizing::TooLarge;
+use super::sizing::TooLarge;
+use crate::scene::{self, Scene};
 
 /// Particle state in vectors of any length (all of the same length).
 #[derive(Clone, Debug)]
@@ -153,6 +155,51 @@ impl From<TooLarge> for BuildError {
     fn from(e: TooLarge) -> Self {
         BuildError::TooLarge(e)
     }
+}
+
+/// Kernel parameters for a scene in precision `T`.
+pub fn params<T: Real>(scene: &Scene) -> Params<T> {
+    let i = &scene.integrator;
+    let mut p = Params::new(T::from_f64(i.dt));
+    p.viscosity = T::from_f64(scene.fluid.viscosity);
+    p.fluid_density = T::from_f64(scene.fluid.density);
+    p.gravity = T::v3_from(scene.gravity);
+    p.flow_velocity = T::v3_from(scene.flow.velocity);
+    p.vorticity = T::v3_from(scene.flow.vorticity);
+    p.hydro = scene.model.hydrodynamics.kernel();
+    p.method = i.method.kernel();
+    p.rotation = scene.model.rotation;
+    p.matrix_free = i.matrix_free;
+    // f32 cannot reach 1e-10: floor the tolerance at a few hundred ulps.
+    let floor = 256.0 * T::EPSILON.to_f64();
+    p.solver = Solver {
+        kind: i.solver.kind(),
+        tolerance: T::from_f64(i.tolerance.max(floor)),
+        max_iterations: u32::try_from(i.max_iterations).unwrap_or(u32::MAX),
+    };
+    // `overlap` is about t = 0 (checked when the scene is read and when the run is
+    // prepared); during the run spheres may come to overlap, as in the paper.
+    p.allow_overlap = true;
+    p.spring_stiffness = T::from_f64(i.stiffness);
+    p.fene = i.fene.map(T::from_f64);
+    // The paper's explicit drag can shiver silently (bounded, wrong) beyond its limit:
+    // the demo refuses such steps up front.
+    p.stability_guard = true;
+    p.contacts = scene
+        .contact
+        .and_then(|c| c.hard_capacity(scene.particles.len()))
+        .map(hydrorattle::Contacts::new);
+    p.brownian = scene.brownian.map(|b| hydrorattle::Brownian {
+        temperature: T::from_f64(b.temperature),
+        drift: b.drift.kernel(),
+    });
+    if let Some(b) = scene.brownian {
+        p.noise_sqrt = b.sqrt.kernel();
+    }
+    p.wall = scene
+        .wall
+        .map(|w| hydrorattle::Wall::new(T::from_f64(w.height)));
+    p
 }
 
 #[cfg(test)]

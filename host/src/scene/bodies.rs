@@ -1,0 +1,209 @@
+//! The bodies of a scene, from the raw form: the particles (or the paper's helix) with
+//! their species, and the bonds, each checked and each error placed at the value at
+//! fault; then the geometry (overlap, nesting) of the whole.
+
+use std::ops::Range;
+
+use toml::Spanned;
+
+use super::error::{Issue, issue};
+use super::raw::{Bound, RawBond, RawHelix, RawParticle, distance, finite_vector, number, vector};
+use super::resolve::BodySpans;
+use super::{Bond, DEFAULT_DENSITY, Helix, Integrator, Method, Overlap, Particle};
+
+pub(super) fn resolve_helix(r: &RawHelix) -> Result<Helix, Issue> {
+    let d = Helix::default();
+    let tails = match &r.tails {
+        None => d.tails,
+        Some(t) if *t.get_ref() == 0 => return Err(issue(t.span(), "tails must be >= 1")),
+        Some(t) => *t.get_ref(),
+    };
+    Ok(Helix {
+        tails,
+        head_ratio: number(&r.head_ratio, d.head_ratio, "head_ratio", Bound::Positive)?,
+        dhat: number(&r.dhat, d.dhat, "dhat", Bound::Positive)?,
+        head_end: r.head_end.unwrap_or_default(),
+        radius: number(&r.radius, d.radius, "helix radius", Bound::Positive)?,
+        pitch: number(&r.pitch, d.pitch, "pitch", Bound::NonNegative)?,
+        density: number(&r.density, d.density, "density", Bound::NonNegative)?,
+    })
+}
+
+pub(super) type ParticleSpans = Vec<(Range<usize>, Range<usize>)>;
+
+pub(super) fn resolve_particles(
+    ps: &Spanned<Vec<RawParticle>>,
+) -> Result<(Vec<Particle>, ParticleSpans, Vec<String>), Issue> {
+    if ps.get_ref().is_empty() {
+        return Err(issue(ps.span(), "the scene has no particles"));
+    }
+    let mut particles = Vec::with_capacity(ps.get_ref().len());
+    let mut spans = Vec::with_capacity(ps.get_ref().len());
+    let mut given = Vec::with_capacity(ps.get_ref().len());
+    for p in ps.get_ref() {
+        let position = finite_vector(&p.position, "position")?;
+        let radius = number(&Some(p.radius.clone()), 0.0, "radius", Bound::Positive)?;
+        let density = number(&p.density, DEFAULT_DENSITY, "density", Bound::NonNegative)?;
+        let velocity = vector(&p.velocity, [0.0; 3], "velocity")?;
+        let angular_velocity = vector(&p.angular_velocity, [0.0; 3], "angular_velocity")?;
+        particles.push(Particle {
+            position,
+            radius,
+            density,
+            velocity,
+            angular_velocity,
+        });
+        let dspan = p.density.as_ref().map_or(p.position.span(), |d| d.span());
+        spans.push((p.position.span(), dspan));
+        given.push(match &p.species {
+            Some(name) => Some(species_name(name)?),
+            None => None,
+        });
+    }
+    let species = default_species(&particles, given);
+    Ok((particles, spans, species))
+}
+
+/// A `species` name: 1 to 32 characters, letters, digits, `_`, `-`, `+` or `.`, so that
+/// every trajectory format and viewer takes it as it is.
+fn species_name(name: &Spanned<String>) -> Result<String, Issue> {
+    let s = name.get_ref();
+    let ok = (1..=32).contains(&s.len())
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-+.".contains(c));
+    if ok {
+        Ok(s.clone())
+    } else {
+        Err(issue(
+            name.span(),
+            format!("species {s:?} must be 1 to 32 letters, digits, '_', '-', '+' or '.'"),
+        ))
+    }
+}
+
+/// Species of explicit particles: the name given, or one name per distinct (radius,
+/// density), `A`, `B`, ... in order of first appearance.
+fn default_species(particles: &[Particle], given: Vec<Option<String>>) -> Vec<String> {
+    let mut classes: Vec<(u64, u64)> = Vec::new();
+    particles
+        .iter()
+        .zip(given)
+        .map(|(p, name)| {
+            name.unwrap_or_else(|| {
+                let key = (p.radius.to_bits(), p.density.to_bits());
+                let k = classes.iter().position(|c| *c == key).unwrap_or_else(|| {
+                    classes.push(key);
+                    classes.len() - 1
+                });
+                class_name(k)
+            })
+        })
+        .collect()
+}
+
+fn class_name(k: usize) -> String {
+    match u8::try_from(k) {
+        Ok(k) if k < 26 => char::from(b'A' + k).to_string(),
+        _ => format!("T{k}"),
+    }
+}
+
+/// The bonds: a length of 0 only for springs (their rest length), and with FENE
+/// springs every bond starts shorter than the maximum extension.
+pub(super) fn resolve_bonds(
+    bonds: Option<&Spanned<Vec<RawBond>>>,
+    particles: &[Particle],
+    integrator: &Integrator,
+) -> Result<(Vec<Bond>, Vec<Range<usize>>), Issue> {
+    let springs = integrator.method == Method::Springs;
+    let Some(bonds) = bonds else {
+        return Ok((Vec::new(), Vec::new()));
+    };
+    let n = particles.len();
+    let mut out: Vec<Bond> = Vec::with_capacity(bonds.get_ref().len());
+    let mut spans = Vec::with_capacity(bonds.get_ref().len());
+    for b in bonds.get_ref() {
+        let [i, j] = *b.between.get_ref();
+        if i >= n || j >= n {
+            return Err(issue(
+                b.between.span(),
+                format!(
+                    "bond between [{i}, {j}]: particle index out of range (the scene has {n} particles, indices 0..={})",
+                    n - 1
+                ),
+            ));
+        }
+        if i == j {
+            return Err(issue(
+                b.between.span(),
+                format!("bond between [{i}, {j}] joins a particle to itself"),
+            ));
+        }
+        if out
+            .iter()
+            .any(|o| (o.i == i && o.j == j) || (o.i == j && o.j == i))
+        {
+            return Err(issue(
+                b.between.span(),
+                format!("bond between [{i}, {j}] is given twice"),
+            ));
+        }
+        let initial = distance(particles[i].position, particles[j].position);
+        let bound = if springs {
+            Bound::NonNegative
+        } else {
+            Bound::Positive
+        };
+        let length =
+            number(&b.length, initial, "bond length", bound).map_err(|e| match &b.length {
+                Some(l) if *l.get_ref() == 0.0 => issue(
+                    l.span(),
+                    "bond length must be > 0 (a rest length of 0 is for method = \"springs\" only)",
+                ),
+                _ => e,
+            })?;
+        if let Some(q0) = integrator.fene.filter(|&q0| initial >= q0) {
+            return Err(issue(
+                b.between.span(),
+                format!(
+                    "bond between [{i}, {j}] starts at distance {initial}, not below the FENE maximum extension {q0}"
+                ),
+            ));
+        }
+        out.push(Bond { i, j, length });
+        spans.push(b.length.as_ref().map_or(b.between.span(), |l| l.span()));
+    }
+    Ok((out, spans))
+}
+
+pub(super) fn check_geometry(
+    particles: &[Particle],
+    overlap: Overlap,
+    spans: &BodySpans,
+) -> Result<(), Issue> {
+    for j in 0..particles.len() {
+        for i in 0..j {
+            let (p, q) = (&particles[i], &particles[j]);
+            let s = distance(p.position, q.position);
+            if s <= (p.radius - q.radius).abs() {
+                return Err(issue(
+                    spans.position(j),
+                    format!(
+                        "particle {j} and particle {i} are nested (centre distance {s}, radii {} and {}): one sphere inside another is not a valid configuration",
+                        q.radius, p.radius
+                    ),
+                ));
+            }
+            if overlap == Overlap::Reject && s < p.radius + q.radius {
+                return Err(issue(
+                    spans.position(j),
+                    format!(
+                        "particle {j} overlaps particle {i} at t = 0 (centre distance {s} < {}); if that is meant, say so with [model] overlap = \"allow\"",
+                        p.radius + q.radius
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
