@@ -54,12 +54,12 @@ fn assert_refused(o: &Output, file: &Path, line: Option<usize>) -> String {
     err
 }
 
-/// A write fault: exit 1, no panic, the message names the trajectory file.
-fn assert_names_trajectory(o: &Output, out: &Path) -> String {
+/// A write fault: exit 1, no panic, the message names the file `name` in `out`.
+fn assert_names_file(o: &Output, out: &Path, name: &str) -> String {
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(!err.contains("panicked"), "{err}");
-    let file = out.join("trajectory.xyz").display().to_string();
+    let file = out.join(name).display().to_string();
     assert!(err.contains(&file), "the message names the file: {err}");
     err
 }
@@ -124,7 +124,7 @@ fn a_full_disk_names_the_file_and_leaves_no_tmp_and_no_folder_of_its_own() {
     std::os::unix::fs::symlink("/dev/full", out.join("trajectory.xyz.tmp")).unwrap();
     let scene = manifest().join("scenes/dimer.toml");
     let (o, _) = run(&scene, &out, &[]);
-    let err = assert_names_trajectory(&o, &out);
+    let err = assert_names_file(&o, &out, "trajectory.xyz");
     assert!(err.to_lowercase().contains("space"), "{err}");
     assert_eq!(tmp_files(&out), Vec::<PathBuf>::new());
     assert!(!out.join("summary.json").exists());
@@ -154,7 +154,8 @@ fn a_read_only_folder_names_the_file_and_leaves_nothing() {
     let scene = manifest().join("scenes/dimer.toml");
     let (o, took) = run(&scene, &out, &[]);
     lock(false);
-    assert_names_trajectory(&o, &out);
+    // The resolved scene is the first file a run writes (so that a killed run resumes).
+    assert_names_file(&o, &out, "scene.toml");
     assert!(took < Duration::from_secs(1));
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0);
 }
