@@ -168,14 +168,16 @@ fn verdicts(rows: &[Row]) -> Vec<BTreeMap<&'static str, &'static str>> {
                 front: f,
             }];
             for (j, other) in rows.iter().enumerate() {
-                if let (Some(c), Some(fj)) = (other.case, &fronts[j]) {
-                    if c != case && !runs.iter().any(|x| x.case == c) && setting(other) == mine {
-                        runs.push(CaseRun {
-                            case: c,
-                            series: &other.series,
-                            front: fj,
-                        });
-                    }
+                if let (Some(c), Some(fj)) = (other.case, &fronts[j])
+                    && c != case
+                    && !runs.iter().any(|x| x.case == c)
+                    && setting(other) == mine
+                {
+                    runs.push(CaseRun {
+                        case: c,
+                        series: &other.series,
+                        front: fj,
+                    });
                 }
             }
             for c in claims(&runs).into_iter().filter(|c| c.case == case) {

@@ -283,10 +283,10 @@ pub fn run_from(
         Precision::F64 => run_loop::run_t::<f64>(&scene, name, out, opts, origin),
         Precision::F32 => run_loop::run_t::<f32>(&scene, name, out, opts, origin),
     };
-    if result.is_err() {
-        if let Some(dir) = fresh.filter(|d| d.exists()) {
-            let _ = std::fs::remove_dir_all(dir);
-        }
+    if result.is_err()
+        && let Some(dir) = fresh.filter(|d| d.exists())
+    {
+        let _ = std::fs::remove_dir_all(dir);
     }
     result
 }

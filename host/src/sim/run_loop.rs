@@ -290,7 +290,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         let cos_vertical = T::from_f64(NEAR_VERTICAL_COS);
         self.front
             .update(&self.bonds, &beads.pos, gravity, cos_vertical, beads.time);
-        let scheduled = s % self.scene.output.every.max(1) == 0;
+        let scheduled = s.is_multiple_of(self.scene.output.every.max(1));
         if scheduled {
             self.last = self.frame(s, beads, tw, rep.iterations, rep.max_tension)?;
         }
@@ -298,7 +298,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         // frame of a run that ends between frames is not part of a longer run.
         if let (Some(t), Some(dir)) = (self.opts.checkpoint_every, self.out) {
             let k = ((t / self.scene.integrator.dt).round() as usize).max(1);
-            if s % k == 0 {
+            if s.is_multiple_of(k) {
                 let marks = self.rec.marks()?;
                 let precision = self.scene.integrator.precision;
                 let trackers = (tw, self.front.times());

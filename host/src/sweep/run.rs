@@ -162,10 +162,10 @@ pub fn write_sweep(sweep: &Sweep, dir: &Path) -> Result<()> {
     let link = dir.join("workspace");
     if std::fs::symlink_metadata(&link).is_err() {
         #[cfg(unix)]
-        if let Err(e) = std::os::unix::fs::symlink(POINTS, &link) {
-            if std::fs::symlink_metadata(&link).is_err() {
-                log::warn!("{}: cannot link to {POINTS}: {e}", link.display());
-            }
+        if let Err(e) = std::os::unix::fs::symlink(POINTS, &link)
+            && std::fs::symlink_metadata(&link).is_err()
+        {
+            log::warn!("{}: cannot link to {POINTS}: {e}", link.display());
         }
     }
     Ok(())
