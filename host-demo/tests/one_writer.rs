@@ -1,7 +1,8 @@
 //! One writer per output folder: two processes on one sweep point, 20 times over, end
 //! as one clean run (the second skips the locked point, or finds it finished), and
 //! `collect` reports a point done only when its files are those its summary records.
-//! A plain `run` into a folder another process writes is refused before it writes.
+//! A point held by another process is skipped and said, or waited for with `--wait`;
+//! a plain `run` into a folder another process writes is refused before it writes.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -172,4 +173,41 @@ fn a_run_into_a_folder_another_process_writes_is_refused_before_it_writes() {
     let o = run();
     assert!(o.status.success(), "{}", text(&o));
     let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn a_locked_point_is_skipped_and_said_or_waited_for_with_wait() {
+    let root = scratch("held");
+    let id = first_point();
+    let point = root.join("points").join(&id);
+    std::fs::create_dir_all(&point).unwrap();
+    let held = FolderLock::take(&point).unwrap();
+    let o = sweep(&root, &id).output().unwrap();
+    let said = text(&o);
+    assert!(o.status.success(), "{said}");
+    assert!(
+        said.contains(": skipped: locked by another process")
+            && said.contains(", 1 skipped: locked by another process"),
+        "{said}"
+    );
+    assert_eq!(std::fs::read_dir(&point).unwrap().count(), 0, "it wrote");
+    let mut waiting = sweep(&root, &id)
+        .arg("--wait")
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    assert!(waiting.try_wait().unwrap().is_none(), "it did not wait");
+    assert_eq!(std::fs::read_dir(&point).unwrap().count(), 0, "it wrote");
+    drop(held);
+    let o = waiting.wait_with_output().unwrap();
+    let said = text(&o);
+    assert!(o.status.success(), "{said}");
+    assert!(
+        said.contains(&format!("{id}: locked by another process: waiting for it"))
+            && said.contains(": ran, "),
+        "{said}"
+    );
+    assert!(point.join("summary.json").is_file());
+    let _ = std::fs::remove_dir_all(&root);
 }
