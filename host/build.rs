@@ -16,10 +16,10 @@ fn main() {
     let mut watched = vec!["HEAD".to_string(), "index".to_string()];
     watched.extend(head_ref.filter(|r| r.starts_with("refs/")));
     for name in watched {
-        if let Some(path) = git(&["rev-parse", "--git-path", &name]) {
-            if std::path::Path::new(&path).exists() {
-                println!("cargo:rerun-if-changed={path}");
-            }
+        if let Some(path) = git(&["rev-parse", "--git-path", &name])
+            && std::path::Path::new(&path).exists()
+        {
+            println!("cargo:rerun-if-changed={path}");
         }
     }
     println!("cargo:rerun-if-changed=build.rs");

@@ -236,7 +236,7 @@ fn killed_runs_of_random_scenes_resume_to_the_bytes_of_one_run() {
         };
         // Not a divisor of the step count: the last checkpoint is before the end.
         let k = (draw.int(steps as u64 / 40, steps as u64 / 8) as usize) | 1;
-        let k = if steps % k == 0 { k + 2 } else { k };
+        let k = if steps.is_multiple_of(k) { k + 2 } else { k };
         let at = (draw.int(1, 5) * k as u64).min((steps / k * k) as u64);
         eprintln!("case {case}: {spec:?}, checkpoints every {k} steps, killed after {at}");
         let dir = scratch(&format!("random-{case}"));

@@ -10,7 +10,9 @@
 //! `steps_per_second`.
 //!
 //! Status: `done`; `stopped_early` (a step failed: the summary says why); `error` (the
-//! run could not start: `error.txt`); `unfinished` (a checkpoint, no summary); `missing`.
+//! run could not start: `error.txt`); `corrupt` (a summary, but the data files are not
+//! those it records: cut short or overwritten since, by size or digest); `unfinished` (a
+//! checkpoint, no summary); `missing`.
 //!
 //! A point is a Figure 1 case when its helix is one of the paper's three. Its claims
 //! are judged on its own observables; a claim comparing two cases ("settles faster
@@ -25,7 +27,7 @@ use serde_json::Value as Json;
 
 use crate::claims::{CaseRun, SPECS, claims};
 use crate::render::{LineChart, Series, line_chart_with_errors};
-use hydrorattle_host::output::{AtomicFile, CsvWriter, format_f64};
+use hydrorattle_host::output::{AtomicFile, CsvWriter, FileCheck, format_f64, mismatch};
 use hydrorattle_host::scene::Scene;
 use hydrorattle_host::sim::{
     CHECKPOINT, COLUMNS, Front, OBSERVABLES_CSV, Observables, SCENE_TOML, SUMMARY_JSON,
@@ -85,17 +87,29 @@ fn read_point(dir: &Path, record: &Json, figure1: &[(&'static str, Scene)]) -> R
     let summary: Option<Json> = std::fs::read_to_string(pdir.join(SUMMARY_JSON))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
-    let error = std::fs::read_to_string(pdir.join(ERROR_TXT)).ok();
+    let mut error = std::fs::read_to_string(pdir.join(ERROR_TXT)).ok();
+    // A summary vouches for the files it records (older summaries record none).
+    let corrupt = summary.as_ref().and_then(|s| {
+        let files = s.get("files")?;
+        match serde_json::from_value::<BTreeMap<String, FileCheck>>(files.clone()) {
+            Ok(files) => mismatch(&pdir, &files),
+            Err(e) => Some(format!("{}: unreadable files record: {e}", SUMMARY_JSON)),
+        }
+    });
     let status = match (&summary, &error) {
+        (Some(_), _) if corrupt.is_some() => "corrupt",
         (Some(s), _) if s["failure"].is_null() => "done",
         (Some(_), _) => "stopped_early",
         (None, Some(_)) => "error",
         (None, None) if pdir.join(CHECKPOINT).is_file() => "unfinished",
         _ => "missing",
     };
+    if corrupt.is_some() {
+        error = corrupt;
+    }
     let mut series = Vec::new();
     let mut case = None;
-    if summary.is_some() {
+    if summary.is_some() && status != "corrupt" {
         let scene = Scene::from_path(&pdir.join(SCENE_TOML)).ok();
         case = scene.and_then(|s| {
             let h = s.helix?;
@@ -168,14 +182,16 @@ fn verdicts(rows: &[Row]) -> Vec<BTreeMap<&'static str, &'static str>> {
                 front: f,
             }];
             for (j, other) in rows.iter().enumerate() {
-                if let (Some(c), Some(fj)) = (other.case, &fronts[j]) {
-                    if c != case && !runs.iter().any(|x| x.case == c) && setting(other) == mine {
-                        runs.push(CaseRun {
-                            case: c,
-                            series: &other.series,
-                            front: fj,
-                        });
-                    }
+                if let (Some(c), Some(fj)) = (other.case, &fronts[j])
+                    && c != case
+                    && !runs.iter().any(|x| x.case == c)
+                    && setting(other) == mine
+                {
+                    runs.push(CaseRun {
+                        case: c,
+                        series: &other.series,
+                        front: fj,
+                    });
                 }
             }
             for c in claims(&runs).into_iter().filter(|c| c.case == case) {
@@ -266,7 +282,7 @@ pub fn collect(dir: &Path, chart: Option<(&str, &str)>) -> Result<Collected> {
                 .map(|spec| v.get(spec.id).map_or(String::new(), |x| x.to_string())),
         );
         let why = match r.status {
-            "error" => r.error.clone().unwrap_or_default().trim().to_string(),
+            "error" | "corrupt" => r.error.clone().unwrap_or_default().trim().to_string(),
             _ => get("failure"),
         };
         row.extend([why.clone(), get("wall_time_s"), get("steps_per_second")]);

@@ -31,6 +31,10 @@ pub struct SweepArgs {
     /// Checkpoint every T of simulated time (default: about ten per run).
     #[arg(long, value_name = "T", value_parser = positive)]
     checkpoint_every: Option<f64>,
+    /// Wait for points another process is running (each holds its point's lock),
+    /// rather than skip them.
+    #[arg(long, conflicts_with_all = ["dry_run", "emit"])]
+    wait: bool,
     /// Expand and check the sweep, list its points, run nothing.
     #[arg(long, conflicts_with_all = ["shard", "point", "emit"])]
     dry_run: bool,
@@ -100,6 +104,7 @@ impl SweepArgs {
         let opts = run::Options {
             jobs,
             checkpoint_every: self.checkpoint_every,
+            wait: self.wait,
         };
         let report = hydrorattle_host::sweep::run_points(&sweep, &self.out, &selection, opts)?;
         println!(

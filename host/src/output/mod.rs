@@ -10,11 +10,15 @@
 
 mod atomic;
 mod csv;
+mod digest;
 pub mod gsd;
+mod lock;
 mod xyz;
 
 pub use atomic::{AtomicFile, continued_source, name_error, tmp_path, write_atomic, write_json};
 pub use csv::{CsvWriter, csv_field};
+pub use digest::{FileCheck, check_files, mismatch};
+pub use lock::{FolderLock, LOCK_FILE, Locked};
 pub use xyz::{Frame, XYZ_PROPERTIES, XyzError, XyzWriter, read_xyz, read_xyz_file};
 
 /// What stays the same from frame to frame of a trajectory: particle types, radii,

@@ -203,7 +203,7 @@ struct Columns {
 
 fn columns(properties: &str) -> Result<Columns, String> {
     let parts: Vec<&str> = properties.split(':').collect();
-    if parts.len() % 3 != 0 {
+    if !parts.len().is_multiple_of(3) {
         return Err(format!(
             "Properties={properties} is not name:type:count triples"
         ));

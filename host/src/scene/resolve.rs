@@ -84,14 +84,15 @@ impl RawScene {
             Some(b) => Some(b.resolve(&model, &integrator)?),
         };
         let cholesky = brownian.is_some_and(|b| b.temperature > 0.0 && b.sqrt == Sqrt::Cholesky);
-        if let Some(m) = raw_int.get_ref().matrix_free.as_ref() {
-            if *m.get_ref() && cholesky {
-                return Err(issue(
-                    m.span(),
-                    "matrix_free draws the noise by Lanczos: [brownian] sqrt = \"cholesky\" \
+        if let Some(m) = raw_int.get_ref().matrix_free.as_ref()
+            && *m.get_ref()
+            && cholesky
+        {
+            return Err(issue(
+                m.span(),
+                "matrix_free draws the noise by Lanczos: [brownian] sqrt = \"cholesky\" \
                      needs the stored mobility (use \"auto\" or \"lanczos\")",
-                ));
-            }
+            ));
         }
         if let (Some(c), Some(raw)) = (contact, &self.contact) {
             super::contact::check_method(c, raw, &integrator, brownian.as_ref())?;
@@ -196,16 +197,16 @@ impl RawScene {
             let min_radius = particles.iter().fold(f64::INFINITY, |m, p| m.min(p.radius));
             raw.check_precision(thermal, &integrator, fluid.viscosity, min_radius)?;
         }
-        if integrator.method.is_inertial() {
-            if let Some(k) = particles.iter().position(|p| p.density <= 0.0) {
-                return Err(issue(
-                    body_span.density(k),
-                    format!(
-                        "particle {k} has density {} but the inertial method needs positive masses",
-                        particles[k].density
-                    ),
-                ));
-            }
+        if integrator.method.is_inertial()
+            && let Some(k) = particles.iter().position(|p| p.density <= 0.0)
+        {
+            return Err(issue(
+                body_span.density(k),
+                format!(
+                    "particle {k} has density {} but the inertial method needs positive masses",
+                    particles[k].density
+                ),
+            ));
         }
 
         let scene = Scene {

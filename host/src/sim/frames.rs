@@ -67,7 +67,7 @@ impl Keeper {
     /// Takes the configuration of step `step` if asked for (steps in increasing order).
     pub(super) fn take<T: Real>(&mut self, step: usize, beads: &Beads<T>) {
         let take = || snapshot::<T>(&beads.pos, &beads.radius, beads.time);
-        if self.every.is_some_and(|e| step % e == 0) {
+        if self.every.is_some_and(|e| step.is_multiple_of(e)) {
             self.frames.push(take());
             self.last_step = Some(step);
         }

@@ -125,6 +125,10 @@ pub struct Summary {
     /// The scene as run: every default filled in and the `auto` choice applied
     /// (`scene.toml` holds the same as a scene file).
     pub resolved_scene: Scene,
+    /// The data files as the run finished them (size and digest, by name), for a
+    /// reader to check that they are still those; last, the fields above unchanged.
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub files: std::collections::BTreeMap<String, crate::output::FileCheck>,
 }
 
 impl Summary {
@@ -161,6 +165,7 @@ impl Summary {
             landing_time: None,
             level_choice: None,
             resolved_scene: scene.clone(),
+            files: Default::default(),
         }
     }
 }
@@ -261,6 +266,11 @@ pub struct Start {
     pub scene_path: Option<PathBuf>,
     /// The checkpoint to continue from.
     pub checkpoint: Option<Checkpoint>,
+    /// The caller holds the output folder's [`FolderLock`](crate::output::FolderLock)
+    /// (a sweep locks a point before it looks at its files); otherwise the run takes
+    /// it, and refuses a folder another process writes with a
+    /// [`Locked`](crate::output::Locked).
+    pub locked: bool,
 }
 
 /// [`run`] from `start`. A run that fails before its files are complete removes the
@@ -278,15 +288,18 @@ pub fn run_from(
         scene_path: start.scene_path.map(|p| p.display().to_string()),
         level_choice: choice,
         checkpoint: start.checkpoint.as_ref(),
+        locked: start.locked,
     };
     let result = match scene.integrator.precision {
         Precision::F64 => run_loop::run_t::<f64>(&scene, name, out, opts, origin),
         Precision::F32 => run_loop::run_t::<f32>(&scene, name, out, opts, origin),
     };
-    if result.is_err() {
-        if let Some(dir) = fresh.filter(|d| d.exists()) {
-            let _ = std::fs::remove_dir_all(dir);
-        }
+    // A folder another process locked is that process's, even one created since.
+    let theirs = |e: &anyhow::Error| e.downcast_ref::<crate::output::Locked>().is_some();
+    if result.as_ref().is_err_and(|e| !theirs(e))
+        && let Some(dir) = fresh.filter(|d| d.exists())
+    {
+        let _ = std::fs::remove_dir_all(dir);
     }
     result
 }
@@ -329,6 +342,7 @@ pub fn run_scene_file(
     let start = Start {
         scene_path: Some(scene_path.to_path_buf()),
         checkpoint: None,
+        locked: false,
     };
     run_from(&scene, &name, Some(out), opts, start)
 }
@@ -387,6 +401,7 @@ pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Resul
     let start = Start {
         scene_path: Some(scene_path),
         checkpoint: Some(checkpoint),
+        locked: false,
     };
     run_from(&scene, &name, Some(dir), opts, start).context("resuming")
 }

@@ -20,7 +20,10 @@ use hydrorattle::{Real, StepReport};
 use super::checkpoint::{Checkpoint, ready_folder};
 use super::engine::Engine;
 use super::frames::Keeper;
-use super::record::{NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, WallGauge, each_row};
+use super::record::{
+    NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, TRAJECTORY_GSD, TRAJECTORY_XYZ,
+    WallGauge, each_row,
+};
 use super::tail::TailSlope;
 use super::{
     Beads, Front, Observables, RunOptions, RunResult, SCENE_TOML, SUMMARY_JSON, Summary, snapshot,
@@ -37,6 +40,8 @@ pub(super) struct Origin<'a> {
     pub level_choice: Option<crate::auto::Choice>,
     /// The checkpoint the run continues from.
     pub checkpoint: Option<&'a Checkpoint>,
+    /// The caller holds the output folder's lock.
+    pub locked: bool,
 }
 
 /// Runs `scene` (its level already applied) from the start or from `origin`'s
@@ -61,8 +66,14 @@ pub(super) fn run_t<T: Real>(
         engine.retries = c.retries;
         engine.lanczos = c.lanczos.unwrap_or_default();
     }
+    let mut lock = None;
     if let Some(dir) = out {
         std::fs::create_dir_all(dir).map_err(|e| crate::output::name_error(dir, e))?;
+        // One writer per folder, held until the run ends: a second one would truncate
+        // this run's files under it.
+        lock = (!origin.locked)
+            .then(|| crate::output::FolderLock::take(dir))
+            .transpose()?;
         ready_folder(dir, scene, origin.checkpoint.is_none())?;
     }
     let mut twist_prev = vec![T::ZERO; engine.beads.len()];
@@ -77,7 +88,9 @@ pub(super) fn run_t<T: Real>(
         &mut front_times,
     )?;
     let (done, failure, wall) = tracks.steps(&mut engine, name)?;
-    tracks.close(engine, done, failure, wall, name, origin)
+    let result = tracks.close(engine, done, failure, wall, name, origin);
+    drop(lock);
+    result
 }
 
 /// The trackers and files of a run, over the caller's storage.
@@ -290,7 +303,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         let cos_vertical = T::from_f64(NEAR_VERTICAL_COS);
         self.front
             .update(&self.bonds, &beads.pos, gravity, cos_vertical, beads.time);
-        let scheduled = s % self.scene.output.every.max(1) == 0;
+        let scheduled = s.is_multiple_of(self.scene.output.every.max(1));
         if scheduled {
             self.last = self.frame(s, beads, tw, rep.iterations, rep.max_tension)?;
         }
@@ -298,7 +311,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         // frame of a run that ends between frames is not part of a longer run.
         if let (Some(t), Some(dir)) = (self.opts.checkpoint_every, self.out) {
             let k = ((t / self.scene.integrator.dt).round() as usize).max(1);
-            if s % k == 0 {
+            if s.is_multiple_of(k) {
                 let marks = self.rec.marks()?;
                 let precision = self.scene.integrator.precision;
                 let trackers = (tw, self.front.times());
@@ -386,6 +399,9 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
                 let resolved = &summary.resolved_scene;
                 write_atomic(&dir.join(SCENE_TOML), resolved.to_toml().as_bytes())?;
             }
+            // Read back after the rename: what a reader of the folder will find.
+            let data = [OBSERVABLES_CSV, TRAJECTORY_XYZ, TRAJECTORY_GSD];
+            summary.files = crate::output::check_files(dir, &data)?;
             write_json(&dir.join(SUMMARY_JSON), &summary)?;
         }
         let (mut frames, mut at) = self.keeper.finish(done, beads);

@@ -175,17 +175,16 @@ pub(super) fn parse(src: &Source<'_>, limits: Limits) -> Result<Sweep, SceneErro
     let base = Base::load(src, doc, base_path, limits)?;
     let (replicas, replicas_span) = replicas.unwrap_or((1, 0..0));
     let seed_key = "brownian.seed";
-    if replicas > 1 {
-        if let Some((_, span)) = factors
+    if replicas > 1
+        && let Some((_, span)) = factors
             .iter()
             .flat_map(|f| &f.keys)
             .find(|k| k.0 == seed_key)
-        {
-            return Err(src.err(
+    {
+        return Err(src.err(
                 span.clone(),
                 "brownian.seed is set by replicas (seed, seed + 1, ...): vary it or give replicas, not both",
             ));
-        }
     }
     for f in &factors {
         for (key, span) in &f.keys {
@@ -398,9 +397,10 @@ fn zip_group(src: &Source<'_>, t: &DeTable<'_>, span: Range<usize>) -> Result<Fa
     };
     for (key, value) in in_file_order(t) {
         let vals = values(src, key.get_ref(), key.span(), value)?;
-        if let Some(first) = f.values.first() {
-            if first.len() != vals.len() {
-                return Err(src.err(
+        if let Some(first) = f.values.first()
+            && first.len() != vals.len()
+        {
+            return Err(src.err(
                     key.span(),
                     format!(
                         "a zip group's lists vary together and must have one length: {:?} has {}, {:?} has {}",
@@ -410,7 +410,6 @@ fn zip_group(src: &Source<'_>, t: &DeTable<'_>, span: Range<usize>) -> Result<Fa
                         vals.len()
                     ),
                 ));
-            }
         }
         f.keys.push((key.get_ref().to_string(), key.span()));
         f.values.push(vals);

@@ -9,6 +9,12 @@
 //! changed scene, a run that failed to start) is run from the start, its old run files
 //! removed first. Thermal-noise runs resume the same way: their checkpoints hold the
 //! noise generator's state.
+//!
+//! One writer per point: a process locks the point's folder ([`FolderLock`]) before it
+//! looks at its files and holds the lock until the run ends. A second process on the
+//! same point (`sbatch` twice, two `--point ID`) skips it and says so, or with
+//! [`Options::wait`] waits for the first and then finds the point finished. The OS
+//! releases the lock of a killed process.
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -18,7 +24,7 @@ use rayon::prelude::*;
 
 use super::file::describe;
 use super::{POINTS, Point, STATEPOINT_JSON, SWEEP_JSON, Sweep, id::canonical_json};
-use crate::output::tmp_path;
+use crate::output::{FolderLock, tmp_path};
 use crate::scene::{Level, Scene};
 use crate::sim::{
     CHECKPOINT, Checkpoint, OBSERVABLES_CSV, SCENE_TOML, SUMMARY_JSON, Start, Summary,
@@ -79,6 +85,8 @@ pub struct Options {
     pub jobs: usize,
     /// Checkpoint every this much simulated time; None: about ten per run, on frames.
     pub checkpoint_every: Option<f64>,
+    /// Wait for a point another process is running, rather than skip it.
+    pub wait: bool,
 }
 
 /// What happened to one point.
@@ -86,6 +94,8 @@ pub struct Options {
 pub enum Outcome {
     /// Already finished: not run.
     Skipped,
+    /// Another process holds the point's lock (it is running it): not run.
+    Locked,
     /// Run, from the start or from its checkpoint (`resumed_from`).
     Ran(Box<Summary>),
     /// Could not be run (the message is also in the folder's `error.txt`).
@@ -99,6 +109,8 @@ pub struct RunReport {
     pub selected: usize,
     /// Already finished.
     pub skipped: usize,
+    /// Skipped: another process was running them.
+    pub locked: usize,
     /// Run from the start.
     pub ran: usize,
     /// Continued from a checkpoint.
@@ -121,7 +133,11 @@ impl std::fmt::Display for RunReport {
             self.skipped,
             self.stopped_early.len(),
             self.failed.len()
-        )
+        )?;
+        if self.locked > 0 {
+            write!(f, ", {} skipped: locked by another process", self.locked)?;
+        }
+        Ok(())
     }
 }
 
@@ -162,10 +178,10 @@ pub fn write_sweep(sweep: &Sweep, dir: &Path) -> Result<()> {
     let link = dir.join("workspace");
     if std::fs::symlink_metadata(&link).is_err() {
         #[cfg(unix)]
-        if let Err(e) = std::os::unix::fs::symlink(POINTS, &link) {
-            if std::fs::symlink_metadata(&link).is_err() {
-                log::warn!("{}: cannot link to {POINTS}: {e}", link.display());
-            }
+        if let Err(e) = std::os::unix::fs::symlink(POINTS, &link)
+            && std::fs::symlink_metadata(&link).is_err()
+        {
+            log::warn!("{}: cannot link to {POINTS}: {e}", link.display());
         }
     }
     Ok(())
@@ -224,6 +240,11 @@ pub fn prepare_points(sweep: &Sweep, dir: &Path) -> Result<usize> {
     for p in &sweep.points {
         let pdir = point_dir(dir, &p.id);
         let text = as_run(&p.scene, &p.id).to_toml();
+        std::fs::create_dir_all(&pdir).with_context(|| format!("creating {}", pdir.display()))?;
+        // A point another process is running is left to it.
+        let Some(_lock) = FolderLock::try_take(&pdir)? else {
+            continue;
+        };
         if let State::New = state(&pdir, &text, &p.scene) {
             prepare(p, &pdir, &text)?;
             prepared += 1;
@@ -242,9 +263,27 @@ fn checkpoint_every(scene: &Scene, every: Option<f64>) -> Option<f64> {
     })
 }
 
-/// Runs one point (the one place a sweep calls the run).
+/// Locks the folder of point `id` (creating it), waiting with `wait`; None when
+/// another process holds it and `wait` is off.
+fn lock_point(pdir: &Path, id: &str, wait: bool) -> Result<Option<FolderLock>> {
+    std::fs::create_dir_all(pdir).with_context(|| format!("creating {}", pdir.display()))?;
+    let lock = FolderLock::try_take(pdir)?;
+    if lock.is_some() || !wait {
+        return Ok(lock);
+    }
+    println!("{id}: locked by another process: waiting for it");
+    Ok(Some(FolderLock::wait(pdir)?))
+}
+
+/// Runs one point (the one place a sweep calls the run), under the point's lock.
 pub fn run_point(point: &Point, dir: &Path, opts: Options) -> Outcome {
     let pdir = point_dir(dir, &point.id);
+    // Held until the run ends: the state read below stays true while it runs.
+    let _lock = match lock_point(&pdir, &point.id, opts.wait) {
+        Ok(Some(lock)) => lock,
+        Ok(None) => return Outcome::Locked,
+        Err(e) => return Outcome::Failed(format!("{e:#}")),
+    };
     let text = as_run(&point.scene, &point.id).to_toml();
     let checkpoint = match state(&pdir, &text, &point.scene) {
         State::Finished => return Outcome::Skipped,
@@ -265,6 +304,7 @@ pub fn run_point(point: &Point, dir: &Path, opts: Options) -> Outcome {
     let start = Start {
         scene_path: None,
         checkpoint,
+        locked: true,
     };
     match crate::sim::run_from(&point.scene, &point.id, Some(&pdir), run_opts, start) {
         Ok(r) => Outcome::Ran(Box::new(r.summary)),
@@ -300,6 +340,10 @@ pub fn run_points(
             let what = describe(&p.params);
             match outcome {
                 Outcome::Skipped => r.skipped += 1,
+                Outcome::Locked => {
+                    r.locked += 1;
+                    println!("{} {what}: skipped: locked by another process", p.id);
+                }
                 Outcome::Ran(s) => {
                     let how = match s.resumed_from {
                         Some(t) => {

@@ -214,10 +214,10 @@ pub(super) fn faster(r: &CaseRun<'_>, other: &CaseRun<'_>) -> Judged {
             (true, None) => Some((k, k)),
             (false, _) => None,
         };
-        if let Some((a, b)) = run {
-            if best.is_none_or(|(c, d)| b - a > d - c) {
-                best = Some((a, b));
-            }
+        if let Some((a, b)) = run
+            && best.is_none_or(|(c, d)| b - a > d - c)
+        {
+            best = Some((a, b));
         }
     }
     let all = ratios.iter().all(|&x| x >= FASTER) && overall >= FASTER;
