@@ -179,26 +179,32 @@ fn spheres_touching_a_wall_to_the_rounding_run() {
     }
 }
 
-/// Issue 33, 4: two f32 spheres under vorticity 100 at dt 0.1 spiral out until their
-/// squared coordinates overflow f32: the run stops with an error naming the column,
-/// exit 1, the rows so far kept (f64 runs to the end).
+/// Issue 33, 4: two spheres under vorticity 100 at dt 0.1 turn 10 rad a step: the
+/// explicit flow term grows their radius tenfold a step until f32's squares overflow
+/// (NaN observables). A rotation no step follows is refused at its line, in either
+/// precision, before any folder exists; at dt 0.01 (1 rad a step) it runs.
 #[test]
-fn observables_the_precision_cannot_compute_fail_the_run() {
+fn a_rotation_faster_than_the_step_is_refused_at_its_line() {
     for precision in ["f32", "f64"] {
-        let text = format!(
-            "[flow]\nvorticity = [0.0, 0.0, 100.0]\n\n[[particle]]\nposition = [0.0, 0.0, 0.0]\nradius = 1.0\n\n\
-             [[particle]]\nposition = [3.0, 0.0, 0.0]\nradius = 1.0\n\n\
-             [integrator]\nmethod = \"overdamped\"\ndt = 0.1\nduration = 10.0\nprecision = \"{precision}\"\n"
-        );
-        let (o, out) = run_text(&format!("vortex-{precision}"), &text);
+        let scene = |dt: f64| {
+            format!(
+                "[flow]\nvorticity = [0.0, 0.0, 100.0]\n\n[[particle]]\nposition = [0.0, 0.0, 0.0]\nradius = 1.0\n\n\
+                 [[particle]]\nposition = [3.0, 0.0, 0.0]\nradius = 1.0\n\n\
+                 [integrator]\nmethod = \"overdamped\"\ndt = {dt}\nduration = 1.0\nprecision = \"{precision}\"\n"
+            )
+        };
+        let (o, out) = run_text(&format!("vortex-{precision}"), &scene(0.1));
         let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains(".toml:2:") && err.contains("rad per step"),
+            "{err}"
+        );
+        assert!(!out.exists(), "a refused scene leaves no folder");
+        let (o, out) = run_text(&format!("vortex-slow-{precision}"), &scene(0.01));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
         let rows = std::fs::read_to_string(out.join("observables.csv")).unwrap();
-        if precision == "f32" {
-            assert_eq!(o.status.code(), Some(1), "{err}");
-            assert!(err.contains("observable twist is NaN"), "{err}");
-        } else {
-            assert!(o.status.success(), "{err}");
-            assert!(!rows.contains("NaN") && !rows.contains("inf"), "{rows}");
-        }
+        assert!(!rows.contains("NaN") && !rows.contains("inf"), "{rows}");
     }
 }

@@ -13,7 +13,7 @@
 //! | --- | --- | --- |
 //! | `[fluid]` | `viscosity` (> 0), `density` (>= 0) | 1, 0 |
 //! | `[gravity]` | `acceleration = [x, y, z]` | `[0, 0, -1]` |
-//! | `[flow]` | `velocity = [..]`, `vorticity = [..]` (uniform flow plus rigid rotation) | zeros |
+//! | `[flow]` | `velocity = [..]`, `vorticity = [..]` (uniform flow plus rigid rotation; at most [`MAX_TURN_PER_STEP`] radians a step: `\|vorticity\| dt <= 1`) | zeros |
 //! | `[[particle]]` | `position = [..]` (required), `radius` (required, > 0), `density` (>= 0), `velocity = [..]`, `angular_velocity = [..]`, `species` (a type name) | density 4.5, at rest, one species per radius and density |
 //! | `[[bond]]` | `between = [i, j]` (required, 0-based), `length` (> 0; >= 0 with `method = "springs"`: a spring's rest length) | initial distance |
 //! | `[helix]` | `tails`, `head_ratio`, `dhat`, `head_end`, `radius`, `pitch`, `density` | see [`Helix`] |
@@ -67,6 +67,7 @@ pub use model::{
     Bond, Flow, Fluid, Hydrodynamics, Integrator, Level, Method, Model, Output, Overlap, Particle,
     Precision, Solver,
 };
+pub use resolve::MAX_TURN_PER_STEP;
 pub use thermal::{DEFAULT_SEED, Drift, Sqrt, Thermal};
 pub use wall::Wall;
 
