@@ -2,7 +2,7 @@
 //! (`hydrorattle-host`): runs in, tables and pictures out.
 //!
 //! * [`figure1`]: the paper's Figure 1 (three helices settling), its claims and pictures;
-//! * [`reference`]: the Figure 1 runs against a small-dt reference (agreement horizons);
+//! * [`mod@reference`]: the Figure 1 runs against a small-dt reference (agreement horizons);
 //! * [`phase`]: the outcome map over the bond gap and head ratio, and the sensitivity table;
 //! * [`claims`]: the paper's claims judged on a run's observables;
 //! * [`charts`]: accuracy and speed charts of the integrators and solvers;

@@ -9,11 +9,11 @@ use std::time::Instant;
 
 use super::args::positive;
 
-/// Run a sweep file's points in DIR/points/<id>/ (finished points skipped,
+/// Run a sweep file's points in `DIR/points/ID/` (finished points skipped,
 /// unfinished ones resumed), or write the job script of an engine that runs them.
 #[derive(Debug, Args)]
 pub struct SweepArgs {
-    /// The sweep file (a scene with a [sweep] table, or [sweep] with base = ...).
+    /// The sweep file (a scene with a `[sweep]` table, or `[sweep]` with `base = ...`).
     file: PathBuf,
     /// The sweep's folder.
     #[arg(long)]
