@@ -13,6 +13,7 @@
 
 mod common;
 
+use common::METHODS;
 use common::fuzz::Rng;
 use hydrorattle::{
     Bond, Brownian, Contacts, DENSE_BONDS_MAX, Layout, Method, NoForce, Noise, NoiseSqrt, Params,
@@ -20,14 +21,6 @@ use hydrorattle::{
 };
 use hydrorattle_heap::Buffers;
 use proptest::prelude::*;
-
-const METHODS: [Method; 5] = [
-    Method::Overdamped,
-    Method::Overdamped2,
-    Method::Rattle,
-    Method::RattleStable,
-    Method::Springs,
-];
 
 /// One combination of the step's switches.
 #[derive(Clone, Copy, Debug)]

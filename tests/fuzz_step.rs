@@ -75,13 +75,6 @@ impl Draw {
     }
 }
 
-const METHODS: [Method; 5] = [
-    Method::Overdamped,
-    Method::Overdamped2,
-    Method::Rattle,
-    Method::RattleStable,
-    Method::Springs,
-];
 const SOLVERS: [SolverKind; 4] = [
     SolverKind::Auto,
     SolverKind::Sweep,

@@ -13,6 +13,15 @@ use hydrorattle::{
 /// Equal-density spheres: density 4.5 with eta = 1 and |g| = 1 gives a lone unit
 /// sphere the Stokes speed `U0 = 2/9 rho a^2 g / eta = 1` and momentum relaxation time
 /// `tau = m / (6 pi eta a) = 1`.
+/// Every integrator, in the order of `Method`'s declaration.
+pub const METHODS: [Method; 5] = [
+    Method::Overdamped,
+    Method::Overdamped2,
+    Method::Rattle,
+    Method::RattleStable,
+    Method::Springs,
+];
+
 pub const RHO: f64 = 4.5;
 
 /// `[x, y, z]` in the precision `T`.
