@@ -47,7 +47,9 @@ pub fn run_scene(
         output: DEFAULT_OUTPUT_LIMIT,
     };
     let r = py
-        .detach(|| hydrorattle_host::sim::run_scene_file(&path, &out, limits, checkpoint_every, false, 0))
+        .detach(|| {
+            hydrorattle_host::sim::run_scene_file(&path, &out, limits, checkpoint_every, false, 0)
+        })
         .map_err(|e| host_error(py, e))?;
     if let Some(f) = &r.summary.failure {
         return Err(PyRuntimeError::new_err(format!(

@@ -3,10 +3,10 @@
 
 use std::time::{Duration, Instant};
 
+use hydrorattle::{Bond, Noise, Real, StepReport};
 use hydrorattle_host::scene::Scene;
 use hydrorattle_host::sim::{Beads, Engine, resolve_level};
 use hydrorattle_host::sizing::DEFAULT_LIMIT;
-use hydrorattle::{Bond, Noise, Real, StepReport};
 use numpy::ndarray::{Array1, Array2};
 use numpy::{
     Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2,
