@@ -196,5 +196,3 @@ impl Iterator for Positions {
 
 impl ExactSizeIterator for Positions {}
 
-#[cfg(test)]
-mod tests;

@@ -1,4 +1,8 @@
-use super::*;
+//! The paper's helix (`hydrorattle::helix`), written once for the host scenes and the
+//! firmware: its bits pinned, every bond at its length to rounding, impossible helices
+//! refused.
+
+use hydrorattle::helix::{HeadEnd, Helix, HelixError};
 
 /// Figure 1 (c) of the paper, as `host-demo/scenes/figure1c.toml` and the firmware
 /// build it.
