@@ -195,4 +195,3 @@ impl Iterator for Positions {
 }
 
 impl ExactSizeIterator for Positions {}
-

@@ -272,8 +272,16 @@ proptest! {
         p.contacts = capacity.map(Contacts::new);
         p.wall = wall.then(|| Wall::new(0.0));
         let auto = Layout::for_params(&p, n, nb);
-        p.solver.kind = p.solver_kind(n, nb);
-        prop_assert_ne!(p.solver.kind, SolverKind::Auto);
+        let resolved = p.solver_kind(n, nb);
+        // The documented rule, written out here: dense up to DENSE_BONDS_MAX rows, the
+        // rows being the bonds, the contact capacity and one wall link per sphere.
+        let rows = nb + capacity.unwrap_or(0) + if wall { n } else { 0 };
+        p.solver.kind = if rows <= DENSE_BONDS_MAX {
+            SolverKind::Newton
+        } else {
+            SolverKind::Krylov
+        };
+        prop_assert_eq!(resolved, p.solver.kind);
         prop_assert_eq!(auto, Layout::for_params(&p, n, nb));
     }
 }

@@ -11,7 +11,7 @@ use crate::claims::{CaseRun, claim_tables};
 use crate::render::{CategoryMap, Mark, category_map};
 use hydrorattle_host::output::{AtomicFile, CsvWriter};
 use hydrorattle_host::progress::Progress;
-use hydrorattle_host::scene::{Bond, HeadEnd, Helix, Hydrodynamics, Method, Particle, Scene};
+use hydrorattle_host::scene::{HeadEnd, Helix, Hydrodynamics, Method, Scene};
 use hydrorattle_host::sim::{Observables, RunOptions, Summary, run};
 
 /// Outcome names (the late states, in `State::ALL` order, and "failed") in map order,
@@ -30,19 +30,8 @@ const CATEGORIES: [(&str, RGBColor); 7] = [
 pub fn with_helix(template: &Scene, helix: Helix) -> Result<Scene> {
     let chain = helix.generate().map_err(|e| anyhow!(e))?;
     let mut s = template.clone();
-    s.particles = (0..chain.positions.len())
-        .map(|k| Particle {
-            position: chain.positions[k],
-            radius: chain.radii[k],
-            density: chain.densities[k],
-            ..Particle::default()
-        })
-        .collect();
-    s.bonds = chain
-        .bonds
-        .iter()
-        .map(|&(i, j, length)| Bond { i, j, length })
-        .collect();
+    s.particles = chain.particles();
+    s.bonds = chain.scene_bonds();
     s.helix = Some(helix);
     Ok(s)
 }

@@ -73,6 +73,28 @@ pub struct Chain {
     pub bonds: Vec<(usize, usize, f64)>,
 }
 
+impl Chain {
+    /// The chain's spheres as scene particles (at rest).
+    pub fn particles(&self) -> Vec<super::Particle> {
+        (0..self.positions.len())
+            .map(|k| super::Particle {
+                position: self.positions[k],
+                radius: self.radii[k],
+                density: self.densities[k],
+                ..super::Particle::default()
+            })
+            .collect()
+    }
+
+    /// The chain's bonds as scene bonds.
+    pub fn scene_bonds(&self) -> Vec<super::Bond> {
+        self.bonds
+            .iter()
+            .map(|&(i, j, length)| super::Bond { i, j, length })
+            .collect()
+    }
+}
+
 impl Helix {
     /// The kernel's helix ([`hydrorattle::helix`]): the one geometry the scenes and the
     /// firmware build.

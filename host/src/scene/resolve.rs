@@ -10,8 +10,7 @@ use super::bodies::{
 use super::error::{Issue, issue, too_large};
 use super::raw::{Bound, RawBond, RawIntegrator, RawParticle, RawScene, number, vector};
 use super::{
-    Bond, Flow, Fluid, Integrator, Level, Method, Model, Output, Particle, Precision, Scene, Sqrt,
-    TARGET_FRAMES,
+    Flow, Fluid, Integrator, Level, Method, Model, Output, Precision, Scene, Sqrt, TARGET_FRAMES,
 };
 use crate::sizing::{Limits, Plan, TooLarge};
 
@@ -152,19 +151,7 @@ impl RawScene {
                 check_output(&integrator, every, helix.tails + 1, limits.output)
                     .map_err(|m| issue(output_span.clone(), m))?;
                 let chain = helix.generate().map_err(|m| issue(h.span(), m))?;
-                let particles = (0..chain.positions.len())
-                    .map(|k| Particle {
-                        position: chain.positions[k],
-                        radius: chain.radii[k],
-                        density: chain.densities[k],
-                        ..Particle::default()
-                    })
-                    .collect();
-                let bonds = chain
-                    .bonds
-                    .iter()
-                    .map(|&(i, j, length)| Bond { i, j, length })
-                    .collect();
+                let (particles, bonds) = (chain.particles(), chain.scene_bonds());
                 let species = (0..=helix.tails)
                     .map(|k| if k == 0 { "head" } else { "tail" }.to_string())
                     .collect();
