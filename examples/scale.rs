@@ -12,7 +12,9 @@
 //! --toggle-collect='*step_slices*' target/profiling/examples/scale o auto 1024` (built
 //! with `--profile profiling`: release code with symbols).
 //! `CHAIN=1` takes the kernel bench's chain (`benches/kernel.rs`, `brownian/...`)
-//! instead of the helix.
+//! instead of the helix. `BOX=L` runs in a cubic periodic box of edge `L` (the Ewald
+//! mobility, `docs/PERIODIC.md`). Each line ends with a digest of the final positions'
+//! bits (the same on every build that keeps the arithmetic).
 
 use hydrorattle::*;
 use hydrorattle_heap::Buffers;
@@ -96,6 +98,9 @@ fn main() {
         p.allow_overlap = true;
         p.matrix_free = std::env::var("MF").is_ok();
         let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
+        if let Some(l) = env("BOX") {
+            p.periodic = Some(Periodic::new([l; 3]).unwrap());
+        }
         if let Some(kt) = env("KT") {
             p.brownian = Some(Brownian {
                 temperature: kt,
@@ -132,8 +137,12 @@ fn main() {
             mid += r.velocity_iterations;
         }
         let us = t0.elapsed().as_secs_f64() * 1e6 / steps as f64;
+        let digest = pos
+            .iter()
+            .flat_map(|v| v.to_array())
+            .fold(0u64, |h, c| (h ^ c.to_bits()).wrapping_mul(0x100_0000_01b3));
         println!(
-            "n {n:5}  {us:9.2} us/step  iterations {:6.1}  Lanczos {:5.1}  midpoint {:5.1}  storage {:.1} MB",
+            "n {n:5}  {us:9.2} us/step  iterations {:6.1}  Lanczos {:5.1}  midpoint {:5.1}  storage {:.1} MB  digest {digest:016x}",
             its as f64 / steps as f64,
             lanczos as f64 / steps as f64,
             mid as f64 / steps as f64,

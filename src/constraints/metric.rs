@@ -11,7 +11,6 @@
 //! component of its sphere's displacement ([`Bond::relative`]).
 
 use crate::bonds::Bond;
-use crate::cell::Periodic;
 use crate::linalg::{self, tri};
 #[cfg(feature = "periodic")]
 use crate::mobility::periodic;
@@ -63,9 +62,10 @@ pub enum Metric<'a, T: Real> {
         scale: T,
         /// The wall's height when there is one ([`wall`]).
         wall: Option<T>,
-        /// The periodic box and the largest radius when the step has one (its Ewald
-        /// parameters are derived from them where a block or product is evaluated).
-        cell: Option<(Periodic<T>, T)>,
+        /// The step's Ewald parameters when it runs in a periodic box whose images
+        /// interact (derived once per step, not per block: `integrate/periodic.rs`).
+        #[cfg(feature = "periodic")]
+        ewald: Option<&'a periodic::Ewald<T>>,
     },
     /// Precomputed displacements `disp[l * beads + p]` (`bonds x beads`, bond-major: a
     /// multiplier's moves of all beads are contiguous, so the table is written in order
@@ -224,13 +224,13 @@ impl<T: Real> Metric<'_, T> {
                 grad,
                 scale,
                 wall,
-                cell,
+                #[cfg(feature = "periodic")]
+                ewald,
             } => {
                 #[cfg(feature = "periodic")]
-                if let Some((c, a_max)) = cell {
-                    return periodic_at(eta, pos, radius, (c, a_max), b, grad[l] * scale, p);
+                if let Some(ew) = ewald {
+                    return periodic_at(ew, eta, pos, radius, b, grad[l] * scale, p);
                 }
-                let _ = cell; // Read above only with the `periodic` feature.
                 // Nested pairs were refused by the product at these positions. The block
                 // (q, p), as `sym_block` reads it.
                 let block = |q| match wall {
@@ -407,21 +407,19 @@ impl<T: Real> Metric<'_, T> {
                 grad,
                 scale,
                 wall,
-                cell,
+                #[cfg(feature = "periodic")]
+                ewald,
             } => {
                 let f = &mut tmp[..n];
                 spread(bonds, grad, c, scale, f);
                 // Nested pairs were refused by the product at these positions.
                 #[cfg(feature = "periodic")]
-                if let Some((c, a_max)) = cell {
-                    let ew = periodic::Ewald::new(c, a_max);
-                    let done = ew.and_then(|e| periodic::tt_product(&e, eta, pos, radius, f, out));
-                    if done.is_err() {
+                if let Some(ew) = ewald {
+                    if periodic::tt_product(ew, eta, pos, radius, f, out).is_err() {
                         out.fill(T::V3_ZERO);
                     }
                     return;
                 }
-                let _ = cell; // Read above only with the `periodic` feature.
                 let done = match wall {
                     Some(h) if cfg!(feature = "wall") => {
                         wall::tt_product(level, eta, h, pos, radius, f, out)
@@ -555,22 +553,19 @@ fn spread<T: Real>(bonds: &[Bond<T>], grad: &[T::V3], c: &[T], scale: T, f: &mut
 }
 
 /// [`Metric::Free`]'s `D_l(p)` in a periodic box: `(mu_pi - mu_pj) g` from the Ewald
-/// blocks (exactly symmetric, so read in either orientation), the parameters derived
-/// for this block (the product at these positions refused nested spheres and a bad box).
+/// blocks (exactly symmetric, so read in either orientation) with the step's
+/// parameters (the product at these positions refused nested spheres).
 #[cfg(feature = "periodic")]
 fn periodic_at<T: Real>(
+    ew: &periodic::Ewald<T>,
     eta: T,
     pos: &[T::V3],
     radius: &[T],
-    (cell, a_max): (Periodic<T>, T),
     b: Bond<T>,
     g: T::V3,
     p: usize,
 ) -> T::V3 {
-    let Ok(ew) = periodic::Ewald::new(cell, a_max) else {
-        return T::V3_ZERO;
-    };
-    let block = |q| periodic::tt_block_at(&ew, eta, pos, radius, p, q).unwrap_or(T::M3_ZERO);
+    let block = |q| periodic::tt_block_at(ew, eta, pos, radius, p, q).unwrap_or(T::M3_ZERO);
     let mu_pj = if b.is_wall() { T::M3_ZERO } else { block(b.j) };
     sym_diff_mul::<T>(block(b.i), mu_pj, g, true)
 }

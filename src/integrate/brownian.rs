@@ -84,7 +84,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         parallel::assemble_apply_then(par, pairs, mu, force, u, bands, copy, pack)
             .map_err(StepError::from)?;
     } else {
-        mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
+        mobility_product(p, s.ewald, s.pos, s.radius, mu, force, u, par, bands)?;
     }
     add_flow(p, s.pos, u);
     let held = Held {
@@ -116,6 +116,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         disp,
         lambda: &mut *lambda,
         scratch: &mut scratch,
+        ewald: s.ewald,
     };
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, xi);
@@ -219,7 +220,7 @@ pub(super) fn kick<T: Real>(
     let mut copied = reduced && copied;
     let product = |v: &[T::V3], w: &mut [T::V3]| {
         if p.matrix_free {
-            let _ = free_product(p, s.pos, s.radius, v, w);
+            let _ = free_product(p, s.ewald, s.pos, s.radius, v, w);
         } else if reduced && copied {
             reduced::apply::<T>(par, fac, n, v, w, bands);
         } else if reduced {
@@ -270,7 +271,7 @@ pub(super) fn kick<T: Real>(
                 parallel::product::<T>(par, mu, n, xi, dx, bands);
                 mu
             } else {
-                mobility_product(p, mid, s.radius, fac, xi, dx, par, bands)?;
+                mobility_product(p, s.ewald, mid, s.radius, fac, xi, dx, par, bands)?;
                 if p.matrix_free { &[] } else { fac }
             };
             if let Some(h) = held {
@@ -279,6 +280,7 @@ pub(super) fn kick<T: Real>(
                 let par = h.scratch.par;
                 let metric = mobility_metric(
                     p,
+                    s.ewald,
                     h.bonds,
                     mid,
                     s.radius,

@@ -11,6 +11,8 @@ use crate::params::{Method, Params};
 use crate::particles::{State, sphere_volume};
 use crate::real::Real;
 
+use super::stages::HeldSums;
+
 /// The thermal settings when this step has noise (`brownian` with `kT > 0`), after
 /// checking that the temperature is valid and the combination is implemented.
 pub(super) fn check_thermal<T: Real>(
@@ -100,14 +102,16 @@ pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result
 /// summed yet); not the Oseen level (the Ewald sum is RPY's; free draining has no pair
 /// blocks and needs none); every radius below half the smallest edge, every bond (and
 /// FENE's maximum extension) shorter than half of it, so that the minimum image of a
-/// bond at its length is the bond; and Ewald parameters the sums' bounds allow.
+/// bond at its length is the bond; and Ewald parameters the sums' bounds allow. Those
+/// parameters are the step's: derived here once and held for every product, assembly
+/// and metric block of the step (`None` without a box, or with free draining).
 pub(super) fn check_periodic<T: Real>(
     p: &Params<T>,
     state: &State<'_, T>,
     bonds: &[Bond<T>],
-) -> Result<(), StepError> {
+) -> Result<HeldSums<T>, StepError> {
     let Some(c) = p.periodic else {
-        return Ok(());
+        return Ok(None);
     };
     if !cfg!(feature = "periodic") {
         return Err(StepError::Unsupported(
@@ -142,10 +146,9 @@ pub(super) fn check_periodic<T: Real>(
     }
     #[cfg(feature = "periodic")]
     if p.hydro != Hydro::FreeDraining {
-        let a_max = state.radius.iter().fold(T::ZERO, |m, &a| m.max(a));
-        crate::mobility::periodic::Ewald::new(c, a_max)?;
+        return Ok(Some(super::periodic::ewald(c, state.radius)?));
     }
-    Ok(())
+    Ok(None)
 }
 
 /// The first sphere whose centre is below `height + a_i (1 - 2 tol)`, less the
@@ -163,19 +166,19 @@ fn below_wall<T: Real>(pos: &[T::V3], radius: &[T], height: T, tol: T) -> Option
 }
 
 /// Stage 1 of a step: every check of its inputs, in order; the thermal settings when
-/// the step has noise.
+/// the step has noise, and the step's Ewald parameters in a box.
 pub(super) fn check_all<T: Real>(
     state: &State<'_, T>,
     bonds: &[Bond<T>],
     p: &Params<T>,
     has_generator: bool,
-) -> Result<Option<crate::params::Brownian<T>>, StepError> {
+) -> Result<(Option<crate::params::Brownian<T>>, HeldSums<T>), StepError> {
     check_inputs(state, bonds, p)?;
     let thermal = check_thermal(p, has_generator)?;
     check_contacts(p, thermal.is_some())?;
     check_wall(p, state)?;
-    check_periodic(p, state, bonds)?;
-    Ok(thermal)
+    let sums = check_periodic(p, state, bonds)?;
+    Ok((thermal, sums))
 }
 
 /// Refuses contacts where they are not implemented.

@@ -45,6 +45,8 @@ pub(super) struct Projection<'l, 'v, 'a, T: Real> {
     pub disp: &'v mut [T::V3],
     pub lambda: &'v mut [T],
     pub scratch: &'v mut Scratch<'a, T>,
+    /// The step's Ewald parameters in a box ([`super::stages::Sums`]).
+    pub ewald: super::stages::Sums<'v, T>,
 }
 
 /// What the overdamped position projection did.
@@ -87,6 +89,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         disp,
         lambda,
         scratch,
+        ewald,
     } = v;
     // Constants without the `contacts` feature: the one-sided path folds away.
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
@@ -124,7 +127,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         };
         bond_vectors(active, start, super::cell(p), grad);
         let par = scratch.par;
-        let metric = mobility_metric(p, active, start, radius, mu, grad, p.dt, disp, par);
+        let metric = mobility_metric(p, ewald, active, start, radius, mu, grad, p.dt, disp, par);
         free(x);
         shift(x, wall, -T::ONE);
         let stats = project_positions(p, active, &metric, x, lambda, scratch)?;

@@ -77,6 +77,8 @@ pub(super) struct Start<'a, T: Real> {
     pub(super) omega: &'a [T::V3],
     pub(super) radius: &'a [T],
     pub(super) density: &'a [T],
+    /// The step's Ewald parameters in a periodic box ([`stages::Sums`]).
+    pub(super) ewald: Sums<'a, T>,
 }
 
 /// Advances the particles of a [`ParticleSet`] by one step of `p.method`: the
@@ -143,7 +145,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
     // 1. Inputs and storage.
     // `p` stays the caller's reference: a firmware's `static` must stay visible to the
     // compiler, which then links only the method it runs.
-    let thermal = check_all(&state, bonds, p, noise.is_some())?;
+    let (thermal, sums) = check_all(&state, bonds, p, noise.is_some())?;
     // The solver, resolved once from every row the step may solve, as the storage was
     // sized ([`Params::solver_kind`]): no stage re-resolves `Auto` from the rows it
     // holds in one round. A concrete kind (firmware's) keeps `p` the caller's reference.
@@ -167,6 +169,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
         omega: state.omega,
         radius: state.radius,
         density: state.density,
+        ewald: sums.as_ref(),
     };
     // 2. Integrate into the workspace (a thermal step draws from a copy of the generator).
     let mut drawn = noise.as_deref().cloned();

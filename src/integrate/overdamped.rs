@@ -3,8 +3,8 @@
 //! predictor-corrector with the same projection.
 
 use super::{
-    Projection, Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors,
-    max_tension, mobility_metric, mobility_product, project_overdamped, report, spin,
+    Projection, Start, StepReport, Sums, add_constraint_forces, add_flow, assemble_tt,
+    bond_vectors, max_tension, mobility_metric, mobility_product, project_overdamped, report, spin,
     step_velocity,
 };
 use crate::bonds::Bond;
@@ -43,7 +43,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     } = v;
     // Forces and mobility at the start; unconstrained velocity U_inf + mu F.
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
+    mobility_product(p, s.ewald, s.pos, s.radius, mu, force, u, par, bands)?;
     add_flow(p, s.pos, u);
     // Unconstrained move r* = r + dt (U_inf + mu F), then the constraint move through
     // the full mobility: r' = r* + dt mu G^T lambda (bonds, and contacts if on).
@@ -58,6 +58,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         disp,
         lambda: &mut *lambda,
         scratch: &mut scratch,
+        ewald: s.ewald,
     };
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
@@ -79,6 +80,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
 #[inline(always)]
 fn projected_velocity<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     mu: &[T::M3],
@@ -100,7 +102,7 @@ fn projected_velocity<T: Real>(
         dt: p.dt,
     };
     let par = scratch.par;
-    let metric = mobility_metric(p, bonds, pos, radius, mu, grad, T::ONE, disp, par);
+    let metric = mobility_metric(p, ew, bonds, pos, radius, mu, grad, T::ONE, disp, par);
     constraints::solve(problem, &metric, bonds, &p.solver, u, kappa, scratch)
 }
 
@@ -134,10 +136,10 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         ..
     } = v;
     // Predictor: projected velocity at r, one projected Euler step.
-    assemble_tt(p, s.pos, s.radius, mu0)?;
+    assemble_tt(p, s.ewald, s.pos, s.radius, mu0)?;
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     projected_velocity(
-        p, s.pos, s.radius, mu0, force, bonds, grad, disp, kappa, &mut sc, f0,
+        p, s.ewald, s.pos, s.radius, mu0, force, bonds, grad, disp, kappa, &mut sc, f0,
     )?;
     // Tension and spin at the start of the step: the velocity projection's multipliers
     // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
@@ -155,13 +157,14 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         disp: &mut *disp,
         lambda: &mut *lambda,
         scratch: &mut sc,
+        ewald: s.ewald,
     };
     project_overdamped(p, bonds, s.pos, s.radius, mu0, views, x_p, predict)?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
-    assemble_tt(p, x_p, s.radius, mu1)?;
+    assemble_tt(p, s.ewald, x_p, s.radius, mu1)?;
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
     projected_velocity(
-        p, x_p, s.radius, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1,
+        p, s.ewald, x_p, s.radius, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1,
     )?;
     // Projection as in the first-order scheme: r' = r* + dt mu(r) G(r)^T lambda.
     let trapezoid = |x: &mut [T::V3]| {
@@ -175,6 +178,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         disp,
         lambda: &mut *lambda,
         scratch: &mut sc,
+        ewald: s.ewald,
     };
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu0, views, new_pos, trapezoid)?;
     step_velocity(s.pos, new_pos, dt, new_vel);

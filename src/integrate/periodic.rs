@@ -1,12 +1,14 @@
 //! The mobility of a step in a periodic box (feature `periodic`): the Ewald sums of
-//! `mobility::periodic` with parameters derived per step.
+//! `mobility::periodic` with parameters derived once per step.
 //!
 //! `xi` and the cutoffs come from the box and the step's largest radius by
-//! [`Ewald::new`] on every call, not from the parameters: the largest radius is the
-//! state's (a radius above a stored one would be refused), deriving them costs about
-//! a hundred `exp` (nothing beside one pair block's sums), and `Params` stays small and
-//! `Copy`. The assembly is serial (the banded assembly of [`crate::parallel`] is free
-//! space's); the products over the assembled matrix still run in bands.
+//! [`Ewald::new`], once, in the step's checks (`check_periodic`), and every product,
+//! assembly and matrix-free metric block of the step reads that one copy
+//! ([`super::stages::Sums`]): they depend on the box and the radii only, which a step
+//! does not change. Not held in the parameters: the largest radius is the state's (a
+//! radius above a stored one would be refused) and `Params` stays small and `Copy`.
+//! The assembly is serial (the banded assembly of [`crate::parallel`] is free space's);
+//! the products over the assembled matrix still run in bands.
 
 use crate::cell::Periodic;
 use crate::error::StepError;
@@ -24,24 +26,22 @@ pub(super) fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>
 /// `mu_tt` of the box into the packed lower triangle `mu` ([`periodic::assemble_tt`]).
 pub(super) fn assemble<T: Real>(
     p: &Params<T>,
-    cell: Periodic<T>,
+    ew: &Ewald<T>,
     pos: &[T::V3],
     radius: &[T],
     mu: &mut [T::M3],
 ) -> Result<(), StepError> {
-    let ew = ewald(cell, radius)?;
-    Ok(periodic::assemble_tt(&ew, p.viscosity, pos, radius, mu)?)
+    Ok(periodic::assemble_tt(ew, p.viscosity, pos, radius, mu)?)
 }
 
 /// `u = mu_tt f` in the box without storing `mu_tt` ([`periodic::tt_product`]).
 pub(super) fn product<T: Real>(
     p: &Params<T>,
-    cell: Periodic<T>,
+    ew: &Ewald<T>,
     pos: &[T::V3],
     radius: &[T],
     f: &[T::V3],
     u: &mut [T::V3],
 ) -> Result<(), StepError> {
-    let ew = ewald(cell, radius)?;
-    Ok(periodic::tt_product(&ew, p.viscosity, pos, radius, f, u)?)
+    Ok(periodic::tt_product(ew, p.viscosity, pos, radius, f, u)?)
 }

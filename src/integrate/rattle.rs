@@ -51,7 +51,7 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
     } = v;
     inverse_masses(s.radius, s.density, inv_mass);
     // Resistance through the Cholesky factor of mu_tt: R dv = mu^-1 (v - U_inf).
-    assemble_tt(p, s.pos, s.radius, mu)?;
+    assemble_tt(p, s.ewald, s.pos, s.radius, mu)?;
     fac.copy_from_slice(mu);
     linalg::cholesky::<T>(fac, n).map_err(|error| StepError::Linalg {
         stage: Stage::Mobility,

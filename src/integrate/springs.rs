@@ -50,7 +50,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         super::cell(p),
         force,
     )?;
-    mobility_product(p, s.pos, s.radius, mu, force, u, par, bands)?;
+    mobility_product(p, s.ewald, s.pos, s.radius, mu, force, u, par, bands)?;
     add_flow(p, s.pos, u);
     let mut noise_iterations = 0;
     match thermal {

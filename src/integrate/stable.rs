@@ -83,7 +83,7 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     } else if p.rotation {
         mobility::assemble_grand(p.hydro, p.viscosity, s.pos, s.radius, mu)?;
     } else {
-        assemble_tt(p, s.pos, s.radius, mu)?;
+        assemble_tt(p, s.ewald, s.pos, s.radius, mu)?;
     }
     for i in 0..n {
         let mass = sphere_volume(s.radius[i]) * s.density[i];

@@ -12,12 +12,30 @@ use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
 
+/// The step's Ewald parameters ([`super::periodic`]): `Some` in a periodic box whose
+/// images interact (not with free draining), derived once by the step's checks and
+/// read by every product, assembly and matrix-free metric of the step. Without the
+/// `periodic` feature there are none (always `None`).
+#[cfg(feature = "periodic")]
+pub(super) type Sums<'a, T> = Option<&'a crate::mobility::periodic::Ewald<T>>;
+/// The step's Ewald parameters: none without the `periodic` feature.
+#[cfg(not(feature = "periodic"))]
+pub(super) type Sums<'a, T> = Option<&'a core::marker::PhantomData<T>>;
+
+/// What the step's checks hold for [`Sums`] to borrow.
+#[cfg(feature = "periodic")]
+pub(super) type HeldSums<T> = Option<crate::mobility::periodic::Ewald<T>>;
+/// What the step's checks hold for [`Sums`] to borrow: nothing without the feature.
+#[cfg(not(feature = "periodic"))]
+pub(super) type HeldSums<T> = Option<core::marker::PhantomData<T>>;
+
 /// `u = mu_tt(pos) f`: assembled into `mu` and applied in one pass, in bands through
 /// `par` (`bands` holds their partial sums, [`crate::parallel`]), or matrix-free (then
-/// `mu` is empty and nothing is stored).
+/// `mu` is empty and nothing is stored); in a box with the step's Ewald sums `ew`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn mobility_product<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     mu: &mut [T::M3],
@@ -27,12 +45,12 @@ pub(super) fn mobility_product<T: Real>(
     bands: &mut [T::V3],
 ) -> Result<(), StepError> {
     if p.matrix_free {
-        return free_product(p, pos, radius, f, u);
+        return free_product(p, ew, pos, radius, f, u);
     }
     #[cfg(feature = "periodic")]
-    if let Some(c) = ewald_cell(p) {
+    if let Some(e) = ew {
         // In a box: assembled serially, then applied in bands (`integrate/periodic.rs`).
-        super::periodic::assemble(p, c, pos, radius, mu)?;
+        super::periodic::assemble(p, e, pos, radius, mu)?;
         crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
         return Ok(());
     }
@@ -56,6 +74,7 @@ pub(super) fn mobility_product<T: Real>(
 #[inline(always)]
 pub(super) fn mobility_metric<'a, T: Real>(
     p: &Params<T>,
+    ew: Sums<'a, T>,
     bonds: &[Bond<T>],
     pos: &'a [T::V3],
     radius: &'a [T],
@@ -74,9 +93,11 @@ pub(super) fn mobility_metric<'a, T: Real>(
             grad,
             scale,
             wall: wall_height(p),
-            cell: ewald_cell(p).map(|c| (c, radius.iter().fold(T::ZERO, |m, &a| m.max(a)))),
+            #[cfg(feature = "periodic")]
+            ewald: ew,
         };
     }
+    let _ = ew; // Read above only with the `periodic` feature.
     if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
         return Metric::Mobility {
             mu,
@@ -94,18 +115,20 @@ pub(super) fn mobility_metric<'a, T: Real>(
 }
 
 /// `u = mu_tt(pos) f` matrix-free: every pair block evaluated where it is used (above
-/// the wall if there is one).
+/// the wall if there is one, in the box with the step's Ewald sums `ew`).
 pub(super) fn free_product<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     f: &[T::V3],
     u: &mut [T::V3],
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
-    if let Some(c) = ewald_cell(p) {
-        return super::periodic::product(p, c, pos, radius, f, u);
+    if let Some(e) = ew {
+        return super::periodic::product(p, e, pos, radius, f, u);
     }
+    let _ = ew; // Read above only with the `periodic` feature.
     let (level, eta) = (p.hydro, p.viscosity);
     match wall_height(p) {
         Some(h) => mobility::wall::tt_product(level, eta, h, pos, radius, f, u)?,
@@ -142,17 +165,19 @@ pub(super) fn ewald_cell<T: Real>(p: &Params<T>) -> Option<Periodic<T>> {
 }
 
 /// `mu_tt(pos)` into the packed lower triangle `mu`: free space, above the wall, or in
-/// the periodic box.
+/// the periodic box (with the step's Ewald sums `ew`).
 pub(super) fn assemble_tt<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     mu: &mut [T::M3],
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
-    if let Some(c) = ewald_cell(p) {
-        return super::periodic::assemble(p, c, pos, radius, mu);
+    if let Some(e) = ew {
+        return super::periodic::assemble(p, e, pos, radius, mu);
     }
+    let _ = ew; // Read above only with the `periodic` feature.
     if let Some(h) = wall_height(p) {
         let (level, eta, serial) = (p.hydro, p.viscosity, &crate::parallel::Serial);
         return Ok(mobility::wall::assemble(
