@@ -51,6 +51,7 @@ fn trajectory_round_trip_is_bit_exact() {
             radii: scene.radii(),
             masses: scene.topology().mass,
             velocities: (0..n).map(|_| numbers.vec3()).collect(),
+            cell: None,
         });
     }
 

@@ -2,7 +2,11 @@
 """Reads the trajectory files of `host-demo run` output folders back with the real
 tools (ASE, the `gsd` package and OVITO's Python module) and checks them against the
 run's own record (`summary.json`): species, masses, velocities, positions, bonds,
-frame count. Exits non-zero on the first disagreement.
+frame count. A run in a periodic box (`[box]`) must also give the box to every tool:
+extended XYZ `Lattice=` with `pbc="T T T"` and unwrapped positions, GSD
+`configuration/box` with positions wrapped into it and `particles/image`, so that
+wrapped + image * L is the XYZ's unwrapped position (to f32 rounding). Exits non-zero
+on the first disagreement.
 
     python host-demo/tools/readback.py OUT_DIR [OUT_DIR ...]
 
@@ -34,7 +38,8 @@ def expected(out):
     mass = np.array([4.0 / 3.0 * math.pi * p["radius"] ** 3 * p["density"] for p in parts])
     radius = np.array([p["radius"] for p in parts])
     bonds = np.array([[b["i"], b["j"]] for b in scene["bonds"]], dtype=np.uint32).reshape(-1, 2)
-    return s, scene["species"], mass, radius, bonds
+    cell = np.array(scene["box"]["size"]) if "box" in scene else None
+    return s, scene["species"], mass, radius, bonds, cell
 
 
 def read_csv_times(out):
@@ -42,13 +47,18 @@ def read_csv_times(out):
     return np.array([float(l.split(",")[0]) for l in lines])
 
 
-def check_ase(out, species, mass, radius, times):
+def check_ase(out, species, mass, radius, times, cell):
     import ase.io
 
     frames = ase.io.read(out / "trajectory.xyz", index=":")
     check(len(frames) == len(times), f"ASE: {len(frames)} frames, observables.csv {len(times)}")
     types = sorted(set(species), key=species.index)
     for k, a in enumerate(frames):
+        if cell is None:
+            check(not a.pbc.any(), f"ASE frame {k}: pbc {a.pbc} without a box")
+        else:
+            check(a.pbc.all(), f"ASE frame {k}: pbc {a.pbc} in a box")
+            check(np.array_equal(a.cell.array, np.diag(cell)), f"ASE frame {k}: cell {a.cell.array} != box {cell}")
         check(len(a) == len(species), f"ASE frame {k}: {len(a)} atoms")
         # 4/3 pi r^3 rho: the same number as the run's to rounding (another order of operations).
         check(np.allclose(a.get_masses(), mass, rtol=1e-14, atol=0), f"ASE frame {k}: masses {a.get_masses()} != {mass}")
@@ -62,7 +72,7 @@ def check_ase(out, species, mass, radius, times):
     return frames
 
 
-def check_gsd(out, species, mass, radius, bonds, ase_frames):
+def check_gsd(out, species, mass, radius, bonds, ase_frames, cell):
     import gsd.hoomd
 
     types = sorted(set(species), key=species.index)
@@ -76,16 +86,37 @@ def check_gsd(out, species, mass, radius, bonds, ase_frames):
             a = ase_frames[k]
             check(np.array_equal(p.mass, a.get_masses().astype(np.float32)), f"gsd frame {k}: mass")
             check(np.array_equal(p.diameter, (2 * radius).astype(np.float32)), f"gsd frame {k}: diameter")
-            check(np.array_equal(p.position, a.positions.astype(np.float32)), f"gsd frame {k}: positions")
+            box = f.configuration.box
+            if cell is None:
+                check(np.array_equal(p.position, a.positions.astype(np.float32)), f"gsd frame {k}: positions")
+            else:
+                # Wrapped into the box centred on the origin, with the image flags that
+                # give back the XYZ's unwrapped positions.
+                check(np.array_equal(box[:3], cell.astype(np.float32)), f"gsd frame {k}: box {box} != {cell}")
+                check(np.all(box[3:] == 0), f"gsd frame {k}: a tilted box")
+                half = cell.astype(np.float32) / 2
+                check(np.all((p.position >= -half) & (p.position < half)), f"gsd frame {k}: a position outside the box")
+                unwrapped = p.position.astype(np.float64) + p.image * cell
+                err = np.abs(unwrapped - a.positions)
+                scale = np.abs(a.positions) + cell
+                check(np.all(err <= 4 * np.finfo(np.float32).eps * scale), f"gsd frame {k}: position + image L != unwrapped (max {err.max()})")
             check(np.array_equal(p.velocity, a.arrays["velo"].astype(np.float32)), f"gsd frame {k}: velocities")
             check(f.bonds.N == len(bonds), f"gsd frame {k}: {f.bonds.N} bonds")
             check(np.array_equal(f.bonds.group, bonds), f"gsd frame {k}: bond groups")
             check(f.log["time"][0] == a.info["Time"], f"gsd frame {k}: log/time")
-            box = f.configuration.box
             check(np.all(np.abs(p.position) < np.array(box[:3]) / 2), f"gsd frame {k}: a particle outside the box")
 
 
-def check_ovito(out, species, mass, bonds, nframes):
+def check_ovito_cell(d, cell, what):
+    """OVITO's simulation cell: the box, periodic on every axis (or none periodic)."""
+    if cell is None:
+        return
+    check(d.cell is not None, f"OVITO {what}: no simulation cell")
+    check(np.allclose(np.diag(d.cell[:, :3]), cell, rtol=1e-6), f"OVITO {what}: cell {d.cell[...]} != {cell}")
+    check(all(d.cell.pbc), f"OVITO {what}: pbc {d.cell.pbc}")
+
+
+def check_ovito(out, species, mass, bonds, nframes, cell):
     from ovito.io import import_file
 
     pipe = import_file(str(out / "trajectory.xyz"))
@@ -97,6 +128,7 @@ def check_ovito(out, species, mass, bonds, nframes):
     check(np.allclose(d.particles["Mass"][...], mass, rtol=1e-14, atol=0), "OVITO xyz: Mass")
     check("Velocity" in d.particles, "OVITO xyz: no standard Velocity property")
     check("Radius" in d.particles, "OVITO xyz: no standard Radius property")
+    check_ovito_cell(d, cell, "xyz")
 
     pipe = import_file(str(out / "trajectory.gsd"))
     check(pipe.source.num_frames == nframes, f"OVITO gsd: {pipe.source.num_frames} frames")
@@ -106,6 +138,9 @@ def check_ovito(out, species, mass, bonds, nframes):
     check(np.array_equal(np.asarray(got, dtype=np.uint32).reshape(-1, 2), bonds), "OVITO gsd: bonds")
     check(np.allclose(d.particles["Mass"][...], mass, rtol=1e-6), "OVITO gsd: Mass")
     check("Velocity" in d.particles, "OVITO gsd: Velocity")
+    check_ovito_cell(d, cell, "gsd")
+    if cell is not None:
+        check("Periodic Image" in d.particles, "OVITO gsd: no Periodic Image property")
 
 
 def main(argv):
@@ -114,16 +149,17 @@ def main(argv):
     if not dirs:
         fail("usage: readback.py OUT_DIR [OUT_DIR ...] [--no-ovito]")
     for out in dirs:
-        s, species, mass, radius, bonds = expected(out)
+        s, species, mass, radius, bonds, cell = expected(out)
         times = read_csv_times(out)
         check(times[-1] == s["final_observables"]["time"], "observables.csv ends at another time than summary.json")
-        frames = check_ase(out, species, mass, radius, times)
-        check_gsd(out, species, mass, radius, bonds, frames)
+        frames = check_ase(out, species, mass, radius, times, cell)
+        check_gsd(out, species, mass, radius, bonds, frames, cell)
         if use_ovito:
-            check_ovito(out, species, mass, bonds, len(frames))
+            check_ovito(out, species, mass, bonds, len(frames), cell)
         tools = "ASE, gsd" + (", OVITO" if use_ovito else "")
+        boxed = "" if cell is None else f", periodic box {list(cell)}"
         print(f"readback: {out}: {len(frames)} frames of {len(species)} particles, "
-              f"{len(bonds)} bonds, types {sorted(set(species), key=species.index)}: read by {tools}")
+              f"{len(bonds)} bonds, types {sorted(set(species), key=species.index)}{boxed}: read by {tools}")
 
 
 if __name__ == "__main__":

@@ -144,6 +144,12 @@ impl Noise {
         self
     }
 
+    /// One uniform deviate in `[0, 1)`: the top 53 bits of the next draw (hosts place
+    /// generated scenes with it, from the same seeded stream as the noise).
+    pub fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * UNIT
+    }
+
     /// One standard normal deviate (Box–Muller: `sqrt(-2 ln u1) (cos, sin)(2 pi u2)`,
     /// `u1` in `(0, 1]` so the logarithm is finite; the sine half is kept for the next
     /// call).

@@ -12,10 +12,15 @@
 //! bonds (one bond type, `rigid`). Every frame holds the time step number, the time
 //! (`log/time`, f64), a box, and positions and velocities (f32, as the schema has
 //! them; the extended XYZ trajectory has the exact f64 values). HOOMD's box is
-//! periodic and centred on the origin; these runs have no periodic cell, so each
-//! frame's box is sized to enclose every sphere with room to spare (side `4 (max |x| +
+//! periodic and centred on the origin. A run without a periodic cell gets, in each
+//! frame, a box sized to enclose every sphere with room to spare (side `4 (max |x| +
 //! max radius) + 1`), which keeps every bond shorter than half a side and so drawn
-//! whole by viewers that apply the minimum image.
+//! whole by viewers that apply the minimum image. A run in a periodic box
+//! ([`Topology::cell`]) writes that box, positions wrapped into it (`[-L/2, L/2)` per
+//! axis) and the chunk `particles/image` (int32, the whole box edges each position was
+//! moved by), so that `position + image L` is the run's unwrapped position (to the f32
+//! rounding of the wrapped one); its name list has `particles/image` at the end (id
+//! 15), so a file without a cell is the same bytes as before boxes existed.
 
 use std::io::{self, Seek, SeekFrom, Write};
 
@@ -32,11 +37,13 @@ const UINT8: u8 = 1;
 const UINT32: u8 = 3;
 const UINT64: u8 = 4;
 const INT8: u8 = 5;
+const INT32: u8 = 7;
 const FLOAT: u8 = 9;
 const DOUBLE: u8 = 10;
 
-/// The chunk names, in id order (the index is sorted by frame, then id).
-const NAMES: [&str; 15] = [
+/// The chunk names, in id order (the index is sorted by frame, then id); the last one
+/// only in a file with a periodic cell.
+const NAMES: [&str; 16] = [
     "bonds/N",
     "bonds/group",
     "bonds/typeid",
@@ -52,10 +59,14 @@ const NAMES: [&str; 15] = [
     "particles/typeid",
     "particles/types",
     "particles/velocity",
+    "particles/image",
 ];
 
+/// Id of `particles/image`, written only with a periodic cell.
+const IMAGE: usize = 15;
+
 /// Ids of the chunks every frame holds.
-const PER_FRAME: [usize; 5] = [4, 6, 7, 11, 14];
+const PER_FRAME: [usize; 6] = [4, 6, 7, 11, 14, IMAGE];
 
 /// One chunk's shape: `n x m` elements of type `kind`.
 #[derive(Clone, Copy)]
@@ -70,7 +81,7 @@ impl Shape {
     fn bytes(&self) -> u64 {
         let size = match self.kind {
             UINT8 | INT8 => 1,
-            UINT32 | FLOAT => 4,
+            UINT32 | INT32 | FLOAT => 4,
             _ => 8,
         };
         self.n * u64::from(self.m) * size
@@ -166,26 +177,38 @@ impl<W: Write + Seek> GsdWriter<W> {
             }
         };
         let vec3s = |v: &[[f64; 3]]| v.iter().flatten().copied().collect::<Vec<f64>>();
+        // In a periodic cell: the box itself, positions wrapped into it, image flags.
+        let (box_, positions, images) = match t.cell {
+            None => (box_of(positions, &t.radius), positions.to_vec(), Vec::new()),
+            Some(cell) => {
+                let (p, i): (Vec<_>, Vec<_>) = positions.iter().map(|&p| wrap(cell, p)).unzip();
+                ([cell[0], cell[1], cell[2], 0.0, 0.0, 0.0], p, i)
+            }
+        };
         for s in self.shapes(self.frames) {
             match s.id {
                 0 => u32s(&mut buf, &mut std::iter::once(t.bonds.len() as u32)),
                 1 => u32s(&mut buf, &mut t.bonds.iter().flatten().map(|&i| i as u32)),
                 2 => u32s(&mut buf, &mut t.bonds.iter().map(|_| 0)),
                 3 => names(&mut buf, &["rigid"], s.m),
-                4 => f32s(&mut buf, &mut box_of(positions, &t.radius).into_iter()),
+                4 => f32s(&mut buf, &mut box_.into_iter()),
                 5 => buf.push(3),
                 6 => buf.extend_from_slice(&step.to_le_bytes()),
                 7 => buf.extend_from_slice(&time.to_le_bytes()),
                 8 => u32s(&mut buf, &mut std::iter::once(n as u32)),
                 9 => f32s(&mut buf, &mut t.radius.iter().map(|r| 2.0 * r)),
                 10 => f32s(&mut buf, &mut t.mass.iter().copied()),
-                11 => f32s(&mut buf, &mut vec3s(positions).into_iter()),
+                11 => f32s(&mut buf, &mut vec3s(&positions).into_iter()),
                 12 => u32s(&mut buf, &mut t.typeid.iter().map(|&i| i as u32)),
                 13 => {
                     let types: Vec<&str> = t.types.iter().map(String::as_str).collect();
                     names(&mut buf, &types, s.m)
                 }
-                _ => f32s(&mut buf, &mut vec3s(velocities).into_iter()),
+                14 => f32s(&mut buf, &mut vec3s(velocities).into_iter()),
+                _ => images
+                    .iter()
+                    .flatten()
+                    .for_each(|i| buf.extend_from_slice(&i.to_le_bytes())),
             }
         }
         self.inner.write_all(&buf)?;
@@ -214,7 +237,11 @@ impl<W: Write + Seek> GsdWriter<W> {
             }
             self.inner.write_all(&entry)?;
         }
-        let mut names: Vec<u8> = NAMES.iter().flat_map(|s| s.bytes().chain([0])).collect();
+        let count = if self.topology.cell.is_some() { IMAGE + 1 } else { IMAGE };
+        let mut names: Vec<u8> = NAMES[..count]
+            .iter()
+            .flat_map(|s| s.bytes().chain([0]))
+            .collect();
         names.push(0);
         names.resize(names.len().div_ceil(NAME_SEGMENT) * NAME_SEGMENT, 0);
         let names_at = index_at + 32 * entries;
@@ -264,10 +291,12 @@ fn shapes(t: &Topology, frame: u64) -> Vec<Shape> {
         shape(12, n, 1, UINT32),
         shape(13, t.types.len() as u64, names_width(&t.types), INT8),
         shape(14, n, 3, FLOAT),
+        shape(IMAGE, n, 3, INT32),
     ];
     all.into_iter()
         .filter(|s| frame == 0 || PER_FRAME.contains(&s.id))
         .filter(|s| b > 0 || s.id > 3)
+        .filter(|s| t.cell.is_some() || s.id != IMAGE)
         .collect()
 }
 
@@ -283,6 +312,26 @@ pub fn data_end(t: &Topology, frames: u64) -> u64 {
         0 => HEADER_BYTES,
         f => HEADER_BYTES + frame_bytes(t, 0) + (f - 1) * frame_bytes(t, 1),
     }
+}
+
+/// A position wrapped into the periodic box of edges `cell` centred on the origin, and
+/// its image flags: per axis `w = p - n L` in `[-L/2, L/2)` in f32 as written (a `w`
+/// that rounds to `L/2` belongs to the next image), `p = w + n L` to the rounding of
+/// the subtraction.
+fn wrap(cell: [f64; 3], p: [f64; 3]) -> ([f64; 3], [i32; 3]) {
+    let mut w = [0.0; 3];
+    let mut img = [0; 3];
+    for k in 0..3 {
+        let l = cell[k];
+        let mut n = (p[k] / l + 0.5).floor();
+        let mut x = p[k] - n * l;
+        if x as f32 >= (0.5 * l) as f32 {
+            n += 1.0;
+            x -= l;
+        }
+        (w[k], img[k]) = (x, n as i32);
+    }
+    (w, img)
 }
 
 /// A box centred on the origin enclosing every sphere with room to spare.
@@ -309,6 +358,7 @@ mod tests {
             radius: vec![1.26, 1.0, 1.0],
             mass: vec![37.7, 18.85, 18.85],
             bonds: vec![[0, 1], [1, 2]],
+            cell: None,
         }
     }
 

@@ -35,6 +35,10 @@ pub struct Topology {
     pub mass: Vec<f64>,
     /// Bonded pairs.
     pub bonds: Vec<[usize; 2]>,
+    /// The periodic box's edges `Lx, Ly, Lz`, when the run has one: the trajectories
+    /// give it (GSD `configuration/box` and `particles/image`, extended XYZ
+    /// `Lattice=`).
+    pub cell: Option<[f64; 3]>,
 }
 
 impl Topology {

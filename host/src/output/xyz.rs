@@ -33,9 +33,14 @@ pub struct Frame {
     pub masses: Vec<f64>,
     /// Velocities.
     pub velocities: Vec<[f64; 3]>,
+    /// The periodic cell's edges, from an orthorhombic `Lattice` (`None` without one).
+    pub cell: Option<[f64; 3]>,
 }
 
-/// Writes frames in extended XYZ, one after another, with no periodic cell:
+/// Writes frames in extended XYZ, one after another; with no periodic cell
+/// (`pbc="F F F"`), or with the [`Topology::cell`] as `Lattice="Lx 0 0 0 Ly 0 0 0 Lz"`
+/// and `pbc="T T T"`, positions unwrapped (as the run holds them: ASE's and OVITO's
+/// positions are then continuous, MSDs direct):
 ///
 /// ```text
 /// 2
@@ -80,10 +85,20 @@ impl<W: Write> XyzWriter<W> {
         if !time_text.contains(['.', 'e', 'N', 'n']) {
             time_text.push_str(".0");
         }
-        writeln!(
-            w,
-            "Properties={XYZ_PROPERTIES} Time={time_text} pbc=\"F F F\""
-        )?;
+        match topology.cell {
+            None => writeln!(
+                w,
+                "Properties={XYZ_PROPERTIES} Time={time_text} pbc=\"F F F\""
+            )?,
+            // The periodic cell, positions unwrapped (ASE and OVITO read both).
+            Some([lx, ly, lz]) => {
+                let [lx, ly, lz] = [lx, ly, lz].map(format_f64);
+                writeln!(
+                    w,
+                    "Lattice=\"{lx} 0 0 0 {ly} 0 0 0 {lz}\" Properties={XYZ_PROPERTIES} Time={time_text} pbc=\"T T T\""
+                )?
+            }
+        }
         for k in 0..n {
             let (p, v, m) = (positions[k], velocities[k], topology.mass[k]);
             let t = topology.typeid[k];
@@ -242,6 +257,16 @@ fn columns(properties: &str) -> Result<Columns, String> {
     })
 }
 
+/// The edges of an orthorhombic `Lattice` (nine numbers, zero off the diagonal).
+fn lattice(text: &str) -> Option<[f64; 3]> {
+    let v: Vec<f64> = text
+        .split_whitespace()
+        .map(|t| t.parse().ok())
+        .collect::<Option<_>>()?;
+    let diagonal = v.len() == 9 && [1, 2, 3, 5, 6, 7].iter().all(|&k| v[k] == 0.0);
+    diagonal.then(|| [v[0], v[4], v[8]])
+}
+
 /// Reads every frame of an extended XYZ stream that has (at least) the columns
 /// species, pos, radius and velo (or velocity) and a `Time` in each comment line.
 pub fn read_xyz<R: BufRead>(reader: R) -> Result<Vec<Frame>, XyzError> {
@@ -280,8 +305,12 @@ pub fn read_xyz<R: BufRead>(reader: R) -> Result<Vec<Frame>, XyzError> {
         let time = time_text
             .parse()
             .map_err(|_| xyz_error(no, format!("bad Time {time_text:?}")))?;
+        let cell = value("Lattice")
+            .map(|l| lattice(l).ok_or_else(|| xyz_error(no, format!("bad Lattice {l:?}"))))
+            .transpose()?;
         let mut frame = Frame {
             time,
+            cell,
             ..Frame::default()
         };
         for k in 0..n {
@@ -350,6 +379,7 @@ mod tests {
             radius: vec![1.5, 1.0],
             mass: vec![2.0, 4.0],
             bonds: vec![[0, 1]],
+            cell: None,
         }
     }
 

@@ -199,6 +199,11 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     p.wall = scene
         .wall
         .map(|w| hydrorattle::Wall::new(T::from_f64(w.height)));
+    // The scene checked the edges (finite, > 0) in f64; one that overflows `T` is
+    // left out here and refused by the scene's check against the first step.
+    p.periodic = scene
+        .periodic
+        .and_then(|b| hydrorattle::Periodic::new(b.size.map(T::from_f64)).ok());
     p
 }
 

@@ -6,6 +6,8 @@ use std::ops::Range;
 
 use toml::Spanned;
 
+use hydrorattle::glam::DVec3;
+
 use super::error::{Issue, issue};
 use super::raw::{Bound, RawBond, RawHelix, RawParticle, distance, finite_vector, number, vector};
 use super::resolve::BodySpans;
@@ -176,15 +178,25 @@ pub(super) fn resolve_bonds(
     Ok((out, spans))
 }
 
+/// Refuses nested spheres, and overlapping ones unless `overlap` allows them, at the
+/// later sphere; in a periodic box through the minimum image.
 pub(super) fn check_geometry(
     particles: &[Particle],
     overlap: Overlap,
+    periodic: Option<&super::PeriodicBox>,
     spans: &BodySpans,
 ) -> Result<(), Issue> {
+    let cell = periodic.and_then(super::PeriodicBox::kernel);
     for j in 0..particles.len() {
         for i in 0..j {
             let (p, q) = (&particles[i], &particles[j]);
-            let s = distance(p.position, q.position);
+            let s = match cell {
+                None => distance(p.position, q.position),
+                Some(c) => {
+                    let d = DVec3::from(q.position) - DVec3::from(p.position);
+                    c.minimum_image(d).length()
+                }
+            };
             if s <= (p.radius - q.radius).abs() {
                 return Err(issue(
                     spans.position(j),

@@ -67,6 +67,8 @@ impl KeySpans {
             span(raw.wall.as_ref().map(|w| w.span()), "a wall"),
             span(raw.wall.as_ref().map(|w| w.span()), "wall"),
             span(raw.contact.as_ref().map(|c| c.span()), "contacts"),
+            span(box_span(raw), "a periodic box"),
+            span(box_span(raw), "periodic"),
         ];
         KeySpans {
             keys: keys.into_iter().flatten().collect(),
@@ -81,6 +83,14 @@ impl KeySpans {
             .find(|(name, _)| message.starts_with(name))
             .map_or_else(|| self.fallback.clone(), |(_, s)| s.clone())
     }
+}
+
+/// The `[box]` table's `size`, else the table (the suspension's, when it sets the box).
+fn box_span(raw: &RawScene) -> Option<Range<usize>> {
+    let table = raw.periodic.as_ref();
+    let size = table.and_then(|b| b.get_ref().size_span());
+    size.or(table.map(|b| b.span()))
+        .or(raw.suspension.as_ref().map(|s| s.span()))
 }
 
 fn sp<T>(v: &super::raw::S<T>) -> Option<Range<usize>> {

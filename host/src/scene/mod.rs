@@ -22,9 +22,12 @@
 //! | `[output]` | `every` (steps between trajectory frames, >= 1) | about [`TARGET_FRAMES`] frames |
 //! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"`, `"springs"` or `"rattle-stable"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
 //! | `[wall]` | `height` (required, finite): a no-slip plane `z = height` below every sphere (`method = "overdamped"` or `"overdamped2"`, level manual; see [`Wall`]) | no wall |
+//! | `[box]` | `size = [Lx, Ly, Lz]` (required unless `[suspension]` sets it; finite, > 0), `method = "ewald"\|"pse"\|"auto"`, `tolerance` (`0 < t < 1`): a periodic box (see [`PeriodicBox`]) | no box; auto, 1e-6 |
+//! | `[suspension]` | `count` (required, >= 1), `fraction` (required, `0 < phi <=` [`MAX_FRACTION`]), `radius`, `polydispersity` (`0 <= p < 1`), `density`, `seed`: spheres placed at random in a cubic box (see [`Suspension`]) | 1, 0, 4.5, 1 |
 //!
-//! A scene gives either a `[helix]` table or explicit `[[particle]]` (and optionally
-//! `[[bond]]`) tables, never both. Units are those of `docs/MODEL.md#units`: tail radius
+//! A scene gives one of a `[helix]` table, a `[suspension]` table (which needs a
+//! `[box]` table, without `size`) or explicit `[[particle]]` (and optionally
+//! `[[bond]]`) tables. Units are those of `docs/MODEL.md#units`: tail radius
 //! 1, viscosity 1, and the default density 4.5 with gravity `[0, 0, -1]` and fluid
 //! density 0 gives a lone tail a buoyant weight of `6 pi`, so it settles at speed 1.
 //!
@@ -49,10 +52,12 @@ mod helix;
 mod kernel;
 mod model;
 mod names;
+mod periodic;
 mod precision;
 mod raw;
 mod resolve;
 pub mod sizing;
+mod suspension;
 #[cfg(test)]
 mod tests;
 mod thermal;
@@ -68,6 +73,8 @@ pub use model::{
     Precision, Solver,
 };
 pub use resolve::MAX_TURN_PER_STEP;
+pub use periodic::{BoxMethod, DEFAULT_BOX_TOLERANCE, PeriodicBox, PseUnwired};
+pub use suspension::{GAP, MAX_FRACTION, Suspension, TRIALS_PER_SPHERE};
 pub use thermal::{DEFAULT_SEED, Drift, Sqrt, Thermal};
 pub use wall::Wall;
 
@@ -157,6 +164,13 @@ pub struct Scene {
     pub brownian: Option<Thermal>,
     /// A no-slip plane wall below the spheres (`[wall]`); `None`: unbounded fluid.
     pub wall: Option<Wall>,
+    /// A periodic box (`[box]`); `None`: unbounded fluid. Left out of the JSON when
+    /// `None`, so that a run without a box records what it did before boxes existed.
+    #[serde(rename = "box", skip_serializing_if = "Option::is_none")]
+    pub periodic: Option<PeriodicBox>,
+    /// The suspension generator's settings, when the scene used one (`[suspension]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub suspension: Option<Suspension>,
     /// Species (type name) of each particle: `head` and `tail` for a helix; the
     /// `species` key, or one name per distinct radius and density, for explicit
     /// particles.
@@ -246,12 +260,17 @@ impl Scene {
                 too_large: None,
             }
         })?;
-        raw.resolve(limits).map_err(|i| SceneError {
+        let method_at = raw.periodic.as_ref().and_then(|b| b.get_ref().method_at());
+        let mut scene = raw.resolve(limits).map_err(|i| SceneError {
             origin: origin.to_string(),
             location: Some(i.span.map_or((1, 1), |s| line_col(text, s.start))),
             message: i.message,
             too_large: i.too_large,
-        })
+        })?;
+        if let Some(b) = scene.periodic.as_mut() {
+            b.method_line = method_at.map(|at| line_col(text, at).0);
+        }
+        Ok(scene)
     }
 
     /// The embedded Figure 1 scenes, parsed: `(case, scene)` for cases a, b, c.
@@ -306,6 +325,7 @@ impl Scene {
                 .map(|p| hydrorattle::particles::sphere_volume(p.radius) * p.density)
                 .collect(),
             bonds: self.bonds.iter().map(|b| [b.i, b.j]).collect(),
+            cell: self.periodic.map(|b| b.size),
         }
     }
 }

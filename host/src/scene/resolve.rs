@@ -105,6 +105,9 @@ impl RawScene {
                 Some(w)
             }
         };
+        if let (Some(b), Some(_)) = (&self.periodic, &self.wall) {
+            return Err(super::periodic::refuse_wall(b));
+        }
         let every = match self.output.as_ref().and_then(|o| o.every.as_ref()) {
             None => integrator.steps().div_ceil(TARGET_FRAMES).max(1),
             Some(e) if *e.get_ref() == 0 => {
@@ -129,7 +132,15 @@ impl RawScene {
             .map(|e| e.span());
         let output_span = every_span.unwrap_or_else(|| raw_int.get_ref().duration.span());
 
+        let mut suspension = None;
         let (particles, bonds, helix, body_span, species) = match (&self.helix, &self.particles) {
+            _ if self.suspension.is_some() => {
+                let (s, (particles, edge)) = self.generate_suspension(&plans, limits, every)?;
+                suspension = Some((s, edge));
+                let species = vec!["sphere".to_string(); particles.len()];
+                let spans = BodySpans::Helix(self.suspension.as_ref().map_or(0..0, |s| s.span()));
+                (particles, Vec::new(), None, spans, species)
+            }
             (Some(h), Some(_)) => {
                 return Err(issue(
                     h.span(),
@@ -176,7 +187,20 @@ impl RawScene {
             }
         };
 
-        check_geometry(&particles, model.overlap, &body_span)?;
+        let periodic = match (&self.periodic, suspension) {
+            (Some(b), s) => Some(super::periodic::resolve(b, s.map(|(_, e)| [e; 3]))?),
+            (None, Some((_, e))) => Some(super::PeriodicBox {
+                size: [e; 3],
+                method: super::BoxMethod::Auto,
+                tolerance: super::DEFAULT_BOX_TOLERANCE,
+                method_line: None,
+            }),
+            (None, None) => None,
+        };
+        if let Some(b) = &periodic {
+            super::periodic::check_particles(b, &particles, &body_span)?;
+        }
+        check_geometry(&particles, model.overlap, periodic.as_ref(), &body_span)?;
         if let Some(w) = wall {
             super::wall::check_particles(w, &particles, &body_span)?;
         }
@@ -211,6 +235,8 @@ impl RawScene {
             brownian,
             species,
             wall,
+            periodic,
+            suspension: suspension.map(|(s, _)| s),
         };
         let keys = super::kernel::KeySpans::of(&self, raw_int.span());
         super::kernel::check(&scene, &keys, &body_span)?;
@@ -218,8 +244,45 @@ impl RawScene {
     }
 }
 
+impl RawScene {
+    /// The `[suspension]` table's spheres and box edge (the only body: no helix, no
+    /// explicit particles or bonds), sized from its count before anything is placed.
+    fn generate_suspension(
+        &self,
+        plans: &[Plan],
+        limits: Limits,
+        every: usize,
+    ) -> Result<(super::Suspension, (Vec<super::Particle>, f64)), Issue> {
+        let Some(raw) = &self.suspension else {
+            return Err(Issue::unplaced("no [suspension] table"));
+        };
+        let other = [
+            self.helix.as_ref().map(|h| h.span()),
+            self.particles.as_ref().map(|p| p.span()),
+            self.bonds.as_ref().map(|b| b.span()),
+        ];
+        if let Some(at) = other.into_iter().flatten().next() {
+            return Err(issue(
+                at,
+                "a [suspension] makes its own spheres (and no bonds): leave out [helix], [[particle]] and [[bond]]",
+            ));
+        }
+        let s = super::suspension::resolve(raw)?;
+        let at = raw.get_ref().count_span().unwrap_or(raw.span());
+        let integrator = self.integrator.as_ref().map(|i| i.get_ref());
+        fits(plans, s.count, 0, limits.storage).map_err(|e| too_large(at.clone(), e))?;
+        if let Some(i) = integrator {
+            let i = resolve_integrator(i)?;
+            check_output(&i, every, s.count, limits.output).map_err(|m| issue(at.clone(), m))?;
+        }
+        let body = s.generate().map_err(|m| issue(raw.span(), m))?;
+        Ok((s, body))
+    }
+}
+
 /// Spans of the body's values, to place geometric errors.
 pub(super) enum BodySpans {
+    /// A generated body (the helix's or the suspension's table).
     Helix(Range<usize>),
     /// Per particle: span of its position, span of its density (or of its position);
     /// per bond: span of its length (or of its `between`).

@@ -101,8 +101,32 @@ impl Scene {
         if let Some(w) = self.wall {
             t.insert("wall".into(), table([("height", value(w.height))]));
         }
-        match &self.helix {
-            Some(h) => {
+        if let Some(b) = self.periodic {
+            let mut bt = table([
+                ("method", value(b.method)),
+                ("tolerance", value(b.tolerance)),
+            ]);
+            // A suspension's box is its own: the generator sets the size.
+            if let (Value::Table(m), None) = (&mut bt, self.suspension) {
+                m.insert("size".into(), value(b.size));
+            }
+            t.insert("box".into(), bt);
+        }
+        match (&self.helix, &self.suspension) {
+            (_, Some(s)) => {
+                t.insert(
+                    "suspension".into(),
+                    table([
+                        ("count", value(s.count as i64)),
+                        ("fraction", value(s.fraction)),
+                        ("radius", value(s.radius)),
+                        ("polydispersity", value(s.polydispersity)),
+                        ("density", value(s.density)),
+                        ("seed", value(s.seed as i64)),
+                    ]),
+                );
+            }
+            (Some(h), None) => {
                 t.insert(
                     "helix".into(),
                     table([
@@ -116,7 +140,7 @@ impl Scene {
                     ]),
                 );
             }
-            None => {
+            (None, None) => {
                 let particles = self.particles.iter().zip(&self.species).map(|(p, s)| {
                     table([
                         ("position", value(p.position)),

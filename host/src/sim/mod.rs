@@ -282,6 +282,8 @@ pub fn run_from(
     opts: RunOptions,
     start: Start,
 ) -> Result<RunResult> {
+    let origin = start.scene_path.as_ref().map(|p| p.display().to_string());
+    scene.check_box_runs(origin.as_deref())?;
     let (scene, choice) = resolve_level(scene, name);
     let fresh = out.filter(|d| !d.exists());
     let origin = run_loop::Origin {
@@ -304,14 +306,17 @@ pub fn run_from(
     result
 }
 
-/// `scene` with `level = "auto"` applied (and what was chosen), or as it is.
+/// `scene` with `level = "auto"` applied (and what was chosen), or as it is; its box's
+/// `method = "auto"` resolved too ([`crate::scene::BoxMethod::resolve`]), so that the
+/// run's `scene.toml` names the path it ran.
 pub fn resolve_level(scene: &Scene, name: &str) -> (Scene, Option<crate::auto::Choice>) {
+    let scene = scene.clone().with_box_resolved();
     if scene.model.level != crate::scene::Level::Auto {
-        return (scene.clone(), None);
+        return (scene, None);
     }
-    let c = crate::auto::choose(scene);
+    let c = crate::auto::choose(&scene);
     log::info!("{name}: level auto: {}", c.reason);
-    (crate::auto::apply(scene, &c), Some(c))
+    (crate::auto::apply(&scene, &c), Some(c))
 }
 
 /// What `host-demo run SCENE --out OUT` does: reads the scene file under `limits` and

@@ -1,0 +1,256 @@
+//! A periodic box: the `[box]` table.
+//!
+//! ```toml
+//! [box]
+//! size = [20.0, 20.0, 20.0]   # Lx, Ly, Lz: every edge finite and > 0
+//! method = "auto"             # "ewald" | "pse" | "auto" (default)
+//! tolerance = 1e-6            # the fast path's relative error (0 < tolerance < 1)
+//! ```
+//!
+//! The kernel's `Params::periodic`: the Ewald-summed RPY mobility (`docs/PERIODIC.md`),
+//! bonds, springs and contacts through the minimum image, positions kept unwrapped
+//! (the trajectories give the box: `docs/SCENES.md`). `"ewald"` is the exact
+//! reference path, summed to about the precision's epsilon whatever the tolerance;
+//! `"pse"` (the positively split Ewald fast path) is read and written back but a run
+//! refuses it ([`PseUnwired`]) until it is wired in; `"auto"` resolves by
+//! [`BoxMethod::resolve`]. Refused at the value at fault: an edge not finite or not
+//! positive, a tolerance outside `(0, 1)`, a sphere whose radius is not below half the
+//! smallest edge (it would overlap its own image), a box with a `[wall]` (the wall's
+//! image system is free space's), and (by the kernel's own check of the first step) a
+//! bond not shorter than half the smallest edge, rotation and the Oseen level.
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+use toml::Spanned;
+
+use super::Particle;
+use super::error::{Issue, issue};
+use super::raw::{Bound, S, number};
+use super::resolve::BodySpans;
+
+/// How the box's mobility is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum BoxMethod {
+    /// The exact Ewald sum (`mobility::periodic`), `O(N^2)` per product.
+    Ewald,
+    /// The positively split Ewald fast path, `O(N log N)`: not yet wired into runs.
+    Pse,
+    /// Chosen by [`BoxMethod::resolve`].
+    #[default]
+    Auto,
+}
+
+impl BoxMethod {
+    /// The method a run uses for `n` spheres: `"auto"` is `"ewald"` for every `n` (the
+    /// only path wired into runs; when the PSE path is, `"auto"` picks it above the
+    /// measured crossover in `n`). `"ewald"` and `"pse"` are themselves.
+    pub fn resolve(self, n: usize) -> BoxMethod {
+        let _ = n; // The crossover's argument, once there is a second path.
+        match self {
+            BoxMethod::Auto => BoxMethod::Ewald,
+            m => m,
+        }
+    }
+}
+
+/// The default `tolerance`: the fast path's relative error.
+pub const DEFAULT_BOX_TOLERANCE: f64 = 1e-6;
+
+/// A rectangular periodic box.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct PeriodicBox {
+    /// Edges `Lx, Ly, Lz` (finite, > 0).
+    pub size: [f64; 3],
+    /// How its mobility is computed.
+    pub method: BoxMethod,
+    /// The fast path's relative error, `0 < tolerance < 1` (the Ewald path sums to
+    /// about the precision's epsilon whatever it says).
+    pub tolerance: f64,
+    /// Line of the `method` key in the scene file that set it (to place a run's
+    /// refusal of `"pse"`); not part of the box (ignored by `==`, not written).
+    #[serde(skip)]
+    pub method_line: Option<usize>,
+}
+
+impl PartialEq for PeriodicBox {
+    fn eq(&self, o: &Self) -> bool {
+        (self.size, self.method, self.tolerance) == (o.size, o.method, o.tolerance)
+    }
+}
+
+impl PeriodicBox {
+    /// The box's smallest edge.
+    pub fn min_edge(&self) -> f64 {
+        self.size.iter().fold(f64::INFINITY, |m, &l| m.min(l))
+    }
+
+    /// The kernel's box (`hydrorattle::Periodic`) in f64, whose minimum image is the
+    /// one the steps take; `None` for an edge not finite or not positive.
+    pub fn kernel(&self) -> Option<hydrorattle::Periodic<f64>> {
+        hydrorattle::Periodic::new(self.size).ok()
+    }
+}
+
+/// `[box]` as written.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawBox {
+    size: S<[f64; 3]>,
+    method: Option<Spanned<BoxMethod>>,
+    tolerance: S<f64>,
+}
+
+impl RawBox {
+    /// Span of `size`, when given.
+    pub(super) fn size_span(&self) -> Option<std::ops::Range<usize>> {
+        self.size.as_ref().map(|s| s.span())
+    }
+
+    /// Where `method` starts, when given (the parser turns it into
+    /// [`PeriodicBox::method_line`]).
+    pub(super) fn method_at(&self) -> Option<usize> {
+        self.method.as_ref().map(|m| m.span().start)
+    }
+}
+
+/// Resolves `[box]`; `size` is the suspension generator's edge when the scene has one
+/// (then the table must not give its own), required otherwise. The parser sets
+/// `method_line` (it holds the text).
+pub(super) fn resolve(
+    raw: &Spanned<RawBox>,
+    generated: Option<[f64; 3]>,
+) -> Result<PeriodicBox, Issue> {
+    let r = raw.get_ref();
+    let size = match (&r.size, generated) {
+        (Some(s), Some(_)) => {
+            return Err(issue(
+                s.span(),
+                "[suspension] sets the box from its count and fraction: leave [box] size out",
+            ));
+        }
+        (None, Some(g)) => g,
+        (None, None) => {
+            return Err(issue(
+                raw.span(),
+                "missing field `size` in [box] (the edges [Lx, Ly, Lz])",
+            ));
+        }
+        (Some(s), None) => {
+            let v = *s.get_ref();
+            if let Some(k) = v.iter().position(|l| !(l.is_finite() && *l > 0.0)) {
+                let axis = ["x", "y", "z"][k];
+                return Err(issue(
+                    s.span(),
+                    format!(
+                        "box size: every edge must be finite and > 0, not L{axis} = {}",
+                        crate::output::format_f64(v[k])
+                    ),
+                ));
+            }
+            v
+        }
+    };
+    let tolerance = number(
+        &r.tolerance,
+        DEFAULT_BOX_TOLERANCE,
+        "box tolerance",
+        Bound::Positive,
+    )?;
+    if let Some(t) = r.tolerance.as_ref().filter(|_| tolerance >= 1.0) {
+        return Err(issue(
+            t.span(),
+            format!("box tolerance must be below 1 (a relative error), not {tolerance}"),
+        ));
+    }
+    let method = r.method.as_ref().map_or(BoxMethod::Auto, |m| *m.get_ref());
+    Ok(PeriodicBox {
+        size,
+        method,
+        tolerance,
+        method_line: None,
+    })
+}
+
+/// Refuses a sphere that would overlap its own image: radius not below half the
+/// smallest edge, placed at the sphere.
+pub(super) fn check_particles(
+    b: &PeriodicBox,
+    particles: &[Particle],
+    spans: &BodySpans,
+) -> Result<(), Issue> {
+    let half = 0.5 * b.min_edge();
+    match particles.iter().position(|p| !(p.radius < half)) {
+        None => Ok(()),
+        Some(k) => Err(issue(
+            spans.position(k),
+            format!(
+                "particle {k} has radius {}, not below half the box's smallest edge ({half}): it would overlap its own image",
+                particles[k].radius
+            ),
+        )),
+    }
+}
+
+/// A box and a wall together, placed at the box.
+pub(super) fn refuse_wall(raw: &Spanned<RawBox>) -> Issue {
+    issue(
+        raw.get_ref().size_span().unwrap_or(raw.span()),
+        "a periodic [box] with a [wall] is not supported (the wall's mobility is that of a wall in unbounded fluid; a wall-bounded periodic layer needs another Green's function)",
+    )
+}
+
+/// A run of a scene whose `[box]` asks for `method = "pse"`, refused until the fast
+/// path is wired into runs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PseUnwired {
+    /// The scene file, when the run came from one.
+    pub origin: Option<String>,
+    /// The line of `method = "pse"`, when the scene was read from a file.
+    pub line: Option<usize>,
+}
+
+impl fmt::Display for PseUnwired {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match (&self.origin, self.line) {
+            (Some(o), Some(l)) => write!(f, "{o}:{l}: ")?,
+            (None, Some(l)) => write!(f, "line {l}: ")?,
+            (Some(o), None) => write!(f, "{o}: ")?,
+            (None, None) => {}
+        }
+        write!(
+            f,
+            "[box] method = \"pse\": the PSE fast path is not wired into runs yet; use method = \"ewald\" or \"auto\""
+        )
+    }
+}
+
+impl std::error::Error for PseUnwired {}
+
+impl super::Scene {
+    /// This scene with its box method resolved for the run ([`BoxMethod::resolve`]:
+    /// `"auto"` becomes the method it picks, so the run's `scene.toml` re-runs the
+    /// same path); `"pse"` stays, for [`check_box_runs`](Self::check_box_runs).
+    pub fn with_box_resolved(mut self) -> super::Scene {
+        let n = self.particles.len();
+        if let Some(b) = self.periodic.as_mut() {
+            b.method = b.method.resolve(n);
+        }
+        self
+    }
+
+    /// Refuses a run of a box whose method is `"pse"` ([`PseUnwired`], placed at its
+    /// line in `origin`).
+    pub fn check_box_runs(&self, origin: Option<&str>) -> Result<(), PseUnwired> {
+        match self.periodic {
+            Some(b) if b.method.resolve(self.particles.len()) == BoxMethod::Pse => {
+                Err(PseUnwired {
+                    origin: origin.map(str::to_string),
+                    line: b.method_line,
+                })
+            }
+            _ => Ok(()),
+        }
+    }
+}
