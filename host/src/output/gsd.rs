@@ -237,7 +237,11 @@ impl<W: Write + Seek> GsdWriter<W> {
             }
             self.inner.write_all(&entry)?;
         }
-        let count = if self.topology.cell.is_some() { IMAGE + 1 } else { IMAGE };
+        let count = if self.topology.cell.is_some() {
+            IMAGE + 1
+        } else {
+            IMAGE
+        };
         let mut names: Vec<u8> = NAMES[..count]
             .iter()
             .flat_map(|s| s.bytes().chain([0]))

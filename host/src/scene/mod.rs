@@ -46,6 +46,8 @@
 pub mod auto;
 mod beads;
 mod bodies;
+#[cfg(test)]
+mod box_tests;
 mod contact;
 mod error;
 mod helix;
@@ -72,8 +74,8 @@ pub use model::{
     Bond, Flow, Fluid, Hydrodynamics, Integrator, Level, Method, Model, Output, Overlap, Particle,
     Precision, Solver,
 };
-pub use resolve::MAX_TURN_PER_STEP;
 pub use periodic::{BoxMethod, DEFAULT_BOX_TOLERANCE, PeriodicBox, PseUnwired};
+pub use resolve::MAX_TURN_PER_STEP;
 pub use suspension::{GAP, MAX_FRACTION, Suspension, TRIALS_PER_SPHERE};
 pub use thermal::{DEFAULT_SEED, Drift, Sqrt, Thermal};
 pub use wall::Wall;

@@ -249,9 +249,9 @@ impl Suspension {
                 }
                 budget -= 1;
                 let p: [f64; 3] = std::array::from_fn(|_| noise.uniform() * edge);
-                let clear = grid.near(p).all(|j| {
-                    grid.distance(p, centre[j]) >= (radii[k] + radii[j]) * (1.0 + GAP)
-                });
+                let clear = grid
+                    .near(p)
+                    .all(|j| grid.distance(p, centre[j]) >= (radii[k] + radii[j]) * (1.0 + GAP));
                 if clear {
                     centre[k] = p;
                     grid.insert(k, p);
