@@ -39,11 +39,15 @@ fn the_box_size_is_a_sweep_key() {
 
 #[test]
 fn a_box_the_scene_refuses_is_an_error_at_the_sweep_value() {
-    let text = format!("{CHAIN}\n[sweep]\n\"box.size\" = [[16.0, 16.0, 24.0],\n [16.0, -1.0, 24.0]]\n");
+    let text =
+        format!("{CHAIN}\n[sweep]\n\"box.size\" = [[16.0, 16.0, 24.0],\n [16.0, -1.0, 24.0]]\n");
     let e = Sweep::parse(&text, "s.toml", Path::new(".")).unwrap_err();
     let line = text.lines().position(|l| l.contains("-1.0")).unwrap() + 1;
     assert_eq!(e.line(), Some(line), "{e}");
-    assert!(e.message.contains("every edge must be finite and > 0"), "{e}");
+    assert!(
+        e.message.contains("every edge must be finite and > 0"),
+        "{e}"
+    );
     // A box too small for the chain's head (radius 2): refused at the value too.
     let text = format!("{CHAIN}\n[sweep]\n\"box.size\" = [[3.5, 16.0, 24.0]]\n");
     let e = Sweep::parse(&text, "s.toml", Path::new(".")).unwrap_err();

@@ -255,7 +255,7 @@ fn a_suspension_fills_its_fraction_without_overlap_and_repeats() {
 fn bad_suspensions_are_refused_at_their_line() {
     let cases: [(&str, &str, usize, &str); 6] = [
         ("count = 200", "count = 0", 2, "count must be >= 1"),
-        ("fraction = 0.2", "fraction = 0.5", 3, "above 0.4"),
+        ("fraction = 0.2", "fraction = 0.5", 3, "above 0.35"),
         (
             "fraction = 0.2",
             "fraction = -0.1",
