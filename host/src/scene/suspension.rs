@@ -229,7 +229,7 @@ impl Suspension {
         let a_max = radii.iter().fold(0.0_f64, |m, &a| m.max(a));
         let cell = Periodic::new([edge; 3])
             .map_err(|_| format!("the box edge {edge} is not a finite positive number"))?;
-        if !(2.0 * a_max < edge) {
+        if 2.0 * a_max >= edge {
             return Err(format!(
                 "a sphere of radius {a_max} does not fit in the box of edge {edge} that {} spheres at fraction {} make: give more spheres",
                 self.count, self.fraction
