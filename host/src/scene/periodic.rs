@@ -181,7 +181,10 @@ pub(super) fn check_particles(
     spans: &BodySpans,
 ) -> Result<(), Issue> {
     let half = 0.5 * b.min_edge();
-    match particles.iter().position(|p| p.radius >= half || p.radius.is_nan()) {
+    match particles
+        .iter()
+        .position(|p| p.radius >= half || p.radius.is_nan())
+    {
         None => Ok(()),
         Some(k) => Err(issue(
             spans.position(k),
