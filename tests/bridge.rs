@@ -218,6 +218,23 @@ fn generator_is_the_reference_xoshiro256plusplus() {
     }
 }
 
+/// [`Noise::uniform`] is the reference stream's top 53 bits times `2^-53` (the
+/// suspension generator places spheres with it), in `[0, 1)`.
+#[test]
+fn uniform_is_the_reference_stream() {
+    use rand_core::{Rng, SeedableRng};
+    for seed in [0, 11, u64::MAX] {
+        let mut reference = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut ours = Noise::new(seed);
+        for _ in 0..5_000 {
+            let want = (reference.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+            let got = ours.uniform();
+            assert_eq!(got.to_bits(), want.to_bits());
+            assert!((0.0..1.0).contains(&got));
+        }
+    }
+}
+
 /// A saved generator restores to the same stream, with a Box-Muller spare pending or
 /// not; words no generator has are refused.
 #[test]
