@@ -1,0 +1,318 @@
+//! The positively split Ewald (PSE) product `u = M F` of the periodic RPY mobility
+//! (Fiore, Balboa Usabiaga, Donev & Swan, J. Chem. Phys. 146, 124116, 2017), in
+//! `O(N log N)`: the same split as the Ewald path ([`crate::mobility::periodic`]),
+//! Hasimoto's `H(k) = (1 + k^2/(4 xi^2)) exp(-k^2/(4 xi^2))` with Beenakker's sphere
+//! factors `1 - k^2 a^2 / 6`, summed differently:
+//!
+//! * wave space on a grid: Gaussian spreading of `F_j` and `a_j^2 F_j` (`spread.rs`), a
+//!   3D FFT (`fft.rs`), the kernel mode by mode (`wave.rs`), the inverse FFT and
+//!   Gaussian interpolation;
+//! * real space as a sparse near-field sum with a cell list (`near.rs`), each block the
+//!   Ewald path's real-space block, so the halves add to the same periodic RPY.
+//!
+//! One tolerance sets every parameter ([`Pse::with_xi`], `docs/PERIODIC.md`, section
+//! PSE). The kernel stays `no_std`, allocation-free and without `unsafe`: the caller
+//! owns the grid and the cell list ([`Pse::storage`], [`PseStorage`]).
+
+mod fft;
+mod near;
+mod spread;
+mod wave;
+
+use core::fmt;
+
+pub use fft::{Cx, good_size};
+pub use spread::MAX_SUPPORT;
+
+use crate::error::ParticleError;
+use crate::mobility::periodic::real::Split;
+use crate::mobility::periodic::{Periodic, PeriodicError};
+use crate::real::Real;
+
+/// `xi a_max` of [`Pse::new`]: the cost optimum measured at volume fraction 0.1
+/// (`docs/PERIODIC.md`).
+pub const XI_PSE: f64 = 0.5;
+
+/// The largest grid edge, in points (a bound on the storage a box can ask for).
+pub const MAX_GRID: usize = 2048;
+
+/// A rejected PSE parameter, configuration or storage.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PseError {
+    /// The box, a parameter, a radius or a position (as the Ewald path).
+    Periodic(PeriodicError),
+    /// The tolerance asks for a Gaussian support above [`MAX_SUPPORT`] points or a grid
+    /// edge above [`MAX_GRID`].
+    GridTooLarge,
+    /// Positions, radii, forces and output differ in length.
+    Length,
+    /// Caller storage too small: `need` and `have` for the complex values, then the
+    /// indices.
+    Storage {
+        /// Values needed (complex, then index).
+        need: [usize; 2],
+        /// Values given.
+        have: [usize; 2],
+    },
+}
+
+impl fmt::Display for PseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Periodic(e) => write!(f, "{e}"),
+            Self::GridTooLarge => write!(f, "the PSE tolerance needs too large a grid"),
+            Self::Length => write!(
+                f,
+                "PSE: positions, radii, forces and output differ in length"
+            ),
+            Self::Storage { need, have } => write!(
+                f,
+                "PSE storage too small: need {} complex and {} index values, have {} and {}",
+                need[0], need[1], have[0], have[1]
+            ),
+        }
+    }
+}
+
+impl From<PeriodicError> for PseError {
+    fn from(e: PeriodicError) -> Self {
+        Self::Periodic(e)
+    }
+}
+
+/// Storage sizes of [`Pse::apply`] for a given number of spheres.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PseSize {
+    /// Complex values: the grid (3 per point), FFT scratch, twiddles and kernel tables.
+    pub complex: usize,
+    /// Indices: the cell list (one per sphere and one per cell, plus one).
+    pub index: usize,
+}
+
+/// Caller-owned storage of [`Pse::apply`], at least [`Pse::storage`].
+pub struct PseStorage<'a, T: Real> {
+    /// Complex values.
+    pub complex: &'a mut [Cx<T>],
+    /// Indices.
+    pub index: &'a mut [usize],
+}
+
+/// The PSE parameters of one box, largest radius and tolerance.
+#[derive(Clone, Copy, Debug)]
+pub struct Pse<T: Real> {
+    cell: Periodic<T>,
+    a_max: T,
+    tol: f64,
+    xi: T,
+    split: Split<T>,
+    grid: fft::Grid3,
+    /// Grid spacing per axis.
+    h: [T; 3],
+    /// The spreading Gaussian's standard deviation and its normalisation.
+    sigma: T,
+    norm: T,
+    /// Gaussian support per axis, in points.
+    support: [usize; 3],
+    /// `1/(4 xi^2) - sigma^2`: the Gaussian rate left in the wave-space kernel.
+    residual: T,
+    /// Cell-list cells per axis.
+    cells: [usize; 3],
+}
+
+impl<T: Real> Pse<T> {
+    /// Parameters by the documented rule with `xi = XI_PSE / a_max`.
+    pub fn new(cell: Periodic<T>, a_max: T, tol: f64) -> Result<Self, PseError> {
+        Self::with_xi(cell, a_max, tol, T::from_f64(XI_PSE) / a_max)
+    }
+
+    /// Parameters for a splitting parameter `xi` and a relative tolerance
+    /// `tol` in `[1e-12, 0.1]`. With `D = ln(1/tol)`:
+    ///
+    /// * `p^2 = D + 3/2 ln(p^2) + 2 ln(1 + (a_max xi p)^2 / 2)` (a fixed point): the
+    ///   Ewald path's rule (the last term, the sphere factors' growth) plus the growth
+    ///   of the number of wave vectors in a shell, `~ p^3`, which dominates the
+    ///   wave-space tail;
+    /// * real-space cutoff `r_c = max(p / xi, 2 a_max)`, wave-space cutoff
+    ///   `k_max = 2 p xi`: both truncations `~ exp(-p^2)`;
+    /// * grid spacing `h_d <= pi / k_max` (the Nyquist wave number at `k_max`; each
+    ///   edge rounded up to an even `2^a 3^b 5^c` number of points);
+    /// * Gaussian `sigma = p / (sqrt(2) k_max)`: its aliasing error
+    ///   `exp(-2 pi^2 sigma^2 / h^2)` is at most `exp(-p^2)`; the kernel keeps
+    ///   `exp(-k^2 / (8 xi^2))` (half of Hasimoto's Gaussian) between the two spreads;
+    /// * support `P_d = ceil(2 sqrt(2 D) sigma / h_d)` points (about `2 p sqrt(D) / pi`):
+    ///   the Gaussian left out is below `exp(-D)` of its peak.
+    ///
+    /// Measured against the Ewald path the error is 5 to 50 times below `tol`
+    /// (`docs/PERIODIC.md`).
+    pub fn with_xi(cell: Periodic<T>, a_max: T, tol: f64, xi: T) -> Result<Self, PseError> {
+        if !(xi > T::ZERO && xi.is_finite()) {
+            return Err(PeriodicError::BadParameter("xi").into());
+        }
+        if !(1e-12..=0.1).contains(&tol) {
+            return Err(PeriodicError::BadParameter("tolerance").into());
+        }
+        if !(a_max > T::ZERO && a_max.is_finite()) {
+            return Err(PeriodicError::BadParameter("largest radius").into());
+        }
+        let size = cell.size();
+        if !(a_max + a_max < size[0].min(size[1]).min(size[2])) {
+            return Err(PeriodicError::SphereTooLarge.into());
+        }
+        // The rule in f64 whatever T.
+        let (x, a, dig) = (xi.to_f64(), a_max.to_f64(), -libm::log(tol));
+        let mut p2 = dig;
+        for _ in 0..6 {
+            let t = a * x * libm::sqrt(p2);
+            p2 = dig + 1.5 * libm::log(p2) + 2.0 * libm::log(1.0 + 0.5 * t * t);
+        }
+        let p = libm::sqrt(p2);
+        let r_cut = (p / x).max(2.0 * a);
+        let k_max = 2.0 * p * x;
+        let sigma = libm::sqrt(0.5 * p2) / k_max;
+        let width = 2.0 * libm::sqrt(2.0 * dig) * sigma;
+        let (mut m, mut h, mut support, mut cells) = ([0; 3], [T::ZERO; 3], [0; 3], [1; 3]);
+        let mut factors = [fft::Factors::new(1).ok_or(PseError::GridTooLarge)?; 3];
+        for d in 0..3 {
+            let l = size[d].to_f64();
+            let need = libm::ceil(l * k_max / core::f64::consts::PI);
+            if !(need <= MAX_GRID as f64) {
+                return Err(PseError::GridTooLarge);
+            }
+            m[d] = good_size(need as usize);
+            factors[d] = fft::Factors::new(m[d]).ok_or(PseError::GridTooLarge)?;
+            let hd = l / m[d] as f64;
+            h[d] = T::from_f64(hd);
+            let s = libm::ceil(width / hd);
+            if !(s <= MAX_SUPPORT as f64) || s as usize > m[d] {
+                return Err(PseError::GridTooLarge);
+            }
+            support[d] = s as usize;
+            cells[d] = (libm::floor(l / r_cut) as usize).clamp(1, MAX_GRID);
+        }
+        let norm = libm::pow(2.0 * core::f64::consts::PI * sigma * sigma, -1.5);
+        Ok(Self {
+            cell,
+            a_max,
+            tol,
+            xi,
+            split: Split::new(cell, xi, r_cut)?,
+            grid: fft::Grid3 {
+                m,
+                factors,
+                comps: 3,
+            },
+            h,
+            sigma: T::from_f64(sigma),
+            norm: T::from_f64(norm),
+            support,
+            residual: T::from_f64(0.25 / (x * x) - sigma * sigma),
+            cells,
+        })
+    }
+
+    /// The box.
+    pub fn cell(&self) -> Periodic<T> {
+        self.cell
+    }
+    /// The splitting parameter.
+    pub fn xi(&self) -> T {
+        self.xi
+    }
+    /// The tolerance the parameters were derived for.
+    pub fn tolerance(&self) -> f64 {
+        self.tol
+    }
+    /// The real-space cutoff.
+    pub fn r_cut(&self) -> T {
+        self.split.r_cut
+    }
+    /// Grid points per axis.
+    pub fn grid(&self) -> [usize; 3] {
+        self.grid.m
+    }
+    /// Gaussian support per axis, in grid points.
+    pub fn support(&self) -> [usize; 3] {
+        self.support
+    }
+    /// Cell-list cells per axis.
+    pub fn cells(&self) -> [usize; 3] {
+        self.cells
+    }
+    /// The largest radius the parameters were chosen for.
+    pub fn a_max(&self) -> T {
+        self.a_max
+    }
+
+    /// Storage [`Pse::apply`] needs for `n` spheres.
+    pub fn storage(&self, n: usize) -> PseSize {
+        let [mx, my, mz] = self.grid.m;
+        let axes = mx + my + mz;
+        PseSize {
+            complex: 3 * mx * my * mz + self.grid.scratch_len() + 2 * axes,
+            index: n + self.cells[0] * self.cells[1] * self.cells[2] + 1,
+        }
+    }
+
+    /// `out = M F`: the periodic RPY mobility (viscosity `eta`) of the spheres at `pos`
+    /// (any image) with radii `radius` (in `(0, a_max]`) applied to `force`, to the
+    /// tolerance. Wave space first, then the near field added row by row, in a fixed
+    /// order: the same inputs give the same bits. On error `out` is unspecified.
+    pub fn apply(
+        &self,
+        eta: T,
+        pos: &[T::V3],
+        radius: &[T],
+        force: &[T::V3],
+        out: &mut [T::V3],
+        store: &mut PseStorage<'_, T>,
+    ) -> Result<(), PseError> {
+        let n = pos.len();
+        if radius.len() != n || force.len() != n || out.len() != n {
+            return Err(PseError::Length);
+        }
+        let size = self.storage(n);
+        if store.complex.len() < size.complex || store.index.len() < size.index {
+            return Err(PseError::Storage {
+                need: [size.complex, size.index],
+                have: [store.complex.len(), store.index.len()],
+            });
+        }
+        if !(eta > T::ZERO && eta.is_finite()) {
+            return Err(PeriodicError::BadParameter("viscosity").into());
+        }
+        for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
+            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) {
+                return Err(
+                    PeriodicError::Particle(ParticleError::NonFinite { particle: i }).into(),
+                );
+            }
+            if !(a > T::ZERO && a <= self.a_max) {
+                return Err(PeriodicError::Radius { particle: i }.into());
+            }
+        }
+        // The near field first (it is the only part that can refuse a configuration).
+        let (order, start) = store.index.split_at_mut(n);
+        near::build(self, pos, order, start);
+        near::product(self, eta, pos, radius, force, out, order, start)?;
+
+        let [mx, my, mz] = self.grid.m;
+        let points = mx * my * mz;
+        let (grid, rest) = store.complex.split_at_mut(3 * points);
+        let (scratch, rest) = rest.split_at_mut(self.grid.scratch_len());
+        let (tw, table) = rest.split_at_mut(mx + my + mz);
+        let (twx, rest) = tw.split_at_mut(mx);
+        let (twy, twz) = rest.split_at_mut(my);
+        fft::twiddles(mx, twx);
+        fft::twiddles(my, twy);
+        fft::twiddles(mz, twz);
+        wave::tables(self, table);
+        grid.fill([T::ZERO; 2]);
+        spread::spread(self, pos, radius, force, grid);
+        let tws = [&*twx, &*twy, &*twz];
+        fft::fft3(&self.grid, grid, scratch, tws, false);
+        wave::apply_kernel(self, eta, table, grid);
+        fft::fft3(&self.grid, grid, scratch, tws, true);
+        spread::interpolate(self, pos, radius, grid, out);
+        Ok(())
+    }
+}
