@@ -8,8 +8,11 @@ mod common;
 
 use common::boxes::{Rng, config_radii, to_t};
 use hydrorattle::Real;
-use hydrorattle::mobility::periodic::{Ewald, Periodic, tt_product};
-use hydrorattle::mobility::pse::{Pse, PseStorage};
+use hydrorattle::error::ParticleError;
+use hydrorattle::linalg::{cholesky, tri};
+use hydrorattle::mobility::periodic::{Ewald, Periodic, PeriodicError, tt_product};
+use hydrorattle::mobility::pse::{Part, Pse, PseError, PseStorage};
+use proptest::prelude::*;
 
 /// `M F` by PSE.
 fn pse_apply<T: Real>(pse: &Pse<T>, pos: &[T::V3], rad: &[T], f: &[T::V3]) -> Vec<T::V3> {
@@ -20,7 +23,7 @@ fn pse_apply<T: Real>(pse: &Pse<T>, pos: &[T::V3], rad: &[T], f: &[T::V3]) -> Ve
         index: &mut ix,
     };
     let mut out = vec![T::V3_ZERO; pos.len()];
-    pse.apply(T::ONE, pos, rad, f, &mut out, &mut store)
+    pse.apply(Part::Both, T::ONE, pos, rad, f, &mut out, &mut store)
         .unwrap();
     out
 }
@@ -55,12 +58,13 @@ fn rel_err(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     (num / den).sqrt()
 }
 
+/// PSE's relative error against `want` for `tol`, at `xi a_max = 0.5 * xi_scale`
+/// (`None`: the rule's own `xi`), with the parameters used.
 fn rel_pse<T: Real>(
     size: [f64; 3],
     tol: f64,
     xi_scale: Option<f64>,
-    pos: &[[f64; 3]],
-    rad: &[f64],
+    (pos, rad): (&[[f64; 3]], &[f64]),
     f: &[[f64; 3]],
     want: &[[f64; 3]],
 ) -> (f64, Pse<T>) {
@@ -80,25 +84,274 @@ fn rel_pse<T: Real>(
     (rel_err(&got, want), pse)
 }
 
-#[test]
-fn against_ewald() {
+/// Random polydisperse configurations (radii 0.5 to 1.5, half the spheres overlapping
+/// another), cubic and rectangular boxes: PSE within each tolerance of the Ewald sum.
+fn against_ewald<T: Real>(tols: &[f64]) {
+    let mut worst = 0.0f64;
     for (size, n, seed) in [
-        ([16.0, 16.0, 16.0], 40, 1u64),
+        ([16.0; 3], 40, 1u64),
         ([14.0, 18.0, 22.0], 60, 2),
         ([20.0; 3], 80, 3),
+        ([11.0, 24.0, 13.0], 50, 4),
     ] {
         let (pos, rad) = config_radii(n, seed, size, [0.5, 1.5], true);
-        let f = forces(n, seed);
+        let f = forces(pos.len(), seed);
         let want = ewald_apply(size, &pos, &rad, &f);
-        for tol in [1e-3, 1e-4, 1e-5, 1e-6] {
-            let (e, pse) = rel_pse::<f64>(size, tol, None, &pos, &rad, &f, &want);
+        for &tol in tols {
+            let (e, pse) = rel_pse::<T>(size, tol, None, (&pos, &rad), &f, &want);
             println!(
-                "box {size:?} n {n} tol {tol:e}: rel err {e:.3e} grid {:?} P {:?} rc {:.2} cells {:?}",
+                "box {size:?} n {} tol {tol:e}: rel err {e:.2e} ({:.3} tol), grid {:?}, P {:?}, r_c {:.2}",
+                pos.len(),
+                e / tol,
                 pse.grid(),
                 pse.support(),
-                pse.r_cut(),
-                pse.cells()
+                pse.r_cut()
+            );
+            assert!(e < tol, "box {size:?} tol {tol:e}: {e:e}");
+            worst = worst.max(e / tol);
+        }
+    }
+    println!("worst error / tolerance {worst:.3}");
+}
+
+#[test]
+fn against_ewald_f64() {
+    against_ewald::<f64>(&[1e-3, 1e-4, 1e-5, 1e-6]);
+}
+
+/// f32: the tolerances its rounding (FFT sums of `~1e5` terms) leaves room for.
+#[test]
+fn against_ewald_f32() {
+    against_ewald::<f32>(&[1e-3, 1e-4, 1e-5]);
+}
+
+/// The same product at three splitting parameters (`xi a_max = 0.35, 0.5, 0.7`):
+/// agreement to the tolerance, though grid, support and cutoff all change.
+#[test]
+fn independent_of_splitting_parameter() {
+    let size = [15.0, 17.0, 19.0];
+    let (pos, rad) = config_radii(50, 9, size, [0.5, 1.5], true);
+    let f = forces(pos.len(), 9);
+    let want = ewald_apply(size, &pos, &rad, &f);
+    for tol in [1e-3, 1e-5] {
+        let runs: Vec<_> = [0.7, 1.0, 1.4]
+            .map(|s| rel_pse::<f64>(size, tol, Some(s), (&pos, &rad), &f, &want))
+            .into_iter()
+            .collect();
+        for (e, pse) in &runs {
+            println!(
+                "tol {tol:e} xi {:.3}: rel err {e:.2e}, grid {:?}, r_c {:.2}",
+                pse.xi(),
+                pse.grid(),
+                pse.r_cut()
+            );
+            assert!(*e < tol);
+        }
+    }
+}
+
+/// Hasimoto's constant for the simple cubic lattice (Hasimoto, J. Fluid Mech. 5, 317,
+/// 1959), to 13 digits.
+const HASIMOTO: f64 = 2.837_297_479_480_6;
+
+/// A lone sphere in a cubic box: `6 pi eta a u / F` against Hasimoto's
+/// `1 - 2.837297 a/L + 4 pi/3 (a/L)^3` (exact for RPY, `docs/PERIODIC.md`), within the
+/// tolerance, for `L/a` from 5 (cutoff beyond half the box: images in the near field)
+/// to 60.
+#[test]
+fn hasimoto_lone_sphere() {
+    for tol in [1e-4, 1e-6] {
+        for l in [5.0, 10.0, 20.0, 60.0] {
+            let pse = Pse::new(Periodic::new([l; 3]).unwrap(), 1.0f64, tol).unwrap();
+            let x = 1.0 / l;
+            let want = 1.0 - HASIMOTO * x + 4.0 / 3.0 * core::f64::consts::PI * x * x * x;
+            let mut worst = 0.0f64;
+            for dir in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] {
+                let u = pse_apply(
+                    &pse,
+                    &[f64::v3(0.3, 1.7, 2.2)],
+                    &[1.0],
+                    &[f64::v3_from(dir)],
+                );
+                let u = f64::v3_to_f64(u[0]);
+                for d in 0..3 {
+                    let got = u[d] * 6.0 * core::f64::consts::PI;
+                    let e = if dir[d] == 1.0 {
+                        (got - want) / want
+                    } else {
+                        got / want
+                    };
+                    worst = worst.max(e.abs());
+                }
+            }
+            println!(
+                "tol {tol:e} L/a {l}: rel err {worst:.2e}, grid {:?}",
+                pse.grid()
+            );
+            assert!(worst < tol, "L/a {l}: {worst:e}");
+        }
+    }
+}
+
+/// The PSE matrix, column by column (`3n` products), as packed 3x3 blocks of its
+/// symmetric part, and the largest asymmetry relative to the largest entry.
+fn assemble<T: Real>(pse: &Pse<T>, pos: &[T::V3], rad: &[T]) -> (Vec<T::M3>, f64) {
+    let n = pos.len();
+    let mut cols = vec![vec![[0.0f64; 3]; n]; 3 * n];
+    for j in 0..3 * n {
+        let mut f = vec![T::V3_ZERO; n];
+        let mut e = [T::ZERO; 3];
+        e[j % 3] = T::ONE;
+        f[j / 3] = T::v3(e[0], e[1], e[2]);
+        cols[j] = pse_apply(pse, pos, rad, &f)
+            .iter()
+            .map(|&v| T::v3_to_f64(v))
+            .collect();
+    }
+    let get = |r: usize, c: usize| cols[c][r / 3][r % 3];
+    let (mut asym, mut big) = (0.0f64, 0.0f64);
+    let mut m = vec![T::M3_ZERO; tri(n)];
+    for bi in 0..n {
+        for bj in 0..=bi {
+            let mut cols3 = [[T::ZERO; 3]; 3];
+            for c in 0..3 {
+                for r in 0..3 {
+                    let (gr, gc) = (3 * bi + r, 3 * bj + c);
+                    let (a, b) = (get(gr, gc), get(gc, gr));
+                    asym = asym.max((a - b).abs());
+                    big = big.max(a.abs());
+                    cols3[c][r] = T::from_f64(0.5 * (a + b));
+                }
+            }
+            m[tri(bi) + bj] = T::m3_cols(
+                T::v3(cols3[0][0], cols3[0][1], cols3[0][2]),
+                T::v3(cols3[1][0], cols3[1][1], cols3[1][2]),
+                T::v3(cols3[2][0], cols3[2][1], cols3[2][2]),
             );
         }
     }
+    (m, asym / big)
+}
+
+/// The PSE operator is symmetric (to rounding) and positive definite: its assembled
+/// matrix has a Cholesky factor, and `F . M F > 0` for a random `F`.
+fn positive_definite<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool, tol: f64) {
+    let (p, r) = config_radii(n, seed, size, [0.5, 1.5], overlap);
+    let a_max = r.iter().cloned().fold(0.0, f64::max);
+    let cell = Periodic::new(size.map(T::from_f64)).unwrap();
+    let pse = Pse::new(cell, T::from_f64(a_max), tol).unwrap();
+    let (pos, rad) = to_t::<T>(&p, &r);
+    let (mut m, asym) = assemble(&pse, &pos, &rad);
+    let eps = T::EPSILON.to_f64();
+    assert!(asym < 1e3 * eps, "asymmetry {asym:e}");
+    cholesky::<T>(&mut m, pos.len()).unwrap();
+    let f: Vec<_> = forces(pos.len(), seed)
+        .iter()
+        .map(|&v| T::v3_from(v))
+        .collect();
+    let u = pse_apply(&pse, &pos, &rad, &f);
+    let q: f64 = f.iter().zip(&u).map(|(a, b)| T::dot(*a, *b).to_f64()).sum();
+    assert!(q > 0.0, "F . M F = {q:e}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    #[test]
+    fn positive_definite_f64(n in 1usize..=8, seed in any::<u64>(), lx in 6.0f64..12.0, ly in 6.0f64..12.0, lz in 6.0f64..12.0, overlap in any::<bool>(), digits in 3i32..=6) {
+        positive_definite::<f64>(n, seed, [lx, ly, lz], overlap, 10f64.powi(-digits));
+    }
+    #[test]
+    fn positive_definite_f32(n in 1usize..=8, seed in any::<u64>(), lx in 6.0f64..12.0, ly in 6.0f64..12.0, lz in 6.0f64..12.0, overlap in any::<bool>(), digits in 3i32..=5) {
+        positive_definite::<f32>(n, seed, [lx, ly, lz], overlap, 10f64.powi(-digits));
+    }
+}
+
+/// The same inputs give the same bits (twice in one process; the golden digest pins
+/// them across machines).
+#[test]
+fn deterministic() {
+    let size = [13.0, 14.0, 15.0];
+    let (p, r) = config_radii(40, 5, size, [0.5, 1.5], true);
+    let pse = Pse::new(Periodic::new(size).unwrap(), 1.5f64, 1e-4).unwrap();
+    let (pos, rad) = to_t::<f64>(&p, &r);
+    let f: Vec<_> = forces(pos.len(), 5)
+        .iter()
+        .map(|&v| f64::v3_from(v))
+        .collect();
+    let a = pse_apply(&pse, &pos, &rad, &f);
+    let b = pse_apply(&pse, &pos, &rad, &f);
+    let bits = |v: &[<f64 as Real>::V3]| -> Vec<u64> {
+        v.iter()
+            .flat_map(|&x| f64::v3_to_f64(x).map(f64::to_bits))
+            .collect()
+    };
+    assert_eq!(bits(&a), bits(&b));
+    println!("digest {:016x}", common::fnv1a(bits(&a)));
+}
+
+/// Typed errors: tolerance, xi and radius out of range, a sphere nested in another's
+/// image, non-finite input, short storage, mismatched lengths.
+#[test]
+fn errors() {
+    let cell = Periodic::new([10.0; 3]).unwrap();
+    let bad = |e: PeriodicError| Err::<Pse<f64>, _>(PseError::Periodic(e));
+    assert_eq!(
+        Pse::new(cell, 1.0, 0.5).map(|_| ()),
+        bad(PeriodicError::BadParameter("tolerance")).map(|_| ())
+    );
+    assert_eq!(
+        Pse::with_xi(cell, 1.0, 1e-4, -1.0).map(|_| ()),
+        bad(PeriodicError::BadParameter("xi")).map(|_| ())
+    );
+    assert_eq!(
+        Pse::new(cell, 5.0, 1e-4).map(|_| ()),
+        bad(PeriodicError::SphereTooLarge).map(|_| ())
+    );
+    let pse = Pse::new(cell, 1.0, 1e-4).unwrap();
+    let size = pse.storage(2);
+    let (mut cx, mut ix) = (vec![[0.0; 2]; size.complex], vec![0usize; size.index]);
+    let mut store = PseStorage {
+        complex: &mut cx,
+        index: &mut ix,
+    };
+    let mut out = vec![f64::V3_ZERO; 2];
+    let f = [f64::v3(1.0, 0.0, 0.0); 2];
+    // Nested through the boundary: centres 0.2 apart across the face, radii 1 and 0.5.
+    let pos = [f64::v3(0.05, 5.0, 5.0), f64::v3(9.95, 5.0, 5.0)];
+    let e = pse.apply(Part::Both, 1.0, &pos, &[1.0, 0.5], &f, &mut out, &mut store);
+    assert_eq!(
+        e,
+        Err(PseError::Periodic(PeriodicError::Particle(
+            ParticleError::Nested { i: 0, j: 1 }
+        )))
+    );
+    let e = pse.apply(Part::Both, 1.0, &pos, &[1.0, 1.5], &f, &mut out, &mut store);
+    assert_eq!(
+        e,
+        Err(PseError::Periodic(PeriodicError::Radius { particle: 1 }))
+    );
+    let e = pse.apply(
+        Part::Both,
+        1.0,
+        &[pos[0], f64::v3(f64::NAN, 0.0, 0.0)],
+        &[1.0, 1.0],
+        &f,
+        &mut out,
+        &mut store,
+    );
+    assert_eq!(
+        e,
+        Err(PseError::Periodic(PeriodicError::Particle(
+            ParticleError::NonFinite { particle: 1 }
+        )))
+    );
+    let e = pse.apply(Part::Both, 1.0, &pos, &[1.0], &f, &mut out, &mut store);
+    assert_eq!(e, Err(PseError::Length));
+    let mut short = PseStorage {
+        complex: &mut cx[..10],
+        index: &mut ix,
+    };
+    let e = pse.apply(Part::Both, 1.0, &pos, &[1.0, 1.0], &f, &mut out, &mut short);
+    assert!(matches!(e, Err(PseError::Storage { .. })), "{e:?}");
+    println!("{}", PseError::GridTooLarge);
 }

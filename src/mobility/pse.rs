@@ -80,6 +80,28 @@ impl From<PeriodicError> for PseError {
     }
 }
 
+/// The spheres and the cell list's order of them.
+#[derive(Clone, Copy)]
+struct Spheres<'a, T: Real> {
+    pos: &'a [T::V3],
+    radius: &'a [T],
+    order: &'a [usize],
+}
+
+/// Which part of the mobility [`Pse::apply`] applies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    /// The whole periodic mobility, `M = M^real + M^wave`.
+    Both,
+    /// The real-space half `M^real` alone: the near field, with the self blocks' real
+    /// parts (the only part that can refuse a configuration: a sphere inside another's
+    /// image).
+    Near,
+    /// The wave-space half `M^wave` alone: spreading, FFT, kernel, inverse FFT,
+    /// interpolation.
+    Wave,
+}
+
 /// Storage sizes of [`Pse::apply`] for a given number of spheres.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PseSize {
@@ -183,7 +205,9 @@ impl<T: Real> Pse<T> {
             let hd = l / m[d] as f64;
             h[d] = T::from_f64(hd);
             let s = libm::ceil(width / hd);
-            if !(s <= MAX_SUPPORT as f64) || s as usize > m[d] {
+            // A support wider than the box is fine: the window then visits a point once
+            // per image of the sphere, each with that image's weight (the periodic sum).
+            if !(s <= MAX_SUPPORT as f64) {
                 return Err(PseError::GridTooLarge);
             }
             support[d] = s as usize;
@@ -253,18 +277,46 @@ impl<T: Real> Pse<T> {
         }
     }
 
-    /// `out = M F`: the periodic RPY mobility (viscosity `eta`) of the spheres at `pos`
-    /// (any image) with radii `radius` (in `(0, a_max]`) applied to `force`, to the
-    /// tolerance. Wave space first, then the near field added row by row, in a fixed
+    /// `out = M F` ([`Part::Both`]): the periodic RPY mobility (viscosity `eta`) of
+    /// the spheres at `pos` (any image) with radii `radius` (in `(0, a_max]`) applied
+    /// to `force`, to the tolerance; or one half of it ([`Part::Near`], [`Part::Wave`]).
+    /// The near field first (row by row), then the wave part added, each in a fixed
     /// order: the same inputs give the same bits. On error `out` is unspecified.
+    #[allow(clippy::too_many_arguments)]
     pub fn apply(
         &self,
+        part: Part,
         eta: T,
         pos: &[T::V3],
         radius: &[T],
         force: &[T::V3],
         out: &mut [T::V3],
         store: &mut PseStorage<'_, T>,
+    ) -> Result<(), PseError> {
+        self.check(eta, pos, radius, force, out, store)?;
+        // The cell list orders both the near field's neighbours and the spreading.
+        let (order, start) = store.index.split_at_mut(pos.len());
+        near::build(self, pos, order, start);
+        match part {
+            Part::Wave => out.fill(T::V3_ZERO),
+            _ => near::product(self, eta, pos, radius, force, out, order, start)?,
+        }
+        if part != Part::Near {
+            let spheres = Spheres { pos, radius, order };
+            self.wave(eta, spheres, force, store.complex, out);
+        }
+        Ok(())
+    }
+
+    /// Lengths, storage, viscosity, positions, forces and radii.
+    fn check(
+        &self,
+        eta: T,
+        pos: &[T::V3],
+        radius: &[T],
+        force: &[T::V3],
+        out: &[T::V3],
+        store: &PseStorage<'_, T>,
     ) -> Result<(), PseError> {
         let n = pos.len();
         if radius.len() != n || force.len() != n || out.len() != n {
@@ -290,14 +342,23 @@ impl<T: Real> Pse<T> {
                 return Err(PeriodicError::Radius { particle: i }.into());
             }
         }
-        // The near field first (it is the only part that can refuse a configuration).
-        let (order, start) = store.index.split_at_mut(n);
-        near::build(self, pos, order, start);
-        near::product(self, eta, pos, radius, force, out, order, start)?;
+        Ok(())
+    }
 
+    /// `out += M^wave F` after the checks and the cell list (whose order the spreading
+    /// follows).
+    fn wave(
+        &self,
+        eta: T,
+        s: Spheres<'_, T>,
+        force: &[T::V3],
+        cx: &mut [Cx<T>],
+        out: &mut [T::V3],
+    ) {
+        let Spheres { pos, radius, order } = s;
         let [mx, my, mz] = self.grid.m;
         let points = mx * my * mz;
-        let (grid, rest) = store.complex.split_at_mut(3 * points);
+        let (grid, rest) = cx.split_at_mut(3 * points);
         let (scratch, rest) = rest.split_at_mut(self.grid.scratch_len());
         let (tw, table) = rest.split_at_mut(mx + my + mz);
         let (twx, rest) = tw.split_at_mut(mx);
@@ -307,12 +368,11 @@ impl<T: Real> Pse<T> {
         fft::twiddles(mz, twz);
         wave::tables(self, table);
         grid.fill([T::ZERO; 2]);
-        spread::spread(self, pos, radius, force, grid);
+        spread::spread(self, pos, radius, force, order, grid);
         let tws = [&*twx, &*twy, &*twz];
         fft::fft3(&self.grid, grid, scratch, tws, false);
         wave::apply_kernel(self, eta, table, grid);
         fft::fft3(&self.grid, grid, scratch, tws, true);
-        spread::interpolate(self, pos, radius, grid, out);
-        Ok(())
+        spread::interpolate(self, pos, radius, order, grid, out);
     }
 }

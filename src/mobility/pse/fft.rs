@@ -17,7 +17,7 @@ use crate::real::Real;
 pub type Cx<T> = [T; 2];
 
 /// Lines transformed together (the scratch's width).
-pub(super) const CHUNK: usize = 16;
+pub(super) const CHUNK: usize = 32;
 
 /// At most this many radix stages (a length below `4^16`).
 const MAX_STAGES: usize = 24;
@@ -151,6 +151,8 @@ fn stage<T: Real, const R: usize>(
 ) {
     let m = n / R;
     let step = n / (ns * R);
+    let mut v = [[[T::ZERO; 2]; R]; CHUNK];
+    let v = &mut v[..batch];
     for j in 0..m {
         let k = j % ns;
         let dst = (j / ns) * ns * R + k;
@@ -159,15 +161,20 @@ fn stage<T: Real, const R: usize>(
             let t = tw[q * k * step];
             *wq = if inverse { [t[0], -t[1]] } else { t };
         }
-        for c in 0..batch {
-            let mut v = [[T::ZERO; 2]; R];
-            v[0] = x[j * batch + c];
-            for q in 1..R {
-                v[q] = mul(x[(j + q * m) * batch + c], w[q]);
+        // Whole rows of `batch` values at a time: slices, so no per-value index checks.
+        for q in 0..R {
+            let src = &x[(j + q * m) * batch..(j + q * m + 1) * batch];
+            for (vc, &xc) in v.iter_mut().zip(src) {
+                vc[q] = if q == 0 { xc } else { mul(xc, w[q]) };
             }
-            butterfly::<T, R>(&mut v, inverse);
-            for (q, vq) in v.into_iter().enumerate() {
-                y[(dst + q * ns) * batch + c] = vq;
+        }
+        for vc in v.iter_mut() {
+            butterfly::<T, R>(vc, inverse);
+        }
+        for q in 0..R {
+            let d = &mut y[(dst + q * ns) * batch..(dst + q * ns + 1) * batch];
+            for (dc, vc) in d.iter_mut().zip(v.iter()) {
+                *dc = vc[q];
             }
         }
     }

@@ -55,67 +55,105 @@ impl<T: Real> Window<T> {
     }
 }
 
-/// Calls `f(at, weight)` for each grid point of a window (`at` the first of its three
-/// components), `z`, then `y`, then `x` ascending in the window: the fixed order of
-/// both spreading and interpolation.
+/// Calls `f(base, w_yz)` for each `(y, z)` row of a window (`base` the row's first
+/// point at `x = 0`), `z`, then `y` ascending in the window: the fixed order of both
+/// spreading and interpolation. Within a row the `x` points follow in window order.
 #[inline(always)]
-fn visit<T: Real>(pse: &Pse<T>, w: &Window<T>, mut f: impl FnMut(usize, T)) {
+fn rows<T: Real>(pse: &Pse<T>, w: &Window<T>, mut f: impl FnMut(usize, T)) {
     let [mx, my, _] = pse.grid.m;
-    let [px, py, pz] = pse.support;
+    let [_, py, pz] = pse.support;
     for tz in 0..pz {
         let (iz, wz) = (w.index[2][tz], w.weight[2][tz]);
         for ty in 0..py {
-            let wyz = w.weight[1][ty] * wz;
-            let base = (w.index[1][ty] + my * iz) * mx;
-            for tx in 0..px {
-                f(3 * (base + w.index[0][tx]), w.weight[0][tx] * wyz);
-            }
+            f((w.index[1][ty] + my * iz) * mx, w.weight[1][ty] * wz);
         }
     }
 }
 
+/// The window's `x` points as one contiguous run `(first, count)` when it does not wrap
+/// around the box (most windows), else `None`.
+#[inline(always)]
+fn run<T: Real>(pse: &Pse<T>, w: &Window<T>) -> Option<usize> {
+    let (i0, px) = (w.index[0][0], pse.support[0]);
+    (i0 + px <= pse.grid.m[0]).then_some(i0)
+}
+
 /// `grid` (3 components per point, zeroed by the caller) `+=` each sphere's Gaussian
-/// times `(F_j, a_j^2 F_j)`, spheres in index order.
+/// times `(F_j, a_j^2 F_j)`, spheres in the order `order` (the cell list's, for cache
+/// locality; a fixed order, so the same bits).
 pub(super) fn spread<T: Real>(
     pse: &Pse<T>,
     pos: &[T::V3],
     radius: &[T],
     force: &[T::V3],
+    order: &[usize],
     grid: &mut [Cx<T>],
 ) {
-    for j in 0..pos.len() {
+    let px = pse.support[0];
+    for &j in order {
         let w = Window::new(pse, pos[j]);
         let a2 = radius[j] * radius[j];
         let v = T::xyz(force[j]).map(|c| [c, a2 * c]);
-        visit(pse, &w, |at, s| {
+        let add = |pt: &mut [Cx<T>], s: T| {
             for c in 0..3 {
-                grid[at + c][0] += s * v[c][0];
-                grid[at + c][1] += s * v[c][1];
+                pt[c][0] += s * v[c][0];
+                pt[c][1] += s * v[c][1];
             }
-        });
+        };
+        let wx = &w.weight[0][..px];
+        match run(pse, &w) {
+            Some(i0) => rows(pse, &w, |base, wyz| {
+                let seg = &mut grid[3 * (base + i0)..3 * (base + i0 + px)];
+                for (pt, &x) in seg.chunks_exact_mut(3).zip(wx) {
+                    add(pt, x * wyz);
+                }
+            }),
+            None => rows(pse, &w, |base, wyz| {
+                for (&i, &x) in w.index[0][..px].iter().zip(wx) {
+                    add(&mut grid[3 * (base + i)..3 * (base + i) + 3], x * wyz);
+                }
+            }),
+        }
     }
 }
 
 /// `out_i += sum_g g(x_g - r_i) (U(x_g) - a_i^2 V(x_g) / 6)` for every sphere, with
 /// `U + i V` the grid after the inverse transform (the quadrature weight `h^3` is in the
-/// wave-space kernel).
+/// wave-space kernel). Each sphere's sum is its own, so the order of `order` changes
+/// nothing but the memory traffic.
 pub(super) fn interpolate<T: Real>(
     pse: &Pse<T>,
     pos: &[T::V3],
     radius: &[T],
+    order: &[usize],
     grid: &[Cx<T>],
     out: &mut [T::V3],
 ) {
     let sixth = T::ONE / T::from_f64(6.0);
-    for i in 0..pos.len() {
+    let px = pse.support[0];
+    for &i in order {
         let w = Window::new(pse, pos[i]);
         let mut acc = [[T::ZERO; 2]; 3];
-        visit(pse, &w, |at, s| {
+        let mut take = |pt: &[Cx<T>], s: T| {
             for c in 0..3 {
-                acc[c][0] += s * grid[at + c][0];
-                acc[c][1] += s * grid[at + c][1];
+                acc[c][0] += s * pt[c][0];
+                acc[c][1] += s * pt[c][1];
             }
-        });
+        };
+        let wx = &w.weight[0][..px];
+        match run(pse, &w) {
+            Some(i0) => rows(pse, &w, |base, wyz| {
+                let seg = &grid[3 * (base + i0)..3 * (base + i0 + px)];
+                for (pt, &x) in seg.chunks_exact(3).zip(wx) {
+                    take(pt, x * wyz);
+                }
+            }),
+            None => rows(pse, &w, |base, wyz| {
+                for (&j, &x) in w.index[0][..px].iter().zip(wx) {
+                    take(&grid[3 * (base + j)..3 * (base + j) + 3], x * wyz);
+                }
+            }),
+        }
         let k = radius[i] * radius[i] * sixth;
         out[i] += T::v3(
             acc[0][0] - k * acc[0][1],
