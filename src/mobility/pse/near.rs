@@ -75,8 +75,7 @@ fn axis_neighbours(c: usize, n: usize) -> ([usize; 3], usize) {
     }
 }
 
-/// `out_i = sum_j M^real_ij F_j` over the pairs within the cutoff and the self blocks,
-/// rows in index order. A sphere inside another's image is
+/// `out_i = sum_j M^real_ij F_j` over the pairs within the cutoff and the self blocks. A sphere inside another's image is
 /// `ParticleError::Nested { i: lower, j: higher }`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn product<T: Real>(
@@ -92,7 +91,10 @@ pub(super) fn product<T: Real>(
     let split = &pse.split;
     let rc2 = split.r_cut * split.r_cut;
     let nc = pse.cells;
-    for i in 0..pos.len() {
+    // Rows in the cell list's order: neighbouring rows share their neighbours, so the
+    // positions they read stay in cache. Each row's sum is its own: the order of rows
+    // changes no bits.
+    for &i in order {
         let a = radius[i];
         // A sphere is never inside its own image (a < L/2): never `None`.
         let own = real_sum(split, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
