@@ -81,11 +81,12 @@ fn best(reps: usize, mut f: impl FnMut()) -> f64 {
 }
 
 /// Heap storage for one `Pse` and `n` spheres, and the product into `out`.
-struct Store(Vec<[f64; 2]>, Vec<usize>);
+struct Store(Vec<[f64; 2]>, Vec<usize>, Vec<V>);
 impl Store {
     fn new(pse: &Pse<f64>, n: usize) -> Self {
         let size = pse.storage(n);
-        Self(vec![[0.0; 2]; size.complex], vec![0; size.index])
+        let v = vec![V::ZERO; size.vectors];
+        Self(vec![[0.0; 2]; size.complex], vec![0; size.index], v)
     }
     fn apply(
         &mut self,
@@ -95,10 +96,7 @@ impl Store {
         f: &[V],
         out: &mut [V],
     ) {
-        let mut store = PseStorage {
-            complex: &mut self.0,
-            index: &mut self.1,
-        };
+        let mut store = PseStorage::new(&mut self.0, &mut self.1, &mut self.2);
         pse.apply(part, 1.0, pos, rad, f, out, &mut store).unwrap();
     }
 }

@@ -15,10 +15,12 @@
 //! owns the grid and the cell list ([`Pse::storage`], [`PseStorage`]).
 
 mod fft;
+mod jobs;
 mod near;
 mod spread;
 mod wave;
 
+use core::convert::Infallible;
 use core::fmt;
 
 pub use fft::{Cx, good_size};
@@ -27,6 +29,7 @@ pub use spread::MAX_SUPPORT;
 use crate::error::ParticleError;
 use crate::mobility::periodic::real::Split;
 use crate::mobility::periodic::{Periodic, PeriodicError};
+use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
 
 /// `xi a_max` of [`Pse::new`]: the cost optimum measured at volume fraction 0.1
@@ -105,18 +108,42 @@ pub enum Part {
 /// Storage sizes of [`Pse::apply`] for a given number of spheres.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PseSize {
-    /// Complex values: the grid (3 per point), FFT scratch, twiddles and kernel tables.
+    /// Complex values: the grid (3 per point), FFT scratch (one per parallel piece),
+    /// twiddles and kernel tables.
     pub complex: usize,
     /// Indices: the cell list (one per sphere and one per cell, plus one).
     pub index: usize,
+    /// Vectors: one per sphere (the rows of the near field and of the interpolation,
+    /// in the cell list's order).
+    pub vectors: usize,
 }
 
-/// Caller-owned storage of [`Pse::apply`], at least [`Pse::storage`].
+/// Caller-owned storage of [`Pse::apply`], at least [`Pse::storage`], and the
+/// [`Parallel`] that runs its pieces ([`Serial`] unless
+/// [`PseStorage::with_parallel`]).
 pub struct PseStorage<'a, T: Real> {
-    /// Complex values.
-    pub complex: &'a mut [Cx<T>],
-    /// Indices.
-    pub index: &'a mut [usize],
+    complex: &'a mut [Cx<T>],
+    index: &'a mut [usize],
+    vectors: &'a mut [T::V3],
+    parallel: &'a dyn Parallel,
+}
+
+impl<'a, T: Real> PseStorage<'a, T> {
+    /// Storage over the caller's arrays (sizes checked by [`Pse::apply`]).
+    pub fn new(complex: &'a mut [Cx<T>], index: &'a mut [usize], vectors: &'a mut [T::V3]) -> Self {
+        Self {
+            complex,
+            index,
+            vectors,
+            parallel: &Serial,
+        }
+    }
+
+    /// Runs the product's pieces through `parallel` (a host's thread pool): the same
+    /// bits as [`Serial`], whatever the number of threads.
+    pub fn with_parallel(self, parallel: &'a dyn Parallel) -> Self {
+        Self { parallel, ..self }
+    }
 }
 
 /// The PSE parameters of one box, largest radius and tolerance.
@@ -272,8 +299,9 @@ impl<T: Real> Pse<T> {
         let [mx, my, mz] = self.grid.m;
         let axes = mx + my + mz;
         PseSize {
-            complex: 3 * mx * my * mz + self.grid.scratch_len() + 2 * axes,
+            complex: 3 * mx * my * mz + jobs::JOBS * self.grid.scratch_len() + 2 * axes,
             index: n + self.cells[0] * self.cells[1] * self.cells[2] + 1,
+            vectors: n,
         }
     }
 
@@ -294,16 +322,27 @@ impl<T: Real> Pse<T> {
         store: &mut PseStorage<'_, T>,
     ) -> Result<(), PseError> {
         self.check(eta, pos, radius, force, out, store)?;
-        // The cell list orders both the near field's neighbours and the spreading.
-        let (order, start) = store.index.split_at_mut(pos.len());
+        let n = pos.len();
+        let par = store.parallel;
+        // The cell list orders the near field's rows and neighbours and the spreading.
+        let (order, start) = store.index.split_at_mut(n);
         near::build(self, pos, order, start);
+        let (order, start) = (&*order, &*start);
+        let rows = &mut store.vectors[..n];
         match part {
             Part::Wave => out.fill(T::V3_ZERO),
-            _ => near::product(self, eta, pos, radius, force, out, order, start)?,
+            _ => {
+                jobs::pieces(par, (&mut *rows, n, 1), jobs::none(), |a, r, _| {
+                    near::product(self, eta, (pos, radius), force, (order, start), a, r)
+                })?;
+                for (&i, &r) in order.iter().zip(rows.iter()) {
+                    out[i] = r;
+                }
+            }
         }
         if part != Part::Near {
             let spheres = Spheres { pos, radius, order };
-            self.wave(eta, spheres, force, store.complex, out);
+            self.wave(eta, spheres, force, (store.complex, rows, par), out);
         }
         Ok(())
     }
@@ -352,14 +391,15 @@ impl<T: Real> Pse<T> {
         eta: T,
         s: Spheres<'_, T>,
         force: &[T::V3],
-        cx: &mut [Cx<T>],
+        (cx, rows, par): (&mut [Cx<T>], &mut [T::V3], &dyn Parallel),
         out: &mut [T::V3],
     ) {
         let Spheres { pos, radius, order } = s;
         let [mx, my, mz] = self.grid.m;
         let points = mx * my * mz;
+        let each = self.grid.scratch_len();
         let (grid, rest) = cx.split_at_mut(3 * points);
-        let (scratch, rest) = rest.split_at_mut(self.grid.scratch_len());
+        let (scratch, rest) = rest.split_at_mut(jobs::JOBS * each);
         let (tw, table) = rest.split_at_mut(mx + my + mz);
         let (twx, rest) = tw.split_at_mut(mx);
         let (twy, twz) = rest.split_at_mut(my);
@@ -367,12 +407,56 @@ impl<T: Real> Pse<T> {
         fft::twiddles(my, twy);
         fft::twiddles(mz, twz);
         wave::tables(self, table);
-        grid.fill([T::ZERO; 2]);
-        spread::spread(self, pos, radius, force, order, grid);
         let tws = [&*twx, &*twy, &*twz];
-        fft::fft3(&self.grid, grid, scratch, tws, false);
+        let slab = 3 * mx * my;
+        // Spreading and the x, y transforms by slabs of planes (in parallel), the z
+        // transforms and the kernel whole (their lines cross every slab).
+        let _ = jobs::pieces(par, (&mut *grid, mz, slab), jobs::none(), |z0, g, _| {
+            g.fill([T::ZERO; 2]);
+            let nz = g.len() / slab;
+            spread::spread(
+                self,
+                (pos, radius, order),
+                force,
+                spread::Slab { z0, nz },
+                g,
+            );
+            Ok::<(), Infallible>(())
+        });
+        let planes = |inverse: bool| {
+            move |_: usize, g: &mut [Cx<T>], sc: &mut [Cx<T>]| {
+                let shape = fft::Grid3 {
+                    m: [mx, my, g.len() / slab],
+                    ..self.grid
+                };
+                fft::fft3(&shape, g, sc, tws, inverse, 0..2);
+                Ok::<(), Infallible>(())
+            }
+        };
+        let _ = jobs::pieces(
+            par,
+            (&mut *grid, mz, slab),
+            (&mut *scratch, each),
+            planes(false),
+        );
+        fft::fft3(&self.grid, grid, &mut scratch[..each], tws, false, 2..3);
         wave::apply_kernel(self, eta, table, grid);
-        fft::fft3(&self.grid, grid, scratch, tws, true);
-        spread::interpolate(self, pos, radius, order, grid, out);
+        fft::fft3(&self.grid, grid, &mut scratch[..each], tws, true, 2..3);
+        let _ = jobs::pieces(
+            par,
+            (&mut *grid, mz, slab),
+            (&mut *scratch, each),
+            planes(true),
+        );
+        let grid = &*grid;
+        let n = pos.len();
+        let _ = jobs::pieces(par, (&mut *rows, n, 1), jobs::none(), |a, r, _| {
+            let k = a..a + r.len();
+            spread::interpolate(self, (pos, radius, &order[k]), grid, r);
+            Ok::<(), Infallible>(())
+        });
+        for (&i, &r) in order.iter().zip(rows.iter()) {
+            out[i] += r;
+        }
     }
 }

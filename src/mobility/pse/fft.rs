@@ -223,9 +223,11 @@ impl Grid3 {
     }
 }
 
-/// The unnormalised 3D DFT (forward `exp(-i k.x)`, inverse `exp(+i k.x)`) of every
-/// component of `grid` (point `x + M_x (y + M_y z)`, component `c` at
-/// `comps * point + c`), axis `x`, then `y`, then `z`; lines in a fixed order. `tw[d]`
+/// The unnormalised DFT (forward `exp(-i k.x)`, inverse `exp(+i k.x)`) along `axes`
+/// (of `x`, `y`, `z`, in that order) of every component of `grid` (point
+/// `x + M_x (y + M_y z)`, component `c` at `comps * point + c`); lines in a fixed order,
+/// each line's arithmetic its own (so slabs of planes transformed apart along `x` and
+/// `y` give the same bits). `tw[d]`
 /// holds [`twiddles`] for `M_d`; `scratch` at least [`Grid3::scratch_len`].
 pub(super) fn fft3<T: Real>(
     g: &Grid3,
@@ -233,10 +235,11 @@ pub(super) fn fft3<T: Real>(
     scratch: &mut [Cx<T>],
     tw: [&[Cx<T>]; 3],
     inverse: bool,
+    axes: core::ops::Range<usize>,
 ) {
     let [mx, my, mz] = g.m;
     let stride = [1, mx, mx * my];
-    for d in 0..3 {
+    for d in axes {
         let n = g.m[d];
         if n == 1 {
             continue;

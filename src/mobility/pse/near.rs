@@ -75,18 +75,18 @@ fn axis_neighbours(c: usize, n: usize) -> ([usize; 3], usize) {
     }
 }
 
-/// `out_i = sum_j M^real_ij F_j` over the pairs within the cutoff and the self blocks. A sphere inside another's image is
+/// `rows[k] = sum_j M^real_ij F_j` for `i = order[first + k]`, over the pairs within the
+/// cutoff and the self block. A sphere inside another's image is
 /// `ParticleError::Nested { i: lower, j: higher }`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn product<T: Real>(
     pse: &Pse<T>,
     eta: T,
-    pos: &[T::V3],
-    radius: &[T],
+    (pos, radius): (&[T::V3], &[T]),
     force: &[T::V3],
-    out: &mut [T::V3],
-    order: &[usize],
-    start: &[usize],
+    (order, start): (&[usize], &[usize]),
+    first: usize,
+    rows: &mut [T::V3],
 ) -> Result<(), PseError> {
     let split = &pse.split;
     let rc2 = split.r_cut * split.r_cut;
@@ -94,7 +94,7 @@ pub(super) fn product<T: Real>(
     // Rows in the cell list's order: neighbouring rows share their neighbours, so the
     // positions they read stay in cache. Each row's sum is its own: the order of rows
     // changes no bits.
-    for &i in order {
+    for (row, &i) in rows.iter_mut().zip(&order[first..]) {
         let a = radius[i];
         // A sphere is never inside its own image (a < L/2): never `None`.
         let own = real_sum(split, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
@@ -131,7 +131,7 @@ pub(super) fn product<T: Real>(
                 }
             }
         }
-        out[i] = acc;
+        *row = acc;
     }
     Ok(())
 }

@@ -32,6 +32,7 @@ impl<T: Real> Window<T> {
     #[inline(always)]
     fn new(pse: &Pse<T>, pos: T::V3) -> Self {
         let p = T::xyz(pse.cell.wrap_into(pos));
+        // The first point as `touches` finds it: the same expression, so the same bits.
         let mut w = Self {
             index: [[0; MAX_SUPPORT]; 3],
             weight: [[T::ZERO; MAX_SUPPORT]; 3],
@@ -55,19 +56,52 @@ impl<T: Real> Window<T> {
     }
 }
 
-/// Calls `f(base, w_yz)` for each `(y, z)` row of a window (`base` the row's first
-/// point at `x = 0`), `z`, then `y` ascending in the window: the fixed order of both
-/// spreading and interpolation. Within a row the `x` points follow in window order.
+/// The planes `z0 .. z0 + nz` of the grid (a slab; the whole grid for interpolation).
+#[derive(Clone, Copy)]
+pub(super) struct Slab {
+    pub(super) z0: usize,
+    pub(super) nz: usize,
+}
+
+impl Slab {
+    #[inline(always)]
+    fn holds(&self, iz: usize) -> bool {
+        iz >= self.z0 && iz < self.z0 + self.nz
+    }
+}
+
+/// Calls `f(base, w_yz)` for each `(y, z)` row of a window in `slab` (`base` the row's
+/// first point at `x = 0`, counted from the slab's first plane), `z`, then `y`
+/// ascending in the window: the fixed order of both spreading and interpolation.
+/// Within a row the `x` points follow in window order.
 #[inline(always)]
-fn rows<T: Real>(pse: &Pse<T>, w: &Window<T>, mut f: impl FnMut(usize, T)) {
+fn rows<T: Real>(pse: &Pse<T>, w: &Window<T>, slab: Slab, mut f: impl FnMut(usize, T)) {
     let [mx, my, _] = pse.grid.m;
     let [_, py, pz] = pse.support;
     for tz in 0..pz {
         let (iz, wz) = (w.index[2][tz], w.weight[2][tz]);
+        if !slab.holds(iz) {
+            continue;
+        }
         for ty in 0..py {
-            f((w.index[1][ty] + my * iz) * mx, w.weight[1][ty] * wz);
+            f(
+                (w.index[1][ty] + my * (iz - slab.z0)) * mx,
+                w.weight[1][ty] * wz,
+            );
         }
     }
+}
+
+/// Whether a window of a sphere at `pos` has a plane in `slab` (no weights computed).
+#[inline(always)]
+fn touches<T: Real>(pse: &Pse<T>, pos: T::V3, slab: Slab) -> bool {
+    let (m, h, support) = (pse.grid.m[2], pse.h[2], pse.support[2]);
+    if slab.z0 == 0 && slab.nz == m {
+        return true;
+    }
+    let p = T::xyz(pse.cell.wrap_into(pos))[2];
+    let g0 = libm::floor((p / h).to_f64() - 0.5 * support as f64) as i64 + 1;
+    (0..support as i64).any(|t| slab.holds((g0 + t).rem_euclid(m as i64) as usize))
 }
 
 /// The window's `x` points as one contiguous run `(first, count)` when it does not wrap
@@ -78,19 +112,22 @@ fn run<T: Real>(pse: &Pse<T>, w: &Window<T>) -> Option<usize> {
     (i0 + px <= pse.grid.m[0]).then_some(i0)
 }
 
-/// `grid` (3 components per point, zeroed by the caller) `+=` each sphere's Gaussian
-/// times `(F_j, a_j^2 F_j)`, spheres in the order `order` (the cell list's, for cache
-/// locality; a fixed order, so the same bits).
+/// The planes `slab` of the grid (3 components per point, zeroed by the caller) `+=`
+/// each sphere's Gaussian times `(F_j, a_j^2 F_j)`, spheres in the order `order` (the
+/// cell list's, for cache locality). Every point receives its terms in that order
+/// whatever the slab, so slabs in parallel give the bits of the whole grid at once.
 pub(super) fn spread<T: Real>(
     pse: &Pse<T>,
-    pos: &[T::V3],
-    radius: &[T],
+    (pos, radius, order): (&[T::V3], &[T], &[usize]),
     force: &[T::V3],
-    order: &[usize],
+    slab: Slab,
     grid: &mut [Cx<T>],
 ) {
     let px = pse.support[0];
     for &j in order {
+        if !touches(pse, pos[j], slab) {
+            continue;
+        }
         let w = Window::new(pse, pos[j]);
         let a2 = radius[j] * radius[j];
         let v = T::xyz(force[j]).map(|c| [c, a2 * c]);
@@ -102,13 +139,13 @@ pub(super) fn spread<T: Real>(
         };
         let wx = &w.weight[0][..px];
         match run(pse, &w) {
-            Some(i0) => rows(pse, &w, |base, wyz| {
+            Some(i0) => rows(pse, &w, slab, |base, wyz| {
                 let seg = &mut grid[3 * (base + i0)..3 * (base + i0 + px)];
                 for (pt, &x) in seg.chunks_exact_mut(3).zip(wx) {
                     add(pt, x * wyz);
                 }
             }),
-            None => rows(pse, &w, |base, wyz| {
+            None => rows(pse, &w, slab, |base, wyz| {
                 for (&i, &x) in w.index[0][..px].iter().zip(wx) {
                     add(&mut grid[3 * (base + i)..3 * (base + i) + 3], x * wyz);
                 }
@@ -117,21 +154,22 @@ pub(super) fn spread<T: Real>(
     }
 }
 
-/// `out_i += sum_g g(x_g - r_i) (U(x_g) - a_i^2 V(x_g) / 6)` for every sphere, with
+/// `rows[k] = sum_g g(x_g - r_i) (U(x_g) - a_i^2 V(x_g) / 6)` for `i = order[k]`, with
 /// `U + i V` the grid after the inverse transform (the quadrature weight `h^3` is in the
-/// wave-space kernel). Each sphere's sum is its own, so the order of `order` changes
-/// nothing but the memory traffic.
+/// wave-space kernel). Each sphere's sum is its own.
 pub(super) fn interpolate<T: Real>(
     pse: &Pse<T>,
-    pos: &[T::V3],
-    radius: &[T],
-    order: &[usize],
+    (pos, radius, order): (&[T::V3], &[T], &[usize]),
     grid: &[Cx<T>],
-    out: &mut [T::V3],
+    rows_out: &mut [T::V3],
 ) {
     let sixth = T::ONE / T::from_f64(6.0);
     let px = pse.support[0];
-    for &i in order {
+    let all = Slab {
+        z0: 0,
+        nz: pse.grid.m[2],
+    };
+    for (row, &i) in rows_out.iter_mut().zip(order) {
         let w = Window::new(pse, pos[i]);
         let mut acc = [[T::ZERO; 2]; 3];
         let mut take = |pt: &[Cx<T>], s: T| {
@@ -142,20 +180,20 @@ pub(super) fn interpolate<T: Real>(
         };
         let wx = &w.weight[0][..px];
         match run(pse, &w) {
-            Some(i0) => rows(pse, &w, |base, wyz| {
+            Some(i0) => rows(pse, &w, all, |base, wyz| {
                 let seg = &grid[3 * (base + i0)..3 * (base + i0 + px)];
                 for (pt, &x) in seg.chunks_exact(3).zip(wx) {
                     take(pt, x * wyz);
                 }
             }),
-            None => rows(pse, &w, |base, wyz| {
+            None => rows(pse, &w, all, |base, wyz| {
                 for (&j, &x) in w.index[0][..px].iter().zip(wx) {
                     take(&grid[3 * (base + j)..3 * (base + j) + 3], x * wyz);
                 }
             }),
         }
         let k = radius[i] * radius[i] * sixth;
-        out[i] += T::v3(
+        *row = T::v3(
             acc[0][0] - k * acc[0][1],
             acc[1][0] - k * acc[1][1],
             acc[2][0] - k * acc[2][1],
