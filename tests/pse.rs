@@ -16,12 +16,23 @@ use proptest::prelude::*;
 
 /// `M F` by PSE.
 fn pse_apply<T: Real>(pse: &Pse<T>, pos: &[T::V3], rad: &[T], f: &[T::V3]) -> Vec<T::V3> {
+    pse_part(Part::Both, pse, pos, rad, f)
+}
+
+/// One part of `M F` by PSE.
+fn pse_part<T: Real>(
+    part: Part,
+    pse: &Pse<T>,
+    pos: &[T::V3],
+    rad: &[T],
+    f: &[T::V3],
+) -> Vec<T::V3> {
     let size = pse.storage(pos.len());
     let (mut cx, mut ix) = (vec![[T::ZERO; 2]; size.complex], vec![0usize; size.index]);
     let mut v = vec![T::V3_ZERO; size.vectors];
     let mut store = PseStorage::new(&mut cx, &mut ix, &mut v);
     let mut out = vec![T::V3_ZERO; pos.len()];
-    pse.apply(Part::Both, T::ONE, pos, rad, f, &mut out, &mut store)
+    pse.apply(part, T::ONE, pos, rad, f, &mut out, &mut store)
         .unwrap();
     out
 }
@@ -193,7 +204,7 @@ fn hasimoto_lone_sphere() {
 
 /// The PSE matrix, column by column (`3n` products), as packed 3x3 blocks of its
 /// symmetric part, and the largest asymmetry relative to the largest entry.
-fn assemble<T: Real>(pse: &Pse<T>, pos: &[T::V3], rad: &[T]) -> (Vec<T::M3>, f64) {
+fn assemble<T: Real>(part: Part, pse: &Pse<T>, pos: &[T::V3], rad: &[T]) -> (Vec<T::M3>, f64) {
     let n = pos.len();
     let mut cols = vec![vec![[0.0f64; 3]; n]; 3 * n];
     for j in 0..3 * n {
@@ -201,7 +212,7 @@ fn assemble<T: Real>(pse: &Pse<T>, pos: &[T::V3], rad: &[T]) -> (Vec<T::M3>, f64
         let mut e = [T::ZERO; 3];
         e[j % 3] = T::ONE;
         f[j / 3] = T::v3(e[0], e[1], e[2]);
-        cols[j] = pse_apply(pse, pos, rad, &f)
+        cols[j] = pse_part(part, pse, pos, rad, &f)
             .iter()
             .map(|&v| T::v3_to_f64(v))
             .collect();
@@ -239,7 +250,7 @@ fn positive_definite<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool
     let cell = Periodic::new(size.map(T::from_f64)).unwrap();
     let pse = Pse::new(cell, T::from_f64(a_max), tol).unwrap();
     let (pos, rad) = to_t::<T>(&p, &r);
-    let (mut m, asym) = assemble(&pse, &pos, &rad);
+    let (mut m, asym) = assemble(Part::Both, &pse, &pos, &rad);
     let eps = T::EPSILON.to_f64();
     assert!(asym < 1e3 * eps, "asymmetry {asym:e}");
     cholesky::<T>(&mut m, pos.len()).unwrap();
@@ -348,4 +359,55 @@ fn errors() {
     let e = pse.apply(Part::Both, 1.0, &pos, &[1.0, 1.0], &f, &mut out, &mut short);
     assert!(matches!(e, Err(PseError::Storage { .. })), "{e:?}");
     println!("{}", PseError::GridTooLarge);
+}
+
+/// The real-space (near-field) part alone, the operator PSE's noise would take a
+/// Lanczos square root of. With Beenakker's polynomial factors (this split) its
+/// positivity is not guaranteed as with PSE's `sinc^2` split: the self block is
+/// `1/(6 pi eta a) - xi/(2 pi^{3/2}) (1 - 10/9 x^2 + 7/9 x^4) / eta`, `x = xi a`, which is
+/// negative from `x = 0.9426` on. Checked here against that closed form (a lone sphere
+/// in a box large enough for no image within the cutoff), and the near part of random
+/// configurations (radii 0.3 to 1.5, overlapping or not) is positive definite at the
+/// rule's `xi a_max = 0.5` and at 0.3 (Cholesky), but not at `xi a_max = 1`.
+#[test]
+fn near_field_positivity() {
+    let self_real = |x: f64| {
+        1.0 / (6.0 * core::f64::consts::PI)
+            - x / (2.0 * core::f64::consts::PI.powf(1.5))
+                * (1.0 - 10.0 / 9.0 * x * x + 7.0 / 9.0 * x.powi(4))
+    };
+    for x in [0.3, 0.5, 0.94, 1.0] {
+        let pse = Pse::with_xi(Periodic::new([60.0; 3]).unwrap(), 1.0f64, 1e-4, x).unwrap();
+        let u = pse_part(
+            Part::Near,
+            &pse,
+            &[f64::v3(1.0, 2.0, 3.0)],
+            &[1.0],
+            &[f64::v3(1.0, 0.0, 0.0)],
+        );
+        let got = f64::v3_to_f64(u[0])[0];
+        assert!(
+            (got - self_real(x)).abs() < 1e-14,
+            "xi a {x}: {got} vs {}",
+            self_real(x)
+        );
+    }
+    assert!(self_real(0.942) > 0.0 && self_real(0.943) < 0.0);
+    let mut not_pd = [0usize; 3];
+    for seed in 0..6u64 {
+        for (size, n, lo) in [([8.0; 3], 12, 0.5), ([6.0; 3], 14, 0.3)] {
+            let (p, r) = config_radii(n, seed, size, [lo, 1.5], seed % 2 == 0);
+            let a_max = r.iter().cloned().fold(0.0, f64::max);
+            let (pos, rad) = to_t::<f64>(&p, &r);
+            for (k, x) in [0.3, 0.5, 1.0].into_iter().enumerate() {
+                let pse =
+                    Pse::with_xi(Periodic::new(size).unwrap(), a_max, 1e-4, x / a_max).unwrap();
+                let (mut m, _) = assemble(Part::Near, &pse, &pos, &rad);
+                not_pd[k] += cholesky::<f64>(&mut m, pos.len()).is_err() as usize;
+            }
+        }
+    }
+    println!("near part not positive definite (of 12) at xi a_max = 0.3, 0.5, 1: {not_pd:?}");
+    assert_eq!(not_pd[..2], [0, 0]);
+    assert_eq!(not_pd[2], 12);
 }
