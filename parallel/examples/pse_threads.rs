@@ -14,13 +14,14 @@ use hydrorattle::{Parallel, Periodic, Serial};
 use hydrorattle_parallel::Threads;
 
 fn main() {
-    let arg = |k: usize, d: usize| {
-        std::env::args()
-            .nth(k)
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(d)
-    };
-    let (n, threads) = (arg(1, 100_000), arg(2, 2));
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    let (n, threads) = (
+        *args.first().unwrap_or(&100_000),
+        *args.get(1).unwrap_or(&2),
+    );
     let l = (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.1).cbrt();
     // SplitMix64 positions and forces.
     let mut s = 7u64;
