@@ -17,6 +17,8 @@
 mod fft;
 mod jobs;
 mod near;
+mod noise;
+mod params;
 mod spread;
 mod wave;
 
@@ -29,6 +31,8 @@ pub use spread::MAX_SUPPORT;
 use crate::error::ParticleError;
 use crate::mobility::periodic::real::Split;
 use crate::mobility::periodic::{Periodic, PeriodicError};
+use crate::noise::Noise;
+use crate::noise::lanczos::LanczosError;
 use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
 
@@ -49,6 +53,9 @@ pub enum PseError {
     GridTooLarge,
     /// Positions, radii, forces and output differ in length.
     Length,
+    /// The real-space noise's Lanczos square root failed (not converged, or the near
+    /// field not positive definite: `docs/PERIODIC.md`, section PSE).
+    Lanczos(LanczosError),
     /// Caller storage too small: `need` and `have` for the complex values, then the
     /// indices.
     Storage {
@@ -64,6 +71,7 @@ impl fmt::Display for PseError {
         match self {
             Self::Periodic(e) => write!(f, "{e}"),
             Self::GridTooLarge => write!(f, "the PSE tolerance needs too large a grid"),
+            Self::Lanczos(e) => write!(f, "PSE real-space noise: {e}"),
             Self::Length => write!(
                 f,
                 "PSE: positions, radii, forces and output differ in length"
@@ -89,6 +97,13 @@ struct Spheres<'a, T: Real> {
     pos: &'a [T::V3],
     radius: &'a [T],
     order: &'a [usize],
+}
+
+/// What the wave stage transforms: the spread forces (the product), or white noise on
+/// the grid (the Brownian displacement).
+enum Source<'a, T: Real> {
+    Force(&'a [T::V3]),
+    Noise(&'a mut Noise),
 }
 
 /// Which part of the mobility [`Pse::apply`] applies.
@@ -169,131 +184,6 @@ pub struct Pse<T: Real> {
 }
 
 impl<T: Real> Pse<T> {
-    /// Parameters by the documented rule with `xi = XI_PSE / a_max`.
-    pub fn new(cell: Periodic<T>, a_max: T, tol: f64) -> Result<Self, PseError> {
-        Self::with_xi(cell, a_max, tol, T::from_f64(XI_PSE) / a_max)
-    }
-
-    /// Parameters for a splitting parameter `xi` and a relative tolerance
-    /// `tol` in `[1e-12, 0.1]`. With `D = ln(1/tol)`:
-    ///
-    /// * `p^2 = D + 3/2 ln(p^2) + 2 ln(1 + (a_max xi p)^2 / 2)` (a fixed point): the
-    ///   Ewald path's rule (the last term, the sphere factors' growth) plus the growth
-    ///   of the number of wave vectors in a shell, `~ p^3`, which dominates the
-    ///   wave-space tail;
-    /// * real-space cutoff `r_c = max(p / xi, 2 a_max)`, wave-space cutoff
-    ///   `k_max = 2 p xi`: both truncations `~ exp(-p^2)`;
-    /// * grid spacing `h_d <= pi / k_max` (the Nyquist wave number at `k_max`; each
-    ///   edge rounded up to an even `2^a 3^b 5^c` number of points);
-    /// * Gaussian `sigma = p / (sqrt(2) k_max)`: its aliasing error
-    ///   `exp(-2 pi^2 sigma^2 / h^2)` is at most `exp(-p^2)`; the kernel keeps
-    ///   `exp(-k^2 / (8 xi^2))` (half of Hasimoto's Gaussian) between the two spreads;
-    /// * support `P_d = ceil(2 sqrt(2 D) sigma / h_d)` points (about `2 p sqrt(D) / pi`):
-    ///   the Gaussian left out is below `exp(-D)` of its peak.
-    ///
-    /// Measured against the Ewald path the error is 5 to 50 times below `tol`
-    /// (`docs/PERIODIC.md`).
-    pub fn with_xi(cell: Periodic<T>, a_max: T, tol: f64, xi: T) -> Result<Self, PseError> {
-        if !(xi > T::ZERO && xi.is_finite()) {
-            return Err(PeriodicError::BadParameter("xi").into());
-        }
-        if !(1e-12..=0.1).contains(&tol) {
-            return Err(PeriodicError::BadParameter("tolerance").into());
-        }
-        if !(a_max > T::ZERO && a_max.is_finite()) {
-            return Err(PeriodicError::BadParameter("largest radius").into());
-        }
-        let size = cell.size();
-        if !(a_max + a_max < size[0].min(size[1]).min(size[2])) {
-            return Err(PeriodicError::SphereTooLarge.into());
-        }
-        // The rule in f64 whatever T.
-        let (x, a, dig) = (xi.to_f64(), a_max.to_f64(), -libm::log(tol));
-        let mut p2 = dig;
-        for _ in 0..6 {
-            let t = a * x * libm::sqrt(p2);
-            p2 = dig + 1.5 * libm::log(p2) + 2.0 * libm::log(1.0 + 0.5 * t * t);
-        }
-        let p = libm::sqrt(p2);
-        let r_cut = (p / x).max(2.0 * a);
-        let k_max = 2.0 * p * x;
-        let sigma = libm::sqrt(0.5 * p2) / k_max;
-        let width = 2.0 * libm::sqrt(2.0 * dig) * sigma;
-        let (mut m, mut h, mut support, mut cells) = ([0; 3], [T::ZERO; 3], [0; 3], [1; 3]);
-        let mut factors = [fft::Factors::new(1).ok_or(PseError::GridTooLarge)?; 3];
-        for d in 0..3 {
-            let l = size[d].to_f64();
-            let need = libm::ceil(l * k_max / core::f64::consts::PI);
-            if !(need <= MAX_GRID as f64) {
-                return Err(PseError::GridTooLarge);
-            }
-            m[d] = good_size(need as usize);
-            factors[d] = fft::Factors::new(m[d]).ok_or(PseError::GridTooLarge)?;
-            let hd = l / m[d] as f64;
-            h[d] = T::from_f64(hd);
-            let s = libm::ceil(width / hd);
-            // A support wider than the box is fine: the window then visits a point once
-            // per image of the sphere, each with that image's weight (the periodic sum).
-            if !(s <= MAX_SUPPORT as f64) {
-                return Err(PseError::GridTooLarge);
-            }
-            support[d] = s as usize;
-            cells[d] = (libm::floor(l / r_cut) as usize).clamp(1, MAX_GRID);
-        }
-        let norm = libm::pow(2.0 * core::f64::consts::PI * sigma * sigma, -1.5);
-        Ok(Self {
-            cell,
-            a_max,
-            tol,
-            xi,
-            split: Split::new(cell, xi, r_cut)?,
-            grid: fft::Grid3 {
-                m,
-                factors,
-                comps: 3,
-            },
-            h,
-            sigma: T::from_f64(sigma),
-            norm: T::from_f64(norm),
-            support,
-            residual: T::from_f64(0.25 / (x * x) - sigma * sigma),
-            cells,
-        })
-    }
-
-    /// The box.
-    pub fn cell(&self) -> Periodic<T> {
-        self.cell
-    }
-    /// The splitting parameter.
-    pub fn xi(&self) -> T {
-        self.xi
-    }
-    /// The tolerance the parameters were derived for.
-    pub fn tolerance(&self) -> f64 {
-        self.tol
-    }
-    /// The real-space cutoff.
-    pub fn r_cut(&self) -> T {
-        self.split.r_cut
-    }
-    /// Grid points per axis.
-    pub fn grid(&self) -> [usize; 3] {
-        self.grid.m
-    }
-    /// Gaussian support per axis, in grid points.
-    pub fn support(&self) -> [usize; 3] {
-        self.support
-    }
-    /// Cell-list cells per axis.
-    pub fn cells(&self) -> [usize; 3] {
-        self.cells
-    }
-    /// The largest radius the parameters were chosen for.
-    pub fn a_max(&self) -> T {
-        self.a_max
-    }
-
     /// Storage [`Pse::apply`] needs for `n` spheres.
     pub fn storage(&self, n: usize) -> PseSize {
         let [mx, my, mz] = self.grid.m;
@@ -342,7 +232,8 @@ impl<T: Real> Pse<T> {
         }
         if part != Part::Near {
             let spheres = Spheres { pos, radius, order };
-            self.wave(eta, spheres, force, (store.complex, rows, par), out);
+            let source = Source::Force(force);
+            self.wave(eta, spheres, source, (store.complex, rows, par), out);
         }
         Ok(())
     }
@@ -384,13 +275,14 @@ impl<T: Real> Pse<T> {
         Ok(())
     }
 
-    /// `out += M^wave F` after the checks and the cell list (whose order the spreading
-    /// follows).
+    /// `out += M^wave F` ([`Source::Force`]) or `out += (M^wave)^{1/2}`-distributed
+    /// noise ([`Source::Noise`]), after the checks and the cell list (whose order the
+    /// spreading follows).
     fn wave(
         &self,
         eta: T,
         s: Spheres<'_, T>,
-        force: &[T::V3],
+        source: Source<'_, T>,
         (cx, rows, par): (&mut [Cx<T>], &mut [T::V3], &dyn Parallel),
         out: &mut [T::V3],
     ) {
@@ -411,18 +303,22 @@ impl<T: Real> Pse<T> {
         let slab = 3 * mx * my;
         // Spreading and the x, y transforms by slabs of planes (in parallel), the z
         // transforms and the kernel whole (their lines cross every slab).
-        let _ = jobs::pieces(par, (&mut *grid, mz, slab), jobs::none(), |z0, g, _| {
-            g.fill([T::ZERO; 2]);
-            let nz = g.len() / slab;
-            spread::spread(
-                self,
-                (pos, radius, order),
-                force,
-                spread::Slab { z0, nz },
-                g,
-            );
-            Ok::<(), Infallible>(())
-        });
+        let noise = matches!(source, Source::Noise(_));
+        match source {
+            Source::Force(force) => {
+                let _ = jobs::pieces(par, (&mut *grid, mz, slab), jobs::none(), |z0, g, _| {
+                    g.fill([T::ZERO; 2]);
+                    let nz = g.len() / slab;
+                    let slab = spread::Slab { z0, nz };
+                    spread::spread(self, (pos, radius, order), force, slab, g);
+                    Ok::<(), Infallible>(())
+                });
+            }
+            // White noise of unit variance at every point (the generator's order).
+            Source::Noise(rng) => grid.iter_mut().for_each(|v| {
+                *v = [T::from_f64(rng.normal()), T::ZERO];
+            }),
+        }
         let planes = |inverse: bool| {
             move |_: usize, g: &mut [Cx<T>], sc: &mut [Cx<T>]| {
                 let shape = fft::Grid3 {
@@ -440,7 +336,10 @@ impl<T: Real> Pse<T> {
             planes(false),
         );
         fft::fft3(&self.grid, grid, &mut scratch[..each], tws, false, 2..3);
-        wave::apply_kernel(self, eta, table, grid);
+        match noise {
+            false => wave::apply_kernel(self, eta, table, grid),
+            true => wave::apply_sqrt_kernel(self, eta, table, grid),
+        }
         fft::fft3(&self.grid, grid, &mut scratch[..each], tws, true, 2..3);
         let _ = jobs::pieces(
             par,

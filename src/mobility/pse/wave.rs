@@ -100,3 +100,54 @@ pub(super) fn apply_kernel<T: Real>(pse: &Pse<T>, eta: T, table: &[Cx<T>], grid:
         }
     }
 }
+
+/// Replaces the transform `Z` of white noise (unit variance at every point and
+/// component) by `sqrt(s(k) / M) (I - k k/k^2) Z(k)`, packed as `u + i k^2 u` like the
+/// product's, with `s(k)` the product's kernel and `M` the number of grid points: the
+/// interpolated field then has covariance `M^wave` exactly (the product is
+/// `B^* s P B`, this is `B^* sqrt(s) P F zeta / sqrt(M)` and `F F^* = M I`). Each mode
+/// alone: `Z` of a real field is Hermitian, so `u` is too.
+pub(super) fn apply_sqrt_kernel<T: Real>(
+    pse: &Pse<T>,
+    eta: T,
+    table: &[Cx<T>],
+    grid: &mut [Cx<T>],
+) {
+    let [mx, my, mz] = pse.grid.m;
+    let (tx, rest) = table.split_at(mx);
+    let (ty, tz) = rest.split_at(my);
+    let total = (mx * my * mz) as f64;
+    let scale = pse.cell.volume() / (eta * T::from_f64(total * total * total));
+    let inv_4xi2 = T::ONE / (T::from_f64(4.0) * pse.xi * pse.xi);
+    let nyquist = |n: usize, m: usize| 2 * n == m;
+    for iz in 0..mz {
+        for iy in 0..my {
+            for ix in 0..mx {
+                let idx = 3 * (ix + mx * (iy + my * iz));
+                let zero = (ix == 0 && iy == 0 && iz == 0)
+                    || nyquist(ix, mx)
+                    || nyquist(iy, my)
+                    || nyquist(iz, mz);
+                if zero {
+                    grid[idx..idx + 3].fill([T::ZERO; 2]);
+                    continue;
+                }
+                let k = [tx[ix][0], ty[iy][0], tz[iz][0]];
+                let k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+                let g = tx[ix][1] * ty[iy][1] * tz[iz][1];
+                let r = (scale * (T::ONE + k2 * inv_4xi2) * g / k2).sqrt();
+                let z = &mut grid[idx..idx + 3];
+                for part in 0..2 {
+                    let kz = (k[0] * z[0][part] + k[1] * z[1][part] + k[2] * z[2][part]) / k2;
+                    for c in 0..3 {
+                        z[c][part] = r * (z[c][part] - k[c] * kz);
+                    }
+                }
+                for v in z.iter_mut() {
+                    let [ur, ui] = *v;
+                    *v = [ur - k2 * ui, ui + k2 * ur];
+                }
+            }
+        }
+    }
+}
