@@ -8,6 +8,7 @@
 //! cargo run --release --example pse_scaling -- tols         # each tolerance at N = 1e4
 //! cargo run --release --example pse_scaling -- xi           # xi a = 0.3 ... 0.8 at N = 1e4
 //! cargo run --release --example pse_scaling -- crossover    # PSE vs Ewald, N = 10 ... 400
+//! cargo run --release --example pse_scaling -- noise        # the Brownian displacement
 //! ```
 //!
 //! Times are the best of a few repetitions on whatever machine runs it (the development
@@ -15,9 +16,9 @@
 
 use std::time::Instant;
 
-use hydrorattle::Real;
 use hydrorattle::mobility::periodic::{Ewald, Periodic, tt_product};
 use hydrorattle::mobility::pse::{Part, Pse, PseStorage};
+use hydrorattle::{Lanczos, Noise, Real};
 
 type V = <f64 as Real>::V3;
 
@@ -204,12 +205,46 @@ fn crossover() {
     }
 }
 
+/// The Brownian displacement (`Pse::noise`, Lanczos tolerance 1e-3) against N.
+fn noise() {
+    let ns = [1_000usize, 10_000, 100_000];
+    let mut times = vec![];
+    for &n in &ns {
+        let (l, pos, rad, _) = suspension(n, 0.1, 7);
+        let pse = Pse::new(Periodic::new([l; 3]).unwrap(), 1.0, 1e-4).unwrap();
+        let mut store = Store::new(&pse, n);
+        let s = Lanczos::default();
+        let (nv, ns_) = Pse::noise_storage(&s, n);
+        let (mut basis, mut work) = (vec![V::ZERO; nv], vec![0.0; ns_]);
+        let mut rng = Noise::new(3);
+        let mut out = vec![V::ZERO; n];
+        let mut iterations = 0;
+        let t = best(if n >= 100_000 { 1 } else { 2 }, || {
+            let mut st = PseStorage::new(&mut store.0, &mut store.1, &mut store.2);
+            let w = (&mut basis[..], &mut work[..]);
+            iterations = pse
+                .noise(1.0, (&pos, &rad), &mut rng, s, &mut out, &mut st, w)
+                .unwrap();
+        });
+        println!("N {n:>6}: noise {t:.3} s, {iterations} Lanczos iterations");
+        times.push(t);
+    }
+    let slope =
+        |i: usize, j: usize| (times[j] / times[i]).ln() / (ns[j] as f64 / ns[i] as f64).ln();
+    println!(
+        "exponent: 1e3-1e4 {:.3}, 1e4-1e5 {:.3}",
+        slope(0, 1),
+        slope(1, 2)
+    );
+}
+
 fn main() {
     let arg = std::env::args().nth(1).unwrap_or_default();
     match arg.as_str() {
         "tols" => tols(),
         "xi" => xi_scan(),
         "crossover" => crossover(),
+        "noise" => noise(),
         "one" => {
             let n: usize = std::env::args()
                 .nth(2)
