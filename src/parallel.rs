@@ -23,7 +23,9 @@ mod blocked;
 mod jobs;
 
 pub(crate) use blocked::{assemble_apply_then, band_rows};
-pub(crate) use jobs::{Jobs, Packed, by_bands, by_bands_and, reduce, run_all};
+#[cfg(feature = "pse")]
+pub(crate) use jobs::{Jobs, run_all};
+pub(crate) use jobs::{Packed, by_bands, by_bands_and, reduce};
 
 use crate::error::ParticleError;
 use crate::linalg::tri;

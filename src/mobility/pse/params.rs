@@ -2,6 +2,10 @@
 //! accessors.
 
 use super::{MAX_GRID, MAX_SUPPORT, Pse, PseError, XI_PSE, fft, good_size};
+
+/// Cell-list cells per axis at most (a bound on the index storage of a large, dilute
+/// box: 128^3 cells).
+const MAX_CELLS: usize = 128;
 use crate::mobility::periodic::real::Split;
 use crate::mobility::periodic::{Periodic, PeriodicError};
 use crate::real::Real;
@@ -76,7 +80,8 @@ impl<T: Real> Pse<T> {
                 return Err(PseError::GridTooLarge);
             }
             support[d] = s as usize;
-            cells[d] = (libm::floor(l / r_cut) as usize).clamp(1, MAX_GRID);
+            // At most MAX_CELLS per axis: wider cells are still at least r_c wide.
+            cells[d] = (libm::floor(l / r_cut) as usize).clamp(1, MAX_CELLS);
         }
         let norm = libm::pow(2.0 * core::f64::consts::PI * sigma * sigma, -1.5);
         Ok(Self {

@@ -32,7 +32,6 @@ impl<T: Real> Window<T> {
     #[inline(always)]
     fn new(pse: &Pse<T>, pos: T::V3) -> Self {
         let p = T::xyz(pse.cell.wrap_into(pos));
-        // The first point as `touches` finds it: the same expression, so the same bits.
         let mut w = Self {
             index: [[0; MAX_SUPPORT]; 3],
             weight: [[T::ZERO; MAX_SUPPORT]; 3],
@@ -40,8 +39,7 @@ impl<T: Real> Window<T> {
         let half = T::ONE / (T::TWO * pse.sigma * pse.sigma);
         for d in 0..3 {
             let (m, h, support) = (pse.grid.m[d] as i64, pse.h[d], pse.support[d]);
-            // First point: above p - P h / 2.
-            let g0 = libm::floor((p[d] / h).to_f64() - 0.5 * support as f64) as i64 + 1;
+            let g0 = first_point(pse, p[d], d);
             for t in 0..support {
                 let g = g0 + t as i64;
                 let x = T::from_f64(g as f64) * h - p[d];
@@ -54,6 +52,13 @@ impl<T: Real> Window<T> {
         }
         w
     }
+}
+
+/// The (unwrapped) index of a window's first point along axis `d` for the wrapped
+/// coordinate `p`: the first above `p - P_d h_d / 2`.
+#[inline(always)]
+fn first_point<T: Real>(pse: &Pse<T>, p: T, d: usize) -> i64 {
+    libm::floor((p / pse.h[d]).to_f64() - 0.5 * pse.support[d] as f64) as i64 + 1
 }
 
 /// The planes `z0 .. z0 + nz` of the grid (a slab; the whole grid for interpolation).
@@ -95,12 +100,11 @@ fn rows<T: Real>(pse: &Pse<T>, w: &Window<T>, slab: Slab, mut f: impl FnMut(usiz
 /// Whether a window of a sphere at `pos` has a plane in `slab` (no weights computed).
 #[inline(always)]
 fn touches<T: Real>(pse: &Pse<T>, pos: T::V3, slab: Slab) -> bool {
-    let (m, h, support) = (pse.grid.m[2], pse.h[2], pse.support[2]);
+    let (m, support) = (pse.grid.m[2], pse.support[2]);
     if slab.z0 == 0 && slab.nz == m {
         return true;
     }
-    let p = T::xyz(pse.cell.wrap_into(pos))[2];
-    let g0 = libm::floor((p / h).to_f64() - 0.5 * support as f64) as i64 + 1;
+    let g0 = first_point(pse, T::xyz(pse.cell.wrap_into(pos))[2], 2);
     (0..support as i64).any(|t| slab.holds((g0 + t).rem_euclid(m as i64) as usize))
 }
 
