@@ -6,7 +6,9 @@
 //! `S2 = (Z(k) - conj Z(-k)) / (2 i)`), Beenakker's sphere factor of the source is formed
 //! as `q = S1 - k^2 S2 / 6`, and
 //!
-//!     u(k) = h^3 / (eta M) (1 + k^2/(4 xi^2)) exp(-k^2/(4 xi^2)) / ghat(k)^2 / k^2 (I - k k/k^2) q,
+//! ```text
+//! u(k) = h^3 / (eta M) (1 + k^2/(4 xi^2)) exp(-k^2/(4 xi^2)) / ghat(k)^2 / k^2 (I - k k/k^2) q,
+//! ```
 //!
 //! with `ghat(k) = exp(-sigma^2 k^2 / 2)` the spreading Gaussian's transform (divided out
 //! twice: once for spreading, once for interpolation) and `M` the number of grid
