@@ -358,6 +358,18 @@ fn errors() {
     let mut short = PseStorage::new(&mut cx[..10], &mut ix, &mut v);
     let e = pse.apply(Part::Both, 1.0, &pos, &[1.0, 1.0], &f, &mut out, &mut short);
     assert!(matches!(e, Err(PseError::Storage { .. })), "{e:?}");
+    let mut short = PseStorage::new(&mut cx, &mut ix, &mut v[..1]);
+    let e = pse.apply(Part::Both, 1.0, &pos, &[1.0, 1.0], &f, &mut out, &mut short);
+    assert!(
+        matches!(
+            e,
+            Err(PseError::Storage {
+                have: [_, _, 1],
+                ..
+            })
+        ),
+        "{e:?}"
+    );
     println!("{}", PseError::GridTooLarge);
 }
 

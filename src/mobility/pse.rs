@@ -59,10 +59,11 @@ pub enum PseError {
     /// Caller storage too small: `need` and `have` for the complex values, then the
     /// indices.
     Storage {
-        /// Values needed (complex, then index).
-        need: [usize; 2],
-        /// Values given.
-        have: [usize; 2],
+        /// Values needed: complex values, indices and vectors ([`Pse::storage`]); for
+        /// [`Pse::noise`]'s own arrays, its vectors and scalars, then 0.
+        need: [usize; 3],
+        /// Values given, in the same order.
+        have: [usize; 3],
     },
 }
 
@@ -78,8 +79,7 @@ impl fmt::Display for PseError {
             ),
             Self::Storage { need, have } => write!(
                 f,
-                "PSE storage too small: need {} complex and {} index values, have {} and {}",
-                need[0], need[1], have[0], have[1]
+                "PSE storage too small: need {need:?} values, have {have:?}"
             ),
         }
     }
@@ -253,11 +253,10 @@ impl<T: Real> Pse<T> {
             return Err(PseError::Length);
         }
         let size = self.storage(n);
-        if store.complex.len() < size.complex || store.index.len() < size.index {
-            return Err(PseError::Storage {
-                need: [size.complex, size.index],
-                have: [store.complex.len(), store.index.len()],
-            });
+        let need = [size.complex, size.index, size.vectors];
+        let have = [store.complex.len(), store.index.len(), store.vectors.len()];
+        if need.iter().zip(&have).any(|(n, h)| h < n) {
+            return Err(PseError::Storage { need, have });
         }
         if !(eta > T::ZERO && eta.is_finite()) {
             return Err(PeriodicError::BadParameter("viscosity").into());

@@ -38,11 +38,14 @@ impl<T: Real> Pse<T> {
         let n = pos.len();
         out.fill(T::V3_ZERO);
         self.check(eta, pos, radius, out, out, store)?;
+        if n == 0 {
+            return Ok(0);
+        }
         let (vectors, scalars) = Self::noise_storage(&s, n);
         if basis.len() < vectors || work.len() < scalars {
             return Err(PseError::Storage {
-                need: [vectors, scalars],
-                have: [basis.len(), work.len()],
+                need: [vectors, scalars, 0],
+                have: [basis.len(), work.len(), 0],
             });
         }
         let (basis, z) = basis.split_at_mut(vectors - n);
