@@ -116,6 +116,21 @@ fn time_pse(n: usize, tol: f64, xi_a: f64, reps: usize) -> (f64, f64, f64, Pse<f
     (total, near, wave, pse)
 }
 
+/// The scaling exponents `d ln t / d ln N` between successive sizes and overall.
+fn exponents(ns: &[usize], times: &[f64]) {
+    let slope =
+        |i: usize, j: usize| (times[j] / times[i]).ln() / (ns[j] as f64 / ns[i] as f64).ln();
+    let last = ns.len() - 1;
+    let steps: Vec<String> = (0..last)
+        .map(|i| format!("{}-{} {:.3}", ns[i], ns[i + 1], slope(i, i + 1)))
+        .collect();
+    println!(
+        "exponent: {}, overall {:.3}",
+        steps.join(", "),
+        slope(0, last)
+    );
+}
+
 fn describe(pse: &Pse<f64>, n: usize) -> String {
     let g = pse.grid();
     let points = g[0] * g[1] * g[2];
@@ -142,14 +157,7 @@ fn scaling(tol: f64) {
         );
         times.push(t);
     }
-    let slope =
-        |i: usize, j: usize| (times[j] / times[i]).ln() / (ns[j] as f64 / ns[i] as f64).ln();
-    println!(
-        "exponent: 1e3-1e4 {:.3}, 1e4-1e5 {:.3}, 1e3-1e5 {:.3}",
-        slope(0, 1),
-        slope(1, 2),
-        slope(0, 2)
-    );
+    exponents(&ns, &times);
 }
 
 fn tols() {
@@ -229,13 +237,7 @@ fn noise() {
         println!("N {n:>6}: noise {t:.3} s, {iterations} Lanczos iterations");
         times.push(t);
     }
-    let slope =
-        |i: usize, j: usize| (times[j] / times[i]).ln() / (ns[j] as f64 / ns[i] as f64).ln();
-    println!(
-        "exponent: 1e3-1e4 {:.3}, 1e4-1e5 {:.3}",
-        slope(0, 1),
-        slope(1, 2)
-    );
+    exponents(&ns, &times);
 }
 
 fn main() {
