@@ -102,6 +102,8 @@ fn against_ewald<T: Real>(tols: &[f64]) {
         ([14.0, 18.0, 22.0], 60, 2),
         ([20.0; 3], 80, 3),
         ([11.0, 24.0, 13.0], 50, 4),
+        // A suspension: volume fraction about 0.1.
+        ([22.0; 3], 200, 6),
     ] {
         let (pos, rad) = config_radii(n, seed, size, [0.5, 1.5], true);
         let f = forces(pos.len(), seed);
