@@ -11,8 +11,11 @@
 //!   Ewald path's real-space block, so the halves add to the same periodic RPY.
 //!
 //! One tolerance sets every parameter ([`Pse::with_xi`], `docs/PERIODIC.md`, section
-//! PSE). The kernel stays `no_std`, allocation-free and without `unsafe`: the caller
-//! owns the grid and the cell list ([`Pse::storage`], [`PseStorage`]).
+//! PSE). Brownian displacements of covariance `M` come from [`Pse::noise`] (`noise.rs`);
+//! a host's thread pool runs the pieces ([`PseStorage::with_parallel`], `jobs.rs`) with
+//! the bits of one thread. The kernel stays `no_std`, allocation-free and without
+//! `unsafe`: the caller owns the grid, the cell list and the rows ([`Pse::storage`],
+//! [`PseStorage`]).
 
 mod fft;
 mod jobs;
@@ -56,8 +59,7 @@ pub enum PseError {
     /// The real-space noise's Lanczos square root failed (not converged, or the near
     /// field not positive definite: `docs/PERIODIC.md`, section PSE).
     Lanczos(LanczosError),
-    /// Caller storage too small: `need` and `have` for the complex values, then the
-    /// indices.
+    /// Caller storage too small (`need` and `have` per array).
     Storage {
         /// Values needed: complex values, indices and vectors ([`Pse::storage`]); for
         /// [`Pse::noise`]'s own arrays, its vectors and scalars, then 0.
