@@ -15,6 +15,8 @@ use crate::real::Real;
 
 #[cfg(feature = "periodic")]
 pub mod periodic;
+#[cfg(feature = "pse")]
+pub mod pse;
 pub mod wall;
 
 /// How much hydrodynamics to model.

@@ -23,6 +23,8 @@ mod blocked;
 mod jobs;
 
 pub(crate) use blocked::{assemble_apply_then, band_rows};
+#[cfg(feature = "pse")]
+pub(crate) use jobs::{Jobs, run_all};
 pub(crate) use jobs::{Packed, by_bands, by_bands_and, reduce};
 
 use crate::error::ParticleError;

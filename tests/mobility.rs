@@ -7,6 +7,9 @@
 //! itself. One generic body per check, instantiated for `f32` and `f64` by
 //! `precision_tests!` with per-precision tolerances.
 
+mod common;
+
+use common::admissible;
 use std::f64::consts::PI;
 
 use hydrorattle::bonds::{Bond, BondSet};
@@ -281,14 +284,10 @@ fn random_config(n: usize, seed: u64, overlap: bool) -> (Vec<[f64; 3]>, Vec<f64>
                 rng.range(0.0, side),
             ]
         };
-        let ok = pos.iter().zip(&rad).all(|(&q, &b)| {
-            let s = norm(sub(p, q));
-            if overlap {
-                s > (a - b).abs() + 0.1 * a.min(b)
-            } else {
-                s > (a + b) * (1.0 + 1e-9)
-            }
-        });
+        let ok = pos
+            .iter()
+            .zip(&rad)
+            .all(|(&q, &b)| admissible(norm(sub(p, q)), a, b, overlap));
         if ok {
             pos.push(p);
             rad.push(a);

@@ -6,6 +6,7 @@
 
 mod common;
 
+use common::boxes::{Rng, config, to_t};
 use common::loglog_slope;
 use hydrorattle::Real;
 use hydrorattle::error::ParticleError;
@@ -44,79 +45,6 @@ fn max_diff(a: &M, b: &M) -> f64 {
         }
     }
     d
-}
-
-/// SplitMix64: configurations from a seed.
-struct Rng(u64);
-
-impl Rng {
-    fn unit(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-}
-
-fn min_image(r: [f64; 3], size: [f64; 3]) -> [f64; 3] {
-    [0, 1, 2].map(|d| r[d] - size[d] * (r[d] / size[d]).round())
-}
-
-fn norm(r: [f64; 3]) -> f64 {
-    (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt()
-}
-
-/// `n` spheres of radii in `[0.5, a_hi]` in the box `size`: with `overlap`, half of them
-/// placed overlapping an earlier one (centre distance between nested-plus-a-margin and
-/// contact), otherwise all apart. Distances are minimum-image distances.
-fn config(
-    n: usize,
-    seed: u64,
-    size: [f64; 3],
-    a_hi: f64,
-    overlap: bool,
-) -> (Vec<[f64; 3]>, Vec<f64>) {
-    let mut rng = Rng(seed);
-    let (mut pos, mut rad): (Vec<[f64; 3]>, Vec<f64>) = (vec![], vec![]);
-    let mut tries = 0;
-    while pos.len() < n && tries < 100_000 {
-        tries += 1;
-        let a = rng.range(0.5, a_hi);
-        let p = if overlap && !pos.is_empty() && rng.unit() < 0.5 {
-            let j = (rng.unit() * pos.len() as f64) as usize;
-            let lo = (a - rad[j]).abs() + 0.1 * a.min(rad[j]);
-            let s = rng.range(lo, a + rad[j]);
-            let (u, phi) = (rng.range(-1.0, 1.0), rng.range(0.0, core::f64::consts::TAU));
-            let w = (1.0 - u * u).sqrt();
-            [0, 1, 2].map(|d| pos[j][d] + s * [w * phi.cos(), w * phi.sin(), u][d])
-        } else {
-            [0, 1, 2].map(|d| rng.range(0.0, size[d]))
-        };
-        let ok = pos.iter().zip(&rad).all(|(q, &b)| {
-            let s = norm(min_image([0, 1, 2].map(|d| p[d] - q[d]), size));
-            if overlap {
-                s > (a - b).abs() + 0.1 * a.min(b)
-            } else {
-                s > (a + b) * (1.0 + 1e-9)
-            }
-        });
-        if ok {
-            pos.push(p);
-            rad.push(a);
-        }
-    }
-    (pos, rad)
-}
-
-fn to_t<T: Real>(pos: &[[f64; 3]], rad: &[f64]) -> (Vec<T::V3>, Vec<T>) {
-    (
-        pos.iter().map(|&p| T::v3_from(p)).collect(),
-        rad.iter().map(|&a| T::from_f64(a)).collect(),
-    )
 }
 
 fn assemble<T: Real>(ew: &Ewald<T>, pos: &[T::V3], rad: &[T]) -> Vec<T::M3> {

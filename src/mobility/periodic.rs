@@ -28,7 +28,7 @@
 //! the cutoffs for a tolerance near epsilon; [`Ewald::with_xi`] takes them from the
 //! caller. Rotation (the `rt`, `rr` blocks) is not here yet.
 
-mod real;
+pub(crate) mod real;
 mod wave;
 
 pub use crate::cell::{Periodic, PeriodicError};
@@ -57,12 +57,11 @@ pub struct Ewald<T: Real> {
     cell: Periodic<T>,
     a_max: T,
     xi: T,
-    r_cut: T,
+    /// The real-space sum's box, `xi`, cutoff and image bounds.
+    split: real::Split<T>,
     k_max: T,
     volume: T,
     inv_4xi2: T,
-    /// Real-space index bound per axis.
-    images: [usize; 3],
     /// Wave-space index bound per axis.
     waves: [usize; 3],
     /// `2 pi / L_d`.
@@ -108,18 +107,17 @@ impl<T: Real> Ewald<T> {
         let p = libm::sqrt(p2);
         let r_cut = (p / x).max(2.0 * a);
         let k_max = 2.0 * p * x;
-        let mut images = [0; 3];
+        let split = real::Split::new(cell, xi, r_cut)?;
         let mut waves = [0; 3];
         let mut dk = [T::ZERO; 3];
         let mut gauss = [[T::ZERO; MAX_INDEX + 1]; 3];
         for d in 0..3 {
             let l = size[d].to_f64();
-            let m = libm::ceil(r_cut / l + 0.5);
             let w = libm::floor(k_max * l / (2.0 * core::f64::consts::PI));
-            if !(m <= MAX_INDEX as f64 && w <= MAX_INDEX as f64) {
+            if !(w <= MAX_INDEX as f64) {
                 return Err(PeriodicError::TooElongated);
             }
-            (images[d], waves[d]) = (m as usize, w as usize);
+            waves[d] = w as usize;
             dk[d] = T::TWO * T::PI / size[d];
             for n in 0..=waves[d] {
                 let k = T::from_f64(n as f64) * dk[d];
@@ -130,11 +128,10 @@ impl<T: Real> Ewald<T> {
             cell,
             a_max,
             xi,
-            r_cut: T::from_f64(r_cut),
+            split,
             k_max: T::from_f64(k_max),
             volume: cell.volume(),
             inv_4xi2: T::ONE / (T::from_f64(4.0) * xi * xi),
-            images,
             waves,
             dk,
             gauss,
@@ -151,7 +148,7 @@ impl<T: Real> Ewald<T> {
     }
     /// The real-space cutoff.
     pub fn r_cut(&self) -> T {
-        self.r_cut
+        self.split.r_cut
     }
     /// The wave-space cutoff.
     pub fn k_max(&self) -> T {
@@ -168,7 +165,7 @@ impl<T: Real> Ewald<T> {
 /// Exactly symmetric; `None` when a sphere lies inside an image of the other.
 pub fn pair_tt<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r: T::V3) -> Option<T::M3> {
     let r0 = ew.cell.minimum_image(r);
-    let real = real::real_sum(ew, eta, ai, aj, r0, false)?;
+    let real = real::real_sum(&ew.split, eta, ai, aj, r0, false)?;
     Some(real + wave::wave_sum(ew, eta, ai, aj, r0))
 }
 
@@ -177,7 +174,7 @@ pub fn pair_tt<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r: T::V3) -> Option
 /// `(1 - 2.837297 a/L + 4 pi/3 (a/L)^3) / (6 pi eta a)`).
 pub fn self_tt<T: Real>(ew: &Ewald<T>, eta: T, a: T) -> T::M3 {
     // No image of a sphere lies inside it (a < L/2), so the real sum is never `None`.
-    let real = real::real_sum(ew, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
+    let real = real::real_sum(&ew.split, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
     real + wave::wave_sum(ew, eta, a, a, T::V3_ZERO)
 }
 
@@ -235,14 +232,14 @@ pub fn tt_product<T: Real>(
     for i in 0..n {
         let a = radius[i];
         // The self block's real part (a < L/2: never `None`, see `self_tt`).
-        let b = real::real_sum(ew, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
+        let b = real::real_sum(&ew.split, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
         y[i] = b * x[i];
     }
     for i in 0..n {
         let mut acc = T::V3_ZERO;
         for j in 0..i {
             let r0 = ew.cell.minimum_image(pos[i] - pos[j]);
-            let b = real::real_sum(ew, eta, radius[i], radius[j], r0, false).ok_or(
+            let b = real::real_sum(&ew.split, eta, radius[i], radius[j], r0, false).ok_or(
                 PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
             )?;
             acc += b * x[j];

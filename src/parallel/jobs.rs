@@ -7,10 +7,10 @@ use super::{BANDS, Parallel, band_start, bands};
 use crate::real::Real;
 
 /// The job list of one round (at most [`BANDS`] jobs, on the stack).
-type Jobs<F> = heapless::Vec<F, BANDS>;
+pub(crate) type Jobs<F> = heapless::Vec<F, BANDS>;
 
 /// Runs one round of jobs through `par`.
-fn run_all<F: FnMut() + Send>(par: &dyn Parallel, jobs: &mut Jobs<F>) {
+pub(crate) fn run_all<F: FnMut() + Send>(par: &dyn Parallel, jobs: &mut Jobs<F>) {
     let mut refs: heapless::Vec<&mut (dyn FnMut() + Send), BANDS> = heapless::Vec::new();
     for job in jobs.iter_mut() {
         let _ = refs.push(job);

@@ -3,6 +3,7 @@
 //! Each test crate uses a different subset of these helpers.
 #![allow(dead_code)]
 
+pub mod boxes;
 pub mod fuzz;
 
 use hydrorattle::{
@@ -60,6 +61,16 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 pub fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
+}
+
+/// Whether spheres of radii `a`, `b` at centre distance `s` may be placed together: with
+/// `overlap`, not nested (a tenth of the smaller radius to spare), otherwise apart.
+pub fn admissible(s: f64, a: f64, b: f64, overlap: bool) -> bool {
+    if overlap {
+        s > (a - b).abs() + 0.1 * a.min(b)
+    } else {
+        s > (a + b) * (1.0 + 1e-9)
+    }
 }
 
 /// Rodrigues' rotation of `r` about the unit `axis` by `angle`.

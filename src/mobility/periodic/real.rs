@@ -2,9 +2,49 @@
 //! within the cutoff minus the smooth kernel `W` whose lattice sum the wave-space half
 //! takes over (`docs/PERIODIC.md`, eqs. W and W0).
 
-use super::Ewald;
+use super::{MAX_INDEX, Periodic, PeriodicError};
 use crate::mobility::{Hydro, self_tt as free_self_tt};
 use crate::real::Real;
+
+/// What the real-space sum reads: the box, the splitting parameter, the cutoff and the
+/// image range per axis. Shared by the Ewald path and the PSE near field
+/// (`mobility::pse`), which sum the same real-space blocks.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Split<T: Real> {
+    pub(crate) cell: Periodic<T>,
+    pub(crate) xi: T,
+    pub(crate) r_cut: T,
+    /// Image index bound per axis: 0 where `r_cut < L_d / 2` (a minimum-image
+    /// separation's other images are then at least `L_d / 2` away along that axis, so
+    /// beyond the cutoff), else `ceil(r_cut / L_d + 1/2)`.
+    images: [usize; 3],
+}
+
+impl<T: Real> Split<T> {
+    /// The split for `xi` and `r_cut` (both positive, checked by the callers);
+    /// [`PeriodicError::TooElongated`] past `MAX_INDEX` images on an axis.
+    pub(crate) fn new(cell: Periodic<T>, xi: T, r_cut: f64) -> Result<Self, PeriodicError> {
+        let mut images = [0; 3];
+        for (d, l) in cell.size().into_iter().enumerate() {
+            let l = l.to_f64();
+            let m = if r_cut < 0.5 * l {
+                0.0
+            } else {
+                libm::ceil(r_cut / l + 0.5)
+            };
+            if !(m <= MAX_INDEX as f64) {
+                return Err(PeriodicError::TooElongated);
+            }
+            images[d] = m as usize;
+        }
+        Ok(Self {
+            cell,
+            xi,
+            r_cut: T::from_f64(r_cut),
+            images,
+        })
+    }
+}
 
 /// Terms of the power series of `W` below `xi r = 1` (the last one is below `1e-22`
 /// relative there, for spheres up to the box's half width).
@@ -118,8 +158,8 @@ fn closed<T: Real>(v: &Scaled<T>) -> (T, T) {
 /// `1/(6 pi eta a) - W(0)`). Images in a fixed order (`n_x`, then `n_y`, then `n_z`,
 /// each ascending), every one with `|r0 + n L| <= r_cut`. `None` when an image of one
 /// sphere lies inside the other (as [`crate::mobility::pair_tt`]).
-pub(super) fn real_sum<T: Real>(
-    ew: &Ewald<T>,
+pub(crate) fn real_sum<T: Real>(
+    ew: &Split<T>,
     eta: T,
     ai: T,
     aj: T,

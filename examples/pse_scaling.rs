@@ -1,0 +1,262 @@
+//! Cost of the PSE product `u = M F` (`mobility::pse`) against N, tolerance and the
+//! splitting parameter, and its crossover with the dense Ewald product
+//! (`mobility::periodic::tt_product`). Unit spheres at volume fraction 0.1 in a cubic
+//! box, random positions (overlaps allowed: equal radii never nest), f64, one thread.
+//!
+//! ```text
+//! cargo run --release --example pse_scaling                 # N = 1e3, 1e4, 1e5 at tol 1e-4
+//! cargo run --release --example pse_scaling -- tols         # each tolerance at N = 1e4
+//! cargo run --release --example pse_scaling -- xi           # xi a = 0.3 ... 0.8 at N = 1e4
+//! cargo run --release --example pse_scaling -- crossover    # PSE vs Ewald, N = 10 ... 400
+//! cargo run --release --example pse_scaling -- noise        # the Brownian displacement
+//! ```
+//!
+//! Times are the best of a few repetitions on whatever machine runs it (the development
+//! machine is shared): read ratios, and the counts printed with them.
+
+use std::time::Instant;
+
+use hydrorattle::mobility::periodic::{Ewald, Periodic, tt_product};
+use hydrorattle::mobility::pse::{Part, Pse, PseStorage};
+use hydrorattle::{Lanczos, Noise, Real};
+
+type V = <f64 as Real>::V3;
+
+/// SplitMix64 in `[0, 1)`.
+struct Rng(u64);
+impl Rng {
+    fn unit(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// `n` unit spheres at volume fraction `phi`: the box edge, positions and forces.
+fn suspension(n: usize, phi: f64, seed: u64) -> (f64, Vec<V>, Vec<f64>, Vec<V>) {
+    let l = (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / phi).cbrt();
+    let mut rng = Rng(seed);
+    let pos = (0..n)
+        .map(|_| f64::v3(rng.unit() * l, rng.unit() * l, rng.unit() * l))
+        .collect();
+    let force = (0..n)
+        .map(|_| f64::v3(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5))
+        .collect();
+    (l, pos, vec![1.0; n], force)
+}
+
+/// This thread's CPU time (user + system), seconds, from `/proc/thread-self/stat`
+/// (clock ticks of 10 ms): on a shared machine it counts this run's work, not the time
+/// it waited for a core. `None` off Linux.
+fn cpu() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    let rest = &s[s.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+/// Best of `reps` measurements of `f`, seconds per call: this thread's CPU time where
+/// the machine tells it (each measurement repeats `f` until at least 0.3 s of it, for
+/// the 10 ms ticks), else the wall clock.
+fn best(reps: usize, mut f: impl FnMut()) -> f64 {
+    (0..reps)
+        .map(|_| {
+            let (t, c) = (Instant::now(), cpu());
+            let mut calls = 0;
+            loop {
+                f();
+                calls += 1;
+                let used = match (c, cpu()) {
+                    (Some(a), Some(b)) => b - a,
+                    _ => t.elapsed().as_secs_f64(),
+                };
+                if used >= 0.3 {
+                    return used / calls as f64;
+                }
+            }
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Heap storage for one `Pse` and `n` spheres, and the product into `out`.
+struct Store(Vec<[f64; 2]>, Vec<usize>, Vec<V>);
+impl Store {
+    fn new(pse: &Pse<f64>, n: usize) -> Self {
+        let size = pse.storage(n);
+        let v = vec![V::ZERO; size.vectors];
+        Self(vec![[0.0; 2]; size.complex], vec![0; size.index], v)
+    }
+    fn apply(
+        &mut self,
+        pse: &Pse<f64>,
+        part: Part,
+        (pos, rad): (&[V], &[f64]),
+        f: &[V],
+        out: &mut [V],
+    ) {
+        let mut store = PseStorage::new(&mut self.0, &mut self.1, &mut self.2);
+        pse.apply(part, 1.0, pos, rad, f, out, &mut store).unwrap();
+    }
+}
+
+/// One PSE timing: (total, near, wave) seconds, and the parameters.
+fn time_pse(n: usize, tol: f64, xi_a: f64, reps: usize) -> (f64, f64, f64, Pse<f64>) {
+    let (l, pos, rad, force) = suspension(n, 0.1, 7);
+    let cell = Periodic::new([l; 3]).unwrap();
+    let pse = Pse::with_xi(cell, 1.0, tol, xi_a).unwrap();
+    let mut store = Store::new(&pse, n);
+    let mut out = vec![V::ZERO; n];
+    let s = (&pos[..], &rad[..]);
+    let total = best(reps, || store.apply(&pse, Part::Both, s, &force, &mut out));
+    let near = best(reps, || store.apply(&pse, Part::Near, s, &force, &mut out));
+    let wave = best(reps, || store.apply(&pse, Part::Wave, s, &force, &mut out));
+    (total, near, wave, pse)
+}
+
+/// The scaling exponents `d ln t / d ln N` between successive sizes and overall.
+fn exponents(ns: &[usize], times: &[f64]) {
+    let slope =
+        |i: usize, j: usize| (times[j] / times[i]).ln() / (ns[j] as f64 / ns[i] as f64).ln();
+    let last = ns.len() - 1;
+    let steps: Vec<String> = (0..last)
+        .map(|i| format!("{}-{} {:.3}", ns[i], ns[i + 1], slope(i, i + 1)))
+        .collect();
+    println!(
+        "exponent: {}, overall {:.3}",
+        steps.join(", "),
+        slope(0, last)
+    );
+}
+
+fn describe(pse: &Pse<f64>, n: usize) -> String {
+    let g = pse.grid();
+    let points = g[0] * g[1] * g[2];
+    format!(
+        "grid {}^3 ({:.1} points/sphere), P {}, r_c {:.2}, storage {:.0} MB",
+        g[0],
+        points as f64 / n as f64,
+        pse.support()[0],
+        pse.r_cut(),
+        (pse.storage(n).complex * 16 + pse.storage(n).index * 8) as f64 / 1e6
+    )
+}
+
+fn scaling(tol: f64) {
+    let ns = [1_000usize, 10_000, 100_000];
+    let mut times = vec![];
+    for &n in &ns {
+        let reps = if n >= 100_000 { 2 } else { 4 };
+        let (t, near, wave, pse) = time_pse(n, tol, 0.5, reps);
+        println!(
+            "N {n:>6}: {t:.4} s (near {near:.4}, wave {wave:.4}), {:.2} us/sphere; {}",
+            t / n as f64 * 1e6,
+            describe(&pse, n)
+        );
+        times.push(t);
+    }
+    exponents(&ns, &times);
+}
+
+fn tols() {
+    let n = 10_000;
+    for tol in [1e-3, 1e-4, 1e-5, 1e-6] {
+        let (t, near, wave, pse) = time_pse(n, tol, 0.5, 3);
+        println!(
+            "tol {tol:e}: {t:.4} s (near {near:.4}, wave {wave:.4}); {}",
+            describe(&pse, n)
+        );
+    }
+}
+
+fn xi_scan() {
+    let n = 10_000;
+    for tol in [1e-3, 1e-4, 1e-6] {
+        for xi_a in [0.3, 0.4, 0.5, 0.6, 0.8] {
+            let (t, near, wave, pse) = time_pse(n, tol, xi_a, 3);
+            println!(
+                "tol {tol:e} xi a {xi_a}: {t:.4} s (near {near:.4}, wave {wave:.4}); {}",
+                describe(&pse, n)
+            );
+        }
+    }
+}
+
+fn crossover() {
+    for n in [10usize, 20, 50, 100, 400] {
+        let (l, pos, rad, force) = suspension(n, 0.1, 7);
+        let cell = Periodic::new([l; 3]).unwrap();
+        let ew = Ewald::new(cell, 1.0).unwrap();
+        let mut y = vec![V::ZERO; n];
+        let te = best(2, || {
+            tt_product(&ew, 1.0, &pos, &rad, &force, &mut y).unwrap()
+        });
+        for tol in [1e-3, 1e-4, 1e-6] {
+            let (tp, _, _, pse) = time_pse(n, tol, 0.5, 3);
+            // The accuracy reached against the Ewald sum (rounding-level).
+            let mut u = vec![V::ZERO; n];
+            Store::new(&pse, n).apply(&pse, Part::Both, (&pos, &rad), &force, &mut u);
+            let num: f64 = u
+                .iter()
+                .zip(&y)
+                .map(|(a, b)| (*a - *b).length_squared())
+                .sum();
+            let den: f64 = y.iter().map(|b| b.length_squared()).sum();
+            println!(
+                "N {n:>4} tol {tol:e}: Ewald {te:.4} s, PSE {tp:.4} s (ratio {:.1}), PSE error {:.2e}",
+                te / tp,
+                (num / den).sqrt()
+            );
+        }
+    }
+}
+
+/// The Brownian displacement (`Pse::noise`, Lanczos tolerance 1e-3) against N.
+fn noise() {
+    let ns = [1_000usize, 10_000, 100_000];
+    let mut times = vec![];
+    for &n in &ns {
+        let (l, pos, rad, _) = suspension(n, 0.1, 7);
+        let pse = Pse::new(Periodic::new([l; 3]).unwrap(), 1.0, 1e-4).unwrap();
+        let mut store = Store::new(&pse, n);
+        let s = Lanczos::default();
+        let (nv, ns_) = Pse::noise_storage(&s, n);
+        let (mut basis, mut work) = (vec![V::ZERO; nv], vec![0.0; ns_]);
+        let mut rng = Noise::new(3);
+        let mut out = vec![V::ZERO; n];
+        let mut iterations = 0;
+        let t = best(if n >= 100_000 { 1 } else { 2 }, || {
+            let mut st = PseStorage::new(&mut store.0, &mut store.1, &mut store.2);
+            let w = (&mut basis[..], &mut work[..]);
+            iterations = pse
+                .noise(1.0, (&pos, &rad), &mut rng, s, &mut out, &mut st, w)
+                .unwrap();
+        });
+        println!("N {n:>6}: noise {t:.3} s, {iterations} Lanczos iterations");
+        times.push(t);
+    }
+    exponents(&ns, &times);
+}
+
+fn main() {
+    let arg = std::env::args().nth(1).unwrap_or_default();
+    match arg.as_str() {
+        "tols" => tols(),
+        "xi" => xi_scan(),
+        "crossover" => crossover(),
+        "noise" => noise(),
+        "one" => {
+            let n: usize = std::env::args()
+                .nth(2)
+                .map_or(10_000, |s| s.parse().unwrap());
+            let (t, near, wave, pse) = time_pse(n, 1e-4, 0.5, 3);
+            println!(
+                "N {n}: {t:.4} s (near {near:.4}, wave {wave:.4}); {}",
+                describe(&pse, n)
+            );
+        }
+        _ => scaling(1e-4),
+    }
+}
