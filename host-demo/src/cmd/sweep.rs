@@ -46,8 +46,8 @@ pub struct SweepArgs {
     /// rather than skip them.
     #[arg(long, conflicts_with_all = ["dry_run", "emit"])]
     wait: bool,
-    /// Expand and check the sweep, list its points (index, id, state point), run
-    /// and write nothing.
+    /// Expand and check the sweep, list its points (id and state point, in sweep
+    /// order), run and write nothing.
     #[arg(long, conflicts_with_all = ["shard", "point", "emit"])]
     dry_run: bool,
     /// Write the point folders, the frozen scenes and an engine's job file instead of
@@ -115,7 +115,7 @@ impl SweepArgs {
                 if self.dry_run {
                     for p in &sweep.points {
                         let json = hydrorattle_host::sweep::id::canonical_json(&p.statepoint);
-                        println!("{} {} {json}", p.index, p.id);
+                        println!("{} {json}", p.id);
                     }
                     eprintln!(
                         "{} points, all valid; nothing run or written",

@@ -2,7 +2,10 @@
 //! refuse at submission, or one that makes no sense for the sweep, is refused here, by
 //! name), and the array indices that rerun only the unfinished points.
 
-use anyhow::{Result, bail};
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
 
 /// SLURM's default largest array index is 1000 (`MaxArraySize = 1001`): an array job
 /// has at most this many tasks unless asked otherwise.
@@ -41,6 +44,59 @@ pub struct SlurmOptions {
     pub checkpoint_every: Option<f64>,
     /// Log verbosity the tasks pass on (`-v` repeated).
     pub verbose: u8,
+}
+
+/// The array job's shape in the sweep's folder, for `collect` to name the tasks of the
+/// unfinished points and the `sbatch --array` line that reruns them.
+pub const SLURM_JSON: &str = "slurm.json";
+
+/// What [`SLURM_JSON`] holds.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ArrayJob {
+    /// Array tasks: task K runs the points whose index is K modulo this.
+    pub tasks: usize,
+    /// At most this many tasks at once, if limited.
+    pub throttle: Option<usize>,
+    /// The job script.
+    pub script: PathBuf,
+}
+
+impl ArrayJob {
+    /// The array job emitted into `dir`, if one was.
+    pub fn read(dir: &Path) -> Result<Option<ArrayJob>> {
+        let path = dir.join(SLURM_JSON);
+        match std::fs::read_to_string(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+            t => {
+                let t = t.with_context(|| format!("reading {}", path.display()))?;
+                let job = serde_json::from_str(&t)
+                    .with_context(|| format!("{}: not an array job record", path.display()))?;
+                Ok(Some(job))
+            }
+        }
+    }
+
+    /// The task that runs point `index`.
+    pub fn task_of(&self, index: usize) -> usize {
+        index % self.tasks.max(1)
+    }
+
+    /// `sbatch --array=...` that reruns the tasks of the points `indices` only (the
+    /// script's throttle kept); None without points.
+    pub fn rerun(&self, indices: &[usize]) -> Option<String> {
+        let mut tasks: Vec<usize> = indices.iter().map(|&i| self.task_of(i)).collect();
+        tasks.sort_unstable();
+        tasks.dedup();
+        if tasks.is_empty() {
+            return None;
+        }
+        let throttle = self.throttle.map_or(String::new(), |m| format!("%{m}"));
+        Some(format!(
+            "sbatch --array={}{throttle} {}",
+            array_ranges(&tasks),
+            self.script.display()
+        ))
+    }
 }
 
 /// A SLURM time limit: minutes, `M:S`, `H:M:S`, `D-H`, `D-H:M`, `D-H:M:S` (whole
@@ -140,11 +196,6 @@ pub fn array_ranges(indices: &[usize]) -> String {
     out.join(",")
 }
 
-/// The array task that runs point `index` of a sweep in `tasks` shards.
-pub fn task_of(index: usize, tasks: usize) -> usize {
-    index % tasks.max(1)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -237,6 +288,16 @@ mod tests {
         assert_eq!(array_ranges(&[0, 1, 2, 3, 7, 9, 10]), "0-3,7,9-10");
         assert_eq!(array_ranges(&[5]), "5");
         assert_eq!(array_ranges(&[]), "");
-        assert_eq!(task_of(13, 4), 1);
+        let job = ArrayJob {
+            tasks: 4,
+            throttle: Some(2),
+            script: "/d/slurm.sh".into(),
+        };
+        assert_eq!(job.task_of(13), 1);
+        assert_eq!(
+            job.rerun(&[13, 1, 2, 7, 3]).unwrap(),
+            "sbatch --array=1-3%2 /d/slurm.sh"
+        );
+        assert_eq!(job.rerun(&[]), None);
     }
 }

@@ -8,28 +8,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use serde::{Deserialize, Serialize};
-
-use super::cluster::SIGNAL_LEAD_S;
+use super::cluster::{ArrayJob, SIGNAL_LEAD_S, SLURM_JSON};
 pub use super::cluster::{DEFAULT_MAX_TASKS, SlurmOptions};
 use super::{POINTS, STATEPOINT_JSON, Sweep, run::prepare_points};
 use crate::output::write_json;
 use crate::sim::SUMMARY_JSON;
-
-/// The array job's shape in the sweep's folder, for `collect` to name the tasks of the
-/// unfinished points and the `sbatch --array` line that reruns them.
-pub const SLURM_JSON: &str = "slurm.json";
-
-/// What [`SLURM_JSON`] holds.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct ArrayJob {
-    /// Array tasks: task K runs the points whose index is K modulo this.
-    pub tasks: usize,
-    /// At most this many tasks at once, if limited.
-    pub throttle: Option<usize>,
-    /// The job script.
-    pub script: PathBuf,
-}
 
 /// Which engine to write for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

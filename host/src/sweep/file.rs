@@ -8,7 +8,7 @@ use toml::de::{DeTable, DeValue};
 use toml::{Spanned, Table, Value};
 
 use super::base::{Base, set_path};
-use super::{MAX_POINTS, SEED_KEY, Sweep, expand, record};
+use super::{MAX_POINTS, SEED_KEY, Sweep, expand, hints, record};
 use crate::scene::{SceneError, line_col};
 use crate::sizing::Limits;
 
@@ -101,6 +101,9 @@ pub(super) fn parse(src: &Source<'_>, limits: Limits) -> Result<Sweep, SceneErro
     })?;
     let doc = doc.get_ref();
     let Some((sweep_key, sweep)) = doc.iter().find(|(k, _)| k.get_ref() == "sweep") else {
+        if let Some(e) = hints::missing_sweep(src, doc) {
+            return Err(e);
+        }
         return Err(SceneError {
             origin: src.origin.to_string(),
             location: None,
@@ -148,6 +151,9 @@ pub(super) fn parse(src: &Source<'_>, limits: Limits) -> Result<Sweep, SceneErro
                 }
             }
             name => {
+                if let Some(e) = hints::misspelled_setting(src, name, key.span(), value.get_ref()) {
+                    return Err(e);
+                }
                 let values = values(src, name, key.span(), value)?;
                 factors.push(Factor {
                     keys: vec![(name.to_string(), key.span())],

@@ -51,6 +51,7 @@ pub mod emit;
 mod expand;
 mod file;
 pub mod frozen;
+mod hints;
 pub mod id;
 pub mod record;
 pub mod run;
