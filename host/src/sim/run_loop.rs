@@ -271,7 +271,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         let (mut done, mut failure) = (self.first - 1, None);
         for s in self.first..=self.steps {
             // Between steps only: the state is whole, and a checkpoint can hold it.
-            if let Some(signal) = self.opts.stop.requested() {
+            if let Some(signal) = self.opts.stop.requested_after(done as u64) {
                 bar.finish();
                 return Ok((done, Halt::Stopped(signal), start.elapsed().as_secs_f64()));
             }

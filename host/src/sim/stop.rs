@@ -11,21 +11,46 @@ use std::fmt;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// A stop request: a flag set to a signal number (0: run on).
+/// SIGTERM's number, the signal [`Stop::after_step`] stands for.
+const SIGTERM: usize = 15;
+
+/// A stop request: a flag set to a signal number (0: run on), or a step count.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct Stop(Option<&'static AtomicUsize>);
+pub struct Stop {
+    flag: Option<&'static AtomicUsize>,
+    after: Option<u64>,
+}
 
 impl Stop {
     /// Stops when `flag` is set to a non-zero value (a signal number).
     pub fn on(flag: &'static AtomicUsize) -> Stop {
-        Stop(Some(flag))
+        Stop {
+            flag: Some(flag),
+            after: None,
+        }
+    }
+
+    /// Stops before the step after step `n`, as a SIGTERM arriving then would: a
+    /// stopped run at a step chosen in advance (the recovery tests' partial states).
+    pub fn after_step(n: u64) -> Stop {
+        Stop {
+            flag: None,
+            after: Some(n),
+        }
     }
 
     /// The signal asked for, if a stop was.
     pub fn requested(&self) -> Option<usize> {
-        self.0
+        self.flag
             .map(|f| f.load(Ordering::Relaxed))
             .filter(|&s| s != 0)
+    }
+
+    /// [`requested`](Self::requested), or SIGTERM once `done` steps reach
+    /// [`after_step`](Self::after_step)'s count.
+    pub fn requested_after(&self, done: u64) -> Option<usize> {
+        let at = self.after.is_some_and(|n| done >= n).then_some(SIGTERM);
+        self.requested().or(at)
     }
 }
 

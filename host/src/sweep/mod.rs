@@ -24,10 +24,11 @@
 //!   `[[sweep.zip]]` group is one factor whose lists (of one length) vary together.
 //! * `replicas = K` runs every point K times with `brownian.seed` = the base scene's
 //!   seed (default 1) plus 0, 1, ..., K - 1; it needs thermal noise in every point.
-//! * Every point is resolved and validated before anything runs. An unknown key, an
-//!   empty list, a value the scene refuses, a point given twice, or more than
-//!   [`MAX_POINTS`] points is an error at its file, line and column
-//!   (`sweep.toml:4:21: ...`), as for scenes.
+//! * Every point is resolved and validated before anything runs, in time linear in the
+//!   points. An unknown key, an empty list, a value the scene refuses, a
+//!   point given twice (numbers compared as numbers), a base that is itself a sweep, a
+//!   misspelled table or setting, or more than [`MAX_POINTS`] points is an error at its
+//!   file, line and column (`sweep.toml:4:21: ...`), as for scenes.
 //!
 //! # Points
 //!
@@ -36,6 +37,11 @@
 //! replica). Its id is the MD5 of the state point's canonical JSON, computed as signac
 //! computes job ids ([`id`]), so `DIR` is a signac project (`.signac/config`,
 //! `workspace -> points`) and a row project (`workflow.toml`) as it is.
+//!
+//! A folder holds one sweep ([`claim`]): `sweep.json` records the sweep's digest, which
+//! covers every point's resolved scene, and another sweep is refused before anything
+//! is written. The points' scenes are frozen in `DIR/frozen` ([`frozen`]) when the
+//! sweep claims the folder; emitted jobs run them from there.
 //!
 //! `DIR/points/<id>/` holds `signac_statepoint.json`, `scene.toml` (the point's
 //! resolved scene) and, once run, the files of a run (`summary.json`,
