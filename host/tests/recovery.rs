@@ -115,7 +115,8 @@ fn any_subset_of_a_points_files_deleted_reruns_to_a_clean_run() {
         .run(
             &(any::<bool>(), 0u64..60, any::<u16>()),
             |(finished, after, mask)| {
-                let _ = std::fs::remove_dir_all(&dir);
+                // The sweep folder is claimed once; each case starts its point afresh.
+                let _ = std::fs::remove_dir_all(point_dir(&dir, &id));
                 let stop = if finished {
                     Stop::default()
                 } else {
