@@ -378,6 +378,7 @@ fn sigterm_checkpoints_a_sweep_that_then_ends_as_a_clean_run() {
             "10",
         ])
         .stdout(Stdio::piped())
+        .stderr(Stdio::null())
         .spawn()
         .unwrap();
     let t0 = Instant::now();
