@@ -30,7 +30,7 @@ enum Command {
     Figure1(cmd::figure1::Figure1),
     Reference(cmd::reference::Reference),
     Phase(cmd::phase::Phase),
-    Sweep(cmd::sweep::SweepArgs),
+    Sweep(Box<cmd::sweep::SweepArgs>),
     Collect(cmd::collect::Collect),
     Chart(cmd::chart::Chart),
 }
