@@ -467,7 +467,7 @@ fn circular_bases_misspellings_and_equal_numbers_are_said_at_their_line() {
     );
     w(
         "b.toml",
-        format!("# b\n[sweep]\nbase = \"a.toml\"\n\"integrator.dt\" = [0.2]\n"),
+        "# b\n[sweep]\nbase = \"a.toml\"\n\"integrator.dt\" = [0.2]\n".to_string(),
     );
     refused_at(
         &a,
