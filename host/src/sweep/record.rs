@@ -58,7 +58,7 @@ pub struct PointRecord {
 /// The sweep's digest: FNV-1a 64 of its resolved base scene, keys, replica count and
 /// point ids in order. With the ids (MD5s of the parameters) it covers every point's
 /// whole resolved scene, and it costs one pass over the ids, not a scene per point.
-pub(super) fn digest(base: &Scene, keys: &[String], replicas: usize, points: &[Point]) -> String {
+pub fn digest(base: &Scene, keys: &[String], replicas: usize, points: &[Point]) -> String {
     let mut text = serde_json::to_vec(base).unwrap_or_default();
     text.extend_from_slice(format!("\n{keys:?}\n{replicas}\n").as_bytes());
     for p in points {

@@ -1,6 +1,6 @@
 //! Running a sweep's points: each in its own folder, skipped when finished, resumed
 //! from its checkpoint when unfinished, and otherwise run from the start (what a
-//! folder's files say: [`super::state`]). A resumed point's files come out byte for
+//! folder's files say: `state.rs`). A resumed point's files come out byte for
 //! byte as those of an uninterrupted run; thermal-noise runs resume the same way (their
 //! checkpoints hold the noise generator's state).
 //!
