@@ -1,7 +1,9 @@
 //! One sweep per folder. A sweep claims its folder before it writes anything there:
 //! under the folder's lock, a folder without `sweep.json` becomes this sweep's (its
 //! frozen scenes, the signac project files, then `sweep.json` last), a folder whose
-//! `sweep.json` has this sweep's digest is this sweep's already, and any other is
+//! `sweep.json` has this sweep's digest is this sweep's already (as is one an older
+//! host-demo wrote, without a digest, for the same point ids: each point's
+//! `scene.toml` is still checked before the point is touched), and any other is
 //! refused with [`AnotherSweep`], nothing written: two sweeps never mix in one folder,
 //! and the first one's files stay as they were.
 
@@ -72,13 +74,17 @@ pub fn claim(sweep: &Sweep, dir: &Path) -> Result<()> {
                 .iter()
                 .zip(&sweep.points)
                 .all(|(a, b)| a.id == b.id);
-        return Err(AnotherSweep {
-            dir: dir.to_path_buf(),
-            theirs: (r.count, r.digest),
-            ours: (sweep.points.len(), sweep.digest.clone()),
-            same_ids,
+        // A record of an older host-demo (format 1, no digest) with the same points is
+        // adopted: each point's scene.toml is still checked before it is touched.
+        if !(r.digest.is_none() && same_ids) {
+            return Err(AnotherSweep {
+                dir: dir.to_path_buf(),
+                theirs: (r.count, r.digest),
+                ours: (sweep.points.len(), sweep.digest.clone()),
+                same_ids,
+            }
+            .into());
         }
-        .into());
     }
     std::fs::create_dir_all(dir.join(POINTS))
         .with_context(|| format!("creating {}", dir.join(POINTS).display()))?;
