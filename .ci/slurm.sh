@@ -5,8 +5,11 @@
 # `host-demo sweep --emit slurm` writes for host-demo/sweeps/small.toml (8 points),
 # waits for it, and checks that `collect` finds every point and that the point folders
 # equal a local `sweep` run byte for byte (summary.json apart from its execution fields:
-# wall_time_s, steps_per_second, machine, resumed_from). Where SLURM cannot start, it
-# says so loudly and runs the GNU parallel command instead. Every wait is bounded.
+# wall_time_s, steps_per_second, machine, resumed_from). Then a task stopped by SIGTERM
+# (what the time limit sends with the emitted --signal) is resubmitted with the line
+# `collect` prints and ends equal to a clean run, though the base scene was edited
+# after emitting. Where SLURM cannot start, it says so loudly and runs the GNU parallel
+# command (and the stop by a plain kill -TERM) instead. Every wait is bounded.
 #
 #   bash .ci/slurm.sh [HOST_DEMO]     (root, or sudo; HOST_DEMO: the built binary)
 #
@@ -200,4 +203,74 @@ assert strip(a) == strip(b), "collected.csv differs"
 print(f"    {len(ids)} points, {files} files equal; collected.csv equal apart from wall times")
 EOF
 cmp "$local_dir/sweep.json" "$engine_dir/sweep.json"
+
+# --- A task stopped by SIGTERM resumes on resubmission -----------------------------
+# What SLURM does at a time limit with the emitted `--signal=B:TERM@60`: SIGTERM to the
+# batch shell, which `exec` made host-demo. `scancel --batch --signal=TERM` sends the
+# same signal now (a real time limit is a minute at least). The task checkpoints its
+# point and exits 143; `collect` names the task and prints the `sbatch --array` line,
+# which is run as printed; the points then equal a clean local run.
+long="$work/long.toml"
+cp host-demo/scenes/figure1a.toml "$work/long-base.toml"
+cat >"$long" <<EOT
+[sweep]
+base = "long-base.toml"
+"integrator.duration" = [1500.0]
+"helix.dhat" = [1.05, 1.5]
+EOT
+say "a stopped task: clean local run of $long"
+timeout 300 "$bin" sweep "$long" --out "$work/long-local" --jobs 2 --checkpoint-every 50 | tail -n 1
+stopped_dir="$work/long-stopped"
+timeout 60 "$bin" sweep "$long" --out "$stopped_dir" --emit slurm --tasks 1 --time 00:05:00 \
+    --checkpoint-every 50 --partition ci >/dev/null
+# The base edited after emitting: the job runs the frozen scenes all the same.
+sed -i 's/viscosity = 1.0/viscosity = 9.0/' "$work/long-base.toml"
+grep -q "viscosity = 9.0" "$work/long-base.toml"
+wait_checkpoint() {
+    timeout 120 bash -c "until ls '$stopped_dir'/points/*/checkpoint.json >/dev/null 2>&1; do sleep 0.1; done"
+}
+if [ "$engine" = slurm ]; then
+    jobid=$(timeout 30 sbatch --parsable "$stopped_dir/slurm.sh")
+    wait_checkpoint || { loud "no checkpoint from job $jobid"; keep_work=1; exit 1; }
+    timeout 30 scancel --batch --signal=TERM "$jobid"
+    timeout 120 bash -c "while [ -n \"\$(squeue -h -j $jobid 2>/dev/null)\" ]; do sleep 0.5; done"
+    cat "$stopped_dir"/slurm/*.out
+    grep -q "stopped by signal 15" "$stopped_dir"/slurm/*.out || { loud "the task was not stopped by SIGTERM"; exit 1; }
+else
+    "$bin" sweep --frozen --out "$stopped_dir" --jobs 1 --checkpoint-every 50 &
+    pid=$!
+    wait_checkpoint || { loud "no checkpoint"; exit 1; }
+    kill -TERM "$pid"
+    status=0; wait "$pid" || status=$?
+    [ "$status" = 143 ] || { loud "expected exit status 143 after SIGTERM, got $status"; exit 1; }
+fi
+if listed=$(timeout 60 "$bin" collect "$stopped_dir"); then
+    loud "collect found every point done after SIGTERM"; exit 1
+fi
+echo "$listed"
+rerun=$(echo "$listed" | grep -o 'sbatch --array=.*') || { loud "collect printed no sbatch line"; exit 1; }
+echo "    collect says: $rerun"
+if [ "$engine" = slurm ]; then
+    jobid=$(timeout 30 ${rerun/sbatch /sbatch --parsable })
+    timeout 300 bash -c "while [ -n \"\$(squeue -h -j $jobid 2>/dev/null)\" ]; do sleep 0.5; done"
+else
+    timeout 300 "$bin" sweep --frozen --out "$stopped_dir" --jobs 2 --checkpoint-every 50 | tail -n 1
+fi
+timeout 60 "$bin" collect "$stopped_dir"
+python3 - "$work/long-local" "$stopped_dir" <<'EOF2'
+import json, os, sys
+a, b = sys.argv[1:3]
+run_fields = {"wall_time_s", "steps_per_second", "machine", "resumed_from"}
+resumed = 0
+for i in sorted(os.listdir(os.path.join(a, "points"))):
+    for n in ["trajectory.xyz", "trajectory.gsd", "observables.csv", "scene.toml", "summary.json"]:
+        x, y = (open(os.path.join(p, "points", i, n), "rb").read() for p in (a, b))
+        if n == "summary.json":
+            x, y = (json.loads(t) for t in (x, y))
+            resumed += y.get("resumed_from") is not None
+            x, y = ({k: v for k, v in d.items() if k not in run_fields} for d in (x, y))
+        assert x == y, f"{i}/{n} differs from the clean run"
+assert resumed >= 1, "no point was resumed from its checkpoint"
+print(f"    stopped, resumed ({resumed} from a checkpoint) and equal to the clean run")
+EOF2
 say "sweep on $engine passed in $(( SECONDS - t_start )) s"

@@ -5,6 +5,7 @@
 
 mod bar;
 mod cmd;
+mod signals;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -29,7 +30,7 @@ enum Command {
     Figure1(cmd::figure1::Figure1),
     Reference(cmd::reference::Reference),
     Phase(cmd::phase::Phase),
-    Sweep(cmd::sweep::SweepArgs),
+    Sweep(Box<cmd::sweep::SweepArgs>),
     Collect(cmd::collect::Collect),
     Chart(cmd::chart::Chart),
 }
@@ -53,13 +54,14 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     init_logging(cli.verbose);
     bar::install();
+    let stop = signals::install();
     let done = match cli.command {
-        Command::Run(c) => c.run(),
-        Command::Resume(c) => c.run(),
+        Command::Run(c) => c.run(stop),
+        Command::Resume(c) => c.run(stop),
         Command::Figure1(c) => c.run(),
         Command::Reference(c) => c.run(),
         Command::Phase(c) => c.run(),
-        Command::Sweep(c) => c.run(),
+        Command::Sweep(c) => c.run(stop, cli.verbose),
         Command::Collect(c) => c.run(),
         Command::Chart(c) => c.run(),
     };
@@ -67,7 +69,9 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            // A stop on request exits as the signal would have (143, 130): documented,
+            // and told apart from a failure.
+            signals::exit_code(&e).map_or(ExitCode::FAILURE, ExitCode::from)
         }
     }
 }

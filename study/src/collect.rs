@@ -11,8 +11,11 @@
 //!
 //! Status: `done`; `stopped_early` (a step failed: the summary says why); `error` (the
 //! run could not start: `error.txt`); `corrupt` (a summary, but the data files are not
-//! those it records: cut short or overwritten since, by size or digest); `unfinished` (a
-//! checkpoint, no summary); `missing`.
+//! those it records: cut short or overwritten since, by size or digest); `foreign` (the
+//! folder's `scene.toml` is not the one `sweep.json` records for the point: another
+//! sweep's, or a run resumed by hand); `unfinished` (a checkpoint, no summary);
+//! `missing`. `unfinished`, `missing`, `error` and `corrupt` points run again when the
+//! sweep does ([`Problem::reruns`]).
 //!
 //! A point is a Figure 1 case when its helix is one of the paper's three. Its claims
 //! are judged on its own observables; a claim comparing two cases ("settles faster
@@ -27,7 +30,7 @@ use serde_json::Value as Json;
 
 use crate::claims::{CaseRun, SPECS, claims};
 use crate::render::{LineChart, Series, line_chart_with_errors};
-use hydrorattle_host::output::{AtomicFile, CsvWriter, FileCheck, format_f64, mismatch};
+use hydrorattle_host::output::{AtomicFile, CsvWriter, FileCheck, fnv1a64, format_f64, mismatch};
 use hydrorattle_host::scene::Scene;
 use hydrorattle_host::sim::{
     CHECKPOINT, COLUMNS, Front, OBSERVABLES_CSV, Observables, SCENE_TOML, SUMMARY_JSON,
@@ -51,6 +54,27 @@ struct Row {
     case: Option<&'static str>,
 }
 
+/// A point not done.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// Its index in the sweep.
+    pub index: usize,
+    /// Its id.
+    pub id: String,
+    /// Its status.
+    pub status: &'static str,
+    /// Why.
+    pub why: String,
+}
+
+impl Problem {
+    /// Whether running the sweep again runs it (`stopped_early` ends the same way
+    /// again; a `foreign` folder is left alone).
+    pub fn reruns(&self) -> bool {
+        matches!(self.status, "unfinished" | "missing" | "error" | "corrupt")
+    }
+}
+
 /// What `collect` found.
 #[derive(Debug, Clone)]
 pub struct Collected {
@@ -58,8 +82,8 @@ pub struct Collected {
     pub csv: PathBuf,
     /// Points.
     pub points: usize,
-    /// Points not done, with their status and why.
-    pub problems: Vec<(String, String, String)>,
+    /// Points not done.
+    pub problems: Vec<Problem>,
     /// The chart drawn, if asked.
     pub chart: Option<PathBuf>,
 }
@@ -96,7 +120,19 @@ fn read_point(dir: &Path, record: &Json, figure1: &[(&'static str, Scene)]) -> R
             Err(e) => Some(format!("{}: unreadable files record: {e}", SUMMARY_JSON)),
         }
     });
+    // The folder is the point's when its scene is the one the sweep recorded.
+    let foreign = record["scene_toml_fnv1a64"].as_str().and_then(|want| {
+        let found = std::fs::read(pdir.join(SCENE_TOML)).ok()?;
+        let found = fnv1a64(&found);
+        (found != want).then(|| {
+            format!(
+                "{}: digest {found} where {SWEEP_JSON} records {want}: another sweep's or a resumed run's scene",
+                pdir.join(SCENE_TOML).display()
+            )
+        })
+    });
     let status = match (&summary, &error) {
+        _ if foreign.is_some() => "foreign",
         (Some(_), _) if corrupt.is_some() => "corrupt",
         (Some(s), _) if s["failure"].is_null() => "done",
         (Some(_), _) => "stopped_early",
@@ -104,12 +140,14 @@ fn read_point(dir: &Path, record: &Json, figure1: &[(&'static str, Scene)]) -> R
         (None, None) if pdir.join(CHECKPOINT).is_file() => "unfinished",
         _ => "missing",
     };
-    if corrupt.is_some() {
+    if foreign.is_some() {
+        error = foreign;
+    } else if corrupt.is_some() {
         error = corrupt;
     }
     let mut series = Vec::new();
     let mut case = None;
-    if summary.is_some() && status != "corrupt" {
+    if summary.is_some() && !matches!(status, "corrupt" | "foreign") {
         let scene = Scene::from_path(&pdir.join(SCENE_TOML)).ok();
         case = scene.and_then(|s| {
             let h = s.helix?;
@@ -282,12 +320,19 @@ pub fn collect(dir: &Path, chart: Option<(&str, &str)>) -> Result<Collected> {
                 .map(|spec| v.get(spec.id).map_or(String::new(), |x| x.to_string())),
         );
         let why = match r.status {
-            "error" | "corrupt" => r.error.clone().unwrap_or_default().trim().to_string(),
+            "error" | "corrupt" | "foreign" => {
+                r.error.clone().unwrap_or_default().trim().to_string()
+            }
             _ => get("failure"),
         };
         row.extend([why.clone(), get("wall_time_s"), get("steps_per_second")]);
         if r.status != "done" {
-            problems.push((r.id.clone(), r.status.to_string(), why));
+            problems.push(Problem {
+                index: k,
+                id: r.id.clone(),
+                status: r.status,
+                why,
+            });
         }
         csv.write_record(&row)?;
         table.push(row);

@@ -2,10 +2,12 @@
 
 use anyhow::Result;
 use clap::Args;
+use hydrorattle_host::sweep::cluster::ArrayJob;
 use std::path::PathBuf;
 
-/// Merge a sweep's points into DIR/collected.csv; list missing and failed points
-/// (exit status 1 if any).
+/// Merge a sweep's points into DIR/collected.csv; list the points not done (exit
+/// status 1 if any), with their array task and the `sbatch --array=...` line that
+/// reruns only those when the sweep was emitted for SLURM.
 #[derive(Debug, Args)]
 pub struct Collect {
     /// The sweep's folder.
@@ -29,8 +31,23 @@ impl Collect {
             println!("wrote {}", p.display());
         }
         if !c.problems.is_empty() {
-            for (id, status, why) in &c.problems {
-                println!("{id} {status} {why}");
+            // With an emitted array job: each point's task, and the line that reruns
+            // the tasks of the points a rerun would run.
+            let job = ArrayJob::read(&self.dir)?;
+            for p in &c.problems {
+                let task = job.as_ref().map_or(String::new(), |j| {
+                    format!(" [array task {}]", j.task_of(p.index))
+                });
+                println!("{} {}{task} {}", p.id, p.status, p.why);
+            }
+            let rerun: Vec<usize> = c
+                .problems
+                .iter()
+                .filter(|p| p.reruns())
+                .map(|p| p.index)
+                .collect();
+            if let Some(line) = job.as_ref().and_then(|j| j.rerun(&rerun)) {
+                println!("{} points to run again: {line}", rerun.len());
             }
             anyhow::bail!("{} of {} points are not done", c.problems.len(), c.points);
         }

@@ -2,7 +2,7 @@
 
 use anyhow::Result;
 use clap::Args;
-use hydrorattle_host::sim::RunOptions;
+use hydrorattle_host::sim::{RunOptions, Stop};
 use std::path::PathBuf;
 
 use super::args::{RunLimits, positive, report};
@@ -25,10 +25,12 @@ pub struct Resume {
 
 impl Resume {
     /// Resumes the run, then draws its pictures.
-    pub fn run(self) -> Result<()> {
+    /// SIGTERM or Ctrl-C (`stop`) checkpoints it again and ends it (143 or 130).
+    pub fn run(self, stop: Stop) -> Result<()> {
         let limits = self.limits.limits();
         let opts = RunOptions {
             threads: self.limits.threads,
+            stop,
             ..RunOptions::files(limits, self.checkpoint_every, true)
         };
         let r = hydrorattle_host::sim::resume(&self.dir, self.until, limits, opts)?;

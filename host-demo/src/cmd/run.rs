@@ -2,6 +2,7 @@
 
 use anyhow::Result;
 use clap::Args;
+use hydrorattle_host::sim::{RunOptions, Stop};
 use std::path::PathBuf;
 
 use super::args::{RunLimits, positive, report};
@@ -25,15 +26,16 @@ pub struct Run {
 impl Run {
     /// Runs the scene, then draws its pictures from the result (a picture that cannot
     /// be drawn is reported; the run's files stay).
-    pub fn run(self) -> Result<()> {
-        let r = hydrorattle_host::sim::run_scene_file(
-            &self.scene,
-            &self.out,
-            self.limits.limits(),
-            self.checkpoint_every,
-            true,
-            self.limits.threads,
-        )?;
+    /// SIGTERM or Ctrl-C (`stop`) checkpoints the run and ends it (exit status 143 or
+    /// 130); `host-demo resume` continues it.
+    pub fn run(self, stop: Stop) -> Result<()> {
+        let limits = self.limits.limits();
+        let opts = RunOptions {
+            threads: self.limits.threads,
+            stop,
+            ..RunOptions::files(limits, self.checkpoint_every, true)
+        };
+        let r = hydrorattle_host::sim::run_scene_file_with(&self.scene, &self.out, limits, opts)?;
         hydrorattle_study::pictures::draw_run(&self.out, &r, true)?;
         let name = hydrorattle_host::sim::scene_name(&self.scene);
         report(&name, &r.summary, &self.out)

@@ -87,6 +87,16 @@ impl AtomicFile {
         Ok(file)
     }
 
+    /// Flushes and leaves the file under its temporary name, for a run stopped on
+    /// request whose checkpoint marks it: the resumed run continues it
+    /// ([`continue_from`](Self::continue_from)).
+    pub fn keep(mut self) -> io::Result<()> {
+        match self.writer.take() {
+            Some(mut w) => w.flush().map_err(|e| name_error(&self.path, e)),
+            None => Ok(()),
+        }
+    }
+
     /// The final path.
     pub fn path(&self) -> &Path {
         &self.path

@@ -24,16 +24,14 @@ impl FileCheck {
     /// Reads `path` through.
     pub fn of(path: &Path) -> io::Result<FileCheck> {
         let mut file = std::fs::File::open(path).map_err(|e| name_error(path, e))?;
-        let (mut hash, mut bytes) = (0xcbf2_9ce4_8422_2325_u64, 0_u64);
+        let (mut hash, mut bytes) = (FNV_BASIS, 0_u64);
         let mut buf = vec![0_u8; 1 << 16];
         loop {
             let n = file.read(&mut buf).map_err(|e| name_error(path, e))?;
             if n == 0 {
                 break;
             }
-            for &b in &buf[..n] {
-                hash = (hash ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
-            }
+            hash = fnv1a64_on(hash, &buf[..n]);
             bytes += n as u64;
         }
         Ok(FileCheck {
@@ -41,6 +39,22 @@ impl FileCheck {
             fnv1a64: format!("{hash:016x}"),
         })
     }
+}
+
+/// FNV-1a's 64-bit offset basis: the digest of no bytes.
+const FNV_BASIS: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// FNV-1a 64 continued from `hash` over `bytes`.
+fn fnv1a64_on(mut hash: u64, bytes: &[u8]) -> u64 {
+    for &b in bytes {
+        hash = (hash ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    hash
+}
+
+/// FNV-1a 64 of `bytes`, as 16 hex digits (what [`FileCheck`] records of a file).
+pub fn fnv1a64(bytes: &[u8]) -> String {
+    format!("{:016x}", fnv1a64_on(FNV_BASIS, bytes))
 }
 
 /// The checks of the files `names` present in `dir`, by name.

@@ -130,6 +130,12 @@ impl<W: Write + Seek> GsdWriter<W> {
         self.inner.flush()
     }
 
+    /// The file as it stands, without its index (a stopped run continues it).
+    pub fn into_inner(mut self) -> io::Result<W> {
+        self.inner.flush()?;
+        Ok(self.inner)
+    }
+
     /// The chunks of frame `frame`, in id order.
     fn shapes(&self, frame: u64) -> Vec<Shape> {
         shapes(&self.topology, frame)

@@ -26,6 +26,7 @@ mod lanczos;
 mod record;
 pub mod retry;
 mod run_loop;
+pub mod stop;
 mod tail;
 
 pub use crate::scene::{Beads, BuildError, bonds, params};
@@ -38,6 +39,7 @@ pub use record::{
     COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
     TRAJECTORY_XYZ,
 };
+pub use stop::{Interrupted, Stop};
 
 use std::path::{Path, PathBuf};
 
@@ -224,6 +226,8 @@ pub struct RunOptions<'a> {
     /// on (smaller scenes run on the calling thread); 0: every core. The bits do not
     /// depend on it.
     pub threads: usize,
+    /// Stop between steps when asked ([`Stop`]): a checkpoint, then [`Interrupted`].
+    pub stop: Stop,
 }
 
 impl Default for RunOptions<'_> {
@@ -236,6 +240,7 @@ impl Default for RunOptions<'_> {
             checkpoint_every: None,
             keep: KeepFrames::default(),
             threads: 0,
+            stop: Stop::default(),
         }
     }
 }
@@ -296,8 +301,12 @@ pub fn run_from(
         Precision::F64 => run_loop::run_t::<f64>(&scene, name, out, opts, origin),
         Precision::F32 => run_loop::run_t::<f32>(&scene, name, out, opts, origin),
     };
-    // A folder another process locked is that process's, even one created since.
-    let theirs = |e: &anyhow::Error| e.downcast_ref::<crate::output::Locked>().is_some();
+    // A folder another process locked is that process's, even one created since; a
+    // run stopped on request keeps its files for the rerun.
+    let theirs = |e: &anyhow::Error| {
+        e.downcast_ref::<crate::output::Locked>().is_some()
+            || e.downcast_ref::<Interrupted>().is_some()
+    };
     if result.as_ref().is_err_and(|e| !theirs(e))
         && let Some(dir) = fresh.filter(|d| d.exists())
     {
@@ -331,6 +340,20 @@ pub fn run_scene_file(
     progress: bool,
     threads: usize,
 ) -> Result<RunResult> {
+    let opts = RunOptions {
+        threads,
+        ..RunOptions::files(limits, checkpoint_every, progress)
+    };
+    run_scene_file_with(scene_path, out, limits, opts)
+}
+
+/// [`run_scene_file`] with the run's options (a stop request, threads, checkpoints).
+pub fn run_scene_file_with(
+    scene_path: &Path,
+    out: &Path,
+    limits: Limits,
+    opts: RunOptions,
+) -> Result<RunResult> {
     let scene = Scene::from_path_limited(scene_path, limits)?;
     log::info!(
         "scene: {} particles, {} bonds, {:?}, {} steps",
@@ -340,10 +363,6 @@ pub fn run_scene_file(
         scene.integrator.steps()
     );
     let name = scene_name(scene_path);
-    let opts = RunOptions {
-        threads,
-        ..RunOptions::files(limits, checkpoint_every, progress)
-    };
     let start = Start {
         scene_path: Some(scene_path.to_path_buf()),
         checkpoint: None,

@@ -411,6 +411,17 @@ impl Recorder {
         })
     }
 
+    /// Leaves every file under its temporary name, flushed (a run stopped on request:
+    /// its checkpoint marks them).
+    pub(super) fn suspend(self) -> Result<()> {
+        if let Some(f) = self.files {
+            f.xyz.into_inner().keep()?;
+            f.gsd.into_inner()?.keep()?;
+            f.csv.into_inner().keep()?;
+        }
+        Ok(())
+    }
+
     /// Completes the GSD index and renames every file to its final name.
     pub(super) fn commit(self) -> Result<()> {
         if let Some(f) = self.files {

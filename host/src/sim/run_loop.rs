@@ -24,6 +24,7 @@ use super::record::{
     NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, TRAJECTORY_GSD, TRAJECTORY_XYZ,
     WallGauge, each_row,
 };
+use super::stop::Interrupted;
 use super::tail::TailSlope;
 use super::{
     Beads, Front, Observables, RunOptions, RunResult, SCENE_TOML, SUMMARY_JSON, Summary, snapshot,
@@ -87,10 +88,25 @@ pub(super) fn run_t<T: Real>(
         &mut twist_prev,
         &mut front_times,
     )?;
-    let (done, failure, wall) = tracks.steps(&mut engine, name)?;
+    let (done, halt, wall) = tracks.steps(&mut engine, name)?;
+    let failure = match halt {
+        Halt::Ended => None,
+        Halt::Failed(why) => Some(why),
+        Halt::Stopped(signal) => return Err(tracks.interrupt(&engine, done, signal)),
+    };
     let result = tracks.close(engine, done, failure, wall, name, origin);
     drop(lock);
     result
+}
+
+/// Why the time loop ended.
+enum Halt {
+    /// Every step made.
+    Ended,
+    /// A step failed (why).
+    Failed(String),
+    /// A stop was requested (by this signal) before the next step.
+    Stopped(usize),
 }
 
 /// The trackers and files of a run, over the caller's storage.
@@ -243,13 +259,9 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
     }
 
     /// The time loop: steps `first..=steps`, each followed by [`Tracks::after_step`];
-    /// stops at the first failed step. Returns the last step done, the failure and the
-    /// wall time.
-    fn steps(
-        &mut self,
-        engine: &mut Engine<T>,
-        name: &str,
-    ) -> Result<(usize, Option<String>, f64)> {
+    /// stops at the first failed step, or before a step once a stop is requested.
+    /// Returns the last step done, why the loop ended and the wall time.
+    fn steps(&mut self, engine: &mut Engine<T>, name: &str) -> Result<(usize, Halt, f64)> {
         let bar = if self.opts.progress {
             Progress::new(self.steps as u64, name)
         } else {
@@ -258,6 +270,11 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         let start = Instant::now();
         let (mut done, mut failure) = (self.first - 1, None);
         for s in self.first..=self.steps {
+            // Between steps only: the state is whole, and a checkpoint can hold it.
+            if let Some(signal) = self.opts.stop.requested_after(done as u64) {
+                bar.finish();
+                return Ok((done, Halt::Stopped(signal), start.elapsed().as_secs_f64()));
+            }
             match engine.step() {
                 Ok(rep) => {
                     done = s;
@@ -286,7 +303,8 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             }
         }
         bar.finish();
-        Ok((done, failure, start.elapsed().as_secs_f64()))
+        let halt = failure.map_or(Halt::Ended, Halt::Failed);
+        Ok((done, halt, start.elapsed().as_secs_f64()))
     }
 
     /// What follows step `s`: the trackers, the scheduled frame, a checkpoint, and the
@@ -312,25 +330,54 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         if let (Some(t), Some(dir)) = (self.opts.checkpoint_every, self.out) {
             let k = ((t / self.scene.integrator.dt).round() as usize).max(1);
             if s.is_multiple_of(k) {
-                let marks = self.rec.marks()?;
-                let precision = self.scene.integrator.precision;
-                let trackers = (tw, self.front.times());
-                let its = self.total_iterations;
-                let mut c =
-                    Checkpoint::of(s as u64, precision, beads, trackers, its, marks, self.last);
-                if self.thermal() {
-                    c.noise = Some(engine.noise.save());
-                    c.retries = engine.retries;
-                    c.lanczos = Some(engine.lanczos);
-                }
-                c.landing = self.landing.map(|t| t.to_f64().to_bits());
-                c.save(dir)?;
+                self.checkpoint(s, engine, tw, dir)?;
             }
         }
         if s == self.steps && !scheduled {
             self.last = self.frame(s, beads, tw, rep.iterations, rep.max_tension)?;
         }
         Ok(())
+    }
+
+    /// Writes `DIR/checkpoint.json` after step `s` (twist so far `tw`).
+    fn checkpoint(&mut self, s: usize, engine: &Engine<T>, tw: T, dir: &Path) -> Result<()> {
+        let marks = self.rec.marks()?;
+        let precision = self.scene.integrator.precision;
+        let trackers = (tw, self.front.times());
+        let its = self.total_iterations;
+        let beads = &engine.beads;
+        let mut c = Checkpoint::of(s as u64, precision, beads, trackers, its, marks, self.last);
+        if self.thermal() {
+            c.noise = Some(engine.noise.save());
+            c.retries = engine.retries;
+            c.lanczos = Some(engine.lanczos);
+        }
+        c.landing = self.landing.map(|t| t.to_f64().to_bits());
+        c.save(dir)
+    }
+
+    /// Ends a run stopped on request after step `done`: a checkpoint there, the files
+    /// left under their temporary names (what it marks), and [`Interrupted`].
+    fn interrupt(mut self, engine: &Engine<T>, done: usize, signal: usize) -> anyhow::Error {
+        let tw = self.twist.total;
+        let checkpoint = self.out.map(|dir| {
+            self.checkpoint(done, engine, tw, dir)
+                .map(|()| dir.join(super::CHECKPOINT))
+        });
+        let checkpoint = match checkpoint.transpose() {
+            Ok(c) => c,
+            Err(e) => return e.context("checkpointing a run stopped on request"),
+        };
+        if let Err(e) = self.rec.suspend() {
+            return e.context("keeping the files of a run stopped on request");
+        }
+        Interrupted {
+            signal,
+            step: done as u64,
+            time: engine.beads.time.to_f64(),
+            checkpoint,
+        }
+        .into()
     }
 
     /// Closes the run after step `done`: a final row when it stopped between frames,

@@ -3,6 +3,7 @@
 //! error placed at the sweep value that caused it (or else in the base scene).
 
 use std::ops::Range;
+use std::path::Path;
 
 use toml::de::{DeTable, DeValue};
 use toml::{Table, Value};
@@ -64,12 +65,13 @@ pub(super) struct Base<'a> {
 }
 
 impl<'a> Base<'a> {
+    /// The base scene (the sweep file itself without `base`), and its resolved scene.
     pub(super) fn load(
         src: &Source<'a>,
         doc: &DeTable<'_>,
         base_path: Option<(String, Range<usize>)>,
         limits: Limits,
-    ) -> Result<Base<'a>, SceneError> {
+    ) -> Result<(Base<'a>, Scene), SceneError> {
         let (text, origin) = match base_path {
             None => (std::borrow::Cow::Borrowed(src.text), src.origin.to_string()),
             Some((file, span)) => {
@@ -89,6 +91,7 @@ impl<'a> Base<'a> {
                         format!("cannot read the base scene {}: {e}", path.display()),
                     )
                 })?;
+                not_a_sweep(src, &path, &text, span)?;
                 (std::borrow::Cow::Owned(text), path.display().to_string())
             }
         };
@@ -106,8 +109,8 @@ impl<'a> Base<'a> {
             limits,
         };
         // The base on its own must be a scene: its errors are its own.
-        base.scene_with(src, &[], &[])?;
-        Ok(base)
+        let scene = base.scene_with(src, &[], &[])?;
+        Ok((base, scene))
     }
 
     /// The scene of a point: the base with `params` set, resolved; an error is placed
@@ -168,6 +171,54 @@ impl<'a> Base<'a> {
             }
         })
     }
+}
+
+/// Refuses a base that is itself a sweep (a `[sweep]` table), or this very file: a base
+/// is a plain scene. Said at the `base` value, naming the base's `[sweep]` line.
+fn not_a_sweep(
+    src: &Source<'_>,
+    path: &Path,
+    text: &str,
+    span: Range<usize>,
+) -> Result<(), SceneError> {
+    let same = |a: &Path, b: &Path| matches!((std::fs::canonicalize(a), std::fs::canonicalize(b)), (Ok(x), Ok(y)) if x == y);
+    if same(path, Path::new(src.origin)) {
+        return Err(src.err(
+            span,
+            "base names this sweep file itself (a circular base): base is the plain scene the sweep varies",
+        ));
+    }
+    let Ok(doc) = DeTable::parse(text) else {
+        return Ok(()); // its own errors are reported when it is read as a scene
+    };
+    let Some((key, value)) = doc.get_ref().iter().find(|(k, _)| k.get_ref() == "sweep") else {
+        return Ok(());
+    };
+    let (line, _) = line_col(text, key.span().start);
+    let theirs = match value.get_ref() {
+        DeValue::Table(t) => t
+            .iter()
+            .find(|(k, _)| k.get_ref() == "base")
+            .and_then(|(_, v)| {
+                let DeValue::String(b) = v.get_ref() else {
+                    return None;
+                };
+                let target = path.parent().unwrap_or(Path::new(".")).join(b.as_ref());
+                Some(target)
+            }),
+        _ => None,
+    };
+    let circle = match theirs {
+        Some(t) if same(&t, Path::new(src.origin)) => ", whose base is this file: a circular base",
+        _ => "",
+    };
+    Err(src.err(
+        span,
+        format!(
+            "the base scene {} is itself a sweep ([sweep] at its line {line}{circle}): a base is a plain scene without [sweep]; point base at the scene the sweeps vary",
+            path.display()
+        ),
+    ))
 }
 
 fn common_prefix(a: &str, b: &str) -> usize {

@@ -1,17 +1,18 @@
 //! The engines a sweep runs on: a SLURM array job, a GNU parallel command, a row
-//! workflow. Each task runs `host-demo sweep FILE --out DIR` on its shard or point,
-//! so the points come out the same whichever engine ran them.
+//! workflow. Each task runs `host-demo sweep --frozen --out DIR` on its shard or point:
+//! the points frozen in `DIR` when the job was emitted ([`super::frozen`]), whatever
+//! happens to the sweep file and its base scenes after, so the points come out the same
+//! whichever engine ran them, and as emitted.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use super::cluster::{ArrayJob, SIGNAL_LEAD_S, SLURM_JSON};
+pub use super::cluster::{DEFAULT_MAX_TASKS, SlurmOptions};
 use super::{POINTS, STATEPOINT_JSON, Sweep, run::prepare_points};
+use crate::output::write_json;
 use crate::sim::SUMMARY_JSON;
-
-/// SLURM's default largest array index is 1000 (`MaxArraySize = 1001`): an array job
-/// has at most this many tasks unless asked otherwise.
-pub const DEFAULT_MAX_TASKS: usize = 1000;
 
 /// Which engine to write for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,24 +46,6 @@ impl Engine {
     }
 }
 
-/// The array job's settings.
-#[derive(Debug, Clone, Default)]
-pub struct SlurmOptions {
-    /// Array tasks (shards); None: one per point, at most [`DEFAULT_MAX_TASKS`].
-    pub tasks: Option<usize>,
-    /// At most this many tasks at once (`%M`).
-    pub throttle: Option<usize>,
-    /// Partition.
-    pub partition: Option<String>,
-    /// Time limit per task (`HH:MM:SS`, `D-HH:MM:SS` or minutes).
-    pub time: Option<String>,
-    /// CPUs per task (points run at once in a task).
-    pub cpus: usize,
-    /// The `host-demo` the tasks run (default: this program), for nodes where it is
-    /// installed elsewhere.
-    pub program: Option<PathBuf>,
-}
-
 /// Quotes `s` for a POSIX shell.
 fn sh(s: &str) -> String {
     if !s.is_empty()
@@ -88,54 +71,76 @@ pub fn emit(
     dir: &Path,
     slurm: &SlurmOptions,
 ) -> Result<(PathBuf, String)> {
+    let n = sweep.points.len();
+    // Every setting checked before anything is written.
+    let tasks = slurm.check(n)?;
     prepare_points(sweep, dir)?;
     let exe = match &slurm.program {
         Some(p) => p.clone(),
         None => absolute(&std::env::current_exe().context("finding this program")?)?,
     };
     let (file, dir) = (absolute(file)?, absolute(dir)?);
+    let verbose = match slurm.verbose {
+        0 => String::new(),
+        v => format!(" -{}", "v".repeat(usize::from(v.min(3)))),
+    };
+    let every = slurm
+        .checkpoint_every
+        .map_or(String::new(), |t| format!(" --checkpoint-every {t}"));
     let base = format!(
-        "{} sweep {} --out {}",
+        "{}{verbose} sweep --frozen --out {}{every}",
         sh(&exe.display().to_string()),
-        sh(&file.display().to_string()),
         sh(&dir.display().to_string())
     );
-    let n = sweep.points.len();
     match engine {
         Engine::Slurm => {
-            let tasks = slurm
-                .tasks
-                .unwrap_or(n.min(DEFAULT_MAX_TASKS))
-                .clamp(1, n.max(1));
             let throttle = slurm.throttle.map_or(String::new(), |m| format!("%{m}"));
             let logs = dir.join("slurm");
             std::fs::create_dir_all(&logs)?;
+            let path = dir.join("slurm.sh");
             let mut s = String::from("#!/bin/bash\n");
             s += &format!(
-                "# {n} points of {} in {tasks} array tasks: task K runs shard K/{tasks} (the points whose\n\
-                 # index is K modulo {tasks}), skipping finished points and resuming unfinished ones,\n\
-                 # so the job can be resubmitted as it is after a time limit or a failure.\n\
+                "# {n} points of {} (frozen in {} when emitted) in {tasks} array tasks: task K runs\n\
+                 # shard K/{tasks} (the points whose index is K modulo {tasks}), skipping finished points\n\
+                 # and resuming unfinished ones. SIGTERM (the time limit, {SIGNAL_LEAD_S} s ahead, or scancel)\n\
+                 # checkpoints the running points; `host-demo collect {}` prints the sbatch line\n\
+                 # that reruns the tasks left unfinished.\n\
                  # Submit: sbatch {}\n",
                 file.display(),
-                dir.join("slurm.sh").display()
+                dir.display(),
+                dir.display(),
+                path.display()
             );
             s += "#SBATCH --job-name=hydrorattle-sweep\n";
             s += &format!("#SBATCH --array=0-{}{throttle}\n", tasks - 1);
             s += "#SBATCH --ntasks=1\n";
             s += &format!("#SBATCH --cpus-per-task={}\n", slurm.cpus.max(1));
-            if let Some(t) = &slurm.time {
-                s += &format!("#SBATCH --time={t}\n");
+            for (name, v) in [
+                ("time", &slurm.time),
+                ("partition", &slurm.partition),
+                ("mem", &slurm.mem),
+                ("account", &slurm.account),
+                ("qos", &slurm.qos),
+                ("constraint", &slurm.constraint),
+            ] {
+                if let Some(v) = v {
+                    s += &format!("#SBATCH --{name}={v}\n");
+                }
             }
-            if let Some(p) = &slurm.partition {
-                s += &format!("#SBATCH --partition={p}\n");
-            }
+            s += &format!("#SBATCH --signal=B:TERM@{SIGNAL_LEAD_S}\n");
             s += &format!("#SBATCH --output={}/%A_%a.out\n", logs.display());
             s += "set -euo pipefail\n";
+            // exec: host-demo is the batch shell, which the B: signal reaches.
             s += &format!(
                 "exec {base} --shard \"$SLURM_ARRAY_TASK_ID/{tasks}\" --jobs \"${{SLURM_CPUS_PER_TASK:-1}}\"\n"
             );
-            let path = dir.join("slurm.sh");
             write_script(&path, &s)?;
+            let job = ArrayJob {
+                tasks,
+                throttle: slurm.throttle,
+                script: path.clone(),
+            };
+            write_json(&dir.join(SLURM_JSON), &job)?;
             Ok((
                 path.clone(),
                 format!("sbatch {}", sh(&path.display().to_string())),

@@ -4,13 +4,12 @@
 use std::ops::Range;
 use std::path::Path;
 
-use serde_json::Value as Json;
 use toml::de::{DeTable, DeValue};
 use toml::{Spanned, Table, Value};
 
 use super::base::{Base, set_path};
-use super::{MAX_POINTS, Point, Sweep, id::point_id};
-use crate::scene::{DEFAULT_SEED, SceneError, line_col};
+use super::{MAX_POINTS, SEED_KEY, Sweep, expand, hints, record};
+use crate::scene::{SceneError, line_col};
 use crate::sizing::Limits;
 
 /// An error at a byte span of a text named `origin`.
@@ -30,20 +29,20 @@ pub(super) fn at(
 
 /// One value of a parameter, with the span of its text in the sweep file.
 #[derive(Clone)]
-struct Item {
-    value: Value,
-    span: Range<usize>,
+pub(super) struct Item {
+    pub(super) value: Value,
+    pub(super) span: Range<usize>,
 }
 
 /// A factor of the product: keys that vary together (one key, or a `zip` group).
-struct Factor {
-    keys: Vec<(String, Range<usize>)>,
+pub(super) struct Factor {
+    pub(super) keys: Vec<(String, Range<usize>)>,
     /// Per key, its values (all of the same length).
-    values: Vec<Vec<Item>>,
+    pub(super) values: Vec<Vec<Item>>,
 }
 
 impl Factor {
-    fn len(&self) -> usize {
+    pub(super) fn len(&self) -> usize {
         self.values.first().map_or(1, Vec::len)
     }
 }
@@ -102,6 +101,9 @@ pub(super) fn parse(src: &Source<'_>, limits: Limits) -> Result<Sweep, SceneErro
     })?;
     let doc = doc.get_ref();
     let Some((sweep_key, sweep)) = doc.iter().find(|(k, _)| k.get_ref() == "sweep") else {
+        if let Some(e) = hints::missing_sweep(src, doc) {
+            return Err(e);
+        }
         return Err(SceneError {
             origin: src.origin.to_string(),
             location: None,
@@ -149,6 +151,9 @@ pub(super) fn parse(src: &Source<'_>, limits: Limits) -> Result<Sweep, SceneErro
                 }
             }
             name => {
+                if let Some(e) = hints::misspelled_setting(src, name, key.span(), value.get_ref()) {
+                    return Err(e);
+                }
                 let values = values(src, name, key.span(), value)?;
                 factors.push(Factor {
                     keys: vec![(name.to_string(), key.span())],
@@ -172,14 +177,13 @@ pub(super) fn parse(src: &Source<'_>, limits: Limits) -> Result<Sweep, SceneErro
         seen.push(key);
     }
     let count = point_count(src, &factors, replicas.as_ref())?;
-    let base = Base::load(src, doc, base_path, limits)?;
+    let (base, base_scene) = Base::load(src, doc, base_path, limits)?;
     let (replicas, replicas_span) = replicas.unwrap_or((1, 0..0));
-    let seed_key = "brownian.seed";
     if replicas > 1
         && let Some((_, span)) = factors
             .iter()
             .flat_map(|f| &f.keys)
-            .find(|k| k.0 == seed_key)
+            .find(|k| k.0 == SEED_KEY)
     {
         return Err(src.err(
                 span.clone(),
@@ -192,77 +196,17 @@ pub(super) fn parse(src: &Source<'_>, limits: Limits) -> Result<Sweep, SceneErro
                 .map_err(|m| src.err(span.clone(), m))?;
         }
     }
-    let seed0 = base
-        .table
-        .get("brownian")
-        .and_then(|b| b.get("seed"))
-        .and_then(Value::as_integer)
-        .unwrap_or(DEFAULT_SEED as i64);
-    let mut points: Vec<Point> = Vec::with_capacity(count);
-    let mut index = vec![0usize; factors.len()];
-    for _ in 0..count / replicas {
-        let mut params: Vec<(String, Value)> = Vec::new();
-        let mut spans: Vec<(String, Range<usize>)> = Vec::new();
-        for (f, &k) in factors.iter().zip(&index) {
-            for ((key, _), vals) in f.keys.iter().zip(&f.values) {
-                params.push((key.clone(), vals[k].value.clone()));
-                spans.push((key.clone(), vals[k].span.clone()));
-            }
-        }
-        for r in 0..replicas {
-            let mut params = params.clone();
-            let replica = (replicas > 1).then_some(r);
-            if replicas > 1 {
-                params.push((seed_key.to_string(), Value::Integer(seed0 + r as i64)));
-            }
-            let scene = base.scene_with(src, &params, &spans)?;
-            if replicas > 1 && !scene.brownian.is_some_and(|b| b.temperature > 0.0) {
-                return Err(src.err(
-                    replicas_span.clone(),
-                    format!(
-                        "replicas = {replicas} would repeat a deterministic run: the point {} has no thermal noise ([brownian] temperature > 0)",
-                        describe(&params)
-                    ),
-                ));
-            }
-            let statepoint = statepoint(&params);
-            let id = point_id(&statepoint);
-            if let Some(p) = points.iter().find(|p| p.id == id) {
-                let span = spans.first().map_or(0..0, |s| s.1.clone());
-                return Err(src.err(
-                    span,
-                    format!(
-                        "the point {} is given twice (it is point {} already)",
-                        describe(&params),
-                        p.index
-                    ),
-                ));
-            }
-            points.push(Point {
-                index: points.len(),
-                id,
-                params,
-                replica,
-                statepoint,
-                scene,
-            });
-        }
-        // The next combination: the last factor varies fastest.
-        for (k, f) in index.iter_mut().zip(&factors).rev() {
-            *k += 1;
-            if *k < f.len() {
-                break;
-            }
-            *k = 0;
-        }
-    }
+    let points = expand::points(src, &factors, &base, count, (replicas, replicas_span))?;
+    let keys: Vec<String> = points
+        .first()
+        .map(|p| p.params.iter().map(|(k, _)| k.clone()).collect())
+        .unwrap_or_default();
+    let digest = record::digest(&base_scene, &keys, replicas, &points);
     Ok(Sweep {
-        keys: points
-            .first()
-            .map(|p| p.params.iter().map(|(k, _)| k.clone()).collect())
-            .unwrap_or_default(),
+        keys,
         replicas,
         points,
+        digest,
     })
 }
 
@@ -301,28 +245,6 @@ fn point_count(
 pub(super) fn describe(params: &[(String, Value)]) -> String {
     let parts: Vec<String> = params.iter().map(|(k, v)| format!("{k} = {v}")).collect();
     format!("({})", parts.join(", "))
-}
-
-/// The state point of a point: its parameters nested at their dots, as signac nests
-/// dotted keys (`{"helix": {"dhat": 1.05}}`).
-pub(super) fn statepoint(params: &[(String, Value)]) -> Json {
-    let mut root = serde_json::Map::new();
-    for (key, value) in params {
-        let parts: Vec<&str> = key.split('.').collect();
-        let mut node = &mut root;
-        for p in &parts[..parts.len() - 1] {
-            let entry = node
-                .entry(p.to_string())
-                .or_insert_with(|| Json::Object(serde_json::Map::new()));
-            if !entry.is_object() {
-                *entry = Json::Object(serde_json::Map::new());
-            }
-            node = entry.as_object_mut().expect("an object was just put here");
-        }
-        let json = serde_json::to_value(value).unwrap_or(Json::Null);
-        node.insert(parts[parts.len() - 1].to_string(), json);
-    }
-    Json::Object(root)
 }
 
 /// The values of a key: a non-empty list, or `{ linspace = [first, last, count] }`.

@@ -123,10 +123,12 @@ pub fn python_float(x: f64) -> String {
 /// MD5 (RFC 1321) of `data`, as 32 lower-case hexadecimal digits.
 pub fn md5_hex(data: &[u8]) -> String {
     const S: [u32; 16] = [7, 12, 17, 22, 5, 9, 14, 20, 4, 11, 16, 23, 6, 10, 15, 21];
-    // K[i] = floor(2^32 |sin(i + 1)|).
-    let k: Vec<u32> = (0..64)
-        .map(|i| ((i as f64 + 1.0).sin().abs() * 4_294_967_296.0) as u32)
-        .collect();
+    // K[i] = floor(2^32 |sin(i + 1)|), computed once (an expansion takes an id per
+    // point).
+    static K: std::sync::OnceLock<[u32; 64]> = std::sync::OnceLock::new();
+    let k = K.get_or_init(|| {
+        std::array::from_fn(|i| ((i as f64 + 1.0).sin().abs() * 4_294_967_296.0) as u32)
+    });
     let mut h: [u32; 4] = [0x6745_2301, 0xefcd_ab89, 0x98ba_dcfe, 0x1032_5476];
     let mut msg = data.to_vec();
     msg.push(0x80);

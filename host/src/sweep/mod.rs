@@ -24,10 +24,11 @@
 //!   `[[sweep.zip]]` group is one factor whose lists (of one length) vary together.
 //! * `replicas = K` runs every point K times with `brownian.seed` = the base scene's
 //!   seed (default 1) plus 0, 1, ..., K - 1; it needs thermal noise in every point.
-//! * Every point is resolved and validated before anything runs. An unknown key, an
-//!   empty list, a value the scene refuses, a point given twice, or more than
-//!   [`MAX_POINTS`] points is an error at its file, line and column
-//!   (`sweep.toml:4:21: ...`), as for scenes.
+//! * Every point is resolved and validated before anything runs, in time linear in the
+//!   points. An unknown key, an empty list, a value the scene refuses, a
+//!   point given twice (numbers compared as numbers), a base that is itself a sweep, a
+//!   misspelled table or setting, or more than [`MAX_POINTS`] points is an error at its
+//!   file, line and column (`sweep.toml:4:21: ...`), as for scenes.
 //!
 //! # Points
 //!
@@ -37,6 +38,11 @@
 //! computes job ids ([`id`]), so `DIR` is a signac project (`.signac/config`,
 //! `workspace -> points`) and a row project (`workflow.toml`) as it is.
 //!
+//! A folder holds one sweep ([`claim`]): `sweep.json` records the sweep's digest, which
+//! covers every point's resolved scene, and another sweep is refused before anything
+//! is written. The points' scenes are frozen in `DIR/frozen` ([`frozen`]) when the
+//! sweep claims the folder; emitted jobs run them from there.
+//!
 //! `DIR/points/<id>/` holds `signac_statepoint.json`, `scene.toml` (the point's
 //! resolved scene) and, once run, the files of a run (`summary.json`,
 //! `observables.csv`, `trajectory.xyz`, `trajectory.gsd`, `checkpoint.json`). They are
@@ -45,23 +51,30 @@
 //! `machine`, and `resumed_from` (the time a resumed run continued from).
 
 mod base;
+pub mod claim;
+pub mod cluster;
 pub mod emit;
+mod expand;
 mod file;
+pub mod frozen;
+mod hints;
 pub mod id;
+pub mod record;
 pub mod run;
+mod state;
 
 use std::path::Path;
 
-use serde::Serialize;
 use serde_json::Value as Json;
 use toml::Value;
 
 use crate::scene::{Scene, SceneError};
 use crate::sizing::Limits;
 
+pub use claim::AnotherSweep;
 pub use emit::{Engine, SlurmOptions, emit};
 pub use file::linspace;
-pub use run::{RunReport, Selection, run_points, run_sweep};
+pub use run::{RunReport, Selection, run_frozen, run_points, run_sweep};
 
 /// Most points a sweep may have (replicas counted).
 pub const MAX_POINTS: usize = 100_000;
@@ -72,6 +85,8 @@ pub const SWEEP_JSON: &str = "sweep.json";
 pub const POINTS: &str = "points";
 /// A point's parameters in its folder, as signac names it.
 pub const STATEPOINT_JSON: &str = "signac_statepoint.json";
+/// The key replicas set.
+const SEED_KEY: &str = "brownian.seed";
 
 /// One point of a sweep.
 #[derive(Debug, Clone)]
@@ -99,6 +114,8 @@ pub struct Sweep {
     pub replicas: usize,
     /// Every point.
     pub points: Vec<Point>,
+    /// The sweep's digest ([`record::digest`]): which sweep a folder holds.
+    pub digest: String,
 }
 
 impl Sweep {
@@ -136,64 +153,6 @@ impl Sweep {
             }
         })
     }
-
-    /// `sweep.json`: every point, its id, state point and parameters.
-    pub fn record(&self) -> SweepRecord<'_> {
-        SweepRecord {
-            format: "host-demo sweep 1",
-            id: "md5 of json.dumps(statepoint, sort_keys=True), as signac.job.calc_id",
-            keys: &self.keys,
-            replicas: self.replicas,
-            count: self.points.len(),
-            points: self
-                .points
-                .iter()
-                .map(|p| PointRecord {
-                    index: p.index,
-                    id: &p.id,
-                    replica: p.replica,
-                    parameters: p
-                        .params
-                        .iter()
-                        .map(|(k, v)| (k.clone(), serde_json::to_value(v).unwrap_or(Json::Null)))
-                        .collect(),
-                    statepoint: &p.statepoint,
-                })
-                .collect(),
-        }
-    }
-}
-
-/// What `sweep.json` holds.
-#[derive(Debug, Serialize)]
-pub struct SweepRecord<'a> {
-    /// Format name and version.
-    pub format: &'static str,
-    /// How ids are computed.
-    pub id: &'static str,
-    /// Parameter keys.
-    pub keys: &'a [String],
-    /// Runs per point.
-    pub replicas: usize,
-    /// Number of points.
-    pub count: usize,
-    /// The points.
-    pub points: Vec<PointRecord<'a>>,
-}
-
-/// One point in `sweep.json`.
-#[derive(Debug, Serialize)]
-pub struct PointRecord<'a> {
-    /// Position in the sweep.
-    pub index: usize,
-    /// Id (folder name).
-    pub id: &'a str,
-    /// Replica number, with replicas.
-    pub replica: Option<usize>,
-    /// Parameters by dotted key.
-    pub parameters: serde_json::Map<String, Json>,
-    /// The state point.
-    pub statepoint: &'a Json,
 }
 
 #[cfg(test)]

@@ -1,20 +1,17 @@
 //! Running a sweep's points: each in its own folder, skipped when finished, resumed
-//! from its checkpoint when unfinished, and otherwise run from the start.
-//!
-//! A point is *finished* when its folder holds `summary.json` and a `scene.toml` equal
-//! to the point's resolved scene (the run writes both last). It is *resumable* when its
-//! `scene.toml` is the point's and a `checkpoint.json` is there (a run stopped by a
-//! signal or a time limit): it continues from the checkpoint, and its files come out
-//! byte for byte as those of an uninterrupted run. Anything else (a new point, a
-//! changed scene, a run that failed to start) is run from the start, its old run files
-//! removed first. Thermal-noise runs resume the same way: their checkpoints hold the
-//! noise generator's state.
+//! from its checkpoint when unfinished, and otherwise run from the start (what a
+//! folder's files say: `state.rs`). A resumed point's files come out byte for
+//! byte as those of an uninterrupted run; thermal-noise runs resume the same way (their
+//! checkpoints hold the noise generator's state).
 //!
 //! One writer per point: a process locks the point's folder ([`FolderLock`]) before it
 //! looks at its files and holds the lock until the run ends. A second process on the
 //! same point (`sbatch` twice, two `--point ID`) skips it and says so, or with
 //! [`Options::wait`] waits for the first and then finds the point finished. The OS
 //! releases the lock of a killed process.
+//!
+//! A stop request ([`Stop`]: SIGTERM, Ctrl-C) checkpoints the points running, starts
+//! no other, and the report says so ([`RunReport::signal`]).
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -23,13 +20,11 @@ use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 
 use super::file::describe;
-use super::{POINTS, Point, STATEPOINT_JSON, SWEEP_JSON, Sweep, id::canonical_json};
+use super::state::{RUN_FILES, State, state};
+use super::{POINTS, Point, STATEPOINT_JSON, Sweep, claim, frozen, id::canonical_json};
 use crate::output::{FolderLock, tmp_path};
 use crate::scene::{Level, Scene};
-use crate::sim::{
-    CHECKPOINT, Checkpoint, OBSERVABLES_CSV, SCENE_TOML, SUMMARY_JSON, Start, Summary,
-    TRAJECTORY_GSD, TRAJECTORY_XYZ,
-};
+use crate::sim::{Interrupted, SCENE_TOML, Start, Stop, Summary};
 
 /// A failed start, written in the point's folder (removed when the point runs again).
 pub const ERROR_TXT: &str = "error.txt";
@@ -87,6 +82,8 @@ pub struct Options {
     pub checkpoint_every: Option<f64>,
     /// Wait for a point another process is running, rather than skip it.
     pub wait: bool,
+    /// Stop on request: running points checkpoint, no other starts.
+    pub stop: Stop,
 }
 
 /// What happened to one point.
@@ -98,8 +95,13 @@ pub enum Outcome {
     Locked,
     /// Run, from the start or from its checkpoint (`resumed_from`).
     Ran(Box<Summary>),
-    /// Could not be run (the message is also in the folder's `error.txt`).
+    /// Could not be run (the message is also in the folder's `error.txt`, unless the
+    /// folder is another sweep's).
     Failed(String),
+    /// Stopped on request (by this signal) and checkpointed.
+    Interrupted(usize),
+    /// Not started: a stop was requested before its turn.
+    NotStarted,
 }
 
 /// What a process did.
@@ -119,6 +121,12 @@ pub struct RunReport {
     pub stopped_early: Vec<String>,
     /// Points that could not be run, with why.
     pub failed: Vec<(String, String)>,
+    /// Points stopped on request and checkpointed (they resume when run again).
+    pub interrupted: usize,
+    /// Points not started because a stop was requested.
+    pub not_started: usize,
+    /// The signal that asked this process to stop, if one did.
+    pub signal: Option<usize>,
 }
 
 impl std::fmt::Display for RunReport {
@@ -136,6 +144,13 @@ impl std::fmt::Display for RunReport {
         )?;
         if self.locked > 0 {
             write!(f, ", {} skipped: locked by another process", self.locked)?;
+        }
+        if let Some(sig) = self.signal {
+            write!(
+                f,
+                "; stopped by signal {sig}: {} checkpointed, {} not started (run again to go on)",
+                self.interrupted, self.not_started
+            )?;
         }
         Ok(())
     }
@@ -155,7 +170,7 @@ pub fn as_run(scene: &Scene, name: &str) -> Scene {
 }
 
 /// Writes `bytes` to `path` unless it already holds them, under a temporary name of
-/// this process (several processes may write the same file at once).
+/// this process.
 fn write_same(path: &Path, bytes: &[u8]) -> Result<()> {
     if std::fs::read(path).is_ok_and(|b| b == bytes) {
         return Ok(());
@@ -165,60 +180,17 @@ fn write_same(path: &Path, bytes: &[u8]) -> Result<()> {
     std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))
 }
 
-/// Writes the sweep's own files in `dir`: `sweep.json`, and the signac project files
-/// (`.signac/config`, `workspace` linked to `points`).
-pub fn write_sweep(sweep: &Sweep, dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir.join(POINTS))
-        .with_context(|| format!("creating {}", dir.join(POINTS).display()))?;
-    let mut json = serde_json::to_vec_pretty(&sweep.record())?;
-    json.push(b'\n');
-    write_same(&dir.join(SWEEP_JSON), &json)?;
-    std::fs::create_dir_all(dir.join(".signac"))?;
-    write_same(&dir.join(".signac/config"), b"schema_version = 2\n")?;
-    let link = dir.join("workspace");
-    if std::fs::symlink_metadata(&link).is_err() {
-        #[cfg(unix)]
-        if let Err(e) = std::os::unix::fs::symlink(POINTS, &link)
-            && std::fs::symlink_metadata(&link).is_err()
-        {
-            log::warn!("{}: cannot link to {POINTS}: {e}", link.display());
-        }
-    }
-    Ok(())
-}
-
-/// Where a point stands.
-enum State {
-    Finished,
-    Resumable(Box<Checkpoint>),
-    New,
-}
-
-fn state(pdir: &Path, scene_text: &str, scene: &Scene) -> State {
-    let same_scene = std::fs::read_to_string(pdir.join(SCENE_TOML)).is_ok_and(|t| t == scene_text);
-    if !same_scene {
-        return State::New;
-    }
-    if pdir.join(SUMMARY_JSON).is_file() {
-        return State::Finished;
-    }
-    match Checkpoint::load(pdir) {
-        Ok(c) if c.precision == scene.integrator.precision => State::Resumable(Box::new(c)),
-        _ => State::New,
-    }
+/// The point's state point in its folder (rewritten only when missing or changed).
+fn write_statepoint(point: &Point, pdir: &Path) -> Result<()> {
+    let mut sp = canonical_json(&point.statepoint).into_bytes();
+    sp.push(b'\n');
+    write_same(&pdir.join(STATEPOINT_JSON), &sp)
 }
 
 /// Clears a point's folder of run files and writes its state point and scene.
 fn prepare(point: &Point, pdir: &Path, scene_text: &str) -> Result<()> {
     std::fs::create_dir_all(pdir).with_context(|| format!("creating {}", pdir.display()))?;
-    for name in [
-        SUMMARY_JSON,
-        CHECKPOINT,
-        OBSERVABLES_CSV,
-        TRAJECTORY_XYZ,
-        TRAJECTORY_GSD,
-        ERROR_TXT,
-    ] {
+    for name in RUN_FILES {
         let path = pdir.join(name);
         for p in [tmp_path(&path), path] {
             if p.exists() {
@@ -226,26 +198,25 @@ fn prepare(point: &Point, pdir: &Path, scene_text: &str) -> Result<()> {
             }
         }
     }
-    let mut sp = canonical_json(&point.statepoint).into_bytes();
-    sp.push(b'\n');
-    write_same(&pdir.join(STATEPOINT_JSON), &sp)?;
+    write_statepoint(point, pdir)?;
     write_same(&pdir.join(SCENE_TOML), scene_text.as_bytes())
 }
 
 /// Writes the folders of the points that are not finished or resumable (state point
-/// and scene), without running them: what `--emit` leaves for the engines.
+/// and scene), without running them: what `--emit` leaves for the engines (row finds
+/// its directories by them). A point folder another sweep wrote is left alone.
 pub fn prepare_points(sweep: &Sweep, dir: &Path) -> Result<usize> {
-    write_sweep(sweep, dir)?;
+    claim::claim(sweep, dir)?;
     let mut prepared = 0;
     for p in &sweep.points {
         let pdir = point_dir(dir, &p.id);
-        let text = as_run(&p.scene, &p.id).to_toml();
+        let text = frozen::run_text(p).0;
         std::fs::create_dir_all(&pdir).with_context(|| format!("creating {}", pdir.display()))?;
         // A point another process is running is left to it.
         let Some(_lock) = FolderLock::try_take(&pdir)? else {
             continue;
         };
-        if let State::New = state(&pdir, &text, &p.scene) {
+        if let State::New = state(&pdir, &text, &as_run(&p.scene, &p.id)) {
             prepare(p, &pdir, &text)?;
             prepared += 1;
         }
@@ -284,10 +255,21 @@ pub fn run_point(point: &Point, dir: &Path, opts: Options) -> Outcome {
         Ok(None) => return Outcome::Locked,
         Err(e) => return Outcome::Failed(format!("{e:#}")),
     };
-    let text = as_run(&point.scene, &point.id).to_toml();
-    let checkpoint = match state(&pdir, &text, &point.scene) {
-        State::Finished => return Outcome::Skipped,
-        State::Resumable(c) => Some(*c),
+    let (text, _) = frozen::run_text(point);
+    let checkpoint = match state(&pdir, &text, &as_run(&point.scene, &point.id)) {
+        State::Foreign(why) => return Outcome::Failed(why),
+        State::Finished => {
+            return match write_statepoint(point, &pdir) {
+                Ok(()) => Outcome::Skipped,
+                Err(e) => Outcome::Failed(format!("{e:#}")),
+            };
+        }
+        State::Resumable(c) => {
+            if let Err(e) = write_statepoint(point, &pdir) {
+                return Outcome::Failed(format!("{e:#}"));
+            }
+            Some(*c)
+        }
         State::New => {
             if let Err(e) = prepare(point, &pdir, &text) {
                 return Outcome::Failed(format!("{e:#}"));
@@ -299,6 +281,7 @@ pub fn run_point(point: &Point, dir: &Path, opts: Options) -> Outcome {
         progress: false,
         keep_series: false,
         checkpoint_every: checkpoint_every(&point.scene, opts.checkpoint_every),
+        stop: opts.stop,
         ..crate::sim::RunOptions::default()
     };
     let start = Start {
@@ -308,6 +291,9 @@ pub fn run_point(point: &Point, dir: &Path, opts: Options) -> Outcome {
     };
     match crate::sim::run_from(&point.scene, &point.id, Some(&pdir), run_opts, start) {
         Ok(r) => Outcome::Ran(Box::new(r.summary)),
+        Err(e) if e.downcast_ref::<Interrupted>().is_some() => {
+            Outcome::Interrupted(e.downcast_ref::<Interrupted>().map_or(0, |i| i.signal))
+        }
         Err(e) => {
             let why = format!("{e:#}");
             let _ = std::fs::write(pdir.join(ERROR_TXT), format!("{why}\n"));
@@ -317,17 +303,41 @@ pub fn run_point(point: &Point, dir: &Path, opts: Options) -> Outcome {
 }
 
 /// Runs the `selection` of `sweep` in `dir` with `opts.jobs` points at a time, printing
-/// a line per point as it ends.
+/// a line per point as it ends. The folder is claimed first ([`claim::claim`]): a
+/// folder holding another sweep is refused before anything is written.
 pub fn run_points(
     sweep: &Sweep,
     dir: &Path,
     selection: &Selection,
     opts: Options,
 ) -> Result<RunReport> {
-    write_sweep(sweep, dir)?;
     let points = selection.points(sweep)?;
+    claim::claim(sweep, dir)?;
+    run_selected(&points, dir, opts, Vec::new())
+}
+
+/// Runs the `selection` of the sweep frozen in `dir` ([`frozen::load`]): neither the
+/// sweep file nor its base scenes are read. A point whose frozen scene was changed is
+/// refused (counted failed) and the others run.
+pub fn run_frozen(dir: &Path, selection: &Selection, opts: Options) -> Result<RunReport> {
+    let (_, points, refused) = frozen::load(dir, selection)?;
+    for (id, why) in &refused {
+        println!("{id}: REFUSED: {why}");
+    }
+    let points: Vec<&Point> = points.iter().collect();
+    run_selected(&points, dir, opts, refused)
+}
+
+/// Runs `points` in `dir`; `refused` are counted failed.
+fn run_selected(
+    points: &[&Point],
+    dir: &Path,
+    opts: Options,
+    refused: Vec<(String, String)>,
+) -> Result<RunReport> {
     let report = Mutex::new(RunReport {
-        selected: points.len(),
+        selected: points.len() + refused.len(),
+        failed: refused,
         ..RunReport::default()
     });
     let pool = rayon::ThreadPoolBuilder::new()
@@ -335,7 +345,10 @@ pub fn run_points(
         .build()?;
     pool.install(|| {
         points.par_iter().for_each(|p| {
-            let outcome = run_point(p, dir, opts);
+            let outcome = match opts.stop.requested() {
+                Some(_) => Outcome::NotStarted,
+                None => run_point(p, dir, opts),
+            };
             let mut r = report.lock().unwrap_or_else(|e| e.into_inner());
             let what = describe(&p.params);
             match outcome {
@@ -369,10 +382,17 @@ pub fn run_points(
                     println!("{} {what}: FAILED: {why}", p.id);
                     r.failed.push((p.id.clone(), why));
                 }
+                Outcome::Interrupted(sig) => {
+                    r.interrupted += 1;
+                    println!("{} {what}: stopped by signal {sig}, checkpointed", p.id);
+                }
+                Outcome::NotStarted => r.not_started += 1,
             }
         });
     });
-    Ok(report.into_inner().unwrap_or_else(|e| e.into_inner()))
+    let mut report = report.into_inner().unwrap_or_else(|e| e.into_inner());
+    report.signal = opts.stop.requested();
+    Ok(report)
 }
 
 /// [`run_points`] of a sweep file.

@@ -1,0 +1,303 @@
+//! The array job's settings, checked before anything is written (a value SLURM would
+//! refuse at submission, or one that makes no sense for the sweep, is refused here, by
+//! name), and the array indices that rerun only the unfinished points.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
+
+/// SLURM's default largest array index is 1000 (`MaxArraySize = 1001`): an array job
+/// has at most this many tasks unless asked otherwise.
+pub const DEFAULT_MAX_TASKS: usize = 1000;
+
+/// Seconds before the time limit at which SLURM sends the batch shell (`host-demo`
+/// itself, by `exec`) SIGTERM (`--signal=B:TERM@60`): time for the running steps to end
+/// and the points to checkpoint.
+pub const SIGNAL_LEAD_S: u32 = 60;
+
+/// The array job's settings.
+#[derive(Debug, Clone, Default)]
+pub struct SlurmOptions {
+    /// Array tasks (shards); None: one per point, at most [`DEFAULT_MAX_TASKS`].
+    pub tasks: Option<usize>,
+    /// At most this many tasks at once (`%M`).
+    pub throttle: Option<usize>,
+    /// Partition.
+    pub partition: Option<String>,
+    /// Time limit per task (`MM`, `MM:SS`, `HH:MM:SS`, `D-HH`, `D-HH:MM`, `D-HH:MM:SS`).
+    pub time: Option<String>,
+    /// Memory per node (`--mem`: a whole number with an optional unit K, M, G or T).
+    pub mem: Option<String>,
+    /// Account charged.
+    pub account: Option<String>,
+    /// Quality of service.
+    pub qos: Option<String>,
+    /// Node features required (`--constraint`).
+    pub constraint: Option<String>,
+    /// CPUs per task (points run at once in a task).
+    pub cpus: usize,
+    /// The `host-demo` the tasks run (default: this program), for nodes where it is
+    /// installed elsewhere.
+    pub program: Option<std::path::PathBuf>,
+    /// Checkpoint interval (simulated time) the tasks pass on.
+    pub checkpoint_every: Option<f64>,
+    /// Log verbosity the tasks pass on (`-v` repeated).
+    pub verbose: u8,
+}
+
+/// The array job's shape in the sweep's folder, for `collect` to name the tasks of the
+/// unfinished points and the `sbatch --array` line that reruns them.
+pub const SLURM_JSON: &str = "slurm.json";
+
+/// What [`SLURM_JSON`] holds.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ArrayJob {
+    /// Array tasks: task K runs the points whose index is K modulo this.
+    pub tasks: usize,
+    /// At most this many tasks at once, if limited.
+    pub throttle: Option<usize>,
+    /// The job script.
+    pub script: PathBuf,
+}
+
+impl ArrayJob {
+    /// The array job emitted into `dir`, if one was.
+    pub fn read(dir: &Path) -> Result<Option<ArrayJob>> {
+        let path = dir.join(SLURM_JSON);
+        match std::fs::read_to_string(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+            t => {
+                let t = t.with_context(|| format!("reading {}", path.display()))?;
+                let job = serde_json::from_str(&t)
+                    .with_context(|| format!("{}: not an array job record", path.display()))?;
+                Ok(Some(job))
+            }
+        }
+    }
+
+    /// The task that runs point `index`.
+    pub fn task_of(&self, index: usize) -> usize {
+        index % self.tasks.max(1)
+    }
+
+    /// `sbatch --array=...` that reruns the tasks of the points `indices` only (the
+    /// script's throttle kept); None without points.
+    pub fn rerun(&self, indices: &[usize]) -> Option<String> {
+        let mut tasks: Vec<usize> = indices.iter().map(|&i| self.task_of(i)).collect();
+        tasks.sort_unstable();
+        tasks.dedup();
+        if tasks.is_empty() {
+            return None;
+        }
+        let throttle = self.throttle.map_or(String::new(), |m| format!("%{m}"));
+        Some(format!(
+            "sbatch --array={}{throttle} {}",
+            array_ranges(&tasks),
+            self.script.display()
+        ))
+    }
+}
+
+/// A SLURM time limit: minutes, `M:S`, `H:M:S`, `D-H`, `D-H:M`, `D-H:M:S` (whole
+/// numbers), or `UNLIMITED`/`INFINITE`.
+fn time_ok(t: &str) -> bool {
+    let num = |s: &str| !s.is_empty() && s.len() <= 9 && s.bytes().all(|b| b.is_ascii_digit());
+    if matches!(t, "UNLIMITED" | "INFINITE") {
+        return true;
+    }
+    let (days, rest) = match t.split_once('-') {
+        Some((d, r)) => (Some(d), r),
+        None => (None, t),
+    };
+    if days.is_some_and(|d| !num(d)) {
+        return false;
+    }
+    let parts: Vec<&str> = rest.split(':').collect();
+    parts.len() <= 3 && parts.iter().all(|p| num(p))
+}
+
+/// A `--mem` size: a whole number and an optional unit K, M, G or T.
+fn mem_ok(m: &str) -> bool {
+    let digits = m.trim_end_matches(['K', 'M', 'G', 'T', 'k', 'm', 'g', 't']);
+    m.len() - digits.len() <= 1 && !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+}
+
+impl SlurmOptions {
+    /// The number of array tasks for `points` points, every setting checked first.
+    pub fn check(&self, points: usize) -> Result<usize> {
+        if self.cpus == 0 {
+            bail!("--cpus 0: a task needs at least one CPU");
+        }
+        if self.throttle == Some(0) {
+            bail!("--throttle 0 would run no task: give at least 1");
+        }
+        let tasks = match self.tasks {
+            Some(0) => bail!("--tasks 0: an array job has at least one task"),
+            Some(t) if t > points => bail!(
+                "--tasks {t} is more than the sweep's {points} points: a task would have no point (give at most {points})"
+            ),
+            Some(t) => t,
+            None => points.clamp(1, DEFAULT_MAX_TASKS),
+        };
+        if let Some(t) = &self.time
+            && !time_ok(t)
+        {
+            bail!(
+                "--time {t:?} is not a SLURM time limit: minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS"
+            );
+        }
+        if let Some(m) = &self.mem
+            && !mem_ok(m)
+        {
+            bail!(
+                "--mem {m:?} is not a size: a whole number with an optional unit K, M, G or T (4G, 500M)"
+            );
+        }
+        for (flag, v) in [
+            ("--partition", &self.partition),
+            ("--account", &self.account),
+            ("--qos", &self.qos),
+            ("--constraint", &self.constraint),
+        ] {
+            if let Some(v) = v
+                && (v.is_empty()
+                    || v.chars()
+                        .any(|c| c.is_whitespace() || c.is_control() || "'\"#\\".contains(c)))
+            {
+                bail!("{flag} {v:?}: a SLURM name without spaces, quotes or #");
+            }
+        }
+        if let Some(c) = self.checkpoint_every
+            && !(c.is_finite() && c > 0.0)
+        {
+            bail!("--checkpoint-every {c}: a positive time");
+        }
+        Ok(tasks)
+    }
+}
+
+/// Array indices as SLURM writes them: runs of consecutive indices as `a-b`, joined by
+/// commas (`0-3,7,9-10`); `indices` sorted.
+pub fn array_ranges(indices: &[usize]) -> String {
+    let mut out: Vec<String> = Vec::new();
+    let mut k = 0;
+    while k < indices.len() {
+        let start = indices[k];
+        while k + 1 < indices.len() && indices[k + 1] == indices[k] + 1 {
+            k += 1;
+        }
+        out.push(match indices[k] {
+            end if end == start => start.to_string(),
+            end => format!("{start}-{end}"),
+        });
+        k += 1;
+    }
+    out.join(",")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nonsense_is_refused_by_name() {
+        let ok = SlurmOptions {
+            cpus: 1,
+            ..SlurmOptions::default()
+        };
+        assert_eq!(ok.check(8).unwrap(), 8);
+        assert_eq!(ok.check(5000).unwrap(), DEFAULT_MAX_TASKS);
+        let bad = |o: SlurmOptions, says: &str| {
+            let e = o.check(8).unwrap_err().to_string();
+            assert!(e.contains(says), "{e}");
+        };
+        bad(
+            SlurmOptions {
+                tasks: Some(0),
+                ..ok.clone()
+            },
+            "--tasks 0",
+        );
+        bad(
+            SlurmOptions {
+                tasks: Some(9),
+                ..ok.clone()
+            },
+            "more than the sweep's 8 points",
+        );
+        bad(
+            SlurmOptions {
+                time: Some("banana".into()),
+                ..ok.clone()
+            },
+            "not a SLURM time limit",
+        );
+        bad(
+            SlurmOptions {
+                mem: Some("4 GB".into()),
+                ..ok.clone()
+            },
+            "not a size",
+        );
+        bad(
+            SlurmOptions {
+                account: Some("a b".into()),
+                ..ok.clone()
+            },
+            "--account",
+        );
+        bad(
+            SlurmOptions {
+                throttle: Some(0),
+                ..ok.clone()
+            },
+            "--throttle 0",
+        );
+        bad(
+            SlurmOptions {
+                cpus: 0,
+                ..ok.clone()
+            },
+            "--cpus 0",
+        );
+        for t in [
+            "30",
+            "30:00",
+            "1:00:00",
+            "2-0",
+            "2-12:00",
+            "1-00:00:00",
+            "UNLIMITED",
+        ] {
+            assert!(time_ok(t), "{t}");
+        }
+        for t in ["", "1:2:3:4", "1h", "-1", "1-", "a-1"] {
+            assert!(!time_ok(t), "{t}");
+        }
+        for m in ["4G", "500", "500M", "1t"] {
+            assert!(mem_ok(m), "{m}");
+        }
+        for m in ["", "G", "4GB", "4.5G", "-4G"] {
+            assert!(!mem_ok(m), "{m}");
+        }
+    }
+
+    #[test]
+    fn array_ranges_join_runs() {
+        assert_eq!(array_ranges(&[0, 1, 2, 3, 7, 9, 10]), "0-3,7,9-10");
+        assert_eq!(array_ranges(&[5]), "5");
+        assert_eq!(array_ranges(&[]), "");
+        let job = ArrayJob {
+            tasks: 4,
+            throttle: Some(2),
+            script: "/d/slurm.sh".into(),
+        };
+        assert_eq!(job.task_of(13), 1);
+        assert_eq!(
+            job.rerun(&[13, 1, 2, 7, 3]).unwrap(),
+            "sbatch --array=1-3%2 /d/slurm.sh"
+        );
+        assert_eq!(job.rerun(&[]), None);
+    }
+}
