@@ -20,9 +20,11 @@
 //! metric).
 
 mod blocked;
+mod free;
 mod jobs;
 
 pub(crate) use blocked::{assemble_apply_then, band_rows};
+pub use free::free_product;
 pub(crate) use jobs::{Packed, by_bands, by_bands_and, reduce};
 
 use crate::error::ParticleError;
@@ -35,6 +37,12 @@ pub trait Parallel: core::fmt::Debug {
     /// Runs every job exactly once, in any order or at once, and returns when all are
     /// done. The jobs share no mutable state, so any schedule gives the same result.
     fn run(&self, jobs: &mut [&mut (dyn FnMut() + Send)]);
+
+    /// Threads the jobs may run on at once (1 by default): what the choice of a product
+    /// path reads ([`Path::choose`]). Never changes a result's bits.
+    fn threads(&self) -> usize {
+        1
+    }
 }
 
 /// One job after the other on the calling thread (the default, and firmware's).

@@ -49,4 +49,8 @@ impl Parallel for Threads {
         self.pool
             .install(|| jobs.par_iter_mut().with_max_len(1).for_each(|job| job()));
     }
+
+    fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
 }

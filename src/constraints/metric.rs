@@ -43,6 +43,11 @@ pub enum Metric<'a, T: Real> {
         scale: T,
         /// How its products run ([`crate::parallel::product`]).
         par: &'a dyn Parallel,
+        /// The compact `f32` copy of `mu` ([`crate::noise::reduced`]) when the
+        /// products of [`Metric::apply_all`] read it (mixed precision,
+        /// [`Params::compact_products`](crate::Params::compact_products)); `None`:
+        /// they read `mu`. Everything else reads `mu`.
+        compact: Option<&'a [T::M3]>,
     },
     /// The same hydrodynamic metric without a stored mobility: each pair block is
     /// evaluated where it is used (matrix-free; bit-identical to [`Metric::Mobility`]).
@@ -394,10 +399,14 @@ impl<T: Real> Metric<'_, T> {
                 grad,
                 scale,
                 par,
+                compact,
             } => {
                 let (f, bands) = tmp.split_at_mut(n);
                 spread(bonds, grad, c, scale, f);
-                crate::parallel::product::<T>(par, mu, n, f, out, bands);
+                match compact {
+                    Some(copy) => crate::noise::reduced::apply::<T>(par, copy, n, f, out, bands),
+                    None => crate::parallel::product::<T>(par, mu, n, f, out, bands),
+                }
             }
             Metric::Free {
                 level,

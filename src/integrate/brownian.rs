@@ -116,6 +116,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         disp,
         lambda: &mut *lambda,
         scratch: &mut scratch,
+        compact: &[],
     };
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, xi);
@@ -286,7 +287,7 @@ pub(super) fn kick<T: Real>(
                     h.grad_mid,
                     T::ONE,
                     h.disp,
-                    par,
+                    (par, &[]),
                 );
                 let solver = midpoint_solver(p, lanczos, h.bonds, h.grad_mid, dx);
                 let problem = Problem::Velocities {

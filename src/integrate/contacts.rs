@@ -45,6 +45,9 @@ pub(super) struct Projection<'l, 'v, 'a, T: Real> {
     pub disp: &'v mut [T::V3],
     pub lambda: &'v mut [T],
     pub scratch: &'v mut Scratch<'a, T>,
+    /// The compact copy of the mobility the constraint products read
+    /// ([`Params::compact_products`]); empty: they read the mobility.
+    pub compact: &'v [T::M3],
 }
 
 /// What the overdamped position projection did.
@@ -87,6 +90,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         disp,
         lambda,
         scratch,
+        compact,
     } = v;
     // Constants without the `contacts` feature: the one-sided path folds away.
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
@@ -124,7 +128,17 @@ pub(super) fn project_overdamped<'l, T: Real>(
         };
         bond_vectors(active, start, super::cell(p), grad);
         let par = scratch.par;
-        let metric = mobility_metric(p, active, start, radius, mu, grad, p.dt, disp, par);
+        let metric = mobility_metric(
+            p,
+            active,
+            start,
+            radius,
+            mu,
+            grad,
+            p.dt,
+            disp,
+            (par, compact),
+        );
         free(x);
         shift(x, wall, -T::ONE);
         let stats = project_positions(p, active, &metric, x, lambda, scratch)?;

@@ -63,7 +63,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
     grad: &'a [T::V3],
     scale: T,
     disp: &'a mut [T::V3],
-    par: &'a dyn Parallel,
+    (par, compact): (&'a dyn Parallel, &'a [T::M3]),
 ) -> Metric<'a, T> {
     if p.matrix_free {
         return Metric::Free {
@@ -83,6 +83,8 @@ pub(super) fn mobility_metric<'a, T: Real>(
             grad,
             scale,
             par,
+            // The compact copy when the step keeps one (`Params::compact_products`).
+            compact: (!compact.is_empty()).then_some(compact),
         };
     }
     let n = pos.len();

@@ -196,7 +196,7 @@ where
 /// (which starts at column `j0`) summed into `acc` in column order, their transposed
 /// products with `x_i` added to `outs`.
 #[inline(always)]
-fn runs<T: Real>(
+pub(super) fn runs<T: Real>(
     src: Pairs<'_, T>,
     i: usize,
     j0: usize,

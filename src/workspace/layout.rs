@@ -133,6 +133,15 @@ impl Layout {
         } else {
             l
         };
+        let l = if p.compact_copy(n, bonds) {
+            // The compact copy of the mobility (`Params::compact_products`).
+            Self {
+                blocks: l.blocks + crate::noise::reduced::slots(n),
+                ..l
+            }
+        } else {
+            l
+        };
         if p.matrix_free {
             l.matrix_free(p.method, p.solver_kind(n, bonds), n, c)
         } else {

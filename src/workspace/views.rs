@@ -103,7 +103,14 @@ impl<T: Real> Workspace<'_, T> {
         };
         let mu = bl.take(if stored { tri(m) } else { 0 });
         let factor = mats == 2 && !(lanczos && (uncorrected || !stored));
-        let fac = bl.take(if factor { tri(m) } else { 0 });
+        // The compact copy of the mobility lives where a factor would
+        // (`Params::compact_products`: first-order Overdamped without noise, no factor).
+        let compact = p.compact_copy(n, bonds);
+        let fac = bl.take(match (factor, compact) {
+            (true, _) => tri(m),
+            (false, true) => crate::noise::reduced::slots(n),
+            (false, false) => 0,
+        });
         let (work_a, work_b, work_c) = (ve.take(work[0]), ve.take(work[1]), ve.take(work[2]));
         let grad_new = ve.take(extra_bonds);
         let kappa = sc.take(extra_bonds);
