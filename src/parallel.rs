@@ -25,7 +25,7 @@ mod jobs;
 
 pub(crate) use blocked::{assemble_apply_then, band_rows};
 pub use free::free_product;
-pub(crate) use jobs::{Packed, by_bands, by_bands_and, reduce};
+pub(crate) use jobs::{Packed, by_bands, by_bands_and, map_bands, reduce};
 
 use crate::error::ParticleError;
 use crate::linalg::tri;

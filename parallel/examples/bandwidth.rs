@@ -91,6 +91,9 @@ fn paths(n: usize, par: &dyn Parallel) -> [f64; 3] {
     parallel::assemble::<f64>(par, Hydro::Rpy, 1.0, &pos, &radius, &mut mu).unwrap();
     let mut copy = vec![f64::M3_ZERO; reduced::slots(n)];
     reduced::copy_apply::<f64>(par, &mu, n, &mut copy, &x, &mut y, &mut z);
+    let packed = best(3, || {
+        reduced::copy_apply::<f64>(par, &mu, n, &mut copy, &x, &mut y, &mut z)
+    });
     let stored = best(5, || {
         parallel::product::<f64>(par, &mu, n, &x, &mut y, &mut z)
     });
@@ -101,6 +104,11 @@ fn paths(n: usize, par: &dyn Parallel) -> [f64; 3] {
         parallel::free_product::<f64>(par, Hydro::Rpy, 1.0, &pos, &radius, &x, &mut y, &mut z)
             .unwrap()
     });
+    eprintln!(
+        "  ({} threads: packing the copy while applying it {:.2} ns/pair)",
+        par.threads(),
+        packed / (n * (n + 1) / 2) as f64 * 1e9
+    );
     [stored, compact, free]
 }
 
