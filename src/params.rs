@@ -187,10 +187,13 @@ pub struct Params<T: Real> {
     /// [`Method::RattleStable`] they are integrated with rotational inertia; otherwise
     /// reported as `Omega_inf + mu_rt F`). Default false.
     pub rotation: bool,
-    /// Matrix-free mobility: never store `mu_tt`, evaluate each pair block where it is
-    /// used (storage `O(N + B)`; the same bits as the stored path below
-    /// [`BANDED_MIN`](crate::parallel::BANDED_MIN) beads, where the stored path does not
-    /// yet sum in bands; at the cost of one pair evaluation per block per product). Honoured by [`Method::Overdamped`] and
+    /// Matrix-free mobility (the recompute path): never store `mu_tt`, evaluate each
+    /// pair block where it is used (storage `O(N + B)`; at the cost of one pair
+    /// evaluation per block per product, which is compute, not memory traffic, so it
+    /// scales with the cores: [`crate::parallel::free_product`]). In free space the
+    /// same bits as the stored path at every size and on any number of threads (the
+    /// same bands); above a wall or in a periodic box the same bits as the stored path
+    /// below [`BANDED_MIN`](crate::parallel::BANDED_MIN) beads, on one thread. Honoured by [`Method::Overdamped`] and
     /// [`Method::Springs`]; the other methods factorise or keep a second mobility and
     /// refuse it ([`StepError::BadParameter`](crate::StepError::BadParameter)).
     /// Default false.

@@ -1,5 +1,5 @@
-//! The product paths on a thread pool: the recompute path (`parallel::free_product`)
-//! gives the stored banded product's bits, and the mixed-precision constraint solve
+//! The product paths on a thread pool: the recompute path (`parallel::free_product`,
+//! `Params::matrix_free`) gives the stored banded product's bits, and the mixed-precision constraint solve
 //! (`Params::compact_products`: `f32` products, `f64` residuals) meets the solver's tolerance, measured here from the
 //! positions, and gives the same bits on any thread count.
 
@@ -79,11 +79,12 @@ fn recomputed_products_are_the_stored_products_bits_on_any_thread_count() {
     assert_eq!(got, want);
 }
 
-/// Steps of a settling `n`-bead helix through `par`; positions and the last report.
+/// Steps of a settling `n`-bead helix through `par` (with `compact_products`, with
+/// `matrix_free`); positions and the last report.
 fn settle(
     n: usize,
     steps: usize,
-    compact: bool,
+    (compact, free): (bool, bool),
     par: &dyn Parallel,
 ) -> (Vec<DVec3>, StepReport<f64>) {
     let start = helix(n);
@@ -97,6 +98,7 @@ fn settle(
     let (radius, density) = (vec![1.0; n], vec![4.5; n]);
     let mut p = Params::<f64>::new(0.05);
     p.compact_products = compact;
+    p.matrix_free = free;
     assert_eq!(p.compact_copy(n, n - 1), compact);
     let mut store = Buffers::<f64>::new(Layout::for_params(&p, n, n - 1));
     let mut ws = store.workspace().with_parallel(par);
@@ -127,8 +129,8 @@ fn settle(
 #[test]
 fn mixed_precision_constraints_meet_the_tolerance_with_the_same_bits_on_any_thread_count() {
     let n = 1024;
-    let (exact, exact_report) = settle(n, 3, false, &Serial);
-    let (serial, report) = settle(n, 3, true, &Serial);
+    let (exact, exact_report) = settle(n, 3, (false, false), &Serial);
+    let (serial, report) = settle(n, 3, (true, false), &Serial);
     // Both meet the tolerance; they differ by the rounded mobility's share of the
     // constraint moves (~1e-7 of them), far below a step's move (~0.02 per step).
     let gap = serial
@@ -144,7 +146,19 @@ fn mixed_precision_constraints_meet_the_tolerance_with_the_same_bits_on_any_thre
     );
     for t in [2, 3] {
         let pool = Threads::new(t).unwrap();
-        let (threaded, _) = settle(n, 3, true, &pool);
+        let (threaded, _) = settle(n, 3, (true, false), &pool);
         assert_eq!(bits(&threaded), bits(&serial), "{t} threads");
+    }
+}
+
+#[test]
+fn matrix_free_steps_are_the_stored_steps_bits_on_any_thread_count() {
+    // 700 beads: sixteen bands, the Krylov solve.
+    let n = 700;
+    let (stored, _) = settle(n, 2, (false, false), &Serial);
+    for t in [1, 2, 3] {
+        let pool = Threads::new(t).unwrap();
+        let (free, _) = settle(n, 2, (false, true), &pool);
+        assert_eq!(bits(&free), bits(&stored), "{t} threads");
     }
 }

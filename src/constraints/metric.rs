@@ -15,7 +15,7 @@ use crate::cell::Periodic;
 use crate::linalg::{self, tri};
 #[cfg(feature = "periodic")]
 use crate::mobility::periodic;
-use crate::mobility::{Hydro, tt_block_at, tt_product, wall};
+use crate::mobility::{Hydro, tt_block_at, wall};
 use crate::parallel::Parallel;
 use crate::real::Real;
 
@@ -71,6 +71,9 @@ pub enum Metric<'a, T: Real> {
         /// The periodic box and the largest radius when the step has one (its Ewald
         /// parameters are derived from them where a block or product is evaluated).
         cell: Option<(Periodic<T>, T)>,
+        /// How its free-space products run ([`crate::parallel::free_product`], the bits
+        /// of the stored product on any number of threads).
+        par: &'a dyn Parallel,
     },
     /// Precomputed displacements `disp[l * beads + p]` (`bonds x beads`, bond-major: a
     /// multiplier's moves of all beads are contiguous, so the table is written in order
@@ -230,6 +233,7 @@ impl<T: Real> Metric<'_, T> {
                 scale,
                 wall,
                 cell,
+                ..
             } => {
                 #[cfg(feature = "periodic")]
                 if let Some((c, a_max)) = cell {
@@ -371,8 +375,9 @@ impl<T: Real> Metric<'_, T> {
 
     /// `out = sum_l c_l D_l` over all bonds at once (the Krylov solver's product):
     /// `G^T c`, then one mobility product (and one drag solve). `tmp` holds at least
-    /// `2m` vectors (`m` block rows of the mobility), and for [`Metric::Mobility`] `n`
-    /// and the product's [`band_scratch`](crate::parallel::band_scratch).
+    /// `2m` vectors (`m` block rows of the mobility), and for [`Metric::Mobility`] and
+    /// [`Metric::Free`] `n` and the product's
+    /// [`band_scratch`](crate::parallel::band_scratch).
     pub fn apply_all(&self, bonds: &[Bond<T>], c: &[T], out: &mut [T::V3], tmp: &mut [T::V3]) {
         let n = out.len();
         match *self {
@@ -417,8 +422,9 @@ impl<T: Real> Metric<'_, T> {
                 scale,
                 wall,
                 cell,
+                par,
             } => {
-                let f = &mut tmp[..n];
+                let (f, bands) = tmp.split_at_mut(n);
                 spread(bonds, grad, c, scale, f);
                 // Nested pairs were refused by the product at these positions.
                 #[cfg(feature = "periodic")]
@@ -435,7 +441,9 @@ impl<T: Real> Metric<'_, T> {
                     Some(h) if cfg!(feature = "wall") => {
                         wall::tt_product(level, eta, h, pos, radius, f, out)
                     }
-                    _ => tt_product(level, eta, pos, radius, f, out),
+                    _ => crate::parallel::free_product::<T>(
+                        par, level, eta, pos, radius, f, out, bands,
+                    ),
                 };
                 if done.is_err() {
                     out.fill(T::V3_ZERO);

@@ -220,7 +220,7 @@ pub(super) fn kick<T: Real>(
     let mut copied = reduced && copied;
     let product = |v: &[T::V3], w: &mut [T::V3]| {
         if p.matrix_free {
-            let _ = free_product(p, s.pos, s.radius, v, w);
+            let _ = free_product(p, s.pos, s.radius, v, w, (par, &mut *bands));
         } else if reduced && copied {
             reduced::apply::<T>(par, fac, n, v, w, bands);
         } else if reduced {

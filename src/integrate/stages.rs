@@ -27,7 +27,7 @@ pub(super) fn mobility_product<T: Real>(
     bands: &mut [T::V3],
 ) -> Result<(), StepError> {
     if p.matrix_free {
-        return free_product(p, pos, radius, f, u);
+        return free_product(p, pos, radius, f, u, (par, bands));
     }
     #[cfg(feature = "periodic")]
     if let Some(c) = ewald_cell(p) {
@@ -75,6 +75,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
             scale,
             wall: wall_height(p),
             cell: ewald_cell(p).map(|c| (c, radius.iter().fold(T::ZERO, |m, &a| m.max(a)))),
+            par,
         };
     }
     if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
@@ -96,13 +97,15 @@ pub(super) fn mobility_metric<'a, T: Real>(
 }
 
 /// `u = mu_tt(pos) f` matrix-free: every pair block evaluated where it is used (above
-/// the wall if there is one).
+/// the wall if there is one). In free space in the bands of the stored product through
+/// `par` (`bands`: their scratch), with its bits.
 pub(super) fn free_product<T: Real>(
     p: &Params<T>,
     pos: &[T::V3],
     radius: &[T],
     f: &[T::V3],
     u: &mut [T::V3],
+    (par, bands): (&dyn Parallel, &mut [T::V3]),
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
     if let Some(c) = ewald_cell(p) {
@@ -111,7 +114,7 @@ pub(super) fn free_product<T: Real>(
     let (level, eta) = (p.hydro, p.viscosity);
     match wall_height(p) {
         Some(h) => mobility::wall::tt_product(level, eta, h, pos, radius, f, u)?,
-        None => mobility::tt_product(level, eta, pos, radius, f, u)?,
+        None => crate::parallel::free_product::<T>(par, level, eta, pos, radius, f, u, bands)?,
     }
     Ok(())
 }

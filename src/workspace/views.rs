@@ -117,7 +117,8 @@ impl<T: Real> Workspace<'_, T> {
         let inv_mass = sc.take(inv_mass);
         let sqrt_m = sc.take(sqrt_m);
         let disp = ve.take(disp);
-        let banded = stored && matches!(method, Method::Overdamped | Method::Springs);
+        // Stored or matrix-free, the products sum in bands (`parallel::free_product`).
+        let banded = matches!(method, Method::Overdamped | Method::Springs);
         let bands = ve.take(if banded { band_scratch(n) } else { 0 });
         let constrained = !matches!(method, Method::Springs);
         let newton = constrained && matches!(kind, SolverKind::Newton);
@@ -131,7 +132,7 @@ impl<T: Real> Workspace<'_, T> {
                 0
             }),
             beads: ve.take(if constrained && krylov {
-                2 * n + 2 * m + if stored { band_scratch(m) } else { 0 }
+                2 * n + 2 * m + band_scratch(m)
             } else {
                 0
             }),
