@@ -10,7 +10,7 @@
 //!    `f64` blocks (72 bytes and 36 flops a pair), the compact `f32` copy (24 bytes, 36
 //!    `f32` flops) and the recompute path (no bytes, 63 + 36 flops): ns per pair and the
 //!    bytes per second each stream drew.
-//! 3. The model: a path's time per pair on `t` threads is the larger of its bytes over
+//! 3. The model (`hydrorattle_parallel::model`): a path's time per pair on `t` threads is the larger of its bytes over
 //!    the bandwidth of `t` threads and its one-thread compute time over `t`; the
 //!    bandwidth of `t` threads is `min(t b1, B)` (`b1` one thread's read rate measured,
 //!    `B` the machine's: measured here; for a machine of CORES cores `SAT b1`, or when
@@ -25,6 +25,7 @@ use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{self, Parallel, Serial, band_scratch};
 use hydrorattle::{Hydro, Real};
 use hydrorattle_parallel::Threads;
+use hydrorattle_parallel::model::{Machine, Path};
 use rayon::prelude::*;
 
 /// Doubles per probe array (256 MB: far beyond any last-level cache here).
@@ -112,14 +113,6 @@ fn paths(n: usize, par: &dyn Parallel) -> [f64; 3] {
     [stored, compact, free]
 }
 
-/// Bytes a pair streams on each path.
-const BYTES: [f64; 3] = [72.0, 24.0, 0.0];
-
-/// Predicted ns per pair on `t` threads: `max(bytes / min(t b1, bw), ns1 / t)`.
-fn model(ns1: f64, bytes: f64, t: f64, b1: f64, bw: f64) -> f64 {
-    (bytes / (t * b1).min(bw)).max(ns1 / t)
-}
-
 fn main() {
     let arg = |k: usize, d: f64| {
         std::env::args()
@@ -153,59 +146,62 @@ fn main() {
     let pairs = (n * (n + 1) / 2) as f64;
     let one = paths(n, &Serial);
     let many = paths(n, pools.last().unwrap());
-    let names = ["stored f64", "compact f32", "recompute"];
-    for k in 0..3 {
+    for (k, path) in Path::ALL.into_iter().enumerate() {
         let (ns1, nst) = (one[k] / pairs * 1e9, many[k] / pairs * 1e9);
         println!(
-            "N = {n} {:>11}: 1 thread {ns1:.2} ns/pair {:.1} GB/s; {threads} threads {nst:.2} ns/pair {:.1} GB/s ({:.2}x)",
-            names[k],
-            BYTES[k] / ns1,
-            BYTES[k] / nst,
+            "N = {n} {path:?}: 1 thread {ns1:.2} ns/pair {:.1} GB/s; {threads} threads {nst:.2} ns/pair {:.1} GB/s ({:.2}x)",
+            path.bytes() / ns1,
+            path.bytes() / nst,
             ns1 / nst
         );
     }
-    // The Overdamped step: one assembly pass (the recompute path's pair work, writing
-    // 72 bytes a pair, 96 with the compact copy; nothing when recomputing) and `k`
-    // products (5 a step on the bench helix at N = 1024 and 4096).
+    // The Overdamped step (`hydrorattle_parallel::model`): one assembly pass and `k`
+    // products (the bench helix takes 4 to 5 at N = 1024 to 4096).
     let k = 5.0;
-    let ns1: Vec<f64> = one.iter().map(|s| s / pairs * 1e9).collect();
-    let step = |path: usize, t: f64, bw: f64| {
-        let written = [72.0, 96.0, 0.0][path];
-        model(ns1[2], written, t, b1, bw) + k * model(ns1[path], BYTES[path], t, b1, bw)
+    let here = Machine {
+        b1,
+        b: bmax,
+        ns: one.map(|s| s / pairs * 1e9),
     };
-    let speedup = |path: usize, t: f64, bw: f64| step(path, 1.0, bw) / step(path, t, bw);
+    let speedup = |m: &Machine, path: Path, t: f64| m.step(path, 1.0, k) / m.step(path, t, k);
     // The model machine's bandwidth in units of one thread's (`SAT`), or else fitted to
     // the issue's 16-core Xeon: stored f64 at N = 4096, 4.87x on 16 threads.
+    let with = |sat: f64| Machine {
+        b: sat * b1,
+        ..here
+    };
     let sat = match target_sat {
         s if s > 0.0 => s,
         _ => (10..=400)
             .map(|s| s as f64 / 10.0)
             .min_by(|&a, &b| {
-                let miss = |s: f64| (speedup(0, 16.0, s * b1) - 4.87).abs();
+                let miss = |s: f64| (speedup(&with(s), Path::Stored, 16.0) - 4.87).abs();
                 miss(a).total_cmp(&miss(b))
             })
             .unwrap_or(1.0),
     };
+    let big = with(sat);
     println!(
         "model: b1 = {b1:.1} GB/s a thread, B = {bmax:.1} GB/s here ({:.2} b1); the {cores}-core \
          machine B = {sat:.1} b1 (stored f64 there: 8 threads {:.2}x, 16 threads {:.2}x; \
          the issue measured 4.57x and 4.87x)",
         bmax / b1,
-        speedup(0, 8.0, sat * b1),
-        speedup(0, 16.0, sat * b1)
+        speedup(&big, Path::Stored, 8.0),
+        speedup(&big, Path::Stored, 16.0)
     );
-    for (label, t, bw) in [
-        ("MEASURED here", threads as f64, bmax),
-        ("PREDICTED", cores, sat * b1),
+    for (label, t, m) in [
+        ("MODEL of this machine", threads as f64, here),
+        ("MODEL of the bigger machine", cores, big),
     ] {
-        for (path, name) in names.iter().enumerate() {
+        for path in Path::ALL {
             println!(
-                "  {label}, {t} threads, {name}: step {:.1} ns/pair, speedup {:.2}x over its 1 thread, \
-                 {:.2}x over 1 thread stored f64",
-                step(path, t, bw),
-                speedup(path, t, bw),
-                step(0, 1.0, bw) / step(path, t, bw)
+                "  {label}, {t} threads, {path:?}: step {:.1} ns/pair, speedup {:.2}x over its 1 thread, \
+                 {:.2}x over 1 thread Stored",
+                m.step(path, t, k),
+                speedup(&m, path, t),
+                m.step(Path::Stored, 1.0, k) / m.step(path, t, k)
             );
         }
+        println!("  {label}, {t} threads: fastest {:?}", m.fastest(t, k));
     }
 }

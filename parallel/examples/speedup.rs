@@ -4,7 +4,8 @@
 //! `cargo run --release -p hydrorattle-parallel --example speedup -- [N] [STEPS] [THREADS] [MODE]`
 //! (defaults 2048, 5, 2, `plain`). MODE `plain`: the deterministic step (the default
 //! parameters); `compact`: with [`Params::compact_products`] (the constraint products
-//! from the `f32` copy); `brownian`: the thermal step (kT = 1, midpoint drift, Lanczos
+//! from the `f32` copy); `free`: [`Params::matrix_free`] (every product recomputes its
+//! pairs: compute-bound, the path that scales with cores); `brownian`: the thermal step (kT = 1, midpoint drift, Lanczos
 //! noise from the reduced copy; the same noise seed on every run), the Brownian twin.
 //! Each thread count runs the same steps from the same start three times; the best time
 //! is kept (the machine may be shared). The constraint products (and Lanczos
@@ -50,9 +51,10 @@ fn main() {
     match mode.as_str() {
         "plain" => {}
         "compact" => p.compact_products = true,
+        "free" => p.matrix_free = true,
         "brownian" => p.brownian = Some(Brownian::new(1.0)),
         other => {
-            eprintln!("unknown mode {other:?}: plain, compact or brownian");
+            eprintln!("unknown mode {other:?}: plain, compact, free or brownian");
             std::process::exit(2);
         }
     }

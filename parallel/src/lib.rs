@@ -21,6 +21,8 @@
 use hydrorattle::Parallel;
 use rayon::prelude::*;
 
+pub mod model;
+
 /// A rayon thread pool that runs the kernel's bands.
 #[derive(Debug)]
 pub struct Threads {
