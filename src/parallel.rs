@@ -38,8 +38,9 @@ pub trait Parallel: core::fmt::Debug {
     /// done. The jobs share no mutable state, so any schedule gives the same result.
     fn run(&self, jobs: &mut [&mut (dyn FnMut() + Send)]);
 
-    /// Threads the jobs may run on at once (1 by default): what the choice of a product
-    /// path reads ([`Path::choose`]). Never changes a result's bits.
+    /// Threads the jobs may run on at once (1 by default), for a host that chooses a
+    /// product path by the thread count (`hydrorattle_parallel::model`). Nothing in the
+    /// kernel's results depends on it.
     fn threads(&self) -> usize {
         1
     }

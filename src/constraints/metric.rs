@@ -51,7 +51,7 @@ pub enum Metric<'a, T: Real> {
     },
     /// The same hydrodynamic metric without a stored mobility: each pair block is
     /// evaluated where it is used (matrix-free; bit-identical to [`Metric::Mobility`]).
-    /// The positions must have passed a product at these positions ([`tt_product`]),
+    /// The positions must have passed a product at these positions ([`tt_product`](crate::mobility::tt_product)),
     /// which refuses nested spheres.
     Free {
         /// Hydrodynamic level.

@@ -46,8 +46,8 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     } = v;
     // Forces and mobility at the start; unconstrained velocity U_inf + mu F.
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    // With `Params::compact_products` each band of the assembly also writes its rows of
-    // the compact copy (in `fac`) while its blocks are in cache.
+    // With `Params::compact_products` the assembly also writes each row of the compact
+    // copy (in `fac`) while the row's blocks are in cache.
     let compact = p.compact_copy(n, bonds.len());
     if compact {
         let pairs = (p.hydro, p.viscosity, s.pos, s.radius);

@@ -163,8 +163,8 @@ fn fused_rows_then<T: Real>(
 /// [`BANDED_MIN`](super::BANDED_MIN)): a second use of the blocks without a second pass
 /// over memory (the reduced copy of the Lanczos noise and of
 /// [`Params::compact_products`](crate::Params::compact_products)). Row by row, not band
-/// by band: a band of a large mobility is out of cache by its end (N = 4096: the copy's
-/// pass 16.9 -> ... ns a pair). The same blocks and product bits either way.
+/// by band: a band of a large mobility (38 MB at N = 4096) is out of cache by its end,
+/// and packing it afterwards read it back from memory. The same blocks and product bits either way.
 /// (`assemble_apply` itself does not go through here: as a generic over `then` it
 /// cost the Brownian firmware 3.7 kB of flash.)
 #[allow(clippy::too_many_arguments)]
