@@ -1,6 +1,8 @@
-//! Measures this machine's practical peak floating-point rate for the build the kernel
-//! uses (no target-cpu flags: SSE2, no FMA): independent multiply-adds on data that
-//! stays in L1, which the compiler vectorises. Prints GFLOP/s for f64 and f32.
+//! Measures this machine's practical peak floating-point rate for the build it is
+//! compiled as (the default: SSE2; the fast build, `--config .cargo/x86-64-v3.toml`:
+//! AVX2, docs/BENCHMARKS.md), without FMA either way (Rust fuses nothing it is not
+//! told to): independent multiply-adds on data that stays in L1, which the compiler
+//! vectorises. Prints GFLOP/s for f64 and f32.
 //!
 //! `cargo run --release --example peak`
 
@@ -31,9 +33,14 @@ where
     (2.0 * L as f64 * reps as f64) / best / 1e9
 }
 
+/// Independent `f64` chains: twelve registers' worth of lanes (two lanes each with SSE2,
+/// four with AVX), enough to hide a multiply's and an add's latency on two pipes each,
+/// few enough to stay in the sixteen registers.
+const CHAINS: usize = if cfg!(target_feature = "avx") { 48 } else { 24 };
+
 fn main() {
-    let f64_rate = rate::<f64, 24>(0.0, black_box(0.999_999), black_box(1e-9));
-    let f32_rate = rate::<f32, 48>(0.0, black_box(0.999_9), black_box(1e-7));
+    let f64_rate = rate::<f64, CHAINS>(0.0, black_box(0.999_999), black_box(1e-9));
+    let f32_rate = rate::<f32, { 2 * CHAINS }>(0.0, black_box(0.999_9), black_box(1e-7));
     println!(
         "peak multiply-add rate, one core: f64 {f64_rate:.2} GFLOP/s, f32 {f32_rate:.2} GFLOP/s"
     );

@@ -20,12 +20,14 @@
 //! metric).
 
 mod blocked;
+mod free;
 mod jobs;
 
 pub(crate) use blocked::{assemble_apply_then, band_rows};
+pub use free::free_product;
 #[cfg(feature = "pse")]
 pub(crate) use jobs::{Jobs, run_all};
-pub(crate) use jobs::{Packed, by_bands, by_bands_and, reduce};
+pub(crate) use jobs::{Packed, by_bands, by_bands_and, map_bands, reduce};
 
 use crate::error::ParticleError;
 use crate::linalg::tri;
@@ -37,6 +39,13 @@ pub trait Parallel: core::fmt::Debug {
     /// Runs every job exactly once, in any order or at once, and returns when all are
     /// done. The jobs share no mutable state, so any schedule gives the same result.
     fn run(&self, jobs: &mut [&mut (dyn FnMut() + Send)]);
+
+    /// Threads the jobs may run on at once (1 by default), for a host that chooses a
+    /// product path by the thread count (`hydrorattle_parallel::model`). Nothing in the
+    /// kernel's results depends on it.
+    fn threads(&self) -> usize {
+        1
+    }
 }
 
 /// One job after the other on the calling thread (the default, and firmware's).

@@ -187,10 +187,13 @@ pub struct Params<T: Real> {
     /// [`Method::RattleStable`] they are integrated with rotational inertia; otherwise
     /// reported as `Omega_inf + mu_rt F`). Default false.
     pub rotation: bool,
-    /// Matrix-free mobility: never store `mu_tt`, evaluate each pair block where it is
-    /// used (storage `O(N + B)`; the same bits as the stored path below
-    /// [`BANDED_MIN`](crate::parallel::BANDED_MIN) beads, where the stored path does not
-    /// yet sum in bands; at the cost of one pair evaluation per block per product). Honoured by [`Method::Overdamped`] and
+    /// Matrix-free mobility (the recompute path): never store `mu_tt`, evaluate each
+    /// pair block where it is used (storage `O(N + B)`; at the cost of one pair
+    /// evaluation per block per product, which is compute, not memory traffic, so it
+    /// scales with the cores: [`crate::parallel::free_product`]). In free space the
+    /// same bits as the stored path at every size and on any number of threads (the
+    /// same bands); above a wall or in a periodic box the same bits as the stored path
+    /// below [`BANDED_MIN`](crate::parallel::BANDED_MIN) beads, on one thread. Honoured by [`Method::Overdamped`] and
     /// [`Method::Springs`]; the other methods factorise or keep a second mobility and
     /// refuse it ([`StepError::BadParameter`](crate::StepError::BadParameter)).
     /// Default false.
@@ -254,6 +257,21 @@ pub struct Params<T: Real> {
     /// half the box's smallest edge is refused with its index
     /// ([`BondError::BadLength`](crate::BondError::BadLength)). Default `None`.
     pub periodic: Option<Periodic<T>>,
+    /// Mixed-precision constraint products: the Krylov constraint solve's products read
+    /// a compact `f32` copy of the stored mobility (24 bytes a block instead of 72,
+    /// written by the assembly's pass, `noise::reduced`; each product right to about
+    /// `1e-7` relative, the approximation the Lanczos noise already makes). The
+    /// residual that must meet [`Solver::tolerance`] is still evaluated in `f64` on the
+    /// positions, so the tolerance holds as with `f64` products; the constraint move is
+    /// `dt M~ G^T lambda` with `M~` the rounded mobility (the unconstrained move stays
+    /// `f64`). A third of the bytes per product: the products stop being bound by
+    /// memory bandwidth on many cores. Taken where [`Params::compact_copy`] says
+    /// (first-order deterministic [`Method::Overdamped`], an `f64` kernel, a stored
+    /// free-space mobility of at least
+    /// [`REDUCED_MIN`](crate::noise::reduced::REDUCED_MIN) beads, the Krylov solver);
+    /// ignored elsewhere. The same bits on any number of threads, not the bits of the
+    /// `f64` products (docs/BENCHMARKS.md, "Product paths"). Default false.
+    pub compact_products: bool,
 }
 
 impl<T: Real> Params<T> {
@@ -290,6 +308,7 @@ impl<T: Real> Params<T> {
             contacts: None,
             wall: None,
             periodic: None,
+            compact_products: false,
         }
     }
 
@@ -329,5 +348,22 @@ impl<T: Real> Params<T> {
     /// cannot disagree.
     pub const fn solver_kind(&self, n: usize, bonds: usize) -> SolverKind {
         self.solver.kind.resolve(self.constraints(n, bonds))
+    }
+
+    /// Whether a step of `n` beads and `bonds` bonds keeps the compact `f32` copy of
+    /// the mobility for its constraint products ([`Params::compact_products`]): asked
+    /// for, first-order [`Method::Overdamped`] without noise, a stored free-space
+    /// mobility (no wall, no box), an `f64` kernel, at least
+    /// [`REDUCED_MIN`](crate::noise::reduced::REDUCED_MIN) beads, the Krylov solver.
+    pub const fn compact_copy(&self, n: usize, bonds: usize) -> bool {
+        self.compact_products
+            && matches!(self.method, Method::Overdamped)
+            && self.brownian.is_none()
+            && !self.matrix_free
+            && self.wall.is_none()
+            && self.periodic.is_none()
+            && core::mem::size_of::<T>() == 8
+            && n >= crate::noise::reduced::REDUCED_MIN
+            && matches!(self.solver_kind(n, bonds), SolverKind::Krylov)
     }
 }

@@ -3,6 +3,10 @@ pygrpy peer (overdamped_numpy.py) in one run, after checking that both give the 
 trajectory (issue 20, item 2).
 
     python3 bench/peer/compare.py [--demo target/release/host-demo] [--scene S] [--rounds 3]
+    python3 bench/peer/compare.py --demo target/release/host-demo --demo target-v3/release/host-demo
+
+With several `--demo` binaries (the default build and the fast x86-64-v3 build), each is
+checked to write a byte-identical trajectory and timed against the same peer run.
 
 1. Agreement: the scene cut to 20 steps with a frame every step is run through
    `host-demo run`; the peer starts from its first frame and must stay within 1e-9 of
@@ -76,12 +80,16 @@ def peer_from(frame, cfg):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--demo", default=str(ROOT / "target/release/host-demo"))
+    ap.add_argument("--demo", action="append", default=None,
+                    help="a host-demo binary; give it more than once (the default build and "
+                         "the fast x86-64-v3 one, docs/BENCHMARKS.md) to time each against the "
+                         "same peer in one run (default target/release/host-demo)")
     ap.add_argument("--scene", default=str(HERE / "helix25.toml"))
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--peer-steps", type=int, default=500)
     ap.add_argument("--threads", type=int, default=None, help="passed to host-demo run")
     args = ap.parse_args()
+    demos = args.demo or [str(ROOT / "target/release/host-demo")]
     text = pathlib.Path(args.scene).read_text()
     cfg = tomllib.loads(text)
     if cfg["fluid"].get("density", 0.0) != 0.0 or cfg["integrator"]["method"] != "overdamped":
@@ -89,11 +97,18 @@ def main():
     dt = cfg["integrator"]["dt"]
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)
-        # 1. Agreement over 20 steps.
+        # 1. Agreement over 20 steps, and every binary's trajectory byte for byte.
         short = tmp / "short.toml"
         short.write_text(toml_text(text, duration=20 * dt, every=1))
-        demo_run(args.demo, short, tmp / "short", args.threads)
-        frames = read_xyz_frames(tmp / "short" / "trajectory.xyz")
+        trajectories = []
+        for k, demo in enumerate(demos):
+            demo_run(demo, short, tmp / f"short{k}", args.threads)
+            trajectories.append((tmp / f"short{k}" / "trajectory.xyz").read_bytes())
+        if any(t != trajectories[0] for t in trajectories):
+            sys.exit("the host-demo binaries' trajectories differ")
+        if len(demos) > 1:
+            print(f"{len(demos)} binaries: trajectories byte-identical")
+        frames = read_xyz_frames(tmp / "short0" / "trajectory.xyz")
         peer = peer_from(frames[0], cfg)
         worst = 0.0
         for k, frame in enumerate(frames[1:], start=1):
@@ -104,24 +119,29 @@ def main():
         if not worst <= 1e-9:
             sys.exit("the peer and the kernel disagree")
         # 2. Speed, alternating, best of `rounds`.
-        demo_best, wall_best, peer_best = np.inf, np.inf, np.inf
+        demo_best = [np.inf] * len(demos)
+        wall_best = [np.inf] * len(demos)
+        peer_best = np.inf
         for _ in range(args.rounds):
-            s, wall = demo_run(args.demo, args.scene, tmp / "full", args.threads)
-            demo_best = min(demo_best, s["wall_time_s"] / s["steps_done"])
-            wall_best = min(wall_best, wall / s["steps_done"])
+            for k, demo in enumerate(demos):
+                s, wall = demo_run(demo, args.scene, tmp / "full", args.threads)
+                demo_best[k] = min(demo_best[k], s["wall_time_s"] / s["steps_done"])
+                wall_best[k] = min(wall_best[k], wall / s["steps_done"])
             peer = peer_from(frames[0], cfg)
             t0 = time.perf_counter()
             for _ in range(args.peer_steps):
                 peer.step()
             peer_best = min(peer_best, (time.perf_counter() - t0) / args.peer_steps)
         steps = s["steps_done"]
-    print(f"host-demo run ({steps} steps, run loop)      {demo_best * 1e6:9.2f} us/step"
-          f"  (mean Newton iterations {s['mean_iterations']:.2f})")
-    print(f"host-demo run (process wall, with start-up) {wall_best * 1e6:9.2f} us/step")
     print(f"NumPy + pygrpy peer ({args.peer_steps} steps)           {peer_best * 1e6:9.2f} us/step"
           f"  (mean Newton iterations {peer.iterations / args.peer_steps:.2f})")
-    print(f"ratio peer / host-demo: {peer_best / demo_best:.1f}x (run loop), "
-          f"{peer_best / wall_best:.1f}x (process wall)")
+    for k, demo in enumerate(demos):
+        print(f"{demo}:")
+        print(f"  host-demo run ({steps} steps, run loop)      {demo_best[k] * 1e6:9.2f} us/step"
+              f"  (mean Newton iterations {s['mean_iterations']:.2f})")
+        print(f"  host-demo run (process wall, with start-up) {wall_best[k] * 1e6:9.2f} us/step")
+        print(f"  ratio peer / host-demo: {peer_best / demo_best[k]:.1f}x (run loop), "
+              f"{peer_best / wall_best[k]:.1f}x (process wall)")
 
 
 if __name__ == "__main__":

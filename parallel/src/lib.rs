@@ -21,6 +21,8 @@
 use hydrorattle::Parallel;
 use rayon::prelude::*;
 
+pub mod model;
+
 /// A rayon thread pool that runs the kernel's bands.
 #[derive(Debug)]
 pub struct Threads {
@@ -48,5 +50,9 @@ impl Parallel for Threads {
     fn run(&self, jobs: &mut [&mut (dyn FnMut() + Send)]) {
         self.pool
             .install(|| jobs.par_iter_mut().with_max_len(1).for_each(|job| job()));
+    }
+
+    fn threads(&self) -> usize {
+        self.pool.current_num_threads()
     }
 }

@@ -17,6 +17,9 @@
 //!   decays as `1/s^3`), so the iteration count barely grows with the chain length.
 //!   If the band is not positive definite, its diagonal (Jacobi) is used instead.
 //! * Reported iterations are PCG iterations, i.e. operator products: the cost count.
+//! * With a compact metric (`Metric::Mobility::compact`) the products read an `f32`
+//!   copy of the mobility; the residual is still evaluated on the positions in `f64`, so the
+//!   tolerance holds as it does for the `f64` products.
 
 use super::{Metric, Problem, Scratch, SolveStats, Solver};
 use crate::bonds::Bond;

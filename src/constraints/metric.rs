@@ -14,7 +14,7 @@ use crate::bonds::Bond;
 use crate::linalg::{self, tri};
 #[cfg(feature = "periodic")]
 use crate::mobility::periodic;
-use crate::mobility::{Hydro, tt_block_at, tt_product, wall};
+use crate::mobility::{Hydro, tt_block_at, wall};
 use crate::parallel::Parallel;
 use crate::real::Real;
 
@@ -42,10 +42,15 @@ pub enum Metric<'a, T: Real> {
         scale: T,
         /// How its products run ([`crate::parallel::product`]).
         par: &'a dyn Parallel,
+        /// The compact `f32` copy of `mu` ([`crate::noise::reduced`]) when the
+        /// products of [`Metric::apply_all`] read it (mixed precision,
+        /// [`Params::compact_products`](crate::Params::compact_products)); `None`:
+        /// they read `mu`. Everything else reads `mu`.
+        compact: Option<&'a [T::M3]>,
     },
     /// The same hydrodynamic metric without a stored mobility: each pair block is
     /// evaluated where it is used (matrix-free; bit-identical to [`Metric::Mobility`]).
-    /// The positions must have passed a product at these positions ([`tt_product`]),
+    /// The positions must have passed a product at these positions ([`tt_product`](crate::mobility::tt_product)),
     /// which refuses nested spheres.
     Free {
         /// Hydrodynamic level.
@@ -66,6 +71,9 @@ pub enum Metric<'a, T: Real> {
         /// interact (derived once per step, not per block: `integrate/periodic.rs`).
         #[cfg(feature = "periodic")]
         ewald: Option<&'a periodic::Ewald<T>>,
+        /// How its free-space products run ([`crate::parallel::free_product`], the bits
+        /// of the stored product on any number of threads).
+        par: &'a dyn Parallel,
     },
     /// Precomputed displacements `disp[l * beads + p]` (`bonds x beads`, bond-major: a
     /// multiplier's moves of all beads are contiguous, so the table is written in order
@@ -226,6 +234,7 @@ impl<T: Real> Metric<'_, T> {
                 wall,
                 #[cfg(feature = "periodic")]
                 ewald,
+                ..
             } => {
                 #[cfg(feature = "periodic")]
                 if let Some(ew) = ewald {
@@ -366,8 +375,9 @@ impl<T: Real> Metric<'_, T> {
 
     /// `out = sum_l c_l D_l` over all bonds at once (the Krylov solver's product):
     /// `G^T c`, then one mobility product (and one drag solve). `tmp` holds at least
-    /// `2m` vectors (`m` block rows of the mobility), and for [`Metric::Mobility`] `n`
-    /// and the product's [`band_scratch`](crate::parallel::band_scratch).
+    /// `2m` vectors (`m` block rows of the mobility), and for [`Metric::Mobility`] and
+    /// [`Metric::Free`] `n` and the product's
+    /// [`band_scratch`](crate::parallel::band_scratch).
     pub fn apply_all(&self, bonds: &[Bond<T>], c: &[T], out: &mut [T::V3], tmp: &mut [T::V3]) {
         let n = out.len();
         match *self {
@@ -394,10 +404,14 @@ impl<T: Real> Metric<'_, T> {
                 grad,
                 scale,
                 par,
+                compact,
             } => {
                 let (f, bands) = tmp.split_at_mut(n);
                 spread(bonds, grad, c, scale, f);
-                crate::parallel::product::<T>(par, mu, n, f, out, bands);
+                match compact {
+                    Some(copy) => crate::noise::reduced::apply::<T>(par, copy, n, f, out, bands),
+                    None => crate::parallel::product::<T>(par, mu, n, f, out, bands),
+                }
             }
             Metric::Free {
                 level,
@@ -409,8 +423,9 @@ impl<T: Real> Metric<'_, T> {
                 wall,
                 #[cfg(feature = "periodic")]
                 ewald,
+                par,
             } => {
-                let f = &mut tmp[..n];
+                let (f, bands) = tmp.split_at_mut(n);
                 spread(bonds, grad, c, scale, f);
                 // Nested pairs were refused by the product at these positions.
                 #[cfg(feature = "periodic")]
@@ -424,7 +439,9 @@ impl<T: Real> Metric<'_, T> {
                     Some(h) if cfg!(feature = "wall") => {
                         wall::tt_product(level, eta, h, pos, radius, f, out)
                     }
-                    _ => tt_product(level, eta, pos, radius, f, out),
+                    _ => crate::parallel::free_product::<T>(
+                        par, level, eta, pos, radius, f, out, bands,
+                    ),
                 };
                 if done.is_err() {
                     out.fill(T::V3_ZERO);

@@ -117,6 +117,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         lambda: &mut *lambda,
         scratch: &mut scratch,
         ewald: s.ewald,
+        compact: &[],
     };
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, xi);
@@ -220,7 +221,7 @@ pub(super) fn kick<T: Real>(
     let mut copied = reduced && copied;
     let product = |v: &[T::V3], w: &mut [T::V3]| {
         if p.matrix_free {
-            let _ = free_product(p, s.ewald, s.pos, s.radius, v, w);
+            let _ = free_product(p, s.ewald, s.pos, s.radius, v, w, (par, &mut *bands));
         } else if reduced && copied {
             reduced::apply::<T>(par, fac, n, v, w, bands);
         } else if reduced {
@@ -288,7 +289,7 @@ pub(super) fn kick<T: Real>(
                     h.grad_mid,
                     T::ONE,
                     h.disp,
-                    par,
+                    (par, &[]),
                 );
                 let solver = midpoint_solver(p, lanczos, h.bonds, h.grad_mid, dx);
                 let problem = Problem::Velocities {

@@ -47,6 +47,9 @@ pub(super) struct Projection<'l, 'v, 'a, T: Real> {
     pub scratch: &'v mut Scratch<'a, T>,
     /// The step's Ewald parameters in a box ([`super::stages::Sums`]).
     pub ewald: super::stages::Sums<'v, T>,
+    /// The compact copy of the mobility the constraint products read
+    /// ([`Params::compact_products`]); empty: they read the mobility.
+    pub compact: &'v [T::M3],
 }
 
 /// What the overdamped position projection did.
@@ -90,6 +93,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         lambda,
         scratch,
         ewald,
+        compact,
     } = v;
     // Constants without the `contacts` feature: the one-sided path folds away.
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
@@ -127,7 +131,18 @@ pub(super) fn project_overdamped<'l, T: Real>(
         };
         bond_vectors(active, start, super::cell(p), grad);
         let par = scratch.par;
-        let metric = mobility_metric(p, ewald, active, start, radius, mu, grad, p.dt, disp, par);
+        let metric = mobility_metric(
+            p,
+            ewald,
+            active,
+            start,
+            radius,
+            mu,
+            grad,
+            p.dt,
+            disp,
+            (par, compact),
+        );
         free(x);
         shift(x, wall, -T::ONE);
         let stats = project_positions(p, active, &metric, x, lambda, scratch)?;

@@ -12,6 +12,8 @@ use crate::constraints::{self, Problem, Scratch, SolveStats};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
 use crate::linalg;
+use crate::noise::reduced;
+use crate::parallel;
 use crate::params::Params;
 use crate::real::Real;
 use crate::workspace::Views;
@@ -27,6 +29,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     let (n, dt) = (s.pos.len(), p.dt);
     let Views {
         mu,
+        fac: copy,
         force,
         work_a: u,
         new_pos,
@@ -43,7 +46,18 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     } = v;
     // Forces and mobility at the start; unconstrained velocity U_inf + mu F.
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    mobility_product(p, s.ewald, s.pos, s.radius, mu, force, u, par, bands)?;
+    // With `Params::compact_products` the assembly also writes each row of the compact
+    // copy (in `fac`) while the row's blocks are in cache.
+    let compact = p.compact_copy(n, bonds.len());
+    if compact {
+        let pairs = (p.hydro, p.viscosity, s.pos, s.radius);
+        let side = (&mut *copy, reduced::copy_start as fn(usize) -> usize);
+        let pack = reduced::pack_rows::<T>;
+        parallel::assemble_apply_then(par, pairs, mu, force, u, bands, side, pack)
+            .map_err(StepError::from)?;
+    } else {
+        mobility_product(p, s.ewald, s.pos, s.radius, mu, force, u, par, bands)?;
+    }
     add_flow(p, s.pos, u);
     // Unconstrained move r* = r + dt (U_inf + mu F), then the constraint move through
     // the full mobility: r' = r* + dt mu G^T lambda (bonds, and contacts if on).
@@ -59,6 +73,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         lambda: &mut *lambda,
         scratch: &mut scratch,
         ewald: s.ewald,
+        compact: if compact { &*copy } else { &[] },
     };
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
@@ -102,7 +117,18 @@ fn projected_velocity<T: Real>(
         dt: p.dt,
     };
     let par = scratch.par;
-    let metric = mobility_metric(p, ew, bonds, pos, radius, mu, grad, T::ONE, disp, par);
+    let metric = mobility_metric(
+        p,
+        ew,
+        bonds,
+        pos,
+        radius,
+        mu,
+        grad,
+        T::ONE,
+        disp,
+        (par, &[]),
+    );
     constraints::solve(problem, &metric, bonds, &p.solver, u, kappa, scratch)
 }
 
@@ -158,6 +184,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         lambda: &mut *lambda,
         scratch: &mut sc,
         ewald: s.ewald,
+        compact: &[],
     };
     project_overdamped(p, bonds, s.pos, s.radius, mu0, views, x_p, predict)?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
@@ -179,6 +206,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         lambda: &mut *lambda,
         scratch: &mut sc,
         ewald: s.ewald,
+        compact: &[],
     };
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu0, views, new_pos, trapezoid)?;
     step_velocity(s.pos, new_pos, dt, new_vel);

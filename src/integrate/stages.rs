@@ -45,7 +45,7 @@ pub(super) fn mobility_product<T: Real>(
     bands: &mut [T::V3],
 ) -> Result<(), StepError> {
     if p.matrix_free {
-        return free_product(p, ew, pos, radius, f, u);
+        return free_product(p, ew, pos, radius, f, u, (par, bands));
     }
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
@@ -82,7 +82,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
     grad: &'a [T::V3],
     scale: T,
     disp: &'a mut [T::V3],
-    par: &'a dyn Parallel,
+    (par, compact): (&'a dyn Parallel, &'a [T::M3]),
 ) -> Metric<'a, T> {
     if p.matrix_free {
         return Metric::Free {
@@ -95,6 +95,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
             wall: wall_height(p),
             #[cfg(feature = "periodic")]
             ewald: ew,
+            par,
         };
     }
     let _ = ew; // Read above only with the `periodic` feature.
@@ -104,6 +105,8 @@ pub(super) fn mobility_metric<'a, T: Real>(
             grad,
             scale,
             par,
+            // The compact copy when the step keeps one (`Params::compact_products`).
+            compact: (!compact.is_empty()).then_some(compact),
         };
     }
     let n = pos.len();
@@ -115,7 +118,9 @@ pub(super) fn mobility_metric<'a, T: Real>(
 }
 
 /// `u = mu_tt(pos) f` matrix-free: every pair block evaluated where it is used (above
-/// the wall if there is one, in the box with the step's Ewald sums `ew`).
+/// the wall if there is one, in the box with the step's Ewald sums `ew`). In free space
+/// in the bands of the stored product through `par` (`bands`: their scratch), with its
+/// bits.
 pub(super) fn free_product<T: Real>(
     p: &Params<T>,
     ew: Sums<'_, T>,
@@ -123,6 +128,7 @@ pub(super) fn free_product<T: Real>(
     radius: &[T],
     f: &[T::V3],
     u: &mut [T::V3],
+    (par, bands): (&dyn Parallel, &mut [T::V3]),
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
@@ -132,7 +138,7 @@ pub(super) fn free_product<T: Real>(
     let (level, eta) = (p.hydro, p.viscosity);
     match wall_height(p) {
         Some(h) => mobility::wall::tt_product(level, eta, h, pos, radius, f, u)?,
-        None => mobility::tt_product(level, eta, pos, radius, f, u)?,
+        None => crate::parallel::free_product::<T>(par, level, eta, pos, radius, f, u, bands)?,
     }
     Ok(())
 }

@@ -126,6 +126,22 @@ pub(super) fn fused_rows<T: Real>(
     y: &mut [T::V3],
     z: &mut [T::V3],
 ) -> Result<(), ParticleError> {
+    fused_rows_then(src, out, b0, x, y, z, |_, _| {})
+}
+
+/// [`fused_rows`], handing each row's blocks (`0 ..= i`) to `row_done(i, blocks)` as
+/// soon as they are written, while they are still in the core's cache (a band of a
+/// large mobility is not: 38 MB at N = 4096).
+#[inline(always)]
+fn fused_rows_then<T: Real>(
+    src: Pairs<'_, T>,
+    out: &mut [T::M3],
+    b0: usize,
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+    mut row_done: impl FnMut(usize, &[T::M3]),
+) -> Result<(), ParticleError> {
     src.start(out, b0, x, y, z);
     let base = tri(b0);
     for k in 0..y.len() {
@@ -136,14 +152,19 @@ pub(super) fn fused_rows<T: Real>(
         let (ys, yi) = y[..=k].split_at_mut(k);
         runs(src, i, b0, inside, ys, &x[b0..], &mut acc)?;
         yi[0] += acc;
+        row_done(i, &out[tri(i) - base..=tri(i) - base + i]);
     }
     Ok(())
 }
 
-/// [`assemble_apply`](super::assemble_apply), each band then handing its rows of the
-/// mobility, just written and still in cache, to `then(b0, b1, rows, side_rows)` with
-/// its rows of `side`: a second use of the blocks without a second pass over memory
-/// (the Lanczos noise's reduced copy). The same blocks and product bits either way.
+/// [`assemble_apply`](super::assemble_apply), handing each row `i` of the mobility,
+/// just written and still in cache, to `then(i, i + 1, row, side_rows)` with `side`
+/// from its row `i` on (in one band of rows `0..n` below
+/// [`BANDED_MIN`](super::BANDED_MIN)): a second use of the blocks without a second pass
+/// over memory (the reduced copy of the Lanczos noise and of
+/// [`Params::compact_products`](crate::Params::compact_products)). Row by row, not band
+/// by band: a band of a large mobility (38 MB at N = 4096) is out of cache by its end,
+/// and packing it afterwards read it back from memory. The same blocks and product bits either way.
 /// (`assemble_apply` itself does not go through here: as a generic over `then` it
 /// cost the Brownian firmware 3.7 kB of flash.)
 #[allow(clippy::too_many_arguments)]
@@ -182,10 +203,12 @@ where
         y,
         z,
         |t, rows, st, yt, zt| {
-            let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-            fused_rows::<T>(src, rows, b0, x, yt, zt)?;
-            then(b0, b1, rows, st);
-            Ok(())
+            // Each row goes to `then` as soon as it is written (still in cache).
+            let b0 = band_start(n, t);
+            let first = side_start(b0);
+            fused_rows_then::<T>(src, rows, b0, x, yt, zt, |i, row| {
+                then(i, i + 1, row, &mut st[side_start(i) - first..]);
+            })
         },
     )?;
     reduce::<T>(n, y, z, par);
@@ -196,7 +219,7 @@ where
 /// (which starts at column `j0`) summed into `acc` in column order, their transposed
 /// products with `x_i` added to `outs`.
 #[inline(always)]
-fn runs<T: Real>(
+pub(super) fn runs<T: Real>(
     src: Pairs<'_, T>,
     i: usize,
     j0: usize,

@@ -18,6 +18,24 @@ pub(crate) fn run_all<F: FnMut() + Send>(par: &dyn Parallel, jobs: &mut Jobs<F>)
     par.run(&mut refs);
 }
 
+/// Runs `job(t)` for every band of `n` rows through `par`; the results in band order
+/// (`None` past the last band).
+pub(crate) fn map_bands<R: Send, J>(par: &dyn Parallel, n: usize, job: J) -> [Option<R>; BANDS]
+where
+    J: Fn(usize) -> R + Sync,
+{
+    let mut results: [Option<R>; BANDS] = core::array::from_fn(|_| None);
+    {
+        let mut jobs = Jobs::new();
+        let job = &job;
+        for (t, result) in results.iter_mut().take(bands(n)).enumerate() {
+            let _ = jobs.push(move || *result = Some(job(t)));
+        }
+        run_all(par, &mut jobs);
+    }
+    results
+}
+
 /// The second round: band `s`'s rows of `y` gain the partial sums of the bands below it,
 /// in band order.
 pub(crate) fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn Parallel) {

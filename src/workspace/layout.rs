@@ -133,6 +133,15 @@ impl Layout {
         } else {
             l
         };
+        let l = if p.compact_copy(n, bonds) {
+            // The compact copy of the mobility (`Params::compact_products`).
+            Self {
+                blocks: l.blocks + crate::noise::reduced::slots(n),
+                ..l
+            }
+        } else {
+            l
+        };
         if p.matrix_free {
             l.matrix_free(p.method, p.solver_kind(n, bonds), n, c)
         } else {
@@ -205,16 +214,16 @@ impl Layout {
         n: usize,
         bonds: usize,
     ) -> Self {
+        // The matrix-free products sum in the stored product's bands too
+        // (`parallel::free_product`): their scratch stays.
         let table = match (method, kind.resolve(bonds)) {
             (Method::Overdamped, SolverKind::Sweep | SolverKind::Newton) => n * bonds,
-            // Krylov's scratch for the stored product's band partial sums.
-            (Method::Overdamped, SolverKind::Krylov) => band_scratch(n),
             _ => 0,
         };
         match method {
             Method::Overdamped | Method::Springs => Self {
                 blocks: self.blocks - tri(n),
-                vectors: self.vectors - table - band_scratch(n),
+                vectors: self.vectors - table,
                 ..self
             },
             _ => self,

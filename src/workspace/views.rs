@@ -103,14 +103,22 @@ impl<T: Real> Workspace<'_, T> {
         };
         let mu = bl.take(if stored { tri(m) } else { 0 });
         let factor = mats == 2 && !(lanczos && (uncorrected || !stored));
-        let fac = bl.take(if factor { tri(m) } else { 0 });
+        // The compact copy of the mobility lives where a factor would
+        // (`Params::compact_products`: first-order Overdamped without noise, no factor).
+        let compact = p.compact_copy(n, bonds);
+        let fac = bl.take(match (factor, compact) {
+            (true, _) => tri(m),
+            (false, true) => crate::noise::reduced::slots(n),
+            (false, false) => 0,
+        });
         let (work_a, work_b, work_c) = (ve.take(work[0]), ve.take(work[1]), ve.take(work[2]));
         let grad_new = ve.take(extra_bonds);
         let kappa = sc.take(extra_bonds);
         let inv_mass = sc.take(inv_mass);
         let sqrt_m = sc.take(sqrt_m);
         let disp = ve.take(disp);
-        let banded = stored && matches!(method, Method::Overdamped | Method::Springs);
+        // Stored or matrix-free, the products sum in bands (`parallel::free_product`).
+        let banded = matches!(method, Method::Overdamped | Method::Springs);
         let bands = ve.take(if banded { band_scratch(n) } else { 0 });
         let constrained = !matches!(method, Method::Springs);
         let newton = constrained && matches!(kind, SolverKind::Newton);
@@ -124,7 +132,7 @@ impl<T: Real> Workspace<'_, T> {
                 0
             }),
             beads: ve.take(if constrained && krylov {
-                2 * n + 2 * m + if stored { band_scratch(m) } else { 0 }
+                2 * n + 2 * m + band_scratch(m)
             } else {
                 0
             }),

@@ -1,0 +1,207 @@
+//! A STREAM-like probe of the machine and the product-path model
+//! (docs/BENCHMARKS.md, "Product paths").
+//!
+//! `cargo run --release -p hydrorattle-parallel --example bandwidth -- [N] [THREADS] [CORES] [SAT]`
+//! (defaults 4096, 2, 16, 0).
+//!
+//! 1. Memory bandwidth: a read-only sum (what a product does to its stored blocks) and
+//!    a triad `a = b + s c` over 256 MB arrays, on 1 ... THREADS threads, best of five.
+//! 2. Each product path at N beads on 1 and THREADS threads, best of five: the stored
+//!    `f64` blocks (72 bytes and 36 flops a pair), the compact `f32` copy (24 bytes, 36
+//!    `f32` flops) and the recompute path (no bytes, 63 + 36 flops): ns per pair and the
+//!    bytes per second each stream drew.
+//! 3. The model (`hydrorattle_parallel::model`): a path's time per pair on `t` threads is the larger of its bytes over
+//!    the bandwidth of `t` threads and its one-thread compute time over `t`; the
+//!    bandwidth of `t` threads is `min(t b1, B)` (`b1` one thread's read rate measured,
+//!    `B` the machine's: measured here; for a machine of CORES cores `SAT b1`, or when
+//!    SAT is 0 fitted to the issue's 16-core measurement of the stored path). The
+//!    predicted speedup of the Overdamped step (one fused assembly and `k` products,
+//!    `k` read from a step) at N = 2048 and 4096 on 2 and CORES cores.
+
+use std::time::Instant;
+
+use hydrorattle::glam::DVec3;
+use hydrorattle::noise::reduced;
+use hydrorattle::parallel::{self, Parallel, Serial, band_scratch};
+use hydrorattle::{Hydro, Real};
+use hydrorattle_parallel::Threads;
+use hydrorattle_parallel::model::{Machine, Path};
+use rayon::prelude::*;
+
+/// Doubles per probe array (256 MB: far beyond any last-level cache here).
+const LEN: usize = 32 << 20;
+
+/// Best of `k` runs of `f`, in seconds.
+fn best(k: usize, mut f: impl FnMut()) -> f64 {
+    (0..k).fold(f64::INFINITY, |b, _| {
+        let t0 = Instant::now();
+        f();
+        b.min(t0.elapsed().as_secs_f64())
+    })
+}
+
+/// Read and triad bandwidth (GB/s) on `pool`.
+fn stream(pool: &rayon::ThreadPool, a: &mut [f64], b: &[f64], c: &[f64]) -> (f64, f64) {
+    let chunk = LEN / 64;
+    let read = best(5, || {
+        // Eight running sums a chunk: the adds' latency must not be what is measured.
+        let sum = |x: &[f64]| {
+            let lanes = x.chunks_exact(8).fold([0.0; 8], |mut s, v| {
+                for (s, &v) in s.iter_mut().zip(v) {
+                    *s += v;
+                }
+                s
+            });
+            lanes.iter().sum::<f64>()
+        };
+        let s: f64 = pool.install(|| b.par_chunks(chunk).map(sum).sum());
+        std::hint::black_box(s);
+    });
+    let triad = best(5, || {
+        pool.install(|| {
+            a.par_chunks_mut(chunk)
+                .zip(b.par_chunks(chunk).zip(c.par_chunks(chunk)))
+                .for_each(|(a, (b, c))| {
+                    for ((a, &b), &c) in a.iter_mut().zip(b).zip(c) {
+                        *a = b + 3.0 * c;
+                    }
+                })
+        })
+    });
+    (
+        8.0 * LEN as f64 / read / 1e9,
+        24.0 * LEN as f64 / triad / 1e9,
+    )
+}
+
+/// Seconds per product of each path (stored, compact, recompute) at `n` beads on `par`.
+fn paths(n: usize, par: &dyn Parallel) -> [f64; 3] {
+    let phi = 2.0 * ((9.0f64 - 6.25).sqrt() / 6.0).asin();
+    let pos: Vec<DVec3> = (0..n)
+        .map(|k| {
+            let a = phi * k as f64;
+            DVec3::new(3.0 * a.cos(), 3.0 * a.sin(), 2.5 * k as f64)
+        })
+        .collect();
+    let radius = vec![1.0; n];
+    let x: Vec<DVec3> = (0..n)
+        .map(|i| DVec3::new((i as f64).sin(), 0.5, 1.0))
+        .collect();
+    let (mut y, mut z) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; band_scratch(n)]);
+    let mut mu = vec![f64::M3_ZERO; n * (n + 1) / 2];
+    parallel::assemble::<f64>(par, Hydro::Rpy, 1.0, &pos, &radius, &mut mu).unwrap();
+    let mut copy = vec![f64::M3_ZERO; reduced::slots(n)];
+    reduced::copy_apply::<f64>(par, &mu, n, &mut copy, &x, &mut y, &mut z);
+    let packed = best(3, || {
+        reduced::copy_apply::<f64>(par, &mu, n, &mut copy, &x, &mut y, &mut z)
+    });
+    let stored = best(5, || {
+        parallel::product::<f64>(par, &mu, n, &x, &mut y, &mut z)
+    });
+    let compact = best(5, || {
+        reduced::apply::<f64>(par, &copy, n, &x, &mut y, &mut z)
+    });
+    let free = best(3, || {
+        parallel::free_product::<f64>(par, Hydro::Rpy, 1.0, &pos, &radius, &x, &mut y, &mut z)
+            .unwrap()
+    });
+    eprintln!(
+        "  ({} threads: packing the copy while applying it {:.2} ns/pair)",
+        par.threads(),
+        packed / (n * (n + 1) / 2) as f64 * 1e9
+    );
+    [stored, compact, free]
+}
+
+fn main() {
+    let arg = |k: usize, d: f64| {
+        std::env::args()
+            .nth(k)
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(d)
+    };
+    let (n, threads, cores, target_sat) = (
+        arg(1, 4096.0) as usize,
+        arg(2, 2.0) as usize,
+        arg(3, 16.0),
+        arg(4, 0.0),
+    );
+    let pools: Vec<Threads> = (1..=threads).map(|t| Threads::new(t).unwrap()).collect();
+    let (mut a, b, c) = (vec![0.0; LEN], vec![1.0; LEN], vec![2.0; LEN]);
+    let mut bw = Vec::new();
+    for pool in &pools {
+        let raw = rayon::ThreadPoolBuilder::new()
+            .num_threads(pool.threads())
+            .build()
+            .unwrap();
+        let (read, triad) = stream(&raw, &mut a, &b, &c);
+        println!(
+            "stream {} threads: read {read:.1} GB/s, triad {triad:.1} GB/s",
+            pool.threads()
+        );
+        bw.push(read);
+    }
+    drop((a, b, c));
+    let (b1, bmax) = (bw[0], bw.iter().cloned().fold(0.0, f64::max));
+    let pairs = (n * (n + 1) / 2) as f64;
+    let one = paths(n, &Serial);
+    let many = paths(n, pools.last().unwrap());
+    for (k, path) in Path::ALL.into_iter().enumerate() {
+        let (ns1, nst) = (one[k] / pairs * 1e9, many[k] / pairs * 1e9);
+        println!(
+            "N = {n} {path:?}: 1 thread {ns1:.2} ns/pair {:.1} GB/s; {threads} threads {nst:.2} ns/pair {:.1} GB/s ({:.2}x)",
+            path.bytes() / ns1,
+            path.bytes() / nst,
+            ns1 / nst
+        );
+    }
+    // The Overdamped step (`hydrorattle_parallel::model`): one assembly pass and `k`
+    // products (the bench helix takes 4 to 5 at N = 1024 to 4096).
+    let k = 5.0;
+    let here = Machine {
+        b1,
+        b: bmax,
+        ns: one.map(|s| s / pairs * 1e9),
+    };
+    let speedup = |m: &Machine, path: Path, t: f64| m.step(path, 1.0, k) / m.step(path, t, k);
+    // The model machine's bandwidth in units of one thread's (`SAT`), or else fitted to
+    // the issue's 16-core Xeon: stored f64 at N = 4096, 4.87x on 16 threads.
+    let with = |sat: f64| Machine {
+        b: sat * b1,
+        ..here
+    };
+    let sat = match target_sat {
+        s if s > 0.0 => s,
+        _ => (10..=400)
+            .map(|s| s as f64 / 10.0)
+            .min_by(|&a, &b| {
+                let miss = |s: f64| (speedup(&with(s), Path::Stored, 16.0) - 4.87).abs();
+                miss(a).total_cmp(&miss(b))
+            })
+            .unwrap_or(1.0),
+    };
+    let big = with(sat);
+    println!(
+        "model: b1 = {b1:.1} GB/s a thread, B = {bmax:.1} GB/s here ({:.2} b1); the {cores}-core \
+         machine B = {sat:.1} b1 (stored f64 there: 8 threads {:.2}x, 16 threads {:.2}x; \
+         the issue measured 4.57x and 4.87x)",
+        bmax / b1,
+        speedup(&big, Path::Stored, 8.0),
+        speedup(&big, Path::Stored, 16.0)
+    );
+    for (label, t, m) in [
+        ("MODEL of this machine", threads as f64, here),
+        ("MODEL of the bigger machine", cores, big),
+    ] {
+        for path in Path::ALL {
+            println!(
+                "  {label}, {t} threads, {path:?}: step {:.1} ns/pair, speedup {:.2}x over its 1 thread, \
+                 {:.2}x over 1 thread Stored",
+                m.step(path, t, k),
+                speedup(&m, path, t),
+                m.step(Path::Stored, 1.0, k) / m.step(path, t, k)
+            );
+        }
+        println!("  {label}, {t} threads: fastest {:?}", m.fastest(t, k));
+    }
+}

@@ -1,0 +1,114 @@
+//! The product-path model: which way of applying the mobility is fastest for a bead
+//! count and a thread count (docs/BENCHMARKS.md, "Every core and every lane").
+//!
+//! A product reads `bytes` per pair from memory and does `ns` of one core's work per
+//! pair. On `t` threads it takes `max(bytes / bw(t), ns / t)` per pair, with
+//! `bw(t) = min(t b1, b)`: one thread draws `b1` bytes per ns, the machine `b` at most.
+//! An Overdamped step is one assembly pass (the pair work of [`Path::Recompute`],
+//! writing what the path stores) and `k` products. All three paths exist in the kernel:
+//! [`Path::Stored`] is the default, [`Path::Compact`] is
+//! `Params::compact_products`, [`Path::Recompute`] is `Params::matrix_free`; the first
+//! and last give the same bits.
+
+/// A way to apply the mobility.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Path {
+    /// Stream the stored `f64` blocks: 72 bytes and 36 flops a pair.
+    Stored,
+    /// Stream the compact `f32` copy: 24 bytes and 36 `f32` flops a pair.
+    Compact,
+    /// Evaluate every pair where it is used: no bytes, 63 + 36 flops a pair.
+    Recompute,
+}
+
+impl Path {
+    /// Every path, in the order of [`Machine::ns`].
+    pub const ALL: [Path; 3] = [Path::Stored, Path::Compact, Path::Recompute];
+
+    /// Bytes a product reads per pair.
+    pub const fn bytes(self) -> f64 {
+        match self {
+            Path::Stored => 72.0,
+            Path::Compact => 24.0,
+            Path::Recompute => 0.0,
+        }
+    }
+
+    /// Bytes the assembly pass writes per pair (the stored blocks, and the copy).
+    pub const fn written(self) -> f64 {
+        match self {
+            Path::Stored => 72.0,
+            Path::Compact => 96.0,
+            Path::Recompute => 0.0,
+        }
+    }
+}
+
+/// What the model knows of a machine (measured by `examples/bandwidth.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Machine {
+    /// One thread's read bandwidth, bytes per ns (GB/s).
+    pub b1: f64,
+    /// The machine's read bandwidth, bytes per ns (GB/s).
+    pub b: f64,
+    /// One thread's time per pair of a product on each path ([`Path::ALL`] order), ns.
+    pub ns: [f64; 3],
+}
+
+impl Machine {
+    /// ns per pair of one product on `path` with `t` threads.
+    pub fn product(&self, path: Path, t: f64) -> f64 {
+        self.pass(self.ns[path as usize], path.bytes(), t)
+    }
+
+    /// ns per pair of a pass doing `ns` of one core's work and moving `bytes` a pair.
+    fn pass(&self, ns: f64, bytes: f64, t: f64) -> f64 {
+        let bw = (t * self.b1).min(self.b);
+        (bytes / bw).max(ns / t)
+    }
+
+    /// ns per pair of an Overdamped step on `path` with `t` threads and `k` products.
+    pub fn step(&self, path: Path, t: f64, k: f64) -> f64 {
+        let assembly = self.pass(self.ns[Path::Recompute as usize], path.written(), t);
+        assembly + k * self.product(path, t)
+    }
+
+    /// The fastest path for `t` threads and `k` products a step.
+    pub fn fastest(&self, t: f64, k: f64) -> Path {
+        let time = |p: &Path| self.step(*p, t, k);
+        Path::ALL
+            .into_iter()
+            .min_by(|a, b| time(a).total_cmp(&time(b)))
+            .unwrap_or(Path::Stored)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Hand-worked cases: compute-bound work divides by the threads, bandwidth-bound
+    /// work stops at the machine's bandwidth, and the fastest path follows.
+    #[test]
+    fn the_model_by_hand() {
+        let m = Machine {
+            b1: 10.0,
+            b: 30.0,
+            ns: [6.0, 3.0, 15.0],
+        };
+        // Stored, 1 thread: max(72 / 10, 6) = 7.2; 16 threads: max(72 / 30, 6 / 16) = 2.4.
+        assert_eq!(m.product(Path::Stored, 1.0), 7.2);
+        assert_eq!(m.product(Path::Stored, 16.0), 2.4);
+        // Recompute: 15 / t, whatever the bandwidth.
+        assert_eq!(m.product(Path::Recompute, 16.0), 15.0 / 16.0);
+        // A step of 5 products, 1 thread: stored 15 + 5 x 7.2 = 51, compact
+        // max(9.6, 15) + 5 x max(2.4, 3) = 30, recompute 6 x 15 = 90.
+        assert_eq!(m.step(Path::Stored, 1.0, 5.0), 51.0);
+        assert_eq!(m.step(Path::Compact, 1.0, 5.0), 30.0);
+        assert_eq!(m.step(Path::Recompute, 1.0, 5.0), 90.0);
+        assert_eq!(m.fastest(1.0, 5.0), Path::Compact);
+        // 64 threads: stored 2.4 + 5 x 2.4 = 14.4, compact 3.2 + 5 x 0.8 = 7.2,
+        // recompute 90 / 64 = 1.41: the pair work wins once it is spread thin enough.
+        assert_eq!(m.fastest(64.0, 5.0), Path::Recompute);
+    }
+}
