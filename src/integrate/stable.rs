@@ -28,7 +28,7 @@
 
 use super::{
     Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors,
-    project_positions, report, step_velocity, wall_height,
+    displacement_tensions, project_positions, project_velocity, report, step_velocity, wall_height,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, SolverKind, apply_drag};
@@ -167,6 +167,10 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     };
     let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut sc)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
+    // The unconstrained displacement `u dt` for the tensions (`u` is the spin's next).
+    for (d, &w) in t[..n].iter_mut().zip(u[..n].iter()) {
+        *d = w * dt;
+    }
     // Angular velocities: the same solve with the constraint forces included.
     if p.rotation {
         add_constraint_forces(bonds, grad, lambda, &mut rhs6[..n]);
@@ -180,6 +184,26 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     kappa.fill(T::ZERO);
     let problem = Problem::Velocities { bond: grad_new, dt };
     let vstats = constraints::solve(problem, &metric, bonds, &p.solver, new_vel, kappa, &mut sc)?;
+    // The tensions from the displacement `u dt`, never added to a position: f32 keeps
+    // them (see `velocity_tensions`).
+    let x = &mut t[..n];
+    if displacement_tensions(p, bonds, &metric, grad, grad_new, x, kappa, &mut sc) {
+        // `sq` is done with once the step's metric is: it takes the inverse masses.
+        for w in &mut sq[..n] {
+            *w = T::ONE / (*w * *w);
+        }
+        u[..n].copy_from_slice(s.vel);
+        let vel = &mut u[..n];
+        if project_velocity(p, bonds, grad, vel, &sq[..n], lambda, &mut sc) {
+            // `v + M^-1 G kappa_0` moves `u dt` by `Q G kappa_0`, the step's metric's
+            // move of `kappa_0 / dt`: the tensions are the displacements' less that.
+            for (l, &k) in lambda.iter_mut().zip(kappa.iter()) {
+                *l = k - *l / dt;
+            }
+        } else {
+            lambda.copy_from_slice(kappa);
+        }
+    }
     Ok(report(stats, vstats.iterations, bonds, lambda))
 }
 
