@@ -115,23 +115,26 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
     spin(p, s.pos, s.radius, drag, new_omega)?;
     // The tensions from the step's displacement `v dt + a dt^2 / 2` (r* - r without the
     // positions' rounding) along the position metric, with `v` tangent to the bonds;
-    // `a` follows `v` through the drag (see `displacement_tensions`).
-    r_star.copy_from_slice(s.vel);
-    if project_velocity(p, bonds, grad, r_star, inv_mass, kappa, &mut sc) {
-        for i in 0..n {
-            drag[i] = r_star[i] - s.vel[i];
-        }
-        linalg::cholesky_solve::<T>(fac, n, drag);
-        for i in 0..n {
-            acc[i] = r_star[i] * dt + (acc[i] - drag[i] * inv_mass[i]) * half_dt2;
-        }
+    // `a` follows `v` through the drag (see `displacement_tensions`); only when asked.
+    if p.resolve_tensions {
         let metric = Metric::Mass {
             inv_mass,
             grad,
             scale: half_dt2,
         };
-        if displacement_tensions(p, bonds, &metric, grad, grad_new, acc, kappa, &mut sc) {
-            lambda.copy_from_slice(kappa);
+        let (vel, x) = (r_star, acc);
+        vel.copy_from_slice(s.vel);
+        if project_velocity(p, bonds, grad, vel, inv_mass, kappa, &mut sc) {
+            for i in 0..n {
+                drag[i] = vel[i] - s.vel[i];
+            }
+            linalg::cholesky_solve::<T>(fac, n, drag);
+            for i in 0..n {
+                x[i] = vel[i] * dt + (x[i] - drag[i] * inv_mass[i]) * half_dt2;
+            }
+            if displacement_tensions(p, bonds, &metric, grad, grad_new, x, kappa, &mut sc) {
+                lambda.copy_from_slice(kappa);
+            }
         }
     }
     Ok(report(stats, vstats.iterations, bonds, lambda))

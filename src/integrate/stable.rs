@@ -185,9 +185,11 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     let problem = Problem::Velocities { bond: grad_new, dt };
     let vstats = constraints::solve(problem, &metric, bonds, &p.solver, new_vel, kappa, &mut sc)?;
     // The tensions from the displacement `u dt`, never added to a position: f32 keeps
-    // them (see `velocity_tensions`).
+    // them (see `displacement_tensions`); only when asked.
     let x = &mut t[..n];
-    if displacement_tensions(p, bonds, &metric, grad, grad_new, x, kappa, &mut sc) {
+    if p.resolve_tensions
+        && displacement_tensions(p, bonds, &metric, grad, grad_new, x, kappa, &mut sc)
+    {
         // `sq` is done with once the step's metric is: it takes the inverse masses.
         for w in &mut sq[..n] {
             *w = T::ONE / (*w * *w);
