@@ -211,6 +211,8 @@ const fn deterministic_f32(method: Method, rotation: bool) -> Params<f32> {
         contacts: None,
         wall: None,
         periodic: None,
+        // The kernel's f32 default: the inertial methods' tensions from the displacements.
+        resolve_tensions: true,
     }
 }
 
