@@ -193,38 +193,83 @@ fn row_fused<T: Real>(
     z: &mut [T::V3],
 ) -> Result<(), ParticleError> {
     let (base, i) = (tri(b0), b0 + k);
+    let row = &mut rows[tri(i) - base..tri(i) - base + i];
+    row_each(src, b0, k, x, y, z, |j, b| row[j] = b)
+}
+
+/// [`row`] on blocks evaluated on the way, each handed to `keep(j, block)`.
+#[inline(always)]
+fn row_each<T: Real>(
+    src: Pairs<'_, T>,
+    b0: usize,
+    k: usize,
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+    mut keep: impl FnMut(usize, T::M3),
+) -> Result<(), ParticleError> {
+    let i = b0 + k;
     let (level, eta, pos, radius) = (src.level, src.eta, src.pos, src.radius);
     let (pi, ai, xi) = (pos[i], radius[i], x[i]);
-    #[inline(always)]
-    fn pair<T: Real>(
-        l: Hydro,
-        eta: T,
-        ai: T,
-        aj: T,
-        r: T::V3,
-        i: usize,
-        j: usize,
-    ) -> Result<T::M3, ParticleError> {
-        pair_tt(l, eta, ai, aj, r).ok_or(ParticleError::Nested { i: j, j: i })
-    }
-    let (left, inside) = rows[tri(i) - base..tri(i) - base + i].split_at_mut(b0);
+    let pair = |j: usize| {
+        pair_tt(level, eta, ai, radius[j], pi - pos[j]).ok_or(ParticleError::Nested { i: j, j: i })
+    };
     let mut acc = T::V3_ZERO;
-    let others = left.iter_mut().zip(z.iter_mut()).zip(pos).zip(radius);
-    for (j, (((o, zj), &pj), &aj)) in others.enumerate() {
-        let b = pair::<T>(level, eta, ai, aj, pi - pj, i, j)?;
-        *o = b;
+    for (j, zj) in z[..b0].iter_mut().enumerate() {
+        let b = pair(j)?;
+        keep(j, b);
         acc += b * x[j];
         *zj += T::m3_tmul(b, xi);
     }
     let (ys, yi) = y[..=k].split_at_mut(k);
-    let others = inside.iter_mut().zip(ys).zip(&pos[b0..]).zip(&radius[b0..]);
-    for (j, (((o, yj), &pj), &aj)) in others.enumerate() {
-        let b = pair::<T>(level, eta, ai, aj, pi - pj, i, b0 + j)?;
-        *o = b;
-        acc += b * x[b0 + j];
+    for (j, yj) in (b0..).zip(ys) {
+        let b = pair(j)?;
+        keep(j, b);
+        acc += b * x[j];
         *yj += T::m3_tmul(b, xi);
     }
     yi[0] += acc;
+    Ok(())
+}
+
+/// `y = mu_tt x` without storing `mu_tt`, in the bands of [`product`] through `par`
+/// (`z` holds at least [`band_scratch`]`(n)` vectors): each band evaluates its rows'
+/// blocks and applies them at once, so the bits are those of [`assemble`] followed by
+/// [`product`] (and below [`BANDED_MIN`] rows those of
+/// [`mobility::tt_product`](crate::mobility::tt_product)) on any number of threads, in
+/// `O(N)` memory. Each pair is evaluated once.
+#[allow(clippy::too_many_arguments)]
+pub fn product_free<T: Real>(
+    par: &dyn Parallel,
+    level: Hydro,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) -> Result<(), ParticleError> {
+    let n = pos.len();
+    let src = Pairs {
+        level,
+        eta,
+        pos,
+        radius,
+    };
+    let band = |b0: usize, yt: &mut [T::V3], zt: &mut [T::V3]| {
+        zt.fill(T::V3_ZERO);
+        for (k, yk) in yt.iter_mut().enumerate() {
+            *yk = T::m3_diag(self_tt(eta, radius[b0 + k])) * x[b0 + k];
+        }
+        (0..yt.len()).try_for_each(|k| row_each(src, b0, k, x, yt, zt, |_, _| {}))
+    };
+    if bands(n) == 1 {
+        return band(0, &mut y[..n], &mut []);
+    }
+    by_bands::<T, _, _>(par, n, &mut [], tri, y, z, |t, _, yt, zt| {
+        band(band_start(n, t), yt, zt)
+    })?;
+    reduce::<T>(n, y, z, par);
     Ok(())
 }
 

@@ -171,6 +171,19 @@ pub fn particle_error(py: Python<'_>, e: ParticleError) -> PyErr {
     )
 }
 
+/// A kernel error met outside a step (the mobility alone, a system's construction) as
+/// a `ValueError` with the kernel's message and `kind` (and `index` for a particle).
+pub fn value_error(py: Python<'_>, e: KStep) -> PyErr {
+    if let KStep::Particle(p) = e {
+        return particle_error(py, p);
+    }
+    let kind = e
+        .kind()
+        .into_pyobject(py)
+        .map_or_else(|_| py.None(), |x| x.into_any().unbind());
+    with_attrs(py, PyValueError::new_err(e.to_string()), &[("kind", kind)])
+}
+
 /// A refused bond as a `ValueError` naming it.
 pub fn bond_error(e: BondError) -> PyErr {
     PyValueError::new_err(e.to_string())

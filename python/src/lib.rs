@@ -11,6 +11,7 @@
 
 use pyo3::prelude::*;
 
+mod dense;
 mod errors;
 mod input;
 mod mobility;

@@ -109,6 +109,27 @@ pub(super) fn check_periodic<T: Real>(
     let Some(c) = p.periodic else {
         return Ok(());
     };
+    check_box(p, state.radius)?;
+    let [x, y, z] = c.size();
+    let half = x.min(y).min(z) * T::HALF;
+    if let Some(bond) = bonds.iter().position(|b| !(b.length < half)) {
+        return Err(crate::error::BondError::BadLength { bond }.into());
+    }
+    if p.method == Method::Springs && p.fene.is_some_and(|q| !(q < half)) {
+        return Err(StepError::BadParameter(
+            "fene (maximum extension below half the periodic box's smallest edge)",
+        ));
+    }
+    Ok(())
+}
+
+/// The box's part of [`check_periodic`] that needs no bonds (the mobility alone,
+/// `integrate::geometry`, asks it too): the feature, no wall, no rotation, not Oseen,
+/// every radius below half the smallest edge, Ewald parameters the sums allow.
+pub(super) fn check_box<T: Real>(p: &Params<T>, radius: &[T]) -> Result<(), StepError> {
+    let Some(c) = p.periodic else {
+        return Ok(());
+    };
     if !cfg!(feature = "periodic") {
         return Err(StepError::Unsupported(
             "a periodic box: the kernel was built without its `periodic` feature",
@@ -129,20 +150,12 @@ pub(super) fn check_periodic<T: Real>(
     }
     let [x, y, z] = c.size();
     let half = x.min(y).min(z) * T::HALF;
-    if let Some(particle) = state.radius.iter().position(|&a| !(a < half)) {
+    if let Some(particle) = radius.iter().position(|&a| !(a < half)) {
         return Err(StepError::Particle(ParticleError::BadRadius { particle }));
-    }
-    if let Some(bond) = bonds.iter().position(|b| !(b.length < half)) {
-        return Err(crate::error::BondError::BadLength { bond }.into());
-    }
-    if p.method == Method::Springs && p.fene.is_some_and(|q| !(q < half)) {
-        return Err(StepError::BadParameter(
-            "fene (maximum extension below half the periodic box's smallest edge)",
-        ));
     }
     #[cfg(feature = "periodic")]
     if p.hydro != Hydro::FreeDraining {
-        let a_max = state.radius.iter().fold(T::ZERO, |m, &a| m.max(a));
+        let a_max = radius.iter().fold(T::ZERO, |m, &a| m.max(a));
         crate::mobility::periodic::Ewald::new(c, a_max)?;
     }
     Ok(())

@@ -28,14 +28,13 @@
 
 use super::{
     Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors,
-    displacement_tensions, project_positions, project_velocity, report, step_velocity, wall_height,
+    displacement_tensions, project_positions, project_velocity, report, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, SolverKind, apply_drag};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
 use crate::linalg::{self, tri};
-use crate::mobility;
 use crate::noise::Noise;
 use crate::params::{Brownian, Params};
 use crate::particles::sphere_volume;
@@ -77,11 +76,8 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
         ..
     } = v;
     // Mobility (translation or grand) and the drag operator K = dt I + S mu S.
-    if let (true, Some(h)) = (p.rotation, wall_height(p)) {
-        let (level, eta) = (p.hydro, p.viscosity);
-        mobility::wall::assemble_grand(level, eta, h, s.pos, s.radius, mu)?;
-    } else if p.rotation {
-        mobility::assemble_grand(p.hydro, p.viscosity, s.pos, s.radius, mu)?;
+    if p.rotation {
+        super::geometry::grand(p, s.pos, s.radius, mu)?;
     } else {
         assemble_tt(p, s.pos, s.radius, mu)?;
     }

@@ -91,6 +91,41 @@ def _column(a: Any, what: str, n: int) -> np.ndarray:
     return x
 
 
+def _wall(h: Any) -> Optional[float]:
+    """A wall height as a float (``None``: no wall)."""
+    return None if h is None else _real(h, "wall")
+
+
+def _box(b: Any) -> Optional["tuple[float, float, float]"]:
+    """Three box edges as floats (``None``: no box)."""
+    if b is None:
+        return None
+    edges = np.asarray(b)
+    if edges.shape != (3,):
+        raise ValueError(f"box must be three edges (Lx, Ly, Lz), not shape {edges.shape}")
+    lx, ly, lz = (_real(x, "box") for x in edges)
+    return (lx, ly, lz)
+
+
+def _real(x: Any, what: str) -> float:
+    """A real number (a bool or a complex number is a ``TypeError`` naming ``what``)."""
+    if isinstance(x, (bool, np.bool_)) or np.iscomplexobj(x):
+        raise TypeError(f"{what} must be a real number, not {type(x).__name__}")
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        raise TypeError(f"{what} must be a real number, not {type(x).__name__}") from None
+
+
+def _count(k: Any, what: str) -> int:
+    """A non-negative integer (``TypeError`` for a non-integer, ``ValueError`` below 0)."""
+    if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)):
+        raise TypeError(f"{what} must be an integer, not {type(k).__name__}")
+    if k < 0:
+        raise ValueError(f"{what} must be >= 0, not {k}")
+    return int(k)
+
+
 def mobility(
     positions: Any,
     radii: Any,
@@ -98,6 +133,8 @@ def mobility(
     hydro: str = "rpy",
     rotation: bool = False,
     precision: str = "f64",
+    wall: Optional[float] = None,
+    box: Optional["tuple[float, float, float]"] = None,
 ) -> np.ndarray:
     """The dense mobility matrix of spheres at ``positions`` with ``radii``.
 
@@ -116,6 +153,14 @@ def mobility(
         With rotation, the ``(6N, 6N)`` grand mobility ``[[tt, tr], [rt, rr]]``.
     precision : {"f64", "f32"}
         Precision of the arithmetic and of the result's dtype.
+    wall : float, optional
+        Height ``H`` of a no-slip plane wall ``z = H`` below every centre: the
+        wall-corrected RPY mobility (Swan & Brady's image system, docs/WALL.md), as
+        ``System(..., wall=H)`` steps with. Rotation is supported.
+    box : (Lx, Ly, Lz), optional
+        A rectangular periodic box: the Ewald-summed RPY mobility (docs/PERIODIC.md),
+        as ``System(..., box=...)`` steps with. Every radius below half the smallest
+        edge; not with ``wall``, ``rotation`` or ``hydro="oseen"`` (``ValueError``).
 
     Returns
     -------
@@ -131,12 +176,21 @@ def mobility(
     Raises
     ------
     ValueError
-        Wrong shapes, NaN or infinite values, a radius <= 0, nested spheres; the
-        message names the particle (``index`` attribute: the particle or pair).
+        Wrong shapes, NaN or infinite values, a radius <= 0, nested spheres, a centre
+        below the wall; the message names the particle (``index`` attribute: the
+        particle or pair). A refused geometry (``box`` with ``wall``, ``rotation`` or
+        Oseen) with the kernel's message and ``kind``.
     """
     pos = _rows(positions, "positions")
     return _core.mobility(
-        pos, _column(radii, "radii", len(pos)), viscosity, hydro, rotation, precision
+        pos,
+        _column(radii, "radii", len(pos)),
+        viscosity,
+        hydro,
+        rotation,
+        precision,
+        _wall(wall),
+        _box(box),
     )
 
 
@@ -149,6 +203,9 @@ def mobility_dot(
     hydro: str = "rpy",
     rotation: bool = False,
     precision: str = "f64",
+    wall: Optional[float] = None,
+    box: Optional["tuple[float, float, float]"] = None,
+    threads: int = 0,
 ) -> Union[np.ndarray, "tuple[np.ndarray, np.ndarray]"]:
     """Velocities of spheres under ``forces`` (and ``torques``), ``M [F; T]``.
 
@@ -158,13 +215,29 @@ def mobility_dot(
     times the forces) and returns the ``(N, 3)`` velocities (``F / (eta L)``). With
     torques or ``rotation=True`` it returns ``(velocities, spins)`` (spins in
     ``F / (eta L^2)``) through the packed grand mobility (``O(N^2)`` memory).
+    ``wall`` and ``box`` as :func:`mobility`.
+
+    ``threads``: the matrix-free product in free space runs its 16 bands of rows on
+    this many threads (0: every core) from ``N = 512`` on; the result has the same bits
+    on any number of threads (and below 512 those of the stored matrix times the
+    forces). Above a wall, in a box and with rotation it runs on one thread.
     """
     pos = _rows(positions, "positions")
     n = len(pos)
     f = _rows(forces, "forces")
     t = None if torques is None else _rows(torques, "torques")
     return _core.mobility_dot(
-        pos, _column(radii, "radii", n), f, t, viscosity, hydro, rotation, precision
+        pos,
+        _column(radii, "radii", n),
+        f,
+        t,
+        viscosity,
+        hydro,
+        rotation,
+        precision,
+        _wall(wall),
+        _box(box),
+        _count(threads, "threads"),
     )
 
 

@@ -49,6 +49,8 @@ def mobility(
     hydro: str = ...,
     rotation: bool = ...,
     precision: str = ...,
+    wall: Optional[float] = ...,
+    box: Optional[tuple[float, float, float]] = ...,
 ) -> npt.NDArray[np.floating[Any]]: ...
 def mobility_dot(
     positions: _F64,
@@ -59,6 +61,9 @@ def mobility_dot(
     hydro: str = ...,
     rotation: bool = ...,
     precision: str = ...,
+    wall: Optional[float] = ...,
+    box: Optional[tuple[float, float, float]] = ...,
+    threads: int = ...,
 ) -> Any: ...
 def load_scene_json(path: Union[str, PathLike[str]]) -> str: ...
 def run_scene(
