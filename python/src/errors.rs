@@ -122,7 +122,7 @@ pub fn step_error(py: Python<'_>, e: KStep) -> PyErr {
         KStep::Linalg { .. } => LinalgError::new_err(msg),
         KStep::NoConvergence { .. } => ConvergenceError::new_err(msg),
         KStep::Degenerate { .. } => DegenerateError::new_err(msg),
-        KStep::NonFinite { .. } => NonFiniteError::new_err(msg),
+        KStep::NonFinite { .. } | KStep::NonFiniteForce { .. } => NonFiniteError::new_err(msg),
         KStep::Overlap { .. } => OverlapError::new_err(msg),
         KStep::Unstable { .. } => UnstableError::new_err(msg),
         KStep::ContactsFull { .. } => ContactsFullError::new_err(msg),

@@ -16,7 +16,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{bond_error, scene_error, step_error};
+use crate::errors::{bond_error, scene_error, step_error, value_error};
 use crate::input::{column, is_f32, rows, spheres};
 use crate::params::params_from;
 
@@ -125,7 +125,7 @@ fn engine_from<T: Real>(
     lengths: Option<&[f64]>,
     kw: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Engine<T>> {
-    let (params, seed) = params_from::<T>(kw)?;
+    let (params, extras) = params_from::<T>(kw)?;
     let (p, r) = spheres::<T>(py, pos, radii, Some(densities))?;
     let n = p.len();
     let index = |k: usize, i: i64| -> PyResult<usize> {
@@ -159,20 +159,32 @@ fn engine_from<T: Real>(
         density: densities.iter().map(|&d| T::from_f64(d)).collect(),
         time: T::ZERO,
     };
-    Engine::from_parts(beads, links, params, Noise::new(seed), None, DEFAULT_LIMIT)
-        .map_err(|e| PyValueError::new_err(e.to_string()))
+    let noise = Noise::new(extras.seed);
+    let engine = Engine::from_parts(beads, links, params, noise, None, DEFAULT_LIMIT)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    ready(py, engine, extras.threads)
+}
+
+/// `e` checked as its first step would check it (a refusal is a `ValueError` with the
+/// kernel's message and `kind`), on `threads` threads.
+fn ready<T: Real>(py: Python<'_>, mut e: Engine<T>, threads: usize) -> PyResult<Engine<T>> {
+    e.check().map_err(|k| value_error(py, k))?;
+    e.with_threads(threads)
+        .map_err(|err| PyValueError::new_err(format!("threads: {err}")))
 }
 
 /// The engine of a scene (its level resolved), in the scene's precision.
-fn engine_of_scene(scene: &Scene) -> PyResult<Inner> {
+fn engine_of_scene(py: Python<'_>, scene: &Scene) -> PyResult<Inner> {
     let (scene, _) = resolve_level(scene, "scene");
     let fail = |e: hydrorattle_host::sim::BuildError| PyValueError::new_err(e.to_string());
     Ok(match scene.integrator.precision {
         hydrorattle_host::scene::Precision::F64 => {
-            Inner::F64(Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?)
+            let e = Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?;
+            Inner::F64(ready(py, e, 0)?)
         }
         hydrorattle_host::scene::Precision::F32 => {
-            Inner::F32(Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?)
+            let e = Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?;
+            Inner::F32(ready(py, e, 0)?)
         }
     })
 }
@@ -338,7 +350,7 @@ impl Core {
     fn from_scene_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Core> {
         let scene = Scene::from_path(&path).map_err(|e| scene_error(py, &e))?;
         Ok(Core {
-            inner: engine_of_scene(&scene)?,
+            inner: engine_of_scene(py, &scene)?,
         })
     }
 
@@ -347,7 +359,7 @@ impl Core {
     fn from_scene_text(py: Python<'_>, text: &str, origin: &str) -> PyResult<Core> {
         let scene = Scene::parse(text, origin).map_err(|e| scene_error(py, &e))?;
         Ok(Core {
-            inner: engine_of_scene(&scene)?,
+            inner: engine_of_scene(py, &scene)?,
         })
     }
 

@@ -186,8 +186,9 @@ pub(super) fn check_all<T: Real>(
     check_inputs(state, bonds, p)?;
     let thermal = check_thermal(p, has_generator)?;
     check_contacts(p, thermal.is_some())?;
-    check_wall(p, state)?;
+    // The box first: a box with a wall is refused as such, not by the wall's check.
     check_periodic(p, state, bonds)?;
+    check_wall(p, state)?;
     Ok(thermal)
 }
 
@@ -285,7 +286,7 @@ pub(super) fn check_inputs<T: Real>(
         if !finite {
             return Err(ParticleError::NonFinite { particle: i }.into());
         }
-        if state.radius[i] <= T::ZERO {
+        if !(state.radius[i] >= T::MIN_POSITIVE) {
             return Err(ParticleError::BadRadius { particle: i }.into());
         }
         if state.density[i] < T::ZERO {

@@ -130,6 +130,19 @@ impl<T: Real> Engine<T> {
         Ok(self)
     }
 
+    /// The checks the kernel's step makes of its inputs (parameters, particles, bonds,
+    /// thermal noise, contacts, wall, box: [`hydrorattle::check_step`]) and of every
+    /// pair (nested or coincident spheres; overlapping ones unless
+    /// [`Params::allow_overlap`]), without stepping. A front end asks it when it builds
+    /// a system, so that what the first step would refuse (`dt = 0`, spheres
+    /// overlapping at the start) is refused there, as a parameter error.
+    pub fn check(&mut self) -> Result<(), StepError> {
+        self.beads.check_pairs(self.params.allow_overlap)?;
+        let mut state = self.beads.state();
+        state.noise = Some(&mut self.noise);
+        hydrorattle::check_step(&state, &self.bonds, &self.params)
+    }
+
     /// One step with the scene's forces only.
     pub fn step(&mut self) -> Result<StepReport<T>, StepError> {
         self.step_with(&mut |_: &[T::V3], _: &[T], _: &mut [T::V3]| {})

@@ -74,9 +74,18 @@ PathLike = Union[str, "os.PathLike[str]"]
 Force = Callable[[np.ndarray], Any]
 
 
+def _real_array(a: Any, what: str) -> np.ndarray:
+    """`a` as an array of reals: complex numbers (whose imaginary part a float64
+    conversion would drop), booleans and non-numbers are a ``TypeError`` naming ``what``."""
+    x = np.asarray(a)
+    if np.iscomplexobj(x) or x.dtype.kind not in "iuf":
+        raise TypeError(f"{what} must hold real numbers, not {x.dtype}")
+    return x
+
+
 def _rows(a: Any, what: str) -> np.ndarray:
     """`a` as a C-contiguous float64 ``(N, 3)`` array (no copy when it already is one)."""
-    x = np.ascontiguousarray(a, dtype=np.float64)
+    x = np.ascontiguousarray(_real_array(a, what), dtype=np.float64)
     if x.ndim != 2 or x.shape[1] != 3:
         raise ValueError(f"{what} must have shape (N, 3), not {x.shape}")
     return x
@@ -84,7 +93,7 @@ def _rows(a: Any, what: str) -> np.ndarray:
 
 def _column(a: Any, what: str, n: int) -> np.ndarray:
     """`a` as a contiguous float64 ``(n,)`` array (a scalar is repeated)."""
-    x = np.asarray(a, dtype=np.float64)
+    x = _real_array(a, what).astype(np.float64, copy=False)
     x = np.full(n, float(x)) if x.ndim == 0 else np.ascontiguousarray(x)
     if x.shape != (n,):
         raise ValueError(f"{what} must have shape ({n},) to match the positions, not {x.shape}")
@@ -279,6 +288,26 @@ def _scene_text(sections: "dict[str, dict[str, Any]]") -> str:
     return "\n".join(out)
 
 
+def _bond_pairs(bonds: Any) -> np.ndarray:
+    """Bonds as a C-contiguous int64 ``(B, 2)`` array: integers, or floats that are whole
+    numbers (``[[0, 1.5]]`` is a ``ValueError``, not the bond ``[0, 1]``)."""
+    if bonds is None:
+        return np.zeros((0, 2), dtype=np.int64)
+    x = np.asarray(bonds)
+    if x.size == 0:
+        x = x.reshape(-1, 2) if x.ndim < 2 else x
+    if np.iscomplexobj(x) or x.dtype.kind not in "iuf":
+        raise TypeError(f"bonds must hold integer particle indices, not {x.dtype}")
+    if x.dtype.kind == "f":
+        bad = ~np.isfinite(x) | (x != np.trunc(x))
+        if bad.any():
+            k = tuple(int(i) for i in np.argwhere(bad)[0])
+            raise ValueError(f"bonds{list(k)}: particle index {x[k]} is not an integer")
+    if x.ndim != 2 or x.shape[1] != 2:
+        raise ValueError(f"bonds must have shape (B, 2), not {x.shape}")
+    return np.ascontiguousarray(x, dtype=np.int64)
+
+
 class System:
     """Particles and bonds stepped by the kernel.
 
@@ -299,11 +328,26 @@ class System:
     ``stability_guard`` (False), ``contacts`` (None, or the hard-contact capacity),
     ``wall`` (None, or the height ``H`` of a no-slip plane wall ``z = H`` below every
     sphere: its mobility and its one-sided constraint; "overdamped" and "overdamped2"),
+    ``box`` (None, or the edges ``(Lx, Ly, Lz)`` of a periodic box: the Ewald-summed
+    mobility and minimum-image bonds; not with ``wall`` or ``rotation``),
+    ``resolve_tensions`` (True in f32, False in f64: the inertial methods' tensions
+    solved again from the step's displacements, two more constraint solves per step,
+    needed in f32 where the position multipliers are rounding noise),
+    ``threads`` (0: every core; the mobility's bands from 512 beads on, the same bits
+    on any number),
     ``temperature`` (None: no thermal noise; ``kT``), ``drift`` ("midpoint",
     "uncorrected"), ``seed`` (1), ``noise_sqrt`` ("auto": Lanczos above
     ``LANCZOS_CROSSOVER`` beads, "cholesky", "lanczos"), ``lanczos_tolerance`` (1e-3,
     the noise's estimated relative error) and ``lanczos_max_iterations`` (64). A particle's mass is ``4/3 pi a^3 density``; gravity
     acts on the buoyant mass (``density - fluid_density``).
+
+    Everything the first step would refuse is refused here: a parameter of the wrong
+    type is a ``TypeError`` naming it (flags take ``True``/``False`` or 1/0), a value out
+    of range a ``ValueError`` naming it (``dt=0``, ``seed=-1``), and the kernel's checks
+    of parameters, particles and bonds (spheres overlapping at the start unless
+    ``allow_overlap``, coincident centres always, a sphere below the wall, a refused
+    combination) a ``ValueError`` with the kernel's message and ``kind``. Bond indices
+    must be integers (``1.5`` is refused), arrays real (complex is a ``TypeError``).
 
     Constructors for the CLI's shapes: :meth:`from_scene` (a scene file, read by the
     CLI's parser, every default as the CLI's) and :meth:`helix`.
@@ -323,10 +367,7 @@ class System:
     ) -> None:
         pos = _rows(positions, "positions")
         n = len(pos)
-        b = np.zeros((0, 2), dtype=np.int64) if bonds is None else bonds
-        b = np.ascontiguousarray(b, dtype=np.int64)
-        if b.ndim != 2 or b.shape[1] != 2:
-            raise ValueError(f"bonds must have shape (B, 2), not {b.shape}")
+        b = _bond_pairs(bonds)
         ls = None if lengths is None else _column(lengths, "lengths", len(b))
         self._core = _core.Core.build(
             pos,
@@ -413,7 +454,9 @@ class System:
         time: Optional[float] = None,
     ) -> None:
         """Replaces the parts of the state given (all or nothing: finite ``(N, 3)``
-        arrays, rounded to the system's precision). Positions off the bond lengths are
+        arrays, rounded to the system's precision; ``time`` any finite number, a
+        negative one too: it is the clock the steps advance, nothing depends on its
+        sign). Positions off the bond lengths are
         pulled back onto them by the next step (its constraint solve targets the
         lengths); one sphere inside another is refused by it."""
         conv = lambda a, w: None if a is None else _rows(a, w)  # noqa: E731
