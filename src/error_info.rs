@@ -253,7 +253,7 @@ mod tests {
     use crate::workspace::Layout;
 
     /// One of every variant (nested ones included).
-    fn every() -> [StepError; 30] {
+    fn every() -> [StepError; 32] {
         let p = |e| StepError::Particle(e);
         let b = |e| StepError::Bond(e);
         let (i, j, bond) = (3, 5, 7);

@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use hydrorattle::{Bond, Noise, Real, StepReport};
 use hydrorattle_host::scene::Scene;
-use hydrorattle_host::sim::{Beads, Engine, resolve_level};
+use hydrorattle_host::sim::{Beads, Engine, Saved, resolve_level};
 use hydrorattle_host::sizing::DEFAULT_LIMIT;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{
@@ -506,6 +506,31 @@ impl Core {
             }
             Ok(())
         })
+    }
+
+    /// The whole system as JSON text (state, bonds, parameters, noise generator,
+    /// counters, the last tensions; every float's bits): what pickling carries.
+    fn save_json(&self) -> PyResult<String> {
+        use hydrorattle_host::scene::Precision;
+        let saved = match &self.inner {
+            Inner::F64(e) => e.save(Precision::F64),
+            Inner::F32(e) => e.save(Precision::F32),
+        };
+        serde_json::to_string(&saved).map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
+    /// The system [`Core::save_json`] wrote.
+    #[staticmethod]
+    fn restore_json(text: &str) -> PyResult<Core> {
+        use hydrorattle_host::scene::Precision;
+        let saved: Saved = serde_json::from_str(text)
+            .map_err(|e| PyValueError::new_err(format!("saved system: {e}")))?;
+        let fail = PyValueError::new_err;
+        let inner = match saved.precision {
+            Precision::F64 => Inner::F64(Engine::restore(&saved).map_err(fail)?),
+            Precision::F32 => Inner::F32(Engine::restore(&saved).map_err(fail)?),
+        };
+        Ok(Core { inner })
     }
 
     /// An independent copy of the system (state, storage, noise generator).

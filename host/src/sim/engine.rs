@@ -43,9 +43,9 @@ pub struct Engine<T: Real> {
     pub lanczos: LanczosTally,
     store: Buffers<T>,
     /// The multipliers of the last accepted step ([`Engine::tensions`]).
-    multipliers: Vec<T>,
+    pub(super) multipliers: Vec<T>,
     /// The pool for the mobility's bands (shared by copies of the system).
-    threads: Option<Arc<Threads>>,
+    pub(super) threads: Option<Arc<Threads>>,
 }
 
 impl<T: Real> Engine<T> {

@@ -26,6 +26,7 @@ mod lanczos;
 mod record;
 pub mod retry;
 mod run_loop;
+mod saved;
 mod tail;
 
 pub use crate::scene::{Beads, BuildError, bonds, params};
@@ -38,6 +39,7 @@ pub use record::{
     COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
     TRAJECTORY_XYZ,
 };
+pub use saved::{Saved, SavedParams};
 
 use std::path::{Path, PathBuf};
 

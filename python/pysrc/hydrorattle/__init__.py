@@ -470,6 +470,67 @@ class System:
 
     __copy__ = copy
 
+    def to_atoms(self) -> Any:
+        """The system as an ASE ``Atoms`` (needs ``ase``): every sphere an atom "X" at
+        its centre with its velocity and mass (``4/3 pi a^3 density``), the radii and
+        densities in the arrays ``radius`` and ``density``, the spins in ``spin``; the
+        bonds ``(B, 2)``, their lengths and the time in ``info``; a periodic box as the
+        cell with ``pbc``. :meth:`from_atoms` reads it back."""
+        from ase import Atoms  # noqa: PLC0415 (optional dependency)
+
+        a, rho = self.radii, self.densities
+        atoms = Atoms(
+            symbols=["X"] * len(a),
+            positions=self.positions,
+            masses=4.0 / 3.0 * math.pi * a**3 * rho,
+        )
+        atoms.set_velocities(self.velocities)
+        atoms.new_array("radius", a)
+        atoms.new_array("density", rho)
+        atoms.new_array("spin", self.spins)
+        atoms.info["bonds"] = self.bonds
+        atoms.info["lengths"] = self.lengths
+        atoms.info["time"] = self.time
+        return atoms
+
+    @classmethod
+    def from_atoms(
+        cls, atoms: Any, radii: Any = None, densities: Any = None, **params: Any
+    ) -> "System":
+        """A system of an ASE ``Atoms``: centres and velocities from it; radii from
+        ``radii`` or its ``radius`` array; densities from ``densities``, its ``density``
+        array, or its masses over the spheres' volumes; bonds and lengths from
+        ``params`` or its ``info`` (as :meth:`to_atoms` writes them); spins and time
+        from its ``spin`` array and ``info["time"]`` when present. ``params`` as the
+        constructor's (``dt`` required)."""
+        n = len(atoms)
+        if radii is None:
+            if "radius" not in atoms.arrays:
+                raise ValueError("from_atoms needs radii=, or a 'radius' array on the atoms")
+            radii = atoms.arrays["radius"]
+        a = _column(radii, "radii", n)
+        if densities is None:
+            if "density" in atoms.arrays:
+                densities = atoms.arrays["density"]
+            else:
+                densities = atoms.get_masses() / (4.0 / 3.0 * math.pi * a**3)
+        params.setdefault("bonds", atoms.info.get("bonds"))
+        params.setdefault("lengths", atoms.info.get("lengths"))
+        s = cls(atoms.get_positions(), a, densities, **params)
+        spins = atoms.arrays.get("spin")
+        s.set_state(velocities=atoms.get_velocities(), spins=spins, time=atoms.info.get("time"))
+        return s
+
+    def __deepcopy__(self, memo: Any) -> "System":
+        return self.copy()
+
+    def __reduce__(self) -> "tuple[Any, tuple[str]]":
+        """Pickling (``pickle``, ``multiprocessing``, ``joblib``) carries the whole
+        system as text: state, bonds, parameters, the noise generator, counters and the
+        last tensions, every float's bits. The unpickled system continues with the
+        same bits as the original, in any process of the same build."""
+        return (_restore_system, (self._core.save_json(),))
+
     @property
     def radii(self) -> np.ndarray:
         """Radii, ``(N,)`` (a copy)."""
@@ -573,6 +634,11 @@ class System:
         """The exact bits of positions, velocities, spins, time and the noise
         generator's next draw: equal lists mean bit-identical states."""
         return self._core.state_bits()
+
+
+def _restore_system(text: str) -> System:
+    """The system :meth:`System.__reduce__` saved (module level: pickle finds it)."""
+    return System._of(_core.Core.restore_json(text))
 
 
 def load_scene(path: PathLike) -> "dict[str, Any]":
