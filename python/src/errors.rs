@@ -11,7 +11,7 @@ pyo3::create_exception!(
     hydrorattle,
     StepError,
     PyRuntimeError,
-    "A step failed; the system's state is exactly as it was before the call."
+    "A step failed. The failed step changed nothing: the state (and noise generator) is as after the last completed step; `step(n)` keeps the steps it completed before the failure, and `completed` says how many (0: the state is as before the call)."
 );
 pyo3::create_exception!(
     hydrorattle,
@@ -92,7 +92,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 /// Sets attributes on an exception instance.
-fn with_attrs(py: Python<'_>, e: PyErr, attrs: &[(&str, Py<PyAny>)]) -> PyErr {
+pub fn with_attrs(py: Python<'_>, e: PyErr, attrs: &[(&str, Py<PyAny>)]) -> PyErr {
     let v = e.value(py);
     for (k, x) in attrs {
         // An attribute that cannot be set leaves the message, which says the same.

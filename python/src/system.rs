@@ -16,7 +16,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{bond_error, scene_error, step_error, value_error};
+use crate::errors::{bond_error, scene_error, step_error, value_error, with_attrs};
 use crate::input::{column, is_f32, rows, spheres};
 use crate::params::params_from;
 
@@ -207,11 +207,13 @@ fn steps<T: Real + Element>(
                 while done < n {
                     let r = e
                         .step()
-                        .map_err(|k| Python::attach(|py| step_error(py, k)))?;
+                        .map_err(|k| Python::attach(|py| completed(py, step_error(py, k), done)))?;
                     last = Some(r);
                     done += 1;
                     if done < n && checked.elapsed() >= SIGNAL_EVERY {
-                        Python::attach(|py| py.check_signals())?;
+                        Python::attach(|py| {
+                            py.check_signals().map_err(|e| completed(py, e, done))
+                        })?;
                         checked = Instant::now();
                     }
                 }
@@ -239,15 +241,24 @@ fn steps<T: Real + Element>(
                 };
                 let r = e.step_with(&mut extra);
                 if let Some(err) = failed {
-                    return Err(err);
+                    return Err(completed(py, err, k));
                 }
-                last = Some(r.map_err(|k| step_error(py, k))?);
+                last = Some(r.map_err(|err| completed(py, step_error(py, err), k))?);
                 if k + 1 < n {
-                    py.check_signals()?;
+                    py.check_signals().map_err(|e| completed(py, e, k + 1))?;
                 }
             }
             Ok(last.map_or(empty(0), |r| Report::of(&r, n)))
         }
+    }
+}
+
+/// `err` with `completed`: the steps of this call that succeeded before it.
+fn completed(py: Python<'_>, err: PyErr, done: usize) -> PyErr {
+    let n = done.into_pyobject(py).map(|x| x.into_any().unbind());
+    match n {
+        Ok(n) => with_attrs(py, err, &[("completed", n)]),
+        Err(_) => err,
     }
 }
 

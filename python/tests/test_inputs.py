@@ -137,3 +137,27 @@ def test_a_non_finite_force_is_reported_as_such(method, bad):
         s.step(1, force=force)
     assert e.value.kind == "non_finite_force" and e.value.index == 1
     assert s.state_bits() == before
+
+
+def test_step_n_keeps_the_completed_steps_and_says_how_many():
+    # A heavy big sphere falls onto a light small one: an overlap after a few steps,
+    # with the GIL released (no force callable).
+    s = hr.System([[0, 0, 0], [0, 0, 6.0]], [1.0, 2.0], [1.0, 5.0], dt=0.1)
+    with pytest.raises(hr.OverlapError) as e:
+        s.step(1000)
+    done = e.value.completed
+    assert 0 < done < 1000
+    assert s.time == pytest.approx(done * 0.1)
+    # With a force callable: it fails on its fourth call.
+    s = hr.System(POS, 1.0, 1.0, dt=0.1)
+    calls = []
+
+    def force(p):
+        calls.append(1)
+        if len(calls) == 4:
+            raise RuntimeError("enough")
+        return np.zeros_like(p)
+
+    with pytest.raises(RuntimeError, match="enough") as e2:
+        s.step(10, force=force)
+    assert e2.value.completed == 3 and s.time == pytest.approx(0.3)

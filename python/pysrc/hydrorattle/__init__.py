@@ -602,11 +602,12 @@ class System:
         and propagates, leaving the state unchanged.
 
         Raises a :class:`StepError` subclass (``kind``, ``stage``, ``index``,
-        ``value``; ``kind`` and ``stage`` are the kernel's snake_case names, e.g.
-        ``"no_convergence"``, ``"particle_bad_radius"``, ``"positions"``) when a step
-        fails: the state (positions, velocities, spins, time,
-        noise generator) is then exactly as it was before that step; the steps before
-        it are kept.
+        ``value``, ``completed``; ``kind`` and ``stage`` are the kernel's snake_case
+        names, e.g. ``"no_convergence"``, ``"particle_bad_radius"``, ``"positions"``)
+        when a step fails: the state (positions, velocities, spins, time, noise
+        generator) is then exactly as it was before that step; the steps of this call
+        before it are kept, and ``completed`` says how many there were. An exception
+        from ``force`` or Ctrl-C carries ``completed`` too.
         """
         return self._core.step(int(n), force)
 

@@ -9,6 +9,7 @@ import numpy.typing as npt
 __version__: str
 
 class StepError(RuntimeError):
+    completed: int
     kind: str
     stage: Optional[str]
     index: Union[int, tuple[int, int], None]
