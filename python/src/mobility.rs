@@ -57,6 +57,7 @@ fn dense<'py, T: Real + Element>(
     level: Hydro,
     rotation: bool,
     g: Geometry,
+    threads: usize,
 ) -> PyResult<Bound<'py, PyArray2<T>>> {
     let p = g.params::<T>(eta, level, rotation)?;
     let (pos, r) = spheres::<T>(py, pos, radii, None)?;
@@ -68,7 +69,8 @@ fn dense<'py, T: Real + Element>(
         false => geometry::mobility_tt(&p, &pos, &r, &mut packed),
     });
     filled.map_err(|e| value_error(py, e))?;
-    let out = py.detach(|| write_dense::<T>(&packed, blocks));
+    let par = threads_for(blocks, threads)?;
+    let out = py.detach(|| write_dense::<T>(&packed, blocks, par_of(&par)));
     Ok(Array2::from_shape_vec((3 * blocks, 3 * blocks), out)
         .expect("3 rows and columns per block")
         .into_pyarray(py))
@@ -76,7 +78,7 @@ fn dense<'py, T: Real + Element>(
 
 /// Dense mobility matrix; see the Python docstring of `hydrorattle.mobility`.
 #[pyfunction]
-#[pyo3(signature = (positions, radii, viscosity=1.0, hydro="rpy", rotation=false, precision="f64", wall=None, r#box=None))]
+#[pyo3(signature = (positions, radii, viscosity=1.0, hydro="rpy", rotation=false, precision="f64", wall=None, r#box=None, threads=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn mobility<'py>(
     py: Python<'py>,
@@ -88,6 +90,7 @@ pub fn mobility<'py>(
     precision: &str,
     wall: Option<f64>,
     r#box: Option<[f64; 3]>,
+    threads: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let pos = rows(&positions, "positions")?;
     let radii = column(&radii, "radii", pos.len())?;
@@ -95,9 +98,9 @@ pub fn mobility<'py>(
     let level = crate::input::hydro(hydro)?;
     let g = geometry(wall, r#box);
     Ok(if is_f32(precision)? {
-        dense::<f32>(py, pos, radii, eta, level, rotation, g)?.into_any()
+        dense::<f32>(py, pos, radii, eta, level, rotation, g, threads)?.into_any()
     } else {
-        dense::<f64>(py, pos, radii, eta, level, rotation, g)?.into_any()
+        dense::<f64>(py, pos, radii, eta, level, rotation, g, threads)?.into_any()
     })
 }
 
@@ -126,6 +129,23 @@ pub fn pool(threads: usize) -> PyResult<Arc<Threads>> {
     Ok(t)
 }
 
+/// The pool for `n` block rows on `threads` threads: none below the kernel's banded
+/// size ([`bands`]) or for one thread.
+fn threads_for(n: usize, threads: usize) -> PyResult<Option<Arc<Threads>>> {
+    match bands(n) > 1 && threads != 1 {
+        true => Ok(Some(pool(threads)?)),
+        false => Ok(None),
+    }
+}
+
+/// The pool as the kernel's [`Parallel`], or the calling thread.
+fn par_of(pool: &Option<Arc<Threads>>) -> &dyn Parallel {
+    match pool {
+        Some(t) => t.as_ref(),
+        None => &Serial,
+    }
+}
+
 /// Velocities (and spins) in precision `T`.
 #[allow(clippy::too_many_arguments)]
 fn product<'py, T: Real + Element>(
@@ -146,20 +166,11 @@ fn product<'py, T: Real + Element>(
     let n = pos.len();
     let f: Vec<T::V3> = forces.iter().map(|&x| T::v3_from(x)).collect();
     if !rotation {
-        let par: Option<Arc<Threads>> = match bands(n) > 1 && threads != 1 {
-            true => Some(pool(threads)?),
-            false => None,
-        };
+        let par = threads_for(n, threads)?;
         let mut u = vec![T::V3_ZERO; n];
         let mut z = vec![T::V3_ZERO; band_scratch(n)];
-        py.detach(|| {
-            let par: &dyn Parallel = match &par {
-                Some(t) => t.as_ref(),
-                None => &Serial,
-            };
-            geometry::mobility_product(&p, par, &pos, &r, &f, &mut u, &mut z)
-        })
-        .map_err(|e| value_error(py, e))?;
+        py.detach(|| geometry::mobility_product(&p, par_of(&par), &pos, &r, &f, &mut u, &mut z))
+            .map_err(|e| value_error(py, e))?;
         return Ok(to_array::<T>(py, &u).into_any());
     }
     // With rotation: the grand mobility packed (O(N^2) storage) and one product.

@@ -145,3 +145,17 @@ def test_threads_must_be_a_count():
         hr.mobility_dot([[0, 0, 0]], [1.0], [[1, 0, 0]], threads=1.5)
     with pytest.raises(ValueError, match="threads"):
         hr.mobility_dot([[0, 0, 0]], [1.0], [[1, 0, 0]], threads=-1)
+
+
+def test_dense_mobility_is_the_same_on_any_threads():
+    rng = np.random.default_rng(8)
+    n = 600
+    pos = rng.uniform(-20, 20, (n, 3))
+    radii = rng.uniform(0.1, 0.3, n)
+    one = hr.mobility(pos, radii, threads=1)
+    assert np.array_equal(hr.mobility(pos, radii, threads=3), one)
+    assert np.array_equal(one, one.T)
+    # The product of the same matrix, matrix-free.
+    f = rng.normal(size=(n, 3))
+    u = hr.mobility_dot(pos, radii, f)
+    assert np.allclose(u.ravel(), one @ f.ravel(), rtol=0, atol=1e-13 * np.abs(u).max())

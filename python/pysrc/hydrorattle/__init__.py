@@ -144,6 +144,7 @@ def mobility(
     precision: str = "f64",
     wall: Optional[float] = None,
     box: Optional["tuple[float, float, float]"] = None,
+    threads: int = 0,
 ) -> np.ndarray:
     """The dense mobility matrix of spheres at ``positions`` with ``radii``.
 
@@ -170,6 +171,11 @@ def mobility(
         A rectangular periodic box: the Ewald-summed RPY mobility (docs/PERIODIC.md),
         as ``System(..., box=...)`` steps with. Every radius below half the smallest
         edge; not with ``wall``, ``rotation`` or ``hydro="oseen"`` (``ValueError``).
+    threads : int
+        Threads writing the dense output from 512 beads on (0: every core; the same
+        values on any number). Above 32 MiB of output (N = 683 in f64) every new array
+        is fresh memory whose first write page-faults (NumPy's own ``np.empty`` pays
+        the same); threads take those faults in parallel.
 
     Returns
     -------
@@ -200,6 +206,7 @@ def mobility(
         precision,
         _wall(wall),
         _box(box),
+        _count(threads, "threads"),
     )
 
 

@@ -52,6 +52,7 @@ def mobility(
     precision: str = ...,
     wall: Optional[float] = ...,
     box: Optional[tuple[float, float, float]] = ...,
+    threads: int = ...,
 ) -> npt.NDArray[np.floating[Any]]: ...
 def mobility_dot(
     positions: _F64,
