@@ -69,6 +69,12 @@ pyo3::create_exception!(
 );
 pyo3::create_exception!(
     hydrorattle,
+    SystemBusyError,
+    PyRuntimeError,
+    "The system is stepping: a second step(n) or a set_state from another thread while one runs, or a read of the system from inside its own step (a force callable reads the positions it is passed). Reads from other threads wait for the end of the current step instead."
+);
+pyo3::create_exception!(
+    hydrorattle,
     SceneError,
     PyValueError,
     "A scene file could not be read or was refused (`file`, `line`, `column`)."
@@ -88,6 +94,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ContactsFullError", py.get_type::<ContactsFullError>())?;
     m.add("UnsupportedError", py.get_type::<UnsupportedError>())?;
     m.add("SceneError", py.get_type::<SceneError>())?;
+    m.add("SystemBusyError", py.get_type::<SystemBusyError>())?;
     Ok(())
 }
 

@@ -17,6 +17,8 @@ mod input;
 mod mobility;
 mod params;
 mod runs;
+mod shared;
+mod stepping;
 mod system;
 
 /// The extension module.

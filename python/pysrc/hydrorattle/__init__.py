@@ -41,6 +41,7 @@ from ._hydrorattle import (
     Report,
     SceneError,
     StepError,
+    SystemBusyError,
     UnstableError,
     UnsupportedError,
     __version__,
@@ -68,6 +69,7 @@ __all__ = [
     "ContactsFullError",
     "UnsupportedError",
     "SceneError",
+    "SystemBusyError",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -591,9 +593,29 @@ class System:
             f"dt={self.dt}, precision={self.precision!r})"
         )
 
-    def step(self, n: int = 1, force: Optional[Force] = None) -> Report:
+    def step(
+        self,
+        n: int = 1,
+        force: Optional[Force] = None,
+        callback: Optional[Callable[["System"], Any]] = None,
+        every: int = 1,
+    ) -> Report:
         """Makes ``n`` steps inside Rust; returns the last step's :class:`Report`
         (constraint iterations, residual, largest tension).
+
+        ``callback(system)`` runs after every ``every``-th step of the call, with the
+        GIL held and the system readable (positions, tensions, observables; it must not
+        call ``step`` or ``set_state``, which raise :class:`SystemBusyError`). Its cost
+        is the Python call and what it reads: taking the GIL back and calling an empty
+        callback is about a microsecond (the steps in between run without the GIL). An
+        exception it raises stops the call (``completed`` on it; the steps made are
+        kept).
+
+        Threads: another thread reading this system while it steps waits for the end
+        of the current step and sees the state between two steps (a consistent
+        snapshot); a second ``step`` or a ``set_state`` from another thread while a
+        ``step(n)`` runs raises :class:`SystemBusyError`, as does a ``force`` callable
+        that reads the system it is stepping (it reads the positions it is passed).
 
         Without ``force`` the GIL is released for the whole call (other Python threads
         run; two systems step in parallel in two threads), and Ctrl-C interrupts it
@@ -616,7 +638,8 @@ class System:
         before it are kept, and ``completed`` says how many there were. An exception
         from ``force`` or Ctrl-C carries ``completed`` too.
         """
-        return self._core.step(int(n), force)
+        bound = None if callback is None else (lambda: callback(self))
+        return self._core.step(_count(n, "n"), force, bound, _count(every, "every"))
 
     def run(
         self, until: float, every: int = 1, force: Optional[Force] = None
