@@ -385,3 +385,41 @@ def test_a_chain_lands_on_a_wall_from_the_scene_code():
     with pytest.raises(ValueError, match="particle 1") as e:
         hr.System([[0.0, 0.0, 2.5], [3.0, 0.0, 0.5]], 1.0, RHO, dt=1.0, wall=0.0)
     assert e.value.index == 1
+
+
+def dimer_closed_form(d, rho, a_top=1.0, a_bottom=2.0):
+    """Tension and speed of a rigid dimer settling vertically, the big sphere below (RPY
+    far field, eta = 1, g = 1): both spheres move with one velocity U, so with the pair
+    block along the bond M and Stokes' mu_k, mu_1 (W_1 + T) + M (W_2 - T) =
+    M (W_1 + T) + mu_2 (W_2 - T)."""
+    w = [4.0 / 3.0 * math.pi * a**3 * rho for a in (a_top, a_bottom)]
+    mu = [1.0 / (6.0 * math.pi * a) for a in (a_top, a_bottom)]
+    s = (a_top**2 + a_bottom**2) / d**2
+    m = ((1 + s / 3) + (1 - s)) / (8 * math.pi * d)
+    t = ((mu[1] - m) * w[1] - (mu[0] - m) * w[0]) / (mu[0] + mu[1] - 2 * m)
+    return t, mu[0] * (w[0] + t) + m * (w[1] - t)
+
+
+@pytest.mark.parametrize("precision", ["f64", "f32"])
+@pytest.mark.parametrize("method", ["overdamped", "rattle", "rattle-stable", "springs"])
+@pytest.mark.parametrize("dt", [0.01, 0.001])
+def test_settling_dimer_tension_in_both_precisions(precision, method, dt):
+    """Radii 1 (above) and 2 (below), 4.5 apart, density 4.5: every method's tension
+    against the closed form (18.2237) in f32 and f64 (issue 30 item 4: f32 rattle read
+    16.6, and -0 at dt = 0.001, before the inertial tensions were solved from the
+    displacements). Springs: the spring law against the closed form at the stretched
+    length, once the stretch has relaxed."""
+    d, rho = 4.5, 4.5
+    want, u = dimer_closed_form(d, rho)
+    s = hr.System(
+        [[0.3, -0.2, d], [0.3, -0.2, 0.0]], [1.0, 2.0], rho, bonds=[[0, 1]], dt=dt,
+        method=method, solver="newton", precision=precision,
+    )
+    s.set_state(velocities=[[0, 0, -u], [0, 0, -u]])
+    s.step(300)
+    got = s.tensions[0]
+    if method == "springs":
+        p = s.positions
+        want = dimer_closed_form(np.linalg.norm(p[0] - p[1]), rho)[0]
+    tol = {"f64": 1e-5, "f32": 1e-2}[precision]
+    assert got == pytest.approx(want, rel=tol), (got, want)
