@@ -171,11 +171,19 @@ pub fn step_error(py: Python<'_>, e: KStep) -> PyErr {
 /// A refused particle as a `ValueError` naming it (`index` set).
 pub fn particle_error(py: Python<'_>, e: ParticleError) -> PyErr {
     let index = index_of(py, e.pair(), e.index());
+    let kind = kind_of(py, KStep::Particle(e));
     with_attrs(
         py,
         PyValueError::new_err(e.to_string()),
-        &[("index", index)],
+        &[("index", index), ("kind", kind)],
     )
+}
+
+/// The kernel's kind of `e` as a Python string.
+fn kind_of(py: Python<'_>, e: KStep) -> Py<PyAny> {
+    e.kind()
+        .into_pyobject(py)
+        .map_or_else(|_| py.None(), |x| x.into_any().unbind())
 }
 
 /// A kernel error met outside a step (the mobility alone, a system's construction) as
@@ -184,16 +192,14 @@ pub fn value_error(py: Python<'_>, e: KStep) -> PyErr {
     if let KStep::Particle(p) = e {
         return particle_error(py, p);
     }
-    let kind = e
-        .kind()
-        .into_pyobject(py)
-        .map_or_else(|_| py.None(), |x| x.into_any().unbind());
+    let kind = kind_of(py, e);
     with_attrs(py, PyValueError::new_err(e.to_string()), &[("kind", kind)])
 }
 
 /// A refused bond as a `ValueError` naming it.
-pub fn bond_error(e: BondError) -> PyErr {
-    PyValueError::new_err(e.to_string())
+pub fn bond_error(py: Python<'_>, e: BondError) -> PyErr {
+    let kind = kind_of(py, KStep::Bond(e));
+    with_attrs(py, PyValueError::new_err(e.to_string()), &[("kind", kind)])
 }
 
 /// A scene error as `SceneError` with `file`, `line` and `column`.

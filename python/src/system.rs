@@ -156,7 +156,7 @@ fn engine_from<T: Real>(
             length: T::from_f64(length),
         });
     }
-    hydrorattle::bonds::validate(&links, n).map_err(bond_error)?;
+    hydrorattle::bonds::validate(&links, n).map_err(|e| bond_error(py, e))?;
     let beads = Beads {
         pos: p,
         vel: vec![T::V3_ZERO; n],

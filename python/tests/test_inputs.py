@@ -29,7 +29,7 @@ def test_subnormal_radii_are_refused(precision, tiny):
     ):
         with pytest.raises(ValueError, match="particle 0: radius must be > 0 and normal") as e:
             call()
-        assert e.value.index == 0
+        assert e.value.index == 0 and e.value.kind == "particle_bad_radius"
     # The smallest normal radius gives a finite mobility.
     m = hr.mobility([[0, 0, 0]], [np.finfo(precision.replace("f", "float")).tiny], precision=precision)
     assert np.isfinite(m).all()
@@ -105,8 +105,9 @@ def test_overlap_at_the_start_is_refused_unless_allowed():
 def test_coincident_centres_say_so_even_where_overlap_is_allowed():
     same = [[1.0, 2.0, 3.0], [1.0, 2.0, 3.0]]
     for kw in ({}, {"allow_overlap": True}):
-        with pytest.raises(ValueError, match="particles 0 and 1: coincident centres"):
+        with pytest.raises(ValueError, match="particles 0 and 1: coincident centres") as e:
             hr.System(same, 1.0, 1.0, dt=0.1, **kw)
+        assert e.value.kind == "particle_coincident" and e.value.index == (0, 1)
     with pytest.raises(ValueError, match="coincident centres"):
         hr.mobility(same, [1.0, 1.0])
 
