@@ -54,7 +54,10 @@ fn band<T: Real>(packed: &[T::M3], blocks: usize, i0: usize, out: &mut [T]) {
 pub fn write_dense<T: Real>(packed: &[T::M3], blocks: usize, par: &dyn Parallel) -> Vec<T> {
     let m = 3 * blocks;
     let mut out = vec![T::ZERO; m * m];
-    let rows = blocks.div_ceil(BANDS).max(1);
+    if blocks == 0 {
+        return out;
+    }
+    let rows = blocks.div_ceil(BANDS);
     let mut jobs: Vec<_> = out
         .chunks_mut(3 * rows * m)
         .enumerate()

@@ -159,3 +159,8 @@ def test_dense_mobility_is_the_same_on_any_threads():
     f = rng.normal(size=(n, 3))
     u = hr.mobility_dot(pos, radii, f)
     assert np.allclose(u.ravel(), one @ f.ravel(), rtol=0, atol=1e-13 * np.abs(u).max())
+
+
+def test_no_spheres():
+    assert hr.mobility(np.zeros((0, 3)), []).shape == (0, 0)
+    assert hr.mobility_dot(np.zeros((0, 3)), [], np.zeros((0, 3))).shape == (0, 3)
