@@ -49,6 +49,7 @@ pub fn geometry(wall: Option<f64>, cell: Option<[f64; 3]>) -> Geometry {
 }
 
 /// The dense `(3N, 3N)` (or `(6N, 6N)` with rotation) mobility in precision `T`.
+#[allow(clippy::too_many_arguments)]
 fn dense<'py, T: Real + Element>(
     py: Python<'py>,
     pos: &[[f64; 3]],

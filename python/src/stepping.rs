@@ -46,7 +46,7 @@ pub fn steps(
 /// Runs the callback after step `done` when it is due.
 fn call_back(py: Python<'_>, every: Option<&Every>, done: usize) -> PyResult<()> {
     match every {
-        Some(c) if done % c.every == 0 => c
+        Some(c) if done.is_multiple_of(c.every) => c
             .callback
             .call0(py)
             .map(|_| ())
@@ -65,7 +65,7 @@ fn free_steps(shared: &Shared<Inner>, n: usize, every: Option<&Every>) -> PyResu
             each!(&mut *g, e, T => e.step().map(|r| Report::of::<T>(&r, done)))
         };
         last = r.map_err(|k| Python::attach(|py| completed(py, step_error(py, k), done - 1)))?;
-        if every.is_some_and(|c| done % c.every == 0) {
+        if every.is_some_and(|c| done.is_multiple_of(c.every)) {
             Python::attach(|py| call_back(py, every, done))?;
         }
         if done < n && checked.elapsed() >= SIGNAL_EVERY {
