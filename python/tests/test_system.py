@@ -404,13 +404,14 @@ def dimer_closed_form(d, rho, a_top=1.0, a_bottom=2.0):
 @pytest.mark.parametrize("method", ["overdamped", "rattle", "rattle-stable", "springs"])
 @pytest.mark.parametrize("dt", [0.01, 0.001])
 def test_settling_dimer_tension_in_both_precisions(precision, method, dt):
-    """Radii 1 (above) and 2 (below), 4.5 apart, density 4.5: every method's tension
-    against the closed form (18.2237) in f32 and f64 (issue 30 item 4: f32 rattle read
+    """Radii 1 (above) and 2 (below), 4 apart, density 4.5: every method's tension
+    against the closed form (14.7596, the issue's figure) in f32 and f64 (issue 30 item 4: f32 rattle read
     16.6, and -0 at dt = 0.001, before the inertial tensions were solved from the
     displacements). Springs: the spring law against the closed form at the stretched
     length, once the stretch has relaxed."""
-    d, rho = 4.5, 4.5
+    d, rho = 4.0, 4.5
     want, u = dimer_closed_form(d, rho)
+    assert want == pytest.approx(14.7596, abs=1e-4)
     s = hr.System(
         [[0.3, -0.2, d], [0.3, -0.2, 0.0]], [1.0, 2.0], rho, bonds=[[0, 1]], dt=dt,
         method=method, solver="newton", precision=precision,
