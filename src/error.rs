@@ -17,7 +17,8 @@ pub enum ParticleError {
         /// Index of the particle.
         particle: usize,
     },
-    /// Radius is zero or negative.
+    /// Radius is zero, negative or subnormal (below the precision's smallest normal
+    /// number, where `1 / (6 pi eta a)` loses its digits or overflows).
     BadRadius {
         /// Index of the particle.
         particle: usize,
@@ -29,6 +30,14 @@ pub enum ParticleError {
     },
     /// One sphere lies inside the other (`|r_i - r_j| <= |a_i - a_j|`).
     Nested {
+        /// First particle.
+        i: usize,
+        /// Second particle.
+        j: usize,
+    },
+    /// Two centres coincide (`r_i = r_j`): no overlap policy allows it (the pair has
+    /// no direction; with equal radii the spheres are one).
+    Coincident {
         /// First particle.
         i: usize,
         /// Second particle.
@@ -178,8 +187,15 @@ pub enum StepError {
         /// The bond; past the bonds, contact `bond - bonds` of the step.
         bond: usize,
     },
-    /// A force, velocity or position became NaN or infinite.
+    /// A velocity or position became NaN or infinite.
     NonFinite {
+        /// The particle.
+        particle: usize,
+    },
+    /// The force on a particle (buoyant weight plus the caller's
+    /// [`ExternalForce`](crate::ExternalForce)) is NaN or infinite: bad input, not a
+    /// failure of the step (nothing was integrated).
+    NonFiniteForce {
         /// The particle.
         particle: usize,
     },
@@ -223,11 +239,18 @@ impl fmt::Display for ParticleError {
         match *self {
             Self::Full => write!(f, "particle set is full"),
             Self::NonFinite { particle } => write!(f, "particle {particle}: non-finite value"),
-            Self::BadRadius { particle } => write!(f, "particle {particle}: radius must be > 0"),
+            Self::BadRadius { particle } => write!(
+                f,
+                "particle {particle}: radius must be > 0 and normal (not subnormal)"
+            ),
             Self::BadDensity { particle } => write!(f, "particle {particle}: density must be >= 0"),
             Self::Nested { i, j } => {
                 write!(f, "particles {i} and {j}: one sphere inside the other")
             }
+            Self::Coincident { i, j } => write!(
+                f,
+                "particles {i} and {j}: coincident centres (refused even where overlaps are allowed)"
+            ),
             Self::Overlap { i, j } => write!(f, "particles {i} and {j} overlap"),
             Self::Massless { particle } => {
                 write!(f, "particle {particle}: inertial method needs mass > 0")
@@ -308,6 +331,10 @@ impl fmt::Display for StepError {
             Self::NonFinite { particle } => {
                 write!(f, "particle {particle}: state became non-finite")
             }
+            Self::NonFiniteForce { particle } => write!(
+                f,
+                "particle {particle}: the force on it is NaN or infinite (weight plus external force)"
+            ),
             Self::Overlap { i, j } => write!(f, "particles {i} and {j} overlap after the step"),
             Self::Storage { need, have } => write!(
                 f,

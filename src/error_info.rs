@@ -17,6 +17,7 @@ impl ParticleError {
             Self::BadRadius { .. } => "bad_radius",
             Self::BadDensity { .. } => "bad_density",
             Self::Nested { .. } => "nested",
+            Self::Coincident { .. } => "coincident",
             Self::Overlap { .. } => "overlap",
             Self::Massless { .. } => "massless",
             Self::BelowWall { .. } => "below_wall",
@@ -32,14 +33,18 @@ impl ParticleError {
             | Self::BadDensity { particle }
             | Self::Massless { particle }
             | Self::BelowWall { particle } => Some(particle),
-            Self::Nested { i, .. } | Self::Overlap { i, .. } => Some(i),
+            Self::Nested { i, .. } | Self::Coincident { i, .. } | Self::Overlap { i, .. } => {
+                Some(i)
+            }
         }
     }
 
     /// The two particles of a nesting or an overlap.
     pub const fn pair(&self) -> Option<(usize, usize)> {
         match *self {
-            Self::Nested { i, j } | Self::Overlap { i, j } => Some((i, j)),
+            Self::Nested { i, j } | Self::Coincident { i, j } | Self::Overlap { i, j } => {
+                Some((i, j))
+            }
             _ => None,
         }
     }
@@ -126,6 +131,7 @@ impl StepError {
                 ParticleError::BadRadius { .. } => "particle_bad_radius",
                 ParticleError::BadDensity { .. } => "particle_bad_density",
                 ParticleError::Nested { .. } => "particle_nested",
+                ParticleError::Coincident { .. } => "particle_coincident",
                 ParticleError::Overlap { .. } => "particle_overlap",
                 ParticleError::Massless { .. } => "particle_massless",
                 ParticleError::BelowWall { .. } => "particle_below_wall",
@@ -147,6 +153,7 @@ impl StepError {
             Self::NoConvergence { .. } => "no_convergence",
             Self::Degenerate { .. } => "degenerate",
             Self::NonFinite { .. } => "non_finite",
+            Self::NonFiniteForce { .. } => "non_finite_force",
             Self::Overlap { .. } => "overlap",
             Self::Storage { .. } => "storage",
             Self::StateLength => "state_length",
@@ -181,7 +188,7 @@ impl StepError {
             Self::Bond(e) => e.index(),
             Self::Linalg { error, .. } => Some(error.row()),
             Self::Degenerate { bond } => Some(bond),
-            Self::NonFinite { particle } => Some(particle),
+            Self::NonFinite { particle } | Self::NonFiniteForce { particle } => Some(particle),
             Self::Overlap { i, .. } => Some(i),
             _ => None,
         }
@@ -246,7 +253,7 @@ mod tests {
     use crate::workspace::Layout;
 
     /// One of every variant (nested ones included).
-    fn every() -> [StepError; 30] {
+    fn every() -> [StepError; 32] {
         let p = |e| StepError::Particle(e);
         let b = |e| StepError::Bond(e);
         let (i, j, bond) = (3, 5, 7);
@@ -262,6 +269,7 @@ mod tests {
             p(ParticleError::BadRadius { particle: i }),
             p(ParticleError::BadDensity { particle: i }),
             p(ParticleError::Nested { i, j }),
+            p(ParticleError::Coincident { i, j }),
             p(ParticleError::Overlap { i, j }),
             p(ParticleError::Massless { particle: i }),
             p(ParticleError::BelowWall { particle: i }),
@@ -285,6 +293,7 @@ mod tests {
             },
             StepError::Degenerate { bond },
             StepError::NonFinite { particle: i },
+            StepError::NonFiniteForce { particle: i },
             StepError::Overlap { i, j },
             StepError::Storage {
                 need: Layout::default(),

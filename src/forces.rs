@@ -42,7 +42,7 @@ pub fn external<T: Real, E: ExternalForce<T>>(
     }
     ext.add(pos, radius, out);
     match out.iter().position(|&f| !T::v3_is_finite(f)) {
-        Some(particle) => Err(StepError::NonFinite { particle }),
+        Some(particle) => Err(StepError::NonFiniteForce { particle }),
         None => Ok(()),
     }
 }

@@ -272,6 +272,16 @@ pub struct Params<T: Real> {
     /// ignored elsewhere. The same bits on any number of threads, not the bits of the
     /// `f64` products (docs/BENCHMARKS.md, "Product paths"). Default false.
     pub compact_products: bool,
+    /// Solve the inertial methods' ([`Method::Rattle`], [`Method::RattleStable`]) bond
+    /// tensions again from the step's displacements instead of reading them off the
+    /// position solve (`displacement_tensions` in `integrate/stages.rs`): their
+    /// constraint displacement `dt^2 F / m` falls below an `f32` position's rounding
+    /// once `dt` is small, and the position multipliers are then rounding noise. Costs
+    /// two more constraint solves per step (and a Cholesky solve for `Rattle`); the
+    /// trajectory does not depend on it, only the multipliers and
+    /// [`StepReport::max_tension`](crate::StepReport::max_tension). The other methods
+    /// ignore it. Default: on in `f32`, off in `f64` (where both agree to rounding).
+    pub resolve_tensions: bool,
 }
 
 impl<T: Real> Params<T> {
@@ -309,6 +319,7 @@ impl<T: Real> Params<T> {
             wall: None,
             periodic: None,
             compact_products: false,
+            resolve_tensions: T::EPSILON.to_f64() > 1e-10,
         }
     }
 

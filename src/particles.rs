@@ -208,7 +208,7 @@ pub fn check_one<T: Real>(i: usize, p: &Particle<T>) -> Result<(), ParticleError
     if !finite {
         return Err(ParticleError::NonFinite { particle: i });
     }
-    if p.radius <= T::ZERO {
+    if !(p.radius >= T::MIN_POSITIVE) {
         return Err(ParticleError::BadRadius { particle: i });
     }
     if p.density < T::ZERO {
@@ -228,6 +228,9 @@ pub fn check_pairs<T: Real>(
         for j in i + 1..pos.len() {
             let s = T::norm(pos[i] - pos[j]);
             let (ai, aj) = (radius[i], radius[j]);
+            if s == T::ZERO {
+                return Err(ParticleError::Coincident { i, j });
+            }
             if s <= (ai - aj).abs() {
                 return Err(ParticleError::Nested { i, j });
             }

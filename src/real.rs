@@ -69,6 +69,9 @@ pub trait Real:
     const PI: Self;
     /// Machine epsilon.
     const EPSILON: Self;
+    /// The smallest positive normal number: a radius below it is refused (subnormal
+    /// radii lose their digits, and `1 / (6 pi eta a)` overflows).
+    const MIN_POSITIVE: Self;
     /// The zero vector.
     const V3_ZERO: Self::V3;
     /// The zero matrix.
@@ -214,6 +217,7 @@ macro_rules! impl_real {
             const HALF: Self = 0.5;
             const PI: Self = core::f64::consts::PI as $t;
             const EPSILON: Self = <$t>::EPSILON;
+            const MIN_POSITIVE: Self = <$t>::MIN_POSITIVE;
             const V3_ZERO: $v = <$v>::ZERO;
             const M3_ZERO: $m = <$m>::ZERO;
             const M3_IDENTITY: $m = <$m>::IDENTITY;

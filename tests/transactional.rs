@@ -87,7 +87,7 @@ fn nan_force<T: Real>() {
             &before,
             &ps,
             &r,
-            |e| *e == StepError::NonFinite { particle: 2 },
+            |e| *e == StepError::NonFiniteForce { particle: 2 },
             &what,
         );
 
@@ -108,7 +108,7 @@ fn nan_force<T: Real>() {
                     &before,
                     &ps,
                     &r,
-                    |e| *e == StepError::NonFinite { particle: 5 },
+                    |e| *e == StepError::NonFiniteForce { particle: 5 },
                     &what,
                 );
                 failed = true;

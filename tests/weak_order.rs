@@ -18,7 +18,9 @@
 //! | 0.1 | 0.33481 +- 0.00047 | 27 | 0.33354 +- 0.00058 | 0 |
 //! | 0.05 | 0.33322 +- 0.00043 | 0 | 0.33331 +- 0.00060 | 0 |
 //!
-//! (of 256 000, 512 000, 1 024 000 and 2 048 000 steps). Fitted order (0.4, 0.2, 0.1):
+//! (of 256 000, 512 000, 1 024 000 and 2 048 000 steps). The entries are `<cos^2>`; the
+//! bias is `<cos^2> - 1/3` (at dt = 0.1: free draining +0.0015 +- 0.0005, RPY +0.0002 +-
+//! 0.0006, not resolved). Fitted order (0.4, 0.2, 0.1):
 //! free draining `p = 1.46` (1 sigma 1.21 to 1.77), RPY `p = 1.22` (0.79 to 1.88); a
 //! dt-independent bias is rejected by chi^2 64 against 3.2 (free draining) and 11.7
 //! against 0.7 (RPY). At dt = 0.05 neither bias is resolved (below 0.0005).

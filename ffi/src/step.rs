@@ -306,7 +306,7 @@ fn describe<T>(e: StepError, r: &mut HrReport<T>) -> HrStatus {
         StepError::Linalg { .. } => HrStatus::Linalg,
         StepError::NoConvergence { .. } => HrStatus::NoConvergence,
         StepError::Degenerate { .. } => HrStatus::Degenerate,
-        StepError::NonFinite { .. } => HrStatus::NonFinite,
+        StepError::NonFinite { .. } | StepError::NonFiniteForce { .. } => HrStatus::NonFinite,
         StepError::Overlap { .. } => HrStatus::Overlap,
         StepError::Storage { .. } => HrStatus::Storage,
         StepError::StateLength => HrStatus::StateLength,

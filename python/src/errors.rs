@@ -11,7 +11,7 @@ pyo3::create_exception!(
     hydrorattle,
     StepError,
     PyRuntimeError,
-    "A step failed; the system's state is exactly as it was before the call."
+    "A step failed. The failed step changed nothing: the state (and noise generator) is as after the last completed step; `step(n)` keeps the steps it completed before the failure, and `completed` says how many (0: the state is as before the call)."
 );
 pyo3::create_exception!(
     hydrorattle,
@@ -69,6 +69,12 @@ pyo3::create_exception!(
 );
 pyo3::create_exception!(
     hydrorattle,
+    SystemBusyError,
+    PyRuntimeError,
+    "The system is stepping: a second step(n) or a set_state from another thread while one runs, or a read of the system from inside its own step (a force callable reads the positions it is passed). Reads from other threads wait for the end of the current step instead."
+);
+pyo3::create_exception!(
+    hydrorattle,
     SceneError,
     PyValueError,
     "A scene file could not be read or was refused (`file`, `line`, `column`)."
@@ -88,11 +94,12 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ContactsFullError", py.get_type::<ContactsFullError>())?;
     m.add("UnsupportedError", py.get_type::<UnsupportedError>())?;
     m.add("SceneError", py.get_type::<SceneError>())?;
+    m.add("SystemBusyError", py.get_type::<SystemBusyError>())?;
     Ok(())
 }
 
 /// Sets attributes on an exception instance.
-fn with_attrs(py: Python<'_>, e: PyErr, attrs: &[(&str, Py<PyAny>)]) -> PyErr {
+pub fn with_attrs(py: Python<'_>, e: PyErr, attrs: &[(&str, Py<PyAny>)]) -> PyErr {
     let v = e.value(py);
     for (k, x) in attrs {
         // An attribute that cannot be set leaves the message, which says the same.
@@ -122,7 +129,7 @@ pub fn step_error(py: Python<'_>, e: KStep) -> PyErr {
         KStep::Linalg { .. } => LinalgError::new_err(msg),
         KStep::NoConvergence { .. } => ConvergenceError::new_err(msg),
         KStep::Degenerate { .. } => DegenerateError::new_err(msg),
-        KStep::NonFinite { .. } => NonFiniteError::new_err(msg),
+        KStep::NonFinite { .. } | KStep::NonFiniteForce { .. } => NonFiniteError::new_err(msg),
         KStep::Overlap { .. } => OverlapError::new_err(msg),
         KStep::Unstable { .. } => UnstableError::new_err(msg),
         KStep::ContactsFull { .. } => ContactsFullError::new_err(msg),
@@ -164,16 +171,35 @@ pub fn step_error(py: Python<'_>, e: KStep) -> PyErr {
 /// A refused particle as a `ValueError` naming it (`index` set).
 pub fn particle_error(py: Python<'_>, e: ParticleError) -> PyErr {
     let index = index_of(py, e.pair(), e.index());
+    let kind = kind_of(py, KStep::Particle(e));
     with_attrs(
         py,
         PyValueError::new_err(e.to_string()),
-        &[("index", index)],
+        &[("index", index), ("kind", kind)],
     )
 }
 
+/// The kernel's kind of `e` as a Python string.
+fn kind_of(py: Python<'_>, e: KStep) -> Py<PyAny> {
+    e.kind()
+        .into_pyobject(py)
+        .map_or_else(|_| py.None(), |x| x.into_any().unbind())
+}
+
+/// A kernel error met outside a step (the mobility alone, a system's construction) as
+/// a `ValueError` with the kernel's message and `kind` (and `index` for a particle).
+pub fn value_error(py: Python<'_>, e: KStep) -> PyErr {
+    if let KStep::Particle(p) = e {
+        return particle_error(py, p);
+    }
+    let kind = kind_of(py, e);
+    with_attrs(py, PyValueError::new_err(e.to_string()), &[("kind", kind)])
+}
+
 /// A refused bond as a `ValueError` naming it.
-pub fn bond_error(e: BondError) -> PyErr {
-    PyValueError::new_err(e.to_string())
+pub fn bond_error(py: Python<'_>, e: BondError) -> PyErr {
+    let kind = kind_of(py, KStep::Bond(e));
+    with_attrs(py, PyValueError::new_err(e.to_string()), &[("kind", kind)])
 }
 
 /// A scene error as `SceneError` with `file`, `line` and `column`.

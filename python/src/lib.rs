@@ -11,11 +11,14 @@
 
 use pyo3::prelude::*;
 
+mod dense;
 mod errors;
 mod input;
 mod mobility;
 mod params;
 mod runs;
+mod shared;
+mod stepping;
 mod system;
 
 /// The extension module.

@@ -1,17 +1,55 @@
-//! The dense mobility matrix and its product with forces (and torques).
+//! The dense mobility matrix and its product with forces (and torques), in free space,
+//! above a wall or in a periodic box: the kernel's `integrate::geometry`, which refuses
+//! what a step would refuse of the geometry.
 
-use hydrorattle::linalg::{sym_get, sym_matvec, tri};
-use hydrorattle::mobility::{assemble_grand, assemble_tt, tt_product};
-use hydrorattle::{Hydro, Real};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use hydrorattle::integrate::geometry;
+use hydrorattle::linalg::{sym_matvec, tri};
+use hydrorattle::parallel::{band_scratch, bands};
+use hydrorattle::{Hydro, Parallel, Params, Periodic, Real, Serial, Wall};
+use hydrorattle_parallel::Threads;
 use numpy::ndarray::Array2;
 use numpy::{Element, IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::errors::particle_error;
+use crate::dense::write_dense;
+use crate::errors::value_error;
 use crate::input::{column, is_f32, rows, spheres};
 
+/// The geometry's keyword arguments: `wall` (a height) and `box` (three edges).
+#[derive(Clone, Copy)]
+pub struct Geometry {
+    wall: Option<f64>,
+    cell: Option<[f64; 3]>,
+}
+
+impl Geometry {
+    /// Kernel parameters in `T` naming the level, viscosity, wall and box (a bad box
+    /// edge is a `ValueError` from the kernel's check).
+    fn params<T: Real>(&self, eta: f64, level: Hydro, rotation: bool) -> PyResult<Params<T>> {
+        let mut p = Params::<T>::new(T::ONE);
+        p.viscosity = T::from_f64(eta);
+        p.hydro = level;
+        p.rotation = rotation;
+        p.wall = self.wall.map(|h| Wall::new(T::from_f64(h)));
+        if let Some(c) = self.cell {
+            let cell = Periodic::new(c.map(T::from_f64));
+            p.periodic = Some(cell.map_err(|e| PyValueError::new_err(format!("box: {e}")))?);
+        }
+        Ok(p)
+    }
+}
+
+/// `wall` and `box` from their Python values.
+pub fn geometry(wall: Option<f64>, cell: Option<[f64; 3]>) -> Geometry {
+    Geometry { wall, cell }
+}
+
 /// The dense `(3N, 3N)` (or `(6N, 6N)` with rotation) mobility in precision `T`.
+#[allow(clippy::too_many_arguments)]
 fn dense<'py, T: Real + Element>(
     py: Python<'py>,
     pos: &[[f64; 3]],
@@ -19,38 +57,30 @@ fn dense<'py, T: Real + Element>(
     eta: f64,
     level: Hydro,
     rotation: bool,
+    g: Geometry,
+    threads: usize,
 ) -> PyResult<Bound<'py, PyArray2<T>>> {
-    let (p, r) = spheres::<T>(py, pos, radii, None)?;
-    let n = p.len();
+    let p = g.params::<T>(eta, level, rotation)?;
+    let (pos, r) = spheres::<T>(py, pos, radii, None)?;
+    let n = pos.len();
     let blocks = if rotation { 2 * n } else { n };
     let mut packed = vec![T::M3_ZERO; tri(blocks)];
-    let eta = T::from_f64(eta);
-    let filled = py.detach(|| {
-        if rotation {
-            assemble_grand(level, eta, &p, &r, &mut packed)
-        } else {
-            assemble_tt(level, eta, &p, &r, &mut packed)
-        }
+    let filled = py.detach(|| match rotation {
+        true => geometry::mobility_grand(&p, &pos, &r, &mut packed),
+        false => geometry::mobility_tt(&p, &pos, &r, &mut packed),
     });
-    filled.map_err(|e| particle_error(py, e))?;
-    let m = 3 * blocks;
-    let mut out = Array2::<T>::from_elem((m, m), T::ZERO);
-    for bi in 0..blocks {
-        for bj in 0..blocks {
-            let b = sym_get::<T>(&packed, bi, bj);
-            for r in 0..3 {
-                for c in 0..3 {
-                    out[(3 * bi + r, 3 * bj + c)] = T::m3_get(b, r, c);
-                }
-            }
-        }
-    }
-    Ok(out.into_pyarray(py))
+    filled.map_err(|e| value_error(py, e))?;
+    let par = threads_for(blocks, threads)?;
+    let out = py.detach(|| write_dense::<T>(&packed, blocks, par_of(&par)));
+    Ok(Array2::from_shape_vec((3 * blocks, 3 * blocks), out)
+        .expect("3 rows and columns per block")
+        .into_pyarray(py))
 }
 
 /// Dense mobility matrix; see the Python docstring of `hydrorattle.mobility`.
 #[pyfunction]
-#[pyo3(signature = (positions, radii, viscosity=1.0, hydro="rpy", rotation=false, precision="f64"))]
+#[pyo3(signature = (positions, radii, viscosity=1.0, hydro="rpy", rotation=false, precision="f64", wall=None, r#box=None, threads=0))]
+#[allow(clippy::too_many_arguments)]
 pub fn mobility<'py>(
     py: Python<'py>,
     positions: PyReadonlyArray2<'py, f64>,
@@ -59,15 +89,19 @@ pub fn mobility<'py>(
     hydro: &str,
     rotation: bool,
     precision: &str,
+    wall: Option<f64>,
+    r#box: Option<[f64; 3]>,
+    threads: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let pos = rows(&positions, "positions")?;
     let radii = column(&radii, "radii", pos.len())?;
     let eta = crate::input::viscosity(viscosity)?;
     let level = crate::input::hydro(hydro)?;
+    let g = geometry(wall, r#box);
     Ok(if is_f32(precision)? {
-        dense::<f32>(py, pos, radii, eta, level, rotation)?.into_any()
+        dense::<f32>(py, pos, radii, eta, level, rotation, g, threads)?.into_any()
     } else {
-        dense::<f64>(py, pos, radii, eta, level, rotation)?.into_any()
+        dense::<f64>(py, pos, radii, eta, level, rotation, g, threads)?.into_any()
     })
 }
 
@@ -77,6 +111,40 @@ fn to_array<'py, T: Real + Element>(py: Python<'py>, v: &[T::V3]) -> Bound<'py, 
     Array2::from_shape_vec((v.len(), 3), flat)
         .expect("3 values per row")
         .into_pyarray(py)
+}
+
+/// A pool of `threads` threads (0: every core), built once per count and kept.
+pub fn pool(threads: usize) -> PyResult<Arc<Threads>> {
+    static POOLS: OnceLock<Mutex<HashMap<usize, Arc<Threads>>>> = OnceLock::new();
+    let mut pools = POOLS
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    if let Some(t) = pools.get(&threads) {
+        return Ok(t.clone());
+    }
+    let t = Arc::new(
+        Threads::new(threads).map_err(|e| PyValueError::new_err(format!("threads: {e}")))?,
+    );
+    pools.insert(threads, t.clone());
+    Ok(t)
+}
+
+/// The pool for `n` block rows on `threads` threads: none below the kernel's banded
+/// size ([`bands`]) or for one thread.
+fn threads_for(n: usize, threads: usize) -> PyResult<Option<Arc<Threads>>> {
+    match bands(n) > 1 && threads != 1 {
+        true => Ok(Some(pool(threads)?)),
+        false => Ok(None),
+    }
+}
+
+/// The pool as the kernel's [`Parallel`], or the calling thread.
+fn par_of(pool: &Option<Arc<Threads>>) -> &dyn Parallel {
+    match pool {
+        Some(t) => t.as_ref(),
+        None => &Serial,
+    }
 }
 
 /// Velocities (and spins) in precision `T`.
@@ -90,15 +158,20 @@ fn product<'py, T: Real + Element>(
     eta: f64,
     level: Hydro,
     rotation: bool,
+    g: Geometry,
+    threads: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (p, r) = spheres::<T>(py, pos, radii, None)?;
-    let n = p.len();
-    let eta = T::from_f64(eta);
+    let rotation = rotation || torques.is_some();
+    let p = g.params::<T>(eta, level, rotation)?;
+    let (pos, r) = spheres::<T>(py, pos, radii, None)?;
+    let n = pos.len();
     let f: Vec<T::V3> = forces.iter().map(|&x| T::v3_from(x)).collect();
-    if torques.is_none() && !rotation {
+    if !rotation {
+        let par = threads_for(n, threads)?;
         let mut u = vec![T::V3_ZERO; n];
-        py.detach(|| tt_product(level, eta, &p, &r, &f, &mut u))
-            .map_err(|e| particle_error(py, e))?;
+        let mut z = vec![T::V3_ZERO; band_scratch(n)];
+        py.detach(|| geometry::mobility_product(&p, par_of(&par), &pos, &r, &f, &mut u, &mut z))
+            .map_err(|e| value_error(py, e))?;
         return Ok(to_array::<T>(py, &u).into_any());
     }
     // With rotation: the grand mobility packed (O(N^2) storage) and one product.
@@ -110,11 +183,11 @@ fn product<'py, T: Real + Element>(
     let mut y = vec![T::V3_ZERO; 2 * n];
     let mut packed = vec![T::M3_ZERO; tri(2 * n)];
     py.detach(|| {
-        assemble_grand(level, eta, &p, &r, &mut packed)?;
+        geometry::mobility_grand(&p, &pos, &r, &mut packed)?;
         sym_matvec::<T>(&packed, 2 * n, &x, &mut y);
         Ok(())
     })
-    .map_err(|e| particle_error(py, e))?;
+    .map_err(|e| value_error(py, e))?;
     let u = to_array::<T>(py, &y[..n]);
     let w = to_array::<T>(py, &y[n..]);
     Ok((u, w).into_pyobject(py)?.into_any())
@@ -122,7 +195,7 @@ fn product<'py, T: Real + Element>(
 
 /// Mobility product; see the Python docstring of `hydrorattle.mobility_dot`.
 #[pyfunction]
-#[pyo3(signature = (positions, radii, forces, torques=None, viscosity=1.0, hydro="rpy", rotation=false, precision="f64"))]
+#[pyo3(signature = (positions, radii, forces, torques=None, viscosity=1.0, hydro="rpy", rotation=false, precision="f64", wall=None, r#box=None, threads=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn mobility_dot<'py>(
     py: Python<'py>,
@@ -134,6 +207,9 @@ pub fn mobility_dot<'py>(
     hydro: &str,
     rotation: bool,
     precision: &str,
+    wall: Option<f64>,
+    r#box: Option<[f64; 3]>,
+    threads: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let pos = rows(&positions, "positions")?;
     let radii = column(&radii, "radii", pos.len())?;
@@ -168,9 +244,10 @@ pub fn mobility_dot<'py>(
     }
     let eta = crate::input::viscosity(viscosity)?;
     let level = crate::input::hydro(hydro)?;
+    let g = geometry(wall, r#box);
     if is_f32(precision)? {
-        product::<f32>(py, pos, radii, f, t, eta, level, rotation)
+        product::<f32>(py, pos, radii, f, t, eta, level, rotation, g, threads)
     } else {
-        product::<f64>(py, pos, radii, f, t, eta, level, rotation)
+        product::<f64>(py, pos, radii, f, t, eta, level, rotation, g, threads)
     }
 }

@@ -1,7 +1,7 @@
 //! Kernel parameters from keyword arguments, with the kernel's names and defaults.
 
 use hydrorattle::{
-    Brownian, Contacts, Drift, Method, Named, NoiseSqrt, Params, Real, SolverKind, Wall,
+    Brownian, Contacts, Drift, Method, Named, NoiseSqrt, Params, Periodic, Real, SolverKind, Wall,
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -16,62 +16,141 @@ pub fn pick<X: Named>(what: &str, name: &str) -> PyResult<X> {
     })
 }
 
-/// Kernel parameters in precision `T` from keyword arguments with the kernel's names
-/// and defaults ([`Params::new`]); the noise seed comes back beside them.
-pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<T>, u64)> {
-    let get = |k: &str| -> PyResult<Option<Bound<'_, PyAny>>> {
-        match kw {
-            Some(d) => d.get_item(k),
-            None => Ok(None),
+/// What a system's keyword arguments set beside the kernel's parameters.
+pub struct Extras {
+    /// The noise generator's seed.
+    pub seed: u64,
+    /// Threads for the mobility's bands (0: every core).
+    pub threads: usize,
+}
+
+/// A keyword argument's value as `X`, or a `TypeError` naming the parameter and the
+/// type it got.
+fn get<'py, X: for<'a> pyo3::FromPyObject<'a, 'py>>(
+    k: &str,
+    x: &Bound<'py, PyAny>,
+    want: &str,
+) -> PyResult<X> {
+    if x.is_instance_of::<pyo3::types::PyComplex>() {
+        return Err(PyTypeError::new_err(format!(
+            "{k} must be {want}, not a complex number"
+        )));
+    }
+    x.extract::<X>()
+        .map_err(|_| PyTypeError::new_err(format!("{k} must be {want}, not {}", type_name(x))))
+}
+
+/// A flag: `True`/`False` (NumPy's too), or the integers 1 and 0 meaning them.
+fn flag(k: &str, x: &Bound<'_, PyAny>) -> PyResult<bool> {
+    if let Ok(b) = x.extract::<bool>() {
+        return Ok(b);
+    }
+    if x.is_instance_of::<pyo3::types::PyInt>() {
+        match x.extract::<i64>() {
+            Ok(0) => return Ok(false),
+            Ok(1) => return Ok(true),
+            _ => {}
         }
+    }
+    let shown = x.repr().map_or_else(|_| type_name(x), |r| r.to_string());
+    Err(PyTypeError::new_err(format!(
+        "{k} must be True or False, not {shown}"
+    )))
+}
+
+/// The type name of `x`, for messages.
+fn type_name(x: &Bound<'_, PyAny>) -> String {
+    x.get_type()
+        .name()
+        .map_or_else(|_| "?".into(), |n| n.to_string())
+}
+
+/// An integer (Python's or NumPy's, not a bool) that fits `X`: a `TypeError` naming the
+/// parameter for another type, a `ValueError` for a value out of range (a negative
+/// seed, say).
+fn count<X: TryFrom<i128>>(k: &str, x: &Bound<'_, PyAny>) -> PyResult<X> {
+    let not_int = || PyTypeError::new_err(format!("{k} must be an integer, not {}", type_name(x)));
+    if x.is_instance_of::<pyo3::types::PyBool>() {
+        return Err(not_int());
+    }
+    let v: i128 = x.extract().map_err(|_| not_int())?;
+    X::try_from(v).map_err(|_| {
+        let max = std::any::type_name::<X>();
+        PyValueError::new_err(format!(
+            "{k} must be an integer in the range of {max} (>= 0), not {v}"
+        ))
+    })
+}
+
+/// Kernel parameters in precision `T` from keyword arguments with the kernel's names
+/// and defaults ([`Params::new`]); the seed and thread count come back beside them.
+/// A value of the wrong type is a `TypeError`, a value out of range a `ValueError`,
+/// each naming the parameter (the kernel's own checks run when the system is built).
+pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<T>, Extras)> {
+    let dt: f64 = match kw.map(|d| d.get_item("dt")).transpose()?.flatten() {
+        Some(x) => get("dt", &x, "a real number")?,
+        None => return Err(PyTypeError::new_err("System needs the time step dt")),
     };
-    let dt: f64 = get("dt")?
-        .ok_or_else(|| PyTypeError::new_err("System needs the time step dt"))?
-        .extract()?;
     let mut p = Params::<T>::new(T::from_f64(dt));
-    let mut seed = 1;
-    let v3 = |x: Bound<'_, PyAny>| -> PyResult<T::V3> { Ok(T::v3_from(x.extract::<[f64; 3]>()?)) };
+    let mut extras = Extras {
+        seed: 1,
+        threads: 0,
+    };
     let Some(d) = kw else {
-        return Ok((p, seed));
+        return Ok((p, extras));
     };
     let mut temperature = None;
     let mut drift = Drift::default();
     for (k, x) in d.iter() {
         let k: String = k.extract()?;
-        match k.as_str() {
+        let k = k.as_str();
+        let real =
+            |x: &Bound<'_, PyAny>| -> PyResult<T> { Ok(T::from_f64(get(k, x, "a real number")?)) };
+        let v3 = |x: &Bound<'_, PyAny>| -> PyResult<T::V3> {
+            Ok(T::v3_from(get::<[f64; 3]>(k, x, "three real numbers")?))
+        };
+        let name = |x: &Bound<'_, PyAny>| -> PyResult<String> { get(k, x, "a string") };
+        match k {
             "dt" => {}
-            "method" => p.method = pick::<Method>("method", &x.extract::<String>()?)?,
-            "viscosity" => p.viscosity = T::from_f64(x.extract()?),
-            "fluid_density" => p.fluid_density = T::from_f64(x.extract()?),
-            "gravity" => p.gravity = v3(x)?,
-            "flow" | "flow_velocity" => p.flow_velocity = v3(x)?,
-            "vorticity" => p.vorticity = v3(x)?,
-            "hydro" => p.hydro = crate::input::hydro(&x.extract::<String>()?)?,
-            "rotation" => p.rotation = x.extract()?,
-            "matrix_free" => p.matrix_free = x.extract()?,
-            "solver" => p.solver.kind = pick::<SolverKind>("solver", &x.extract::<String>()?)?,
-            "tolerance" => p.solver.tolerance = T::from_f64(x.extract()?),
-            "max_iterations" => p.solver.max_iterations = x.extract()?,
-            "allow_overlap" => p.allow_overlap = x.extract()?,
-            "spring_stiffness" => p.spring_stiffness = T::from_f64(x.extract()?),
-            "fene" => p.fene = x.extract::<Option<f64>>()?.map(T::from_f64),
-            "stability_guard" => p.stability_guard = x.extract()?,
+            "method" => p.method = pick::<Method>("method", &name(&x)?)?,
+            "viscosity" => p.viscosity = real(&x)?,
+            "fluid_density" => p.fluid_density = real(&x)?,
+            "gravity" => p.gravity = v3(&x)?,
+            "flow" | "flow_velocity" => p.flow_velocity = v3(&x)?,
+            "vorticity" => p.vorticity = v3(&x)?,
+            "hydro" => p.hydro = crate::input::hydro(&name(&x)?)?,
+            "rotation" => p.rotation = flag(k, &x)?,
+            "matrix_free" => p.matrix_free = flag(k, &x)?,
+            "solver" => p.solver.kind = pick::<SolverKind>("solver", &name(&x)?)?,
+            "tolerance" => p.solver.tolerance = real(&x)?,
+            "max_iterations" => p.solver.max_iterations = count(k, &x)?,
+            "allow_overlap" => p.allow_overlap = flag(k, &x)?,
+            "spring_stiffness" => p.spring_stiffness = real(&x)?,
+            "fene" => p.fene = (!x.is_none()).then(|| real(&x)).transpose()?,
+            "stability_guard" => p.stability_guard = flag(k, &x)?,
+            "resolve_tensions" => p.resolve_tensions = flag(k, &x)?,
             "contacts" => {
-                p.contacts = x.extract::<Option<usize>>()?.map(Contacts::new);
+                p.contacts = (!x.is_none())
+                    .then(|| count::<usize>(k, &x))
+                    .transpose()?
+                    .map(Contacts::new);
             }
-            "wall" => {
-                p.wall = x
-                    .extract::<Option<f64>>()?
-                    .map(|h| Wall::new(T::from_f64(h)))
+            "wall" => p.wall = (!x.is_none()).then(|| real(&x)).transpose()?.map(Wall::new),
+            "box" => {
+                if !x.is_none() {
+                    let edges = v3(&x)?;
+                    let cell = Periodic::new(T::xyz(edges));
+                    p.periodic =
+                        Some(cell.map_err(|e| PyValueError::new_err(format!("box: {e}")))?);
+                }
             }
-            "temperature" => temperature = x.extract::<Option<f64>>()?,
-            "drift" => drift = pick::<Drift>("drift", &x.extract::<String>()?)?,
-            "seed" => seed = x.extract()?,
-            "noise_sqrt" => {
-                p.noise_sqrt = pick::<NoiseSqrt>("noise_sqrt", &x.extract::<String>()?)?
-            }
-            "lanczos_tolerance" => p.lanczos.tolerance = T::from_f64(x.extract()?),
-            "lanczos_max_iterations" => p.lanczos.max_iterations = x.extract()?,
+            "temperature" => temperature = (!x.is_none()).then(|| real(&x)).transpose()?,
+            "drift" => drift = pick::<Drift>("drift", &name(&x)?)?,
+            "seed" => extras.seed = count(k, &x)?,
+            "threads" => extras.threads = count(k, &x)?,
+            "noise_sqrt" => p.noise_sqrt = pick::<NoiseSqrt>("noise_sqrt", &name(&x)?)?,
+            "lanczos_tolerance" => p.lanczos.tolerance = real(&x)?,
+            "lanczos_max_iterations" => p.lanczos.max_iterations = count(k, &x)?,
             other => {
                 return Err(PyTypeError::new_err(format!(
                     "System got an unexpected parameter {other:?}"
@@ -80,8 +159,8 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
         }
     }
     p.brownian = temperature.map(|t| Brownian {
-        temperature: T::from_f64(t),
+        temperature: t,
         drift,
     });
-    Ok((p, seed))
+    Ok((p, extras))
 }

@@ -1,27 +1,23 @@
 //! A system stepped by the kernel: the host library's [`Engine`] in f64 or f32, with
 //! NumPy getters (copies) and `step(n)` run with the GIL released.
 
-use std::time::{Duration, Instant};
-
 use hydrorattle::{Bond, Noise, Real, StepReport};
 use hydrorattle_host::scene::Scene;
-use hydrorattle_host::sim::{Beads, Engine, resolve_level};
+use hydrorattle_host::sim::{Beads, Engine, Saved, resolve_level};
 use hydrorattle_host::sizing::DEFAULT_LIMIT;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{
-    Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2,
-    PyUntypedArrayMethods,
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{bond_error, scene_error, step_error};
+use crate::errors::{bond_error, scene_error, value_error};
 use crate::input::{column, is_f32, rows, spheres};
 use crate::params::params_from;
-
-/// How often a long `step(n)` looks for Ctrl-C.
-const SIGNAL_EVERY: Duration = Duration::from_millis(20);
+use crate::shared::Shared;
+use crate::stepping::{Every, steps};
 
 /// The report of the last step.
 #[pyclass(module = "hydrorattle", frozen, get_all)]
@@ -58,7 +54,7 @@ impl Report {
 }
 
 impl Report {
-    fn of<T: Real>(r: &StepReport<T>, steps: usize) -> Self {
+    pub fn of<T: Real>(r: &StepReport<T>, steps: usize) -> Self {
         Report {
             iterations: r.iterations,
             velocity_iterations: r.velocity_iterations,
@@ -74,20 +70,21 @@ impl Report {
 }
 
 /// The engine in its precision.
-enum Inner {
+pub enum Inner {
     F64(Engine<f64>),
     F32(Engine<f32>),
 }
 
 /// Runs `$body` with `$e` bound to the engine, `$t` to its precision.
+#[macro_export]
 macro_rules! each {
     ($inner:expr, $e:ident, $t:ident => $body:expr) => {
         match $inner {
-            Inner::F64($e) => {
+            $crate::system::Inner::F64($e) => {
                 type $t = f64;
                 $body
             }
-            Inner::F32($e) => {
+            $crate::system::Inner::F32($e) => {
                 type $t = f32;
                 $body
             }
@@ -95,14 +92,23 @@ macro_rules! each {
     };
 }
 
-/// The Rust side of `hydrorattle.System`.
-#[pyclass(module = "hydrorattle")]
+/// The Rust side of `hydrorattle.System`: the engine shared between Python threads
+/// ([`Shared`]: reads from other threads while it steps wait for the end of the step).
+#[pyclass(module = "hydrorattle", frozen)]
 pub struct Core {
-    inner: Inner,
+    shared: Shared<Inner>,
+}
+
+impl Core {
+    fn of(inner: Inner) -> Core {
+        Core {
+            shared: Shared::new(inner),
+        }
+    }
 }
 
 /// `(N, 3)` rows in precision `T` as a float64 array.
-fn rows_f64<'py, T: Real>(py: Python<'py>, v: &[T::V3]) -> Bound<'py, PyArray2<f64>> {
+pub fn rows_f64<'py, T: Real>(py: Python<'py>, v: &[T::V3]) -> Bound<'py, PyArray2<f64>> {
     let flat: Vec<f64> = v.iter().flat_map(|&x| T::v3_to_f64(x)).collect();
     Array2::from_shape_vec((v.len(), 3), flat)
         .expect("3 values per row")
@@ -125,7 +131,7 @@ fn engine_from<T: Real>(
     lengths: Option<&[f64]>,
     kw: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Engine<T>> {
-    let (params, seed) = params_from::<T>(kw)?;
+    let (params, extras) = params_from::<T>(kw)?;
     let (p, r) = spheres::<T>(py, pos, radii, Some(densities))?;
     let n = p.len();
     let index = |k: usize, i: i64| -> PyResult<usize> {
@@ -150,7 +156,7 @@ fn engine_from<T: Real>(
             length: T::from_f64(length),
         });
     }
-    hydrorattle::bonds::validate(&links, n).map_err(bond_error)?;
+    hydrorattle::bonds::validate(&links, n).map_err(|e| bond_error(py, e))?;
     let beads = Beads {
         pos: p,
         vel: vec![T::V3_ZERO; n],
@@ -159,135 +165,34 @@ fn engine_from<T: Real>(
         density: densities.iter().map(|&d| T::from_f64(d)).collect(),
         time: T::ZERO,
     };
-    Engine::from_parts(beads, links, params, Noise::new(seed), None, DEFAULT_LIMIT)
-        .map_err(|e| PyValueError::new_err(e.to_string()))
+    let noise = Noise::new(extras.seed);
+    let engine = Engine::from_parts(beads, links, params, noise, None, DEFAULT_LIMIT)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    ready(py, engine, extras.threads)
+}
+
+/// `e` checked as its first step would check it (a refusal is a `ValueError` with the
+/// kernel's message and `kind`), on `threads` threads.
+fn ready<T: Real>(py: Python<'_>, mut e: Engine<T>, threads: usize) -> PyResult<Engine<T>> {
+    e.check().map_err(|k| value_error(py, k))?;
+    e.with_threads(threads)
+        .map_err(|err| PyValueError::new_err(format!("threads: {err}")))
 }
 
 /// The engine of a scene (its level resolved), in the scene's precision.
-fn engine_of_scene(scene: &Scene) -> PyResult<Inner> {
+fn engine_of_scene(py: Python<'_>, scene: &Scene) -> PyResult<Inner> {
     let (scene, _) = resolve_level(scene, "scene");
     let fail = |e: hydrorattle_host::sim::BuildError| PyValueError::new_err(e.to_string());
     Ok(match scene.integrator.precision {
         hydrorattle_host::scene::Precision::F64 => {
-            Inner::F64(Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?)
+            let e = Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?;
+            Inner::F64(ready(py, e, 0)?)
         }
         hydrorattle_host::scene::Precision::F32 => {
-            Inner::F32(Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?)
+            let e = Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?;
+            Inner::F32(ready(py, e, 0)?)
         }
     })
-}
-
-/// `n` steps of `e`; the first failure ends them (the state as after the last good
-/// step). `force` adds the Python callable's forces; without it the steps run with
-/// the GIL released, looking for Ctrl-C every [`SIGNAL_EVERY`].
-fn steps<T: Real + Element>(
-    py: Python<'_>,
-    e: &mut Engine<T>,
-    n: usize,
-    force: Option<&Bound<'_, PyAny>>,
-) -> PyResult<Report> {
-    let mut last = None;
-    match force {
-        None => {
-            let mut done = 0;
-            let outcome = py.detach(|| -> Result<(), PyErr> {
-                let mut checked = Instant::now();
-                while done < n {
-                    let r = e
-                        .step()
-                        .map_err(|k| Python::attach(|py| step_error(py, k)))?;
-                    last = Some(r);
-                    done += 1;
-                    if done < n && checked.elapsed() >= SIGNAL_EVERY {
-                        Python::attach(|py| py.check_signals())?;
-                        checked = Instant::now();
-                    }
-                }
-                Ok(())
-            });
-            outcome?;
-            Ok(last.map_or(empty(0), |r| Report::of(&r, done)))
-        }
-        Some(f) => {
-            for k in 0..n {
-                let mut failed: Option<PyErr> = None;
-                let mut extra = |pos: &[T::V3], _: &[T], out: &mut [T::V3]| {
-                    if failed.is_some() {
-                        return;
-                    }
-                    match call_force::<T>(py, f, pos, out) {
-                        Ok(()) => {}
-                        Err(err) => {
-                            // A NaN force makes the kernel refuse the step, leaving the
-                            // state as it was; the Python error is raised instead.
-                            out.iter_mut().for_each(|v| *v = T::v3_from([f64::NAN; 3]));
-                            failed = Some(err);
-                        }
-                    }
-                };
-                let r = e.step_with(&mut extra);
-                if let Some(err) = failed {
-                    return Err(err);
-                }
-                last = Some(r.map_err(|k| step_error(py, k))?);
-                if k + 1 < n {
-                    py.check_signals()?;
-                }
-            }
-            Ok(last.map_or(empty(0), |r| Report::of(&r, n)))
-        }
-    }
-}
-
-/// A report for a call that made no step.
-fn empty(steps: usize) -> Report {
-    Report {
-        iterations: 0,
-        velocity_iterations: 0,
-        residual: 0.0,
-        max_tension: 0.0,
-        contacts: 0,
-        wall_contacts: 0,
-        contact_rounds: 0,
-        noise_iterations: 0,
-        steps,
-    }
-}
-
-/// Calls `f(positions)` and adds its `(N, 3)` result into `out`.
-fn call_force<T: Real>(
-    py: Python<'_>,
-    f: &Bound<'_, PyAny>,
-    pos: &[T::V3],
-    out: &mut [T::V3],
-) -> PyResult<()> {
-    let ret = f.call1((rows_f64::<T>(py, pos),))?;
-    // A C-contiguous float64 array is read as it is; anything else goes through NumPy.
-    let arr: PyReadonlyArray2<'_, f64> = match ret.extract::<PyReadonlyArray2<'_, f64>>() {
-        Ok(a) if a.is_c_contiguous() => a,
-        _ => py
-            .import("numpy")?
-            .call_method1("ascontiguousarray", (ret, "float64"))?
-            .extract()
-            .map_err(|_| {
-                PyValueError::new_err(format!(
-                    "the force callable must return shape ({}, 3)",
-                    pos.len()
-                ))
-            })?,
-    };
-    let forces = rows(&arr, "the force callable's result")?;
-    if forces.len() != out.len() {
-        return Err(PyValueError::new_err(format!(
-            "the force callable returned {} rows for {} particles",
-            forces.len(),
-            out.len()
-        )));
-    }
-    for (o, &f) in out.iter_mut().zip(forces) {
-        *o += T::v3_from(f);
-    }
-    Ok(())
 }
 
 #[pymethods]
@@ -330,85 +235,88 @@ impl Core {
                 py, pos, radii, densities, pairs, lengths, params,
             )?)
         };
-        Ok(Core { inner })
+        Ok(Core::of(inner))
     }
 
     /// The system of a scene file, read by the CLI's parser.
     #[staticmethod]
     fn from_scene_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Core> {
         let scene = Scene::from_path(&path).map_err(|e| scene_error(py, &e))?;
-        Ok(Core {
-            inner: engine_of_scene(&scene)?,
-        })
+        Ok(Core::of(engine_of_scene(py, &scene)?))
     }
 
     /// The system of scene text (TOML), read by the CLI's parser; `origin` names it.
     #[staticmethod]
     fn from_scene_text(py: Python<'_>, text: &str, origin: &str) -> PyResult<Core> {
         let scene = Scene::parse(text, origin).map_err(|e| scene_error(py, &e))?;
-        Ok(Core {
-            inner: engine_of_scene(&scene)?,
-        })
+        Ok(Core::of(engine_of_scene(py, &scene)?))
     }
 
-    /// `n` steps; the last step's report.
-    #[pyo3(signature = (n=1, force=None))]
+    /// `n` steps; the last step's report. `callback()` runs after every `every`-th
+    /// step (GIL held, the system readable).
+    #[pyo3(signature = (n=1, force=None, callback=None, every=1))]
     fn step(
-        &mut self,
+        &self,
         py: Python<'_>,
         n: usize,
         force: Option<Bound<'_, PyAny>>,
+        callback: Option<Py<PyAny>>,
+        every: usize,
     ) -> PyResult<Report> {
-        each!(&mut self.inner, e, T => steps::<T>(py, e, n, force.as_ref()))
+        if every == 0 {
+            return Err(PyValueError::new_err("every must be >= 1"));
+        }
+        let every = callback.map(|callback| Every { callback, every });
+        steps(py, &self.shared, n, force.as_ref(), every)
     }
 
     /// Positions `(N, 3)`, a float64 copy.
     #[getter]
-    fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        each!(&self.inner, e, T => rows_f64::<T>(py, &e.beads.pos))
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => rows_f64::<T>(py, &e.beads.pos)))
     }
 
     /// Velocities `(N, 3)`, a float64 copy.
     #[getter]
-    fn velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        each!(&self.inner, e, T => rows_f64::<T>(py, &e.beads.vel))
+    fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => rows_f64::<T>(py, &e.beads.vel)))
     }
 
     /// Angular velocities `(N, 3)`, a float64 copy.
     #[getter]
-    fn spins<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        each!(&self.inner, e, T => rows_f64::<T>(py, &e.beads.omega))
+    fn spins<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => rows_f64::<T>(py, &e.beads.omega)))
     }
 
     /// Radii `(N,)`, a float64 copy.
     #[getter]
-    fn radii<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        each!(&self.inner, e, T => values_f64::<T>(py, &e.beads.radius))
+    fn radii<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => values_f64::<T>(py, &e.beads.radius)))
     }
 
     /// Densities `(N,)`, a float64 copy.
     #[getter]
-    fn densities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        each!(&self.inner, e, T => values_f64::<T>(py, &e.beads.density))
+    fn densities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => values_f64::<T>(py, &e.beads.density)))
     }
 
     /// Bonds `(B, 2)`, an int64 copy.
     #[getter]
-    fn bonds<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
-        each!(&self.inner, e, T => {
+    fn bonds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => {
             let _: Option<T> = None;
             let flat: Vec<i64> = e.bonds.iter().flat_map(|b| [b.i as i64, b.j as i64]).collect();
             Array2::from_shape_vec((e.bonds.len(), 2), flat).expect("2 per row").into_pyarray(py)
-        })
+        }))
     }
 
     /// Bond lengths `(B,)`, a float64 copy.
     #[getter]
-    fn lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        each!(&self.inner, e, T => {
+    fn lengths<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => {
             let l: Vec<T> = e.bonds.iter().map(|b| b.length).collect();
             values_f64::<T>(py, &l)
-        })
+        }))
     }
 
     /// Bond tensions `(B,)` after the last accepted step, a float64 copy (force units;
@@ -416,42 +324,44 @@ impl Core {
     /// springs: the spring law at the current length). `None` before the first step
     /// and for `overdamped2`, whose last projection's multipliers are only a correction.
     #[getter]
-    fn tensions<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
-        each!(&self.inner, e, T => e.tensions().map(|t| values_f64::<T>(py, &t)))
+    fn tensions<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => e.tensions().map(|t| values_f64::<T>(py, &t))))
     }
 
     /// Simulated time.
     #[getter]
-    fn time(&self) -> f64 {
-        each!(&self.inner, e, T => { let t: T = e.beads.time; t.to_f64() })
+    fn time(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(each!(&*self.shared.read(py)?, e, T => { let t: T = e.beads.time; t.to_f64() }))
     }
 
     /// Time step.
     #[getter]
-    fn dt(&self) -> f64 {
-        each!(&self.inner, e, T => { let t: T = e.params.dt; t.to_f64() })
+    fn dt(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(each!(&*self.shared.read(py)?, e, T => { let t: T = e.params.dt; t.to_f64() }))
     }
 
     /// "f64" or "f32".
     #[getter]
-    fn precision(&self) -> &'static str {
-        match self.inner {
+    fn precision(&self, py: Python<'_>) -> PyResult<&'static str> {
+        Ok(match &*self.shared.read(py)? {
             Inner::F64(_) => "f64",
             Inner::F32(_) => "f32",
-        }
+        })
     }
 
     /// Replaces the positions, velocities, spins and time given (each `(N, 3)` or a
     /// float), checked as the kernel checks a particle (finite values): all or nothing.
     #[pyo3(signature = (positions=None, velocities=None, spins=None, time=None))]
     fn set_state(
-        &mut self,
+        &self,
+        py: Python<'_>,
         positions: Option<PyReadonlyArray2<'_, f64>>,
         velocities: Option<PyReadonlyArray2<'_, f64>>,
         spins: Option<PyReadonlyArray2<'_, f64>>,
         time: Option<f64>,
     ) -> PyResult<()> {
-        let n = each!(&self.inner, e, T => { let _: Option<T> = None; e.beads.len() });
+        let mut guard = self.shared.write(py)?;
+        let n = each!(&*guard, e, T => { let _: Option<T> = None; e.beads.len() });
         let mut new: [Option<&[[f64; 3]]>; 3] = [None; 3];
         let given = [
             ("positions", &positions),
@@ -480,7 +390,7 @@ impl Core {
                 "time must be finite, not {t}"
             )));
         }
-        each!(&mut self.inner, e, T => {
+        each!(&mut *guard, e, T => {
             let b = &mut e.beads;
             for (v, dst) in new.iter().zip([&mut b.pos, &mut b.vel, &mut b.omega]) {
                 if let Some(v) = v {
@@ -496,20 +406,43 @@ impl Core {
         })
     }
 
+    /// The whole system as JSON text (state, bonds, parameters, noise generator,
+    /// counters, the last tensions; every float's bits): what pickling carries.
+    fn save_json(&self, py: Python<'_>) -> PyResult<String> {
+        use hydrorattle_host::scene::Precision;
+        let saved = match &*self.shared.read(py)? {
+            Inner::F64(e) => e.save(Precision::F64),
+            Inner::F32(e) => e.save(Precision::F32),
+        };
+        serde_json::to_string(&saved).map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
+    /// The system [`Core::save_json`] wrote.
+    #[staticmethod]
+    fn restore_json(text: &str) -> PyResult<Core> {
+        use hydrorattle_host::scene::Precision;
+        let saved: Saved = serde_json::from_str(text)
+            .map_err(|e| PyValueError::new_err(format!("saved system: {e}")))?;
+        let fail = PyValueError::new_err;
+        let inner = match saved.precision {
+            Precision::F64 => Inner::F64(Engine::restore(&saved).map_err(fail)?),
+            Precision::F32 => Inner::F32(Engine::restore(&saved).map_err(fail)?),
+        };
+        Ok(Core::of(inner))
+    }
+
     /// An independent copy of the system (state, storage, noise generator).
-    fn copy(&self) -> Core {
-        Core {
-            inner: match &self.inner {
-                Inner::F64(e) => Inner::F64(e.clone()),
-                Inner::F32(e) => Inner::F32(e.clone()),
-            },
-        }
+    fn copy(&self, py: Python<'_>) -> PyResult<Core> {
+        Ok(Core::of(match &*self.shared.read(py)? {
+            Inner::F64(e) => Inner::F64(e.clone()),
+            Inner::F32(e) => Inner::F32(e.clone()),
+        }))
     }
 
     /// The state's bits (positions, velocities, spins, time, then the noise
     /// generator's next draw on a copy), for exact comparisons.
-    fn state_bits(&self) -> Vec<u64> {
-        each!(&self.inner, e, T => {
+    fn state_bits(&self, py: Python<'_>) -> PyResult<Vec<u64>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => {
             let mut out = Vec::new();
             for v in [&e.beads.pos, &e.beads.vel, &e.beads.omega] {
                 for &x in v.iter() {
@@ -519,6 +452,6 @@ impl Core {
             out.push(e.beads.time.to_f64().to_bits());
             out.push(e.noise.clone().normal().to_bits());
             out
-        })
+        }))
     }
 }

@@ -135,8 +135,10 @@ def test_a_step_keeps_every_bond_or_raises_and_changes_nothing(
         s = hr.System(pos, radii, rng.uniform(0.5, 5.0, n), bonds=bonds, dt=dt, method=method,
                       solver=solver, hydro=hydro, allow_overlap=True, precision=precision,
                       temperature=temperature, seed=seed)
-    except ValueError as e:  # the random walk put one sphere inside another
-        assert "inside" in str(e)
+    except ValueError as e:
+        # The random walk put one sphere inside another, or the kernel refuses the
+        # combination (thermal noise with overdamped2, say) when the system is built.
+        assert "inside" in str(e) or getattr(e, "kind", None) == "unsupported", e
         assume(False)
     lengths = s.lengths
     tol = 1e-8 if precision == "f64" else 1e-3
@@ -231,9 +233,10 @@ def test_bad_system_input_is_refused():
         hr.System(pos, 1.0, RHO, bonds=bonds)
     with pytest.raises(ValueError, match="method must be one of"):
         hr.System(pos, 1.0, RHO, bonds=bonds, dt=0.1, method="verlet")
-    s = hr.System(pos, 1.0, RHO, bonds=bonds, dt=-0.1)
-    with pytest.raises(hr.InvalidStateError, match="time step"):
-        s.step()
+    # Parameters the first step would refuse are refused when the system is built.
+    with pytest.raises(ValueError, match="time step") as e:
+        hr.System(pos, 1.0, RHO, bonds=bonds, dt=-0.1)
+    assert e.value.kind == "bad_time_step"
 
 
 def test_helix_keys_build_the_scene_files_chain():
@@ -379,7 +382,45 @@ def test_a_chain_lands_on_a_wall_from_the_scene_code():
     one = hr.System([[0.0, 0.0, 2.5]], 1.0, RHO, dt=1.0, wall=0.0)
     one.step(10)
     assert one.positions[0, 2] == pytest.approx(1.0, abs=1e-9)
-    below = hr.System([[0.0, 0.0, 2.5], [3.0, 0.0, 0.5]], 1.0, RHO, dt=1.0, wall=0.0)
-    with pytest.raises(hr.InvalidStateError, match="particle 1") as e:
-        below.step()
+    with pytest.raises(ValueError, match="particle 1") as e:
+        hr.System([[0.0, 0.0, 2.5], [3.0, 0.0, 0.5]], 1.0, RHO, dt=1.0, wall=0.0)
     assert e.value.index == 1
+
+
+def dimer_closed_form(d, rho, a_top=1.0, a_bottom=2.0):
+    """Tension and speed of a rigid dimer settling vertically, the big sphere below (RPY
+    far field, eta = 1, g = 1): both spheres move with one velocity U, so with the pair
+    block along the bond M and Stokes' mu_k, mu_1 (W_1 + T) + M (W_2 - T) =
+    M (W_1 + T) + mu_2 (W_2 - T)."""
+    w = [4.0 / 3.0 * math.pi * a**3 * rho for a in (a_top, a_bottom)]
+    mu = [1.0 / (6.0 * math.pi * a) for a in (a_top, a_bottom)]
+    s = (a_top**2 + a_bottom**2) / d**2
+    m = ((1 + s / 3) + (1 - s)) / (8 * math.pi * d)
+    t = ((mu[1] - m) * w[1] - (mu[0] - m) * w[0]) / (mu[0] + mu[1] - 2 * m)
+    return t, mu[0] * (w[0] + t) + m * (w[1] - t)
+
+
+@pytest.mark.parametrize("precision", ["f64", "f32"])
+@pytest.mark.parametrize("method", ["overdamped", "rattle", "rattle-stable", "springs"])
+@pytest.mark.parametrize("dt", [0.01, 0.001])
+def test_settling_dimer_tension_in_both_precisions(precision, method, dt):
+    """Radii 1 (above) and 2 (below), 4 apart, density 4.5: every method's tension
+    against the closed form (14.7596, the issue's figure) in f32 and f64 (issue 30 item 4: f32 rattle read
+    16.6, and -0 at dt = 0.001, before the inertial tensions were solved from the
+    displacements). Springs: the spring law against the closed form at the stretched
+    length, once the stretch has relaxed."""
+    d, rho = 4.0, 4.5
+    want, u = dimer_closed_form(d, rho)
+    assert want == pytest.approx(14.7596, abs=1e-4)
+    s = hr.System(
+        [[0.3, -0.2, d], [0.3, -0.2, 0.0]], [1.0, 2.0], rho, bonds=[[0, 1]], dt=dt,
+        method=method, solver="newton", precision=precision,
+    )
+    s.set_state(velocities=[[0, 0, -u], [0, 0, -u]])
+    s.step(300)
+    got = s.tensions[0]
+    if method == "springs":
+        p = s.positions
+        want = dimer_closed_form(np.linalg.norm(p[0] - p[1]), rho)[0]
+    tol = {"f64": 1e-5, "f32": 1e-2}[precision]
+    assert got == pytest.approx(want, rel=tol), (got, want)

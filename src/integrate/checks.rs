@@ -114,6 +114,28 @@ pub(super) fn check_periodic<T: Real>(
     let Some(c) = p.periodic else {
         return Ok(None);
     };
+    let sums = check_box(p, state.radius)?;
+    let [x, y, z] = c.size();
+    let half = x.min(y).min(z) * T::HALF;
+    if let Some(bond) = bonds.iter().position(|b| !(b.length < half)) {
+        return Err(crate::error::BondError::BadLength { bond }.into());
+    }
+    if p.method == Method::Springs && p.fene.is_some_and(|q| !(q < half)) {
+        return Err(StepError::BadParameter(
+            "fene (maximum extension below half the periodic box's smallest edge)",
+        ));
+    }
+    Ok(sums)
+}
+
+/// The box's part of [`check_periodic`] that needs no bonds (the mobility alone,
+/// `integrate::geometry`, asks it too): the feature, no wall, no rotation, not Oseen,
+/// every radius below half the smallest edge, Ewald parameters the sums allow (which it
+/// returns, as [`check_periodic`] does).
+pub(super) fn check_box<T: Real>(p: &Params<T>, radius: &[T]) -> Result<HeldSums<T>, StepError> {
+    let Some(c) = p.periodic else {
+        return Ok(None);
+    };
     if !cfg!(feature = "periodic") {
         return Err(StepError::Unsupported(
             "a periodic box: the kernel was built without its `periodic` feature",
@@ -134,20 +156,12 @@ pub(super) fn check_periodic<T: Real>(
     }
     let [x, y, z] = c.size();
     let half = x.min(y).min(z) * T::HALF;
-    if let Some(particle) = state.radius.iter().position(|&a| !(a < half)) {
+    if let Some(particle) = radius.iter().position(|&a| !(a < half)) {
         return Err(StepError::Particle(ParticleError::BadRadius { particle }));
-    }
-    if let Some(bond) = bonds.iter().position(|b| !(b.length < half)) {
-        return Err(crate::error::BondError::BadLength { bond }.into());
-    }
-    if p.method == Method::Springs && p.fene.is_some_and(|q| !(q < half)) {
-        return Err(StepError::BadParameter(
-            "fene (maximum extension below half the periodic box's smallest edge)",
-        ));
     }
     #[cfg(feature = "periodic")]
     if p.hydro != Hydro::FreeDraining {
-        return Ok(Some(super::periodic::ewald(c, state.radius)?));
+        return Ok(Some(super::periodic::ewald(c, radius)?));
     }
     Ok(None)
 }
@@ -177,8 +191,9 @@ pub(super) fn check_all<T: Real>(
     check_inputs(state, bonds, p)?;
     let thermal = check_thermal(p, has_generator)?;
     check_contacts(p, thermal.is_some())?;
-    check_wall(p, state)?;
+    // The box first: a box with a wall is refused as such, not by the wall's check.
     let sums = check_periodic(p, state, bonds)?;
+    check_wall(p, state)?;
     Ok((thermal, sums))
 }
 
@@ -276,7 +291,7 @@ pub(super) fn check_inputs<T: Real>(
         if !finite {
             return Err(ParticleError::NonFinite { particle: i }.into());
         }
-        if state.radius[i] <= T::ZERO {
+        if !(state.radius[i] >= T::MIN_POSITIVE) {
             return Err(ParticleError::BadRadius { particle: i }.into());
         }
         if state.density[i] < T::ZERO {

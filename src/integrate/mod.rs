@@ -14,6 +14,7 @@
 mod brownian;
 mod checks;
 mod contacts;
+pub mod geometry;
 mod overdamped;
 #[cfg(feature = "periodic")]
 mod periodic;

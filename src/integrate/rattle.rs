@@ -4,7 +4,10 @@
 //! SHAKE with the mass metric (eq. 3) fixes the positions and RATTLE (eq. 4) the
 //! velocities. Stable only for `dt` below about `2 m / zeta`.
 
-use super::{Start, StepReport, assemble_tt, bond_vectors, cell, report, spin};
+use super::{
+    Start, StepReport, assemble_tt, bond_vectors, cell, displacement_tensions, project_velocity,
+    report, spin,
+};
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem};
 use crate::error::{Stage, StepError};
@@ -110,6 +113,30 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
     let vstats = constraints::solve(problem, &metric, bonds, &p.solver, new_vel, kappa, &mut sc)?;
     // Each sphere pushes on the fluid with R (v - U_inf).
     spin(p, s.pos, s.radius, drag, new_omega)?;
+    // The tensions from the step's displacement `v dt + a dt^2 / 2` (r* - r without the
+    // positions' rounding) along the position metric, with `v` tangent to the bonds;
+    // `a` follows `v` through the drag (see `displacement_tensions`); only when asked.
+    if p.resolve_tensions {
+        let metric = Metric::Mass {
+            inv_mass,
+            grad,
+            scale: half_dt2,
+        };
+        let (vel, x) = (r_star, acc);
+        vel.copy_from_slice(s.vel);
+        if project_velocity(p, bonds, grad, vel, inv_mass, kappa, &mut sc) {
+            for i in 0..n {
+                drag[i] = vel[i] - s.vel[i];
+            }
+            linalg::cholesky_solve::<T>(fac, n, drag);
+            for i in 0..n {
+                x[i] = vel[i] * dt + (x[i] - drag[i] * inv_mass[i]) * half_dt2;
+            }
+            if displacement_tensions(p, bonds, &metric, grad, grad_new, x, kappa, &mut sc) {
+                lambda.copy_from_slice(kappa);
+            }
+        }
+    }
     Ok(report(stats, vstats.iterations, bonds, lambda))
 }
 

@@ -28,14 +28,13 @@
 
 use super::{
     Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors,
-    project_positions, report, step_velocity, wall_height,
+    displacement_tensions, project_positions, project_velocity, report, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, SolverKind, apply_drag};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
 use crate::linalg::{self, tri};
-use crate::mobility;
 use crate::noise::Noise;
 use crate::params::{Brownian, Params};
 use crate::particles::sphere_volume;
@@ -77,11 +76,8 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
         ..
     } = v;
     // Mobility (translation or grand) and the drag operator K = dt I + S mu S.
-    if let (true, Some(h)) = (p.rotation, wall_height(p)) {
-        let (level, eta) = (p.hydro, p.viscosity);
-        mobility::wall::assemble_grand(level, eta, h, s.pos, s.radius, mu)?;
-    } else if p.rotation {
-        mobility::assemble_grand(p.hydro, p.viscosity, s.pos, s.radius, mu)?;
+    if p.rotation {
+        super::geometry::grand(p, s.pos, s.radius, mu)?;
     } else {
         assemble_tt(p, s.ewald, s.pos, s.radius, mu)?;
     }
@@ -167,6 +163,10 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     };
     let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut sc)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
+    // The unconstrained displacement `u dt` for the tensions (`u` is the spin's next).
+    for (d, &w) in t[..n].iter_mut().zip(u[..n].iter()) {
+        *d = w * dt;
+    }
     // Angular velocities: the same solve with the constraint forces included.
     if p.rotation {
         add_constraint_forces(bonds, grad, lambda, &mut rhs6[..n]);
@@ -180,6 +180,28 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     kappa.fill(T::ZERO);
     let problem = Problem::Velocities { bond: grad_new, dt };
     let vstats = constraints::solve(problem, &metric, bonds, &p.solver, new_vel, kappa, &mut sc)?;
+    // The tensions from the displacement `u dt`, never added to a position: f32 keeps
+    // them (see `displacement_tensions`); only when asked.
+    let x = &mut t[..n];
+    if p.resolve_tensions
+        && displacement_tensions(p, bonds, &metric, grad, grad_new, x, kappa, &mut sc)
+    {
+        // `sq` is done with once the step's metric is: it takes the inverse masses.
+        for w in &mut sq[..n] {
+            *w = T::ONE / (*w * *w);
+        }
+        u[..n].copy_from_slice(s.vel);
+        let vel = &mut u[..n];
+        if project_velocity(p, bonds, grad, vel, &sq[..n], lambda, &mut sc) {
+            // `v + M^-1 G kappa_0` moves `u dt` by `Q G kappa_0`, the step's metric's
+            // move of `kappa_0 / dt`: the tensions are the displacements' less that.
+            for (l, &k) in lambda.iter_mut().zip(kappa.iter()) {
+                *l = k - *l / dt;
+            }
+        } else {
+            lambda.copy_from_slice(kappa);
+        }
+    }
     Ok(report(stats, vstats.iterations, bonds, lambda))
 }
 

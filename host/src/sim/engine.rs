@@ -43,9 +43,9 @@ pub struct Engine<T: Real> {
     pub lanczos: LanczosTally,
     store: Buffers<T>,
     /// The multipliers of the last accepted step ([`Engine::tensions`]).
-    multipliers: Vec<T>,
+    pub(super) multipliers: Vec<T>,
     /// The pool for the mobility's bands (shared by copies of the system).
-    threads: Option<Arc<Threads>>,
+    pub(super) threads: Option<Arc<Threads>>,
 }
 
 impl<T: Real> Engine<T> {
@@ -128,6 +128,19 @@ impl<T: Real> Engine<T> {
             false => None,
         };
         Ok(self)
+    }
+
+    /// The checks the kernel's step makes of its inputs (parameters, particles, bonds,
+    /// thermal noise, contacts, wall, box: [`hydrorattle::check_step`]) and of every
+    /// pair (nested or coincident spheres; overlapping ones unless
+    /// [`Params::allow_overlap`]), without stepping. A front end asks it when it builds
+    /// a system, so that what the first step would refuse (`dt = 0`, spheres
+    /// overlapping at the start) is refused there, as a parameter error.
+    pub fn check(&mut self) -> Result<(), StepError> {
+        self.beads.check_pairs(self.params.allow_overlap)?;
+        let mut state = self.beads.state();
+        state.noise = Some(&mut self.noise);
+        hydrorattle::check_step(&state, &self.bonds, &self.params)
     }
 
     /// One step with the scene's forces only.

@@ -26,6 +26,7 @@ mod lanczos;
 mod record;
 pub mod retry;
 mod run_loop;
+mod saved;
 pub mod stop;
 mod tail;
 
@@ -39,6 +40,7 @@ pub use record::{
     COLUMNS, Label, Marks, NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observables, TRAJECTORY_GSD,
     TRAJECTORY_XYZ,
 };
+pub use saved::{Saved, SavedParams};
 pub use stop::{Interrupted, Stop};
 
 use std::path::{Path, PathBuf};

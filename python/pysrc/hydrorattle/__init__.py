@@ -41,6 +41,7 @@ from ._hydrorattle import (
     Report,
     SceneError,
     StepError,
+    SystemBusyError,
     UnstableError,
     UnsupportedError,
     __version__,
@@ -68,15 +69,25 @@ __all__ = [
     "ContactsFullError",
     "UnsupportedError",
     "SceneError",
+    "SystemBusyError",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
 Force = Callable[[np.ndarray], Any]
 
 
+def _real_array(a: Any, what: str) -> np.ndarray:
+    """`a` as an array of reals: complex numbers (whose imaginary part a float64
+    conversion would drop), booleans and non-numbers are a ``TypeError`` naming ``what``."""
+    x = np.asarray(a)
+    if np.iscomplexobj(x) or x.dtype.kind not in "iuf":
+        raise TypeError(f"{what} must hold real numbers, not {x.dtype}")
+    return x
+
+
 def _rows(a: Any, what: str) -> np.ndarray:
     """`a` as a C-contiguous float64 ``(N, 3)`` array (no copy when it already is one)."""
-    x = np.ascontiguousarray(a, dtype=np.float64)
+    x = np.ascontiguousarray(_real_array(a, what), dtype=np.float64)
     if x.ndim != 2 or x.shape[1] != 3:
         raise ValueError(f"{what} must have shape (N, 3), not {x.shape}")
     return x
@@ -84,11 +95,46 @@ def _rows(a: Any, what: str) -> np.ndarray:
 
 def _column(a: Any, what: str, n: int) -> np.ndarray:
     """`a` as a contiguous float64 ``(n,)`` array (a scalar is repeated)."""
-    x = np.asarray(a, dtype=np.float64)
+    x = _real_array(a, what).astype(np.float64, copy=False)
     x = np.full(n, float(x)) if x.ndim == 0 else np.ascontiguousarray(x)
     if x.shape != (n,):
         raise ValueError(f"{what} must have shape ({n},) to match the positions, not {x.shape}")
     return x
+
+
+def _wall(h: Any) -> Optional[float]:
+    """A wall height as a float (``None``: no wall)."""
+    return None if h is None else _real(h, "wall")
+
+
+def _box(b: Any) -> Optional["tuple[float, float, float]"]:
+    """Three box edges as floats (``None``: no box)."""
+    if b is None:
+        return None
+    edges = np.asarray(b)
+    if edges.shape != (3,):
+        raise ValueError(f"box must be three edges (Lx, Ly, Lz), not shape {edges.shape}")
+    lx, ly, lz = (_real(x, "box") for x in edges)
+    return (lx, ly, lz)
+
+
+def _real(x: Any, what: str) -> float:
+    """A real number (a bool or a complex number is a ``TypeError`` naming ``what``)."""
+    if isinstance(x, (bool, np.bool_)) or np.iscomplexobj(x):
+        raise TypeError(f"{what} must be a real number, not {type(x).__name__}")
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        raise TypeError(f"{what} must be a real number, not {type(x).__name__}") from None
+
+
+def _count(k: Any, what: str) -> int:
+    """A non-negative integer (``TypeError`` for a non-integer, ``ValueError`` below 0)."""
+    if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)):
+        raise TypeError(f"{what} must be an integer, not {type(k).__name__}")
+    if k < 0:
+        raise ValueError(f"{what} must be >= 0, not {k}")
+    return int(k)
 
 
 def mobility(
@@ -98,6 +144,9 @@ def mobility(
     hydro: str = "rpy",
     rotation: bool = False,
     precision: str = "f64",
+    wall: Optional[float] = None,
+    box: Optional["tuple[float, float, float]"] = None,
+    threads: int = 0,
 ) -> np.ndarray:
     """The dense mobility matrix of spheres at ``positions`` with ``radii``.
 
@@ -116,6 +165,19 @@ def mobility(
         With rotation, the ``(6N, 6N)`` grand mobility ``[[tt, tr], [rt, rr]]``.
     precision : {"f64", "f32"}
         Precision of the arithmetic and of the result's dtype.
+    wall : float, optional
+        Height ``H`` of a no-slip plane wall ``z = H`` below every centre: the
+        wall-corrected RPY mobility (Swan & Brady's image system, docs/WALL.md), as
+        ``System(..., wall=H)`` steps with. Rotation is supported.
+    box : (Lx, Ly, Lz), optional
+        A rectangular periodic box: the Ewald-summed RPY mobility (docs/PERIODIC.md),
+        as ``System(..., box=...)`` steps with. Every radius below half the smallest
+        edge; not with ``wall``, ``rotation`` or ``hydro="oseen"`` (``ValueError``).
+    threads : int
+        Threads writing the dense output from 512 beads on (0: every core; the same
+        values on any number). Above 32 MiB of output (N = 683 in f64) every new array
+        is fresh memory whose first write page-faults (NumPy's own ``np.empty`` pays
+        the same); threads take those faults in parallel.
 
     Returns
     -------
@@ -131,12 +193,22 @@ def mobility(
     Raises
     ------
     ValueError
-        Wrong shapes, NaN or infinite values, a radius <= 0, nested spheres; the
-        message names the particle (``index`` attribute: the particle or pair).
+        Wrong shapes, NaN or infinite values, a radius <= 0, nested spheres, a centre
+        below the wall; the message names the particle (``index`` attribute: the
+        particle or pair). A refused geometry (``box`` with ``wall``, ``rotation`` or
+        Oseen) with the kernel's message and ``kind``.
     """
     pos = _rows(positions, "positions")
     return _core.mobility(
-        pos, _column(radii, "radii", len(pos)), viscosity, hydro, rotation, precision
+        pos,
+        _column(radii, "radii", len(pos)),
+        viscosity,
+        hydro,
+        rotation,
+        precision,
+        _wall(wall),
+        _box(box),
+        _count(threads, "threads"),
     )
 
 
@@ -149,6 +221,9 @@ def mobility_dot(
     hydro: str = "rpy",
     rotation: bool = False,
     precision: str = "f64",
+    wall: Optional[float] = None,
+    box: Optional["tuple[float, float, float]"] = None,
+    threads: int = 0,
 ) -> Union[np.ndarray, "tuple[np.ndarray, np.ndarray]"]:
     """Velocities of spheres under ``forces`` (and ``torques``), ``M [F; T]``.
 
@@ -158,13 +233,29 @@ def mobility_dot(
     times the forces) and returns the ``(N, 3)`` velocities (``F / (eta L)``). With
     torques or ``rotation=True`` it returns ``(velocities, spins)`` (spins in
     ``F / (eta L^2)``) through the packed grand mobility (``O(N^2)`` memory).
+    ``wall`` and ``box`` as :func:`mobility`.
+
+    ``threads``: the matrix-free product in free space runs its 16 bands of rows on
+    this many threads (0: every core) from ``N = 512`` on; the result has the same bits
+    on any number of threads (and below 512 those of the stored matrix times the
+    forces). Above a wall, in a box and with rotation it runs on one thread.
     """
     pos = _rows(positions, "positions")
     n = len(pos)
     f = _rows(forces, "forces")
     t = None if torques is None else _rows(torques, "torques")
     return _core.mobility_dot(
-        pos, _column(radii, "radii", n), f, t, viscosity, hydro, rotation, precision
+        pos,
+        _column(radii, "radii", n),
+        f,
+        t,
+        viscosity,
+        hydro,
+        rotation,
+        precision,
+        _wall(wall),
+        _box(box),
+        _count(threads, "threads"),
     )
 
 
@@ -206,6 +297,26 @@ def _scene_text(sections: "dict[str, dict[str, Any]]") -> str:
     return "\n".join(out)
 
 
+def _bond_pairs(bonds: Any) -> np.ndarray:
+    """Bonds as a C-contiguous int64 ``(B, 2)`` array: integers, or floats that are whole
+    numbers (``[[0, 1.5]]`` is a ``ValueError``, not the bond ``[0, 1]``)."""
+    if bonds is None:
+        return np.zeros((0, 2), dtype=np.int64)
+    x = np.asarray(bonds)
+    if x.size == 0:
+        x = x.reshape(-1, 2) if x.ndim < 2 else x
+    if np.iscomplexobj(x) or x.dtype.kind not in "iuf":
+        raise TypeError(f"bonds must hold integer particle indices, not {x.dtype}")
+    if x.dtype.kind == "f":
+        bad = ~np.isfinite(x) | (x != np.trunc(x))
+        if bad.any():
+            k = tuple(int(i) for i in np.argwhere(bad)[0])
+            raise ValueError(f"bonds{list(k)}: particle index {x[k]} is not an integer")
+    if x.ndim != 2 or x.shape[1] != 2:
+        raise ValueError(f"bonds must have shape (B, 2), not {x.shape}")
+    return np.ascontiguousarray(x, dtype=np.int64)
+
+
 class System:
     """Particles and bonds stepped by the kernel.
 
@@ -226,11 +337,26 @@ class System:
     ``stability_guard`` (False), ``contacts`` (None, or the hard-contact capacity),
     ``wall`` (None, or the height ``H`` of a no-slip plane wall ``z = H`` below every
     sphere: its mobility and its one-sided constraint; "overdamped" and "overdamped2"),
+    ``box`` (None, or the edges ``(Lx, Ly, Lz)`` of a periodic box: the Ewald-summed
+    mobility and minimum-image bonds; not with ``wall`` or ``rotation``),
+    ``resolve_tensions`` (True in f32, False in f64: the inertial methods' tensions
+    solved again from the step's displacements, two more constraint solves per step,
+    needed in f32 where the position multipliers are rounding noise),
+    ``threads`` (0: every core; the mobility's bands from 512 beads on, the same bits
+    on any number),
     ``temperature`` (None: no thermal noise; ``kT``), ``drift`` ("midpoint",
     "uncorrected"), ``seed`` (1), ``noise_sqrt`` ("auto": Lanczos above
     ``LANCZOS_CROSSOVER`` beads, "cholesky", "lanczos"), ``lanczos_tolerance`` (1e-3,
     the noise's estimated relative error) and ``lanczos_max_iterations`` (64). A particle's mass is ``4/3 pi a^3 density``; gravity
     acts on the buoyant mass (``density - fluid_density``).
+
+    Everything the first step would refuse is refused here: a parameter of the wrong
+    type is a ``TypeError`` naming it (flags take ``True``/``False`` or 1/0), a value out
+    of range a ``ValueError`` naming it (``dt=0``, ``seed=-1``), and the kernel's checks
+    of parameters, particles and bonds (spheres overlapping at the start unless
+    ``allow_overlap``, coincident centres always, a sphere below the wall, a refused
+    combination) a ``ValueError`` with the kernel's message and ``kind``. Bond indices
+    must be integers (``1.5`` is refused), arrays real (complex is a ``TypeError``).
 
     Constructors for the CLI's shapes: :meth:`from_scene` (a scene file, read by the
     CLI's parser, every default as the CLI's) and :meth:`helix`.
@@ -250,10 +376,7 @@ class System:
     ) -> None:
         pos = _rows(positions, "positions")
         n = len(pos)
-        b = np.zeros((0, 2), dtype=np.int64) if bonds is None else bonds
-        b = np.ascontiguousarray(b, dtype=np.int64)
-        if b.ndim != 2 or b.shape[1] != 2:
-            raise ValueError(f"bonds must have shape (B, 2), not {b.shape}")
+        b = _bond_pairs(bonds)
         ls = None if lengths is None else _column(lengths, "lengths", len(b))
         self._core = _core.Core.build(
             pos,
@@ -340,7 +463,9 @@ class System:
         time: Optional[float] = None,
     ) -> None:
         """Replaces the parts of the state given (all or nothing: finite ``(N, 3)``
-        arrays, rounded to the system's precision). Positions off the bond lengths are
+        arrays, rounded to the system's precision; ``time`` any finite number, a
+        negative one too: it is the clock the steps advance, nothing depends on its
+        sign). Positions off the bond lengths are
         pulled back onto them by the next step (its constraint solve targets the
         lengths); one sphere inside another is refused by it."""
         conv = lambda a, w: None if a is None else _rows(a, w)  # noqa: E731
@@ -353,6 +478,67 @@ class System:
         return System._of(self._core.copy())
 
     __copy__ = copy
+
+    def to_atoms(self) -> Any:
+        """The system as an ASE ``Atoms`` (needs ``ase``): every sphere an atom "X" at
+        its centre with its velocity and mass (``4/3 pi a^3 density``), the radii and
+        densities in the arrays ``radius`` and ``density``, the spins in ``spin``; the
+        bonds ``(B, 2)``, their lengths and the time in ``info``; a periodic box as the
+        cell with ``pbc``. :meth:`from_atoms` reads it back."""
+        from ase import Atoms  # noqa: PLC0415 (optional dependency)
+
+        a, rho = self.radii, self.densities
+        atoms = Atoms(
+            symbols=["X"] * len(a),
+            positions=self.positions,
+            masses=4.0 / 3.0 * math.pi * a**3 * rho,
+        )
+        atoms.set_velocities(self.velocities)
+        atoms.new_array("radius", a)
+        atoms.new_array("density", rho)
+        atoms.new_array("spin", self.spins)
+        atoms.info["bonds"] = self.bonds
+        atoms.info["lengths"] = self.lengths
+        atoms.info["time"] = self.time
+        return atoms
+
+    @classmethod
+    def from_atoms(
+        cls, atoms: Any, radii: Any = None, densities: Any = None, **params: Any
+    ) -> "System":
+        """A system of an ASE ``Atoms``: centres and velocities from it; radii from
+        ``radii`` or its ``radius`` array; densities from ``densities``, its ``density``
+        array, or its masses over the spheres' volumes; bonds and lengths from
+        ``params`` or its ``info`` (as :meth:`to_atoms` writes them); spins and time
+        from its ``spin`` array and ``info["time"]`` when present. ``params`` as the
+        constructor's (``dt`` required)."""
+        n = len(atoms)
+        if radii is None:
+            if "radius" not in atoms.arrays:
+                raise ValueError("from_atoms needs radii=, or a 'radius' array on the atoms")
+            radii = atoms.arrays["radius"]
+        a = _column(radii, "radii", n)
+        if densities is None:
+            if "density" in atoms.arrays:
+                densities = atoms.arrays["density"]
+            else:
+                densities = atoms.get_masses() / (4.0 / 3.0 * math.pi * a**3)
+        params.setdefault("bonds", atoms.info.get("bonds"))
+        params.setdefault("lengths", atoms.info.get("lengths"))
+        s = cls(atoms.get_positions(), a, densities, **params)
+        spins = atoms.arrays.get("spin")
+        s.set_state(velocities=atoms.get_velocities(), spins=spins, time=atoms.info.get("time"))
+        return s
+
+    def __deepcopy__(self, memo: Any) -> "System":
+        return self.copy()
+
+    def __reduce__(self) -> "tuple[Any, tuple[str]]":
+        """Pickling (``pickle``, ``multiprocessing``, ``joblib``) carries the whole
+        system as text: state, bonds, parameters, the noise generator, counters and the
+        last tensions, every float's bits. The unpickled system continues with the
+        same bits as the original, in any process of the same build."""
+        return (_restore_system, (self._core.save_json(),))
 
     @property
     def radii(self) -> np.ndarray:
@@ -407,9 +593,29 @@ class System:
             f"dt={self.dt}, precision={self.precision!r})"
         )
 
-    def step(self, n: int = 1, force: Optional[Force] = None) -> Report:
+    def step(
+        self,
+        n: int = 1,
+        force: Optional[Force] = None,
+        callback: Optional[Callable[["System"], Any]] = None,
+        every: int = 1,
+    ) -> Report:
         """Makes ``n`` steps inside Rust; returns the last step's :class:`Report`
         (constraint iterations, residual, largest tension).
+
+        ``callback(system)`` runs after every ``every``-th step of the call, with the
+        GIL held and the system readable (positions, tensions, observables; it must not
+        call ``step`` or ``set_state``, which raise :class:`SystemBusyError`). Its cost
+        is the Python call and what it reads: taking the GIL back and calling an empty
+        callback is about a microsecond (the steps in between run without the GIL). An
+        exception it raises stops the call (``completed`` on it; the steps made are
+        kept).
+
+        Threads: another thread reading this system while it steps waits for the end
+        of the current step and sees the state between two steps (a consistent
+        snapshot); a second ``step`` or a ``set_state`` from another thread while a
+        ``step(n)`` runs raises :class:`SystemBusyError`, as does a ``force`` callable
+        that reads the system it is stepping (it reads the positions it is passed).
 
         Without ``force`` the GIL is released for the whole call (other Python threads
         run; two systems step in parallel in two threads), and Ctrl-C interrupts it
@@ -425,13 +631,15 @@ class System:
         and propagates, leaving the state unchanged.
 
         Raises a :class:`StepError` subclass (``kind``, ``stage``, ``index``,
-        ``value``; ``kind`` and ``stage`` are the kernel's snake_case names, e.g.
-        ``"no_convergence"``, ``"particle_bad_radius"``, ``"positions"``) when a step
-        fails: the state (positions, velocities, spins, time,
-        noise generator) is then exactly as it was before that step; the steps before
-        it are kept.
+        ``value``, ``completed``; ``kind`` and ``stage`` are the kernel's snake_case
+        names, e.g. ``"no_convergence"``, ``"particle_bad_radius"``, ``"positions"``)
+        when a step fails: the state (positions, velocities, spins, time, noise
+        generator) is then exactly as it was before that step; the steps of this call
+        before it are kept, and ``completed`` says how many there were. An exception
+        from ``force`` or Ctrl-C carries ``completed`` too.
         """
-        return self._core.step(int(n), force)
+        bound = None if callback is None else (lambda: callback(self))
+        return self._core.step(_count(n, "n"), force, bound, _count(every, "every"))
 
     def run(
         self, until: float, every: int = 1, force: Optional[Force] = None
@@ -457,6 +665,11 @@ class System:
         """The exact bits of positions, velocities, spins, time and the noise
         generator's next draw: equal lists mean bit-identical states."""
         return self._core.state_bits()
+
+
+def _restore_system(text: str) -> System:
+    """The system :meth:`System.__reduce__` saved (module level: pickle finds it)."""
+    return System._of(_core.Core.restore_json(text))
 
 
 def load_scene(path: PathLike) -> "dict[str, Any]":

@@ -9,6 +9,7 @@ import numpy.typing as npt
 __version__: str
 
 class StepError(RuntimeError):
+    completed: int
     kind: str
     stage: Optional[str]
     index: Union[int, tuple[int, int], None]
@@ -23,6 +24,8 @@ class OverlapError(StepError): ...
 class UnstableError(StepError): ...
 class ContactsFullError(StepError): ...
 class UnsupportedError(StepError): ...
+
+class SystemBusyError(RuntimeError): ...
 
 class SceneError(ValueError):
     file: str
@@ -49,6 +52,9 @@ def mobility(
     hydro: str = ...,
     rotation: bool = ...,
     precision: str = ...,
+    wall: Optional[float] = ...,
+    box: Optional[tuple[float, float, float]] = ...,
+    threads: int = ...,
 ) -> npt.NDArray[np.floating[Any]]: ...
 def mobility_dot(
     positions: _F64,
@@ -59,6 +65,9 @@ def mobility_dot(
     hydro: str = ...,
     rotation: bool = ...,
     precision: str = ...,
+    wall: Optional[float] = ...,
+    box: Optional[tuple[float, float, float]] = ...,
+    threads: int = ...,
 ) -> Any: ...
 def load_scene_json(path: Union[str, PathLike[str]]) -> str: ...
 def run_scene(
@@ -84,7 +93,13 @@ class Core:
     def from_scene_file(path: Union[str, PathLike[str]]) -> Core: ...
     @staticmethod
     def from_scene_text(text: str, origin: str) -> Core: ...
-    def step(self, n: int = ..., force: Optional[Callable[[_F64], Any]] = ...) -> Report: ...
+    def step(
+        self,
+        n: int = ...,
+        force: Optional[Callable[[_F64], Any]] = ...,
+        callback: Optional[Callable[[], Any]] = ...,
+        every: int = ...,
+    ) -> Report: ...
     positions: _F64
     velocities: _F64
     spins: _F64
@@ -104,4 +119,7 @@ class Core:
         time: Optional[float] = ...,
     ) -> None: ...
     def copy(self) -> Core: ...
+    def save_json(self) -> str: ...
+    @staticmethod
+    def restore_json(text: str) -> Core: ...
     def state_bits(self) -> list[int]: ...

@@ -1,0 +1,115 @@
+"""Systems that pickle, deep-copy and travel between processes with the same bits
+(issue 30 item 2), and the ASE round trip."""
+
+import copy
+import multiprocessing
+import pickle
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import hydrorattle as hr
+
+
+def chain(n, rng):
+    radii = rng.uniform(0.5, 1.2, n)
+    pos = np.zeros((n, 3))
+    for i in range(1, n):
+        d = rng.normal(size=3)
+        pos[i] = pos[i - 1] + d / np.linalg.norm(d) * (radii[i] + radii[i - 1]) * 1.1
+    return pos, radii, [[i, i + 1] for i in range(n - 1)]
+
+
+# (method, temperature) pairs the kernel takes.
+CASES = [
+    ("overdamped", None),
+    ("overdamped", 0.3),
+    ("overdamped2", None),
+    ("rattle", None),
+    ("rattle-stable", None),
+    ("rattle-stable", 0.3),
+    ("springs", 0.3),
+]
+
+
+def build(case, n, seed, precision):
+    method, temperature = case
+    rng = np.random.default_rng(seed)
+    pos, radii, bonds = chain(n, rng)
+    return hr.System(
+        pos, radii, rng.uniform(1.0, 3.0, n), bonds=bonds, dt=0.01, method=method,
+        temperature=temperature, seed=seed, precision=precision, allow_overlap=True,
+    )
+
+
+def same(a, b):
+    assert a.state_bits() == b.state_bits()
+    ta, tb = a.tensions, b.tensions
+    assert (ta is None and tb is None) or np.array_equal(ta, tb)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    case=st.sampled_from(CASES),
+    n=st.integers(1, 7),
+    seed=st.integers(0, 2**63),
+    before=st.integers(0, 5),
+    after=st.integers(1, 5),
+    precision=st.sampled_from(["f64", "f32"]),
+)
+def test_a_pickled_system_continues_with_the_same_bits(case, n, seed, before, after, precision):
+    s = build(case, n, seed, precision)
+    s.step(before)
+    t = pickle.loads(pickle.dumps(s))
+    same(s, t)
+    assert t.precision == s.precision and t.dt == s.dt
+    s.step(after)
+    t.step(after)
+    same(s, t)
+    d = copy.deepcopy(s)
+    s.step(2)
+    d.step(2)
+    same(s, d)
+
+
+def _step_remotely(s, k):
+    s.step(k)
+    return s
+
+
+def test_a_system_steps_in_another_process_with_the_same_bits():
+    s = build(("rattle-stable", 0.3), 5, 7, "f64")
+    s.step(3)
+    ctx = multiprocessing.get_context("spawn")
+    with ctx.Pool(1) as pool:
+        remote = pool.apply(_step_remotely, (s, 4))
+    s.step(4)
+    same(s, remote)
+
+
+def test_a_corrupt_record_is_refused():
+    with pytest.raises(ValueError, match="saved system"):
+        hr._restore_system('{"version": 99}')
+
+
+def test_ase_round_trip():
+    ase = pytest.importorskip("ase")
+    s = build(("rattle", None), 4, 3, "f64")
+    s.step(5)
+    atoms = s.to_atoms()
+    assert isinstance(atoms, ase.Atoms)
+    assert np.array_equal(atoms.arrays["radius"], s.radii)
+    assert np.allclose(atoms.get_masses(), 4 / 3 * np.pi * s.radii**3 * s.densities)
+    t = hr.System.from_atoms(atoms, dt=0.01, method="rattle", allow_overlap=True)
+    assert np.array_equal(t.positions, s.positions)
+    assert np.array_equal(t.bonds, s.bonds) and np.array_equal(t.lengths, s.lengths)
+    assert t.time == s.time
+    assert np.allclose(t.velocities, s.velocities, rtol=1e-12, atol=0)
+    # Densities from the masses when the atoms carry none.
+    del atoms.arrays["density"]
+    u = hr.System.from_atoms(atoms, dt=0.01, method="rattle", allow_overlap=True)
+    assert np.allclose(u.densities, s.densities, rtol=1e-12)
+    with pytest.raises(ValueError, match="radii"):
+        hr.System.from_atoms(ase.Atoms("X2", positions=[[0, 0, 0], [3, 0, 0]]), dt=0.1)

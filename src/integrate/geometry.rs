@@ -1,0 +1,96 @@
+//! The mobility of the geometry a [`Params`] names (free space, above its wall
+//! [`Params::wall`], in its periodic box [`Params::periodic`]) on its own: the matrix
+//! and its product without a step, for front ends that hand them out (the Python
+//! package's `mobility` and `mobility_dot`). The same functions the steps assemble
+//! with, after the same refusals (a box with a wall, with rotation or with Oseen; a
+//! radius not below half the box's smallest edge), so a front end cannot get a matrix
+//! no step would use.
+
+use super::checks::check_box;
+use super::stages::{HeldSums, assemble_tt, free_product, wall_height};
+use crate::error::StepError;
+use crate::linalg::tri;
+use crate::mobility;
+use crate::parallel::{Parallel, band_scratch};
+use crate::params::Params;
+use crate::real::Real;
+
+/// Refuses what a step would refuse of this geometry (every sphere is checked by the
+/// mobility itself: finite, radius > 0, no nesting, above the wall).
+/// Returns the box's Ewald parameters when there is one.
+fn check<T: Real>(p: &Params<T>, radius: &[T]) -> Result<HeldSums<T>, StepError> {
+    if !(p.viscosity > T::ZERO && p.viscosity.is_finite()) {
+        return Err(StepError::BadParameter("viscosity"));
+    }
+    if p.wall.is_some_and(|w| !w.height.is_finite()) {
+        return Err(StepError::BadParameter("wall.height (finite)"));
+    }
+    check_box(p, radius)
+}
+
+/// `mu_tt` (`n x n` blocks, packed lower triangle: [`tri`]`(n)` blocks of `out`).
+pub fn mobility_tt<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    out: &mut [T::M3],
+) -> Result<(), StepError> {
+    let sums = check(p, radius)?;
+    assemble_tt(p, sums.as_ref(), pos, radius, &mut out[..tri(pos.len())])
+}
+
+/// The grand mobility (`2n x 2n` blocks, translations then rotations, packed as
+/// [`mobility::assemble_grand`] stores it: [`tri`]`(2n)` blocks of `out`); free space
+/// or above the wall (a box refuses rotation).
+pub fn mobility_grand<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    out: &mut [T::M3],
+) -> Result<(), StepError> {
+    check(
+        &Params {
+            rotation: true,
+            ..*p
+        },
+        radius,
+    )?;
+    grand(p, pos, radius, out)
+}
+
+/// The grand mobility of free space or above the wall (the checks done): the one
+/// place that picks between the two ([`mobility_grand`], `RattleStable` with rotation).
+pub(super) fn grand<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    out: &mut [T::M3],
+) -> Result<(), StepError> {
+    let (level, eta, out) = (p.hydro, p.viscosity, &mut out[..tri(2 * pos.len())]);
+    match wall_height(p) {
+        Some(h) => mobility::wall::assemble_grand(level, eta, h, pos, radius, out)?,
+        None => mobility::assemble_grand(level, eta, pos, radius, out)?,
+    }
+    Ok(())
+}
+
+/// `u = mu_tt f` without storing `mu_tt`, as a matrix-free step computes it. In free
+/// space in the bands of [`crate::parallel`] through `par` (`scratch` holds
+/// [`band_scratch`]`(n)` vectors, [`crate::parallel::free_product`]): the bits of the
+/// stored mobility's banded product on any number of threads. Above a wall and in a
+/// box: serial.
+pub fn mobility_product<T: Real>(
+    p: &Params<T>,
+    par: &dyn Parallel,
+    pos: &[T::V3],
+    radius: &[T],
+    f: &[T::V3],
+    u: &mut [T::V3],
+    scratch: &mut [T::V3],
+) -> Result<(), StepError> {
+    let sums = check(p, radius)?;
+    let n = pos.len();
+    let scratch = &mut scratch[..band_scratch(n)];
+    let (f, u) = (&f[..n], &mut u[..n]);
+    free_product(p, sums.as_ref(), pos, radius, f, u, (par, scratch))
+}
