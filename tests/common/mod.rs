@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod fuzz;
+pub mod thermal;
 
 use hydrorattle::{
     BondSet, ExternalForce, Method, Params, Particle, ParticleSet, Real, SolverKind, StepError,
