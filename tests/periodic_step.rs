@@ -8,7 +8,7 @@
 //!   bit), and against the same dimer unbroken by the face (to rounding);
 //! * bond lengths, contact distances and overlaps measured here by the test's own
 //!   minimum image;
-//! * the refusals (a bond of half the box, a wall, rotation, the Oseen level), typed,
+//! * the refusals (a bond of half the box, a wall, the Oseen level), typed,
 //!   with the state untouched.
 
 mod common;
@@ -137,11 +137,15 @@ impl<T: Real> ExternalForce<T> for Twist {
     }
 }
 
-/// The variants each method is run in: plain, matrix-free, thermal (Cholesky and
-/// Lanczos), contacts, and the three solvers.
+/// The variants each method is run in: plain, with rotation (the box's `rt`, `rr`
+/// blocks), matrix-free, thermal (Cholesky and Lanczos), contacts, and the three solvers.
 fn variants<T: Real>(method: Method) -> Vec<Params<T>> {
     let base = boxed::<T>(0.01, method, 8.0);
     let mut out = vec![base];
+    out.push(Params {
+        rotation: true,
+        ..base
+    });
     for kind in [SolverKind::Sweep, SolverKind::Newton, SolverKind::Krylov] {
         let mut p = base;
         p.solver.kind = kind;
@@ -249,6 +253,15 @@ fn straddling_bond<T: Real>() {
                     "{method:?} {:?}: sphere {k} off by {e:e}",
                     p.solver.kind
                 );
+                let (wa, wb) = (f64s::<T>(a.omega[k]), f64s::<T>(b.omega[k]));
+                let w = norm(sub(wa, wb));
+                assert!(
+                    w < tol * (1.0 + norm(wa)),
+                    "{method:?}: omega {k} off by {w:e}"
+                );
+                if p.rotation {
+                    assert!(norm(wa) > 1e-3, "{method:?}: no spin with rotation");
+                }
             }
         }
     }
@@ -300,8 +313,8 @@ fn contacts_across<T: Real>() {
 }
 
 /// A bond not shorter than half the smallest edge is refused with its index, the state
-/// untouched; so are a radius of half the box, a box with a wall, with rotation or
-/// with the Oseen level, and FENE's maximum extension of half the box.
+/// untouched; so are a radius of half the box, a box with a wall or with the Oseen
+/// level, and FENE's maximum extension of half the box.
 fn refusals<T: Real>() {
     let s = [
         one([1.0, 1.0, 1.0], 0.2, RHO),
@@ -336,28 +349,13 @@ fn refusals<T: Real>() {
         step(&mut copy, &bonds, &ok, &mut ws, &mut NoForce).unwrap();
     }
     let base = boxed::<T>(0.01, Method::Overdamped, 4.0);
-    let cases: [(Params<T>, &str); 4] = [
+    let cases: [(Params<T>, &str); 2] = [
         (
             Params {
                 wall: Some(Wall::new(T::ZERO)),
                 ..base
             },
             "wall",
-        ),
-        (
-            Params {
-                rotation: true,
-                ..base
-            },
-            "rotation",
-        ),
-        (
-            Params {
-                rotation: true,
-                method: Method::RattleStable,
-                ..base
-            },
-            "rotation",
         ),
         (
             Params {

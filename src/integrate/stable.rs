@@ -27,7 +27,7 @@
 //! drift term: the noise enters the momentum, and the position is differentiable.
 
 use super::{
-    Start, StepReport, add_constraint_forces, add_flow, assemble_tt, bond_vectors,
+    Start, StepReport, add_constraint_forces, add_flow, assemble_grand, assemble_tt, bond_vectors,
     project_positions, report, step_velocity, wall_height,
 };
 use crate::bonds::Bond;
@@ -81,7 +81,7 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
         let (level, eta) = (p.hydro, p.viscosity);
         mobility::wall::assemble_grand(level, eta, h, s.pos, s.radius, mu)?;
     } else if p.rotation {
-        mobility::assemble_grand(p.hydro, p.viscosity, s.pos, s.radius, mu)?;
+        assemble_grand(p, s.ewald, s.pos, s.radius, mu)?;
     } else {
         assemble_tt(p, s.ewald, s.pos, s.radius, mu)?;
     }

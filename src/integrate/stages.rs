@@ -187,6 +187,24 @@ pub(super) fn assemble_tt<T: Real>(
     mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
 }
 
+/// The free-space or box grand mobility `[[tt, tr], [rt, rr]]` into `mu` (`tri(2n)`
+/// blocks); the wall's is assembled by its caller.
+pub(super) fn assemble_grand<T: Real>(
+    p: &Params<T>,
+    ew: Sums<'_, T>,
+    pos: &[T::V3],
+    radius: &[T],
+    mu: &mut [T::M3],
+) -> Result<(), StepError> {
+    #[cfg(feature = "periodic")]
+    if let Some(e) = ew {
+        let eta = p.viscosity;
+        return Ok(mobility::periodic::assemble_grand(e, eta, pos, radius, mu)?);
+    }
+    let _ = ew; // Read above only with the `periodic` feature.
+    mobility::assemble_grand(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
+}
+
 /// `g_l = r_i - r_j` for every bond (its minimum image in a periodic box `cell`);
 /// `(0, 0, a)` for a wall link (the wall's normal, scaled as the link's relative vector
 /// at contact: [`Bond::wall`]).
@@ -236,14 +254,22 @@ pub(super) fn add_constraint_forces<T: Real>(
 
 /// Angular velocities of torque-free spheres: `W_i = Omega_inf + sum_j rt_ij f_j`, with
 /// `f` the force each sphere exerts on the fluid; `Omega_inf` alone when not resolved.
+/// In a box, the `rt` blocks are the step's Ewald sums `ew`.
 pub(super) fn spin<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     f: &[T::V3],
     out: &mut [T::V3],
 ) -> Result<(), StepError> {
     out.fill(p.vorticity);
+    #[cfg(feature = "periodic")]
+    if let (true, Some(e)) = (p.rotation, ew) {
+        let eta = p.viscosity;
+        return Ok(mobility::periodic::add_spin(e, eta, pos, radius, f, out)?);
+    }
+    let _ = ew; // Read above only with the `periodic` feature.
     if let (true, Some(h)) = (p.rotation, wall_height(p)) {
         let (level, eta) = (p.hydro, p.viscosity);
         return Ok(mobility::wall::add_spin(

@@ -29,7 +29,10 @@
 //! caller. Rotation (the `rt`, `rr` blocks) is not here yet.
 
 mod real;
+mod rot;
 mod wave;
+
+pub use rot::{RotBlocks, add_spin, assemble_grand, pair_rot, self_rr};
 
 pub use crate::cell::{Periodic, PeriodicError};
 use crate::error::ParticleError;
