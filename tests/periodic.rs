@@ -272,7 +272,8 @@ fn large_box_tends_to_free_space() {
     );
 }
 
-fn positive_definite<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool) {
+/// Cholesky of the assembled `mu_tt` (or, with `rotation`, of the `6N` grand matrix).
+fn positive_definite<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool, rotation: bool) {
     let (p, r) = config(n, seed, size, 2.0, overlap);
     let (pos, rad) = to_t::<T>(&p, &r);
     let ew = Ewald::new(
@@ -280,30 +281,14 @@ fn positive_definite<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool
         T::from_f64(2.0),
     )
     .unwrap();
-    let m = assemble(&ew, &pos, &rad);
-    let mut fac = m.clone();
-    let res = cholesky::<T>(&mut fac, pos.len());
+    let (mut fac, m) = match rotation {
+        true => (grand(&ew, &pos, &rad), 2 * pos.len()),
+        false => (assemble(&ew, &pos, &rad), pos.len()),
+    };
+    let res = cholesky::<T>(&mut fac, m);
     assert!(
         res.is_ok(),
-        "n = {} seed {seed} box {size:?} overlap {overlap}: {res:?}",
-        pos.len()
-    );
-}
-
-/// The `6N` operator: Cholesky of the assembled grand mobility.
-fn positive_definite_grand<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool) {
-    let (p, r) = config(n, seed, size, 2.0, overlap);
-    let (pos, rad) = to_t::<T>(&p, &r);
-    let ew = Ewald::new(
-        Periodic::new(size.map(T::from_f64)).unwrap(),
-        T::from_f64(2.0),
-    )
-    .unwrap();
-    let mut fac = grand(&ew, &pos, &rad);
-    let res = cholesky::<T>(&mut fac, 2 * pos.len());
-    assert!(
-        res.is_ok(),
-        "grand: n = {} seed {seed} box {size:?} overlap {overlap}: {res:?}",
+        "n = {} seed {seed} box {size:?} overlap {overlap} rotation {rotation}: {res:?}",
         pos.len()
     );
 }
@@ -312,19 +297,19 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
     #[test]
     fn positive_definite_grand_f64(n in 1usize..=10, seed in any::<u64>(), lx in 4.5f64..12.0, ly in 4.5f64..12.0, lz in 4.5f64..12.0, overlap in any::<bool>()) {
-        positive_definite_grand::<f64>(n, seed, [lx, ly, lz], overlap);
+        positive_definite::<f64>(n, seed, [lx, ly, lz], overlap, true);
     }
     #[test]
     fn positive_definite_grand_f32(n in 1usize..=10, seed in any::<u64>(), lx in 4.5f64..12.0, ly in 4.5f64..12.0, lz in 4.5f64..12.0, overlap in any::<bool>()) {
-        positive_definite_grand::<f32>(n, seed, [lx, ly, lz], overlap);
+        positive_definite::<f32>(n, seed, [lx, ly, lz], overlap, true);
     }
     #[test]
     fn positive_definite_f64(n in 1usize..=10, seed in any::<u64>(), lx in 4.5f64..12.0, ly in 4.5f64..12.0, lz in 4.5f64..12.0, overlap in any::<bool>()) {
-        positive_definite::<f64>(n, seed, [lx, ly, lz], overlap);
+        positive_definite::<f64>(n, seed, [lx, ly, lz], overlap, false);
     }
     #[test]
     fn positive_definite_f32(n in 1usize..=10, seed in any::<u64>(), lx in 4.5f64..12.0, ly in 4.5f64..12.0, lz in 4.5f64..12.0, overlap in any::<bool>()) {
-        positive_definite::<f32>(n, seed, [lx, ly, lz], overlap);
+        positive_definite::<f32>(n, seed, [lx, ly, lz], overlap, false);
     }
 }
 
