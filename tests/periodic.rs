@@ -539,8 +539,9 @@ fn timing() {
 /// 1 - (4 pi / 3)(a/L)^3` (the images lie beyond contact, where the RPY `rr` block is
 /// the point dipole `-(I - 3 e e) / (16 pi eta r^3)`, whose sum over each cubic shell is
 /// zero; what remains is the excluded mean `k = 0`, the direction average `(2/3) I / 4`
-/// of `P(k) / 4`, over `eta V`; the published finite-size correction of rotational
-/// diffusion, e.g. Linke et al. 2016, has this form).
+/// of `P(k) / 4`, over `eta V`: `1 - V_sphere / V_box`, the form of the finite-size
+/// correction of rotational diffusion of Linke, Köfinger and Hummer, J. Phys. Chem.
+/// Lett. 9, 2874, 2018).
 #[test]
 fn rotation_lone_sphere_cubic() {
     for l in [2.5, 5.0, 10.0, 20.0, 100.0] {

@@ -159,6 +159,8 @@ fn variants<T: Real>(method: Method) -> Vec<Params<T>> {
         let mut p = base;
         p.matrix_free = true;
         out.push(p);
+        p.rotation = true;
+        out.push(p);
     }
     if matches!(
         method,
