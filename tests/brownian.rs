@@ -22,6 +22,7 @@
 
 mod common;
 
+use common::thermal::*;
 use common::*;
 use hydrorattle::{
     BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, ParticleSet, Real, SolverKind,
@@ -29,50 +30,6 @@ use hydrorattle::{
 };
 use hydrorattle_heap::Buffers;
 use std::f64::consts::PI;
-
-/// Thermal parameters: no gravity, `kT = 1`, the given drift and hydrodynamics.
-fn thermal<T: Real>(dt: f64, eta: f64, hydro: Hydro, drift: Drift) -> hydrorattle::Params<T> {
-    let mut p = params::<T>(dt, Method::Overdamped, SolverKind::Auto);
-    p.viscosity = T::from_f64(eta);
-    p.gravity = T::V3_ZERO;
-    p.hydro = hydro;
-    p.brownian = Some(Brownian {
-        temperature: T::ONE,
-        drift,
-    });
-    p
-}
-
-/// `steps` thermal steps from `ps`, calling `observe` after each.
-fn sample<T: Real, const N: usize, const B: usize>(
-    ps: &mut ParticleSet<T, N>,
-    bonds: &BondSet<T, B>,
-    p: &hydrorattle::Params<T>,
-    seed: u64,
-    steps: usize,
-    mut observe: impl FnMut(&ParticleSet<T, N>),
-) {
-    let mut buf = Buffers::<T>::new(Layout::for_params(p, ps.len(), bonds.len()));
-    let mut ws = buf.workspace();
-    let mut noise = Noise::new(seed);
-    for k in 0..steps {
-        step_thermal(ps, bonds, p, &mut ws, &mut NoForce, &mut noise)
-            .unwrap_or_else(|e| panic!("step {k}: {e}"));
-        observe(ps);
-    }
-}
-
-/// Mean of `x` and its standard error from `blocks` block means.
-fn block_mean(x: &[f64], blocks: usize) -> (f64, f64) {
-    let len = x.len() / blocks;
-    let means: Vec<f64> = x
-        .chunks_exact(len)
-        .map(|c| c.iter().sum::<f64>() / len as f64)
-        .collect();
-    let m = means.iter().sum::<f64>() / means.len() as f64;
-    let var = means.iter().map(|b| (b - m) * (b - m)).sum::<f64>() / (means.len() - 1) as f64;
-    (m, (var / means.len() as f64).sqrt())
-}
 
 fn sphere(pos: [f64; 3], radius: f64) -> Sphere {
     Sphere {

@@ -211,7 +211,7 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
     }
     // A periodic box on an eighth: edges around the chain's extent (so that it may wrap
     // and meet its own images), or hostile ones; a clean case drops what a box
-    // refuses (a wall, rotation, the Oseen level).
+    // refuses (a wall, the Oseen level) and keeps rotation.
     if rng.below(8) == 0 {
         let mut edge = |typical: f64| match rng.1 && rng.below(4) == 0 {
             true => rng.value(typical),
@@ -221,7 +221,7 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
         if let Ok(c) = Periodic::new(size.map(T::from_f64)) {
             p.periodic = Some(c);
             if !hostile {
-                (p.wall, p.rotation) = (None, false);
+                p.wall = None;
                 if p.hydro == Hydro::Oseen {
                     p.hydro = Hydro::Rpy;
                 }

@@ -20,6 +20,7 @@
 
 mod common;
 
+use common::thermal::block_mean;
 use common::*;
 use hydrorattle::{
     BondSet, Brownian, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, ParticleSet, Real,
@@ -47,19 +48,6 @@ fn unit(pos: [f64; 3]) -> Sphere {
         radius: 1.0,
         density: RHO,
     }
-}
-
-/// Mean and standard error of the means of `blocks` equal blocks of `x`.
-fn block_mean(x: &[f64], blocks: usize) -> (f64, f64) {
-    let len = x.len() / blocks;
-    let means: Vec<f64> = x
-        .chunks_exact(len)
-        .map(|c| c.iter().sum::<f64>() / len as f64)
-        .collect();
-    let k = means.len() as f64;
-    let m = means.iter().sum::<f64>() / k;
-    let var = means.iter().map(|b| (b - m) * (b - m)).sum::<f64>() / (k - 1.0);
-    (m, (var / k).sqrt())
 }
 
 /// `steps` steps of a lone sphere (seed `seed`), calling `observe(position, velocity,

@@ -12,7 +12,8 @@ use hydrorattle::Real;
 use hydrorattle::error::ParticleError;
 use hydrorattle::linalg::{cholesky, sym_get, sym_matvec, tri};
 use hydrorattle::mobility::periodic::{
-    Ewald, Periodic, PeriodicError, assemble_tt, pair_tt, self_tt, tt_product,
+    Ewald, Periodic, PeriodicError, add_spin, assemble_grand, assemble_tt, pair_rot, pair_tt,
+    self_rr, self_tt, tt_product,
 };
 use hydrorattle::mobility::{self, Hydro};
 use proptest::prelude::*;
@@ -50,6 +51,13 @@ fn max_diff(a: &M, b: &M) -> f64 {
 fn assemble<T: Real>(ew: &Ewald<T>, pos: &[T::V3], rad: &[T]) -> Vec<T::M3> {
     let mut out = vec![T::M3_ZERO; tri(pos.len())];
     assemble_tt(ew, T::ONE, pos, rad, &mut out).unwrap();
+    out
+}
+
+/// The `2n x 2n` grand mobility of the box (`eta = 1`), packed lower triangle.
+fn grand<T: Real>(ew: &Ewald<T>, pos: &[T::V3], rad: &[T]) -> Vec<T::M3> {
+    let mut out = vec![T::M3_ZERO; tri(2 * pos.len())];
+    assemble_grand(ew, T::ONE, pos, rad, &mut out).unwrap();
     out
 }
 
@@ -114,9 +122,35 @@ fn rel_diff(a: &[hydrorattle::glam::DMat3], b: &[hydrorattle::glam::DMat3]) -> f
         / scale
 }
 
+/// An assembly of the box's mobility (`assemble` or `grand`).
+type Build = fn(&Ewald<f64>, &[hydrorattle::glam::DVec3], &[f64]) -> Vec<hydrorattle::glam::DMat3>;
+
+/// The largest relative difference of the matrix `build` assembles at the three
+/// splitting parameters of [`xis`] from the one at the rule's.
+fn across_xi(
+    size: [f64; 3],
+    a_hi: f64,
+    pos: &[hydrorattle::glam::DVec3],
+    rad: &[f64],
+    build: Build,
+) -> f64 {
+    let cell = Periodic::new(size).unwrap();
+    let mats: Vec<_> = xis(size, a_hi)
+        .iter()
+        .map(|&xi| {
+            build(
+                &Ewald::with_xi(cell, a_hi, xi, f64::EPSILON / 8.0).unwrap(),
+                pos,
+                rad,
+            )
+        })
+        .collect();
+    rel_diff(&mats[0], &mats[1]).max(rel_diff(&mats[2], &mats[1]))
+}
+
 #[test]
 fn independent_of_splitting_parameter() {
-    let mut worst = 0.0f64;
+    let (mut worst, mut worst_rot) = (0.0f64, 0.0f64);
     for (size, a_hi) in [
         ([10.0; 3], 2.0),
         ([7.0, 11.0, 16.0], 2.0),
@@ -125,26 +159,19 @@ fn independent_of_splitting_parameter() {
         for seed in 0..4u64 {
             let (p, r) = config(10, seed, size, a_hi, seed % 2 == 1);
             let (pos, rad) = to_t::<f64>(&p, &r);
-            let cell = Periodic::new(size).unwrap();
-            let mats: Vec<_> = xis(size, a_hi)
-                .iter()
-                .map(|&xi| {
-                    assemble(
-                        &Ewald::with_xi(cell, a_hi, xi, f64::EPSILON / 8.0).unwrap(),
-                        &pos,
-                        &rad,
-                    )
-                })
-                .collect();
-            let d = rel_diff(&mats[0], &mats[1]).max(rel_diff(&mats[2], &mats[1]));
+            let d = across_xi(size, a_hi, &pos, &rad, assemble::<f64>);
             worst = worst.max(d);
             assert!(
                 d < 1e-13,
                 "box {size:?} seed {seed}: relative difference {d:e}"
             );
+            // The grand matrix, rotation blocks included.
+            let dg = across_xi(size, a_hi, &pos, &rad, grand::<f64>);
+            worst_rot = worst_rot.max(dg);
+            assert!(dg < 1e-13, "box {size:?} seed {seed}: grand {dg:e}");
         }
     }
-    println!("largest relative difference across xi: {worst:.2e}");
+    println!("largest relative difference across xi: {worst:.2e} (grand {worst_rot:.2e})");
 }
 
 #[test]
@@ -173,7 +200,8 @@ fn large_box_tends_to_free_space() {
     );
 }
 
-fn positive_definite<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool) {
+/// Cholesky of the assembled `mu_tt` (or, with `rotation`, of the `6N` grand matrix).
+fn positive_definite<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool, rotation: bool) {
     let (p, r) = config(n, seed, size, 2.0, overlap);
     let (pos, rad) = to_t::<T>(&p, &r);
     let ew = Ewald::new(
@@ -181,12 +209,14 @@ fn positive_definite<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool
         T::from_f64(2.0),
     )
     .unwrap();
-    let m = assemble(&ew, &pos, &rad);
-    let mut fac = m.clone();
-    let res = cholesky::<T>(&mut fac, pos.len());
+    let (mut fac, m) = match rotation {
+        true => (grand(&ew, &pos, &rad), 2 * pos.len()),
+        false => (assemble(&ew, &pos, &rad), pos.len()),
+    };
+    let res = cholesky::<T>(&mut fac, m);
     assert!(
         res.is_ok(),
-        "n = {} seed {seed} box {size:?} overlap {overlap}: {res:?}",
+        "n = {} seed {seed} box {size:?} overlap {overlap} rotation {rotation}: {res:?}",
         pos.len()
     );
 }
@@ -194,12 +224,20 @@ fn positive_definite<T: Real>(n: usize, seed: u64, size: [f64; 3], overlap: bool
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
     #[test]
+    fn positive_definite_grand_f64(n in 1usize..=10, seed in any::<u64>(), lx in 4.5f64..12.0, ly in 4.5f64..12.0, lz in 4.5f64..12.0, overlap in any::<bool>()) {
+        positive_definite::<f64>(n, seed, [lx, ly, lz], overlap, true);
+    }
+    #[test]
+    fn positive_definite_grand_f32(n in 1usize..=10, seed in any::<u64>(), lx in 4.5f64..12.0, ly in 4.5f64..12.0, lz in 4.5f64..12.0, overlap in any::<bool>()) {
+        positive_definite::<f32>(n, seed, [lx, ly, lz], overlap, true);
+    }
+    #[test]
     fn positive_definite_f64(n in 1usize..=10, seed in any::<u64>(), lx in 4.5f64..12.0, ly in 4.5f64..12.0, lz in 4.5f64..12.0, overlap in any::<bool>()) {
-        positive_definite::<f64>(n, seed, [lx, ly, lz], overlap);
+        positive_definite::<f64>(n, seed, [lx, ly, lz], overlap, false);
     }
     #[test]
     fn positive_definite_f32(n in 1usize..=10, seed in any::<u64>(), lx in 4.5f64..12.0, ly in 4.5f64..12.0, lz in 4.5f64..12.0, overlap in any::<bool>()) {
-        positive_definite::<f32>(n, seed, [lx, ly, lz], overlap);
+        positive_definite::<f32>(n, seed, [lx, ly, lz], overlap, false);
     }
 }
 
@@ -422,5 +460,95 @@ fn timing() {
             dt * 1e6 / (n * (n + 1) / 2) as f64,
             m.len()
         );
+    }
+}
+
+/// A lone sphere's rotational mobility in a cubic box: `8 pi eta a^3 mu_rr =
+/// 1 - (4 pi / 3)(a/L)^3` (the images lie beyond contact, where the RPY `rr` block is
+/// the point dipole `-(I - 3 e e) / (16 pi eta r^3)`, whose sum over each cubic shell is
+/// zero; what remains is the excluded mean `k = 0`, the direction average `(2/3) I / 4`
+/// of `P(k) / 4`, over `eta V`: `1 - V_sphere / V_box`, the form of the finite-size
+/// correction of rotational diffusion of Linke, Köfinger and Hummer, J. Phys. Chem.
+/// Lett. 9, 2874, 2018).
+#[test]
+fn rotation_lone_sphere_cubic() {
+    for l in [2.5, 5.0, 10.0, 20.0, 100.0] {
+        let ew = Ewald::new(Periodic::new([l; 3]).unwrap(), 1.0).unwrap();
+        let m = m64::<f64>(self_rr(&ew, 1.0, 1.0));
+        let got = m[0][0] * 8.0 * core::f64::consts::PI;
+        let want = 1.0 - 4.0 * core::f64::consts::PI / 3.0 / (l * l * l);
+        let off = m[0][1].abs().max(m[0][2].abs()).max(m[1][2].abs());
+        println!(
+            "L/a = {l}: 8 pi eta a^3 mu_rr = {got:.16} (want {want:.16}, {:.1e})",
+            got - want
+        );
+        assert!((got - want).abs() < 2e-14, "L {l}: {got} vs {want}");
+        assert!((m[1][1] - m[0][0]).abs() < 1e-15 && (m[2][2] - m[0][0]).abs() < 1e-15);
+        assert!(off < 1e-15, "off-diagonal {off:e}");
+        // The rt self block is zero, and a pair's rt, rr agree with the grand matrix.
+        let g = grand(&ew, &[[0.1, 0.2, 0.3].into()], &[1.0]);
+        assert_eq!(max_abs(&m64::<f64>(g[tri(1)])), 0.0);
+    }
+}
+
+/// The rotation blocks tend to free space's as the box grows, the difference falling
+/// as `1/L^3` (the mean vorticity excluded with `k = 0` and the images' dipolar field).
+#[test]
+fn rotation_large_box_tends_to_free_space() {
+    let (ai, aj, r) = (1.0, 0.6, [1.1, 0.7, -0.4]);
+    let free =
+        mobility::pair_blocks(Hydro::Rpy, 1.0, ai, aj, hydrorattle::glam::DVec3::from(r)).unwrap();
+    let (mut ls, mut d) = (vec![], [vec![], vec![], vec![]]);
+    for l in [10.0, 20.0, 40.0, 80.0] {
+        let ew = Ewald::new(Periodic::new([l; 3]).unwrap(), ai).unwrap();
+        let (rt_ij, rt_ji, rr) = pair_rot(&ew, 1.0, ai, aj, r.into()).unwrap();
+        ls.push(l);
+        for (k, (a, b)) in [(rt_ij, free.rt_ij), (rt_ji, free.rt_ji), (rr, free.rr)]
+            .into_iter()
+            .enumerate()
+        {
+            d[k].push(max_diff(&m64::<f64>(a), &m64::<f64>(b)));
+        }
+    }
+    for (name, ds) in ["rt_ij", "rt_ji", "rr"].iter().zip(&d) {
+        let slope = loglog_slope(&ls, ds);
+        println!("{name}: |M_L - M_free| {ds:?}, slope {slope:.4}");
+        assert!((slope + 3.0).abs() < 0.05, "{name}: slope {slope}");
+    }
+}
+
+/// The spin from forces (`add_spin`: real blocks pair by pair, wave part through
+/// structure factors) against the assembled `rt` blocks times the forces.
+#[test]
+fn spin_matches_assembly() {
+    let size = [9.0, 10.0, 12.0];
+    for seed in 0..4u64 {
+        let (p, r) = config(8, seed, size, 2.0, seed % 2 == 1);
+        let (pos, rad) = to_t::<f64>(&p, &r);
+        let ew = Ewald::new(Periodic::new(size).unwrap(), 2.0).unwrap();
+        let g = grand(&ew, &pos, &rad);
+        let n = pos.len();
+        let f: Vec<_> = (0..n)
+            .map(|i| hydrorattle::glam::DVec3::new(1.0 + i as f64, -0.5 * i as f64, 0.3))
+            .collect();
+        let mut want = vec![hydrorattle::glam::DVec3::ZERO; n];
+        for i in 0..n {
+            for j in 0..n {
+                // Row n + i, column j: below the diagonal, stored.
+                want[i] += g[tri(n + i) + j] * f[j];
+            }
+        }
+        let mut got = vec![hydrorattle::glam::DVec3::ZERO; n];
+        add_spin(&ew, 1.0, &pos, &rad, &f, &mut got).unwrap();
+        let scale = want
+            .iter()
+            .map(|v| v.abs().max_element())
+            .fold(0.0, f64::max);
+        let d = want
+            .iter()
+            .zip(&got)
+            .map(|(a, b)| (*a - *b).abs().max_element())
+            .fold(0.0, f64::max);
+        assert!(d < 1e-13 * scale, "seed {seed}: {d:e} of {scale:e}");
     }
 }

@@ -25,11 +25,10 @@
 //! dt-independent bias is rejected by chi^2 64 against 3.2 (free draining) and 11.7
 //! against 0.7 (RPY). At dt = 0.05 neither bias is resolved (below 0.0005).
 
-use hydrorattle::glam::DVec3;
-use hydrorattle::{
-    BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, Params, Particle, ParticleSet,
-    step,
-};
+mod common;
+
+use common::thermal::{over_seeds, step_retrying, thermal, zigzag_chain};
+use hydrorattle::{Drift, Hydro, Layout, Noise};
 use hydrorattle_heap::Buffers;
 
 const N: usize = 8;
@@ -40,28 +39,14 @@ static RETRIED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize:
 /// One chain's run: `<cos^2>` over the 6 consecutive bond pairs, sampled every `every`
 /// steps after `burn` steps, as (sum, count).
 fn chain_run(hydro: Hydro, dt: f64, seed: u64, time: f64) -> (f64, f64) {
-    let mut ps = ParticleSet::<f64, N>::new();
-    // A zigzag start (bonds of length 3, right angles in alternating planes).
-    let mut r = DVec3::ZERO;
-    for k in 0..N {
-        ps.push(Particle::new(r, 1.0, 0.0)).unwrap();
-        r += match k % 3 {
-            0 => DVec3::X,
-            1 => DVec3::Y,
-            _ => DVec3::Z,
-        } * 3.0;
-    }
-    let bonds: BondSet<f64, { N - 1 }> = BondSet::chain(&ps.pos).unwrap();
-    let mut p = Params::<f64>::new(dt);
-    p.method = Method::Overdamped;
-    p.viscosity = 1.0 / (6.0 * std::f64::consts::PI);
-    p.gravity = DVec3::ZERO;
-    p.hydro = hydro;
+    let (mut ps, bonds) = zigzag_chain::<N, { N - 1 }>(N, 3.0);
+    let mut p = thermal::<f64>(
+        dt,
+        1.0 / (6.0 * std::f64::consts::PI),
+        hydro,
+        Drift::Midpoint,
+    );
     p.allow_overlap = true;
-    p.brownian = Some(Brownian {
-        temperature: 1.0,
-        drift: Drift::Midpoint,
-    });
     ps.noise = Some(Noise::new(seed));
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, N, N - 1));
     let mut ws = buf.workspace();
@@ -74,25 +59,7 @@ fn chain_run(hydro: Hydro, dt: f64, seed: u64, time: f64) -> (f64, f64) {
     );
     let (mut sum, mut count) = (0.0, 0.0);
     for k in 0..steps {
-        if let Err(e) = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce) {
-            // A refused step (no root of the projection near the start) as 2, 4, ...
-            // sub-steps along the Brownian bridge, as host-demo retries it.
-            let (start, base) = (ps.clone(), ps.noise.clone().unwrap());
-            let done = (1..=6u8).any(|depth| {
-                let mut q = p;
-                q.dt = dt / f64::from(1u32 << depth);
-                let ok = (0..1u32 << depth).all(|index| {
-                    ps.noise = Some(base.split(depth, index));
-                    step(&mut ps, &bonds, &q, &mut ws, &mut NoForce).is_ok()
-                });
-                if ok {
-                    ps.noise = ps.noise.take().map(Noise::join);
-                } else {
-                    ps = start.clone();
-                }
-                ok
-            });
-            assert!(done, "{hydro:?} dt {dt} seed {seed} step {k}: {e}");
+        if step_retrying(&mut ps, &bonds, &p, &mut ws) {
             RETRIED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
         if k >= burn && (k - burn) % every == 0 {
@@ -111,30 +78,10 @@ fn chain_run(hydro: Hydro, dt: f64, seed: u64, time: f64) -> (f64, f64) {
 /// `<cos^2>` and its standard error over `seeds` independent chains (each chain's mean
 /// one sample), on two threads.
 fn cos2(hydro: Hydro, dt: f64, seeds: u64, time: f64) -> (f64, f64) {
-    let per: Vec<f64> = std::thread::scope(|s| {
-        let half = seeds / 2;
-        let ranges = [0..half, half..seeds];
-        let handles: Vec<_> = ranges
-            .into_iter()
-            .map(|r| {
-                s.spawn(move || {
-                    r.map(|seed| {
-                        let (sum, count) = chain_run(hydro, dt, 1000 + seed, time);
-                        sum / count
-                    })
-                    .collect::<Vec<f64>>()
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap())
-            .collect()
-    });
-    let k = per.len() as f64;
-    let m = per.iter().sum::<f64>() / k;
-    let var = per.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (k - 1.0);
-    (m, (var / k).sqrt())
+    over_seeds(seeds, |seed| {
+        let (sum, count) = chain_run(hydro, dt, 1000 + seed, time);
+        sum / count
+    })
 }
 
 #[test]

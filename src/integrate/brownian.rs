@@ -122,7 +122,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, xi);
     add_constraint_forces(r.held, grad, lambda, force);
-    spin(p, s.pos, s.radius, force, mid)?;
+    spin(p, s.ewald, s.pos, s.radius, force, mid)?;
     Ok(StepReport {
         noise_iterations,
         contacts: r.contacts,

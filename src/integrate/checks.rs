@@ -99,8 +99,7 @@ pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result
 }
 
 /// Checks the periodic box: the kernel built with its `periodic` feature; no wall (its
-/// image system is free space's) and no rotation (the box's `rt`, `rr` blocks are not
-/// summed yet); not the Oseen level (the Ewald sum is RPY's; free draining has no pair
+/// image system is free space's); not the Oseen level (the Ewald sum is RPY's; free draining has no pair
 /// blocks and needs none); every radius below half the smallest edge, every bond (and
 /// FENE's maximum extension) shorter than half of it, so that the minimum image of a
 /// bond at its length is the bond; and Ewald parameters the sums' bounds allow. Those
@@ -143,11 +142,6 @@ pub(super) fn check_box<T: Real>(p: &Params<T>, radius: &[T]) -> Result<HeldSums
     }
     if p.wall.is_some() {
         return Err(StepError::Unsupported("a periodic box with a wall"));
-    }
-    if p.rotation {
-        return Err(StepError::Unsupported(
-            "a periodic box with rotation (the box's rt and rr blocks are not summed yet)",
-        ));
     }
     if p.hydro == Hydro::Oseen {
         return Err(StepError::Unsupported(

@@ -7,7 +7,7 @@
 //! no step would use.
 
 use super::checks::check_box;
-use super::stages::{HeldSums, assemble_tt, free_product, wall_height};
+use super::stages::{HeldSums, Sums, assemble_tt, free_product, wall_height};
 use crate::error::StepError;
 use crate::linalg::tri;
 use crate::mobility;
@@ -40,33 +40,42 @@ pub fn mobility_tt<T: Real>(
 }
 
 /// The grand mobility (`2n x 2n` blocks, translations then rotations, packed as
-/// [`mobility::assemble_grand`] stores it: [`tri`]`(2n)` blocks of `out`); free space
-/// or above the wall (a box refuses rotation).
+/// [`mobility::assemble_grand`] stores it: [`tri`]`(2n)` blocks of `out`): free space,
+/// above the wall or in the box.
 pub fn mobility_grand<T: Real>(
     p: &Params<T>,
     pos: &[T::V3],
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), StepError> {
-    check(
+    let sums = check(
         &Params {
             rotation: true,
             ..*p
         },
         radius,
     )?;
-    grand(p, pos, radius, out)
+    grand(p, sums.as_ref(), pos, radius, out)
 }
 
-/// The grand mobility of free space or above the wall (the checks done): the one
-/// place that picks between the two ([`mobility_grand`], `RattleStable` with rotation).
+/// The grand mobility of free space, above the wall or in the box (the checks done,
+/// `ew` the box's Ewald sums): the one place that picks between the three
+/// ([`mobility_grand`], `RattleStable` with rotation).
 pub(super) fn grand<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), StepError> {
     let (level, eta, out) = (p.hydro, p.viscosity, &mut out[..tri(2 * pos.len())]);
+    #[cfg(feature = "periodic")]
+    if let Some(e) = ew {
+        return Ok(mobility::periodic::assemble_grand(
+            e, eta, pos, radius, out,
+        )?);
+    }
+    let _ = ew; // Read above only with the `periodic` feature.
     match wall_height(p) {
         Some(h) => mobility::wall::assemble_grand(level, eta, h, pos, radius, out)?,
         None => mobility::assemble_grand(level, eta, pos, radius, out)?,

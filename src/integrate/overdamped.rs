@@ -78,7 +78,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
     add_constraint_forces(r.held, grad, lambda, force);
-    spin(p, s.pos, s.radius, force, new_omega)?;
+    spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
     Ok(StepReport {
         contacts: r.contacts,
         wall_contacts: r.wall_contacts,
@@ -171,7 +171,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
     let tension = max_tension(bonds, kappa);
     add_constraint_forces(bonds, grad, kappa, force);
-    spin(p, s.pos, s.radius, force, new_omega)?;
+    spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
     let predict = |x: &mut [T::V3]| {
         for i in 0..n {
             x[i] = s.pos[i] + f0[i] * dt;

@@ -112,7 +112,7 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
     let problem = Problem::Velocities { bond: grad_new, dt };
     let vstats = constraints::solve(problem, &metric, bonds, &p.solver, new_vel, kappa, &mut sc)?;
     // Each sphere pushes on the fluid with R (v - U_inf).
-    spin(p, s.pos, s.radius, drag, new_omega)?;
+    spin(p, s.ewald, s.pos, s.radius, drag, new_omega)?;
     // The tensions from the step's displacement `v dt + a dt^2 / 2` (r* - r without the
     // positions' rounding) along the position metric, with `v` tangent to the bonds;
     // `a` follows `v` through the drag (see `displacement_tensions`); only when asked.

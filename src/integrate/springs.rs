@@ -82,7 +82,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
             forces::overstretched(k, T::norm2(new_pos[b.i] - new_pos[b.j]) / (q0 * q0))?;
         }
     }
-    spin(p, s.pos, s.radius, force, new_omega)?;
+    spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
     Ok(StepReport {
         noise_iterations,
         ..spring_report(p, bonds, new_pos)

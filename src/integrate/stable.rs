@@ -77,7 +77,7 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
     } = v;
     // Mobility (translation or grand) and the drag operator K = dt I + S mu S.
     if p.rotation {
-        super::geometry::grand(p, s.pos, s.radius, mu)?;
+        super::geometry::grand(p, s.ewald, s.pos, s.radius, mu)?;
     } else {
         assemble_tt(p, s.ewald, s.pos, s.radius, mu)?;
     }

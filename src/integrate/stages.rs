@@ -242,14 +242,22 @@ pub(super) fn add_constraint_forces<T: Real>(
 
 /// Angular velocities of torque-free spheres: `W_i = Omega_inf + sum_j rt_ij f_j`, with
 /// `f` the force each sphere exerts on the fluid; `Omega_inf` alone when not resolved.
+/// In a box, the `rt` blocks are the step's Ewald sums `ew`.
 pub(super) fn spin<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     f: &[T::V3],
     out: &mut [T::V3],
 ) -> Result<(), StepError> {
     out.fill(p.vorticity);
+    #[cfg(feature = "periodic")]
+    if let (true, Some(e)) = (p.rotation, ew) {
+        let eta = p.viscosity;
+        return Ok(mobility::periodic::add_spin(e, eta, pos, radius, f, out)?);
+    }
+    let _ = ew; // Read above only with the `periodic` feature.
     if let (true, Some(h)) = (p.rotation, wall_height(p)) {
         let (level, eta) = (p.hydro, p.viscosity);
         return Ok(mobility::wall::add_spin(

@@ -26,10 +26,14 @@
 //!
 //! **Parameters.** [`Ewald::new`] picks `xi` to balance the cost of the two sums and
 //! the cutoffs for a tolerance near epsilon; [`Ewald::with_xi`] takes them from the
-//! caller. Rotation (the `rt`, `rr` blocks) is not here yet.
+//! caller. The rotation blocks (`rt`, `rr`) are summed with the same split in `rot.rs`
+//! ([`pair_rot`], [`self_rr`], [`assemble_grand`], [`add_spin`]).
 
 pub(crate) mod real;
+mod rot;
 mod wave;
+
+pub use rot::{RotBlocks, add_spin, assemble_grand, pair_rot, self_rr};
 
 pub use crate::cell::{Periodic, PeriodicError};
 use crate::error::ParticleError;

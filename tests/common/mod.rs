@@ -5,6 +5,7 @@
 
 pub mod boxes;
 pub mod fuzz;
+pub mod thermal;
 
 use hydrorattle::{
     BondSet, ExternalForce, Method, Params, Particle, ParticleSet, Real, SolverKind, StepError,

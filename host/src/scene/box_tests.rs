@@ -162,16 +162,29 @@ fn spheres_and_bonds_too_large_for_the_box_are_refused_at_their_line() {
 }
 
 #[test]
-fn a_box_with_a_wall_rotation_or_oseen_is_refused_at_the_box() {
+fn a_box_with_a_wall_or_oseen_is_refused_at_the_box() {
     let wall = BOXED.replace("[integrator]", "[wall]\nheight = -5\n\n[integrator]");
     let e = refused(&wall);
     assert_eq!(e.line(), Some(13), "{e}");
     assert!(e.message.contains("with a [wall] is not supported"), "{e}");
-    for model in ["rotation = true", "hydrodynamics = \"oseen\""] {
-        let text = BOXED.replace("[integrator]", &format!("[model]\n{model}\n\n[integrator]"));
-        let e = refused(&text);
-        assert_eq!(e.line(), Some(13), "{model}: {e}");
-        assert!(e.message.contains("a periodic box with"), "{model}: {e}");
+    let model = "hydrodynamics = \"oseen\"";
+    let text = BOXED.replace("[integrator]", &format!("[model]\n{model}\n\n[integrator]"));
+    let e = refused(&text);
+    assert_eq!(e.line(), Some(13), "{model}: {e}");
+    assert!(e.message.contains("a periodic box with"), "{model}: {e}");
+}
+
+/// Rotation in a box is accepted (the kernel sums the box's `rt` and `rr` blocks), for
+/// the overdamped method and the stable RATTLE that assembles the grand mobility.
+#[test]
+fn a_box_with_rotation_is_accepted() {
+    for method in ["overdamped", "rattle-stable"] {
+        let text = BOXED
+            .replace("[integrator]", "[model]\nrotation = true\n\n[integrator]")
+            .replace("method = \"overdamped\"", &format!("method = \"{method}\""));
+        let s = Scene::parse(&text, "b.toml").unwrap_or_else(|e| panic!("{method}: {e}"));
+        assert!(s.periodic.is_some());
+        assert_eq!(Scene::parse(&s.to_toml(), "scene.toml").unwrap(), s);
     }
 }
 

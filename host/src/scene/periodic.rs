@@ -17,7 +17,8 @@
 //! positive, a tolerance outside `(0, 1)`, a sphere whose radius is not below half the
 //! smallest edge (it would overlap its own image), a box with a `[wall]` (the wall's
 //! image system is free space's), and (by the kernel's own check of the first step) a
-//! bond not shorter than half the smallest edge, rotation and the Oseen level.
+//! bond not shorter than half the smallest edge and the Oseen level. Rotation is
+//! accepted: the kernel sums the box's `rt` and `rr` blocks too.
 
 use std::fmt;
 

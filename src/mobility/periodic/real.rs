@@ -170,10 +170,36 @@ pub(crate) fn real_sum<T: Real>(
     let alpha = (ai * ai + aj * aj) / six;
     let beta = ai * ai * aj * aj / (six * six);
     let inv_eta = T::ONE / eta;
+    let mut acc = T::M3_ZERO;
+    for_each_image(ew, r0, |origin, rn, s2| {
+        if same && origin {
+            let (a0, _) = smooth(ew.xi, alpha, beta, T::ZERO);
+            acc += T::m3_diag(free_self_tt(eta, ai) - a0 * inv_eta);
+            return Some(());
+        }
+        let rpy = crate::mobility::pair_tt(Hydro::Rpy, eta, ai, aj, rn)?;
+        let (s, inv_s) = s2.root_and_inverse();
+        let e = rn * inv_s;
+        let (a, b) = smooth(ew.xi, alpha, beta, s);
+        let w = T::m3_add_diag(T::outer(e, e) * (b * inv_eta), a * inv_eta);
+        acc += rpy - w;
+        Some(())
+    })?;
+    Some(acc)
+}
+
+/// Calls `f(origin, r0 + n L, |r0 + n L|^2)` for every image `n` with
+/// `|r0 + n L| <= r_cut`, in a fixed order (`n_x`, then `n_y`, then `n_z`, each
+/// ascending; `origin` for `n = 0`); stops at the first `None` and returns it.
+#[inline(always)]
+pub(super) fn for_each_image<T: Real>(
+    ew: &Split<T>,
+    r0: T::V3,
+    mut f: impl FnMut(bool, T::V3, T) -> Option<()>,
+) -> Option<()> {
     let [lx, ly, lz] = ew.cell.size();
     let [mx, my, mz] = ew.images.map(|m| m as i32);
     let rc2 = ew.r_cut * ew.r_cut;
-    let mut acc = T::M3_ZERO;
     for nx in -mx..=mx {
         for ny in -my..=my {
             for nz in -mz..=mz {
@@ -187,21 +213,11 @@ pub(crate) fn real_sum<T: Real>(
                 if !(s2 <= rc2) {
                     continue;
                 }
-                if same && nx == 0 && ny == 0 && nz == 0 {
-                    let (a0, _) = smooth(ew.xi, alpha, beta, T::ZERO);
-                    acc += T::m3_diag(free_self_tt(eta, ai) - a0 * inv_eta);
-                    continue;
-                }
-                let rpy = crate::mobility::pair_tt(Hydro::Rpy, eta, ai, aj, rn)?;
-                let (s, inv_s) = s2.root_and_inverse();
-                let e = rn * inv_s;
-                let (a, b) = smooth(ew.xi, alpha, beta, s);
-                let w = T::m3_add_diag(T::outer(e, e) * (b * inv_eta), a * inv_eta);
-                acc += rpy - w;
+                f(nx == 0 && ny == 0 && nz == 0, rn, s2)?;
             }
         }
     }
-    Some(acc)
+    Some(())
 }
 
 #[cfg(test)]

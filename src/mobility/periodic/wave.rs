@@ -11,7 +11,7 @@ use crate::real::Real;
 /// The wave vector of index `n`, `1/k^2`, and the radius-free factor
 /// `(1 + k^2/(4 xi^2)) exp(-k^2/(4 xi^2)) / k^2`.
 #[inline(always)]
-fn mode<T: Real>(ew: &Ewald<T>, n: [i32; 3]) -> (T::V3, T, T, T) {
+pub(super) fn mode<T: Real>(ew: &Ewald<T>, n: [i32; 3]) -> (T::V3, T, T, T) {
     let [nx, ny, nz] = n;
     let [kx, ky, kz] = ew.dk;
     let k = T::v3(
@@ -31,7 +31,7 @@ fn mode<T: Real>(ew: &Ewald<T>, n: [i32; 3]) -> (T::V3, T, T, T) {
 /// ascending from 0, then `n_y`, then `n_z`, each ascending), the `n_z` range cut to the
 /// sphere `|k| <= k_max` for each `(n_x, n_y)` so that no index outside it is visited.
 #[inline(always)]
-fn for_each_mode<T: Real>(ew: &Ewald<T>, mut f: impl FnMut([i32; 3])) {
+pub(super) fn for_each_mode<T: Real>(ew: &Ewald<T>, mut f: impl FnMut([i32; 3])) {
     let [mx, my, mz] = ew.waves.map(|m| m as i32);
     let [kx, ky, kz] = ew.dk;
     let km2 = ew.k_max * ew.k_max;
@@ -60,10 +60,16 @@ fn radius_factor<T: Real>(k2: T, a: T) -> T {
     T::ONE - k2 * a * a / T::from_f64(6.0)
 }
 
-/// The wave-space block for radii `a_i`, `a_j` at separation `r0` (minimum image).
-/// `cos(k . r0)` comes from the axis phases `exp(i n_d k_d r_d)`, raised to the `n`-th
-/// power by repeated multiplication (exact to a few ulp for the `n <= MAX_INDEX` used).
-pub(super) fn wave_sum<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r0: T::V3) -> T::M3 {
+/// Calls `f(k, k^2, 1/k^2, h, cos(k . r0), sin(k . r0))` for every mode of
+/// [`for_each_mode`] (`h` the radius-free factor of [`mode`]). The phases come from the
+/// axis phases `exp(i n_d k_d r_d)`, raised to the `n`-th power by repeated
+/// multiplication (exact to a few ulp for the `n <= MAX_INDEX` used).
+#[inline(always)]
+pub(super) fn for_each_phase<T: Real>(
+    ew: &Ewald<T>,
+    r0: T::V3,
+    mut f: impl FnMut(T::V3, T, T, T, T, T),
+) {
     let r = T::xyz(r0);
     let mut pw = [[(T::ONE, T::ZERO); MAX_INDEX + 1]; 3];
     for d in 0..3 {
@@ -79,34 +85,57 @@ pub(super) fn wave_sum<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r0: T::V3) 
         let (c, s) = pw[d][n.unsigned_abs() as usize];
         if n < 0 { (c, -s) } else { (c, s) }
     };
-    let (mut diag, mut kk) = (T::ZERO, [T::ZERO; 6]);
     for_each_mode(ew, |[nx, ny, nz]| {
         let (k, k2, inv_k2, base) = mode(ew, [nx, ny, nz]);
         let (c1, s1) = phase(0, nx);
         let (c2, s2) = phase(1, ny);
         let (c3, s3) = phase(2, nz);
         let (c12, s12) = (c1 * c2 - s1 * s2, c1 * s2 + s1 * c2);
-        let cos = c12 * c3 - s12 * s3;
-        let f = base * radius_factor(k2, ai) * radius_factor(k2, aj) * cos;
-        diag += f;
-        let g = f * inv_k2;
-        let [x, y, z] = T::xyz(k);
-        let (gx, gy) = (g * x, g * y);
-        kk[0] += gx * x;
-        kk[1] += gx * y;
-        kk[2] += gx * z;
-        kk[3] += gy * y;
-        kk[4] += gy * z;
-        kk[5] += g * z * z;
+        f(
+            k,
+            k2,
+            inv_k2,
+            base,
+            c12 * c3 - s12 * s3,
+            c12 * s3 + s12 * c3,
+        );
     });
-    let w = T::TWO / (eta * ew.volume);
+}
+
+/// `sum c k k^T` as the six entries `xx, xy, xz, yy, yz, zz` added to `kk`.
+#[inline(always)]
+pub(super) fn add_kk<T: Real>(kk: &mut [T; 6], k: T::V3, c: T) {
+    let [x, y, z] = T::xyz(k);
+    let (gx, gy) = (c * x, c * y);
+    kk[0] += gx * x;
+    kk[1] += gx * y;
+    kk[2] += gx * z;
+    kk[3] += gy * y;
+    kk[4] += gy * z;
+    kk[5] += c * z * z;
+}
+
+/// `w (d I - kk)`, `kk` as [`add_kk`] sums it: the symmetric block of a projected sum.
+#[inline(always)]
+pub(super) fn projected<T: Real>(d: T, kk: [T; 6], w: T) -> T::M3 {
     let [xx, xy, xz, yy, yz, zz] = kk.map(|v| -(v * w));
-    let d = diag * w;
+    let d = d * w;
     T::m3_cols(
         T::v3(xx + d, xy, xz),
         T::v3(xy, yy + d, yz),
         T::v3(xz, yz, zz + d),
     )
+}
+
+/// The wave-space block for radii `a_i`, `a_j` at separation `r0` (minimum image).
+pub(super) fn wave_sum<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r0: T::V3) -> T::M3 {
+    let (mut diag, mut kk) = (T::ZERO, [T::ZERO; 6]);
+    for_each_phase(ew, r0, |k, k2, inv_k2, base, cos, _| {
+        let f = base * radius_factor(k2, ai) * radius_factor(k2, aj) * cos;
+        diag += f;
+        add_kk(&mut kk, k, f * inv_k2);
+    });
+    projected(diag, kk, T::TWO / (eta * ew.volume))
 }
 
 /// `y += M_wave x` for all spheres through structure factors: for each wave vector,

@@ -1,0 +1,256 @@
+//! The rotation blocks in the box: the Ewald sums of the RPY rotation-translation
+//! (`rt`) and rotation-rotation (`rr`) blocks (`docs/PERIODIC.md`, "Rotation").
+//!
+//! In Fourier space a force `F` on sphere `j` turns sphere `i` by
+//! `(i / (2 eta k^2)) k x F e^{i k.r}` and a torque by `(1 / (4 eta)) (I - k k / k^2) T
+//! e^{i k.r}` (the vorticity, half the curl, of the Stokes flow and of the rotlet).
+//! Beyond contact the RPY blocks are these point kernels exactly (the radius terms of
+//! the translational block are a gradient, curl-free), so the split carries no sphere
+//! factors: wave space takes the kernels times Hasimoto's `H(k)`, real space the
+//! free-space RPY blocks ([`crate::mobility::pair_blocks`], both branches) minus the
+//! transforms `W` of the wave-space kernels. With `h` the transform of `H(k) / k^2`,
+//! `4 pi h(r) = erf(xi r) / r + xi exp(-xi^2 r^2) / sqrt(pi)`:
+//! `eta W_rt(r) F = (h'(r) / (2 r)) r x F` and
+//! `eta W_rr(r) = ((h'' - h'/r) e e^T - (h'' + h'/r) I) / 4`.
+
+use super::real::for_each_image;
+use super::wave::{add_kk, for_each_mode, for_each_phase, projected};
+use super::{Ewald, PeriodicError, check};
+use crate::error::ParticleError;
+use crate::linalg::tri;
+use crate::mobility::{Hydro, pair_blocks, self_rr as free_self_rr};
+use crate::real::Real;
+
+/// Terms of the power series below `xi r = 1` (as for the translational kernel).
+const SERIES_TERMS: usize = 28;
+
+/// `(h'/r, A, B)` at distance `s >= 0`: `eta W_rt F = (h'/r) / 2 (r x F)` and
+/// `eta W_rr = A I + B e e^T`. Entire in `s`; the closed form cancels like `1/(xi s)^3`
+/// near the origin, so below `xi s = 1` the power series is summed: with
+/// `K = xi^3 / (4 pi^{3/2})`, `u_m = (-x^2)^m / m!`, `d_m = (2m + 3) / (2m + 1)`,
+/// `h'/r = -2 K sum d_{m+1} u_m`, `A = K sum (m + 1) d_{m+1} u_m`,
+/// `B = -K sum m d_{m+1} u_m`.
+pub(super) fn smooth_rot<T: Real>(xi: T, s: T) -> (T, T, T) {
+    if xi * s < T::ONE {
+        series(xi, s)
+    } else {
+        closed(xi, s)
+    }
+}
+
+/// [`smooth_rot`] by its power series.
+fn series<T: Real>(xi: T, s: T) -> (T, T, T) {
+    let c = |v: f64| T::from_f64(v);
+    let (x, xi2) = (xi * s, xi * xi);
+    let x2 = x * x;
+    {
+        let k = xi2 * xi / (c(4.0) * T::PI * T::PI.sqrt());
+        let (mut hp, mut a, mut b, mut u) = (T::ZERO, T::ZERO, T::ZERO, T::ONE);
+        for m in 0..SERIES_TERMS {
+            let mf = c(m as f64);
+            let d = (mf + mf + c(5.0)) / (mf + mf + c(3.0));
+            hp += d * u;
+            a += (mf + T::ONE) * d * u;
+            b += mf * d * u;
+            u = -u * x2 / (mf + T::ONE);
+        }
+        (-(c(2.0) * k * hp), k * a, -(k * b))
+    }
+}
+
+/// [`smooth_rot`] in closed form (accurate from `xi s` about 1 on).
+fn closed<T: Real>(xi: T, s: T) -> (T, T, T) {
+    let c = |v: f64| T::from_f64(v);
+    let (x, xi2) = (xi * s, xi * xi);
+    let x2 = x * x;
+    // 4 pi h' = c g / s - erf / s^2 - c xi^2 s g,
+    // 4 pi h'' = 2 erf / s^3 - 2 c g / s^2 - c xi^2 g (3 - 2 x^2), c = 2 xi / sqrt(pi).
+    let cg = c(2.0) * xi / T::PI.sqrt() * (-x2).exp();
+    let erf = x.erf();
+    let inv = T::ONE / s;
+    let inv2 = inv * inv;
+    let k = T::ONE / (c(4.0) * T::PI);
+    let h1 = k * (cg * inv - erf * inv2 - xi2 * s * cg);
+    let h2 =
+        k * (c(2.0) * erf * inv2 * inv - c(2.0) * cg * inv2 - xi2 * cg * (c(3.0) - c(2.0) * x2));
+    let h1r = h1 * inv;
+    let q = c(0.25);
+    (h1r, -(q * (h2 + h1r)), q * (h2 - h1r))
+}
+
+/// The rotation blocks of a pair: `rt_ij` (rotation of `i` from force on `j`), `rt_ji`,
+/// `rr`, in the conventions of [`crate::mobility::PairBlocks`].
+pub type RotBlocks<T> = (<T as Real>::M3, <T as Real>::M3, <T as Real>::M3);
+
+/// Real-space sums of the rotation blocks at minimum-image separation `r0` (for `same`,
+/// a sphere with its own images: `rr` of `n = 0` is `1/(8 pi eta a^3) - W_rr(0)`, and
+/// `rt` is zero by inversion symmetry, so it is not summed).
+fn real_rot<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    ai: T,
+    aj: T,
+    r0: T::V3,
+    same: bool,
+) -> Option<RotBlocks<T>> {
+    let inv_eta = T::ONE / eta;
+    let (mut rt_ij, mut rt_ji, mut rr) = (T::M3_ZERO, T::M3_ZERO, T::M3_ZERO);
+    for_each_image(&ew.split, r0, |origin, rn, s2| {
+        if same && origin {
+            let (_, a0, _) = smooth_rot(ew.xi, T::ZERO);
+            rr += T::m3_diag(free_self_rr(eta, ai) - a0 * inv_eta);
+            return Some(());
+        }
+        let b = pair_blocks(Hydro::Rpy, eta, ai, aj, rn)?;
+        let (s, inv_s) = s2.root_and_inverse();
+        let e = rn * inv_s;
+        let (h1r, a, bb) = smooth_rot(ew.xi, s);
+        let w_rt = T::m3_cross(rn) * (h1r * T::HALF * inv_eta);
+        rr += b.rr - T::m3_add_diag(T::outer(e, e) * (bb * inv_eta), a * inv_eta);
+        if !same {
+            rt_ij += b.rt_ij - w_rt;
+            rt_ji += b.rt_ji + w_rt;
+        }
+        Some(())
+    })?;
+    Some((rt_ij, rt_ji, rr))
+}
+
+/// Wave-space sums of `rt_ij` and `rr` at separation `r0` (`rt_ji` is `-rt_ij`: the
+/// kernel is odd and radius-free). Half space: the modes `k` and `-k` together give
+/// `rt_ij = -1/(eta V) sum H/k^2 sin(k.r) [k x]` and `rr = 2/(4 eta V) sum H P(k) cos(k.r)`.
+fn wave_rot<T: Real>(ew: &Ewald<T>, eta: T, r0: T::V3) -> (T::M3, T::M3) {
+    let (mut diag, mut kk, mut ks) = (T::ZERO, [T::ZERO; 6], T::V3_ZERO);
+    for_each_phase(ew, r0, |k, k2, inv_k2, base, cos, sin| {
+        let f = base * k2 * cos;
+        diag += f;
+        add_kk(&mut kk, k, f * inv_k2);
+        ks += k * (base * sin);
+    });
+    let w = T::TWO / (eta * ew.volume);
+    let rt = T::m3_cross(ks) * (-(w * T::HALF));
+    (rt, projected(diag, kk, w * T::from_f64(0.25)))
+}
+
+/// The rotation blocks `(rt_ij, rt_ji, rr)` of the pair `(i, j)`, `i != j`, at
+/// separation `r = r_i - r_j` (any image); `None` when a sphere lies inside an image of
+/// the other. `rr` is exactly symmetric.
+pub fn pair_rot<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r: T::V3) -> Option<RotBlocks<T>> {
+    let r0 = ew.cell.minimum_image(r);
+    let (rt_ij, rt_ji, rr) = real_rot(ew, eta, ai, aj, r0, false)?;
+    let (rt, rr_w) = wave_rot(ew, eta, r0);
+    Some((rt_ij + rt, rt_ji - rt, rr + rr_w))
+}
+
+/// The `rr` self block of a sphere of radius `a` in the box (for a cubic box of edge
+/// `L`, `(1 - (4 pi / 3)(a/L)^3) / (8 pi eta a^3)`); its `rt` self block is zero.
+pub fn self_rr<T: Real>(ew: &Ewald<T>, eta: T, a: T) -> T::M3 {
+    // No image of a sphere lies inside it (a < L/2), so the real sum is never `None`.
+    let (_, _, rr) =
+        real_rot(ew, eta, a, a, T::V3_ZERO, true).unwrap_or((T::M3_ZERO, T::M3_ZERO, T::M3_ZERO));
+    rr + wave_rot(ew, eta, T::V3_ZERO).1
+}
+
+/// Assembles the `2n x 2n` grand mobility `[[tt, tr], [rt, rr]]` of the box, packed
+/// lower triangle, in the layout of [`crate::mobility::assemble_grand`].
+pub fn assemble_grand<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    out: &mut [T::M3],
+) -> Result<(), PeriodicError> {
+    check(ew, pos, radius)?;
+    let n = pos.len();
+    for i in 0..n {
+        let a = radius[i];
+        let (ti, ri) = (tri(i), tri(n + i));
+        out[ti + i] = super::self_tt(ew, eta, a);
+        out[ri + n + i] = self_rr(ew, eta, a);
+        out[ri + i] = T::M3_ZERO;
+        for j in 0..i {
+            let nested = PeriodicError::Particle(ParticleError::Nested { i: j, j: i });
+            let r = pos[i] - pos[j];
+            let tt = super::pair_tt(ew, eta, a, radius[j], r).ok_or(nested)?;
+            let (rt_ij, rt_ji, rr) = pair_rot(ew, eta, a, radius[j], r).ok_or(nested)?;
+            let rj = tri(n + j);
+            out[ti + j] = tt;
+            out[ri + n + j] = rr;
+            out[ri + j] = rt_ij;
+            out[rj + i] = rt_ji;
+        }
+    }
+    Ok(())
+}
+
+/// `out_i += sum_j rt_ij f_j` (the spin of torque-free spheres from the forces): the
+/// real-space blocks pair by pair, the wave-space part through structure factors,
+/// `-1/(eta V) sum H/k^2 k x (sin(k.r_i) C - cos(k.r_i) S)` with
+/// `C, S = sum_j (cos, sin)(k.r_j) f_j` (the `j = i` terms cancel).
+pub fn add_spin<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    f: &[T::V3],
+    out: &mut [T::V3],
+) -> Result<(), PeriodicError> {
+    check(ew, pos, radius)?;
+    for i in 0..pos.len() {
+        for j in 0..i {
+            let r0 = ew.cell.minimum_image(pos[i] - pos[j]);
+            let (rt_ij, rt_ji, _) = real_rot(ew, eta, radius[i], radius[j], r0, false).ok_or(
+                PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
+            )?;
+            out[i] += rt_ij * f[j];
+            out[j] += rt_ji * f[i];
+        }
+    }
+    let w = T::ONE / (eta * ew.volume);
+    for_each_mode(ew, |n| {
+        let (k, _, _, base) = super::wave::mode(ew, n);
+        let (mut c, mut s) = (T::V3_ZERO, T::V3_ZERO);
+        for j in 0..pos.len() {
+            let t = T::dot(k, ew.cell.wrap_into(pos[j]));
+            c += f[j] * t.cos();
+            s += f[j] * t.sin();
+        }
+        let h = -(base * w);
+        for i in 0..pos.len() {
+            let t = T::dot(k, ew.cell.wrap_into(pos[i]));
+            out[i] += T::cross(k, c * t.sin() - s * t.cos()) * h;
+        }
+    });
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{closed, series, smooth_rot};
+
+    /// The series and the closed form agree around the switch at `xi r = 1`, and far
+    /// out `W` is the point rotlet and dipole: `h'/r = -1/(4 pi r^3)`,
+    /// `A = -1/(16 pi r^3)`, `B = 3/(16 pi r^3)`.
+    #[test]
+    fn series_meets_closed_form_and_far_field() {
+        for xi in [0.3f64, 1.0, 2.4] {
+            for x in [0.8, 1.0, 1.3] {
+                let (a, b) = (series(xi, x / xi), closed(xi, x / xi));
+                let d = [a.0 - b.0, a.1 - b.1, a.2 - b.2]
+                    .map(f64::abs)
+                    .into_iter()
+                    .fold(0.0, f64::max);
+                assert!(
+                    d < 5e-15 * xi * xi * xi,
+                    "xi {xi} x {x}: {:e}",
+                    d / (xi * xi * xi)
+                );
+            }
+            let r = 9.0 / xi;
+            let (h1r, a, b) = smooth_rot(xi, r);
+            let c = 1.0 / (16.0 * core::f64::consts::PI * r * r * r);
+            assert!((h1r + 4.0 * c).abs() < 1e-15 * c, "{h1r}");
+            assert!((a + c).abs() < 1e-15 * c && (b - 3.0 * c).abs() < 1e-15 * c);
+        }
+    }
+}
