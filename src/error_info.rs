@@ -200,9 +200,7 @@ impl StepError {
             Self::Bond(e) => e.other(),
             Self::Overlap { j, .. } => Some(j),
             Self::Infeasible {
-                constraints,
-                shown,
-                ..
+                constraints, shown, ..
             } if shown > 1 => Some(constraints[1]),
             _ => None,
         }

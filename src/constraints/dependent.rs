@@ -52,14 +52,27 @@ pub(super) fn infeasible<T: Real>(
             }
             v[j] = -s * fac[j * n + j];
         }
-        for (l, x) in v.iter_mut().enumerate() {
-            *x = x.abs() * T::norm(metric.grad(l));
-        }
+        return self_stress(metric, v);
     } else {
         for (k, x) in v.iter_mut().enumerate() {
             *x = if dependent(k) { T::ONE } else { T::ZERO };
         }
     }
+    listed(v)
+}
+
+/// The [`StepError::Infeasible`] of the self-stress `v` (multipliers with no net
+/// force): the constraints where `|v_l| |g_l|` is not negligible, the largest listed.
+pub(super) fn self_stress<T: Real>(metric: &Metric<'_, T>, v: &mut [T]) -> StepError {
+    for (l, x) in v.iter_mut().enumerate() {
+        *x = x.abs() * T::norm(metric.grad(l));
+    }
+    listed(v)
+}
+
+/// [`StepError::Infeasible`] listing the constraints of weight `v` (non-negative;
+/// overwritten).
+fn listed<T: Real>(v: &mut [T]) -> StepError {
     let biggest = v.iter().fold(T::ZERO, |m, &x| m.max(x));
     let cut = biggest * T::from_f64(1e-6);
     let count = v.iter().filter(|&&x| x > cut).count();

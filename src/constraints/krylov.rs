@@ -18,7 +18,7 @@
 //!   If the band is not positive definite, its diagonal (Jacobi) is used instead.
 //! * Reported iterations are PCG iterations, i.e. operator products: the cost count.
 
-use super::{Metric, Problem, Scratch, SolveStats, Solver};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent};
 use crate::bonds::Bond;
 use crate::error::{LinalgError, StepError};
 use crate::linalg::band;
@@ -68,6 +68,11 @@ pub fn krylov<T: Real>(
     let mut products = 0u32;
     let mut outer = 0u32;
     let mut initial = None;
+    let floor = dependent::rank_floor::<T>(nb);
+    // The last chord step met a direction `p` of (numerically) zero curvature: a
+    // self-stress of dependent constraints, left in `p`.
+    let mut previous: Option<T> = None;
+    let mut null = false;
     loop {
         // Nonlinear residual of the chord iteration.
         let mut worst = T::ZERO;
@@ -85,6 +90,13 @@ pub fn krylov<T: Real>(
                 residual: worst,
             });
         }
+        // A chord step stopped by a self-stress that then fails to halve the residual:
+        // the dependent constraints ask for what the others forbid.
+        if null && previous.is_some_and(|p| worst > p * T::HALF) {
+            return Err(dependent::self_stress(metric, p));
+        }
+        previous = Some(worst);
+        null = false;
         // A chord iteration that has grown the residual a hundredfold is diverging.
         let first = *initial.get_or_insert(worst);
         if outer == solver.max_iterations
@@ -109,6 +121,16 @@ pub fn krylov<T: Real>(
                 q[k] = T::dot(metric.grad(k), b.relative(w)) * c;
             }
             let pq = dot(p, q);
+            // `p A p` against `p diag(A) p`: zero curvature along a self-stress of
+            // dependent constraints (`docs/CONTACTS.md`). What is left of `r` along it
+            // is the part no move can meet: the step is done.
+            let curvature = (0..nb).fold(T::ZERO, |s, k| {
+                s + p[k] * p[k] * T::dot(metric.grad(k), metric.relative(bonds, k, k)) * c
+            });
+            if pq.is_finite() && pq <= floor * curvature {
+                null = true;
+                break;
+            }
             if !pq.is_finite() {
                 // The iterate overflowed: a diverging chord iteration (the projection
                 // has no solution near the start), not an indefinite matrix.
@@ -154,8 +176,8 @@ pub fn krylov<T: Real>(
     }
 }
 
-/// Band of `A` factorised into `pre`; its diagonal square roots when the band is not
-/// positive definite.
+/// Band of `A` factorised into `pre` (regularised where rows are dependent); its
+/// diagonal square roots when the band is not positive semi-definite.
 fn precondition<T: Real>(metric: &Metric<'_, T>, bonds: &[Bond<T>], c: T, pre: &mut [T]) {
     let nb = bonds.len();
     let entry = |k: usize, l: usize| T::dot(metric.grad(k), metric.relative(bonds, k, l)) * c;
@@ -164,7 +186,12 @@ fn precondition<T: Real>(metric: &Metric<'_, T>, bonds: &[Bond<T>], c: T, pre: &
         let row = &mut pre[band::at(BAND, k, first)..=band::at(BAND, k, k)];
         metric.jacobian_row(bonds, k, metric.grad(k) * c, first, row);
     }
-    if band::cholesky(pre, nb, BAND).is_ok() {
+    // Dependent constraints (`docs/CONTACTS.md`) make `A` singular: their pivots are
+    // replaced by their diagonals, which keeps the preconditioner positive definite;
+    // conjugate gradients on the singular but consistent `A delta = r` still converge
+    // (to the solution in the range of `A`: the minimum-norm multipliers).
+    let floor = super::dependent::rank_floor::<T>(nb);
+    if band::regularised(pre, nb, BAND, floor).is_ok() {
         return;
     }
     log::debug!("krylov: band preconditioner not positive definite, using Jacobi");

@@ -98,8 +98,8 @@ pub fn newton<T: Real>(
             linalg::cholesky_dense_solve(jac, nb, rhs);
         } else {
             if refresh {
-                deficient = linalg::lu_ranked(jac, nb, piv, floor * max_diagonal(jac, nb))
-                    .map_err(fail)?;
+                deficient =
+                    linalg::lu_ranked(jac, nb, piv, floor * max_diagonal(jac, nb)).map_err(fail)?;
             }
             linalg::lu_solve(jac, nb, piv, rhs);
         }
