@@ -68,11 +68,16 @@ pub fn krylov<T: Real>(
     let mut products = 0u32;
     let mut outer = 0u32;
     let mut initial = None;
-    let floor = dependent::rank_floor::<T>(nb);
+    // Curvature below `sqrt(eps)` of the diagonal's: a direction of zero curvature
+    // to the precision that a step of `1 / curvature` can use (the rounding of `q` is
+    // `eps |A| |p|`, so a smaller `p A p` is noise, and the move it asks for, rounding
+    // amplified).
+    let floor = T::EPSILON.sqrt();
     // The last chord step met a direction `p` of (numerically) zero curvature: a
     // self-stress of dependent constraints, left in `p`.
     let mut previous: Option<T> = None;
     let mut null = false;
+    let mut stalls = 0;
     loop {
         // Nonlinear residual of the chord iteration.
         let mut worst = T::ZERO;
@@ -90,9 +95,14 @@ pub fn krylov<T: Real>(
                 residual: worst,
             });
         }
-        // A chord step stopped by a self-stress that then fails to halve the residual:
-        // the dependent constraints ask for what the others forbid.
-        if null && previous.is_some_and(|p| worst > p * T::HALF) {
+        // Chord steps stopped by a self-stress that then fail to halve the residual,
+        // three in a row: the dependent constraints ask for what the others forbid
+        // (one such step may be a nonlinear remainder the next removes).
+        stalls = match null && previous.is_some_and(|p| worst > p * T::HALF) {
+            true => stalls + 1,
+            false => 0,
+        };
+        if stalls == 3 {
             return Err(dependent::self_stress(metric, p));
         }
         previous = Some(worst);

@@ -22,11 +22,12 @@ use crate::real::Real;
 ///   Velocities are linear: one step.
 /// * Dependent constraints (`docs/CONTACTS.md`): both factorisations take the rank
 ///   tolerance [`dependent::rank_floor`]; a dependent row gets a zero multiplier update
-///   (the basic solution) and positions move as the independent rows demand. While the
-///   chord is rank-deficient it is kept (the Jacobian at the iterate would be singular
-///   too, and LU without column pivoting reveals rank poorly); a rank-deficient
-///   iteration that fails to halve the residual means the dependent rows ask what the
-///   others forbid: [`StepError::Infeasible`], naming the dependent set.
+///   (the basic solution) and positions move as the independent rows demand. A
+///   rank-deficient iteration on the Jacobian at the iterate that fails to halve the
+///   residual means the dependent rows ask what the others forbid:
+///   [`StepError::Infeasible`], naming the dependent set (on the chord such a stall is
+///   first taken for the chord's own slowness on a large move, and the Jacobian at the
+///   iterate takes over as without dependent rows).
 pub fn newton<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,
@@ -64,12 +65,11 @@ pub fn newton<T: Real>(
             return Err(problem.no_convergence(it, residual));
         }
         let fast = previous.is_some_and(|p| residual <= p * T::from_f64(0.1));
-        if deficient > 0 && previous.is_some_and(|p| residual > p * T::HALF) {
-            // The factor is still that of the last iteration (kept, not refreshed).
+        if deficient > 0 && !chord && previous.is_some_and(|p| residual > p * T::HALF) {
+            // The factor is still that of the last iteration.
             return Err(dependent::infeasible(metric, bonds, jac, rhs, chord));
         }
-        // A rank-deficient chord is kept: refactorising it gives the same factor.
-        let refresh = previous.is_none() || (!fast && deficient == 0);
+        let refresh = previous.is_none() || !fast;
         if refresh && previous.is_some() {
             chord = false;
         }
