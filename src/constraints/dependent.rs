@@ -16,49 +16,42 @@ use crate::bonds::Bond;
 use crate::error::{INFEASIBLE_SHOWN, StepError};
 use crate::real::Real;
 
-/// Relative rank tolerance of a factorisation of `rows` rows: a pivot at or below
-/// `64 rows eps` times its row's diagonal is rounding, not information (the pivot of
-/// an exactly dependent row is the difference of two sums of `rows` rounded terms of
-/// the diagonal's size). 1.4e-12 at 100 rows in f64, 7.6e-4 in f32.
-pub(crate) fn rank_floor<T: Real>(rows: usize) -> T {
-    T::EPSILON * T::from_f64(64.0 * rows.max(1) as f64)
+/// Relative rank tolerance of a factorisation: a pivot at or below `sqrt(eps)` times
+/// its row's diagonal (1.5e-8 in f64, 3.5e-4 in f32) is taken for a dependent row. An
+/// exactly dependent row's pivot is the difference of sums of rounded terms of the
+/// diagonal's size, a few hundred `eps` at a few hundred rows (measured: the pile of
+/// `host-demo/scenes/pile.toml` went below `-64 rows eps` at 280 rows); a row that
+/// independent has a condition number of `1 / eps` against the others, and its
+/// multiplier would carry no digit the step can use.
+pub(crate) fn rank_floor<T: Real>() -> T {
+    T::EPSILON.sqrt()
 }
 
-/// The [`StepError::Infeasible`] of a rank-deficient factor of `bonds.len()` rows:
-/// from a [`cholesky_dense`](crate::linalg::cholesky_dense) factor (`chord`), the
+/// The [`StepError::Infeasible`] of a rank-deficient
+/// [`cholesky_dense`](crate::linalg::cholesky_dense) factor of `bonds.len()` rows: the
 /// self-stress of its first dependent row, listed by the forces `|v_l| |g_l|` it puts
-/// on the constraints (`work`: `bonds.len()` scalars); from an LU factor, its
-/// dependent columns.
+/// on the constraints (`work`: `bonds.len()` scalars).
 pub(super) fn infeasible<T: Real>(
     metric: &Metric<'_, T>,
     bonds: &[Bond<T>],
     fac: &[T],
     work: &mut [T],
-    chord: bool,
 ) -> StepError {
     let n = bonds.len();
-    let dependent = |k: usize| fac[k * n + k] == T::ZERO;
-    let first = (0..n).find(|&k| dependent(k)).unwrap_or(0);
+    let first = (0..n).find(|&k| fac[k * n + k] == T::ZERO).unwrap_or(0);
     let v = &mut work[..n];
     v.fill(T::ZERO);
-    if chord {
-        // `L^T v = 0` above row `first`, by back substitution (a dependent row's
-        // column of `L` is zero: its entry stays 0).
-        v[first] = T::ONE;
-        for j in (0..first).rev() {
-            let mut s = fac[first * n + j];
-            for i in j + 1..first {
-                s += fac[i * n + j] * v[i];
-            }
-            v[j] = -s * fac[j * n + j];
+    // `L^T v = 0` above row `first`, by back substitution (a dependent row's column of
+    // `L` is zero: its entry stays 0).
+    v[first] = T::ONE;
+    for j in (0..first).rev() {
+        let mut s = fac[first * n + j];
+        for i in j + 1..first {
+            s += fac[i * n + j] * v[i];
         }
-        return self_stress(metric, v);
-    } else {
-        for (k, x) in v.iter_mut().enumerate() {
-            *x = if dependent(k) { T::ONE } else { T::ZERO };
-        }
+        v[j] = -s * fac[j * n + j];
     }
-    listed(v)
+    self_stress(metric, v)
 }
 
 /// The [`StepError::Infeasible`] of the self-stress `v` (multipliers with no net

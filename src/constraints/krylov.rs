@@ -68,11 +68,10 @@ pub fn krylov<T: Real>(
     let mut products = 0u32;
     let mut outer = 0u32;
     let mut initial = None;
-    // Curvature below `sqrt(eps)` of the diagonal's: a direction of zero curvature
-    // to the precision that a step of `1 / curvature` can use (the rounding of `q` is
-    // `eps |A| |p|`, so a smaller `p A p` is noise, and the move it asks for, rounding
-    // amplified).
-    let floor = T::EPSILON.sqrt();
+    // Curvature below the rank tolerance (`sqrt(eps)`) of the diagonal's: a direction
+    // of zero curvature to the precision that a step of `1 / curvature` can use (the
+    // rounding of `q` is `eps |A| |p|`, and the move asked for would amplify it).
+    let floor = dependent::rank_floor::<T>();
     // The last chord step met a direction `p` of (numerically) zero curvature: a
     // self-stress of dependent constraints, left in `p`.
     let mut previous: Option<T> = None;
@@ -200,7 +199,7 @@ fn precondition<T: Real>(metric: &Metric<'_, T>, bonds: &[Bond<T>], c: T, pre: &
     // replaced by their diagonals, which keeps the preconditioner positive definite;
     // conjugate gradients on the singular but consistent `A delta = r` still converge
     // (to the solution in the range of `A`: the minimum-norm multipliers).
-    let floor = super::dependent::rank_floor::<T>(nb);
+    let floor = super::dependent::rank_floor::<T>();
     if band::regularised(pre, nb, BAND, floor).is_ok() {
         return;
     }

@@ -47,7 +47,7 @@ pub fn newton<T: Real>(
     // iterate, refreshed whenever the residual falls less than tenfold.
     let mut chord = matches!(problem, Problem::Positions { .. });
     let mut previous: Option<T> = None;
-    let floor = dependent::rank_floor::<T>(nb);
+    let floor = dependent::rank_floor::<T>();
     // Dependent rows found by the last factorisation.
     let mut deficient = 0;
     for it in 0..=solver.max_iterations {
@@ -66,8 +66,15 @@ pub fn newton<T: Real>(
         }
         let fast = previous.is_some_and(|p| residual <= p * T::from_f64(0.1));
         if deficient > 0 && !chord && previous.is_some_and(|p| residual > p * T::HALF) {
-            // The factor is still that of the last iteration.
-            return Err(dependent::infeasible(metric, bonds, jac, rhs, chord));
+            // Named by the chord's self-stress (an LU factor shows only which columns
+            // it skipped): refactorised here, on the way out.
+            let c = problem.chord_factor();
+            for k in 0..nb {
+                let row = &mut jac[k * nb..k * nb + k + 1];
+                metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
+            }
+            let _ = linalg::cholesky_dense(jac, nb, floor);
+            return Err(dependent::infeasible(metric, bonds, jac, rhs));
         }
         let refresh = previous.is_none() || !fast;
         if refresh && previous.is_some() {

@@ -41,7 +41,7 @@ pub fn regularised<T: Real>(
                 a[at(w, k, l)] = s / a[at(w, l, l)];
             } else if s > floor * diagonal && s.is_finite() {
                 a[at(w, k, k)] = s.sqrt();
-            } else if floor > T::ZERO && diagonal > T::ZERO && s.abs() <= floor * diagonal {
+            } else if floor > T::ZERO && diagonal > T::ZERO && s.is_finite() {
                 a[at(w, k, k)] = diagonal.sqrt();
                 replaced += 1;
             } else {

@@ -114,13 +114,14 @@ pub fn lu_solve<T: Real>(a: &[T], n: usize, piv: &[usize], x: &mut [T]) {
 /// [`LinalgError::NotPositiveDefinite`]. Cost: about `n^3 / 6` multiply-adds, half of
 /// [`lu`]'s, and no pivot search.
 ///
-/// Semi-definite matrices: a pivot `d` with `|d| <= floor A_kk` marks row `k`
-/// dependent (a Gram matrix `G M G^T` whose row `k` of `G` lies in the span of the rows
+/// Semi-definite matrices: a pivot `d <= floor A_kk` (negative ones included: a
+/// Gram matrix has none but by rounding) marks row `k` dependent (a Gram matrix `G M G^T` whose row `k` of `G` lies in the span of the rows
 /// before it: its Schur complement vanishes, up to rounding, in its whole row). Its
 /// stored `1 / L_kk` is zero, so column `k` of `L` is zero and [`cholesky_dense_solve`]
 /// gives its unknown zero. Returns the number of dependent rows. Rows are taken in
 /// order (no pivoting), so which of a dependent set is dropped is the last one listed:
-/// deterministic. A pivot below `-floor A_kk` is still not positive definite.
+/// deterministic. A non-finite pivot, or a diagonal entry that is not positive, is
+/// still not positive definite.
 pub fn cholesky_dense<T: Real>(a: &mut [T], n: usize, floor: T) -> Result<usize, LinalgError> {
     let a = &mut a[..n * n];
     let mut k = 0;
@@ -153,13 +154,13 @@ pub fn cholesky_dense<T: Real>(a: &mut [T], n: usize, floor: T) -> Result<usize,
 }
 
 /// `L_kk = sqrt(A_kk - sum_j L_kj^2)` for `row = [L_k0, .., L_k(k-1), A_kk]`; stores and
-/// returns `1 / L_kk`, or zero for a dependent row (`|d| <= floor A_kk`).
+/// returns `1 / L_kk`, or zero for a dependent row (`d <= floor A_kk`).
 #[inline(always)]
 fn pivot<T: Real>(row: &mut [T], k: usize, floor: T) -> Result<T, LinalgError> {
     let (head, last) = row.split_at_mut(k);
     let d = head.iter().fold(last[0], |s, &x| s - x * x);
     if !(d > T::ZERO && d.is_finite()) || d <= floor * last[0] {
-        if floor > T::ZERO && last[0] > T::ZERO && d.abs() <= floor * last[0] {
+        if floor > T::ZERO && last[0] > T::ZERO && d.is_finite() {
             last[0] = T::ZERO;
             return Ok(T::ZERO);
         }
