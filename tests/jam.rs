@@ -434,7 +434,7 @@ fn random_piles_hold_or_refuse() {
     const N: usize = 12;
     let cases = 150;
     for case in 0..cases {
-        let mut rng = Rng::case(0x6a61_6d, case);
+        let mut rng = Rng::case(0x006a_616d, case);
         let h = 4.0 * rng.unit() - 2.0;
         let n = 3 + rng.below(N - 3);
         let mut spheres: Vec<Sphere> = Vec::new();

@@ -21,7 +21,7 @@ use crate::real::Real;
 ///   D_l(j_k))`, solved by LU, refreshed whenever the residual falls less than tenfold.
 ///   Velocities are linear: one step.
 /// * Dependent constraints (`docs/CONTACTS.md`): both factorisations take the rank
-///   tolerance [`dependent::rank_floor`]; a dependent row gets a zero multiplier update
+///   tolerance `sqrt(eps)` (`docs/CONTACTS.md`); a dependent row gets a zero multiplier update
 ///   (the basic solution) and positions move as the independent rows demand. A
 ///   rank-deficient iteration on the Jacobian at the iterate that fails to halve the
 ///   residual means the dependent rows ask what the others forbid:
