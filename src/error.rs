@@ -152,6 +152,9 @@ pub enum Stage {
     Contacts,
 }
 
+/// Most constraints a [`StepError::Infeasible`] lists.
+pub const INFEASIBLE_SHOWN: usize = 4;
+
 /// A step failed; the caller's state is exactly as it was before the call.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum StepError {
@@ -186,6 +189,22 @@ pub enum StepError {
     Degenerate {
         /// The bond; past the bonds, contact `bond - bonds` of the step.
         bond: usize,
+    },
+    /// The constraints cannot all hold at once: the geometry is infeasible (a sphere
+    /// squeezed between two that cannot move apart: a bond shorter than the spheres
+    /// between its ends, walls of spheres pinned by bonds). Found where the
+    /// constraints are linearly dependent and the solve stops converging on them
+    /// (`docs/CONTACTS.md`).
+    Infeasible {
+        /// The constraints of the dependent set, in increasing index (a bond; past the
+        /// bonds, one-sided constraint `k - bonds` of the step: a contact or a wall
+        /// link); the first `shown` are valid.
+        constraints: [usize; INFEASIBLE_SHOWN],
+        /// How many of `constraints` are valid.
+        shown: usize,
+        /// How many constraints the dependent set holds (`shown` of them listed: the
+        /// ones carrying the largest forces).
+        count: usize,
     },
     /// A velocity or position became NaN or infinite.
     NonFinite {
@@ -326,6 +345,23 @@ impl fmt::Display for StepError {
                 write!(
                     f,
                     "bond {bond} turned too far in one step (degenerate SHAKE update)"
+                )
+            }
+            Self::Infeasible {
+                constraints,
+                shown,
+                count,
+            } => {
+                write!(f, "constraints")?;
+                for (k, c) in constraints.iter().take(shown).enumerate() {
+                    write!(f, "{}{c}", if k == 0 { " " } else { ", " })?;
+                }
+                if count > shown {
+                    write!(f, " (of {count} dependent)")?;
+                }
+                write!(
+                    f,
+                    " cannot all hold: infeasible geometry (spheres squeezed by constraints that cannot give way)"
                 )
             }
             Self::NonFinite { particle } => {

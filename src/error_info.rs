@@ -152,6 +152,7 @@ impl StepError {
             },
             Self::NoConvergence { .. } => "no_convergence",
             Self::Degenerate { .. } => "degenerate",
+            Self::Infeasible { .. } => "infeasible",
             Self::NonFinite { .. } => "non_finite",
             Self::NonFiniteForce { .. } => "non_finite_force",
             Self::Overlap { .. } => "overlap",
@@ -188,6 +189,7 @@ impl StepError {
             Self::Bond(e) => e.index(),
             Self::Linalg { error, .. } => Some(error.row()),
             Self::Degenerate { bond } => Some(bond),
+            Self::Infeasible { constraints, .. } => Some(constraints[0]),
             Self::NonFinite { particle } | Self::NonFiniteForce { particle } => Some(particle),
             Self::Overlap { i, .. } => Some(i),
             _ => None,
@@ -204,6 +206,9 @@ impl StepError {
             },
             Self::Bond(e) => e.other(),
             Self::Overlap { j, .. } => Some(j),
+            Self::Infeasible {
+                constraints, shown, ..
+            } if shown > 1 => Some(constraints[1]),
             _ => None,
         }
     }
@@ -217,11 +222,23 @@ impl StepError {
         }
     }
 
-    /// A count the error carries: the iterations done (`NoConvergence`) or the contact
-    /// capacity (`ContactsFull`).
+    /// Every constraint an `Infeasible` lists (empty for the others).
+    pub fn constraints(&self) -> &[usize] {
+        match self {
+            Self::Infeasible {
+                constraints, shown, ..
+            } => &constraints[..*shown],
+            _ => &[],
+        }
+    }
+
+    /// A count the error carries: the iterations done (`NoConvergence`), the contact
+    /// capacity (`ContactsFull`) or the size of an infeasible dependent set
+    /// (`Infeasible`).
     pub const fn count(&self) -> Option<usize> {
         match *self {
             Self::NoConvergence { iterations, .. } => Some(iterations as usize),
+            Self::Infeasible { count, .. } => Some(count),
             Self::ContactsFull { capacity } => Some(capacity),
             _ => None,
         }
@@ -253,7 +270,7 @@ mod tests {
     use crate::workspace::Layout;
 
     /// One of every variant (nested ones included).
-    fn every() -> [StepError; 32] {
+    fn every() -> [StepError; 33] {
         let p = |e| StepError::Particle(e);
         let b = |e| StepError::Bond(e);
         let (i, j, bond) = (3, 5, 7);
@@ -305,6 +322,11 @@ mod tests {
                 limit: 0.05,
             },
             StepError::ContactsFull { capacity: 9 },
+            StepError::Infeasible {
+                constraints: [2, 5, 7, 0],
+                shown: 3,
+                count: 6,
+            },
             StepError::Unsupported("noise"),
             StepError::Particle(ParticleError::Full),
         ]
@@ -362,6 +384,11 @@ mod tests {
         let e = at("unstable");
         assert_eq!((e.value(), e.limit()), (Some(0.1), Some(0.05)));
         assert_eq!(at("contacts_full").count(), Some(9));
+        let e = at("infeasible");
+        assert_eq!(
+            (e.index(), e.other(), e.count(), e.constraints()),
+            (Some(2), Some(5), Some(6), &[2, 5, 7][..])
+        );
         assert_eq!(at("overlap").pair(), Some((3, 5)));
         assert_eq!(at("bad_parameter").detail(), Some("tolerance"));
         assert_eq!(at("unsupported").detail(), Some("noise"));

@@ -58,6 +58,10 @@ enum HrStatus
   // (`error_index`). The C interface sets no contacts, so this is never returned
   // today; the value is reserved so that codes stay stable.
   HR_STATUS_CONTACTS_FULL = 14,
+  // `StepError::Infeasible`: constraints that cannot all hold (`error_index`,
+  // `error_other`: the first two of the dependent set). Reserved like
+  // `ContactsFull`: without contacts a dependent set is rarely infeasible.
+  HR_STATUS_INFEASIBLE = 15,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L

@@ -312,6 +312,7 @@ fn describe<T>(e: StepError, r: &mut HrReport<T>) -> HrStatus {
         StepError::StateLength => HrStatus::StateLength,
         StepError::Unstable { .. } => HrStatus::Unstable,
         StepError::ContactsFull { .. } => HrStatus::ContactsFull,
+        StepError::Infeasible { .. } => HrStatus::Infeasible,
         StepError::Unsupported(_) => HrStatus::Unsupported,
     }
 }

@@ -53,6 +53,10 @@ pub enum HrStatus {
     /// (`error_index`). The C interface sets no contacts, so this is never returned
     /// today; the value is reserved so that codes stay stable.
     ContactsFull = 14,
+    /// `StepError::Infeasible`: constraints that cannot all hold (`error_index`,
+    /// `error_other`: the first two of the dependent set). Reserved like
+    /// `ContactsFull`: without contacts a dependent set is rarely infeasible.
+    Infeasible = 15,
 }
 
 /// Values of [`HrParams::method`] (the kernel's `Method`).

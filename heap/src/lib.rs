@@ -57,6 +57,13 @@ impl<T: Real> Buffers<T> {
         })
     }
 
+    /// The constraint list of the last step with contacts or a wall: the bonds, then
+    /// the one-sided constraints held ([`StepReport`](hydrorattle::StepReport)'s
+    /// `contacts + wall_contacts` of them), in the order of the multipliers.
+    pub fn links(&self) -> &[Bond<T>] {
+        &self.links
+    }
+
     /// A workspace over these buffers.
     pub fn workspace(&mut self) -> Workspace<'_, T> {
         Workspace::new(

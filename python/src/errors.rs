@@ -35,7 +35,7 @@ pyo3::create_exception!(
     hydrorattle,
     DegenerateError,
     StepError,
-    "A bond turned too far in one step (`index`: the bond)."
+    "A bond turned too far in one step, or constraints that cannot all hold (`index`: the bond, or the first of the dependent set)."
 );
 pyo3::create_exception!(
     hydrorattle,
@@ -128,7 +128,7 @@ pub fn step_error(py: Python<'_>, e: KStep) -> PyErr {
     let err = match e {
         KStep::Linalg { .. } => LinalgError::new_err(msg),
         KStep::NoConvergence { .. } => ConvergenceError::new_err(msg),
-        KStep::Degenerate { .. } => DegenerateError::new_err(msg),
+        KStep::Degenerate { .. } | KStep::Infeasible { .. } => DegenerateError::new_err(msg),
         KStep::NonFinite { .. } | KStep::NonFiniteForce { .. } => NonFiniteError::new_err(msg),
         KStep::Overlap { .. } => OverlapError::new_err(msg),
         KStep::Unstable { .. } => UnstableError::new_err(msg),

@@ -21,7 +21,7 @@
 //!   copy of the mobility; the residual is still evaluated on the positions in `f64`, so the
 //!   tolerance holds as it does for the `f64` products.
 
-use super::{Metric, Problem, Scratch, SolveStats, Solver};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent};
 use crate::bonds::Bond;
 use crate::error::{LinalgError, StepError};
 use crate::linalg::band;
@@ -71,6 +71,15 @@ pub fn krylov<T: Real>(
     let mut products = 0u32;
     let mut outer = 0u32;
     let mut initial = None;
+    // Curvature below the rank tolerance (`sqrt(eps)`) of the diagonal's: a direction
+    // of zero curvature to the precision that a step of `1 / curvature` can use (the
+    // rounding of `q` is `eps |A| |p|`, and the move asked for would amplify it).
+    let floor = dependent::rank_floor::<T>();
+    // The last chord step met a direction `p` of (numerically) zero curvature: a
+    // self-stress of dependent constraints, left in `p`.
+    let mut previous: Option<T> = None;
+    let mut null = false;
+    let mut stalls = 0;
     loop {
         // Nonlinear residual of the chord iteration.
         let mut worst = T::ZERO;
@@ -88,6 +97,18 @@ pub fn krylov<T: Real>(
                 residual: worst,
             });
         }
+        // Chord steps stopped by a self-stress that then fail to halve the residual,
+        // three in a row: the dependent constraints ask for what the others forbid
+        // (one such step may be a nonlinear remainder the next removes).
+        stalls = match null && previous.is_some_and(|p| worst > p * T::HALF) {
+            true => stalls + 1,
+            false => 0,
+        };
+        if stalls == 3 {
+            return Err(dependent::self_stress(metric, p));
+        }
+        previous = Some(worst);
+        null = false;
         // A chord iteration that has grown the residual a hundredfold is diverging.
         let first = *initial.get_or_insert(worst);
         if outer == solver.max_iterations
@@ -112,6 +133,16 @@ pub fn krylov<T: Real>(
                 q[k] = T::dot(metric.grad(k), b.relative(w)) * c;
             }
             let pq = dot(p, q);
+            // `p A p` against `p diag(A) p`: zero curvature along a self-stress of
+            // dependent constraints (`docs/CONTACTS.md`). What is left of `r` along it
+            // is the part no move can meet: the step is done.
+            let curvature = (0..nb).fold(T::ZERO, |s, k| {
+                s + p[k] * p[k] * T::dot(metric.grad(k), metric.relative(bonds, k, k)) * c
+            });
+            if pq.is_finite() && pq <= floor * curvature {
+                null = true;
+                break;
+            }
             if !pq.is_finite() {
                 // The iterate overflowed: a diverging chord iteration (the projection
                 // has no solution near the start), not an indefinite matrix.
@@ -157,8 +188,8 @@ pub fn krylov<T: Real>(
     }
 }
 
-/// Band of `A` factorised into `pre`; its diagonal square roots when the band is not
-/// positive definite.
+/// Band of `A` factorised into `pre` (regularised where rows are dependent); its
+/// diagonal square roots when the band is not positive semi-definite.
 fn precondition<T: Real>(metric: &Metric<'_, T>, bonds: &[Bond<T>], c: T, pre: &mut [T]) {
     let nb = bonds.len();
     let entry = |k: usize, l: usize| T::dot(metric.grad(k), metric.relative(bonds, k, l)) * c;
@@ -167,7 +198,12 @@ fn precondition<T: Real>(metric: &Metric<'_, T>, bonds: &[Bond<T>], c: T, pre: &
         let row = &mut pre[band::at(BAND, k, first)..=band::at(BAND, k, k)];
         metric.jacobian_row(bonds, k, metric.grad(k) * c, first, row);
     }
-    if band::cholesky(pre, nb, BAND).is_ok() {
+    // Dependent constraints (`docs/CONTACTS.md`) make `A` singular: their pivots are
+    // replaced by their diagonals, which keeps the preconditioner positive definite;
+    // conjugate gradients on the singular but consistent `A delta = r` still converge
+    // (to the solution in the range of `A`: the minimum-norm multipliers).
+    let floor = super::dependent::rank_floor::<T>();
+    if band::regularised(pre, nb, BAND, floor).is_ok() {
         return;
     }
     log::debug!("krylov: band preconditioner not positive definite, using Jacobi");

@@ -13,6 +13,7 @@
 //! `g = (0, 0, a)`; everything else (metrics, Jacobians, solvers) treats it as a link
 //! whose other end does not move along the normal ([`Bond::relative`]).
 
+mod dependent;
 mod krylov;
 mod metric;
 mod newton;

@@ -1,7 +1,7 @@
 //! Newton on the dense `bonds x bonds` Jacobian, solved by LU: quadratic convergence,
 //! `O(B^3)` per factorisation. The choice for small bond counts.
 
-use super::{Metric, Problem, Scratch, SolveStats, Solver, worst};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, worst};
 use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::linalg;
@@ -20,6 +20,14 @@ use crate::real::Real;
 ///   many bond lengths) the Jacobian at the iterate `J_kl = dir_k . (D_l(i_k) -
 ///   D_l(j_k))`, solved by LU, refreshed whenever the residual falls less than tenfold.
 ///   Velocities are linear: one step.
+/// * Dependent constraints (`docs/CONTACTS.md`): both factorisations take the rank
+///   tolerance `sqrt(eps)` (`docs/CONTACTS.md`); a dependent row gets a zero multiplier update
+///   (the basic solution) and positions move as the independent rows demand. A
+///   rank-deficient iteration on the Jacobian at the iterate that fails to halve the
+///   residual means the dependent rows ask what the others forbid:
+///   [`StepError::Infeasible`], naming the dependent set (on the chord such a stall is
+///   first taken for the chord's own slowness on a large move, and the Jacobian at the
+///   iterate takes over as without dependent rows).
 pub fn newton<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,
@@ -39,6 +47,9 @@ pub fn newton<T: Real>(
     // iterate, refreshed whenever the residual falls less than tenfold.
     let mut chord = matches!(problem, Problem::Positions { .. });
     let mut previous: Option<T> = None;
+    let floor = dependent::rank_floor::<T>();
+    // Dependent rows found by the last factorisation.
+    let mut deficient = 0;
     for it in 0..=solver.max_iterations {
         let residual = worst(&problem, bonds, x);
         if !residual.is_finite() {
@@ -54,6 +65,17 @@ pub fn newton<T: Real>(
             return Err(problem.no_convergence(it, residual));
         }
         let fast = previous.is_some_and(|p| residual <= p * T::from_f64(0.1));
+        if deficient > 0 && !chord && previous.is_some_and(|p| residual > p * T::HALF) {
+            // Named by the chord's self-stress (an LU factor shows only which columns
+            // it skipped): refactorised here, on the way out.
+            let c = problem.chord_factor();
+            for k in 0..nb {
+                let row = &mut jac[k * nb..k * nb + k + 1];
+                metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
+            }
+            let _ = linalg::cholesky_dense(jac, nb, floor);
+            return Err(dependent::infeasible(metric, bonds, jac, rhs));
+        }
         let refresh = previous.is_none() || !fast;
         if refresh && previous.is_some() {
             chord = false;
@@ -78,12 +100,13 @@ pub fn newton<T: Real>(
         };
         if chord {
             if refresh {
-                linalg::cholesky_dense(jac, nb).map_err(fail)?;
+                deficient = linalg::cholesky_dense(jac, nb, floor).map_err(fail)?;
             }
             linalg::cholesky_dense_solve(jac, nb, rhs);
         } else {
             if refresh {
-                linalg::lu(jac, nb, piv).map_err(fail)?;
+                deficient =
+                    linalg::lu_ranked(jac, nb, piv, floor * max_diagonal(jac, nb)).map_err(fail)?;
             }
             linalg::lu_solve(jac, nb, piv, rhs);
         }
@@ -98,4 +121,10 @@ pub fn newton<T: Real>(
         iterations: solver.max_iterations,
         residual: f64::NAN,
     })
+}
+
+/// Largest `|A_kk|`: the scale of the LU rank tolerance (the rows of one problem share
+/// their units).
+fn max_diagonal<T: Real>(a: &[T], n: usize) -> T {
+    (0..n).fold(T::ZERO, |m, k| m.max(a[k * n + k].abs()))
 }

@@ -15,6 +15,15 @@
 //!    one per round;
 //! 4. repeat until nothing changes: every active contact pushes, no other pair overlaps.
 //!
+//! **Anti-cycling.** A contact released in a step is remembered (at the far end of the
+//! pool, past the active ones); if it has to be added again it is *held*: never
+//! released again in this step, even if its multiplier pulls (it then pulls for one
+//! step, at contact distance; the next step starts from it and may release it). So
+//! each pair is released at most once and added at most twice per step, and the
+//! rounds are bounded by `3 x pool + 1` whatever the multipliers do — with dependent
+//! constraints they are not unique (`docs/CONTACTS.md`), so the one that looks like it
+//! pulls may be the wrong one to release. A full pool forgets the oldest release.
+//!
 //! Each round projects from the unconstrained move again, so the result does not
 //! depend on the path. No stiffness: the contacts do not limit `dt`. A step so large
 //! that a pair would end in contact on the far side of where it started is refused
@@ -109,17 +118,19 @@ pub(super) fn project_overdamped<'l, T: Real>(
     };
     let tol = p.solver.tolerance;
     let mut nc = 0;
+    // Contacts released in this step, at the pool's far end (anti-cycling).
+    let mut released = 0;
     if one_sided.is_some() {
         links[..nb].copy_from_slice(bonds);
         // The last step's contacts end within the tolerance of touching.
         let reach = T::ONE + tol * T::TWO;
         if contacts.is_some() {
-            add_pairs(
-                bonds, start, start, radius, cell, reach, pool, links, &mut nc,
-            )?;
+            let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
+            add_pairs(bonds, start, start, radius, cell, reach, &mut set)?;
         }
         if let Some(w) = wall {
-            add_wall(nb, start, w.height, radius, reach, pool, links, &mut nc)?;
+            let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
+            add_wall(start, w.height, radius, reach, &mut set)?;
         }
     }
     let mut round = 0;
@@ -157,13 +168,14 @@ pub(super) fn project_overdamped<'l, T: Real>(
         };
         let reach = T::ONE - tol;
         let mut added = 0;
+        let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
         if contacts.is_some() {
-            added += add_pairs(bonds, start, x, radius, cell, reach, pool, links, &mut nc)?;
+            added += add_pairs(bonds, start, x, radius, cell, reach, &mut set)?;
         }
         if wall.is_some() {
-            added += add_wall(nb, x, T::ZERO, radius, reach, pool, links, &mut nc)?;
+            added += add_wall(x, T::ZERO, radius, reach, &mut set)?;
         }
-        if added == 0 && !release_pulling(nb, links, lambda, &mut nc) {
+        if added == 0 && !set.release_pulling(lambda) {
             // Every contact must end on the side it started from (a sphere above the
             // wall: `grad = (0, 0, a)`, its relative vector `(0, 0, z)`).
             for (k, l) in links[nb..nb + nc].iter().enumerate() {
@@ -207,46 +219,119 @@ fn shift<T: Real>(x: &mut [T::V3], wall: Option<Wall<T>>, sign: T) {
 /// Appends a wall link for every sphere whose centre is closer than `reach` times its
 /// radius to the plane `z = height` (or below it) and has none yet; returns how many
 /// were added.
-#[allow(clippy::too_many_arguments)]
 fn add_wall<T: Real>(
-    nb: usize,
     pos: &[T::V3],
     height: T,
     radius: &[T],
     reach: T,
-    pool: usize,
-    links: &mut [Bond<T>],
-    nc: &mut usize,
+    set: &mut Active<'_, T>,
 ) -> Result<usize, StepError> {
     let mut added = 0;
     for (i, (&r, &a)) in pos.iter().zip(radius).enumerate() {
         if !(T::xyz(r)[2] - height < a * reach) {
             continue;
         }
-        if links[nb..nb + *nc].iter().any(|l| l.is_wall() && l.i == i) {
+        if set.held().iter().any(|l| l.is_wall() && l.i == i) {
             continue;
         }
-        push(Bond::wall(i, a), nb, pool, links, nc)?;
+        set.push(Bond::wall(i, a))?;
         added += 1;
     }
     Ok(added)
 }
 
-/// Appends `link` to the one-sided constraints held (`nc` of them after the `nb`
-/// bonds), unless the pool is full.
-fn push<T: Real>(
-    link: Bond<T>,
+/// The one-sided constraints of a step in the link storage: `nc` active ones after
+/// the `nb` bonds, and at the pool's far end the `released` ones (latest last from the
+/// end) that the anti-cycling rule remembers.
+struct Active<'s, T: Real> {
     nb: usize,
     pool: usize,
-    links: &mut [Bond<T>],
-    nc: &mut usize,
-) -> Result<(), StepError> {
-    if *nc == pool {
-        return Err(StepError::ContactsFull { capacity: pool });
+    links: &'s mut [Bond<T>],
+    nc: &'s mut usize,
+    released: &'s mut usize,
+}
+
+impl<'s, T: Real> Active<'s, T> {
+    fn new(
+        nb: usize,
+        pool: usize,
+        links: &'s mut [Bond<T>],
+        nc: &'s mut usize,
+        released: &'s mut usize,
+    ) -> Self {
+        Self {
+            nb,
+            pool,
+            links,
+            nc,
+            released,
+        }
     }
-    links[nb + *nc] = link;
-    *nc += 1;
-    Ok(())
+
+    /// The active one-sided constraints.
+    fn held(&self) -> &[Bond<T>] {
+        &self.links[self.nb..self.nb + *self.nc]
+    }
+
+    /// The released ones remembered.
+    fn remembered(&self) -> &[Bond<T>] {
+        let end = self.nb + self.pool;
+        &self.links[end - *self.released..end]
+    }
+
+    /// Appends `link`, unless the pool is full; forgets the oldest release to make
+    /// room.
+    fn push(&mut self, link: Bond<T>) -> Result<(), StepError> {
+        if *self.nc == self.pool {
+            return Err(StepError::ContactsFull {
+                capacity: self.pool,
+            });
+        }
+        if *self.nc + *self.released == self.pool {
+            *self.released -= 1;
+        }
+        self.links[self.nb + *self.nc] = link;
+        *self.nc += 1;
+        Ok(())
+    }
+
+    /// Releases the contact whose multiplier pulls hardest (negative: a contact pushes
+    /// along `r_i - r_j` with a positive multiplier), keeping the others in order;
+    /// a contact released once in this step is held (anti-cycling).
+    fn release_pulling(&mut self, lambda: &[T]) -> bool {
+        let (nb, nc) = (self.nb, *self.nc);
+        let mut worst: Option<(usize, T)> = None;
+        for (k, link) in self.held().iter().enumerate() {
+            let l = lambda[nb + k];
+            let again = self.remembered().iter().any(|r| same(r, link));
+            if l < T::ZERO && !again && worst.is_none_or(|(_, w)| l < w) {
+                worst = Some((k, l));
+            }
+        }
+        let Some((k, _)) = worst else {
+            return false;
+        };
+        let link = self.links[nb + k];
+        self.links.copy_within(nb + k + 1..nb + nc, nb + k);
+        *self.nc -= 1;
+        // Remember it: the slot freed at the end of the active ones is at most the
+        // one written here.
+        let end = nb + self.pool;
+        if *self.released < self.pool - *self.nc {
+            *self.released += 1;
+        }
+        let slot = end - *self.released;
+        self.links.copy_within(slot + 1..end, slot);
+        self.links[end - 1] = link;
+        true
+    }
+}
+
+/// Whether two links hold the same constraint (the same pair, or the same sphere's
+/// wall link).
+fn same<T: Real>(a: &Bond<T>, b: &Bond<T>) -> bool {
+    a.is_wall() == b.is_wall()
+        && ((a.i == b.i && a.j == b.j) || (!a.is_wall() && a.i == b.j && a.j == b.i))
 }
 
 /// Appends every unbonded pair that ends closer than `reach` times its contact distance
@@ -256,7 +341,6 @@ fn push<T: Real>(
 /// displacement (the image is not taken again at its end, where a pair near half the
 /// box apart would jump across the box and seem to pass through contact); the end
 /// is compared by its minimum image.
-#[allow(clippy::too_many_arguments)]
 fn add_pairs<T: Real>(
     bonds: &[Bond<T>],
     from: &[T::V3],
@@ -264,11 +348,8 @@ fn add_pairs<T: Real>(
     radius: &[T],
     cell: Option<Periodic<T>>,
     reach: T,
-    pool: usize,
-    links: &mut [Bond<T>],
-    nc: &mut usize,
+    set: &mut Active<'_, T>,
 ) -> Result<usize, StepError> {
-    let nb = bonds.len();
     let mut added = 0;
     for i in 0..to.len() {
         for j in 0..i {
@@ -287,15 +368,14 @@ fn add_pairs<T: Real>(
                 continue;
             }
             let joins = |b: &Bond<T>| (b.i == i && b.j == j) || (b.i == j && b.j == i);
-            if bonds.iter().any(joins) || links[nb..nb + *nc].iter().any(joins) {
+            if bonds.iter().any(joins) || set.held().iter().any(joins) {
                 continue;
             }
-            let link = Bond {
+            set.push(Bond {
                 i,
                 j,
                 length: sigma,
-            };
-            push(link, nb, pool, links, nc)?;
+            })?;
             added += 1;
         }
     }
@@ -312,29 +392,6 @@ fn closest2<T: Real>(d0: T::V3, d1: T::V3) -> T {
         T::ZERO
     };
     T::norm2(d0 + e * t)
-}
-
-/// Releases the contact whose multiplier pulls hardest (negative: a contact pushes
-/// along `r_i - r_j` with a positive multiplier), keeping the others in order.
-fn release_pulling<T: Real>(
-    nb: usize,
-    links: &mut [Bond<T>],
-    lambda: &[T],
-    nc: &mut usize,
-) -> bool {
-    let mut worst: Option<(usize, T)> = None;
-    for k in 0..*nc {
-        let l = lambda[nb + k];
-        if l < T::ZERO && worst.is_none_or(|(_, w)| l < w) {
-            worst = Some((k, l));
-        }
-    }
-    let Some((k, _)) = worst else {
-        return false;
-    };
-    links.copy_within(nb + k + 1..nb + *nc, nb + k);
-    *nc -= 1;
-    true
 }
 
 /// Largest relative overlap `1 - |r_ij| / (a_i + a_j)` (the minimum image in a box), and

@@ -15,22 +15,41 @@ pub fn at(w: usize, k: usize, l: usize) -> usize {
 
 /// In-place Cholesky `A = L L^T` of a banded symmetric matrix (lower band stored).
 pub fn cholesky<T: Real>(a: &mut [T], n: usize, w: usize) -> Result<(), LinalgError> {
+    regularised(a, n, w, T::ZERO).map(|_| ())
+}
+
+/// [`cholesky`] of a positive semi-definite matrix for a preconditioner: a pivot at or
+/// below `floor` times its row's diagonal (a row dependent on the ones before it) is
+/// replaced by that diagonal, so the factor is that of `A` plus a positive diagonal
+/// where `A` is singular: positive definite, and `A` itself elsewhere. Returns how
+/// many pivots were replaced. With `floor = 0` it is [`cholesky`].
+pub fn regularised<T: Real>(
+    a: &mut [T],
+    n: usize,
+    w: usize,
+    floor: T,
+) -> Result<usize, LinalgError> {
+    let mut replaced = 0;
     for k in 0..n {
         for l in k.saturating_sub(w)..=k {
-            let mut s = a[at(w, k, l)];
+            let diagonal = a[at(w, k, l)];
+            let mut s = diagonal;
             for t in k.saturating_sub(w).max(l.saturating_sub(w))..l {
                 s -= a[at(w, k, t)] * a[at(w, l, t)];
             }
             if l < k {
                 a[at(w, k, l)] = s / a[at(w, l, l)];
-            } else if s > T::ZERO && s.is_finite() {
+            } else if s > floor * diagonal && s.is_finite() {
                 a[at(w, k, k)] = s.sqrt();
+            } else if floor > T::ZERO && diagonal > T::ZERO && s.is_finite() {
+                a[at(w, k, k)] = diagonal.sqrt();
+                replaced += 1;
             } else {
                 return Err(LinalgError::NotPositiveDefinite { row: k });
             }
         }
     }
-    Ok(())
+    Ok(replaced)
 }
 
 /// Solves `L L^T x = b` in place with a factor from [`cholesky`].

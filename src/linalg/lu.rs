@@ -1,6 +1,16 @@
 //! Small dense scalar matrices of the dense Newton solve: Cholesky of the symmetric
 //! chord Jacobian (positions), LU with partial pivoting of the Jacobian at the iterate
 //! (velocities, and positions when the chord slows).
+//!
+//! **Dependent rows.** Constraints that are linearly dependent (a pile of spheres on a
+//! wall, a square with both diagonals) make these matrices exactly singular, though the
+//! projection's positions stay unique. Both factorisations take a relative rank
+//! tolerance `floor`: a pivot at or below `floor` times its row's scale marks the row
+//! (column) dependent instead of failing. Its factor column is set to zero and the
+//! solves give its unknown zero: the *basic* solution, which keeps the independent
+//! rows' equations exactly and drops the dependent row's, which for a consistent
+//! right-hand side (one that the others imply) holds as well. `floor = 0` keeps the
+//! strict behaviour (every pivot must be positive).
 
 use crate::error::LinalgError;
 use crate::real::Real;
@@ -10,7 +20,22 @@ use crate::real::Real;
 /// `piv[k]` records the row swapped into row `k`. A zero or non-finite pivot is
 /// [`LinalgError::Singular`].
 pub fn lu<T: Real>(a: &mut [T], n: usize, piv: &mut [usize]) -> Result<(), LinalgError> {
+    lu_ranked(a, n, piv, T::ZERO).map(|_| ())
+}
+
+/// [`lu`] with the absolute rank tolerance `floor`: a column whose largest remaining
+/// entry is at most `floor` (and finite) is dependent: it is not eliminated, its
+/// diagonal is stored as exactly zero and [`lu_solve`] gives its unknown zero. Returns
+/// the number of dependent columns. With `floor = 0` a zero pivot is still
+/// [`LinalgError::Singular`].
+pub fn lu_ranked<T: Real>(
+    a: &mut [T],
+    n: usize,
+    piv: &mut [usize],
+    floor: T,
+) -> Result<usize, LinalgError> {
     let a = &mut a[..n * n];
+    let mut dependent = 0;
     for k in 0..n {
         let mut p = k;
         let mut best = a[k * n + k].abs();
@@ -21,8 +46,17 @@ pub fn lu<T: Real>(a: &mut [T], n: usize, piv: &mut [usize]) -> Result<(), Linal
                 p = r;
             }
         }
-        if !(best > T::ZERO && best.is_finite()) {
-            return Err(LinalgError::Singular { row: k });
+        if !(best > floor && best.is_finite()) {
+            if !(floor > T::ZERO && best.is_finite()) {
+                return Err(LinalgError::Singular { row: k });
+            }
+            // Dependent column: nothing to eliminate; the solve skips its unknown.
+            piv[k] = k;
+            for row in a[k * n..].chunks_exact_mut(n) {
+                row[k] = T::ZERO;
+            }
+            dependent += 1;
+            continue;
         }
         piv[k] = p;
         if p != k {
@@ -41,10 +75,11 @@ pub fn lu<T: Real>(a: &mut [T], n: usize, piv: &mut [usize]) -> Result<(), Linal
             }
         }
     }
-    Ok(())
+    Ok(dependent)
 }
 
-/// Solves `A x = b` in place with the factors from [`lu`].
+/// Solves `A x = b` in place with the factors from [`lu`] (a dependent column's unknown,
+/// a zero diagonal from [`lu_ranked`], is zero).
 pub fn lu_solve<T: Real>(a: &[T], n: usize, piv: &[usize], x: &mut [T]) {
     let x = &mut x[..n];
     for k in 0..n {
@@ -64,7 +99,8 @@ pub fn lu_solve<T: Real>(a: &[T], n: usize, piv: &[usize], x: &mut [T]) {
             .iter()
             .zip(&x[r + 1..])
             .fold(x[r], |acc, (&u, &y)| acc - u * y);
-        x[r] = acc / a[r * n + r];
+        let u = a[r * n + r];
+        x[r] = if u == T::ZERO { T::ZERO } else { acc / u };
     }
 }
 
@@ -77,7 +113,16 @@ pub fn lu_solve<T: Real>(a: &[T], n: usize, piv: &[usize], x: &mut [T]) {
 /// `1 / L_kk`, so solves only multiply. A pivot that is not positive and finite is
 /// [`LinalgError::NotPositiveDefinite`]. Cost: about `n^3 / 6` multiply-adds, half of
 /// [`lu`]'s, and no pivot search.
-pub fn cholesky_dense<T: Real>(a: &mut [T], n: usize) -> Result<(), LinalgError> {
+///
+/// Semi-definite matrices: a pivot `d <= floor A_kk` (negative ones included: a
+/// Gram matrix has none but by rounding) marks row `k` dependent (a Gram matrix `G M G^T` whose row `k` of `G` lies in the span of the rows
+/// before it: its Schur complement vanishes, up to rounding, in its whole row). Its
+/// stored `1 / L_kk` is zero, so column `k` of `L` is zero and [`cholesky_dense_solve`]
+/// gives its unknown zero. Returns the number of dependent rows. Rows are taken in
+/// order (no pivoting), so which of a dependent set is dropped is the last one listed:
+/// deterministic. A non-finite pivot, or a diagonal entry that is not positive, is
+/// still not positive definite.
+pub fn cholesky_dense<T: Real>(a: &mut [T], n: usize, floor: T) -> Result<usize, LinalgError> {
     let a = &mut a[..n * n];
     let mut k = 0;
     while k + 1 < n {
@@ -90,9 +135,9 @@ pub fn cholesky_dense<T: Real>(a: &mut [T], n: usize) -> Result<(), LinalgError>
             row_k[j] = (row_k[j] - s) * row_j[j];
             row_m[j] = (row_m[j] - t) * row_j[j];
         }
-        let inv = pivot(row_k, k)?;
+        let inv = pivot(row_k, k, floor)?;
         row_m[k] = (row_m[k] - dot(&row_m[..k], &row_k[..k])) * inv;
-        pivot(row_m, k + 1)?;
+        pivot(row_m, k + 1, floor)?;
         k += 2;
     }
     if k < n {
@@ -102,18 +147,23 @@ pub fn cholesky_dense<T: Real>(a: &mut [T], n: usize) -> Result<(), LinalgError>
             let (head, tail) = row_k.split_at_mut(j);
             tail[0] = (tail[0] - dot(head, &row_j[..j])) * row_j[j];
         }
-        pivot(row_k, k)?;
+        pivot(row_k, k, floor)?;
     }
-    Ok(())
+    // The dependent rows' stored `1 / L_kk` is exactly zero (a regular one is > 0).
+    Ok((0..n).filter(|&k| a[k * n + k] == T::ZERO).count())
 }
 
 /// `L_kk = sqrt(A_kk - sum_j L_kj^2)` for `row = [L_k0, .., L_k(k-1), A_kk]`; stores and
-/// returns `1 / L_kk`.
+/// returns `1 / L_kk`, or zero for a dependent row (`d <= floor A_kk`).
 #[inline(always)]
-fn pivot<T: Real>(row: &mut [T], k: usize) -> Result<T, LinalgError> {
+fn pivot<T: Real>(row: &mut [T], k: usize, floor: T) -> Result<T, LinalgError> {
     let (head, last) = row.split_at_mut(k);
     let d = head.iter().fold(last[0], |s, &x| s - x * x);
-    if !(d > T::ZERO && d.is_finite()) {
+    if !(d > T::ZERO && d.is_finite()) || d <= floor * last[0] {
+        if floor > T::ZERO && last[0] > T::ZERO && d.is_finite() {
+            last[0] = T::ZERO;
+            return Ok(T::ZERO);
+        }
         return Err(LinalgError::NotPositiveDefinite { row: k });
     }
     last[0] = T::ONE / d.sqrt();

@@ -20,7 +20,7 @@
 pub mod band;
 mod lu;
 
-pub use lu::{cholesky_dense, cholesky_dense_solve, lu, lu_solve};
+pub use lu::{cholesky_dense, cholesky_dense_solve, lu, lu_ranked, lu_solve};
 
 use crate::error::LinalgError;
 use crate::real::Real;
