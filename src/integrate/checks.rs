@@ -3,7 +3,7 @@
 //! candidate state before it is committed.
 
 use crate::bonds::Bond;
-use crate::cell::image;
+use crate::cell::{Periodic, image};
 use crate::constraints::Solver;
 use crate::error::{ParticleError, StepError};
 use crate::mobility::Hydro;
@@ -144,11 +144,59 @@ pub(super) fn check_periodic<T: Real>(
             "fene (maximum extension below half the periodic box's smallest edge)",
         ));
     }
-    #[cfg(feature = "periodic")]
-    if p.hydro != Hydro::FreeDraining {
-        return Ok(Some(super::periodic::ewald(c, state.radius)?));
+    if p.hydro == Hydro::FreeDraining {
+        return Ok(None);
     }
+    match p.pse {
+        None => ewald_sums(c, state),
+        Some(tol) => pse_sums(p, c, state, bonds.len(), tol),
+    }
+}
+
+/// The step's Ewald parameters.
+#[cfg(feature = "periodic")]
+fn ewald_sums<T: Real>(c: Periodic<T>, state: &State<'_, T>) -> Result<HeldSums<T>, StepError> {
+    let e = super::periodic::ewald(c, state.radius)?;
+    Ok(Some(super::periodic::Held::Ewald(e)))
+}
+
+/// Without the `periodic` feature the box was refused above.
+#[cfg(not(feature = "periodic"))]
+fn ewald_sums<T: Real>(_: Periodic<T>, _: &State<'_, T>) -> Result<HeldSums<T>, StepError> {
     Ok(None)
+}
+
+/// PSE ([`Params::pse`]): products only, so the step must need nothing else (matrix
+/// free; with constraints the Krylov solver; no Cholesky noise, which `matrix_free`
+/// refuses already); then its parameters from the tolerance.
+fn pse_sums<T: Real>(
+    p: &Params<T>,
+    c: Periodic<T>,
+    state: &State<'_, T>,
+    bonds: usize,
+    tol: f64,
+) -> Result<HeldSums<T>, StepError> {
+    if !cfg!(feature = "pse") {
+        return Err(StepError::Unsupported(
+            "PSE (Params::pse): the kernel was built without its `pse` feature",
+        ));
+    }
+    let constrained = p.method != Method::Springs && p.constraints(state.len(), bonds) > 0;
+    let krylov = p.solver_kind(state.len(), bonds) == crate::constraints::SolverKind::Krylov;
+    if !p.matrix_free || (constrained && !krylov) {
+        return Err(StepError::Unsupported(super::stages::PSE_ASSEMBLED));
+    }
+    #[cfg(feature = "pse")]
+    return Ok(Some(super::periodic::Held::Pse(super::periodic::pse(
+        c,
+        state.radius,
+        tol,
+    )?)));
+    #[cfg(not(feature = "pse"))]
+    {
+        let _ = (c, tol);
+        Ok(None)
+    }
 }
 
 /// The first sphere whose centre is below `height + a_i (1 - 2 tol)`, less the

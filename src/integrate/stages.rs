@@ -12,22 +12,28 @@ use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
 
-/// The step's Ewald parameters ([`super::periodic`]): `Some` in a periodic box whose
-/// images interact (not with free draining), derived once by the step's checks and
-/// read by every product, assembly and matrix-free metric of the step. Without the
-/// `periodic` feature there are none (always `None`).
+/// The step's periodic sums ([`super::periodic`], [`BoxSums`](crate::mobility::sums::BoxSums):
+/// Ewald, or PSE with [`Params::pse`]): `Some` in a periodic box whose images interact
+/// (not with free draining), derived once by the step's checks and read by every
+/// product, assembly and matrix-free metric of the step. Without the `periodic`
+/// feature there are none (always `None`).
 #[cfg(feature = "periodic")]
-pub(super) type Sums<'a, T> = Option<&'a crate::mobility::periodic::Ewald<T>>;
+pub(super) type Sums<'a, T> = Option<crate::mobility::sums::BoxSums<'a, T>>;
 /// The step's Ewald parameters: none without the `periodic` feature.
 #[cfg(not(feature = "periodic"))]
 pub(super) type Sums<'a, T> = Option<&'a core::marker::PhantomData<T>>;
 
 /// What the step's checks hold for [`Sums`] to borrow.
 #[cfg(feature = "periodic")]
-pub(super) type HeldSums<T> = Option<crate::mobility::periodic::Ewald<T>>;
+pub(super) type HeldSums<T> = Option<super::periodic::Held<T>>;
 /// What the step's checks hold for [`Sums`] to borrow: nothing without the feature.
 #[cfg(not(feature = "periodic"))]
 pub(super) type HeldSums<T> = Option<core::marker::PhantomData<T>>;
+
+/// Why PSE ([`Params::pse`]) cannot serve a stage that needs the assembled mobility.
+pub(super) const PSE_ASSEMBLED: &str = "PSE (Params::pse) where the step needs the assembled mobility \
+     (without matrix_free, Cholesky noise, the Sweep or Newton solver, RattleStable): \
+     PSE gives products only";
 
 /// `u = mu_tt(pos) f`: assembled into `mu` and applied in one pass, in bands through
 /// `par` (`bands` holds their partial sums, [`crate::parallel`]), or matrix-free (then
@@ -50,7 +56,7 @@ pub(super) fn mobility_product<T: Real>(
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
         // In a box: assembled serially, then applied in bands (`integrate/periodic.rs`).
-        super::periodic::assemble(p, e, pos, radius, mu)?;
+        assemble_tt(p, Some(e), pos, radius, mu)?;
         crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
         return Ok(());
     }
@@ -126,7 +132,7 @@ pub(super) fn free_product<T: Real>(
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
-        return super::periodic::product(p, e, pos, radius, f, u);
+        return e.product(p.viscosity, pos, radius, f, u);
     }
     let _ = ew; // Read above only with the `periodic` feature.
     let (level, eta) = (p.hydro, p.viscosity);
@@ -175,6 +181,8 @@ pub(super) fn assemble_tt<T: Real>(
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
+        // PSE has no blocks; the checks refuse it wherever the step assembles.
+        let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
         return super::periodic::assemble(p, e, pos, radius, mu);
     }
     let _ = ew; // Read above only with the `periodic` feature.

@@ -211,6 +211,7 @@ const fn deterministic_f32(method: Method, rotation: bool) -> Params<f32> {
         contacts: None,
         wall: None,
         periodic: None,
+        pse: None,
     }
 }
 
