@@ -22,17 +22,9 @@ use hydrorattle::{Lanczos, Noise, Real};
 
 type V = <f64 as Real>::V3;
 
-/// SplitMix64 in `[0, 1)`.
-struct Rng(u64);
-impl Rng {
-    fn unit(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+#[path = "shared/splitmix.rs"]
+mod splitmix;
+use splitmix::Rng;
 
 /// `n` unit spheres at volume fraction `phi`: the box edge, positions and forces.
 fn suspension(n: usize, phi: f64, seed: u64) -> (f64, Vec<V>, Vec<f64>, Vec<V>) {

@@ -84,8 +84,14 @@ impl<T: Real> Periodic<T> {
     pub fn minimum_image(&self, r: T::V3) -> T::V3 {
         let v = T::xyz(r);
         let f = |d: usize| {
-            let l = self.size[d];
-            v[d] - T::from_f64(libm::round((v[d] / l).to_f64())) * l
+            let (l, q) = (self.size[d], v[d] / self.size[d]);
+            // Below half an edge `round` gives a signed zero and `v - 0 l` is `v + 0`
+            // bit for bit (-0 included): skips libm's `round`, the hot spot of the
+            // contacts' all-pairs search in a large box.
+            match q.abs() < T::HALF {
+                true => v[d] + T::ZERO,
+                false => v[d] - T::from_f64(libm::round(q.to_f64())) * l,
+            }
         };
         T::v3(f(0), f(1), f(2))
     }
@@ -109,5 +115,35 @@ pub fn image<T: Real>(cell: Option<&Periodic<T>>, r: T::V3) -> T::V3 {
     match cell {
         Some(c) if cfg!(feature = "periodic") => c.minimum_image(r),
         _ => r,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shortcut below half an edge gives the bits of `v - round(v / L) L` (signed
+    /// zeros, half-edge ties and far images included), in f64 and f32.
+    #[test]
+    fn minimum_image_has_the_bits_of_the_rounded_form() {
+        fn check<T: Real>(l: f64, x: f64) {
+            let c = Periodic::<T>::new([T::from_f64(l); 3]).unwrap();
+            let (lt, v) = (T::from_f64(l), T::from_f64(x));
+            let want = v - T::from_f64(libm::round((v / lt).to_f64())) * lt;
+            let got = T::xyz(c.minimum_image(T::v3(v, v, v)))[0];
+            assert_eq!(
+                got.to_f64().to_bits(),
+                want.to_f64().to_bits(),
+                "{x} in {l}"
+            );
+        }
+        let special = [0.0, -0.0, 5.0, -5.0, 4.999999, -5.000001, 1e-300, -1e-300];
+        let spread = (0..2000).map(|k| (k as f64 - 1000.0) * 0.0137 * 3.1);
+        for x in special.into_iter().chain(spread) {
+            for l in [10.0, 7.3, 0.9] {
+                check::<f64>(l, x);
+                check::<f32>(l, x);
+            }
+        }
     }
 }

@@ -433,6 +433,26 @@ impl From<crate::cell::PeriodicError> for StepError {
     }
 }
 
+/// A PSE product's error as the step's own ([`crate::mobility::pse::PseError`]): the
+/// box and particles as the Ewald path's, the rest named.
+#[cfg(feature = "pse")]
+impl From<crate::mobility::pse::PseError> for StepError {
+    fn from(e: crate::mobility::pse::PseError) -> Self {
+        use crate::mobility::pse::PseError as E;
+        match e {
+            E::Periodic(e) => e.into(),
+            E::GridTooLarge => Self::Unsupported(
+                "a PSE tolerance whose grid exceeds the bounds (mobility::pse::MAX_GRID, MAX_SUPPORT)",
+            ),
+            E::Length => Self::BadParameter("PSE: positions, radii and forces differ in length"),
+            E::Lanczos(_) => Self::Unsupported("PSE noise's Lanczos square root failed"),
+            E::Storage { .. } => Self::BadParameter(
+                "the workspace's PSE storage (Workspace::with_pse, at least integrate::pse_storage)",
+            ),
+        }
+    }
+}
+
 impl From<BondError> for StepError {
     fn from(e: BondError) -> Self {
         Self::Bond(e)

@@ -17,6 +17,8 @@ use crate::real::Real;
 pub mod periodic;
 #[cfg(feature = "pse")]
 pub mod pse;
+#[cfg(feature = "periodic")]
+pub mod sums;
 pub mod wall;
 
 /// How much hydrodynamics to model.

@@ -282,6 +282,18 @@ pub struct Params<T: Real> {
     /// [`StepReport::max_tension`](crate::StepReport::max_tension). The other methods
     /// ignore it. Default: on in `f32`, off in `f64` (where both agree to rounding).
     pub resolve_tensions: bool,
+    /// Sum the periodic box's mobility by PSE, the `O(N log N)` fast path
+    /// ([`mobility::pse`](crate::mobility::pse), kernel feature `pse`), to this relative
+    /// tolerance (`1e-3` to `1e-6` measured; `docs/PERIODIC.md`), instead of the exact
+    /// Ewald sums. PSE gives products only, so it needs [`Params::matrix_free`]
+    /// ([`Method::Overdamped`], [`Method::Springs`]; the noise by Lanczos from PSE
+    /// products) and, with constraints, the Krylov solver ([`SolverKind::Auto`]
+    /// resolves to it); the rest is refused with
+    /// [`StepError::Unsupported`](crate::StepError::Unsupported). Its storage is the
+    /// caller's ([`Workspace::with_pse`](crate::Workspace::with_pse), sized by
+    /// [`pse_storage`](crate::integrate::pse_storage)). Read only with a box (and not
+    /// with free draining). Default `None`: the Ewald sums, the same bits as before.
+    pub pse: Option<f64>,
 }
 
 impl<T: Real> Params<T> {
@@ -320,6 +332,7 @@ impl<T: Real> Params<T> {
             periodic: None,
             compact_products: false,
             resolve_tensions: T::EPSILON.to_f64() > 1e-10,
+            pse: None,
         }
     }
 
@@ -357,8 +370,13 @@ impl<T: Real> Params<T> {
     /// held in one round. [`Layout::for_params`](crate::Layout::for_params) sizes the
     /// storage from this same choice, and every stage of the step runs it, so the two
     /// cannot disagree.
+    /// With PSE in a box ([`Params::pse`]) `Auto` is Krylov at every size: the only
+    /// solver that needs products alone.
     pub const fn solver_kind(&self, n: usize, bonds: usize) -> SolverKind {
-        self.solver.kind.resolve(self.constraints(n, bonds))
+        match (self.solver.kind, self.pse, self.periodic) {
+            (SolverKind::Auto, Some(_), Some(_)) => SolverKind::Krylov,
+            (kind, ..) => kind.resolve(self.constraints(n, bonds)),
+        }
     }
 
     /// Whether a step of `n` beads and `bonds` bonds keeps the compact `f32` copy of

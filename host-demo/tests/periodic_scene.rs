@@ -1,8 +1,10 @@
 //! Periodic boxes through the CLI (issue 27, items 3 and 4): the shipped periodic
 //! scenes run and write both trajectory formats with the box, the GSD file's wrapped
 //! positions plus image flags give back the extended XYZ's unwrapped ones, the bonds
-//! measured straight from the unwrapped positions keep their lengths, and a box asking
-//! for `method = "pse"` stops the run at its file and line before any output.
+//! measured straight from the unwrapped positions keep their lengths; a box on the PSE
+//! path runs within its tolerance of the Ewald run, and asks for `method = "pse"` with
+//! a solver that needs the assembled mobility stop the run at its file and line before
+//! any output.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -72,7 +74,9 @@ fn i32s(b: &[u8]) -> Vec<i32> {
 #[test]
 fn periodic_scenes_run_and_give_the_box_in_both_formats() {
     let mut crossed = 0;
-    for name in ["periodic_chain", "periodic_suspension"] {
+    // The chain names "ewald"; the suspension's "auto" needs products only
+    // (overdamped, hard contacts, solver auto): PSE, written back with matrix_free.
+    for (name, method) in [("periodic_chain", "ewald"), ("periodic_suspension", "pse")] {
         let path = manifest().join("scenes").join(format!("{name}.toml"));
         let scene = Scene::from_path(&path).unwrap();
         let cell = scene.periodic.unwrap().size;
@@ -84,7 +88,9 @@ fn periodic_scenes_run_and_give_the_box_in_both_formats() {
             String::from_utf8_lossy(&r.stderr)
         );
         let written = std::fs::read_to_string(out.join("scene.toml")).unwrap();
-        assert!(written.contains("[box]\nmethod = \"ewald\""), "{written}");
+        let named = format!("[box]\nmethod = \"{method}\"");
+        assert!(written.contains(&named), "{written}");
+        assert_eq!(written.contains("matrix_free = true"), method == "pse");
         let frames = read_xyz_file(&out.join("trajectory.xyz")).unwrap();
         let xyz = std::fs::read_to_string(out.join("trajectory.xyz")).unwrap();
         let lattice = format!(
@@ -154,20 +160,71 @@ fn a_run_without_a_box_writes_no_box() {
     assert!(!gsd.windows(15).any(|w| w == b"particles/image"));
 }
 
+/// The chain on PSE (`method = "pse"`, tolerance 1e-6) runs; without noise (the two
+/// paths draw theirs differently: Cholesky and Lanczos) it ends within 1e-5 of the
+/// Ewald run (relative to the largest displacement); with the Newton solver (which
+/// reads single blocks of the assembled mobility) "pse" stops the run at its line
+/// before any output.
 #[test]
-fn pse_stops_the_run_at_its_line_before_any_output() {
+fn pse_runs_and_matches_ewald_or_stops_at_its_line() {
     let dir = scratch("pse");
     std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string(manifest().join("scenes/periodic_chain.toml")).unwrap();
+    let chain = manifest().join("scenes/periodic_chain.toml");
+    let text = std::fs::read_to_string(&chain).unwrap();
     let text = text.replace("method = \"ewald\"", "method = \"pse\"");
-    let line = text.lines().position(|l| l == "method = \"pse\"").unwrap() + 1;
     let path = dir.join("pse.toml");
     std::fs::write(&path, &text).unwrap();
-    let out = dir.join("out");
+    let r = demo_run(&path, &dir.join("thermal"));
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let written = std::fs::read_to_string(dir.join("thermal/scene.toml")).unwrap();
+    assert!(written.contains("[box]\nmethod = \"pse\""), "{written}");
+    let cold = |t: &str, name: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, t.replace("temperature = 0.5", "temperature = 0.0")).unwrap();
+        p
+    };
+    let ewald = std::fs::read_to_string(&chain).unwrap();
+    let (out, ewald_out) = (dir.join("out"), dir.join("ewald"));
+    assert!(
+        demo_run(&cold(&text, "cold_pse.toml"), &out)
+            .status
+            .success()
+    );
+    assert!(
+        demo_run(&cold(&ewald, "cold_ewald.toml"), &ewald_out)
+            .status
+            .success()
+    );
+    let (a, b) = (
+        read_xyz_file(&out.join("trajectory.xyz")).unwrap(),
+        read_xyz_file(&ewald_out.join("trajectory.xyz")).unwrap(),
+    );
+    let (first, last, other) = (&b[0], b.last().unwrap(), a.last().unwrap());
+    let dist = |p: [f64; 3], q: [f64; 3]| (0..3).map(|c| (p[c] - q[c]).powi(2)).sum::<f64>().sqrt();
+    let moved = (0..first.positions.len())
+        .map(|i| dist(first.positions[i], last.positions[i]))
+        .fold(0.0, f64::max);
+    let diff = (0..first.positions.len())
+        .map(|i| dist(other.positions[i], last.positions[i]))
+        .fold(0.0, f64::max);
+    assert!(
+        moved > 0.1 && diff < 1e-5 * moved,
+        "moved {moved}, PSE vs Ewald {diff}"
+    );
+    let text = text.replace("[integrator]", "[integrator]\nsolver = \"newton\"");
+    let line = text.lines().position(|l| l == "method = \"pse\"").unwrap() + 1;
+    std::fs::write(&path, &text).unwrap();
+    let out = dir.join("refused");
     let r = demo_run(&path, &out);
     assert!(!r.status.success());
     let err = String::from_utf8_lossy(&r.stderr);
-    let at = format!("{}:{line}: [box] method = \"pse\"", path.display());
+    let at = format!("{}:{line}:", path.display());
     assert!(err.contains(&at), "{err}");
+    assert!(
+        err.contains(
+            "[box] method = \"pse\" gives mobility products only, and the sweep or newton solver"
+        ),
+        "{err}"
+    );
     assert!(!out.exists());
 }

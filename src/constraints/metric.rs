@@ -12,9 +12,9 @@
 
 use crate::bonds::Bond;
 use crate::linalg::{self, tri};
-#[cfg(feature = "periodic")]
-use crate::mobility::periodic;
 use crate::mobility::{Hydro, tt_block_at, wall};
+#[cfg(feature = "periodic")]
+use crate::mobility::{periodic, sums::BoxSums};
 use crate::parallel::Parallel;
 use crate::real::Real;
 
@@ -67,10 +67,12 @@ pub enum Metric<'a, T: Real> {
         scale: T,
         /// The wall's height when there is one ([`wall`]).
         wall: Option<T>,
-        /// The step's Ewald parameters when it runs in a periodic box whose images
-        /// interact (derived once per step, not per block: `integrate/periodic.rs`).
+        /// The step's periodic sums when it runs in a box whose images interact
+        /// (derived once per step, not per block: `integrate/periodic.rs`): Ewald, or
+        /// PSE, which has products only (its `D_l(p)` entries are zero: the step
+        /// refuses the solvers that read them).
         #[cfg(feature = "periodic")]
-        ewald: Option<&'a periodic::Ewald<T>>,
+        ewald: Option<BoxSums<'a, T>>,
         /// How its free-space products run ([`crate::parallel::free_product`], the bits
         /// of the stored product on any number of threads).
         par: &'a dyn Parallel,
@@ -237,8 +239,11 @@ impl<T: Real> Metric<'_, T> {
                 ..
             } => {
                 #[cfg(feature = "periodic")]
-                if let Some(ew) = ewald {
-                    return periodic_at(ew, eta, pos, radius, b, grad[l] * scale, p);
+                if let Some(sums) = ewald {
+                    return match sums.ewald() {
+                        Some(ew) => periodic_at(ew, eta, pos, radius, b, grad[l] * scale, p),
+                        None => T::V3_ZERO,
+                    };
                 }
                 // Nested pairs were refused by the product at these positions. The block
                 // (q, p), as `sym_block` reads it.
@@ -429,8 +434,8 @@ impl<T: Real> Metric<'_, T> {
                 spread(bonds, grad, c, scale, f);
                 // Nested pairs were refused by the product at these positions.
                 #[cfg(feature = "periodic")]
-                if let Some(ew) = ewald {
-                    if periodic::tt_product(ew, eta, pos, radius, f, out).is_err() {
+                if let Some(sums) = ewald {
+                    if sums.product(eta, pos, radius, f, out).is_err() {
                         out.fill(T::V3_ZERO);
                     }
                     return;

@@ -3,7 +3,7 @@
 //! candidate state before it is committed.
 
 use crate::bonds::Bond;
-use crate::cell::image;
+use crate::cell::{Periodic, image};
 use crate::constraints::Solver;
 use crate::error::{ParticleError, StepError};
 use crate::mobility::Hydro;
@@ -98,13 +98,11 @@ pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result
     }
 }
 
-/// Checks the periodic box: the kernel built with its `periodic` feature; no wall (its
-/// image system is free space's); not the Oseen level (the Ewald sum is RPY's; free draining has no pair
-/// blocks and needs none); every radius below half the smallest edge, every bond (and
-/// FENE's maximum extension) shorter than half of it, so that the minimum image of a
-/// bond at its length is the bond; and Ewald parameters the sums' bounds allow. Those
-/// parameters are the step's: derived here once and held for every product, assembly
-/// and metric block of the step (`None` without a box, or with free draining).
+/// Checks the periodic box: every radius, the box itself ([`check_box`]), every bond
+/// (and FENE's maximum extension) shorter than half the smallest edge, so that the
+/// minimum image of a bond at its length is the bond; then the step's sums, Ewald or PSE
+/// ([`Params::pse`]), derived here once and held for every product, assembly and metric
+/// block of the step (`None` without a box, or with free draining).
 pub(super) fn check_periodic<T: Real>(
     p: &Params<T>,
     state: &State<'_, T>,
@@ -113,7 +111,7 @@ pub(super) fn check_periodic<T: Real>(
     let Some(c) = p.periodic else {
         return Ok(None);
     };
-    let sums = check_box(p, state.radius)?;
+    let summed = box_geometry(p, state.radius)?;
     let [x, y, z] = c.size();
     let half = x.min(y).min(z) * T::HALF;
     if let Some(bond) = bonds.iter().position(|b| !(b.length < half)) {
@@ -124,14 +122,27 @@ pub(super) fn check_periodic<T: Real>(
             "fene (maximum extension below half the periodic box's smallest edge)",
         ));
     }
-    Ok(sums)
+    match (summed, p.pse) {
+        (None, _) => Ok(None),
+        (Some(c), None) => ewald_sums(c, state.radius),
+        (Some(c), Some(tol)) => pse_sums(p, c, state, bonds.len(), tol),
+    }
 }
 
 /// The box's part of [`check_periodic`] that needs no bonds (the mobility alone,
-/// `integrate::geometry`, asks it too): the feature, no wall, no rotation, not Oseen,
-/// every radius below half the smallest edge, Ewald parameters the sums allow (which it
-/// returns, as [`check_periodic`] does).
+/// `integrate::geometry`, asks it too), with the box's Ewald sums.
 pub(super) fn check_box<T: Real>(p: &Params<T>, radius: &[T]) -> Result<HeldSums<T>, StepError> {
+    match box_geometry(p, radius)? {
+        Some(c) => ewald_sums(c, radius),
+        None => Ok(None),
+    }
+}
+
+/// The kernel built with its `periodic` feature; no wall (its image system is free
+/// space's); not the Oseen level (the Ewald sum is RPY's); every radius below half the
+/// smallest edge. The box when its images interact (not with free draining, which has
+/// no pair blocks).
+fn box_geometry<T: Real>(p: &Params<T>, radius: &[T]) -> Result<Option<Periodic<T>>, StepError> {
     let Some(c) = p.periodic else {
         return Ok(None);
     };
@@ -153,11 +164,58 @@ pub(super) fn check_box<T: Real>(p: &Params<T>, radius: &[T]) -> Result<HeldSums
     if let Some(particle) = radius.iter().position(|&a| !(a < half)) {
         return Err(StepError::Particle(ParticleError::BadRadius { particle }));
     }
-    #[cfg(feature = "periodic")]
-    if p.hydro != Hydro::FreeDraining {
-        return Ok(Some(super::periodic::ewald(c, radius)?));
-    }
+    Ok((p.hydro != Hydro::FreeDraining).then_some(c))
+}
+
+/// The step's Ewald parameters.
+#[cfg(feature = "periodic")]
+fn ewald_sums<T: Real>(c: Periodic<T>, radius: &[T]) -> Result<HeldSums<T>, StepError> {
+    let e = super::periodic::ewald(c, radius)?;
+    Ok(Some(super::periodic::Held::Ewald(e)))
+}
+
+/// Without the `periodic` feature the box was refused above.
+#[cfg(not(feature = "periodic"))]
+fn ewald_sums<T: Real>(_: Periodic<T>, _: &[T]) -> Result<HeldSums<T>, StepError> {
     Ok(None)
+}
+
+/// PSE ([`Params::pse`]): products only, so the step must need nothing else (matrix
+/// free; with constraints the Krylov solver; no Cholesky noise, which `matrix_free`
+/// refuses already); then its parameters from the tolerance.
+fn pse_sums<T: Real>(
+    p: &Params<T>,
+    c: Periodic<T>,
+    state: &State<'_, T>,
+    bonds: usize,
+    tol: f64,
+) -> Result<HeldSums<T>, StepError> {
+    if !cfg!(feature = "pse") {
+        return Err(StepError::Unsupported(
+            "PSE (Params::pse): the kernel was built without its `pse` feature",
+        ));
+    }
+    let constrained = p.method != Method::Springs && p.constraints(state.len(), bonds) > 0;
+    let krylov = p.solver_kind(state.len(), bonds) == crate::constraints::SolverKind::Krylov;
+    if !p.matrix_free || (constrained && !krylov) {
+        return Err(StepError::Unsupported(super::stages::PSE_ASSEMBLED));
+    }
+    if p.rotation {
+        return Err(StepError::Unsupported(
+            "PSE with rotation (its rt and rr products are not built: Ewald sums them)",
+        ));
+    }
+    #[cfg(feature = "pse")]
+    return Ok(Some(super::periodic::Held::Pse(super::periodic::pse(
+        c,
+        state.radius,
+        tol,
+    )?)));
+    #[cfg(not(feature = "pse"))]
+    {
+        let _ = (c, tol);
+        Ok(None)
+    }
 }
 
 /// The first sphere whose centre is below `height + a_i (1 - 2 tol)`, less the

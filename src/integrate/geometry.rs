@@ -7,7 +7,7 @@
 //! no step would use.
 
 use super::checks::check_box;
-use super::stages::{HeldSums, Sums, assemble_tt, free_product, wall_height};
+use super::stages::{HeldSums, Sums, assemble_tt, free_product, held_ewald, wall_height};
 use crate::error::StepError;
 use crate::linalg::tri;
 use crate::mobility;
@@ -36,7 +36,13 @@ pub fn mobility_tt<T: Real>(
     out: &mut [T::M3],
 ) -> Result<(), StepError> {
     let sums = check(p, radius)?;
-    assemble_tt(p, sums.as_ref(), pos, radius, &mut out[..tri(pos.len())])
+    assemble_tt(
+        p,
+        held_ewald(&sums),
+        pos,
+        radius,
+        &mut out[..tri(pos.len())],
+    )
 }
 
 /// The grand mobility (`2n x 2n` blocks, translations then rotations, packed as
@@ -55,7 +61,7 @@ pub fn mobility_grand<T: Real>(
         },
         radius,
     )?;
-    grand(p, sums.as_ref(), pos, radius, out)
+    grand(p, held_ewald(&sums), pos, radius, out)
 }
 
 /// The grand mobility of free space, above the wall or in the box (the checks done,
@@ -71,6 +77,11 @@ pub(super) fn grand<T: Real>(
     let (level, eta, out) = (p.hydro, p.viscosity, &mut out[..tri(2 * pos.len())]);
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
+        let Some(e) = e.ewald() else {
+            return Err(StepError::Unsupported(
+                "PSE with rotation (its rt and rr products are not built: Ewald sums them)",
+            ));
+        };
         return Ok(mobility::periodic::assemble_grand(
             e, eta, pos, radius, out,
         )?);
@@ -101,5 +112,5 @@ pub fn mobility_product<T: Real>(
     let n = pos.len();
     let scratch = &mut scratch[..band_scratch(n)];
     let (f, u) = (&f[..n], &mut u[..n]);
-    free_product(p, sums.as_ref(), pos, radius, f, u, (par, scratch))
+    free_product(p, held_ewald(&sums), pos, radius, f, u, (par, scratch))
 }

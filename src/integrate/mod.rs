@@ -11,6 +11,9 @@
 //! candidate, `stages.rs` the stages the integrators share, `contacts.rs` the hard
 //! contacts of the position projection.
 
+#[cfg(feature = "pse")]
+pub use periodic::pse_storage;
+
 mod brownian;
 mod checks;
 mod contacts;
@@ -164,18 +167,30 @@ fn advance<T: Real, E: ExternalForce<T>>(
         }
         _ => p,
     };
-    let s = Start {
-        pos: state.pos,
-        vel: state.vel,
-        omega: state.omega,
-        radius: state.radius,
-        density: state.density,
-        ewald: sums.as_ref(),
-    };
     // 2. Integrate into the workspace (a thermal step draws from a copy of the generator).
     let mut drawn = noise.as_deref().cloned();
     let integrated = {
-        let v = ws.views(p, n, bonds.len())?;
+        #[allow(unused_mut)] // Taken from only with the `pse` feature.
+        let mut v = ws.views(p, n, bonds.len())?;
+        // PSE's storage, the caller's (`Workspace::with_pse`), shared by the products.
+        #[cfg(feature = "pse")]
+        let store = {
+            let slices = core::mem::take(&mut v.pse);
+            periodic::pse_store(sums.as_ref(), n, slices, v.par)?
+        };
+        let s = Start {
+            pos: state.pos,
+            vel: state.vel,
+            omega: state.omega,
+            radius: state.radius,
+            density: state.density,
+            #[cfg(feature = "pse")]
+            ewald: periodic::sums(sums.as_ref(), store.as_ref()),
+            #[cfg(all(feature = "periodic", not(feature = "pse")))]
+            ewald: periodic::sums(sums.as_ref()),
+            #[cfg(not(feature = "periodic"))]
+            ewald: sums.as_ref(),
+        };
         match (p.method, thermal, drawn.as_mut()) {
             (Method::Overdamped, Some(b), Some(g)) => {
                 overdamped_thermal(p, b, &s, bonds, v, ext, g)
@@ -197,7 +212,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
     let (new_vel, rest) = rest.split_at(n);
     let new_omega = &rest[..n];
     let mut report = integrated
-        .and_then(|r| accept(new_pos, new_vel, new_omega, s.radius, p, par).map(|()| r))
+        .and_then(|r| accept(new_pos, new_vel, new_omega, state.radius, p, par).map(|()| r))
         .inspect_err(|e| log::debug!("step at t = {} refused, state kept: {e}", *state.time))?;
     log::trace!(
         "t = {}: {} position / {} velocity iterations",

@@ -12,22 +12,45 @@ use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
 
-/// The step's Ewald parameters ([`super::periodic`]): `Some` in a periodic box whose
-/// images interact (not with free draining), derived once by the step's checks and
-/// read by every product, assembly and matrix-free metric of the step. Without the
-/// `periodic` feature there are none (always `None`).
+/// The step's periodic sums ([`super::periodic`], [`BoxSums`](crate::mobility::sums::BoxSums):
+/// Ewald, or PSE with [`Params::pse`]): `Some` in a periodic box whose images interact
+/// (not with free draining), derived once by the step's checks and read by every
+/// product, assembly and matrix-free metric of the step. Without the `periodic`
+/// feature there are none (always `None`).
 #[cfg(feature = "periodic")]
-pub(super) type Sums<'a, T> = Option<&'a crate::mobility::periodic::Ewald<T>>;
+pub(super) type Sums<'a, T> = Option<crate::mobility::sums::BoxSums<'a, T>>;
 /// The step's Ewald parameters: none without the `periodic` feature.
 #[cfg(not(feature = "periodic"))]
 pub(super) type Sums<'a, T> = Option<&'a core::marker::PhantomData<T>>;
 
+/// The Ewald sums of what [`super::checks::check_box`] holds, as [`Sums`] (it never
+/// holds PSE's).
+#[cfg(feature = "periodic")]
+pub(super) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
+    match held.as_ref()? {
+        super::periodic::Held::Ewald(e) => Some(crate::mobility::sums::BoxSums::Ewald(e)),
+        #[cfg(feature = "pse")]
+        super::periodic::Held::Pse(_) => None,
+    }
+}
+
+/// Nothing to hold without the `periodic` feature.
+#[cfg(not(feature = "periodic"))]
+pub(super) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
+    held.as_ref()
+}
+
 /// What the step's checks hold for [`Sums`] to borrow.
 #[cfg(feature = "periodic")]
-pub(super) type HeldSums<T> = Option<crate::mobility::periodic::Ewald<T>>;
+pub(super) type HeldSums<T> = Option<super::periodic::Held<T>>;
 /// What the step's checks hold for [`Sums`] to borrow: nothing without the feature.
 #[cfg(not(feature = "periodic"))]
 pub(super) type HeldSums<T> = Option<core::marker::PhantomData<T>>;
+
+/// Why PSE ([`Params::pse`]) cannot serve a stage that needs the assembled mobility.
+pub(super) const PSE_ASSEMBLED: &str = "PSE (Params::pse) where the step needs the assembled mobility \
+     (without matrix_free, Cholesky noise, the Sweep or Newton solver, RattleStable): \
+     PSE gives products only";
 
 /// `u = mu_tt(pos) f`: assembled into `mu` and applied in one pass, in bands through
 /// `par` (`bands` holds their partial sums, [`crate::parallel`]), or matrix-free (then
@@ -50,7 +73,7 @@ pub(super) fn mobility_product<T: Real>(
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
         // In a box: assembled serially, then applied in bands (`integrate/periodic.rs`).
-        super::periodic::assemble(p, e, pos, radius, mu)?;
+        assemble_tt(p, Some(e), pos, radius, mu)?;
         crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
         return Ok(());
     }
@@ -132,7 +155,7 @@ pub(super) fn free_product<T: Real>(
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
-        return super::periodic::product(p, e, pos, radius, f, u);
+        return e.product(p.viscosity, pos, radius, f, u);
     }
     let _ = ew; // Read above only with the `periodic` feature.
     let (level, eta) = (p.hydro, p.viscosity);
@@ -181,6 +204,8 @@ pub(super) fn assemble_tt<T: Real>(
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
+        // PSE has no blocks; the checks refuse it wherever the step assembles.
+        let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
         return super::periodic::assemble(p, e, pos, radius, mu);
     }
     let _ = ew; // Read above only with the `periodic` feature.
@@ -253,7 +278,7 @@ pub(super) fn spin<T: Real>(
 ) -> Result<(), StepError> {
     out.fill(p.vorticity);
     #[cfg(feature = "periodic")]
-    if let (true, Some(e)) = (p.rotation, ew) {
+    if let (true, Some(e)) = (p.rotation, ew.and_then(|s| s.ewald())) {
         let eta = p.viscosity;
         return Ok(mobility::periodic::add_spin(e, eta, pos, radius, f, out)?);
     }

@@ -39,7 +39,19 @@ pub struct Workspace<'a, T: Real> {
     pub(crate) indices: &'a mut [usize],
     pub(crate) links: &'a mut [Bond<T>],
     pub(crate) parallel: &'a dyn Parallel,
+    /// PSE's arrays (complex, index, vectors) for a step with [`Params::pse`](crate::Params::pse).
+    #[cfg(feature = "pse")]
+    pub(crate) pse: PseSlices<'a, T>,
 }
+
+/// The caller's PSE arrays: complex values, indices, vectors
+/// ([`crate::mobility::pse::PseStorage`]).
+#[cfg(feature = "pse")]
+pub(crate) type PseSlices<'a, T> = (
+    &'a mut [crate::mobility::pse::Cx<T>],
+    &'a mut [usize],
+    &'a mut [<T as Real>::V3],
+);
 
 impl<'a, T: Real> Workspace<'a, T> {
     /// A workspace over four caller-owned slices (contents are overwritten by steps).
@@ -56,6 +68,8 @@ impl<'a, T: Real> Workspace<'a, T> {
             indices,
             links: &mut [],
             parallel: &Serial,
+            #[cfg(feature = "pse")]
+            pse: (&mut [], &mut [], &mut []),
         }
     }
 
@@ -69,6 +83,26 @@ impl<'a, T: Real> Workspace<'a, T> {
     /// ([`Layout::links`] entries: the bonds are copied in, the contacts follow).
     pub fn with_links(self, links: &'a mut [Bond<T>]) -> Self {
         Self { links, ..self }
+    }
+
+    /// This workspace with the arrays of the PSE products of a step with
+    /// [`Params::pse`](crate::Params::pse): at least
+    /// [`pse_storage`](crate::integrate::pse_storage) (complex values, indices,
+    /// vectors), else the step is refused with
+    /// [`StepError::BadParameter`](crate::StepError::BadParameter) before anything is
+    /// touched. Not counted by [`Layout`]: the grid depends on the box and the
+    /// tolerance at run time.
+    #[cfg(feature = "pse")]
+    pub fn with_pse(
+        self,
+        complex: &'a mut [crate::mobility::pse::Cx<T>],
+        index: &'a mut [usize],
+        vectors: &'a mut [T::V3],
+    ) -> Self {
+        Self {
+            pse: (complex, index, vectors),
+            ..self
+        }
     }
 
     /// The element counts this workspace holds.

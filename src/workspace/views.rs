@@ -40,6 +40,9 @@ pub(crate) struct Views<'a, T: Real> {
     pub par: &'a dyn Parallel,
     /// The stored `mu_tt` product's band partial sums ([`band_scratch`]).
     pub bands: &'a mut [T::V3],
+    /// The caller's PSE arrays ([`Workspace::with_pse`]).
+    #[cfg(feature = "pse")]
+    pub pse: super::PseSlices<'a, T>,
 }
 
 /// Takes slices off the front of a slice.
@@ -164,6 +167,8 @@ impl<T: Real> Workspace<'_, T> {
             links,
             par: self.parallel,
             bands,
+            #[cfg(feature = "pse")]
+            pse: (&mut *self.pse.0, &mut *self.pse.1, &mut *self.pse.2),
         })
     }
 }

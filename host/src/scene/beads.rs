@@ -204,6 +204,14 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     p.periodic = scene
         .periodic
         .and_then(|b| hydrorattle::Periodic::new(b.size.map(T::from_f64)).ok());
+    // PSE where the scene names it or the run resolved to it
+    // (`Scene::with_box_resolved`); "auto" left unresolved is the Ewald path. PSE
+    // gives products only: its steps are matrix-free.
+    p.pse = scene
+        .periodic
+        .filter(|b| b.method == scene::BoxMethod::Pse)
+        .map(|b| b.tolerance);
+    p.matrix_free |= p.pse.is_some();
     p
 }
 

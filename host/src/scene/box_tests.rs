@@ -54,30 +54,48 @@ fn a_box_is_read_with_its_defaults_and_written_back() {
 }
 
 #[test]
-fn pse_is_read_but_a_run_refuses_it_at_its_line() {
-    let text = BOXED.replace(
-        "size = [10, 10, 12]",
-        "size = [10, 10, 12]\nmethod = \"pse\"",
-    );
-    let s = Scene::parse(&text, "b.toml").unwrap();
-    let e = s.check_box_runs(Some("b.toml")).unwrap_err();
-    assert_eq!(e.line, Some(14));
-    assert!(
-        e.to_string()
-            .starts_with("b.toml:14: [box] method = \"pse\""),
-        "{e}"
-    );
-    // "auto" and "ewald" run, and "auto" is written back as the method it picked.
-    for m in ["auto", "ewald"] {
+fn pse_runs_where_products_suffice_and_is_refused_at_its_line_elsewhere() {
+    let with = |m: &str, extra: &str| {
         let text = BOXED.replace(
             "size = [10, 10, 12]",
             &format!("size = [10, 10, 12]\nmethod = \"{m}\""),
         );
-        let s = Scene::parse(&text, "b.toml").unwrap();
-        assert!(s.check_box_runs(None).is_ok());
-        let run = s.with_box_resolved();
-        assert_eq!(run.periodic.unwrap().method, BoxMethod::Ewald);
+        Scene::parse(&format!("{text}{extra}"), "b.toml").unwrap()
+    };
+    let s = with("pse", "");
+    let why = s.needs_matrix();
+    // "pse" and "auto" run on PSE where products suffice (matrix-free, written back).
+    assert_eq!(why, None);
+    {
+        for m in ["pse", "auto"] {
+            let s = with(m, "");
+            assert!(s.check_box_runs(None).is_ok());
+            let run = s.with_box_resolved();
+            assert_eq!(run.periodic.unwrap().method, BoxMethod::Pse, "{m}");
+            assert!(run.integrator.matrix_free);
+            assert!(run.to_toml().contains("method = \"pse\""));
+            assert!(run.to_toml().contains("matrix_free = true"));
+        }
     }
+    // A scene that needs the assembled matrix: "pse" refused at its line, "auto" is Ewald.
+    let mut s = with("pse", "");
+    s.integrator.method = super::Method::RattleStable;
+    let e = s.check_box_runs(Some("b.toml")).unwrap_err();
+    assert_eq!(e.line, Some(14));
+    assert!(
+        e.to_string()
+            .starts_with("b.toml:14: [box] method = \"pse\" gives mobility products only"),
+        "{e}"
+    );
+    let mut s = with("auto", "");
+    s.integrator.method = super::Method::RattleStable;
+    let run = s.with_box_resolved();
+    assert_eq!(run.periodic.unwrap().method, BoxMethod::Ewald);
+    assert!(!run.integrator.matrix_free);
+    // "ewald" stays itself.
+    let run = with("ewald", "").with_box_resolved();
+    assert_eq!(run.periodic.unwrap().method, BoxMethod::Ewald);
+    assert!(!run.integrator.matrix_free);
 }
 
 #[test]

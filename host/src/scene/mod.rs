@@ -74,7 +74,7 @@ pub use model::{
     Bond, Flow, Fluid, Hydrodynamics, Integrator, Level, Method, Model, Output, Overlap, Particle,
     Precision, Solver,
 };
-pub use periodic::{BoxMethod, DEFAULT_BOX_TOLERANCE, PeriodicBox, PseUnwired};
+pub use periodic::{BoxMethod, DEFAULT_BOX_TOLERANCE, PeriodicBox, PseUnsupported};
 pub use resolve::MAX_TURN_PER_STEP;
 pub use suspension::{GAP, MAX_FRACTION, Suspension, TRIALS_PER_SPHERE};
 pub use thermal::{DEFAULT_SEED, Drift, Sqrt, Thermal};

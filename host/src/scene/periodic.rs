@@ -11,9 +11,12 @@
 //! bonds, springs and contacts through the minimum image, positions kept unwrapped
 //! (the trajectories give the box: `docs/SCENES.md`). `"ewald"` is the exact
 //! reference path, summed to about the precision's epsilon whatever the tolerance;
-//! `"pse"` (the positively split Ewald fast path) is read and written back but a run
-//! refuses it ([`PseUnwired`]) until it is wired in; `"auto"` resolves by
-//! [`BoxMethod::resolve`]. Refused at the value at fault: an edge not finite or not
+//! `"pse"` is the positively split Ewald fast path (`O(N log N)` products, the kernel's
+//! `Params::pse` at `tolerance`), which gives products only: a run with it is
+//! matrix-free (written back as `matrix_free = true`), and a scene whose method,
+//! solver or noise needs the assembled mobility refuses it at its line
+//! ([`PseUnsupported`]); `"auto"` resolves by [`BoxMethod::resolve`] and the run's
+//! `scene.toml` names the method it picked. Refused at the value at fault: an edge not finite or not
 //! positive, a tolerance outside `(0, 1)`, a sphere whose radius is not below half the
 //! smallest edge (it would overlap its own image), a box with a `[wall]` (the wall's
 //! image system is free space's), and (by the kernel's own check of the first step) a
@@ -36,7 +39,7 @@ use super::resolve::BodySpans;
 pub enum BoxMethod {
     /// The exact Ewald sum (`mobility::periodic`), `O(N^2)` per product.
     Ewald,
-    /// The positively split Ewald fast path, `O(N log N)`: not yet wired into runs.
+    /// The positively split Ewald fast path, `O(N log N)` per product, to `tolerance`.
     Pse,
     /// Chosen by [`BoxMethod::resolve`].
     #[default]
@@ -44,12 +47,16 @@ pub enum BoxMethod {
 }
 
 impl BoxMethod {
-    /// The method a run uses for `n` spheres: `"auto"` is `"ewald"` for every `n` (the
-    /// only path wired into runs; when the PSE path is, `"auto"` picks it above the
-    /// measured crossover in `n`). `"ewald"` and `"pse"` are themselves.
-    pub fn resolve(self, n: usize) -> BoxMethod {
-        let _ = n; // The crossover's argument, once there is a second path.
+    /// The method a run uses: `"auto"` is `"pse"` where the scene needs mobility
+    /// products only (`products_only`, [`Scene::products_only`](super::Scene::products_only)),
+    /// `"ewald"` otherwise. Why not a crossover in `N`: the PSE product was measured
+    /// cheaper than the dense Ewald product at every size tried, from N = 10 (1.8 to
+    /// 3.4 times) to 400 (16 to 41 times), at tolerances 1e-3 to 1e-6
+    /// (`docs/PERIODIC.md`, PSE, crossover); what decides is whether the run needs the
+    /// assembled matrix. `"ewald"` and `"pse"` are themselves.
+    pub fn resolve(self, products_only: bool) -> BoxMethod {
         match self {
+            BoxMethod::Auto if products_only => BoxMethod::Pse,
             BoxMethod::Auto => BoxMethod::Ewald,
             m => m,
         }
@@ -205,17 +212,19 @@ pub(super) fn refuse_wall(raw: &Spanned<RawBox>) -> Issue {
     )
 }
 
-/// A run of a scene whose `[box]` asks for `method = "pse"`, refused until the fast
-/// path is wired into runs.
+/// A run of a scene whose `[box]` asks for `method = "pse"` with a method, solver or
+/// noise that needs the assembled mobility (PSE gives products only).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct PseUnwired {
+pub struct PseUnsupported {
     /// The scene file, when the run came from one.
     pub origin: Option<String>,
     /// The line of `method = "pse"`, when the scene was read from a file.
     pub line: Option<usize>,
+    /// What needs the assembled mobility.
+    pub why: &'static str,
 }
 
-impl fmt::Display for PseUnwired {
+impl fmt::Display for PseUnsupported {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match (&self.origin, self.line) {
             (Some(o), Some(l)) => write!(f, "{o}:{l}: ")?,
@@ -225,35 +234,70 @@ impl fmt::Display for PseUnwired {
         }
         write!(
             f,
-            "[box] method = \"pse\": the PSE fast path is not wired into runs yet; use method = \"ewald\" or \"auto\""
+            "[box] method = \"pse\" gives mobility products only, and {} needs the assembled mobility; use method = \"ewald\" or \"auto\"",
+            self.why
         )
     }
 }
 
-impl std::error::Error for PseUnwired {}
+impl std::error::Error for PseUnsupported {}
 
 impl super::Scene {
+    /// What in this scene needs the assembled mobility (so PSE cannot run it), or
+    /// `None` where mobility products suffice: the overdamped or springs method
+    /// (matrix-free), `level = "manual"` (the automatic level may pick another method),
+    /// no rotation, the `"auto"` or `"krylov"` solver (Sweep and Newton read single
+    /// blocks) and no Cholesky noise.
+    pub fn needs_matrix(&self) -> Option<&'static str> {
+        use super::{Level, Method, Solver, Sqrt};
+        let i = &self.integrator;
+        if !matches!(i.method, Method::Overdamped | Method::Springs) {
+            return Some("a method other than overdamped or springs");
+        }
+        if self.model.level != Level::Manual {
+            return Some("level = \"auto\" (it may pick another method)");
+        }
+        if self.model.rotation {
+            return Some("rotation");
+        }
+        if matches!(i.solver, Solver::Sweep | Solver::Newton) {
+            return Some("the sweep or newton solver");
+        }
+        let thermal = self.brownian.is_some_and(|b| b.temperature > 0.0);
+        if thermal && self.brownian.is_some_and(|b| b.sqrt == Sqrt::Cholesky) {
+            return Some("[brownian] sqrt = \"cholesky\"");
+        }
+        None
+    }
+
+    /// Whether this scene needs mobility products only ([`needs_matrix`](Self::needs_matrix)).
+    pub fn products_only(&self) -> bool {
+        self.needs_matrix().is_none()
+    }
+
     /// This scene with its box method resolved for the run ([`BoxMethod::resolve`]:
     /// `"auto"` becomes the method it picks, so the run's `scene.toml` re-runs the
-    /// same path); `"pse"` stays, for [`check_box_runs`](Self::check_box_runs).
+    /// same path); a run on PSE is matrix-free (`matrix_free = true`, written back).
     pub fn with_box_resolved(mut self) -> super::Scene {
-        let n = self.particles.len();
+        let products = self.products_only();
         if let Some(b) = self.periodic.as_mut() {
-            b.method = b.method.resolve(n);
+            b.method = b.method.resolve(products);
+            if b.method == BoxMethod::Pse && products {
+                self.integrator.matrix_free = true;
+            }
         }
         self
     }
 
-    /// Refuses a run of a box whose method is `"pse"` ([`PseUnwired`], placed at its
-    /// line in `origin`).
-    pub fn check_box_runs(&self, origin: Option<&str>) -> Result<(), PseUnwired> {
-        match self.periodic {
-            Some(b) if b.method.resolve(self.particles.len()) == BoxMethod::Pse => {
-                Err(PseUnwired {
-                    origin: origin.map(str::to_string),
-                    line: b.method_line,
-                })
-            }
+    /// Refuses a run of a box whose method is `"pse"` where the scene needs the
+    /// assembled mobility ([`PseUnsupported`], placed at its line in `origin`).
+    pub fn check_box_runs(&self, origin: Option<&str>) -> Result<(), PseUnsupported> {
+        match (self.periodic, self.needs_matrix()) {
+            (Some(b), Some(why)) if b.method == BoxMethod::Pse => Err(PseUnsupported {
+                origin: origin.map(str::to_string),
+                line: b.method_line,
+                why,
+            }),
             _ => Ok(()),
         }
     }

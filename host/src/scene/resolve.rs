@@ -238,6 +238,11 @@ impl RawScene {
             periodic,
             suspension: suspension.map(|(s, _)| s),
         };
+        // "pse" where the scene needs the assembled mobility: placed at the method.
+        if let (Err(e), Some(raw)) = (scene.check_box_runs(None), &self.periodic) {
+            let at = raw.get_ref().method_at().map(|s| s..s + 1);
+            return Err(issue(at.unwrap_or(raw.span()), e.to_string()));
+        }
         let keys = super::kernel::KeySpans::of(&self, raw_int.span());
         super::kernel::check(&scene, &keys, &body_span)?;
         Ok(scene)
@@ -346,6 +351,7 @@ fn plans(
         brownian,
         wall,
         matrix_free: integrator.matrix_free,
+        pse: false,
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],

@@ -117,6 +117,9 @@ pub struct Plan {
     pub wall: bool,
     /// No stored mobility (`[integrator] matrix_free`).
     pub matrix_free: bool,
+    /// The box summed by PSE (`[box] method = "pse"`): the solver `"auto"` is Krylov
+    /// (the kernel's `Params::solver_kind`).
+    pub pse: bool,
 }
 
 impl Plan {
@@ -131,6 +134,9 @@ impl Plan {
             brownian: scene.brownian,
             wall: scene.wall.is_some(),
             matrix_free: scene.integrator.matrix_free,
+            pse: scene
+                .periodic
+                .is_some_and(|b| b.method == super::BoxMethod::Pse),
         }
     }
 
@@ -150,7 +156,12 @@ impl Plan {
             p.solver.kind = self.solver.kind();
             p.contacts = contacts.map(Contacts::new);
             p.wall = self.wall.then_some(hydrorattle::Wall::new(0.0));
-            p.matrix_free = self.matrix_free;
+            p.matrix_free = self.matrix_free || self.pse;
+            if self.pse {
+                // Any box: only the solver's resolution reads it.
+                p.periodic = hydrorattle::Periodic::new([1.0; 3]).ok();
+                p.pse = Some(1e-3);
+            }
             if let Some(t) = self.brownian {
                 p.brownian = Some(hydrorattle::Brownian {
                     temperature: t.temperature,
@@ -204,6 +215,7 @@ mod tests {
             brownian: None,
             wall: false,
             matrix_free: false,
+            pse: false,
         }
     }
 

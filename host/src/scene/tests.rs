@@ -139,6 +139,7 @@ fn overdamped() -> Plan {
         brownian: None,
         wall: false,
         matrix_free: false,
+        pse: false,
     }
 }
 

@@ -46,6 +46,9 @@ pub struct Engine<T: Real> {
     pub(super) multipliers: Vec<T>,
     /// The pool for the mobility's bands (shared by copies of the system).
     pub(super) threads: Option<Arc<Threads>>,
+    /// PSE's arrays (complex, indices, vectors) when the box is summed by PSE
+    /// ([`hydrorattle::integrate::pse_storage`]); empty otherwise.
+    pse: (Vec<[T; 2]>, Vec<usize>, Vec<T::V3>),
 }
 
 impl<T: Real> Engine<T> {
@@ -93,7 +96,20 @@ impl<T: Real> Engine<T> {
         limit: usize,
     ) -> Result<Self, BuildError> {
         let (n, b) = (beads.len(), bonds.len());
-        let bytes = layout.bytes::<T>();
+        // PSE's grid and cell list, from the parameters the step derives (parameters it
+        // refuses leave none: the first step then refuses them, typed).
+        let pse = hydrorattle::integrate::pse_storage(&params, &beads.radius);
+        let pse = pse
+            .ok()
+            .flatten()
+            .unwrap_or(hydrorattle::mobility::pse::PseSize {
+                complex: 0,
+                index: 0,
+                vectors: 0,
+            });
+        let real = std::mem::size_of::<T>();
+        let pse_bytes = pse.complex * 2 * real + pse.index * 8 + pse.vectors * 3 * real;
+        let bytes = layout.bytes::<T>() + pse_bytes;
         if bytes > limit {
             return Err(TooLarge {
                 particles: n,
@@ -115,6 +131,11 @@ impl<T: Real> Engine<T> {
             store,
             multipliers: Vec::new(),
             threads: None,
+            pse: (
+                vec![[T::ZERO; 2]; pse.complex],
+                vec![0; pse.index],
+                vec![T::V3_ZERO; pse.vectors],
+            ),
         })
     }
 
@@ -159,10 +180,12 @@ impl<T: Real> Engine<T> {
             }
             extra(pos, radius, force);
         };
-        let mut ws = match &self.threads {
+        let ws = match &self.threads {
             Some(pool) => self.store.workspace().with_parallel(pool.as_ref()),
             None => self.store.workspace(),
         };
+        let (c, i, v) = &mut self.pse;
+        let mut ws = ws.with_pse(c, i, v);
         let report = retry::step(
             &mut self.beads,
             &self.bonds,

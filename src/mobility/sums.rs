@@ -1,0 +1,131 @@
+//! The periodic mobility a step sums with: the exact Ewald sums
+//! ([`crate::mobility::periodic`], the default) or the PSE fast path
+//! ([`crate::mobility::pse`], [`Params::pse`](crate::Params::pse)). Held once per step
+//! (parameters derived in the step's checks) and read by every product of the step:
+//! the mobility product, the Krylov metric's product and the Lanczos noise's.
+//!
+//! PSE gives products only. Everything that needs a block of the matrix (assembly,
+//! Cholesky noise, the tabulating solvers Sweep and Newton) reads the Ewald sums, and
+//! the step's checks refuse those with PSE ([`BoxSums::ewald`] is `None` then).
+//! PSE's storage is the caller's ([`Workspace::with_pse`](crate::Workspace::with_pse)),
+//! held in a `RefCell` ([`PseStep`]) so that the step's products, which share the
+//! metric and product closures by shared reference, can each borrow it in turn (they
+//! never nest, so a borrow never fails; if one did, the product reports it). The
+//! step's stages see it as a [`BoxProduct`] trait object: the storage's own lifetime
+//! stays out of their signatures.
+
+#[cfg(feature = "pse")]
+use core::cell::RefCell;
+use core::fmt;
+
+use crate::error::StepError;
+use crate::mobility::periodic::{self, Ewald};
+#[cfg(feature = "pse")]
+use crate::mobility::pse::{Part, Pse, PseStorage};
+use crate::real::Real;
+
+/// The step's periodic sums: Ewald's parameters, or PSE's with the caller's storage.
+pub enum BoxSums<'a, T: Real> {
+    /// The exact Ewald sums (dense pair blocks; assembly and products).
+    Ewald(&'a Ewald<T>),
+    /// The PSE product (`docs/PERIODIC.md`, section PSE) with its storage ([`PseStep`]).
+    #[cfg(feature = "pse")]
+    Pse(&'a dyn BoxProduct<T>),
+}
+
+/// A product `u = M f` of the box's mobility, over storage the implementor holds.
+pub trait BoxProduct<T: Real> {
+    /// `u = M f` with viscosity `eta` for the spheres at `pos` with radii `radius`.
+    fn product(
+        &self,
+        eta: T,
+        pos: &[T::V3],
+        radius: &[T],
+        f: &[T::V3],
+        u: &mut [T::V3],
+    ) -> Result<(), StepError>;
+}
+
+/// PSE's parameters and the caller's storage for one step's products.
+#[cfg(feature = "pse")]
+pub struct PseStep<'s, T: Real> {
+    pse: &'s Pse<T>,
+    store: RefCell<PseStorage<'s, T>>,
+}
+
+#[cfg(feature = "pse")]
+impl<'s, T: Real> PseStep<'s, T> {
+    /// The products of `pse` over `store` (checked by each product).
+    pub fn new(pse: &'s Pse<T>, store: PseStorage<'s, T>) -> Self {
+        Self {
+            pse,
+            store: RefCell::new(store),
+        }
+    }
+}
+
+#[cfg(feature = "pse")]
+impl<T: Real> BoxProduct<T> for PseStep<'_, T> {
+    fn product(
+        &self,
+        eta: T,
+        pos: &[T::V3],
+        radius: &[T],
+        f: &[T::V3],
+        u: &mut [T::V3],
+    ) -> Result<(), StepError> {
+        let mut store = self
+            .store
+            .try_borrow_mut()
+            .map_err(|_| StepError::Unsupported("a PSE product inside another (storage in use)"))?;
+        Ok(self
+            .pse
+            .apply(Part::Both, eta, pos, radius, f, u, &mut store)?)
+    }
+}
+
+impl<T: Real> Clone for BoxSums<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T: Real> Copy for BoxSums<'_, T> {}
+
+impl<T: Real> fmt::Debug for BoxSums<'_, T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Ewald(e) => f.debug_tuple("Ewald").field(e).finish(),
+            #[cfg(feature = "pse")]
+            Self::Pse(_) => f.write_str("Pse"),
+        }
+    }
+}
+
+impl<'a, T: Real> BoxSums<'a, T> {
+    /// The Ewald parameters, where the step sums by Ewald (`None` on the PSE path,
+    /// which has no pair blocks).
+    pub fn ewald(self) -> Option<&'a Ewald<T>> {
+        match self {
+            Self::Ewald(e) => Some(e),
+            #[cfg(feature = "pse")]
+            Self::Pse(..) => None,
+        }
+    }
+
+    /// `u = M f`, the box's translational mobility (viscosity `eta`) by the step's sums.
+    pub fn product(
+        self,
+        eta: T,
+        pos: &[T::V3],
+        radius: &[T],
+        f: &[T::V3],
+        u: &mut [T::V3],
+    ) -> Result<(), StepError> {
+        match self {
+            Self::Ewald(e) => Ok(periodic::tt_product(e, eta, pos, radius, f, u)?),
+            #[cfg(feature = "pse")]
+            Self::Pse(p) => p.product(eta, pos, radius, f, u),
+        }
+    }
+}
