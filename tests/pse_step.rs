@@ -300,6 +300,15 @@ fn refusals() {
             true,
         ),
         (
+            // The box's rotation blocks are Ewald's alone.
+            "rotation",
+            Params {
+                rotation: true,
+                ..pse
+            },
+            false,
+        ),
+        (
             "Sweep",
             Params {
                 solver: hydrorattle::Solver {
