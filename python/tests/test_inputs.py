@@ -76,7 +76,6 @@ def test_flags_take_bools_and_0_or_1():
         ({"dt": 0.1, "gravity": [0, 0]}, TypeError, "gravity must be three real numbers"),
         ({"dt": 0.1, "method": "rattle", "temperature": 1.0}, ValueError, "not supported"),
         ({"dt": 0.1, "box": (10, 10, 10), "wall": -5.0}, ValueError, "periodic box with a wall"),
-        ({"dt": 0.1, "box": (10, 10, 10), "rotation": True}, ValueError, "periodic box with rotation"),
         ({"dt": 0.1, "box": (10, -1, 10)}, ValueError, "box"),
     ],
 )
