@@ -279,7 +279,7 @@ impl super::Scene {
     /// `"auto"` becomes the method it picks, so the run's `scene.toml` re-runs the
     /// same path); a run on PSE is matrix-free (`matrix_free = true`, written back).
     pub fn with_box_resolved(mut self) -> super::Scene {
-        let products = self.products_only();
+        let products = self.products_only() && self.pse_fits();
         if let Some(b) = self.periodic.as_mut() {
             b.method = b.method.resolve(products);
             if b.method == BoxMethod::Pse && products {
@@ -287,6 +287,21 @@ impl super::Scene {
             }
         }
         self
+    }
+
+    /// Whether PSE's parameters for this box, its largest radius and its tolerance are
+    /// within the kernel's bounds (`mobility::pse::Pse::new`: a grid edge of at most
+    /// `MAX_GRID`, a support of at most `MAX_SUPPORT`): `"auto"` picks PSE only then,
+    /// so that the resolved scene written back runs (a dilute suspension's box can
+    /// need a grid past the bounds; the Ewald path has none).
+    fn pse_fits(&self) -> bool {
+        let Some(b) = self.periodic else {
+            return true;
+        };
+        let a_max = self.radii().into_iter().fold(0.0, f64::max);
+        hydrorattle::Periodic::new(b.size).is_ok_and(|cell| {
+            hydrorattle::mobility::pse::Pse::new(cell, a_max, b.tolerance).is_ok()
+        })
     }
 
     /// Refuses a run of a box whose method is `"pse"` where the scene needs the
