@@ -21,6 +21,8 @@ pub mod geometry;
 mod overdamped;
 #[cfg(feature = "periodic")]
 mod periodic;
+#[cfg(feature = "pse")]
+mod pse_noise;
 mod rattle;
 mod springs;
 mod stable;

@@ -34,7 +34,6 @@ pub use spread::MAX_SUPPORT;
 use crate::error::ParticleError;
 use crate::mobility::periodic::real::Split;
 use crate::mobility::periodic::{Periodic, PeriodicError};
-use crate::noise::Noise;
 use crate::noise::lanczos::LanczosError;
 use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
@@ -101,11 +100,11 @@ struct Spheres<'a, T: Real> {
     order: &'a [usize],
 }
 
-/// What the wave stage transforms: the spread forces (the product), or white noise on
-/// the grid (the Brownian displacement).
+/// What the wave stage transforms: the spread forces (the product), or the white noise
+/// already drawn on the grid (the Brownian displacement, [`Pse::noise_in`]).
 enum Source<'a, T: Real> {
     Force(&'a [T::V3]),
-    Noise(&'a mut Noise),
+    Noise,
 }
 
 /// Which part of the mobility [`Pse::apply`] applies.
@@ -304,7 +303,7 @@ impl<T: Real> Pse<T> {
         let slab = 3 * mx * my;
         // Spreading and the x, y transforms by slabs of planes (in parallel), the z
         // transforms and the kernel whole (their lines cross every slab).
-        let noise = matches!(source, Source::Noise(_));
+        let noise = matches!(source, Source::Noise);
         match source {
             Source::Force(force) => {
                 let _ = jobs::pieces(par, (&mut *grid, mz, slab), jobs::none(), |z0, g, _| {
@@ -315,10 +314,8 @@ impl<T: Real> Pse<T> {
                     Ok::<(), Infallible>(())
                 });
             }
-            // White noise of unit variance at every point (the generator's order).
-            Source::Noise(rng) => grid.iter_mut().for_each(|v| {
-                *v = [T::from_f64(rng.normal()), T::ZERO];
-            }),
+            // White noise of unit variance at every point, drawn by `noise_in`.
+            Source::Noise => {}
         }
         let planes = |inverse: bool| {
             move |_: usize, g: &mut [Cx<T>], sc: &mut [Cx<T>]| {
