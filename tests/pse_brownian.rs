@@ -208,7 +208,8 @@ fn check_lone(l: f64, steps: usize, seed: u64) {
 #[test]
 fn lone_sphere_diffusion_follows_hasimoto() {
     for (k, l) in [5.0, 10.0].into_iter().enumerate() {
-        check_lone(l, 15_000, 300 + k as u64);
+        let steps = std::env::var("STEPS").map_or(15_000, |s| s.parse().unwrap());
+        check_lone(l, steps, 300 + k as u64);
     }
 }
 
@@ -269,5 +270,45 @@ fn refusal_keeps_state_and_repeats_bits() {
     match run(&capped, 1) {
         Err(StepError::NoConvergence { .. }) => {}
         other => panic!("{other:?}"),
+    }
+}
+
+/// PSE's deviates are one draw over both parts (`Noise::fill_parts`): unsplit, the
+/// real part's vectors and then the grid's values in stream order (as `fill` and
+/// `normal` give them); split into `2^2` sub-steps along the bridge, the four leaves of
+/// both parts add up to twice the unsplit draw (so a retried PSE step's sub-steps add
+/// up to the refused step's noise), to rounding.
+#[test]
+fn deviates_bridge_over_both_parts() {
+    let (n, m) = (5, 7);
+    let g = Noise::new(42);
+    let mut head = vec![f64::V3_ZERO; n];
+    let mut tail = vec![[1.0f64, 1.0]; 3 * m];
+    g.clone().fill_parts::<f64>(&mut head, &mut tail);
+    let mut plain = g.clone();
+    let mut want = vec![f64::V3_ZERO; n];
+    plain.fill::<f64>(&mut want);
+    assert_eq!(head, want);
+    for v in &tail {
+        assert_eq!(v[0].to_bits(), plain.normal().to_bits());
+        assert_eq!(v[1], 0.0);
+    }
+    let (mut sh, mut st) = (vec![[0.0; 3]; n], vec![0.0; 3 * m]);
+    for index in 0..4 {
+        let (mut h, mut t) = (vec![f64::V3_ZERO; n], vec![[0.0f64; 2]; 3 * m]);
+        g.split(2, index).fill_parts::<f64>(&mut h, &mut t);
+        for (s, &x) in sh.iter_mut().zip(&h) {
+            *s = add(*s, f64s::<f64>(x));
+        }
+        for (s, x) in st.iter_mut().zip(&t) {
+            *s += x[0];
+        }
+    }
+    for (s, &x) in sh.iter().zip(&head) {
+        let d = sub(*s, f64s::<f64>(x).map(|c| 2.0 * c));
+        assert!(norm(d) < 1e-14, "{d:?}");
+    }
+    for (s, x) in st.iter().zip(&tail) {
+        assert!((s - 2.0 * x[0]).abs() < 1e-14);
     }
 }
