@@ -312,3 +312,53 @@ fn deviates_bridge_over_both_parts() {
         assert!((s - 2.0 * x[0]).abs() < 1e-14);
     }
 }
+
+/// One freely jointed chain's `R^2` samples on the PSE path: 5 unit beads, rigid bonds
+/// 3, phantom, `Drift::Midpoint` (whose `M^-1 L w` the conjugate gradients give: the
+/// only place a PSE step solves with `M`), `dt = 0.1`, box of edge 10, sampled every
+/// 0.5 time units after 20 (as `tests/periodic_brownian.rs` does on the Ewald path).
+fn chain_r2(seed: u64, steps: usize) -> f64 {
+    const C: usize = 5;
+    let (l, dt) = (10.0, 0.1);
+    let (mut ps, bonds) = zigzag_chain::<C, { C - 1 }>(C, 3.0);
+    let mut p = thermal::<f64>(dt, 1.0 / (6.0 * PI), Hydro::Rpy, Drift::Midpoint);
+    p.allow_overlap = true;
+    p.periodic = Some(Periodic::new([l; 3]).unwrap());
+    p.matrix_free = true;
+    p.pse = Some(1e-4);
+    ps.noise = Some(Noise::new(seed));
+    let mut buf = Buffers::<f64>::new(Layout::for_params(&p, C, C - 1));
+    let (mut cx, mut ix, mut v) = arrays(&p, &[1.0; C]);
+    let mut ws = buf.workspace().with_pse(&mut cx, &mut ix, &mut v);
+    let (burn, every) = ((20.0 / dt) as usize, (0.5 / dt) as usize);
+    let mut out = Vec::new();
+    for k in 0..steps {
+        step_retrying(&mut ps, &bonds, &p, &mut ws);
+        if k >= burn && (k - burn) % every == 0 {
+            let r = (1..C).fold([0.0; 3], |acc, j| {
+                let d = sub(f64s::<f64>(ps.pos[j]), f64s::<f64>(ps.pos[j - 1]));
+                add(acc, d.map(|x| x - l * (x / l).round()))
+            });
+            out.push(dot(r, r));
+        }
+    }
+    mean_se(&out).0
+}
+
+/// `<R^2>` of the chain above against `B b^2 = 36` within 3 standard errors (each
+/// chain's time average one sample, the spread over chains): `CHAINS` chains (default
+/// 8) of `STEPS` steps (default 8 000). `-- --ignored` (minutes).
+#[test]
+#[ignore = "minutes: cargo test --release --test pse_brownian -- --ignored chain"]
+fn chain_end_to_end() {
+    let env = |k: &str, d: usize| std::env::var(k).map_or(d, |s| s.parse().unwrap());
+    let (chains, steps) = (env("CHAINS", 8) as u64, env("STEPS", 8_000));
+    let t = std::time::Instant::now();
+    let (m, se) = over_seeds(chains, |seed| chain_r2(500 + seed, steps));
+    println!(
+        "PSE chain in a box: <R^2> = {m:.3} +- {se:.3} (36, {:+.2} se), {chains} x {steps} steps, {:.1} s",
+        (m - 36.0) / se,
+        t.elapsed().as_secs_f64()
+    );
+    assert!((m - 36.0).abs() < 3.0 * se, "<R^2> {m} vs 36");
+}

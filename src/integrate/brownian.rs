@@ -212,12 +212,17 @@ pub(super) fn kick<T: Real>(
         copied,
     } = krylov;
     // On the PSE path the noise is PSE's own (`pse_noise`): no product with the whole
-    // mobility but the midpoint's solve.
+    // mobility but the midpoint's solve. Without bonds to project onto, the midpoint's
+    // mean is `kT dt div M`, zero for the box's RPY mobility (each Fourier mode is
+    // transverse, `P(k) k = 0`), so the midpoint (a solve of some 30 to 50 products)
+    // is left out: the uncorrected draw, whose covariance is `M` exactly.
     #[cfg(feature = "pse")]
     if let Some(sums) = s.ewald.and_then(|e| e.pse()) {
+        let bonded = held.as_ref().is_some_and(|h| !h.bonds.is_empty());
+        let drift = if bonded { b.drift } else { Drift::Uncorrected };
         let vectors = (&mut *xi, &mut *mid, &mut *dx);
-        let iterations = super::pse_noise::draw(p, b.drift, s, sums, noise, vectors, basis, work)?;
-        let projected = match b.drift {
+        let iterations = super::pse_noise::draw(p, drift, s, sums, noise, vectors, basis, work)?;
+        let projected = match drift {
             Drift::Uncorrected => {
                 dx.iter_mut().for_each(|d| *d *= amplitude);
                 0

@@ -7,7 +7,8 @@
 //! parts) is not square, so there is no `L^-T w` for the Fixman midpoint. What the
 //! midpoint needs of it is `E[(L w) v^T] = I` and `cov v = M^-1`; `v = M^-1 (L w)`
 //! has both (`E[L w w^T L^T] M^-1 = I`, `M^-1 M M^-1 = M^-1`), so the midpoint solves
-//! `M v = L w` by conjugate gradients with PSE products.
+//! `M v = L w` by conjugate gradients with PSE products. It is needed only with bonds
+//! (`brownian::kick` leaves it out otherwise: the box's mobility is divergence-free).
 
 use super::Start;
 use crate::error::StepError;
@@ -47,7 +48,9 @@ pub(super) fn draw<T: Real>(
 
 /// `x = M^-1 b` by conjugate gradients from `x = 0`, products by `sums`, to the
 /// relative residual `|b - M x| <= tol |b|` (`tol` the Lanczos tolerance, the noise's
-/// own accuracy) within the Lanczos iteration cap; `r` holds the residual, `basis`
+/// own accuracy) within four times the Lanczos iteration cap (the solve stores no
+/// basis; `M` of 10^3 to 10^4 spheres apart at volume fraction 0.1 took 32 and 55
+/// iterations at `1e-3`); `r` holds the residual, `basis`
 /// (at least `2 n` vectors) the direction and its product. Sums in a fixed order.
 fn solve<T: Real>(
     p: &Params<T>,
@@ -70,7 +73,7 @@ fn solve<T: Real>(
     d.copy_from_slice(b);
     let goal = p.lanczos.tolerance * p.lanczos.tolerance * dot(b, b);
     let mut rr = dot(r, r);
-    let cap = p.lanczos.max_iterations;
+    let cap = 4 * p.lanczos.max_iterations;
     let mut k = 0;
     while rr > goal {
         if k == cap {
