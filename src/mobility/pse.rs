@@ -45,6 +45,13 @@ pub const XI_PSE: f64 = 0.5;
 /// The largest grid edge, in points (a bound on the storage a box can ask for).
 pub const MAX_GRID: usize = 2048;
 
+/// The tolerances [`Pse::with_xi`] accepts, `MIN_TOLERANCE ..= MAX_TOLERANCE`: below,
+/// the Ewald path is the tool (it sums to rounding); above, the rule's asymptotic
+/// error estimates no longer hold (a host checks a scene's tolerance against these).
+pub const MIN_TOLERANCE: f64 = 1e-12;
+/// See [`MIN_TOLERANCE`].
+pub const MAX_TOLERANCE: f64 = 0.1;
+
 /// A rejected PSE parameter, configuration or storage.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PseError {

@@ -4,7 +4,7 @@
 //! [box]
 //! size = [20.0, 20.0, 20.0]   # Lx, Ly, Lz: every edge finite and > 0
 //! method = "auto"             # "ewald" | "pse" | "auto" (default)
-//! tolerance = 1e-6            # the fast path's relative error (0 < tolerance < 1)
+//! tolerance = 1e-6            # the fast path's relative error (1e-12 to 0.1)
 //! ```
 //!
 //! The kernel's `Params::periodic`: the Ewald-summed RPY mobility (`docs/PERIODIC.md`),
@@ -17,7 +17,7 @@
 //! solver or noise needs the assembled mobility refuses it at its line
 //! ([`PseUnsupported`]); `"auto"` resolves by [`BoxMethod::resolve`] and the run's
 //! `scene.toml` names the method it picked. Refused at the value at fault: an edge not finite or not
-//! positive, a tolerance outside `(0, 1)`, a sphere whose radius is not below half the
+//! positive, a tolerance outside PSE's `[1e-12, 0.1]`, a sphere whose radius is not below half the
 //! smallest edge (it would overlap its own image), a box with a `[wall]` (the wall's
 //! image system is free space's), and (by the kernel's own check of the first step) a
 //! bond not shorter than half the smallest edge and the Oseen level. Rotation is
@@ -73,7 +73,7 @@ pub struct PeriodicBox {
     pub size: [f64; 3],
     /// How its mobility is computed.
     pub method: BoxMethod,
-    /// The fast path's relative error, `0 < tolerance < 1` (the Ewald path sums to
+    /// The fast path's relative error, `1e-12 <= tolerance <= 0.1` (the Ewald path sums to
     /// about the precision's epsilon whatever it says).
     pub tolerance: f64,
     /// Line of the `method` key in the scene file that set it (to place a run's
@@ -166,10 +166,20 @@ pub(super) fn resolve(
         "box tolerance",
         Bound::Positive,
     )?;
-    if let Some(t) = r.tolerance.as_ref().filter(|_| tolerance >= 1.0) {
+    // PSE's range, the kernel's (`Pse::with_xi`), refused here at the key rather than
+    // by the first step (for "ewald" too: the key is PSE's, and "auto" may pick it).
+    use hydrorattle::mobility::pse::{MAX_TOLERANCE, MIN_TOLERANCE};
+    if let Some(t) = r
+        .tolerance
+        .as_ref()
+        .filter(|_| !(MIN_TOLERANCE..=MAX_TOLERANCE).contains(&tolerance))
+    {
         return Err(issue(
             t.span(),
-            format!("box tolerance must be below 1 (a relative error), not {tolerance}"),
+            format!(
+                "box tolerance must be between {MIN_TOLERANCE:e} and {MAX_TOLERANCE} (PSE's relative error), not {}",
+                crate::output::format_f64(tolerance)
+            ),
         ));
     }
     let method = r.method.as_ref().map_or(BoxMethod::Auto, |m| *m.get_ref());
