@@ -342,8 +342,15 @@ fn main() {
         "crossover" => crossover(),
         "noise" => noise(),
         "step" => {
-            let ns: Vec<usize> = std::env::args().skip(2).map(|s| s.parse().unwrap()).collect();
-            steps(if ns.is_empty() { &[1_000, 10_000, 100_000] } else { &ns })
+            let ns: Vec<usize> = std::env::args()
+                .skip(2)
+                .map(|s| s.parse().unwrap())
+                .collect();
+            steps(if ns.is_empty() {
+                &[1_000, 10_000, 100_000]
+            } else {
+                &ns
+            })
         }
         "one" => {
             let n: usize = std::env::args()

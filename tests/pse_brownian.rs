@@ -38,7 +38,11 @@ type Arrays = (Vec<Cx<f64>>, Vec<usize>, Vec<<f64 as Real>::V3>);
 
 fn arrays(p: &Params<f64>, radius: &[f64]) -> Arrays {
     let z = pse_storage(p, radius).unwrap().expect("a PSE step");
-    (vec![[0.0; 2]; z.complex], vec![0; z.index], vec![f64::V3_ZERO; z.vectors])
+    (
+        vec![[0.0; 2]; z.complex],
+        vec![0; z.index],
+        vec![f64::V3_ZERO; z.vectors],
+    )
 }
 
 /// `draws` steps of `p` from the same configuration `s` (reset before each), the
@@ -194,7 +198,10 @@ fn check_lone(l: f64, steps: usize, seed: u64) {
         "L/a = {l}: D/D0 = {d:.5} +- {se:.5} (blocks {se_blocks:.5}), Hasimoto {want:.5}, {:+.2} se",
         (d - want) / se
     );
-    assert!((se_blocks / se - 1.0).abs() < 0.3, "block se {se_blocks} vs {se}");
+    assert!(
+        (se_blocks / se - 1.0).abs() < 0.3,
+        "block se {se_blocks} vs {se}"
+    );
     assert!((d - want).abs() < 3.0 * se, "L = {l}: D {d} vs {want}");
     // Power: the free value, and Hasimoto without its (a/L)^3 term, are far off.
     assert!(1.0 - want > 20.0 * se, "cannot tell the box");

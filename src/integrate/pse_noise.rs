@@ -67,7 +67,11 @@ fn solve<T: Real>(
     }
     let (d, q) = basis.split_at_mut(n);
     let q = &mut q[..n];
-    let dot = |a: &[T::V3], c: &[T::V3]| a.iter().zip(c).fold(T::ZERO, |t, (&u, &v)| t + T::dot(u, v));
+    let dot = |a: &[T::V3], c: &[T::V3]| {
+        a.iter()
+            .zip(c)
+            .fold(T::ZERO, |t, (&u, &v)| t + T::dot(u, v))
+    };
     x.fill(T::V3_ZERO);
     r.copy_from_slice(b);
     d.copy_from_slice(b);

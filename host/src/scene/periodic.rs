@@ -252,6 +252,18 @@ impl fmt::Display for PseUnsupported {
 
 impl std::error::Error for PseUnsupported {}
 
+/// Whether PSE's parameters for a box of edges `size`, spheres up to radius `a_max` and
+/// `tolerance` are within the kernel's bounds (`mobility::pse::Pse::new`: a grid edge
+/// of at most `MAX_GRID`, a support of at most `MAX_SUPPORT`, the tolerance's range):
+/// `"auto"` picks PSE only then ([`BoxMethod::resolve`] with it and "products only"),
+/// so that a resolved scene written back runs (a dilute suspension's box can need a
+/// grid past the bounds; the Ewald path has none). The rule of scenes and of the Python
+/// package's `mobility_dot`.
+pub fn pse_fits(size: [f64; 3], a_max: f64, tolerance: f64) -> bool {
+    hydrorattle::Periodic::new(size)
+        .is_ok_and(|cell| hydrorattle::mobility::pse::Pse::new(cell, a_max, tolerance).is_ok())
+}
+
 impl super::Scene {
     /// What in this scene needs the assembled mobility (so PSE cannot run it), or
     /// `None` where mobility products suffice: the overdamped or springs method
@@ -299,19 +311,14 @@ impl super::Scene {
         self
     }
 
-    /// Whether PSE's parameters for this box, its largest radius and its tolerance are
-    /// within the kernel's bounds (`mobility::pse::Pse::new`: a grid edge of at most
-    /// `MAX_GRID`, a support of at most `MAX_SUPPORT`): `"auto"` picks PSE only then,
-    /// so that the resolved scene written back runs (a dilute suspension's box can
-    /// need a grid past the bounds; the Ewald path has none).
+    /// Whether PSE's parameters for this box, its largest radius and its tolerance fit
+    /// the kernel's bounds ([`pse_fits`]).
     fn pse_fits(&self) -> bool {
         let Some(b) = self.periodic else {
             return true;
         };
         let a_max = self.radii().into_iter().fold(0.0, f64::max);
-        hydrorattle::Periodic::new(b.size).is_ok_and(|cell| {
-            hydrorattle::mobility::pse::Pse::new(cell, a_max, b.tolerance).is_ok()
-        })
+        pse_fits(b.size, a_max, b.tolerance)
     }
 
     /// Refuses a run of a box whose method is `"pse"` where the scene needs the
