@@ -69,8 +69,8 @@ def test_auto_picks_pse_where_it_serves():
     u2, w2 = hr.mobility_dot(pos, radii, f, t, box=box, method="ewald")
     assert np.array_equal(u, u2) and np.array_equal(w, w2)
     # Free draining: no pair interacts; "auto" leaves it to the kernel's own path.
-    fd = hr.mobility_dot(pos, radii, f, box=box, hydro="free")
-    assert np.array_equal(fd, hr.mobility_dot(pos, radii, f, box=box, hydro="free", method="ewald"))
+    fd = hr.mobility_dot(pos, radii, f, box=box, hydro="free-draining")
+    assert np.array_equal(fd, hr.mobility_dot(pos, radii, f, box=box, hydro="free-draining", method="ewald"))
     # A tolerance whose grid would pass the kernel's bounds: "auto" is the Ewald sum
     # (a dilute box of two small spheres at 1e-12), "pse" is refused.
     tiny = ([[1.0, 1.0, 1.0], [30.0, 40.0, 50.0]], [0.05, 0.05], np.ones((2, 3)))
