@@ -17,6 +17,13 @@ use crate::noise::Noise;
 use crate::params::{Drift, Params};
 use crate::real::Real;
 
+/// The step's deviate vectors, its midpoint and its displacement ([`draw`]).
+type Vectors<'a, T> = (
+    &'a mut [<T as Real>::V3],
+    &'a mut [<T as Real>::V3],
+    &'a mut [<T as Real>::V3],
+);
+
 /// PSE's Brownian draw for one step, before scaling: `w` the real part's deviates
 /// (the step's deviate vectors), then with [`Drift::Uncorrected`] `dx = L w`; with
 /// [`Drift::Midpoint`] `mid = L w` and `w <- M^-1 L w` (the solve's residual in `dx`,
@@ -28,7 +35,7 @@ pub(super) fn draw<T: Real>(
     s: &Start<'_, T>,
     sums: &dyn BoxProduct<T>,
     noise: &mut Noise,
-    (w, mid, dx): (&mut [T::V3], &mut [T::V3], &mut [T::V3]),
+    (w, mid, dx): Vectors<'_, T>,
     basis: &mut [T::V3],
     work: &mut [T],
 ) -> Result<u32, StepError> {
