@@ -85,10 +85,11 @@ fn particles_overlapping<const M: usize>(s: &[Sphere]) -> ParticleSet<f64, M> {
 
 /// The step's displacement covariance over 4000 draws against `2 kT dt M`, `M` the
 /// Ewald path's assembled mobility: 3 polydisperse spheres (an overlapping pair) in a
-/// `8 x 9 x 10` box with `Drift::Uncorrected`, 4 equal ones in `7^3` with
-/// `Drift::Midpoint` (`dt = 1e-4`: the midpoint moves the spheres by about `1e-2`, so
-/// `mu(x~)` differs from `mu(x)` by far less than the statistical error; the midpoint's
-/// solve `M^-1 L w` is what this checks there). PSE at `1e-4`, Lanczos at `1e-6`.
+/// `8 x 9 x 10` box with `Drift::Uncorrected`, 4 spheres in `7^3` with the default
+/// `Drift::Midpoint` (without bonds the step takes the uncorrected draw: the box's
+/// mobility is divergence-free; `dt = 1e-4`). PSE at `1e-4`, Lanczos at `1e-6`. The
+/// midpoint's solve `M^-1 L w` (bonds only) is run by `chain_end_to_end` and
+/// `host-demo/tests/periodic_scene.rs`.
 /// Standard error of the second moment `C_ab` of a zero-mean normal: `sqrt((M_aa M_bb +
 /// M_ab^2) / n)`; asserted within 5 of them entry by entry (the largest of 45 to 78
 /// entries), and the trace within 4 (`var = 2 sum M_ab^2 / n`). Power: a real part or
