@@ -10,7 +10,8 @@
 //! * a lone sphere's diffusion coefficient in cubic boxes against Hasimoto's
 //!   `1 - 2.8372974794806 a/L + (4 pi/3)(a/L)^3` (the constant written here).
 //!
-//! `cargo test --release --test pse_brownian -- --nocapture` (about 20 s on 2 cores);
+//! `cargo test --release --test pse_brownian -- --nocapture` (about 20 s of CPU, 45 s
+//! on the loaded 2 cores);
 //! the longer Hasimoto run with `-- --ignored`.
 
 mod common;
