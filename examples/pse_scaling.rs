@@ -9,6 +9,7 @@
 //! cargo run --release --example pse_scaling -- xi           # xi a = 0.3 ... 0.8 at N = 1e4
 //! cargo run --release --example pse_scaling -- crossover    # PSE vs Ewald, N = 10 ... 400
 //! cargo run --release --example pse_scaling -- noise        # the Brownian displacement
+//! cargo run --release --example pse_scaling -- step [N...]   # a Brownian step on PSE
 //! ```
 //!
 //! Times are the best of a few repetitions on whatever machine runs it (the development
@@ -37,6 +38,38 @@ fn suspension(n: usize, phi: f64, seed: u64) -> (f64, Vec<V>, Vec<f64>, Vec<V>) 
         .map(|_| f64::v3(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5))
         .collect();
     (l, pos, vec![1.0; n], force)
+}
+
+/// `n` unit spheres at volume fraction `phi` placed at random without overlap (a
+/// suspension a step with contacts could hold; overlapping random spheres make the
+/// mobility nearly singular): the box edge and positions. Rejection against the
+/// spheres already placed in the neighbouring cells of a grid of cells at least 2 wide.
+fn apart(n: usize, phi: f64, seed: u64) -> (f64, Vec<V>) {
+    let l = (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / phi).cbrt();
+    let c = ((l / 2.0).floor() as usize).max(1);
+    let mut cells: Vec<Vec<V>> = vec![vec![]; c * c * c];
+    let mut rng = Rng(seed);
+    let mut pos = Vec::with_capacity(n);
+    let idx = |x: f64| (((x / l) * c as f64) as usize).min(c - 1);
+    while pos.len() < n {
+        let p = f64::v3(rng.unit() * l, rng.unit() * l, rng.unit() * l);
+        let a = f64::v3_to_f64(p).map(idx);
+        let mut free = true;
+        for d in 0..27 {
+            let k: Vec<usize> = (0..3)
+                .map(|e| (a[e] + c + [d % 3, d / 3 % 3, d / 9][e] - 1) % c)
+                .collect();
+            for &q in &cells[k[0] + c * (k[1] + c * k[2])] {
+                let r = f64::v3_to_f64(p - q).map(|x| x - l * (x / l).round());
+                free &= r.iter().map(|x| x * x).sum::<f64>() >= 4.0;
+            }
+        }
+        if free {
+            cells[a[0] + c * (a[1] + c * a[2])].push(p);
+            pos.push(p);
+        }
+    }
+    (l, pos)
 }
 
 /// This thread's CPU time (user + system), seconds, from `/proc/thread-self/stat`
@@ -232,6 +265,75 @@ fn noise() {
     exponents(&ns, &times);
 }
 
+/// A whole Brownian step on the PSE path (`Params::pse = 1e-4`, `Overdamped`,
+/// matrix-free, `kT = 1`, `dt = 0.01`, no bonds, unit spheres apart at volume fraction
+/// 0.1 ([`apart`]) settling under gravity, Lanczos
+/// tolerance 1e-3, the default drift: without bonds the step takes PSE's uncorrected
+/// draw), against N (default 1e3, 1e4, 1e5): this thread's CPU time per step (best of
+/// 2, one step each) and the noise's Lanczos iterations (the near field's).
+fn steps(ns: &[usize]) {
+    use hydrorattle::integrate::{pse_storage, step_slices};
+    use hydrorattle::{Brownian, Drift, Layout, Method, NoForce, Params, State};
+    for drift in [Drift::Midpoint] {
+        let mut times = vec![];
+        for &n in ns {
+            let (l, pos0) = apart(n, 0.1, 7);
+            let rad = vec![1.0; n];
+            let mut p = Params::<f64>::new(0.01);
+            p.method = Method::Overdamped;
+            p.periodic = Some(Periodic::new([l; 3]).unwrap());
+            p.matrix_free = true;
+            p.allow_overlap = true;
+            p.pse = Some(1e-4);
+            p.brownian = Some(Brownian {
+                temperature: 1.0,
+                drift,
+            });
+            let size = pse_storage(&p, &rad).unwrap().unwrap();
+            let mut cx = vec![[0.0; 2]; size.complex];
+            let mut ix = vec![0usize; size.index];
+            let mut vx = vec![V::ZERO; size.vectors];
+            let mut buf = hydrorattle_heap::Buffers::<f64>::new(Layout::for_params(&p, n, 0));
+            let mut ws = buf.workspace().with_pse(&mut cx, &mut ix, &mut vx);
+            let density = vec![1.0; n];
+            let (mut pos, mut vel, mut omega) = (pos0.clone(), vec![V::ZERO; n], vec![V::ZERO; n]);
+            let (mut time, mut rng) = (0.0, Noise::new(11));
+            let mut report = None;
+            let mut one = || {
+                let state = State {
+                    pos: &mut pos,
+                    vel: &mut vel,
+                    omega: &mut omega,
+                    radius: &rad,
+                    density: &density,
+                    time: &mut time,
+                    noise: Some(&mut rng),
+                };
+                report = Some(step_slices(state, &[], &p, &mut ws, &mut NoForce).unwrap());
+            };
+            let t = (0..2)
+                .map(|_| {
+                    let (w, c) = (Instant::now(), cpu());
+                    one();
+                    match (c, cpu()) {
+                        (Some(a), Some(b)) => b - a,
+                        _ => w.elapsed().as_secs_f64(),
+                    }
+                })
+                .fold(f64::INFINITY, f64::min);
+            let r = report.unwrap();
+            println!(
+                "{drift:?} N {n:>6}: step {t:.3} s, noise iterations {}",
+                r.noise_iterations
+            );
+            times.push(t);
+        }
+        if ns.len() > 1 {
+            exponents(ns, &times);
+        }
+    }
+}
+
 fn main() {
     let arg = std::env::args().nth(1).unwrap_or_default();
     match arg.as_str() {
@@ -239,6 +341,17 @@ fn main() {
         "xi" => xi_scan(),
         "crossover" => crossover(),
         "noise" => noise(),
+        "step" => {
+            let ns: Vec<usize> = std::env::args()
+                .skip(2)
+                .map(|s| s.parse().unwrap())
+                .collect();
+            steps(if ns.is_empty() {
+                &[1_000, 10_000, 100_000]
+            } else {
+                &ns
+            })
+        }
         "one" => {
             let n: usize = std::env::args()
                 .nth(2)

@@ -445,10 +445,30 @@ impl From<crate::mobility::pse::PseError> for StepError {
                 "a PSE tolerance whose grid exceeds the bounds (mobility::pse::MAX_GRID, MAX_SUPPORT)",
             ),
             E::Length => Self::BadParameter("PSE: positions, radii and forces differ in length"),
-            E::Lanczos(_) => Self::Unsupported("PSE noise's Lanczos square root failed"),
+            E::Lanczos(e) => e.into(),
             E::Storage { .. } => Self::BadParameter(
                 "the workspace's PSE storage (Workspace::with_pse, at least integrate::pse_storage)",
             ),
+        }
+    }
+}
+
+/// A failed Lanczos square root (the noise's, or PSE's real part's) as the step's error,
+/// at the mobility stage.
+impl From<crate::noise::lanczos::LanczosError> for StepError {
+    fn from(e: crate::noise::lanczos::LanczosError) -> Self {
+        use crate::noise::lanczos::LanczosError as E;
+        match e {
+            E::NoConvergence { iterations, change } => Self::NoConvergence {
+                stage: Stage::Mobility,
+                iterations,
+                residual: change,
+            },
+            E::NotPositiveDefinite { .. } => Self::Linalg {
+                stage: Stage::Mobility,
+                error: LinalgError::NotPositiveDefinite { row: 0 },
+            },
+            E::Storage => Self::BadParameter("lanczos.max_iterations (> 0)"),
         }
     }
 }

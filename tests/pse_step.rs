@@ -1,9 +1,10 @@
 //! Steps on the PSE path (`Params::pse`, issue 27 item 2 in steps): the matrix-free
-//! product, the Krylov metric's product (bonds, contacts) and the Lanczos noise read
-//! `Pse::apply`. Each PSE step is checked against the same step on the exact Ewald
-//! path (itself checked against Hasimoto's expansion in `tests/periodic_step.rs`)
-//! within the requested tolerance; repeats give the same bits; the combinations that
-//! need the assembled matrix are refused, typed, with the state untouched.
+//! product and the Krylov metric's product (bonds, contacts) read `Pse::apply`; the
+//! Brownian noise is PSE's own (`Pse::noise_in`, tested in `tests/pse_brownian.rs`).
+//! Each PSE step is checked against the same step on the exact Ewald path (itself
+//! checked against Hasimoto's expansion in `tests/periodic_step.rs`) within the
+//! requested tolerance; repeats give the same bits; the combinations that need the
+//! assembled matrix are refused, typed, with the state untouched.
 
 mod common;
 
@@ -220,36 +221,6 @@ fn contacts_match_ewald() {
 
 fn min_image(r: [f64; 3]) -> [f64; 3] {
     r.map(|x| x - L * (x / L).round())
-}
-
-/// Brownian steps with the noise by Lanczos from PSE products: within the tolerance
-/// (plus the Lanczos tolerance) of the Ewald path's with the same draws, and the same
-/// bits on a repeat.
-#[test]
-fn thermal_matches_ewald_and_repeats() {
-    let s = suspension();
-    let none = BondSet::<f64, 0>::new();
-    let thermal = |tol| {
-        let mut p = boxed(Method::Overdamped, tol);
-        p.brownian = Some(Brownian::new(0.5));
-        p.lanczos.tolerance = 1e-9;
-        p
-    };
-    let go = |p: &Params<f64>| {
-        let mut ps = particles::<f64, N>(&s);
-        ps.noise = Some(hydrorattle::Noise::new(5));
-        run(&mut ps, &none, p, &mut NoForce, 2).unwrap()
-    };
-    let ewald = go(&thermal(None));
-    let pse = go(&thermal(Some(1e-5)));
-    let err = relative(&s, &ewald[1], &pse[1]);
-    println!("thermal tol 1e-5: PSE vs Ewald after 2 steps {err:.2e}");
-    assert!(err < 1e-4, "{err}");
-    let again = go(&thermal(Some(1e-5)));
-    let bits = |v: &Vec<Vec<[f64; 3]>>| -> Vec<u64> {
-        v.iter().flatten().flatten().map(|x| x.to_bits()).collect()
-    };
-    assert_eq!(bits(&pse), bits(&again));
 }
 
 /// What needs the assembled matrix is refused with PSE, typed, the state untouched;

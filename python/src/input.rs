@@ -49,6 +49,19 @@ pub fn spheres<T: Real>(
     radii: &[f64],
     densities: Option<&[f64]>,
 ) -> PyResult<(Vec<T::V3>, Vec<T>)> {
+    let (p, r) = each_sphere::<T>(py, pos, radii, densities)?;
+    check_pairs(&p, &r, true).map_err(|e| particle_error(py, e))?;
+    Ok((p, r))
+}
+
+/// [`spheres`] without the check of every pair (`O(N^2)`), for the PSE product, whose
+/// near field refuses a sphere inside another's image itself in `O(N)`.
+pub fn each_sphere<T: Real>(
+    py: Python<'_>,
+    pos: &[[f64; 3]],
+    radii: &[f64],
+    densities: Option<&[f64]>,
+) -> PyResult<(Vec<T::V3>, Vec<T>)> {
     let mut p = Vec::with_capacity(pos.len());
     let mut r = Vec::with_capacity(pos.len());
     for (k, (&x, &a)) in pos.iter().zip(radii).enumerate() {
@@ -58,7 +71,6 @@ pub fn spheres<T: Real>(
         p.push(q.position);
         r.push(q.radius);
     }
-    check_pairs(&p, &r, true).map_err(|e| particle_error(py, e))?;
     Ok((p, r))
 }
 

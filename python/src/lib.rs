@@ -1,7 +1,8 @@
 //! `hydrorattle._hydrorattle`: the Python extension module of the hydrorattle kernel
 //! (PyO3). The Python package `hydrorattle` (in `pysrc/`) wraps it:
 //!
-//! * [`mobility`]: the dense RPY / Oseen / free-draining mobility and its product;
+//! * [`mobility`]: the dense RPY / Oseen / free-draining mobility and its product
+//!   (in a box by PSE where it fits: [`pse`]);
 //! * [`system`]: a system stepped by the kernel through the host library's
 //!   [`Engine`](hydrorattle_host::sim::Engine);
 //! * [`runs`]: scene files and runs, through the CLI's own library code;
@@ -16,6 +17,7 @@ mod errors;
 mod input;
 mod mobility;
 mod params;
+mod pse;
 mod runs;
 mod shared;
 mod stepping;

@@ -195,7 +195,7 @@ fn product<'py, T: Real + Element>(
 
 /// Mobility product; see the Python docstring of `hydrorattle.mobility_dot`.
 #[pyfunction]
-#[pyo3(signature = (positions, radii, forces, torques=None, viscosity=1.0, hydro="rpy", rotation=false, precision="f64", wall=None, r#box=None, threads=0))]
+#[pyo3(signature = (positions, radii, forces, torques=None, viscosity=1.0, hydro="rpy", rotation=false, precision="f64", wall=None, r#box=None, threads=0, method="auto", tolerance=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn mobility_dot<'py>(
     py: Python<'py>,
@@ -210,6 +210,8 @@ pub fn mobility_dot<'py>(
     wall: Option<f64>,
     r#box: Option<[f64; 3]>,
     threads: usize,
+    method: &str,
+    tolerance: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let pos = rows(&positions, "positions")?;
     let radii = column(&radii, "radii", pos.len())?;
@@ -245,9 +247,45 @@ pub fn mobility_dot<'py>(
     let eta = crate::input::viscosity(viscosity)?;
     let level = crate::input::hydro(hydro)?;
     let g = geometry(wall, r#box);
+    let asked = crate::pse::method(method, tolerance)?;
+    let rotation = rotation || t.is_some();
+    if let Some(size) = r#box.filter(|_| wall.is_none()) {
+        if crate::pse::uses_pse(asked, Some(size), radii, level, rotation)? {
+            let pse = (size, asked.1);
+            return Ok(match is_f32(precision)? {
+                true => pse_product::<f32>(py, pos, radii, f, eta, pse, threads)?.into_any(),
+                false => pse_product::<f64>(py, pos, radii, f, eta, pse, threads)?.into_any(),
+            });
+        }
+    } else {
+        crate::pse::uses_pse(asked, None, radii, level, rotation)?;
+    }
     if is_f32(precision)? {
         product::<f32>(py, pos, radii, f, t, eta, level, rotation, g, threads)
     } else {
         product::<f64>(py, pos, radii, f, t, eta, level, rotation, g, threads)
     }
+}
+
+/// Velocities in precision `T` in the box `size` by PSE to `tolerance`: the spheres
+/// checked one by one here, pairs by the near field (`O(N)`), the pieces run on
+/// `threads` threads from the kernel's banded size on.
+fn pse_product<'py, T: Real + Element>(
+    py: Python<'py>,
+    pos: &[[f64; 3]],
+    radii: &[f64],
+    forces: &[[f64; 3]],
+    eta: f64,
+    (size, tolerance): ([f64; 3], f64),
+    threads: usize,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let (pos, r) = crate::input::each_sphere::<T>(py, pos, radii, None)?;
+    let n = pos.len();
+    let f: Vec<T::V3> = forces.iter().map(|&x| T::v3_from(x)).collect();
+    let par = threads_for(n, threads)?;
+    let mut u = vec![T::V3_ZERO; n];
+    let par = par.as_deref();
+    py.detach(|| crate::pse::product::<T>(size, tolerance, eta, &pos, &r, &f, &mut u, par))
+        .map_err(|e| value_error(py, e))?;
+    Ok(to_array::<T>(py, &u))
 }

@@ -203,7 +203,6 @@ pub(super) fn kick<T: Real>(
             error,
         })?;
     }
-    noise.fill::<T>(xi);
     let amplitude = (T::TWO * kt * dt).sqrt();
     let Krylov {
         basis,
@@ -212,6 +211,30 @@ pub(super) fn kick<T: Real>(
         bands,
         copied,
     } = krylov;
+    // On the PSE path the noise is PSE's own (`pse_noise`): no product with the whole
+    // mobility but the midpoint's solve. Without bonds to project onto, the midpoint's
+    // mean is `kT dt div M`, zero for the box's RPY mobility (each Fourier mode is
+    // transverse, `P(k) k = 0`), so the midpoint (a solve of some 30 to 50 products)
+    // is left out: the uncorrected draw, whose covariance is `M` exactly.
+    #[cfg(feature = "pse")]
+    if let Some(sums) = s.ewald.and_then(|e| e.pse()) {
+        let bonded = held.as_ref().is_some_and(|h| !h.bonds.is_empty());
+        let drift = if bonded { b.drift } else { Drift::Uncorrected };
+        let vectors = (&mut *xi, &mut *mid, &mut *dx);
+        let iterations = super::pse_noise::draw(p, drift, s, sums, noise, vectors, basis, work)?;
+        let projected = match drift {
+            Drift::Uncorrected => {
+                dx.iter_mut().for_each(|d| *d *= amplitude);
+                0
+            }
+            Drift::Midpoint => {
+                let mids = (mu, fac, xi, mid, dx);
+                midpoint(p, b, s, mids, held, (par, bands), lanczos)?
+            }
+        };
+        return Ok((iterations, projected));
+    }
+    noise.fill::<T>(xi);
     // `w = mu v` at the start: the stored mobility in bands, or matrix-free (the start
     // has passed a product at these positions already, so no pair is nested). In free
     // space (symmetric blocks) a large f64 mobility is read from a reduced copy instead
@@ -255,54 +278,81 @@ pub(super) fn kick<T: Real>(
                 linalg::lower_mul::<T>(fac, n, xi, mid);
                 linalg::solve_upper::<T>(fac, n, xi);
             }
-            let half = (kt * dt * T::HALF).sqrt();
-            for (m, &r) in mid.iter_mut().zip(s.pos) {
-                *m = r + *m * half;
-            }
-            for z in xi.iter_mut() {
-                *z *= amplitude;
-            }
-            // dx = P(x~) mu(x~) xi: the factor's storage takes mu(x~), assembled and
-            // applied (matrix-free: applied only), above the wall if there is one. Free
-            // draining's mobility without a wall does not depend on the positions:
-            // mu(x~) is mu, and is not assembled again.
-            let mid = &*mid;
-            let same = p.hydro == Hydro::FreeDraining && p.wall.is_none() && !p.matrix_free;
-            let mu_mid: &[T::M3] = if same {
-                parallel::product::<T>(par, mu, n, xi, dx, bands);
-                mu
-            } else {
-                mobility_product(p, s.ewald, mid, s.radius, fac, xi, dx, par, bands)?;
-                if p.matrix_free { &[] } else { fac }
-            };
-            if let Some(h) = held {
-                bond_vectors(h.bonds, mid, super::cell(p), h.grad_mid);
-                h.kappa.fill(T::ZERO);
-                let par = h.scratch.par;
-                let metric = mobility_metric(
-                    p,
-                    s.ewald,
-                    h.bonds,
-                    mid,
-                    s.radius,
-                    mu_mid,
-                    h.grad_mid,
-                    T::ONE,
-                    h.disp,
-                    (par, &[]),
-                );
-                let solver = midpoint_solver(p, lanczos, h.bonds, h.grad_mid, dx);
-                let problem = Problem::Velocities {
-                    bond: h.grad_mid,
-                    dt: T::ONE,
-                };
-                let stats =
-                    constraints::solve(problem, &metric, h.bonds, &solver, dx, h.kappa, h.scratch)?;
-                projected = stats.iterations;
-            }
+            let mids = (mu, &mut *fac, xi, mid, dx);
+            projected = midpoint(p, b, s, mids, held, (par, bands), lanczos)?;
         }
     }
     Ok((iterations, projected))
+}
+
+/// The midpoint's half of [`kick`], from `mid = L xi` and `xi = L^-T xi` (any `L` with
+/// `L L^T = mu` and the same draws: `E[(L xi) (L^-T xi)^T] = I` is what the drift
+/// needs): `mid` becomes `x~ = x + sqrt(kT dt / 2) L xi`, `xi` is scaled by
+/// `sqrt(2 kT dt)`, and `dx = P(x~) mu(x~) xi` (without `held`, unprojected). Returns
+/// the projection's iterations.
+#[allow(clippy::type_complexity)]
+fn midpoint<T: Real>(
+    p: &Params<T>,
+    b: Brownian<T>,
+    s: &Start<'_, T>,
+    (mu, fac, xi, mid, dx): (
+        &[T::M3],
+        &mut [T::M3],
+        &mut [T::V3],
+        &mut [T::V3],
+        &mut [T::V3],
+    ),
+    held: Option<Held<'_, '_, T>>,
+    (par, bands): (&dyn Parallel, &mut [T::V3]),
+    lanczos: bool,
+) -> Result<u32, StepError> {
+    let (n, dt, kt) = (s.pos.len(), p.dt, b.temperature);
+    let amplitude = (T::TWO * kt * dt).sqrt();
+    let half = (kt * dt * T::HALF).sqrt();
+    for (m, &r) in mid.iter_mut().zip(s.pos) {
+        *m = r + *m * half;
+    }
+    for z in xi.iter_mut() {
+        *z *= amplitude;
+    }
+    // dx = P(x~) mu(x~) xi: the factor's storage takes mu(x~), assembled and applied
+    // (matrix-free: applied only), above the wall if there is one. Free draining's
+    // mobility without a wall does not depend on the positions: mu(x~) is mu, and is
+    // not assembled again.
+    let mid = &*mid;
+    let same = p.hydro == Hydro::FreeDraining && p.wall.is_none() && !p.matrix_free;
+    let mu_mid: &[T::M3] = if same {
+        parallel::product::<T>(par, mu, n, xi, dx, bands);
+        mu
+    } else {
+        mobility_product(p, s.ewald, mid, s.radius, fac, xi, dx, par, bands)?;
+        if p.matrix_free { &[] } else { fac }
+    };
+    let Some(h) = held else {
+        return Ok(0);
+    };
+    bond_vectors(h.bonds, mid, super::cell(p), h.grad_mid);
+    h.kappa.fill(T::ZERO);
+    let par = h.scratch.par;
+    let metric = mobility_metric(
+        p,
+        s.ewald,
+        h.bonds,
+        mid,
+        s.radius,
+        mu_mid,
+        h.grad_mid,
+        T::ONE,
+        h.disp,
+        (par, &[]),
+    );
+    let solver = midpoint_solver(p, lanczos, h.bonds, h.grad_mid, dx);
+    let problem = Problem::Velocities {
+        bond: h.grad_mid,
+        dt: T::ONE,
+    };
+    let stats = constraints::solve(problem, &metric, h.bonds, &solver, dx, h.kappa, h.scratch)?;
+    Ok(stats.iterations)
 }
 
 /// The solver of the midpoint's projection `P(x~) mu(x~) xi` of the noise `dx` (before
@@ -336,16 +386,5 @@ fn midpoint_solver<T: Real>(
 
 /// A failed Lanczos square root as the step's error (at the mobility stage).
 fn refused(e: LanczosError) -> StepError {
-    match e {
-        LanczosError::NoConvergence { iterations, change } => StepError::NoConvergence {
-            stage: Stage::Mobility,
-            iterations,
-            residual: change,
-        },
-        LanczosError::NotPositiveDefinite { .. } => StepError::Linalg {
-            stage: Stage::Mobility,
-            error: crate::error::LinalgError::NotPositiveDefinite { row: 0 },
-        },
-        LanczosError::Storage => StepError::BadParameter("lanczos.max_iterations (> 0)"),
-    }
+    e.into()
 }

@@ -21,6 +21,8 @@ pub mod geometry;
 mod overdamped;
 #[cfg(feature = "periodic")]
 mod periodic;
+#[cfg(feature = "pse")]
+mod pse_noise;
 mod rattle;
 mod springs;
 mod stable;
@@ -70,7 +72,9 @@ pub struct StepReport<T> {
     /// contacts or a wall).
     pub contact_rounds: u32,
     /// Lanczos iterations of the thermal noise's square root ([`Params::noise_sqrt`]);
-    /// 0 without noise or with the Cholesky factor.
+    /// 0 without noise or with the Cholesky factor. On the PSE path
+    /// ([`Params::pse`]): the near field's Lanczos iterations plus, with bonds and the
+    /// midpoint, the conjugate-gradient iterations of its solve `M^-1 L w`.
     pub noise_iterations: u32,
 }
 

@@ -34,7 +34,6 @@ pub use spread::MAX_SUPPORT;
 use crate::error::ParticleError;
 use crate::mobility::periodic::real::Split;
 use crate::mobility::periodic::{Periodic, PeriodicError};
-use crate::noise::Noise;
 use crate::noise::lanczos::LanczosError;
 use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
@@ -45,6 +44,13 @@ pub const XI_PSE: f64 = 0.5;
 
 /// The largest grid edge, in points (a bound on the storage a box can ask for).
 pub const MAX_GRID: usize = 2048;
+
+/// The tolerances [`Pse::with_xi`] accepts, `MIN_TOLERANCE ..= MAX_TOLERANCE`: below,
+/// the Ewald path is the tool (it sums to rounding); above, the rule's asymptotic
+/// error estimates no longer hold (a host checks a scene's tolerance against these).
+pub const MIN_TOLERANCE: f64 = 1e-12;
+/// See [`MIN_TOLERANCE`].
+pub const MAX_TOLERANCE: f64 = 0.1;
 
 /// A rejected PSE parameter, configuration or storage.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -101,11 +107,11 @@ struct Spheres<'a, T: Real> {
     order: &'a [usize],
 }
 
-/// What the wave stage transforms: the spread forces (the product), or white noise on
-/// the grid (the Brownian displacement).
+/// What the wave stage transforms: the spread forces (the product), or the white noise
+/// already drawn on the grid (the Brownian displacement, [`Pse::noise_in`]).
 enum Source<'a, T: Real> {
     Force(&'a [T::V3]),
-    Noise(&'a mut Noise),
+    Noise,
 }
 
 /// Which part of the mobility [`Pse::apply`] applies.
@@ -304,7 +310,7 @@ impl<T: Real> Pse<T> {
         let slab = 3 * mx * my;
         // Spreading and the x, y transforms by slabs of planes (in parallel), the z
         // transforms and the kernel whole (their lines cross every slab).
-        let noise = matches!(source, Source::Noise(_));
+        let noise = matches!(source, Source::Noise);
         match source {
             Source::Force(force) => {
                 let _ = jobs::pieces(par, (&mut *grid, mz, slab), jobs::none(), |z0, g, _| {
@@ -315,10 +321,8 @@ impl<T: Real> Pse<T> {
                     Ok::<(), Infallible>(())
                 });
             }
-            // White noise of unit variance at every point (the generator's order).
-            Source::Noise(rng) => grid.iter_mut().for_each(|v| {
-                *v = [T::from_f64(rng.normal()), T::ZERO];
-            }),
+            // White noise of unit variance at every point, drawn by `noise_in`.
+            Source::Noise => {}
         }
         let planes = |inverse: bool| {
             move |_: usize, g: &mut [Cx<T>], sc: &mut [Cx<T>]| {

@@ -22,6 +22,8 @@ use crate::error::StepError;
 use crate::mobility::periodic::{self, Ewald};
 #[cfg(feature = "pse")]
 use crate::mobility::pse::{Part, Pse, PseStorage};
+#[cfg(feature = "pse")]
+use crate::noise::{Noise, lanczos::Lanczos};
 use crate::real::Real;
 
 /// The step's periodic sums: Ewald's parameters, or PSE's with the caller's storage.
@@ -44,6 +46,23 @@ pub trait BoxProduct<T: Real> {
         f: &[T::V3],
         u: &mut [T::V3],
     ) -> Result<(), StepError>;
+
+    /// `out` = a Brownian displacement of covariance `M` by the sums' own noise
+    /// ([`Pse::noise_in`]: the real part by Lanczos to `s` from the deviates `z`,
+    /// the wave part from white noise on the grid), drawn from `rng`; `basis` and
+    /// `work` hold the Lanczos basis. Returns the Lanczos iterations.
+    #[cfg(feature = "pse")]
+    #[allow(clippy::too_many_arguments)]
+    fn noise(
+        &self,
+        eta: T,
+        spheres: (&[T::V3], &[T]),
+        rng: &mut Noise,
+        s: Lanczos<T>,
+        z: &mut [T::V3],
+        out: &mut [T::V3],
+        scratch: (&mut [T::V3], &mut [T]),
+    ) -> Result<u32, StepError>;
 }
 
 /// PSE's parameters and the caller's storage for one step's products.
@@ -82,6 +101,24 @@ impl<T: Real> BoxProduct<T> for PseStep<'_, T> {
             .pse
             .apply(Part::Both, eta, pos, radius, f, u, &mut store)?)
     }
+
+    fn noise(
+        &self,
+        eta: T,
+        spheres: (&[T::V3], &[T]),
+        rng: &mut Noise,
+        s: Lanczos<T>,
+        z: &mut [T::V3],
+        out: &mut [T::V3],
+        scratch: (&mut [T::V3], &mut [T]),
+    ) -> Result<u32, StepError> {
+        let mut store = self
+            .store
+            .try_borrow_mut()
+            .map_err(|_| StepError::Unsupported("a PSE draw inside a product (storage in use)"))?;
+        let pse = self.pse;
+        Ok(pse.noise_in(eta, spheres, rng, s, z, out, &mut store, scratch)?)
+    }
 }
 
 impl<T: Real> Clone for BoxSums<'_, T> {
@@ -103,6 +140,15 @@ impl<T: Real> fmt::Debug for BoxSums<'_, T> {
 }
 
 impl<'a, T: Real> BoxSums<'a, T> {
+    /// The PSE sums' own products and noise, where the step sums by PSE.
+    #[cfg(feature = "pse")]
+    pub fn pse(self) -> Option<&'a dyn BoxProduct<T>> {
+        match self {
+            Self::Ewald(_) => None,
+            Self::Pse(p) => Some(p),
+        }
+    }
+
     /// The Ewald parameters, where the step sums by Ewald (`None` on the PSE path,
     /// which has no pair blocks).
     pub fn ewald(self) -> Option<&'a Ewald<T>> {

@@ -168,8 +168,35 @@ impl Noise {
     /// Fills `out` with independent standard normal vectors, bead by bead (x, y, z);
     /// for a split generator, with its leaf of the bridge ([`Noise::split`]).
     pub fn fill<T: Real>(&mut self, out: &mut [T::V3]) {
-        for v in out.iter_mut() {
-            *v = T::v3_from(self.vector());
+        self.fill_parts::<T>(out, &mut []);
+    }
+
+    /// [`Noise::fill`] of `head` followed by `tail` as one sequence: `head`'s vectors,
+    /// then `tail` three values at a time (its real parts, the imaginary parts set to
+    /// zero; a `tail` not a multiple of three leaves its last values as they were).
+    /// For a split generator the bridge runs over the whole sequence, so that the
+    /// leaves of both parts add up to the unsplit draw (PSE's noise: the real part's
+    /// vectors, then the white noise on the wave grid).
+    pub fn fill_parts<T: Real>(&mut self, head: &mut [T::V3], tail: &mut [[T; 2]]) {
+        let n = head.len();
+        let count = n + tail.len() / 3;
+        // Writes (`sign` None) or mixes (`sign` the path's half) the `k`-th vector.
+        let mut put = |k: usize, x: [f64; 3], sign: Option<T>, root: T| match (k < n, sign) {
+            (true, None) => head[k] = T::v3_from(x),
+            (true, Some(s)) => head[k] = (head[k] + T::v3_from(x) * s) * root,
+            (false, _) => {
+                for (c, &x) in x.iter().enumerate() {
+                    let v = &mut tail[3 * (k - n) + c];
+                    v[0] = match sign {
+                        None => T::from_f64(x),
+                        Some(s) => (v[0] + T::from_f64(x) * s) * root,
+                    };
+                    v[1] = T::ZERO;
+                }
+            }
+        };
+        for k in 0..count {
+            put(k, self.vector(), None, T::ONE);
         }
         let Part { depth, index } = self.part;
         let root = T::from_f64(core::f64::consts::FRAC_1_SQRT_2);
@@ -182,10 +209,10 @@ impl Noise {
                 -T::ONE
             };
             for node in 0..1u32 << (level - 1) {
-                for v in out.iter_mut() {
-                    let eta = T::v3_from(self.vector());
+                for k in 0..count {
+                    let eta = self.vector();
                     if node == parent {
-                        *v = (*v + eta * sign) * root;
+                        put(k, eta, Some(sign), root);
                     }
                 }
             }

@@ -100,7 +100,7 @@ fn pse_runs_where_products_suffice_and_is_refused_at_its_line_elsewhere() {
 
 #[test]
 fn bad_boxes_are_refused_at_their_line() {
-    let cases: [(&str, &str, usize, &str); 8] = [
+    let cases: [(&str, &str, usize, &str); 10] = [
         (
             "size = [10, 10, 12]",
             "size = [10, 0, 12]",
@@ -135,7 +135,19 @@ fn bad_boxes_are_refused_at_their_line() {
             "size = [10, 10, 12]",
             "size = [10, 10, 12]\ntolerance = 1.5",
             14,
-            "box tolerance must be below 1",
+            "box tolerance must be between 1e-12 and 0.1 (PSE's relative error), not 1.5",
+        ),
+        (
+            "size = [10, 10, 12]",
+            "size = [10, 10, 12]\ntolerance = 0.5",
+            14,
+            "between 1e-12 and 0.1 (PSE's relative error), not 0.5",
+        ),
+        (
+            "size = [10, 10, 12]",
+            "size = [10, 10, 12]\nmethod = \"ewald\"\ntolerance = 1e-13",
+            15,
+            "box tolerance must be between 1e-12 and 0.1",
         ),
         (
             "size = [10, 10, 12]",

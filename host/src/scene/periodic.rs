@@ -4,7 +4,7 @@
 //! [box]
 //! size = [20.0, 20.0, 20.0]   # Lx, Ly, Lz: every edge finite and > 0
 //! method = "auto"             # "ewald" | "pse" | "auto" (default)
-//! tolerance = 1e-6            # the fast path's relative error (0 < tolerance < 1)
+//! tolerance = 1e-6            # the fast path's relative error (1e-12 to 0.1)
 //! ```
 //!
 //! The kernel's `Params::periodic`: the Ewald-summed RPY mobility (`docs/PERIODIC.md`),
@@ -17,7 +17,7 @@
 //! solver or noise needs the assembled mobility refuses it at its line
 //! ([`PseUnsupported`]); `"auto"` resolves by [`BoxMethod::resolve`] and the run's
 //! `scene.toml` names the method it picked. Refused at the value at fault: an edge not finite or not
-//! positive, a tolerance outside `(0, 1)`, a sphere whose radius is not below half the
+//! positive, a tolerance outside PSE's `[1e-12, 0.1]`, a sphere whose radius is not below half the
 //! smallest edge (it would overlap its own image), a box with a `[wall]` (the wall's
 //! image system is free space's), and (by the kernel's own check of the first step) a
 //! bond not shorter than half the smallest edge and the Oseen level. Rotation is
@@ -73,7 +73,7 @@ pub struct PeriodicBox {
     pub size: [f64; 3],
     /// How its mobility is computed.
     pub method: BoxMethod,
-    /// The fast path's relative error, `0 < tolerance < 1` (the Ewald path sums to
+    /// The fast path's relative error, `1e-12 <= tolerance <= 0.1` (the Ewald path sums to
     /// about the precision's epsilon whatever it says).
     pub tolerance: f64,
     /// Line of the `method` key in the scene file that set it (to place a run's
@@ -166,10 +166,20 @@ pub(super) fn resolve(
         "box tolerance",
         Bound::Positive,
     )?;
-    if let Some(t) = r.tolerance.as_ref().filter(|_| tolerance >= 1.0) {
+    // PSE's range, the kernel's (`Pse::with_xi`), refused here at the key rather than
+    // by the first step (for "ewald" too: the key is PSE's, and "auto" may pick it).
+    use hydrorattle::mobility::pse::{MAX_TOLERANCE, MIN_TOLERANCE};
+    if let Some(t) = r
+        .tolerance
+        .as_ref()
+        .filter(|_| !(MIN_TOLERANCE..=MAX_TOLERANCE).contains(&tolerance))
+    {
         return Err(issue(
             t.span(),
-            format!("box tolerance must be below 1 (a relative error), not {tolerance}"),
+            format!(
+                "box tolerance must be between {MIN_TOLERANCE:e} and {MAX_TOLERANCE} (PSE's relative error), not {}",
+                crate::output::format_f64(tolerance)
+            ),
         ));
     }
     let method = r.method.as_ref().map_or(BoxMethod::Auto, |m| *m.get_ref());
@@ -242,6 +252,18 @@ impl fmt::Display for PseUnsupported {
 
 impl std::error::Error for PseUnsupported {}
 
+/// Whether PSE's parameters for a box of edges `size`, spheres up to radius `a_max` and
+/// `tolerance` are within the kernel's bounds (`mobility::pse::Pse::new`: a grid edge
+/// of at most `MAX_GRID`, a support of at most `MAX_SUPPORT`, the tolerance's range):
+/// `"auto"` picks PSE only then ([`BoxMethod::resolve`] with it and "products only"),
+/// so that a resolved scene written back runs (a dilute suspension's box can need a
+/// grid past the bounds; the Ewald path has none). The rule of scenes and of the Python
+/// package's `mobility_dot`.
+pub fn pse_fits(size: [f64; 3], a_max: f64, tolerance: f64) -> bool {
+    hydrorattle::Periodic::new(size)
+        .is_ok_and(|cell| hydrorattle::mobility::pse::Pse::new(cell, a_max, tolerance).is_ok())
+}
+
 impl super::Scene {
     /// What in this scene needs the assembled mobility (so PSE cannot run it), or
     /// `None` where mobility products suffice: the overdamped or springs method
@@ -289,19 +311,14 @@ impl super::Scene {
         self
     }
 
-    /// Whether PSE's parameters for this box, its largest radius and its tolerance are
-    /// within the kernel's bounds (`mobility::pse::Pse::new`: a grid edge of at most
-    /// `MAX_GRID`, a support of at most `MAX_SUPPORT`): `"auto"` picks PSE only then,
-    /// so that the resolved scene written back runs (a dilute suspension's box can
-    /// need a grid past the bounds; the Ewald path has none).
+    /// Whether PSE's parameters for this box, its largest radius and its tolerance fit
+    /// the kernel's bounds ([`pse_fits`]).
     fn pse_fits(&self) -> bool {
         let Some(b) = self.periodic else {
             return true;
         };
         let a_max = self.radii().into_iter().fold(0.0, f64::max);
-        hydrorattle::Periodic::new(b.size).is_ok_and(|cell| {
-            hydrorattle::mobility::pse::Pse::new(cell, a_max, b.tolerance).is_ok()
-        })
+        pse_fits(b.size, a_max, b.tolerance)
     }
 
     /// Refuses a run of a box whose method is `"pse"` where the scene needs the

@@ -224,6 +224,8 @@ def mobility_dot(
     wall: Optional[float] = None,
     box: Optional["tuple[float, float, float]"] = None,
     threads: int = 0,
+    method: str = "auto",
+    tolerance: Optional[float] = None,
 ) -> Union[np.ndarray, "tuple[np.ndarray, np.ndarray]"]:
     """Velocities of spheres under ``forces`` (and ``torques``), ``M [F; T]``.
 
@@ -235,10 +237,20 @@ def mobility_dot(
     ``F / (eta L^2)``) through the packed grand mobility (``O(N^2)`` memory).
     ``wall`` and ``box`` as :func:`mobility`.
 
-    ``threads``: the matrix-free product in free space runs its 16 bands of rows on
-    this many threads (0: every core) from ``N = 512`` on; the result has the same bits
-    on any number of threads (and below 512 those of the stored matrix times the
-    forces). Above a wall, in a box and with rotation it runs on one thread.
+    ``method`` (in a box): ``"ewald"``, the exact Ewald sum (``O(N^2)``, to rounding);
+    ``"pse"``, the positively split Ewald fast path (``O(N log N)``, relative error
+    below ``tolerance``, translation and the RPY level only); ``"auto"`` (default),
+    PSE where it can serve (no torques or rotation, ``hydro="rpy"``) and its grid fits
+    the kernel's bounds, the Ewald sum otherwise: the rule of a scene's
+    ``[box] method = "auto"``. ``tolerance``: PSE's relative error, ``1e-12`` to
+    ``0.1`` (default ``1e-6``, as in scenes). Outside a box ``method`` is ignored
+    (``"pse"`` is a ``ValueError``).
+
+    ``threads``: the matrix-free product in free space and the PSE product run on this
+    many threads (0: every core) from ``N = 512`` on; the result has the same bits on
+    any number of threads (and below 512 in free space those of the stored matrix times
+    the forces). Above a wall, by the Ewald sum in a box and with rotation it runs on
+    one thread.
     """
     pos = _rows(positions, "positions")
     n = len(pos)
@@ -256,6 +268,8 @@ def mobility_dot(
         _wall(wall),
         _box(box),
         _count(threads, "threads"),
+        method,
+        None if tolerance is None else _real(tolerance, "tolerance"),
     )
 
 

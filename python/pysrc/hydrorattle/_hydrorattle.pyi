@@ -68,6 +68,8 @@ def mobility_dot(
     wall: Optional[float] = ...,
     box: Optional[tuple[float, float, float]] = ...,
     threads: int = ...,
+    method: str = ...,
+    tolerance: Optional[float] = ...,
 ) -> Any: ...
 def load_scene_json(path: Union[str, PathLike[str]]) -> str: ...
 def run_scene(

@@ -36,11 +36,6 @@ impl<T: Real> Pse<T> {
         (basis, work): (&mut [T::V3], &mut [T]),
     ) -> Result<u32, PseError> {
         let n = pos.len();
-        out.fill(T::V3_ZERO);
-        self.check(eta, pos, radius, out, out, store)?;
-        if n == 0 {
-            return Ok(0);
-        }
         let (vectors, scalars) = Self::noise_storage(&s, n);
         if basis.len() < vectors || work.len() < scalars {
             return Err(PseError::Storage {
@@ -49,7 +44,44 @@ impl<T: Real> Pse<T> {
             });
         }
         let (basis, z) = basis.split_at_mut(vectors - n);
-        rng.fill::<T>(&mut z[..n]);
+        self.noise_in(eta, (pos, radius), rng, s, z, out, store, (basis, work))
+    }
+
+    /// [`Pse::noise`] with the `n` deviates `z` of the real part in the caller's array
+    /// (a step keeps them in its own vectors) and `basis` of [`lanczos::vectors`]`(cap,
+    /// n)` vectors. The deviates of both parts are one draw ([`Noise::fill_parts`]: a
+    /// split generator's bridge spans both) taken before anything else; on error `out`
+    /// is unspecified and `rng` has moved on (a step draws from a copy).
+    #[allow(clippy::too_many_arguments)]
+    pub fn noise_in(
+        &self,
+        eta: T,
+        (pos, radius): (&[T::V3], &[T]),
+        rng: &mut Noise,
+        s: Lanczos<T>,
+        z: &mut [T::V3],
+        out: &mut [T::V3],
+        store: &mut PseStorage<'_, T>,
+        (basis, work): (&mut [T::V3], &mut [T]),
+    ) -> Result<u32, PseError> {
+        let n = pos.len();
+        out.fill(T::V3_ZERO);
+        self.check(eta, pos, radius, out, out, store)?;
+        if n == 0 {
+            return Ok(0);
+        }
+        let cap = s.max_iterations as usize;
+        let (vectors, scalars) = (lanczos::vectors(cap, n), lanczos::scalars(cap));
+        if basis.len() < vectors || work.len() < scalars || z.len() < n {
+            return Err(PseError::Storage {
+                need: [vectors + n, scalars, 0],
+                have: [basis.len() + z.len(), work.len(), 0],
+            });
+        }
+        // The grid is the wave stage's alone: the near field's products leave it be.
+        let [mx, my, mz] = self.grid.m;
+        let z = &mut z[..n];
+        rng.fill_parts::<T>(z, &mut store.complex[..3 * mx * my * mz]);
         let mut failed = None;
         let product = |v: &[T::V3], w: &mut [T::V3]| {
             if failed.is_none() {
@@ -58,7 +90,7 @@ impl<T: Real> Pse<T> {
                 }
             }
         };
-        let result = lanczos::sqrt(s, product, &z[..n], basis, work, out, None);
+        let result = lanczos::sqrt(s, product, z, basis, work, out, None);
         if let Some(e) = failed {
             return Err(e);
         }
@@ -72,7 +104,7 @@ impl<T: Real> Pse<T> {
         };
         let rows = &mut store.vectors[..n];
         let work = (&mut *store.complex, rows, store.parallel);
-        self.wave(eta, spheres, Source::Noise(rng), work, out);
+        self.wave(eta, spheres, Source::Noise, work, out);
         Ok(iterations)
     }
 }

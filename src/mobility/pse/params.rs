@@ -39,7 +39,7 @@ impl<T: Real> Pse<T> {
         if !(xi > T::ZERO && xi.is_finite()) {
             return Err(PeriodicError::BadParameter("xi").into());
         }
-        if !(1e-12..=0.1).contains(&tol) {
+        if !(super::MIN_TOLERANCE..=super::MAX_TOLERANCE).contains(&tol) {
             return Err(PeriodicError::BadParameter("tolerance").into());
         }
         if !(a_max > T::ZERO && a_max.is_finite()) {
