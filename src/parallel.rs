@@ -24,7 +24,7 @@ mod free;
 mod jobs;
 
 pub(crate) use blocked::assemble_apply_then;
-pub use free::{free_product, free_products};
+pub use free::{free_band, free_product, free_products};
 #[cfg(feature = "pse")]
 pub(crate) use jobs::{Jobs, run_all};
 pub(crate) use jobs::{Packed, by_bands, by_bands_and, by_bands_k, map_bands, reduce};
@@ -271,17 +271,36 @@ pub fn products<T: Real, const K: usize>(
     z: &mut [T::V3],
 ) {
     let _ = by_bands_then_reduce::<T, (), K>(par, n, y, z, |t, yt, zt| {
-        blocked::band_rows_k::<T, K>(a, band_start(n, t), x, yt, zt);
+        product_band::<T, K>(a, n, t, x, yt, zt);
         Ok(())
     });
 }
 
+/// Band `t` of [`products`] (`y`: its rows of each product, `z`: its partial sums, as
+/// [`by_bands_then_reduce`] hands them out). Inlined into its caller, so that a host
+/// can compile it inside a function with wider vector instructions enabled
+/// (`hydrorattle_parallel::wide`) and get the same bits: the arithmetic and its order
+/// are the same.
+#[inline(always)]
+pub fn product_band<T: Real, const K: usize>(
+    a: &[T::M3],
+    n: usize,
+    t: usize,
+    x: [&[T::V3]; K],
+    y: [&mut [T::V3]; K],
+    z: [&mut [T::V3]; K],
+) {
+    blocked::band_rows_k::<T, K>(a, band_start(n, t), x, y, z);
+}
+
 /// The `K` products `y` of [`products`] and its kin: `band(t, y_t, z_t)` for every band
-/// `t` (its rows of each `y_q`, its partial sums of each `z_q`, `z` cut as
+/// `t` of `n` rows (its rows of each `y_q`, its partial sums of each `z_q`, `z` cut into
 /// [`band_scratch`]`(n)` vectors a product) through `par`, then each product's partial
-/// sums added in band order ([`reduce`]); one band is run on the calling thread. The first
-/// error in band order.
-pub(crate) fn by_bands_then_reduce<T: Real, E: Send, const K: usize>(
+/// sums added in band order; one band is run on the calling thread. The first error in
+/// band order. With `band` one of [`product_band`], [`free_band`] or
+/// [`reduced::apply_band`](crate::noise::reduced::apply_band) this is [`products`],
+/// [`free_products`] or [`reduced::apply_k`](crate::noise::reduced::apply_k).
+pub fn by_bands_then_reduce<T: Real, E: Send, const K: usize>(
     par: &dyn Parallel,
     n: usize,
     y: [&mut [T::V3]; K],

@@ -152,3 +152,47 @@ fn block_recompute_refuses_nested_spheres_as_the_single_product_does() {
     assert!(one.is_err());
     assert_eq!(two, one);
 }
+
+/// The runtime-selected AVX2 copies (`wide`) against the portable kernel functions,
+/// bit for bit (on a CPU without AVX2 both are the portable code).
+#[test]
+fn the_avx2_copies_give_the_portable_bits() {
+    use hydrorattle_parallel::wide;
+    eprintln!("AVX2 copies in use: {}", wide::avx2());
+    let pool = Threads::new(2).unwrap();
+    for n in [37, 530] {
+        let (pos, radius) = helix(n);
+        let mut mu = vec![f64::M3_ZERO; n * (n + 1) / 2];
+        parallel::assemble::<f64>(&Serial, Hydro::Rpy, 1.0, &pos, &radius, &mut mu).unwrap();
+        let (pos, radius, mu) = (&pos[..], &radius[..], &mu[..]);
+        check::<2>(
+            n,
+            &pool,
+            "stored, AVX2",
+            &|p, x, y, z| parallel::product::<f64>(p, mu, n, x, y, z),
+            &|p, x, y, z| wide::products::<2>(p, mu, n, x, y, z),
+        );
+        check::<1>(
+            n,
+            &pool,
+            "recompute, AVX2",
+            &|p, x, y, z| {
+                parallel::free_product::<f64>(p, Hydro::Rpy, 1.0, pos, radius, x, y, z).unwrap()
+            },
+            &|p, x, y, z| {
+                wide::free_products::<1>(p, Hydro::Rpy, 1.0, pos, radius, x, y, z).unwrap()
+            },
+        );
+        let mut copy = vec![f64::M3_ZERO; reduced::slots(n)];
+        let (x, mut y) = (rhs(n, 0), vec![DVec3::ZERO; n]);
+        let mut z = vec![DVec3::ZERO; band_scratch(n)];
+        reduced::copy_apply::<f64>(&Serial, mu, n, &mut copy, &x, &mut y, &mut z);
+        check::<2>(
+            n,
+            &pool,
+            "compact, AVX2",
+            &|p, x, y, z| reduced::apply::<f64>(p, &copy, n, x, y, z),
+            &|p, x, y, z| wide::compact_products::<2>(p, &copy, n, x, y, z),
+        );
+    }
+}

@@ -185,6 +185,7 @@ fn walk_row<T: Real, const K: usize>(
 /// Rows `b0..b0 + y_q.len()` from their groups `rows` into `y_q`, the transposed blocks
 /// left of the band into `z_q` (both from zero, in `f64`, as in [`parallel::product`]'s
 /// bands), one column tile at a time, for `K` vectors at once.
+#[inline(always)]
 fn band<T: Real, const K: usize>(
     rows: &[T::M3],
     b0: usize,
@@ -267,12 +268,25 @@ pub fn apply_k<T: Real, const K: usize>(
     y: [&mut [T::V3]; K],
     z: &mut [T::V3],
 ) {
-    let x = x.map(|xq| &xq[..n]);
     let _ = parallel::by_bands_then_reduce::<T, (), K>(par, n, y, z, |t, yt, zt| {
-        let b0 = band_start(n, t);
-        band::<T, K>(&copy[copy_start(b0)..], b0, x, yt, zt);
+        apply_band::<T, K>(copy, n, t, x, yt, zt);
         Ok(())
     });
+}
+
+/// Band `t` of [`apply_k`] (as [`parallel::product_band`] is of [`parallel::products`];
+/// inlined, for a host's wider-vector copy).
+#[inline(always)]
+pub fn apply_band<T: Real, const K: usize>(
+    copy: &[T::M3],
+    n: usize,
+    t: usize,
+    x: [&[T::V3]; K],
+    y: [&mut [T::V3]; K],
+    z: [&mut [T::V3]; K],
+) {
+    let b0 = band_start(n, t);
+    band::<T, K>(&copy[copy_start(b0)..], b0, x.map(|xq| &xq[..n]), y, z);
 }
 
 /// [`apply`] while writing the copy of the packed mobility `mu` (`n` block rows) into

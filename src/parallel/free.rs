@@ -20,6 +20,7 @@ const SPAN: usize = 64;
 /// Rows `b0..b0 + y_q.len()` of `y_q = mu_tt x_q` for `K` vectors, their transposed
 /// blocks left of the band summed into `z_q` (from zero), as a stored band computes
 /// them: each block evaluated once and applied to every vector.
+#[inline(always)]
 fn band_free<T: Real, const K: usize>(
     src: Pairs<'_, T>,
     b0: usize,
@@ -92,13 +93,26 @@ pub fn free_products<T: Real, const K: usize>(
     z: &mut [T::V3],
 ) -> Result<(), ParticleError> {
     let n = pos.len();
+    by_bands_then_reduce::<T, _, K>(par, n, y, z, |t, yt, zt| {
+        free_band::<T, K>((level, eta, pos, radius), t, x, yt, zt)
+    })
+}
+
+/// Band `t` of [`free_products`] (as [`super::product_band`] is of
+/// [`super::products`]; inlined, for a host's wider-vector copy).
+#[inline(always)]
+pub fn free_band<T: Real, const K: usize>(
+    (level, eta, pos, radius): (Hydro, T, &[T::V3], &[T]),
+    t: usize,
+    x: [&[T::V3]; K],
+    y: [&mut [T::V3]; K],
+    z: [&mut [T::V3]; K],
+) -> Result<(), ParticleError> {
     let src = Pairs {
         level,
         eta,
         pos,
         radius,
     };
-    by_bands_then_reduce::<T, _, K>(par, n, y, z, |t, yt, zt| {
-        band_free::<T, K>(src, band_start(n, t), x, yt, zt)
-    })
+    band_free::<T, K>(src, band_start(pos.len(), t), x, y, z)
 }
