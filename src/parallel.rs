@@ -24,6 +24,7 @@ mod free;
 mod jobs;
 
 pub(crate) use blocked::assemble_apply_then;
+pub(crate) use free::band_blocks;
 pub use free::{free_band, free_product, free_products};
 #[cfg(feature = "pse")]
 pub(crate) use jobs::{Jobs, run_all};

@@ -38,13 +38,20 @@ fn bits(v: &[DVec3]) -> Vec<[u64; 3]> {
     v.iter().map(|x| x.to_array().map(f64::to_bits)).collect()
 }
 
+/// A single product `(par, x, y, z)`.
+type Single<'a> = &'a dyn Fn(&dyn Parallel, &[DVec3], &mut [DVec3], &mut [DVec3]);
+
+/// A block product of `K` vectors `(par, x, y, z)`.
+type Block<'a, const K: usize> =
+    &'a dyn Fn(&dyn Parallel, [&[DVec3]; K], [&mut [DVec3]; K], &mut [DVec3]);
+
 /// The `K` products by `block` against `K` single products by `single`, on `par`.
 fn check<const K: usize>(
     n: usize,
     par: &dyn Parallel,
     what: &str,
-    single: &dyn Fn(&dyn Parallel, &[DVec3], &mut [DVec3], &mut [DVec3]),
-    block: &dyn Fn(&dyn Parallel, [&[DVec3]; K], [&mut [DVec3]; K], &mut [DVec3]),
+    single: Single,
+    block: Block<K>,
 ) {
     let xs: Vec<Vec<DVec3>> = (0..K).map(|q| rhs(n, q)).collect();
     let mut z = vec![DVec3::ZERO; K * band_scratch(n)];

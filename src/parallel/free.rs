@@ -116,3 +116,40 @@ pub fn free_band<T: Real, const K: usize>(
     };
     band_free::<T, K>(src, band_start(pos.len(), t), x, y, z)
 }
+
+/// Rows `b0..b0 + y.len()` of `y = A x` for a general block source: `diag(i)` the
+/// diagonal block, `block(i, j)` (`j < i`) the lower block (not symmetric in general,
+/// as above a wall), evaluated where they are used, summed as the stored row-by-row
+/// band [`band`](super::band) sums the stored blocks (the same bits on any number of
+/// threads). The first error in row order.
+#[inline(always)]
+pub(crate) fn band_blocks<T: Real, E>(
+    b0: usize,
+    diag: impl Fn(usize) -> T::M3,
+    block: impl Fn(usize, usize) -> Result<T::M3, E>,
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) -> Result<(), E> {
+    z.fill(T::V3_ZERO);
+    for (k, yk) in y.iter_mut().enumerate() {
+        *yk = diag(b0 + k) * x[b0 + k];
+    }
+    for k in 0..y.len() {
+        let i = b0 + k;
+        let (xi, mut acc) = (x[i], T::V3_ZERO);
+        for (j, zj) in z.iter_mut().enumerate() {
+            let b = block(i, j)?;
+            acc += b * x[j];
+            *zj += T::m3_tmul(b, xi);
+        }
+        let (ys, yi) = y[..=k].split_at_mut(k);
+        for (c, yj) in ys.iter_mut().enumerate() {
+            let b = block(i, b0 + c)?;
+            acc += b * x[b0 + c];
+            *yj += T::m3_tmul(b, xi);
+        }
+        yi[0] += acc;
+    }
+    Ok(())
+}
