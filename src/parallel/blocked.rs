@@ -72,10 +72,11 @@ pub(crate) fn band_rows_k<T: Real, const K: usize>(
             y[q][k] = a[tri(i) + i] * x[q][i];
         }
     }
-    // Rows a group walks: `ROWS / K` (at least 2), so that the group's running sums
-    // (`3 R K` scalars) stay about the size that measured best for one vector; any
-    // group size gives the same bits. (k = 4 with 8 rows spilled: 0.71 of four single
-    // products' time at N = 1024, against 0.66 for k = 2.)
+    // Rows a group walks: `ROWS` for one vector, `ROWS / 2` for two, one row from four
+    // on, so that the group's running sums (`3 R K` scalars) stay about the size that
+    // measured best for one vector; any group size gives the same bits. (k = 4 with 8
+    // rows spilled: 0.71 of four single products' time at N = 1024; with one row, 0.77
+    // to 0.93 in CPU time, docs/BENCHMARKS.md.)
     match K {
         1 => groups::<T, ROWS, K>(a, b0, x, &mut y, &mut z),
         2 => groups::<T, { ROWS / 2 }, K>(a, b0, x, &mut y, &mut z),
