@@ -23,11 +23,12 @@ mod blocked;
 mod free;
 mod jobs;
 
-pub(crate) use blocked::{assemble_apply_then, band_rows};
-pub use free::free_product;
+pub(crate) use blocked::assemble_apply_then;
+pub(crate) use free::band_blocks;
+pub use free::{free_band, free_product, free_products};
 #[cfg(feature = "pse")]
 pub(crate) use jobs::{Jobs, run_all};
-pub(crate) use jobs::{Packed, by_bands, by_bands_and, map_bands, reduce};
+pub(crate) use jobs::{Packed, by_bands, by_bands_and, by_bands_k, map_bands, reduce};
 
 use crate::error::ParticleError;
 use crate::linalg::tri;
@@ -255,11 +256,84 @@ pub fn product<T: Real>(
         band::<T>(a, 0, x, &mut y[..n], &mut []);
         return;
     }
-    let _ = by_bands::<T, (), _>(par, n, &mut [], tri, y, z, |t, _, yt, zt| {
-        band_rows::<T>(a, band_start(n, t), x, yt, zt);
+    products::<T, 1>(par, a, n, [x], [y], z);
+}
+
+/// [`product`] of `K` vectors in one pass over the blocks (a block product: each block
+/// is read once and applied to all `K`): `y[q]` gets the bits `product` gives it for
+/// `x[q]`, at every `n` and on any number of threads. `z` holds at least `K`
+/// [`band_scratch`]`(n)` vectors.
+pub fn products<T: Real, const K: usize>(
+    par: &dyn Parallel,
+    a: &[T::M3],
+    n: usize,
+    x: [&[T::V3]; K],
+    y: [&mut [T::V3]; K],
+    z: &mut [T::V3],
+) {
+    let _ = by_bands_then_reduce::<T, (), K>(par, n, y, z, |t, yt, zt| {
+        product_band::<T, K>(a, n, t, x, yt, zt);
         Ok(())
     });
-    reduce::<T>(n, y, z, par);
+}
+
+/// Band `t` of [`products`] (`y`: its rows of each product, `z`: its partial sums, as
+/// [`by_bands_then_reduce`] hands them out). Inlined into its caller, so that a host
+/// can compile it inside a function with wider vector instructions enabled
+/// (`hydrorattle_parallel::wide`) and get the same bits: the arithmetic and its order
+/// are the same.
+#[inline(always)]
+pub fn product_band<T: Real, const K: usize>(
+    a: &[T::M3],
+    n: usize,
+    t: usize,
+    x: [&[T::V3]; K],
+    y: [&mut [T::V3]; K],
+    z: [&mut [T::V3]; K],
+) {
+    blocked::band_rows_k::<T, K>(a, band_start(n, t), x, y, z);
+}
+
+/// The `K` products `y` of [`products`] and its kin: `band(t, y_t, z_t)` for every band
+/// `t` of `n` rows (its rows of each `y_q`, its partial sums of each `z_q`, `z` cut into
+/// [`band_scratch`]`(n)` vectors a product) through `par`, then each product's partial
+/// sums added in band order; one band is run on the calling thread. The first error in
+/// band order. With `band` one of [`product_band`], [`free_band`] or
+/// [`reduced::apply_band`](crate::noise::reduced::apply_band) this is [`products`],
+/// [`free_products`] or [`reduced::apply_k`](crate::noise::reduced::apply_k).
+pub fn by_bands_then_reduce<T: Real, E: Send, const K: usize>(
+    par: &dyn Parallel,
+    n: usize,
+    y: [&mut [T::V3]; K],
+    z: &mut [T::V3],
+    band: impl Fn(usize, [&mut [T::V3]; K], [&mut [T::V3]; K]) -> Result<(), E> + Sync,
+) -> Result<(), E> {
+    let mut y = y.map(|yq| &mut yq[..n]);
+    let ys = y.each_mut().map(|yq| &mut **yq);
+    if bands(n) == 1 {
+        return band(0, ys, [(); K].map(|_| &mut [][..]));
+    }
+    let none = || (&mut [][..], tri as fn(usize) -> usize);
+    let zs = scratches::<T, K>(n, z);
+    by_bands_k::<T, E, _, K>(par, n, none(), none(), ys, zs, |t, _, _, yt, zt| {
+        band(t, yt, zt)
+    })?;
+    let zs = scratches::<T, K>(n, z);
+    for (yq, zq) in y.into_iter().zip(zs) {
+        reduce::<T>(n, yq, zq, par);
+    }
+    Ok(())
+}
+
+/// `K` consecutive runs of [`band_scratch`]`(n)` vectors of `z`, one per product.
+fn scratches<T: Real, const K: usize>(n: usize, z: &mut [T::V3]) -> [&mut [T::V3]; K] {
+    let s = band_scratch(n);
+    let mut rest = &mut z[..K * s];
+    core::array::from_fn(|_| {
+        let (head, tail) = core::mem::take(&mut rest).split_at_mut(s);
+        rest = tail;
+        head
+    })
 }
 
 /// [`assemble_tt`](crate::mobility::assemble_tt) in bands through `par`: the same blocks

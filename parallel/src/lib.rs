@@ -22,6 +22,7 @@ use hydrorattle::Parallel;
 use rayon::prelude::*;
 
 pub mod model;
+pub mod wide;
 
 /// A rayon thread pool that runs the kernel's bands.
 #[derive(Debug)]

@@ -442,7 +442,7 @@ impl<T: Real> Metric<'_, T> {
                 }
                 let done = match wall {
                     Some(h) if cfg!(feature = "wall") => {
-                        wall::tt_product(level, eta, h, pos, radius, f, out)
+                        wall::free_product(par, level, eta, h, pos, radius, f, out, bands)
                     }
                     _ => crate::parallel::free_product::<T>(
                         par, level, eta, pos, radius, f, out, bands,

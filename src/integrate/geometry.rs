@@ -97,8 +97,8 @@ pub(super) fn grand<T: Real>(
 /// `u = mu_tt f` without storing `mu_tt`, as a matrix-free step computes it. In free
 /// space in the bands of [`crate::parallel`] through `par` (`scratch` holds
 /// [`band_scratch`]`(n)` vectors, [`crate::parallel::free_product`]): the bits of the
-/// stored mobility's banded product on any number of threads. Above a wall and in a
-/// box: serial.
+/// stored mobility's banded product on any number of threads, above a wall too
+/// ([`crate::mobility::wall::free_product`]). In a box: serial.
 pub fn mobility_product<T: Real>(
     p: &Params<T>,
     par: &dyn Parallel,

@@ -142,8 +142,8 @@ pub(super) fn mobility_metric<'a, T: Real>(
 
 /// `u = mu_tt(pos) f` matrix-free: every pair block evaluated where it is used (above
 /// the wall if there is one, in the box with the step's Ewald sums `ew`). In free space
-/// in the bands of the stored product through `par` (`bands`: their scratch), with its
-/// bits.
+/// and above a wall in the bands of the stored product through `par` (`bands`: their
+/// scratch), with its bits.
 pub(super) fn free_product<T: Real>(
     p: &Params<T>,
     ew: Sums<'_, T>,
@@ -160,7 +160,7 @@ pub(super) fn free_product<T: Real>(
     let _ = ew; // Read above only with the `periodic` feature.
     let (level, eta) = (p.hydro, p.viscosity);
     match wall_height(p) {
-        Some(h) => mobility::wall::tt_product(level, eta, h, pos, radius, f, u)?,
+        Some(h) => mobility::wall::free_product(par, level, eta, h, pos, radius, f, u, bands)?,
         None => crate::parallel::free_product::<T>(par, level, eta, pos, radius, f, u, bands)?,
     }
     Ok(())

@@ -236,9 +236,52 @@ pub fn assemble<T: Real>(
     })
 }
 
+/// `y = mu_tt x` above the wall without storing `mu_tt`, in the bands of
+/// [`crate::parallel::product`] through `par` (`z`: at least
+/// [`band_scratch`](crate::parallel::band_scratch)`(n)` vectors): the bits of
+/// [`assemble`] then [`crate::parallel::product`] at every `n` and on any number of
+/// threads (below [`BANDED_MIN`](crate::parallel::BANDED_MIN) rows those of
+/// [`tt_product`]). The first error of [`tt_product`]: a sphere below the wall (in
+/// particle order), then nested spheres in row order.
+#[allow(clippy::too_many_arguments)]
+pub fn free_product<T: Real>(
+    par: &dyn Parallel,
+    level: Hydro,
+    eta: T,
+    height: T,
+    pos: &[T::V3],
+    radius: &[T],
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) -> Result<(), ParticleError> {
+    for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
+        lift(height, a, p, i)?;
+    }
+    // Every sphere is above the wall: the lifts below cannot fail.
+    let at = |i: usize| {
+        lift(height, radius[i], pos[i], i).unwrap_or(Lifted {
+            p: pos[i],
+            h: radius[i],
+            b: T::ONE,
+        })
+    };
+    let n = pos.len();
+    crate::parallel::by_bands_then_reduce::<T, _, 1>(par, n, [y], z, |t, [yt], [zt]| {
+        let diag = |i: usize| self_block(eta, radius[i], at(i));
+        let block = |i: usize, j: usize| {
+            pair(level, eta, radius[i], radius[j], at(i), at(j))
+                .ok_or(ParticleError::Nested { i: j, j: i })
+        };
+        let x = &x[..n];
+        crate::parallel::band_blocks::<T, _>(band_start(n, t), diag, block, x, yt, zt)
+    })
+}
+
 /// `y = mu_tt x` above the wall without storing `mu_tt`, in the order of [`assemble`]
 /// followed by [`sym_matvec`](crate::linalg::sym_matvec) (the same bits below
-/// [`BANDED_MIN`](crate::parallel::BANDED_MIN) rows, as in free space).
+/// [`BANDED_MIN`](crate::parallel::BANDED_MIN) rows, as in free space); one thread
+/// ([`free_product`] runs in bands).
 pub fn tt_product<T: Real>(
     level: Hydro,
     eta: T,

@@ -148,66 +148,96 @@ const TILE: usize = 40 * GROUP;
 /// A tile's vector: per chunk of four beads, `x`, `y` and `z` as four lanes each.
 type Lanes = [[Vec4; 3]; TILE / 4];
 
-/// Row `i`'s blocks in one tile (`row`, whole groups): `sum_j B_ij x_j` (returned, from
-/// four lane sums in a fixed order) while `y_j += B_ij x_i`. (Written with `Vec4`:
-/// left to the vectoriser, the same loop on `[f32; 4]` took twice as long, shuffling.)
+/// Row `i`'s blocks in one tile (`row`, whole groups) for `K` vectors: `sum_j B_ij x_qj`
+/// (returned, from four lane sums in a fixed order) while `y_qj += B_ij x_qi`, each
+/// vector's sums in the order of its own product (the vectors share the blocks' loads).
+/// (Written with `Vec4`: left to the vectoriser, the same loop on `[f32; 4]` took twice
+/// as long, shuffling.)
 #[inline(always)]
-fn walk_row<T: Real>(row: &[T::M3], x: &Lanes, y: &mut Lanes, xi: [f32; 3]) -> [f32; 3] {
-    let xi = xi.map(Vec4::splat);
-    let mut acc = [Vec4::ZERO; 3];
-    let chunks = x.chunks_exact(CHUNKS).zip(y.chunks_exact_mut(CHUNKS));
-    for (b, (xg, yg)) in row.chunks_exact(BLOCK_SLOTS).zip(chunks) {
+fn walk_row<T: Real, const K: usize>(
+    row: &[T::M3],
+    x: [&Lanes; K],
+    y: [&mut Lanes; K],
+    xi: [[f32; 3]; K],
+) -> [[f32; 3]; K] {
+    let xi = xi.map(|v| v.map(Vec4::splat));
+    let mut acc = [[Vec4::ZERO; 3]; K];
+    for (g, b) in row.chunks_exact(BLOCK_SLOTS).enumerate() {
         for c in 0..CHUNKS {
             let [xx, yy, zz, xy, xz, yz]: [Vec4; 6] =
                 core::array::from_fn(|q| Vec4::from_array(get4::<T>(b, 6 * c + q)));
-            let (xl, yl) = (&xg[c], &mut yg[c]);
-            for (k, r) in [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
-                .iter()
-                .enumerate()
-            {
-                acc[k] += r[0] * xl[0] + r[1] * xl[1] + r[2] * xl[2];
-                yl[k] += r[0] * xi[0] + r[1] * xi[1] + r[2] * xi[2];
+            let h = CHUNKS * g + c;
+            for q in 0..K {
+                let (xl, yl) = (&x[q][h], &mut y[q][h]);
+                for (k, r) in [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
+                    .iter()
+                    .enumerate()
+                {
+                    acc[q][k] += r[0] * xl[0] + r[1] * xl[1] + r[2] * xl[2];
+                    yl[k] += r[0] * xi[q][0] + r[1] * xi[q][1] + r[2] * xi[q][2];
+                }
             }
         }
     }
-    acc.map(|a| (a.x + a.y) + (a.z + a.w))
+    acc.map(|a| a.map(|a| (a.x + a.y) + (a.z + a.w)))
 }
 
-/// Rows `b0..b0 + y.len()` from their groups `rows` into `y`, the transposed blocks
-/// left of the band into `z` (both from zero, in `f64`, as in [`parallel::product`]'s
-/// bands), one column tile at a time.
-fn band<T: Real>(rows: &[T::M3], b0: usize, x: &[T::V3], y: &mut [T::V3], z: &mut [T::V3]) {
-    let b1 = b0 + y.len();
-    y.fill(T::V3_ZERO);
-    z.fill(T::V3_ZERO);
+/// Rows `b0..b0 + y_q.len()` from their groups `rows` into `y_q`, the transposed blocks
+/// left of the band into `z_q` (both from zero, in `f64`, as in [`parallel::product`]'s
+/// bands), one column tile at a time, for `K` vectors at once.
+#[inline(always)]
+fn band<T: Real, const K: usize>(
+    rows: &[T::M3],
+    b0: usize,
+    x: [&[T::V3]; K],
+    mut y: [&mut [T::V3]; K],
+    mut z: [&mut [T::V3]; K],
+) {
+    let b1 = b0 + y[0].len();
+    for q in 0..K {
+        y[q].fill(T::V3_ZERO);
+        z[q].fill(T::V3_ZERO);
+    }
     let base = BLOCK_SLOTS * row_start(b0);
-    let lane = |j: usize, k: usize| match x.get(j) {
+    let lane = |q: usize, j: usize, k: usize| match x[q].get(j) {
         Some(&v) => T::xyz(v)[k].to_f64() as f32,
         None => 0.0,
     };
-    // Adds `f32` sums to row `j` of the band's partial sum (`z` above the band).
-    let mut add = |j: usize, v: [f32; 3]| {
-        let out = if j < b0 { &mut z[j] } else { &mut y[j - b0] };
+    // Adds `f32` sums to row `j` of the band's partial sum `q` (`z` above the band).
+    let mut add = |q: usize, j: usize, v: [f32; 3]| {
+        let out = if j < b0 {
+            &mut z[q][j]
+        } else {
+            &mut y[q][j - b0]
+        };
         *out += T::v3_from(v.map(f64::from));
     };
     for t0 in (0..b1).step_by(TILE) {
-        let mut xt: Lanes = [[Vec4::ZERO; 3]; TILE / 4];
-        let mut yt: Lanes = [[Vec4::ZERO; 3]; TILE / 4];
-        for (h, chunk) in xt.iter_mut().enumerate() {
-            let lanes = |k| Vec4::from_array(core::array::from_fn(|l| lane(t0 + 4 * h + l, k)));
-            *chunk = core::array::from_fn(lanes);
+        let mut xt: [Lanes; K] = [[[Vec4::ZERO; 3]; TILE / 4]; K];
+        let mut yt: [Lanes; K] = [[[Vec4::ZERO; 3]; TILE / 4]; K];
+        for (q, xq) in xt.iter_mut().enumerate() {
+            for (h, chunk) in xq.iter_mut().enumerate() {
+                let lanes =
+                    |k| Vec4::from_array(core::array::from_fn(|l| lane(q, t0 + 4 * h + l, k)));
+                *chunk = core::array::from_fn(lanes);
+            }
         }
         for i in b0.max(t0)..b1 {
             // The row's groups from the tile's first to its last or the row's end.
             let g = (groups(i) - t0 / GROUP).min(TILE / GROUP);
             let start = BLOCK_SLOTS * (row_start(i) + t0 / GROUP) - base;
             let row = &rows[start..][..BLOCK_SLOTS * g];
-            let xi = core::array::from_fn(|k| lane(i, k));
-            add(i, walk_row::<T>(row, &xt, &mut yt, xi));
+            let xi = core::array::from_fn(|q| core::array::from_fn(|k| lane(q, i, k)));
+            let sums = walk_row::<T, K>(row, xt.each_ref(), yt.each_mut(), xi);
+            for (q, v) in sums.into_iter().enumerate() {
+                add(q, i, v);
+            }
         }
         for j in t0..(t0 + TILE).min(b1) {
             let r = j - t0;
-            add(j, core::array::from_fn(|k| yt[r / 4][k][r % 4]));
+            for (q, yq) in yt.iter().enumerate() {
+                add(q, j, core::array::from_fn(|k| yq[r / 4][k][r % 4]));
+            }
         }
     }
 }
@@ -224,13 +254,39 @@ pub fn apply<T: Real>(
     y: &mut [T::V3],
     z: &mut [T::V3],
 ) {
-    let x = &x[..n];
-    let _ = parallel::by_bands::<T, (), _>(par, n, &mut [], tri, y, z, |t, _, yt, zt| {
-        let b0 = band_start(n, t);
-        band::<T>(&copy[copy_start(b0)..], b0, x, yt, zt);
+    apply_k::<T, 1>(par, copy, n, [x], [y], z);
+}
+
+/// [`apply`] of `K` vectors in one pass over the copy (a block product: each block is
+/// read once and applied to all `K`): `y[q]` gets the bits `apply` gives it for `x[q]`.
+/// `z` holds at least `K` [`parallel::band_scratch`]`(n)` vectors.
+pub fn apply_k<T: Real, const K: usize>(
+    par: &dyn Parallel,
+    copy: &[T::M3],
+    n: usize,
+    x: [&[T::V3]; K],
+    y: [&mut [T::V3]; K],
+    z: &mut [T::V3],
+) {
+    let _ = parallel::by_bands_then_reduce::<T, (), K>(par, n, y, z, |t, yt, zt| {
+        apply_band::<T, K>(copy, n, t, x, yt, zt);
         Ok(())
     });
-    parallel::reduce::<T>(n, y, z, par);
+}
+
+/// Band `t` of [`apply_k`] (as [`parallel::product_band`] is of [`parallel::products`];
+/// inlined, for a host's wider-vector copy).
+#[inline(always)]
+pub fn apply_band<T: Real, const K: usize>(
+    copy: &[T::M3],
+    n: usize,
+    t: usize,
+    x: [&[T::V3]; K],
+    y: [&mut [T::V3]; K],
+    z: [&mut [T::V3]; K],
+) {
+    let b0 = band_start(n, t);
+    band::<T, K>(&copy[copy_start(b0)..], b0, x.map(|xq| &xq[..n]), y, z);
 }
 
 /// [`apply`] while writing the copy of the packed mobility `mu` (`n` block rows) into
@@ -249,7 +305,7 @@ pub fn copy_apply<T: Real>(
     let _ = parallel::by_bands::<T, (), _>(par, n, copy, copy_start, y, z, |t, rows, yt, zt| {
         let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
         pack_rows::<T>(b0, b1, &mu[tri(b0)..tri(b1)], rows);
-        band::<T>(rows, b0, x, yt, zt);
+        band::<T, 1>(rows, b0, [x], [yt], [zt]);
         Ok(())
     });
     parallel::reduce::<T>(n, y, z, par);

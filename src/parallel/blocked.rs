@@ -26,81 +26,119 @@ use crate::real::Real;
 /// 12: 4.3, 16: 5.3 ns per block at N = 1024).
 pub(super) const ROWS: usize = 8;
 
-/// Column `j` for a group of rows: `acc_r += B_rj x_j` for every row `r` of the group,
-/// then `out += B_rj^T x_r` in row order.
+/// Column `j` for a group of rows and `K` vectors: `acc_rq += B_rj x_qj` for every row
+/// `r` of the group, then `out_q += B_rj^T x_qr` in row order, for each vector `q` (each
+/// sum in the order of one vector's product: the vectors only share the block's load).
 #[inline(always)]
-fn column<T: Real, const R: usize>(
+fn column<T: Real, const R: usize, const K: usize>(
     rows: &[&[T::M3]; R],
     j: usize,
-    xj: T::V3,
-    xs: &[T::V3; R],
-    acc: &mut [T::V3; R],
-    out: &mut T::V3,
+    xj: [T::V3; K],
+    xs: &[[T::V3; K]; R],
+    acc: &mut [[T::V3; K]; R],
+    out: [&mut T::V3; K],
 ) {
-    let mut o = *out;
+    let mut o: [T::V3; K] = core::array::from_fn(|q| *out[q]);
     for r in 0..R {
         let b = rows[r][j];
-        acc[r] += b * xj;
-        o += T::m3_tmul(b, xs[r]);
+        for q in 0..K {
+            acc[r][q] += b * xj[q];
+            o[q] += T::m3_tmul(b, xs[r][q]);
+        }
     }
-    *out = o;
+    for (dst, v) in out.into_iter().zip(o) {
+        *dst = v;
+    }
 }
 
-/// Rows `b0..b0 + y.len()` of `y = A x` as [`band`](super::band) computes them (the same
-/// bits), [`ROWS`] rows at a time, the rows left over at the band's end one by one.
+/// Rows `b0..b0 + y_q.len()` of `y_q = A x_q` for `K` vectors in one pass over the
+/// blocks (a block product), [`ROWS`] rows at a time, the rows left over at the band's
+/// end one by one: output `q` gets the bits [`band`](super::band) gives it alone.
 #[inline(always)]
-pub(crate) fn band_rows<T: Real>(
+pub(crate) fn band_rows_k<T: Real, const K: usize>(
     a: &[T::M3],
     b0: usize,
-    x: &[T::V3],
-    y: &mut [T::V3],
-    z: &mut [T::V3],
+    x: [&[T::V3]; K],
+    mut y: [&mut [T::V3]; K],
+    mut z: [&mut [T::V3]; K],
 ) {
-    z.fill(T::V3_ZERO);
-    for (k, yk) in y.iter_mut().enumerate() {
+    for zq in z.iter_mut() {
+        zq.fill(T::V3_ZERO);
+    }
+    let m = y[0].len();
+    for k in 0..m {
         let i = b0 + k;
-        *yk = a[tri(i) + i] * x[i];
+        for q in 0..K {
+            y[q][k] = a[tri(i) + i] * x[q][i];
+        }
     }
-    let m = y.len();
-    let mut k = 0;
-    while k + ROWS <= m {
-        group::<T, ROWS>(a, b0, k, x, y, z);
-        k += ROWS;
-    }
-    for k in k..m {
-        group::<T, 1>(a, b0, k, x, y, z);
+    // Rows a group walks: `ROWS` for one vector, `ROWS / 2` for two, one row from four
+    // on, so that the group's running sums (`3 R K` scalars) stay about the size that
+    // measured best for one vector; any group size gives the same bits. (k = 4 with 8
+    // rows spilled: 0.71 of four single products' time at N = 1024; with one row, 0.77
+    // to 0.93 in CPU time, docs/BENCHMARKS.md.)
+    match K {
+        1 => groups::<T, ROWS, K>(a, b0, x, &mut y, &mut z),
+        2 => groups::<T, { ROWS / 2 }, K>(a, b0, x, &mut y, &mut z),
+        _ => groups::<T, 1, K>(a, b0, x, &mut y, &mut z),
     }
 }
 
-/// Rows `b0 + k..b0 + k + R` of a [`band_rows`], walked column by column.
+/// The rows of a [`band_rows_k`] in groups of `R`, the rows left over one by one.
 #[inline(always)]
-fn group<T: Real, const R: usize>(
+fn groups<T: Real, const R: usize, const K: usize>(
+    a: &[T::M3],
+    b0: usize,
+    x: [&[T::V3]; K],
+    y: &mut [&mut [T::V3]; K],
+    z: &mut [&mut [T::V3]; K],
+) {
+    let m = y[0].len();
+    let mut k = 0;
+    while k + R <= m {
+        group::<T, R, K>(a, b0, k, x, y, z);
+        k += R;
+    }
+    for k in k..m {
+        group::<T, 1, K>(a, b0, k, x, y, z);
+    }
+}
+
+/// Rows `b0 + k..b0 + k + R` of a [`band_rows_k`], walked column by column.
+#[inline(always)]
+fn group<T: Real, const R: usize, const K: usize>(
     a: &[T::M3],
     b0: usize,
     k: usize,
-    x: &[T::V3],
-    y: &mut [T::V3],
-    z: &mut [T::V3],
+    x: [&[T::V3]; K],
+    y: &mut [&mut [T::V3]; K],
+    z: &mut [&mut [T::V3]; K],
 ) {
     let i = b0 + k;
     let rows: [&[T::M3]; R] = core::array::from_fn(|r| &a[tri(i + r)..=tri(i + r) + i + r]);
-    let xs: [T::V3; R] = core::array::from_fn(|r| x[i + r]);
-    let mut acc = [T::V3_ZERO; R];
-    for (j, (zj, &xj)) in z.iter_mut().zip(x).enumerate() {
-        column::<T, R>(&rows, j, xj, &xs, &mut acc, zj);
+    let xs: [[T::V3; K]; R] = core::array::from_fn(|r| x.map(|xq| xq[i + r]));
+    let mut acc = [[T::V3_ZERO; K]; R];
+    for j in 0..b0 {
+        let out = z.each_mut().map(|zq| &mut zq[j]);
+        column::<T, R, K>(&rows, j, x.map(|xq| xq[j]), &xs, &mut acc, out);
     }
-    for (j, (yj, &xj)) in y[..k].iter_mut().zip(&x[b0..]).enumerate() {
-        column::<T, R>(&rows, b0 + j, xj, &xs, &mut acc, yj);
+    for c in 0..k {
+        let out = y.each_mut().map(|yq| &mut yq[c]);
+        column::<T, R, K>(&rows, b0 + c, x.map(|xq| xq[b0 + c]), &xs, &mut acc, out);
     }
     // The group's own triangle, row by row: row `i + r` meets columns `i..i + r`,
     // whose sums are complete before it adds to them.
-    for (r, (&xr, acc_r)) in xs.iter().zip(&mut acc).enumerate() {
+    for (r, (xr, acc_r)) in xs.iter().zip(&mut acc).enumerate() {
         for c in 0..r {
             let b = rows[r][i + c];
-            *acc_r += b * x[i + c];
-            y[k + c] += T::m3_tmul(b, xr);
+            for q in 0..K {
+                acc_r[q] += b * x[q][i + c];
+                y[q][k + c] += T::m3_tmul(b, xr[q]);
+            }
         }
-        y[k + r] += *acc_r;
+        for q in 0..K {
+            y[q][k + r] += acc_r[q];
+        }
     }
 }
 
@@ -228,13 +266,28 @@ pub(super) fn runs<T: Real>(
     x: &[T::V3],
     acc: &mut T::V3,
 ) -> Result<(), ParticleError> {
+    let mut a = [*acc];
+    runs_k::<T, 1>(src, i, j0, blocks, [outs], [x], &mut a)?;
+    *acc = a[0];
+    Ok(())
+}
+
+/// [`runs`] for `K` vectors: each block, evaluated once, applied to every `x_q` (sums
+/// into `acc_q`) and, transposed, to every `x_qi` (into `outs_q`), each in the order
+/// [`runs`] sums it alone.
+#[inline(always)]
+pub(super) fn runs_k<T: Real, const K: usize>(
+    src: Pairs<'_, T>,
+    i: usize,
+    j0: usize,
+    blocks: &mut [T::M3],
+    outs: [&mut [T::V3]; K],
+    x: [&[T::V3]; K],
+    acc: &mut [T::V3; K],
+) -> Result<(), ParticleError> {
     let (level, eta, pi, ai) = (src.level, src.eta, src.pos[i], src.radius[i]);
-    let xi = x[i - j0];
-    let runs = blocks
-        .chunks_mut(RUN)
-        .zip(outs.chunks_mut(RUN))
-        .zip(x.chunks(RUN));
-    for (c, ((bs, os), xs)) in runs.enumerate() {
+    let xi = x.map(|xq| xq[i - j0]);
+    for (c, bs) in blocks.chunks_mut(RUN).enumerate() {
         let j = j0 + c * RUN;
         let pos = &src.pos[j..j + bs.len()];
         let radius = &src.radius[j..j + bs.len()];
@@ -244,11 +297,28 @@ pub(super) fn runs<T: Real>(
                 .ok_or(ParticleError::Nested { i: j + k, j: i })?;
         }
         let roots: [(T, T); RUN] = core::array::from_fn(|k| s2[k].root_and_inverse());
-        let cols = bs.iter_mut().zip(os).zip(xs).zip(pos.iter().zip(radius));
-        for (k, (((b, o), &xj), (&pj, &aj))) in cols.enumerate() {
+        let cols = bs.iter_mut().zip(pos.iter().zip(radius));
+        if K == 1 {
+            // Each block applied as soon as it is built.
+            for (k, (b, (&pj, &aj))) in cols.enumerate() {
+                *b = pair_tt_from(level, eta, ai, aj, pi - pj, s2[k], roots[k]);
+                let col = c * RUN + k;
+                acc[0] += *b * x[0][col];
+                outs[0][col] += T::m3_tmul(*b, xi[0]);
+            }
+            continue;
+        }
+        // Several vectors: the run's blocks first, then each vector's sums over them
+        // (the same order per vector; a vector at a time keeps its sums in registers).
+        for (k, (b, (&pj, &aj))) in cols.enumerate() {
             *b = pair_tt_from(level, eta, ai, aj, pi - pj, s2[k], roots[k]);
-            *acc += *b * xj;
-            *o += T::m3_tmul(*b, xi);
+        }
+        for q in 0..K {
+            for (k, &b) in bs.iter().enumerate() {
+                let col = c * RUN + k;
+                acc[q] += b * x[q][col];
+                outs[q][col] += T::m3_tmul(b, xi[q]);
+            }
         }
     }
     Ok(())
@@ -291,7 +361,7 @@ mod tests {
             let (y0, y1) = (&mut y0[..b1 - b0], &mut y1[..b1 - b0]);
             let (z0, z1) = (&mut z0[..b0], &mut z1[..b0]);
             super::super::band::<f64>(&a, b0, &x, y0, z0);
-            band_rows::<f64>(&a, b0, &x, y1, z1);
+            band_rows_k::<f64, 1>(&a, b0, [&x], [y1], [z1]);
             assert!(same(y0, y1, DVec3::to_array), "rows {b0}..{b1}");
             assert!(same(z0, z1, DVec3::to_array), "rows {b0}..{b1}");
         }

@@ -8,55 +8,54 @@
 //! product ([`product`](super::product) after [`assemble`](super::assemble)) on any
 //! number of threads.
 
-use super::blocked::runs;
-use super::{Pairs, Parallel, band_start, bands, by_bands, reduce};
+use super::blocked::runs_k;
+use super::{Pairs, Parallel, band_start, by_bands_then_reduce};
 use crate::error::ParticleError;
-use crate::linalg::tri;
 use crate::mobility::{Hydro, self_tt};
 use crate::real::Real;
 
 /// Columns evaluated into the stack buffer at a time (whole runs of square roots).
 const SPAN: usize = 64;
 
-/// Rows `b0..b0 + y.len()` of `y = mu_tt x`, their transposed blocks left of the band
-/// summed into `z` (from zero), as a stored band computes them.
-fn band_free<T: Real>(
+/// Rows `b0..b0 + y_q.len()` of `y_q = mu_tt x_q` for `K` vectors, their transposed
+/// blocks left of the band summed into `z_q` (from zero), as a stored band computes
+/// them: each block evaluated once and applied to every vector.
+#[inline(always)]
+fn band_free<T: Real, const K: usize>(
     src: Pairs<'_, T>,
     b0: usize,
-    x: &[T::V3],
-    y: &mut [T::V3],
-    z: &mut [T::V3],
+    x: [&[T::V3]; K],
+    mut y: [&mut [T::V3]; K],
+    mut z: [&mut [T::V3]; K],
 ) -> Result<(), ParticleError> {
-    z.fill(T::V3_ZERO);
-    for (k, yk) in y.iter_mut().enumerate() {
-        let i = b0 + k;
-        *yk = T::m3_diag(self_tt(src.eta, src.radius[i])) * x[i];
+    let m = y[0].len();
+    for q in 0..K {
+        z[q].fill(T::V3_ZERO);
+        for k in 0..m {
+            let i = b0 + k;
+            y[q][k] = T::m3_diag(self_tt(src.eta, src.radius[i])) * x[q][i];
+        }
     }
     let mut buf = [T::M3_ZERO; SPAN];
-    for k in 0..y.len() {
+    for k in 0..m {
         let i = b0 + k;
-        let mut acc = T::V3_ZERO;
+        let mut acc = [T::V3_ZERO; K];
         // Left of the band: columns 0..b0 into z; inside it: b0..i into y.
         for j0 in (0..b0).step_by(SPAN) {
             let j1 = (j0 + SPAN).min(b0);
             let blocks = &mut buf[..j1 - j0];
-            runs(src, i, j0, blocks, &mut z[j0..j1], &x[j0..], &mut acc)?;
+            let outs = z.each_mut().map(|zq| &mut zq[j0..j1]);
+            runs_k(src, i, j0, blocks, outs, x.map(|xq| &xq[j0..]), &mut acc)?;
         }
-        let (ys, yi) = y[..=k].split_at_mut(k);
         for j0 in (b0..i).step_by(SPAN) {
             let j1 = (j0 + SPAN).min(i);
             let blocks = &mut buf[..j1 - j0];
-            runs(
-                src,
-                i,
-                j0,
-                blocks,
-                &mut ys[j0 - b0..j1 - b0],
-                &x[j0..],
-                &mut acc,
-            )?;
+            let outs = y.each_mut().map(|yq| &mut yq[j0 - b0..j1 - b0]);
+            runs_k(src, i, j0, blocks, outs, x.map(|xq| &xq[j0..]), &mut acc)?;
         }
-        yi[0] += acc;
+        for q in 0..K {
+            y[q][k] += acc[q];
+        }
     }
     Ok(())
 }
@@ -76,19 +75,81 @@ pub fn free_product<T: Real>(
     y: &mut [T::V3],
     z: &mut [T::V3],
 ) -> Result<(), ParticleError> {
+    free_products::<T, 1>(par, level, eta, pos, radius, [x], [y], z)
+}
+
+/// [`free_product`] of `K` vectors in one pass over the pairs (each block evaluated
+/// once, applied to all `K`): `y[q]` gets the bits `free_product` gives it for `x[q]`.
+/// `z` holds at least `K` [`band_scratch`](super::band_scratch)`(n)` vectors.
+#[allow(clippy::too_many_arguments)]
+pub fn free_products<T: Real, const K: usize>(
+    par: &dyn Parallel,
+    level: Hydro,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    x: [&[T::V3]; K],
+    y: [&mut [T::V3]; K],
+    z: &mut [T::V3],
+) -> Result<(), ParticleError> {
     let n = pos.len();
+    by_bands_then_reduce::<T, _, K>(par, n, y, z, |t, yt, zt| {
+        free_band::<T, K>((level, eta, pos, radius), t, x, yt, zt)
+    })
+}
+
+/// Band `t` of [`free_products`] (as [`super::product_band`] is of
+/// [`super::products`]; inlined, for a host's wider-vector copy).
+#[inline(always)]
+pub fn free_band<T: Real, const K: usize>(
+    (level, eta, pos, radius): (Hydro, T, &[T::V3], &[T]),
+    t: usize,
+    x: [&[T::V3]; K],
+    y: [&mut [T::V3]; K],
+    z: [&mut [T::V3]; K],
+) -> Result<(), ParticleError> {
     let src = Pairs {
         level,
         eta,
         pos,
         radius,
     };
-    if bands(n) == 1 {
-        return band_free::<T>(src, 0, x, &mut y[..n], &mut []);
+    band_free::<T, K>(src, band_start(pos.len(), t), x, y, z)
+}
+
+/// Rows `b0..b0 + y.len()` of `y = A x` for a general block source: `diag(i)` the
+/// diagonal block, `block(i, j)` (`j < i`) the lower block (not symmetric in general,
+/// as above a wall), evaluated where they are used, summed as the stored row-by-row
+/// band [`band`](super::band) sums the stored blocks (the same bits on any number of
+/// threads). The first error in row order.
+#[inline(always)]
+pub(crate) fn band_blocks<T: Real, E>(
+    b0: usize,
+    diag: impl Fn(usize) -> T::M3,
+    block: impl Fn(usize, usize) -> Result<T::M3, E>,
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) -> Result<(), E> {
+    z.fill(T::V3_ZERO);
+    for (k, yk) in y.iter_mut().enumerate() {
+        *yk = diag(b0 + k) * x[b0 + k];
     }
-    by_bands::<T, _, _>(par, n, &mut [], tri, y, z, |t, _, yt, zt| {
-        band_free::<T>(src, band_start(n, t), x, yt, zt)
-    })?;
-    reduce::<T>(n, y, z, par);
+    for k in 0..y.len() {
+        let i = b0 + k;
+        let (xi, mut acc) = (x[i], T::V3_ZERO);
+        for (j, zj) in z.iter_mut().enumerate() {
+            let b = block(i, j)?;
+            acc += b * x[j];
+            *zj += T::m3_tmul(b, xi);
+        }
+        let (ys, yi) = y[..=k].split_at_mut(k);
+        for (c, yj) in ys.iter_mut().enumerate() {
+            let b = block(i, b0 + c)?;
+            acc += b * x[b0 + c];
+            *yj += T::m3_tmul(b, xi);
+        }
+        yi[0] += acc;
+    }
     Ok(())
 }

@@ -97,14 +97,38 @@ pub(crate) type Packed<'a, T> = (&'a mut [<T as Real>::M3], fn(usize) -> usize);
 pub(crate) fn by_bands_and<T: Real, E: Send, J>(
     par: &dyn Parallel,
     n: usize,
-    (out, start): Packed<'_, T>,
-    (side, side_start): Packed<'_, T>,
+    out: Packed<'_, T>,
+    side: Packed<'_, T>,
     y: &mut [T::V3],
     z: &mut [T::V3],
     job: J,
 ) -> Result<(), E>
 where
     J: Fn(usize, &mut [T::M3], &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
+{
+    let job = |t,
+               rows: &mut [T::M3],
+               side: &mut [T::M3],
+               [yt]: [&mut [T::V3]; 1],
+               [zt]: [&mut [T::V3]; 1]| { job(t, rows, side, yt, zt) };
+    by_bands_k::<T, E, _, 1>(par, n, out, side, [y], [z], job)
+}
+
+/// [`by_bands_and`] for `K` products at once: every band gets its rows of each of the
+/// `K` outputs `y` and its partial-sum slice of each of the `K` scratches `z` (each
+/// empty, or as [`by_bands`] cuts it).
+pub(crate) fn by_bands_k<T: Real, E: Send, J, const K: usize>(
+    par: &dyn Parallel,
+    n: usize,
+    (out, start): Packed<'_, T>,
+    (side, side_start): Packed<'_, T>,
+    y: [&mut [T::V3]; K],
+    z: [&mut [T::V3]; K],
+    job: J,
+) -> Result<(), E>
+where
+    J: Fn(usize, &mut [T::M3], &mut [T::M3], [&mut [T::V3]; K], [&mut [T::V3]; K]) -> Result<(), E>
+        + Sync,
 {
     let k = bands(n);
     let mut results: [Option<Result<(), E>>; BANDS] = core::array::from_fn(|_| None);
@@ -120,19 +144,19 @@ where
                 false => f(b1) - f(b0),
             };
             let (lo, ls) = (rows(os, start), rows(ss, side_start));
-            let (ly, lz) = (
-                if ys.is_empty() { 0 } else { b1 - b0 },
-                if zs.is_empty() { 0 } else { b0 },
-            );
             let (ot, rest) = core::mem::take(&mut os).split_at_mut(lo);
             os = rest;
             let (st, rest) = core::mem::take(&mut ss).split_at_mut(ls);
             ss = rest;
-            let (yt, rest) = core::mem::take(&mut ys).split_at_mut(ly);
-            ys = rest;
-            let (zt, rest) = core::mem::take(&mut zs).split_at_mut(lz);
-            zs = rest;
-            let _ = jobs.push(move || *result = Some(job(t, ot, st, yt, zt)));
+            let mut yt = cut::<T, K>(&mut ys, b1 - b0);
+            let mut zt = cut::<T, K>(&mut zs, b0);
+            let _ = jobs.push(move || {
+                let (yt, zt) = (
+                    yt.each_mut().map(|s| &mut **s),
+                    zt.each_mut().map(|s| &mut **s),
+                );
+                *result = Some(job(t, ot, st, yt, zt));
+            });
         }
         run_all(par, &mut jobs);
     }
@@ -140,4 +164,17 @@ where
         r.unwrap_or(Ok(()))?;
     }
     Ok(())
+}
+
+/// The first `len` entries of each non-empty slice of `v` (which keeps the rest).
+fn cut<'a, T: Real, const K: usize>(
+    v: &mut [&'a mut [T::V3]; K],
+    len: usize,
+) -> [&'a mut [T::V3]; K] {
+    core::array::from_fn(|q| {
+        let s = core::mem::take(&mut v[q]);
+        let (head, rest) = s.split_at_mut(if s.is_empty() { 0 } else { len });
+        v[q] = rest;
+        head
+    })
 }

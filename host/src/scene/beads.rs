@@ -170,6 +170,7 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     p.method = i.method.kernel();
     p.rotation = scene.model.rotation;
     p.matrix_free = i.matrix_free;
+    p.compact_products = i.compact_products;
     // f32 cannot reach 1e-10: floor the tolerance at a few hundred ulps.
     let floor = 256.0 * T::EPSILON.to_f64();
     p.solver = Solver {

@@ -248,6 +248,12 @@ pub struct Integrator {
     /// pair blocks evaluated where they are used; thermal noise by Lanczos).
     /// `method = "overdamped"` or `"springs"` with `level = "manual"` only.
     pub matrix_free: bool,
+    /// Mixed-precision constraint products (the kernel's `Params::compact_products`:
+    /// the Krylov solve's products read an `f32` copy of the stored mobility, the
+    /// residual stays `f64`; a third of the bytes per product). The kernel takes it
+    /// where it applies (deterministic overdamped, `f64`, free space, at least 700
+    /// beads, Krylov) and ignores it elsewhere.
+    pub compact_products: bool,
 }
 
 impl Integrator {

@@ -104,6 +104,7 @@ pub(super) struct RawIntegrator {
     pub(super) stiffness: S<f64>,
     pub(super) fene: S<f64>,
     pub(super) matrix_free: Option<Spanned<bool>>,
+    pub(super) compact_products: Option<bool>,
 }
 
 #[derive(Deserialize)]

@@ -351,6 +351,7 @@ fn plans(
         brownian,
         wall,
         matrix_free: integrator.matrix_free,
+        compact_products: integrator.compact_products,
         pse: false,
     };
     match model.level {
@@ -433,6 +434,7 @@ fn resolve_integrator(r: &RawIntegrator) -> Result<Integrator, Issue> {
         stiffness: number(&r.stiffness, 1e4, "stiffness", Bound::Positive)?,
         fene: resolve_fene(r)?,
         matrix_free: r.matrix_free.as_ref().is_some_and(|m| *m.get_ref()),
+        compact_products: r.compact_products.unwrap_or(false),
     })
 }
 

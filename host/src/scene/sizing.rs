@@ -117,6 +117,9 @@ pub struct Plan {
     pub wall: bool,
     /// No stored mobility (`[integrator] matrix_free`).
     pub matrix_free: bool,
+    /// The compact `f32` copy for the constraint products
+    /// (`[integrator] compact_products`; storage where the kernel takes it).
+    pub compact_products: bool,
     /// The box summed by PSE (`[box] method = "pse"`): the solver `"auto"` is Krylov
     /// (the kernel's `Params::solver_kind`).
     pub pse: bool,
@@ -134,6 +137,7 @@ impl Plan {
             brownian: scene.brownian,
             wall: scene.wall.is_some(),
             matrix_free: scene.integrator.matrix_free,
+            compact_products: scene.integrator.compact_products,
             pse: scene
                 .periodic
                 .is_some_and(|b| b.method == super::BoxMethod::Pse),
@@ -157,6 +161,7 @@ impl Plan {
             p.contacts = contacts.map(Contacts::new);
             p.wall = self.wall.then_some(hydrorattle::Wall::new(0.0));
             p.matrix_free = self.matrix_free || self.pse;
+            p.compact_products = self.compact_products;
             if self.pse {
                 // Any box: only the solver's resolution reads it.
                 p.periodic = hydrorattle::Periodic::new([1.0; 3]).ok();
@@ -215,6 +220,7 @@ mod tests {
             brownian: None,
             wall: false,
             matrix_free: false,
+            compact_products: false,
             pse: false,
         }
     }

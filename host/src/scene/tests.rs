@@ -139,6 +139,7 @@ fn overdamped() -> Plan {
         brownian: None,
         wall: false,
         matrix_free: false,
+        compact_products: false,
         pse: false,
     }
 }
@@ -198,4 +199,32 @@ fn solvers_are_named_as_in_the_kernel() {
             solver
         );
     }
+}
+
+/// `[integrator] compact_products`: off by default and then not written; on, it reaches
+/// the kernel's parameters and the storage plan (the copy is a third of the mobility
+/// where the kernel takes it) and is written back.
+#[test]
+fn compact_products_reaches_the_kernel_and_is_written_back_only_when_set() {
+    let plain = Scene::parse(&row(700, 699, "manual"), "row.toml").unwrap();
+    assert!(!plain.integrator.compact_products);
+    assert!(!plain.to_toml().contains("compact_products"));
+    assert!(!params::<f64>(&plain).compact_products);
+    let text = row(700, 699, "manual")
+        .replace("duration = 1\n", "duration = 1\ncompact_products = true\n");
+    let s = Scene::parse(&text, "row.toml").unwrap();
+    assert!(s.integrator.compact_products);
+    assert!(params::<f64>(&s).compact_products);
+    let written = s.to_toml();
+    assert!(written.contains("compact_products = true"));
+    let again = Scene::parse(&written, "scene.toml").unwrap();
+    assert!(again.integrator.compact_products);
+    // Storage: the plan keeps the copy where the kernel takes it (700 beads, Krylov).
+    let (with, without) = (Plan::of(&s), Plan::of(&plain));
+    let (a, b) = (
+        with.bytes(700, 699).unwrap(),
+        without.bytes(700, 699).unwrap(),
+    );
+    let mobility = 700 * 701 / 2 * 72;
+    assert!(a > b + mobility / 4, "{a} against {b}");
 }

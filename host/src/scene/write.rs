@@ -69,6 +69,9 @@ impl Scene {
         if let (Some(q0), Some(Value::Table(it))) = (i.fene, t.get_mut("integrator")) {
             it.insert("fene".into(), value(q0));
         }
+        if let (true, Some(Value::Table(it))) = (i.compact_products, t.get_mut("integrator")) {
+            it.insert("compact_products".into(), value(true));
+        }
         t.insert(
             "output".into(),
             table([("every", value(self.output.every as i64))]),

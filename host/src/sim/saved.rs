@@ -31,6 +31,9 @@ pub struct SavedParams {
     method: String,
     rotation: bool,
     matrix_free: bool,
+    /// Absent in systems saved before the key (false).
+    #[serde(default)]
+    compact_products: bool,
     solver: String,
     tolerance: u64,
     max_iterations: u32,
@@ -103,6 +106,7 @@ impl SavedParams {
             method: p.method.name().into(),
             rotation: p.rotation,
             matrix_free: p.matrix_free,
+            compact_products: p.compact_products,
             solver: p.solver.kind.name().into(),
             tolerance: b(p.solver.tolerance),
             max_iterations: p.solver.max_iterations,
@@ -133,6 +137,7 @@ impl SavedParams {
         p.method = named::<Method>(&self.method)?;
         p.rotation = self.rotation;
         p.matrix_free = self.matrix_free;
+        p.compact_products = self.compact_products;
         p.solver = Solver {
             kind: named::<SolverKind>(&self.solver)?,
             tolerance: f(self.tolerance),
