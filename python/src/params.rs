@@ -121,6 +121,7 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
             "hydro" => p.hydro = crate::input::hydro(&name(&x)?)?,
             "rotation" => p.rotation = flag(k, &x)?,
             "matrix_free" => p.matrix_free = flag(k, &x)?,
+            "compact_products" => p.compact_products = flag(k, &x)?,
             "solver" => p.solver.kind = pick::<SolverKind>("solver", &name(&x)?)?,
             "tolerance" => p.solver.tolerance = real(&x)?,
             "max_iterations" => p.solver.max_iterations = count(k, &x)?,

@@ -424,3 +424,24 @@ def test_settling_dimer_tension_in_both_precisions(precision, method, dt):
         want = dimer_closed_form(np.linalg.norm(p[0] - p[1]), rho)[0]
     tol = {"f64": 1e-5, "f32": 1e-2}[precision]
     assert got == pytest.approx(want, rel=tol), (got, want)
+
+
+def test_compact_products_keep_the_bonds_and_stay_near_the_f64_run():
+    """The f32 copy of the mobility for the Krylov products (700 beads and more):
+    every bond still meets the tolerance, and the positions stay within the f32
+    copy's rounding of the all-f64 run's."""
+    pos, bonds = chain(720)
+    kw = dict(bonds=bonds, dt=0.05, solver="krylov", tolerance=1e-10)
+    plain = hr.System(pos, 1.0, RHO, **kw)
+    compact = hr.System(pos, 1.0, RHO, compact_products=True, **kw)
+    plain.step(2)
+    compact.step(2)
+    p, c = plain.positions, compact.positions
+    rest = np.linalg.norm(pos[1:] - pos[:-1], axis=1)
+    lengths = np.linalg.norm(c[1:] - c[:-1], axis=1)
+    assert np.max(np.abs(lengths - rest)) < 1e-8
+    moved = np.max(np.abs(p - pos))
+    gap = np.max(np.abs(p - c))
+    # Different storage, so not the same bits; f32's rounding of the matrix, 6e-8
+    # relative, bounds how far the constrained velocities may differ.
+    assert 0 < gap < 1e-5 * moved, (gap, moved)

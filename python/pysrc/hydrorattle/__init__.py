@@ -344,7 +344,11 @@ class System:
     (required), ``method`` ("overdamped", "overdamped2", "rattle", "rattle-stable",
     "springs"; default "overdamped"), ``viscosity`` (1), ``fluid_density`` (0),
     ``gravity`` ((0, 0, -1)), ``flow`` ((0, 0, 0)), ``vorticity`` ((0, 0, 0)), ``hydro``
-    ("rpy"), ``rotation`` (False), ``matrix_free`` (False), ``solver`` ("auto",
+    ("rpy"), ``rotation`` (False), ``matrix_free`` (False), ``compact_products`` (False: the
+    Krylov constraint products read an f32 copy of the mobility, a third of the bytes,
+    with the residual kept in f64 so the bonds still meet ``tolerance``; taken only by
+    f64 "overdamped" without noise, wall or box, from 700 beads, and ignored
+    elsewhere), ``solver`` ("auto",
     "sweep", "newton", "krylov"), ``tolerance`` (1e-10 in f64, 1e-5 in f32),
     ``max_iterations`` (100), ``allow_overlap`` (False), ``spring_stiffness`` (1e3), ``fene`` (None:
     Hookean springs; ``Q0``: FENE springs of maximum extension ``Q0``),
