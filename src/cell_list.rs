@@ -27,9 +27,11 @@
 use crate::cell::Periodic;
 use crate::real::Real;
 
-/// Spheres from which the pair searches use a cell list; below, every pair is visited
-/// (cheaper there: measured, `docs/PERIODIC.md`, "Pair searches").
-pub const CELLS_MIN: usize = 96;
+/// Spheres from which the pair searches use a cell list; below, every pair is visited.
+/// Measured (`examples/pair_search.rs`: a step with contacts on, CPU time): the cell
+/// list costs more at 16 spheres (17-19 against 14.5-15 us a step), the same at 32 and
+/// 48, less from 64 (46-49 against 51-57 us; at 256, 318-324 against 636-684 us).
+pub const CELLS_MIN: usize = 64;
 
 /// Relative widening of the cutoff (rounding of the distances compared).
 const MARGIN: f64 = 1.0 / 1024.0;
