@@ -33,7 +33,7 @@ enum Place {
 /// region of edge `size`, settling with hard contacts for `steps` steps; the digest of
 /// the end state and of every step's contact count, and the most contacts held.
 fn settle<T: Real>(place: Place, steps: usize) -> (u64, u32) {
-    assert!(N >= cell_list::CELLS_MIN, "the cell list must be in use");
+    const { assert!(N >= cell_list::CELLS_MIN, "the cell list must be in use") };
     let size = [14.0, 14.0, 14.0];
     let (pos, rad) = config_radii(N, 27, size, [0.5, 1.0], false);
     assert_eq!(pos.len(), N);

@@ -375,7 +375,9 @@ pub(super) fn check_inputs<T: Real>(
 /// in `cells` finds ([`crate::cell_list`], cells as wide as the largest contact
 /// distance), which is the same pair.
 pub(super) fn accept<T: Real>(
-    (pos, vel, omega): (&[T::V3], &[T::V3], &[T::V3]),
+    pos: &[T::V3],
+    vel: &[T::V3],
+    omega: &[T::V3],
     radius: &[T],
     p: &Params<T>,
     par: &dyn Parallel,
@@ -549,8 +551,7 @@ mod tests {
                 },
             ] {
                 for store in [&mut cells[..], &mut []] {
-                    let candidate = (&pos[..], &zero[..], &zero[..]);
-                    let got = accept(candidate, &radius, &q, &Serial, store);
+                    let got = accept(&pos, &zero, &zero, &radius, &q, &Serial, store);
                     assert_eq!(got, want, "{moves:?}");
                 }
             }

@@ -212,9 +212,8 @@ fn advance<T: Real, E: ExternalForce<T>>(
     let (new_pos, rest) = ws.vectors.split_at(n);
     let (new_vel, rest) = rest.split_at(n);
     let new_omega = &rest[..n];
-    let candidate = (new_pos, new_vel, new_omega);
     let mut report = integrated
-        .and_then(|r| accept(candidate, state.radius, p, par, cells).map(|()| r))
+        .and_then(|r| accept(new_pos, new_vel, new_omega, state.radius, p, par, cells).map(|()| r))
         .inspect_err(|e| log::debug!("step at t = {} refused, state kept: {e}", *state.time))?;
     log::trace!(
         "t = {}: {} position / {} velocity iterations",
