@@ -177,10 +177,21 @@ fn run(l: f64, start: &[[f64; 3]], tol: Option<f64>, steps: usize) -> Run {
         let c0 = cpu();
         let r = step_slices(state, &[], &p, &mut ws, &mut NoForce)
             .unwrap_or_else(|e| panic!("step {k}: {e}"));
-        cpu_sum = match (cpu_sum, c0, cpu()) {
+        let c1 = cpu();
+        cpu_sum = match (cpu_sum, c0, c1) {
             (Some(s), Some(a), Some(b)) => Some(s + b - a),
             _ => None,
         };
+        if n >= 1000 {
+            // Large runs are long: each step on stderr as it ends.
+            eprintln!(
+                "step {k}: {} contacts, {} rounds, {} solver iterations, {:.2} s CPU",
+                r.contacts,
+                r.contact_rounds,
+                r.iterations,
+                c0.zip(c1).map_or(f64::NAN, |(a, b)| b - a)
+            );
+        }
         contacts = contacts.max(r.contacts);
         rounds += r.contact_rounds;
         most_rounds = most_rounds.max(r.contact_rounds);

@@ -394,8 +394,9 @@ pub(super) fn accept<T: Real>(
         }
     }
     let n = pos.len();
-    let cutoff = crate::cell_list::largest(radius) * T::TWO;
-    let list = if n >= crate::cell_list::CELLS_MIN {
+    // Without the `cells` feature (firmware) this is the all-pairs check alone.
+    let list = if cfg!(feature = "cells") && n >= crate::cell_list::CELLS_MIN {
+        let cutoff = crate::cell_list::largest(radius) * T::TWO;
         CellList::build(pos, super::cell(p).as_ref(), cutoff, cells)
     } else {
         None
@@ -425,31 +426,6 @@ pub(super) fn accept<T: Real>(
     }
 }
 
-/// The box, the contact reach (`1 - 2 tol` with contacts: touching within the
-/// solver's tolerance is accepted) and whether overlaps are allowed: what [`clashes`]
-/// reads.
-#[inline(always)]
-fn clash_rule<T: Real>(p: &Params<T>) -> (Option<crate::cell::Periodic<T>>, T, bool) {
-    let reach = match p.contacts {
-        Some(_) => T::ONE - p.solver.tolerance * T::TWO,
-        None => T::ONE,
-    };
-    (super::cell(p), reach, p.allow_overlap)
-}
-
-/// Whether spheres `(pi, ai)` and `(pj, aj)`, `i < j`, clash by `rule`
-/// ([`clash_rule`]): nested, or (unless allowed) overlapping.
-#[inline(always)]
-fn clashes<T: Real>(
-    (cell, reach, allow_overlap): (Option<&crate::cell::Periodic<T>>, T, bool),
-    (pi, ai): (T::V3, T),
-    (pj, aj): (T::V3, T),
-) -> bool {
-    let s2 = T::norm2(image(cell, pi - pj));
-    let (dif, sum) = (ai - aj, (ai + aj) * reach);
-    s2 <= dif * dif || (!allow_overlap && s2 < sum * sum)
-}
-
 /// The first pair `(i, j)`, `i < j`, in that order, of nested (or, unless allowed,
 /// overlapping) spheres among the pairs whose later sphere `j` is in `rows`.
 fn first_clash<T: Real>(
@@ -458,15 +434,21 @@ fn first_clash<T: Real>(
     p: &Params<T>,
     rows: core::ops::Range<usize>,
 ) -> Option<(usize, usize)> {
-    let (cell, reach, allow_overlap) = clash_rule(p);
-    let rule = (cell.as_ref(), reach, allow_overlap);
+    let allow_overlap = p.allow_overlap;
+    let cell = super::cell(p);
+    let reach = match p.contacts {
+        Some(_) => T::ONE - p.solver.tolerance * T::TWO,
+        None => T::ONE,
+    };
     let mut first: Option<(usize, usize)> = None;
     for j in rows {
         let (pj, aj) = (pos[j], radius[j]);
         // A later row can only improve on `first` with a smaller `i`.
         let end = first.map_or(j, |(i, _)| i.min(j));
         for (i, (&pi, &ai)) in pos[..end].iter().zip(radius).enumerate() {
-            if clashes(rule, (pi, ai), (pj, aj)) {
+            let s2 = T::norm2(image(cell.as_ref(), pi - pj));
+            let (dif, sum) = (ai - aj, (ai + aj) * reach);
+            if s2 <= dif * dif || (!allow_overlap && s2 < sum * sum) {
                 first = Some((i, j));
                 break;
             }
@@ -475,9 +457,10 @@ fn first_clash<T: Real>(
     first
 }
 
-/// [`first_clash`] over the cell list's neighbours: the first pair `(i, j)`, `i < j`,
-/// whose earlier sphere `i` is in `rows` (the smallest `i` with a clash, then its
-/// smallest `j`).
+/// [`first_clash`] over the cell list's neighbours (the same test, kept beside the
+/// all-pairs loop rather than shared so that firmware's code stays as it was): the
+/// first pair `(i, j)`, `i < j`, whose earlier sphere `i` is in `rows` (the smallest
+/// `i` with a clash, then its smallest `j`).
 fn first_near<T: Real>(
     pos: &[T::V3],
     radius: &[T],
@@ -485,14 +468,22 @@ fn first_near<T: Real>(
     list: &CellList<'_>,
     rows: core::ops::Range<usize>,
 ) -> Option<(usize, usize)> {
-    let (cell, reach, allow_overlap) = clash_rule(p);
-    let rule = (cell.as_ref(), reach, allow_overlap);
+    let (allow_overlap, cell) = (p.allow_overlap, super::cell(p));
+    let reach = match p.contacts {
+        Some(_) => T::ONE - p.solver.tolerance * T::TWO,
+        None => T::ONE,
+    };
+    let clashes = |(pi, ai): (T::V3, T), (pj, aj): (T::V3, T)| {
+        let s2 = T::norm2(image(cell.as_ref(), pi - pj));
+        let (dif, sum) = (ai - aj, (ai + aj) * reach);
+        s2 <= dif * dif || (!allow_overlap && s2 < sum * sum)
+    };
     for i in rows {
         let mut first: Option<usize> = None;
         let (pi, ai) = (pos[i], radius[i]);
         list.near::<T>(pi, |j| {
             let later = j > i && first.is_none_or(|f| j < f);
-            if later && clashes(rule, (pi, ai), (pos[j], radius[j])) {
+            if later && clashes((pi, ai), (pos[j], radius[j])) {
                 first = Some(j);
             }
         });
