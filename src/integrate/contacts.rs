@@ -106,7 +106,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         ewald,
         compact,
     } = v;
-    let Links { list: links, cells } = links;
+    let (links, cells) = links.split();
     // Constants without the `contacts` feature: the one-sided path folds away.
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
     let wall = p.wall.filter(|_| cfg!(feature = "contacts"));

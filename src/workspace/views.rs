@@ -52,17 +52,28 @@ pub(crate) struct Views<'a, T: Real> {
 pub(crate) struct Links<'a, T: Real> {
     /// Bonds then contacts ([`Layout::links`]; empty without contacts or a wall).
     pub list: &'a mut [Bond<T>],
-    /// The cell list's indices.
+    /// The cell list's indices (only with the `cells` feature: firmware's projection
+    /// takes the link list alone, as before).
+    #[cfg(feature = "cells")]
     pub cells: &'a mut [usize],
 }
 
-impl<T: Real> Links<'_, T> {
+impl<'a, T: Real> Links<'a, T> {
     /// The same storage, borrowed for a shorter time (a second projection).
     pub fn reborrow(&mut self) -> Links<'_, T> {
         Links {
             list: &mut *self.list,
+            #[cfg(feature = "cells")]
             cells: &mut *self.cells,
         }
+    }
+
+    /// The link list and the cell list's indices (none without the `cells` feature).
+    pub fn split(self) -> (&'a mut [Bond<T>], &'a mut [usize]) {
+        #[cfg(feature = "cells")]
+        return (self.list, self.cells);
+        #[cfg(not(feature = "cells"))]
+        return (self.list, &mut []);
     }
 }
 
@@ -162,6 +173,7 @@ impl<T: Real> Workspace<'_, T> {
             }),
             par: self.parallel,
         };
+        #[cfg(feature = "cells")]
         let cells = ix.take(crate::cell_list::indices(n));
         let cap = p.lanczos.max_iterations as usize;
         let basis = ve.take(if lanczos { lanczos_vectors(cap, n) } else { 0 });
@@ -186,7 +198,11 @@ impl<T: Real> Workspace<'_, T> {
             scratch,
             basis,
             krylov_t,
-            links: Links { list: links, cells },
+            links: Links {
+                list: links,
+                #[cfg(feature = "cells")]
+                cells,
+            },
             par: self.parallel,
             bands,
             #[cfg(feature = "pse")]
