@@ -27,6 +27,10 @@ use hydrorattle_heap::Buffers;
 
 type V = <f64 as Real>::V3;
 
+#[path = "shared/cpu.rs"]
+mod cpu;
+use cpu::cpu;
+
 #[path = "shared/splitmix.rs"]
 mod splitmix;
 use splitmix::Rng;
@@ -117,11 +121,16 @@ struct Run {
     u: f64,
     /// Final positions.
     end: Vec<[f64; 3]>,
-    /// Wall-clock seconds per step.
+    /// Wall-clock seconds per step (the example's overlap check included).
     per_step: f64,
+    /// This thread's CPU seconds per step, in the kernel's step alone (`None` off
+    /// Linux).
+    cpu_step: Option<f64>,
     /// Most contacts held in a step, and the smallest gap seen (`r - 2`).
     contacts: u32,
     gap: f64,
+    /// Active-set rounds (constraint solves) per step, mean and most.
+    rounds: (f64, u32),
 }
 
 /// `steps` steps from `start` in the box `l`, PSE at `tol` or Ewald (`None`).
@@ -151,6 +160,8 @@ fn run(l: f64, start: &[[f64; 3]], tol: Option<f64>, steps: usize) -> Run {
     };
     let mut ws = buf.workspace().with_pse(&mut c, &mut ix, &mut ve);
     let (mut sum, mut contacts, mut gap) = (0.0, 0, f64::INFINITY);
+    let (mut rounds, mut most_rounds) = (0, 0);
+    let mut cpu_sum = Some(0.0);
     let t0 = Instant::now();
     for k in 0..steps {
         let before: Vec<f64> = pos.iter().map(|r| r.z).collect();
@@ -163,9 +174,27 @@ fn run(l: f64, start: &[[f64; 3]], tol: Option<f64>, steps: usize) -> Run {
             time: &mut time,
             noise: None,
         };
+        let c0 = cpu();
         let r = step_slices(state, &[], &p, &mut ws, &mut NoForce)
             .unwrap_or_else(|e| panic!("step {k}: {e}"));
+        let c1 = cpu();
+        cpu_sum = match (cpu_sum, c0, c1) {
+            (Some(s), Some(a), Some(b)) => Some(s + b - a),
+            _ => None,
+        };
+        if n >= 1000 {
+            // Large runs are long: each step on stderr as it ends.
+            eprintln!(
+                "step {k}: {} contacts, {} rounds, {} solver iterations, {:.2} s CPU",
+                r.contacts,
+                r.contact_rounds,
+                r.iterations,
+                c0.zip(c1).map_or(f64::NAN, |(a, b)| b - a)
+            );
+        }
         contacts = contacts.max(r.contacts);
+        rounds += r.contact_rounds;
+        most_rounds = most_rounds.max(r.contact_rounds);
         sum += pos.iter().zip(&before).map(|(r, z)| z - r.z).sum::<f64>() / (n as f64 * 0.05);
         let now: Vec<[f64; 3]> = pos.iter().map(|r| r.to_array()).collect();
         for (i, j, r) in close_pairs(&now, l, 2.0 + 1e-3) {
@@ -180,8 +209,10 @@ fn run(l: f64, start: &[[f64; 3]], tol: Option<f64>, steps: usize) -> Run {
         u: sum / steps as f64,
         end: pos.iter().map(|r| r.to_array()).collect(),
         per_step: t0.elapsed().as_secs_f64() / steps as f64,
+        cpu_step: cpu_sum.map(|s| s / steps as f64),
         contacts,
         gap,
+        rounds: (f64::from(rounds) / steps as f64, most_rounds),
     }
 }
 
@@ -250,12 +281,15 @@ fn main() {
             );
             let s = run(l, &start, Some(1e-3), steps);
             println!(
-                "PSE 1e-3, {steps} steps: U/U0 = {:.4} (RZ {:.4}), {:.2} s/step, {} contacts at most, smallest gap {:.2e}, no overlap at any step",
+                "PSE 1e-3, {steps} steps: U/U0 = {:.4} (RZ {:.4}), {:.3} s/step wall ({:.3} s CPU in the step), {} contacts at most, smallest gap {:.2e}, {:.1} active-set rounds a step ({} at most), no overlap at any step",
                 s.u,
                 rz(0.1),
                 s.per_step,
+                s.cpu_step.unwrap_or(f64::NAN),
                 s.contacts,
-                s.gap
+                s.gap,
+                s.rounds.0,
+                s.rounds.1
             );
         }
     }

@@ -24,6 +24,7 @@
 
 pub mod bonds;
 pub mod cell;
+pub mod cell_list;
 pub mod constraints;
 pub mod error;
 mod error_info;

@@ -42,14 +42,16 @@
 use super::{bond_vectors, mobility_metric, project_positions};
 use crate::bonds::Bond;
 use crate::cell::{Periodic, image};
+use crate::cell_list::{self, CellList};
 use crate::constraints::{Scratch, SolveStats};
 use crate::error::{Stage, StepError};
 use crate::params::{Contacts, Params, Wall};
 use crate::real::Real;
+use crate::workspace::Links;
 
 /// The slices the overdamped position projection works in.
 pub(super) struct Projection<'l, 'v, 'a, T: Real> {
-    pub links: &'l mut [Bond<T>],
+    pub links: Links<'l, T>,
     pub grad: &'v mut [T::V3],
     pub disp: &'v mut [T::V3],
     pub lambda: &'v mut [T],
@@ -104,6 +106,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         ewald,
         compact,
     } = v;
+    let (links, cells) = links.split();
     // Constants without the `contacts` feature: the one-sided path folds away.
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
     let wall = p.wall.filter(|_| cfg!(feature = "contacts"));
@@ -126,7 +129,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         let reach = T::ONE + tol * T::TWO;
         if contacts.is_some() {
             let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
-            add_pairs(bonds, start, start, radius, cell, reach, &mut set)?;
+            add_pairs(bonds, (start, start), radius, cell, reach, &mut set, cells)?;
         }
         if let Some(w) = wall {
             let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
@@ -170,7 +173,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         let mut added = 0;
         let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
         if contacts.is_some() {
-            added += add_pairs(bonds, start, x, radius, cell, reach, &mut set)?;
+            added += add_pairs(bonds, (start, x), radius, cell, reach, &mut set, cells)?;
         }
         if wall.is_some() {
             added += add_wall(x, T::ZERO, radius, reach, &mut set)?;
@@ -341,42 +344,74 @@ fn same<T: Real>(a: &Bond<T>, b: &Bond<T>) -> bool {
 /// displacement (the image is not taken again at its end, where a pair near half the
 /// box apart would jump across the box and seem to pass through contact); the end
 /// is compared by its minimum image.
+///
+/// The pairs are visited in the order `i` ascending, then `j < i` ascending: every
+/// pair, or from [`cell_list::CELLS_MIN`] spheres on the candidates of a cell list
+/// (`cells`, [`cell_list::indices`]) over the end positions with cells as wide as the
+/// largest contact distance within `reach` plus twice the largest displacement (a
+/// pair whose path comes within contact ends no farther apart than that), sorted
+/// into the same order: the same pairs, pushed in the same order, the same bits.
 fn add_pairs<T: Real>(
     bonds: &[Bond<T>],
-    from: &[T::V3],
-    to: &[T::V3],
+    (from, to): (&[T::V3], &[T::V3]),
     radius: &[T],
     cell: Option<Periodic<T>>,
     reach: T,
     set: &mut Active<'_, T>,
+    cells: &mut [usize],
 ) -> Result<usize, StepError> {
     let mut added = 0;
-    for i in 0..to.len() {
-        for j in 0..i {
-            let sigma = radius[i] + radius[j];
-            let far = sigma * reach;
-            let (d0, d1) = match cell {
-                Some(c) if cfg!(feature = "periodic") => {
-                    let d0 = c.minimum_image(from[i] - from[j]);
-                    (d0, d0 + ((to[i] - from[i]) - (to[j] - from[j])))
+    let mut pair = |i: usize, j: usize| -> Result<(), StepError> {
+        let sigma = radius[i] + radius[j];
+        let far = sigma * reach;
+        let (d0, d1) = match cell {
+            Some(c) if cfg!(feature = "periodic") => {
+                let d0 = c.minimum_image(from[i] - from[j]);
+                (d0, d0 + ((to[i] - from[i]) - (to[j] - from[j])))
+            }
+            _ => (from[i] - from[j], to[i] - to[j]),
+        };
+        let ends = T::norm2(image(cell.as_ref(), d1)) < far * far;
+        let crossed = !(T::dot(d0, d1) > T::ZERO) && closest2::<T>(d0, d1) < far * far;
+        if !(ends || crossed) {
+            return Ok(());
+        }
+        let joins = |b: &Bond<T>| (b.i == i && b.j == j) || (b.i == j && b.j == i);
+        if bonds.iter().any(joins) || set.held().iter().any(joins) {
+            return Ok(());
+        }
+        set.push(Bond {
+            i,
+            j,
+            length: sigma,
+        })?;
+        added += 1;
+        Ok(())
+    };
+    let list = if to.len() >= cell_list::CELLS_MIN {
+        let moved = from
+            .iter()
+            .zip(to)
+            .fold(T::ZERO, |m, (&a, &b)| m.max(T::norm2(b - a)));
+        let contact = cell_list::largest(radius) * T::TWO * reach.max(T::ONE);
+        CellList::build(to, cell.as_ref(), contact + moved.sqrt() * T::TWO, cells)
+    } else {
+        None
+    };
+    match list {
+        Some((list, row)) => {
+            for i in 0..to.len() {
+                for &j in list.below::<T>(i, to[i], row) {
+                    pair(i, j)?;
                 }
-                _ => (from[i] - from[j], to[i] - to[j]),
-            };
-            let ends = T::norm2(image(cell.as_ref(), d1)) < far * far;
-            let crossed = !(T::dot(d0, d1) > T::ZERO) && closest2::<T>(d0, d1) < far * far;
-            if !(ends || crossed) {
-                continue;
             }
-            let joins = |b: &Bond<T>| (b.i == i && b.j == j) || (b.i == j && b.j == i);
-            if bonds.iter().any(joins) || set.held().iter().any(joins) {
-                continue;
+        }
+        None => {
+            for i in 0..to.len() {
+                for j in 0..i {
+                    pair(i, j)?;
+                }
             }
-            set.push(Bond {
-                i,
-                j,
-                length: sigma,
-            })?;
-            added += 1;
         }
     }
     Ok(added)

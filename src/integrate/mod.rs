@@ -211,12 +211,13 @@ fn advance<T: Real, E: ExternalForce<T>>(
         }
     };
     // 3. Accept. The candidate state heads the vector storage (see `Workspace::views`).
-    let par = ws.parallel;
+    // Every index of the workspace is free by now: the pair check's cell list.
+    let (par, cells) = (ws.parallel, &mut *ws.indices);
     let (new_pos, rest) = ws.vectors.split_at(n);
     let (new_vel, rest) = rest.split_at(n);
     let new_omega = &rest[..n];
     let mut report = integrated
-        .and_then(|r| accept(new_pos, new_vel, new_omega, state.radius, p, par).map(|()| r))
+        .and_then(|r| accept(new_pos, new_vel, new_omega, state.radius, p, par, cells).map(|()| r))
         .inspect_err(|e| log::debug!("step at t = {} refused, state kept: {e}", *state.time))?;
     log::trace!(
         "t = {}: {} position / {} velocity iterations",

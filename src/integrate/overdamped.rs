@@ -158,7 +158,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         lambda,
         kappa,
         scratch: mut sc,
-        links,
+        mut links,
         ..
     } = v;
     // Predictor: projected velocity at r, one projected Euler step.
@@ -178,7 +178,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         }
     };
     let views = Projection {
-        links: &mut *links,
+        links: links.reborrow(),
         grad: &mut *grad,
         disp: &mut *disp,
         lambda: &mut *lambda,

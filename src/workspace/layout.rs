@@ -58,7 +58,10 @@ impl Layout {
     ///   Krylov.
     ///
     /// The dense Newton solve adds `B^2 + B` scalars and `B` indices; Krylov adds
-    /// `9 B` scalars and `2n + 2m` vectors; the sweep adds nothing.
+    /// `9 B` scalars and `2n + 2m` vectors; the sweep adds nothing. From
+    /// [`CELLS_MIN`](crate::cell_list::CELLS_MIN) spheres on (with the `cells` feature)
+    /// the pair searches' cell list adds `3n + 1` indices
+    /// ([`cell_list::indices`](crate::cell_list::indices)).
     pub const fn with_solver(
         method: Method,
         rotation: bool,
@@ -114,6 +117,8 @@ impl Layout {
             l.vectors += v;
             l.indices += i;
         }
+        // The pair searches' cell list (the acceptance's overlap check, every method).
+        l.indices += crate::cell_list::indices(n);
         l
     }
 

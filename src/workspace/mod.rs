@@ -22,7 +22,7 @@ mod views;
 
 pub use layout::Layout;
 pub(crate) use layout::block_rows;
-pub(crate) use views::Views;
+pub(crate) use views::{Links, Views};
 
 use crate::bonds::Bond;
 use crate::parallel::{Parallel, Serial};

@@ -34,8 +34,9 @@ pub(crate) struct Views<'a, T: Real> {
     /// The Lanczos basis and its scalars (thermal steps by Lanczos only).
     pub basis: &'a mut [T::V3],
     pub krylov_t: &'a mut [T],
-    /// Bonds then contacts (steps with contacts only; empty otherwise).
-    pub links: &'a mut [Bond<T>],
+    /// Bonds then contacts (steps with contacts only; empty otherwise), and the
+    /// contacts' pair search's cell list.
+    pub links: Links<'a, T>,
     /// How the mobility's bands run ([`Workspace::with_parallel`]).
     pub par: &'a dyn Parallel,
     /// The stored `mu_tt` product's band partial sums ([`band_scratch`]).
@@ -43,6 +44,37 @@ pub(crate) struct Views<'a, T: Real> {
     /// The caller's PSE arrays ([`Workspace::with_pse`]).
     #[cfg(feature = "pse")]
     pub pse: super::PseSlices<'a, T>,
+}
+
+/// The storage of the one-sided constraints (contacts, wall links): the link list
+/// (bonds, then contacts) and the contacts' pair search's cell list
+/// ([`crate::cell_list::indices`] indices; empty below its threshold).
+pub(crate) struct Links<'a, T: Real> {
+    /// Bonds then contacts ([`Layout::links`]; empty without contacts or a wall).
+    pub list: &'a mut [Bond<T>],
+    /// The cell list's indices (only with the `cells` feature: firmware's projection
+    /// takes the link list alone, as before).
+    #[cfg(feature = "cells")]
+    pub cells: &'a mut [usize],
+}
+
+impl<'a, T: Real> Links<'a, T> {
+    /// The same storage, borrowed for a shorter time (a second projection).
+    pub fn reborrow(&mut self) -> Links<'_, T> {
+        Links {
+            list: &mut *self.list,
+            #[cfg(feature = "cells")]
+            cells: &mut *self.cells,
+        }
+    }
+
+    /// The link list and the cell list's indices (none without the `cells` feature).
+    pub fn split(self) -> (&'a mut [Bond<T>], &'a mut [usize]) {
+        #[cfg(feature = "cells")]
+        return (self.list, self.cells);
+        #[cfg(not(feature = "cells"))]
+        return (self.list, &mut []);
+    }
 }
 
 /// Takes slices off the front of a slice.
@@ -141,6 +173,8 @@ impl<T: Real> Workspace<'_, T> {
             }),
             par: self.parallel,
         };
+        #[cfg(feature = "cells")]
+        let cells = ix.take(crate::cell_list::indices(n));
         let cap = p.lanczos.max_iterations as usize;
         let basis = ve.take(if lanczos { lanczos_vectors(cap, n) } else { 0 });
         let krylov_t = sc.take(if lanczos { lanczos_scalars(cap) } else { 0 });
@@ -164,7 +198,11 @@ impl<T: Real> Workspace<'_, T> {
             scratch,
             basis,
             krylov_t,
-            links,
+            links: Links {
+                list: links,
+                #[cfg(feature = "cells")]
+                cells,
+            },
             par: self.parallel,
             bands,
             #[cfg(feature = "pse")]
