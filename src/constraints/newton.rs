@@ -1,7 +1,7 @@
 //! Newton on the dense `bonds x bonds` Jacobian, solved by LU: quadratic convergence,
 //! `O(B^3)` per factorisation. The choice for small bond counts.
 
-use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, worst};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided, worst};
 use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::linalg;
@@ -28,6 +28,11 @@ use crate::real::Real;
 ///   [`StepError::Infeasible`], naming the dependent set (on the chord such a stall is
 ///   first taken for the chord's own slowness on a large move, and the Jacobian at the
 ///   iterate takes over as without dependent rows).
+/// * One-sided rows (contacts, wall links: [`Problem::Positions`]) are inequalities:
+///   each iteration decides which of them are equalities (`onesided.rs`, the
+///   primal-dual active set); the others get a zero update on a decoupled diagonal
+///   row. A change of the set refactorises. Without one-sided rows nothing of this
+///   runs.
 pub fn newton<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,
@@ -38,11 +43,14 @@ pub fn newton<T: Real>(
     scratch: &mut Scratch<'_, T>,
 ) -> Result<SolveStats<T>, StepError> {
     let nb = bonds.len();
-    let (jac, rhs, piv) = (
-        &mut scratch.jac[..nb * nb],
-        &mut scratch.rhs[..nb],
-        &mut scratch.piv[..nb],
-    );
+    let (piv, state) = scratch.piv.split_at_mut(nb);
+    let (jac, rhs) = (&mut scratch.jac[..nb * nb], &mut scratch.rhs[..nb]);
+    // One-sided rows from `from` on (`nb`: none, the equality solve as it always was).
+    let from = problem.one_sided(nb);
+    let one_sided = from < nb;
+    if one_sided {
+        onesided::reset(&mut state[..nb]);
+    }
     // Positions start on the chord; every solve falls back to the Jacobian at the
     // iterate, refreshed whenever the residual falls less than tenfold.
     let mut chord = matches!(problem, Problem::Positions { .. });
@@ -51,11 +59,20 @@ pub fn newton<T: Real>(
     // Dependent rows found by the last factorisation.
     let mut deficient = 0;
     for it in 0..=solver.max_iterations {
-        let residual = worst(&problem, bonds, x);
+        let (mut changed, mut pushes) = (false, true);
+        let residual = match one_sided {
+            false => worst(&problem, bonds, x),
+            true => {
+                changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
+                let (r, p) = onesided::residual(&problem, bonds, from, x, mult, state);
+                pushes = p;
+                r
+            }
+        };
         if !residual.is_finite() {
             return Err(problem.no_convergence(it, residual));
         }
-        if residual <= solver.tolerance {
+        if residual <= solver.tolerance && pushes {
             return Ok(SolveStats {
                 iterations: it,
                 residual,
@@ -65,7 +82,11 @@ pub fn newton<T: Real>(
             return Err(problem.no_convergence(it, residual));
         }
         let fast = previous.is_some_and(|p| residual <= p * T::from_f64(0.1));
-        if deficient > 0 && !chord && previous.is_some_and(|p| residual > p * T::HALF) {
+        if deficient > 0
+            && !chord
+            && !changed
+            && previous.is_some_and(|p| residual > p * T::HALF)
+        {
             // Named by the chord's self-stress (an LU factor shows only which columns
             // it skipped): refactorised here, on the way out.
             let c = problem.chord_factor();
@@ -73,11 +94,14 @@ pub fn newton<T: Real>(
                 let row = &mut jac[k * nb..k * nb + k + 1];
                 metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
             }
+            if one_sided {
+                decouple(jac, rhs, nb, from, state, true, true);
+            }
             let _ = linalg::cholesky_dense(jac, nb, floor);
             return Err(dependent::infeasible(metric, bonds, jac, rhs));
         }
-        let refresh = previous.is_none() || !fast;
-        if refresh && previous.is_some() {
+        let refresh = previous.is_none() || !fast || changed;
+        if refresh && previous.is_some() && !changed {
             chord = false;
         }
         previous = Some(residual);
@@ -93,6 +117,9 @@ pub fn newton<T: Real>(
                 };
                 metric.jacobian_row(bonds, k, dir, 0, &mut jac[k * nb..k * nb + len]);
             }
+        }
+        if one_sided {
+            decouple(jac, rhs, nb, from, state, refresh, chord);
         }
         let fail = |error| StepError::Linalg {
             stage: problem.stage(),
@@ -121,6 +148,44 @@ pub fn newton<T: Real>(
         iterations: solver.max_iterations,
         residual: f64::NAN,
     })
+}
+
+/// The inactive one-sided rows' equations replaced by `A_kk delta_k = 0`: their row
+/// and column zeroed but the diagonal (of the chord's lower triangle, or of the whole
+/// Jacobian), so that their updates are exactly zero and the active rows' system does
+/// not see them.
+fn decouple<T: Real>(
+    jac: &mut [T],
+    rhs: &mut [T],
+    nb: usize,
+    from: usize,
+    state: &[usize],
+    refresh: bool,
+    chord: bool,
+) {
+    for k in from..nb {
+        if onesided::active(state[k]) {
+            continue;
+        }
+        rhs[k] = T::ZERO;
+        if !refresh {
+            continue;
+        }
+        let (len, below) = if chord { (k, k + 1) } else { (nb, 0) };
+        for l in 0..len {
+            if l != k {
+                jac[k * nb + l] = T::ZERO;
+            }
+        }
+        for l in below..nb {
+            if l != k {
+                jac[l * nb + k] = T::ZERO;
+            }
+        }
+        if !(jac[k * nb + k] > T::ZERO) {
+            jac[k * nb + k] = T::ONE;
+        }
+    }
 }
 
 /// Largest `|A_kk|`: the scale of the LU rank tolerance (the rows of one problem share

@@ -156,7 +156,8 @@ pub(super) fn project_overdamped<'l, T: Real>(
         );
         free(x);
         shift(x, wall, -T::ONE);
-        let stats = project_positions(p, active, &metric, x, lambda, scratch)?;
+        // Contacts and wall links are inequalities inside the solve (`docs/CONTACTS.md`).
+        let stats = project_positions(p, active, &metric, x, lambda, scratch, nb)?;
         let Some(c) = one_sided else {
             return Ok(Projected {
                 stats,

@@ -1,0 +1,130 @@
+//! Contacts and wall links as inequalities inside the solve (`docs/CONTACTS.md`):
+//! `sigma_k(x) >= 0`, `lambda_k >= 0`, `lambda_k sigma_k(x) = 0` for the rows from
+//! [`Problem::Positions::one_sided`] on; the bonds before them stay equalities.
+//!
+//! * **Newton and Krylov: a primal-dual active set inside the iteration** (the
+//!   semismooth Newton method on `min(lambda_k A_kk, sigma_k) = 0`, Hintermüller, Ito
+//!   and Kunisch 2002). Each iteration a one-sided row is *active* (an equality) where
+//!   `lambda_k A_kk > sigma_k` (it pushes, or it overlaps), *inactive* otherwise: its
+//!   multiplier is set to zero (the positions move by `-lambda_k D_k`), and its row and
+//!   column of the linear system are replaced by the diagonal with a zero right-hand
+//!   side, so its update is exactly zero. A contact that would pull is thus let go in the
+//!   next iteration, before the equalities it took part in jam; a contact that the
+//!   move makes overlap is taken in. `A_kk` is the chord matrix's diagonal (the
+//!   scale that turns a multiplier into a residual).
+//! * **Anti-cycling**: the active set of this method can cycle where `A` is not an
+//!   M-matrix. Each row counts its switches; after [`SWITCHES`] it is *held* active
+//!   (an equality for the rest of the solve, whatever its multiplier: the rule the
+//!   active-set rounds apply between solves, `integrate/contacts.rs`). So the set
+//!   changes at most `SWITCHES x rows` times, and between changes the iteration is
+//!   the equality solve's (bounded by [`Solver::max_iterations`](super::Solver)).
+//! * **Sweep: projected Gauss-Seidel**: each one-sided update is clipped so that the
+//!   multiplier stays non-negative.
+//!
+//! Converged: bonds and active rows within the tolerance, inactive rows overlapping
+//! by at most the tolerance, every active row that is not held pushing
+//! (`lambda >= 0`).
+
+use super::{Metric, Problem};
+use crate::bonds::Bond;
+use crate::real::Real;
+
+/// Switches between active and inactive after which a row is held active.
+pub(super) const SWITCHES: usize = 4;
+
+/// A row's state word: bit 0 set when active, the switches counted above it.
+const ACTIVE: usize = 1;
+
+/// Index scratch per row (the state words) that the one-sided solve needs, where
+/// contacts are compiled in.
+pub(super) const STATE_PER_ROW: usize = if cfg!(feature = "contacts") { 1 } else { 0 };
+
+/// Whether a state word is active.
+#[inline]
+pub(super) fn active(state: usize) -> bool {
+    state & ACTIVE != 0
+}
+
+/// The chord matrix's diagonal `A_kk = c g_k . (D_k(i_k) - D_k(j_k))`.
+pub(super) fn diagonal<T: Real>(metric: &Metric<'_, T>, bonds: &[Bond<T>], c: T, k: usize) -> T {
+    T::dot(metric.grad(k), metric.relative(bonds, k, k)) * c
+}
+
+/// The start of a solve: every one-sided row inactive, no switch counted.
+pub(super) fn reset(state: &mut [usize]) {
+    state.fill(0);
+}
+
+/// One active-set update of the one-sided rows (`from..`): decides each row's state
+/// from its multiplier and residual at `x`, and lets go the rows that turn inactive
+/// (their multipliers to zero, `x` moved back by their pushes). Returns whether the set
+/// changed.
+pub(super) fn update<T: Real>(
+    problem: &Problem<'_, T>,
+    metric: &Metric<'_, T>,
+    bonds: &[Bond<T>],
+    from: usize,
+    x: &mut [T::V3],
+    mult: &mut [T],
+    state: &mut [usize],
+) -> bool {
+    let c = problem.chord_factor();
+    let mut changed = false;
+    for k in from..bonds.len() {
+        let s = state[k];
+        let held = s >> 1 >= SWITCHES;
+        let (value, _, _) = problem.eval(&bonds[k], k, x);
+        let on = held || mult[k] * diagonal(metric, bonds, c, k) > value;
+        if on != active(s) {
+            state[k] = ((s >> 1) + 1) << 1 | on as usize;
+            changed = true;
+        }
+        if !on && mult[k] != T::ZERO {
+            metric.apply_one(bonds, k, -mult[k], x);
+            mult[k] = T::ZERO;
+        }
+    }
+    changed
+}
+
+/// The largest normalised residual under complementarity: the equality rows' (bonds
+/// and active rows) error, the inactive rows' overlap; and whether every active row
+/// that is not held pushes (otherwise the set must change: not converged).
+pub(super) fn residual<T: Real>(
+    problem: &Problem<'_, T>,
+    bonds: &[Bond<T>],
+    from: usize,
+    x: &[T::V3],
+    mult: &[T],
+    state: &[usize],
+) -> (T, bool) {
+    let mut worst = T::ZERO;
+    let mut pushes = true;
+    for (k, b) in bonds.iter().enumerate() {
+        let (value, _, norm) = problem.eval(b, k, x);
+        if k < from || active(state[k]) {
+            if k >= from && mult[k] < T::ZERO && state[k] >> 1 < SWITCHES {
+                pushes = false;
+            }
+            worst = worst.max_sticky(norm);
+        } else if !(value >= T::ZERO) {
+            worst = worst.max_sticky(norm);
+        }
+    }
+    (worst, pushes)
+}
+
+/// The projected Gauss-Seidel clip of a one-sided row's update: `lambda + delta`
+/// kept non-negative.
+#[inline]
+pub(super) fn clip<T: Real>(lambda: T, delta: T) -> T {
+    (lambda + delta).max(T::ZERO) - lambda
+}
+
+/// Whether a row's residual needs no update under complementarity (the sweep's test):
+/// a one-sided row that does not push and does not overlap is satisfied whatever its
+/// gap.
+#[inline]
+pub(super) fn slack<T: Real>(one_sided: bool, lambda: T, value: T) -> bool {
+    one_sided && lambda <= T::ZERO && value >= T::ZERO
+}
