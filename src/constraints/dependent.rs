@@ -37,7 +37,13 @@ pub(super) fn infeasible<T: Real>(
     fac: &[T],
     work: &mut [T],
 ) -> StepError {
-    let n = bonds.len();
+    self_stress(metric, null_vector(fac, bonds.len(), work))
+}
+
+/// The self-stress `v` (signed, `v_first = 1`) of the first dependent row of a
+/// rank-deficient [`cholesky_dense`](crate::linalg::cholesky_dense) factor of `n`
+/// rows, in `work` (`n` scalars).
+pub(super) fn null_vector<'w, T: Real>(fac: &[T], n: usize, work: &'w mut [T]) -> &'w mut [T] {
     let first = (0..n).find(|&k| fac[k * n + k] == T::ZERO).unwrap_or(0);
     let v = &mut work[..n];
     v.fill(T::ZERO);
@@ -51,7 +57,7 @@ pub(super) fn infeasible<T: Real>(
         }
         v[j] = -s * fac[j * n + j];
     }
-    self_stress(metric, v)
+    v
 }
 
 /// The [`StepError::Infeasible`] of the self-stress `v` (multipliers with no net

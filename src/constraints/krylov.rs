@@ -132,6 +132,14 @@ pub fn krylov<T: Real>(
             true => stalls + 1,
             false => 0,
         };
+        if stalls > 0 && one_sided {
+            // An active contact that the contradiction asks to open is let go
+            // (`onesided.rs`); the set changes at the next update.
+            if onesided::let_go(&problem, metric, bonds, from, p, x, mult, state) {
+                (previous, stalls, null) = (None, 0, false);
+                continue;
+            }
+        }
         if stalls == 3 {
             return Err(dependent::self_stress(metric, p));
         }

@@ -98,6 +98,15 @@ pub fn newton<T: Real>(
                 decouple(jac, rhs, nb, from, state, true, true);
             }
             let _ = linalg::cholesky_dense(jac, nb, floor);
+            if one_sided {
+                // An active contact that the contradiction asks to open is let go
+                // (`onesided.rs`); the set changed: refactorised.
+                let v = dependent::null_vector(jac, nb, rhs);
+                if onesided::let_go(&problem, metric, bonds, from, v, x, mult, state) {
+                    previous = None;
+                    continue;
+                }
+            }
             return Err(dependent::infeasible(metric, bonds, jac, rhs));
         }
         let refresh = previous.is_none() || !fast || changed;

@@ -32,8 +32,23 @@ use crate::real::Real;
 /// Switches between active and inactive after which a row is held active.
 pub(super) const SWITCHES: usize = 4;
 
-/// A row's state word: bit 0 set when active, the switches counted above it.
+/// A row's state word: bit 0 set when active, bit 1 when let go by [`let_go`] (kept
+/// inactive by the next [`update`]), the switches counted above them.
 const ACTIVE: usize = 1;
+const LET_GO: usize = 2;
+const SHIFT: u32 = 2;
+
+/// Whether a row is held active (switched [`SWITCHES`] times).
+#[inline]
+fn held(state: usize) -> bool {
+    state >> SHIFT >= SWITCHES as usize
+}
+
+/// `state` switched to `on`.
+#[inline]
+fn switched(state: usize, on: bool) -> usize {
+    ((state >> SHIFT) + 1) << SHIFT | on as usize
+}
 
 /// Index scratch per row (the state words) that the one-sided solve needs, where
 /// contacts are compiled in.
@@ -72,11 +87,14 @@ pub(super) fn update<T: Real>(
     let mut changed = false;
     for k in from..bonds.len() {
         let s = state[k];
-        let held = s >> 1 >= SWITCHES;
         let (value, _, _) = problem.eval(&bonds[k], k, x);
-        let on = held || mult[k] * diagonal(metric, bonds, c, k) > value;
+        let on = s & LET_GO == 0
+            && (held(s) || mult[k] * diagonal(metric, bonds, c, k) > value);
+        state[k] = s & !LET_GO;
+        // A row let go changed the set since the last update.
+        changed |= s & LET_GO != 0;
         if on != active(s) {
-            state[k] = ((s >> 1) + 1) << 1 | on as usize;
+            state[k] = switched(s, on);
             changed = true;
         }
         if !on && mult[k] != T::ZERO {
@@ -103,7 +121,7 @@ pub(super) fn residual<T: Real>(
     for (k, b) in bonds.iter().enumerate() {
         let (value, _, norm) = problem.eval(b, k, x);
         if k < from || active(state[k]) {
-            if k >= from && mult[k] < T::ZERO && state[k] >> 1 < SWITCHES {
+            if k >= from && mult[k] < T::ZERO && !held(state[k]) {
                 pushes = false;
             }
             worst = worst.max_sticky(norm);
@@ -112,6 +130,44 @@ pub(super) fn residual<T: Real>(
         }
     }
     (worst, pushes)
+}
+
+/// Where the active rows' equalities contradict each other along the self-stress `v`
+/// (`G^T v = 0`, so `v . sigma` is the same after any move: the equalities need it
+/// zero) and some active one-sided row `k` not held has `v_k (v . sigma) > 0`, that
+/// row can open (`sigma_k = (v . sigma) / v_k > 0`) while the others close: it is let
+/// go (inactive for the next update, its multiplier to zero, counted as a switch),
+/// the one of largest force `|v_k| |g_k|`. `false` where there is none: no first-order
+/// move meets the constraints (Farkas), the geometry is infeasible.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn let_go<T: Real>(
+    problem: &Problem<'_, T>,
+    metric: &Metric<'_, T>,
+    bonds: &[Bond<T>],
+    from: usize,
+    v: &[T],
+    x: &mut [T::V3],
+    mult: &mut [T],
+    state: &mut [usize],
+) -> bool {
+    let s = (0..bonds.len()).fold(T::ZERO, |s, k| s + v[k] * problem.eval(&bonds[k], k, x).0);
+    let mut best: Option<(usize, T)> = None;
+    for k in from..bonds.len() {
+        let force = v[k].abs() * T::norm(metric.grad(k));
+        let opens = v[k] * s > T::ZERO && active(state[k]) && !held(state[k]);
+        if opens && best.is_none_or(|(_, f)| force > f) {
+            best = Some((k, force));
+        }
+    }
+    let Some((k, _)) = best else {
+        return false;
+    };
+    state[k] = switched(state[k], false) | LET_GO;
+    if mult[k] != T::ZERO {
+        metric.apply_one(bonds, k, -mult[k], x);
+        mult[k] = T::ZERO;
+    }
+    true
 }
 
 /// The projected Gauss-Seidel clip of a one-sided row's update: `lambda + delta`
