@@ -135,7 +135,7 @@ pub fn krylov<T: Real>(
         if stalls > 0 && one_sided {
             // An active contact that the contradiction asks to open is let go
             // (`onesided.rs`); the set changes at the next update.
-            if onesided::let_go(&problem, metric, bonds, from, p, x, mult, state) {
+            if onesided::let_go(&problem, metric, bonds, from, p, x, state) {
                 (previous, stalls, null) = (None, 0, false);
                 continue;
             }
@@ -158,6 +158,26 @@ pub fn krylov<T: Real>(
         // PCG on A delta = r from delta = 0.
         delta.fill(T::ZERO);
         acc.fill(T::V3_ZERO);
+        if one_sided && (from..nb).any(|k| !onesided::active(state[k]) && mult[k] != T::ZERO) {
+            // Rows released since the last solve: `delta_k = -lambda_k`, solved with
+            // the active rows (their right-hand side gains `A_:k lambda_k`,
+            // `onesided.rs`).
+            for k in 0..nb {
+                let off = k >= from && !onesided::active(state[k]);
+                z[k] = if off { mult[k] } else { T::ZERO };
+                delta[k] = -z[k];
+            }
+            metric.apply_all(bonds, z, w, tmp);
+            products += 1;
+            for (k, b) in bonds.iter().enumerate() {
+                if k < from || onesided::active(state[k]) {
+                    r[k] += T::dot(metric.grad(k), b.relative(w)) * c;
+                }
+            }
+            for (a, &wi) in acc.iter_mut().zip(w.iter()) {
+                *a -= wi;
+            }
+        }
         z.copy_from_slice(r);
         band::solve(pre, nb, BAND, z);
         p.copy_from_slice(z);

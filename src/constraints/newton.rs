@@ -58,6 +58,8 @@ pub fn newton<T: Real>(
     let floor = dependent::rank_floor::<T>();
     // Dependent rows found by the last factorisation.
     let mut deficient = 0;
+    // The chord is kept to the end (one-sided rows dependent at the iterate only).
+    let mut stay = false;
     for it in 0..=solver.max_iterations {
         let (mut changed, mut pushes) = (false, true);
         let residual = match one_sided {
@@ -82,8 +84,9 @@ pub fn newton<T: Real>(
             return Err(problem.no_convergence(it, residual));
         }
         let fast = previous.is_some_and(|p| residual <= p * T::from_f64(0.1));
+        // One-sided rows never leave the chord: their stall is judged on it.
         if deficient > 0
-            && !chord
+            && (!chord || one_sided)
             && !changed
             && previous.is_some_and(|p| residual > p * T::HALF)
         {
@@ -95,14 +98,20 @@ pub fn newton<T: Real>(
                 metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
             }
             if one_sided {
-                decouple(jac, rhs, nb, from, state, true, true);
+                decouple(jac, rhs, nb, (from, state), mult, true);
             }
-            let _ = linalg::cholesky_dense(jac, nb, floor);
+            let chord_deficient = linalg::cholesky_dense(jac, nb, floor);
+            if one_sided && chord_deficient == Ok(0) {
+                // Dependent at the iterate only (a pair turned far within the step):
+                // no self-stress to name; the chord, which has none, goes on alone.
+                (chord, stay, previous) = (true, true, None);
+                continue;
+            }
             if one_sided {
                 // An active contact that the contradiction asks to open is let go
                 // (`onesided.rs`); the set changed: refactorised.
                 let v = dependent::null_vector(jac, nb, rhs);
-                if onesided::let_go(&problem, metric, bonds, from, v, x, mult, state) {
+                if onesided::let_go(&problem, metric, bonds, from, v, x, state) {
                     previous = None;
                     continue;
                 }
@@ -110,7 +119,7 @@ pub fn newton<T: Real>(
             return Err(dependent::infeasible(metric, bonds, jac, rhs));
         }
         let refresh = previous.is_none() || !fast || changed;
-        if refresh && previous.is_some() && !changed {
+        if refresh && previous.is_some() && !changed && !stay && !one_sided {
             chord = false;
         }
         previous = Some(residual);
@@ -128,7 +137,7 @@ pub fn newton<T: Real>(
             }
         }
         if one_sided {
-            decouple(jac, rhs, nb, from, state, refresh, chord);
+            decouple(jac, rhs, nb, (from, state), mult, refresh);
         }
         let fail = |error| StepError::Linalg {
             stage: problem.stage(),
@@ -150,6 +159,14 @@ pub fn newton<T: Real>(
             *m += r;
         }
         metric.apply_each(bonds, rhs, x);
+        if one_sided {
+            // Released: exactly zero (the solve gives `-lambda_k` to rounding).
+            for k in from..nb {
+                if !onesided::active(state[k]) {
+                    mult[k] = T::ZERO;
+                }
+            }
+        }
     }
     // The loop returns on its last pass (it == max_iterations).
     Err(StepError::NoConvergence {
@@ -159,41 +176,40 @@ pub fn newton<T: Real>(
     })
 }
 
-/// The inactive one-sided rows' equations replaced by `A_kk delta_k = 0`: their row
-/// and column zeroed but the diagonal (of the chord's lower triangle, or of the whole
-/// Jacobian), so that their updates are exactly zero and the active rows' system does
-/// not see them.
+/// The inactive one-sided rows' equations (of the chord's lower triangle) replaced by
+/// `A_kk delta_k = -A_kk lambda_k`: their row and column zeroed but the diagonal, the
+/// active rows' right-hand side corrected by `A_jk lambda_k` (the release of `lambda_k`
+/// solved with them, `onesided.rs`). `refresh`: the triangle was just built (otherwise
+/// it is the factor of the same set, every inactive multiplier already zero).
 fn decouple<T: Real>(
     jac: &mut [T],
     rhs: &mut [T],
     nb: usize,
-    from: usize,
-    state: &[usize],
+    (from, state): (usize, &[usize]),
+    mult: &[T],
     refresh: bool,
-    chord: bool,
 ) {
     for k in from..nb {
         if onesided::active(state[k]) {
             continue;
         }
-        rhs[k] = T::ZERO;
         if !refresh {
+            rhs[k] = T::ZERO;
             continue;
         }
-        let (len, below) = if chord { (k, k + 1) } else { (nb, 0) };
-        for l in 0..len {
-            if l != k {
-                jac[k * nb + l] = T::ZERO;
+        let l = mult[k];
+        for j in 0..nb {
+            if j == k {
+                continue;
             }
-        }
-        for l in below..nb {
-            if l != k {
-                jac[l * nb + k] = T::ZERO;
-            }
+            let at = if j < k { k * nb + j } else { j * nb + k };
+            rhs[j] += jac[at] * l;
+            jac[at] = T::ZERO;
         }
         if !(jac[k * nb + k] > T::ZERO) {
             jac[k * nb + k] = T::ONE;
         }
+        rhs[k] = -jac[k * nb + k] * l;
     }
 }
 

@@ -71,35 +71,50 @@ pub(super) fn reset(state: &mut [usize]) {
 }
 
 /// One active-set update of the one-sided rows (`from..`): decides each row's state
-/// from its multiplier and residual at `x`, and lets go the rows that turn inactive
-/// (their multipliers to zero, `x` moved back by their pushes). Returns whether the set
-/// changed.
+/// from its multiplier and residual at `x`. A row that turns inactive keeps its
+/// multiplier until the next linear solve takes it to zero (`delta_k = -lambda_k`,
+/// the active rows' right-hand side corrected by `A_:k lambda_k`): applied alone, the
+/// release of a large multiplier of nearly dependent rows is a large move that the
+/// others would have to undo. Returns whether the set changed.
 pub(super) fn update<T: Real>(
     problem: &Problem<'_, T>,
     metric: &Metric<'_, T>,
     bonds: &[Bond<T>],
     from: usize,
-    x: &mut [T::V3],
-    mult: &mut [T],
+    x: &[T::V3],
+    mult: &[T],
     state: &mut [usize],
 ) -> bool {
     let c = problem.chord_factor();
+    // The active row that pulls hardest (`lambda_k A_kk - sigma_k` most negative) is
+    // the only one released per update: releasing every puller at once made the set
+    // oscillate on the pile (`docs/CONTACTS.md`).
+    let mut worst: Option<(usize, T)> = None;
+    for k in from..bonds.len() {
+        let s = state[k];
+        if !active(s) || held(s) || s & LET_GO != 0 {
+            continue;
+        }
+        let (value, _, _) = problem.eval(&bonds[k], k, x);
+        let slack = mult[k] * diagonal(metric, bonds, c, k) - value;
+        if !(slack > T::ZERO) && worst.is_none_or(|(_, w)| slack < w) {
+            worst = Some((k, slack));
+        }
+    }
     let mut changed = false;
     for k in from..bonds.len() {
         let s = state[k];
-        let (value, _, _) = problem.eval(&bonds[k], k, x);
-        let on = s & LET_GO == 0
-            && (held(s) || mult[k] * diagonal(metric, bonds, c, k) > value);
+        let on = match () {
+            _ if s & LET_GO != 0 => false,
+            _ if active(s) => worst.is_none_or(|(w, _)| w != k),
+            _ => !(problem.eval(&bonds[k], k, x).0 >= T::ZERO),
+        };
         state[k] = s & !LET_GO;
         // A row let go changed the set since the last update.
         changed |= s & LET_GO != 0;
         if on != active(s) {
             state[k] = switched(s, on);
             changed = true;
-        }
-        if !on && mult[k] != T::ZERO {
-            metric.apply_one(bonds, k, -mult[k], x);
-            mult[k] = T::ZERO;
         }
     }
     changed
@@ -125,8 +140,11 @@ pub(super) fn residual<T: Real>(
                 pushes = false;
             }
             worst = worst.max_sticky(norm);
-        } else if !(value >= T::ZERO) {
-            worst = worst.max_sticky(norm);
+        } else {
+            pushes &= mult[k] == T::ZERO;
+            if !(value >= T::ZERO) {
+                worst = worst.max_sticky(norm);
+            }
         }
     }
     (worst, pushes)
@@ -136,7 +154,8 @@ pub(super) fn residual<T: Real>(
 /// (`G^T v = 0`, so `v . sigma` is the same after any move: the equalities need it
 /// zero) and some active one-sided row `k` not held has `v_k (v . sigma) > 0`, that
 /// row can open (`sigma_k = (v . sigma) / v_k > 0`) while the others close: it is let
-/// go (inactive for the next update, its multiplier to zero, counted as a switch),
+/// go (inactive through the next update, counted as a switch; its multiplier goes in
+/// the next linear solve),
 /// the one of largest force `|v_k| |g_k|`. `false` where there is none: no first-order
 /// move meets the constraints (Farkas), the geometry is infeasible.
 #[allow(clippy::too_many_arguments)]
@@ -146,8 +165,7 @@ pub(super) fn let_go<T: Real>(
     bonds: &[Bond<T>],
     from: usize,
     v: &[T],
-    x: &mut [T::V3],
-    mult: &mut [T],
+    x: &[T::V3],
     state: &mut [usize],
 ) -> bool {
     let s = (0..bonds.len()).fold(T::ZERO, |s, k| s + v[k] * problem.eval(&bonds[k], k, x).0);
@@ -163,10 +181,6 @@ pub(super) fn let_go<T: Real>(
         return false;
     };
     state[k] = switched(state[k], false) | LET_GO;
-    if mult[k] != T::ZERO {
-        metric.apply_one(bonds, k, -mult[k], x);
-        mult[k] = T::ZERO;
-    }
     true
 }
 
