@@ -113,7 +113,10 @@ fn pulling_contact_is_released<T: Real>() {
     let r = one_step(&mut ps, &p).unwrap();
     assert_eq!(r.contacts, 0, "released");
     // Held at the start; let go inside the solve (an inequality), in one round.
-    assert_eq!(r.contact_rounds, 1, "held at the start, released in the solve");
+    assert_eq!(
+        r.contact_rounds, 1,
+        "held at the start, released in the solve"
+    );
     for (i, want) in free.iter().enumerate() {
         let u = f64s::<T>(ps.vel[i])[2];
         assert!((u + want).abs() <= tol * want, "sphere {i}: {u} vs -{want}");

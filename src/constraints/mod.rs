@@ -234,7 +234,11 @@ pub struct Scratch<'a, T: Real> {
 /// of the mobility and `bonds` bonds.
 pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) -> [usize; 3] {
     match kind.resolve(bonds) {
-        SolverKind::Newton => [bonds * bonds + bonds, 0, index_scratch(SolverKind::Newton, bonds)],
+        SolverKind::Newton => [
+            bonds * bonds + bonds,
+            0,
+            index_scratch(SolverKind::Newton, bonds),
+        ],
         SolverKind::Krylov => [
             krylov::SCALARS_PER_BOND * bonds,
             2 * n + 2 * m + crate::parallel::band_scratch(m),
