@@ -285,36 +285,34 @@ fn braced_square_sediments_f32() {
 
 /// Sphere 1 at the midpoint of spheres 0 and 2, bonded at 3.5 (the spheres need 4):
 /// the contacts and the bond are collinear, dependent, and ask for opposite things.
+/// Every solver refuses with `Infeasible`, naming the bond and both contacts, and the
+/// state is kept.
 #[test]
 fn squeezed_sphere_is_infeasible() {
-    let s = |x: f64| Sphere {
-        pos: [x, 0.0, 5.0],
-        radius: 1.0,
-        density: RHO,
-    };
-    let spheres = [s(0.0), s(1.75), s(3.5)];
-    let list: Vec<_> = spheres
-        .iter()
-        .map(|s| hydrorattle::Particle::new(v3::<f64>(s.pos[0], 0.0, 5.0), 1.0, RHO))
-        .collect();
-    let mut ps = ParticleSet::<f64, 3>::from_slice(&list, true).unwrap();
-    let mut bonds = BondSet::<f64, 1>::new();
-    bonds.push_current(0, 2, &ps.pos[..3]).unwrap();
-    let mut p = params::<f64>(0.1, Method::Overdamped, SolverKind::Newton);
-    p.contacts = Some(Contacts::new(4));
-    p.allow_overlap = true;
-    let mut store = Buffers::<f64>::new(Layout::for_params(&p, 3, 1));
-    let before = snapshot(&ps);
-    let e = one_step(&mut ps, &bonds, &p, &mut store).unwrap_err();
-    assert_eq!(snapshot(&ps), before, "state kept");
-    assert!(matches!(e, StepError::Infeasible { .. }), "{e}");
-    // The bond (0) and the two contacts (1, 2: the step's one-sided constraints 0, 1).
-    assert_eq!(
-        (e.constraints(), e.count()),
-        (&[0, 1, 2][..], Some(3)),
-        "{e}"
-    );
-    assert_eq!(e.kind(), "infeasible");
+    for kind in [SolverKind::Newton, SolverKind::Krylov, SolverKind::Sweep] {
+        let list: Vec<_> = [0.0, 1.75, 3.5]
+            .iter()
+            .map(|&x| hydrorattle::Particle::new(v3::<f64>(x, 0.0, 5.0), 1.0, RHO))
+            .collect();
+        let mut ps = ParticleSet::<f64, 3>::from_slice(&list, true).unwrap();
+        let mut bonds = BondSet::<f64, 1>::new();
+        bonds.push_current(0, 2, &ps.pos[..3]).unwrap();
+        let mut p = params::<f64>(0.1, Method::Overdamped, kind);
+        p.contacts = Some(Contacts::new(4));
+        p.allow_overlap = true;
+        let mut store = Buffers::<f64>::new(Layout::for_params(&p, 3, 1));
+        let before = snapshot(&ps);
+        let e = one_step(&mut ps, &bonds, &p, &mut store).unwrap_err();
+        assert_eq!(snapshot(&ps), before, "{kind:?}: state kept");
+        assert!(matches!(e, StepError::Infeasible { .. }), "{kind:?}: {e}");
+        // The bond (0) and the two contacts (1, 2: the step's one-sided constraints 0, 1).
+        assert_eq!(
+            (e.constraints(), e.count()),
+            (&[0, 1, 2][..], Some(3)),
+            "{kind:?}: {e}"
+        );
+        assert_eq!(e.kind(), "infeasible");
+    }
 }
 
 /// Spheres on a jittered column lattice `side x side x layers`, spacing 2.3, above the

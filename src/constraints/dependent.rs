@@ -97,3 +97,32 @@ fn listed<T: Real>(v: &mut [T]) -> StepError {
         count,
     }
 }
+
+/// Whether the multipliers `v` are a self-stress to `share`: their net force on every
+/// bead at most `share` times the largest force of one constraint `|v_l| |g_l|`. The
+/// sweep's multipliers on an inconsistent dependent set grow along its self-stress by
+/// the same amount each sweep while their net force stays bounded (`sweep.rs`).
+pub(super) fn is_self_stress<T: Real>(
+    metric: &Metric<'_, T>,
+    bonds: &[Bond<T>],
+    beads: usize,
+    v: &[T],
+    share: T,
+) -> bool {
+    let largest =
+        (0..bonds.len()).fold(T::ZERO, |m, l| m.max(v[l].abs() * T::norm(metric.grad(l))));
+    if !(largest > T::ZERO) {
+        return false;
+    }
+    (0..beads).all(|p| {
+        let mut f = T::V3_ZERO;
+        for (l, b) in bonds.iter().enumerate() {
+            if b.i == p {
+                f += metric.grad(l) * v[l];
+            } else if b.j == p && !b.is_wall() {
+                f -= metric.grad(l) * v[l];
+            }
+        }
+        T::norm(f) <= share * largest
+    })
+}

@@ -139,6 +139,8 @@ pub fn krylov<T: Real>(
                 (previous, stalls, null) = (None, 0, false);
                 continue;
             }
+            // No active contact can open: infeasible to first order (Farkas).
+            return Err(dependent::self_stress(metric, p));
         }
         if stalls == 3 {
             return Err(dependent::self_stress(metric, p));

@@ -3,7 +3,7 @@
 //! Gauss-Seidel: each update clipped so that the multiplier stays non-negative
 //! (`onesided.rs`).
 
-use super::{Metric, Problem, SolveStats, Solver, onesided};
+use super::{Metric, Problem, SolveStats, Solver, dependent, onesided};
 use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::real::Real;
@@ -56,6 +56,14 @@ pub fn sweep<T: Real>(
             });
         }
         if it == solver.max_iterations {
+            // With one-sided rows: multipliers grown into a self-stress (net force on
+            // every bead below 5 % of the largest constraint force) name an infeasible
+            // dependent set (`docs/CONTACTS.md`).
+            let share = T::from_f64(0.05);
+            if from < bonds.len() && dependent::is_self_stress(metric, bonds, x.len(), mult, share)
+            {
+                return Err(dependent::self_stress(metric, mult));
+            }
             return Err(problem.no_convergence(it, residual));
         }
     }
