@@ -41,7 +41,7 @@ const SHIFT: u32 = 2;
 /// Whether a row is held active (switched [`SWITCHES`] times).
 #[inline]
 fn held(state: usize) -> bool {
-    state >> SHIFT >= SWITCHES as usize
+    state >> SHIFT >= SWITCHES
 }
 
 /// `state` switched to `on`.
