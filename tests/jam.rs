@@ -479,8 +479,9 @@ fn pile_of_100_settles_f64() {
 }
 
 /// Random piles: random radii in `[0.5, 1.5]`, spheres scattered over a small region
-/// just above a random wall (not overlapping), random solver and method, one step of
-/// random `dt`. The step keeps every constraint within the tolerance or refuses with a
+/// just above a random wall (not overlapping), up to three random bonds, random solver
+/// and method, six steps of random `dt` (contacts and wall links inequalities inside
+/// the solve). The step keeps every constraint within the tolerance or refuses with a
 /// typed error other than a factorisation failure, and a refusal keeps the state.
 #[test]
 fn random_piles_hold_or_refuse() {
@@ -514,15 +515,37 @@ fn random_piles_hold_or_refuse() {
         let dt = [0.05, 0.3, 1.5][rng.below(3)];
         let p = jam_params::<f64>(dt, method, kind, h);
         let mut ps = particles::<f64, N>(&spheres);
-        let bonds = BondSet::<f64, 1>::new();
-        let mut store = Buffers::<f64>::new(Layout::for_params(&p, n, 0));
-        let what = format!("case {case}: {n} spheres, {kind:?} {method:?} dt {dt}");
+        // Up to three random bonds at their current lengths: equalities beside the
+        // one-sided rows.
+        let mut bonds = BondSet::<f64, 4>::new();
+        for _ in 0..rng.below(4) {
+            let (i, j) = (rng.below(n), rng.below(n));
+            if i != j {
+                let _ = bonds.push_current(i, j, &ps.pos[..n]);
+            }
+        }
+        let bonded = |i: usize, j: usize| {
+            bonds
+                .as_slice()
+                .iter()
+                .any(|b| (b.i, b.j) == (i, j) || (b.i, b.j) == (j, i))
+        };
+        let mut store = Buffers::<f64>::new(Layout::for_params(&p, n, bonds.len()));
+        let what = format!(
+            "case {case}: {n} spheres, {} bonds, {kind:?} {method:?} dt {dt}",
+            bonds.len()
+        );
         for k in 0..6 {
             let before = snapshot(&ps);
             match one_step(&mut ps, &bonds, &p, &mut store) {
                 Ok(_) => {
-                    let v = worst_violation(&ps, n, h, &|_, _| false);
+                    let v = worst_violation(&ps, n, h, &bonded);
                     assert!(v <= slack(&p, h), "{what} step {k}: violation {v}");
+                    let (_, r) = bonds.max_residual(&ps.pos[..n]);
+                    assert!(
+                        r <= p.solver.tolerance,
+                        "{what} step {k}: bond residual {r}"
+                    );
                 }
                 Err(e) => {
                     assert!(
