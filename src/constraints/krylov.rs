@@ -71,7 +71,8 @@ pub fn krylov<T: Real>(
     let delta = &mut rest[..nb];
     let (w, rest) = scratch.beads.split_at_mut(n);
     let (acc, tmp) = rest.split_at_mut(n);
-    // One-sided rows from `from` on (`nb`: none, the equality solve as it always was).
+    // One-sided rows from `from` on (`usize::MAX`: none, the equality solve as it
+    // always was).
     let from = problem.one_sided(nb);
     let one_sided = from < nb;
     let state = &mut scratch.piv[..if one_sided { nb } else { 0 }];

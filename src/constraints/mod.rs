@@ -176,15 +176,18 @@ impl<T: Real> Problem<'_, T> {
         }
     }
 
-    /// The first one-sided row of `rows` (`rows` where there is none), `0` where
-    /// contacts are compiled out.
+    /// The first one-sided row of `rows`: `usize::MAX` where there is none (a
+    /// constant where contacts are compiled out, so that every one-sided branch folds
+    /// away).
     #[inline(always)]
     fn one_sided(&self, rows: usize) -> usize {
         match *self {
-            Problem::Positions { one_sided, .. } if cfg!(feature = "contacts") => {
-                one_sided.min(rows)
+            Problem::Positions { one_sided, .. }
+                if cfg!(feature = "contacts") && one_sided < rows =>
+            {
+                one_sided
             }
-            _ => rows,
+            _ => usize::MAX,
         }
     }
 

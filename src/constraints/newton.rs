@@ -43,10 +43,14 @@ pub fn newton<T: Real>(
     scratch: &mut Scratch<'_, T>,
 ) -> Result<SolveStats<T>, StepError> {
     let nb = bonds.len();
-    let (piv, state) = scratch.piv.split_at_mut(nb);
-    let (jac, rhs) = (&mut scratch.jac[..nb * nb], &mut scratch.rhs[..nb]);
-    // One-sided rows from `from` on (`nb`: none, the equality solve as it always was).
+    // One-sided rows from `from` on (`usize::MAX`: none, the equality solve as it
+    // always was); their states after the pivots.
     let from = problem.one_sided(nb);
+    #[cfg(feature = "contacts")]
+    let (piv, state) = scratch.piv.split_at_mut(nb);
+    #[cfg(not(feature = "contacts"))]
+    let (piv, state): (_, &mut [usize]) = (&mut scratch.piv[..nb], &mut []);
+    let (jac, rhs) = (&mut scratch.jac[..nb * nb], &mut scratch.rhs[..nb]);
     let one_sided = from < nb;
     if one_sided {
         onesided::reset(&mut state[..nb]);
