@@ -4,14 +4,15 @@
 //!
 //! * **Newton and Krylov: a primal-dual active set inside the iteration** (the
 //!   semismooth Newton method on `min(lambda_k A_kk, sigma_k) = 0`, Hintermüller, Ito
-//!   and Kunisch 2002). Each iteration a one-sided row is *active* (an equality) where
-//!   `lambda_k A_kk > sigma_k` (it pushes, or it overlaps), *inactive* otherwise: its
-//!   multiplier is set to zero (the positions move by `-lambda_k D_k`), and its row and
-//!   column of the linear system are replaced by the diagonal with a zero right-hand
-//!   side, so its update is exactly zero. A contact that would pull is thus let go in the
-//!   next iteration, before the equalities it took part in jam; a contact that the
-//!   move makes overlap is taken in. `A_kk` is the chord matrix's diagonal (the
-//!   scale that turns a multiplier into a residual).
+//!   and Kunisch 2002). Each iteration every inactive row that overlaps is taken in as
+//!   an equality, and of the active rows whose `lambda_k A_kk - sigma_k <= 0` (they
+//!   pull) the one that pulls hardest is released. A released row's multiplier goes to
+//!   zero in the next linear solve (`delta_k = -lambda_k`, the active rows'
+//!   right-hand side corrected by `A_:k lambda_k`); its row and column are otherwise
+//!   decoupled (Newton: the diagonal alone; Krylov: masked out of the conjugate
+//!   gradients). `A_kk` is the chord matrix's diagonal (the scale that turns a
+//!   multiplier into a residual). Where the active equalities contradict each other
+//!   along a self-stress, [`let_go`] releases the contact that can open (Farkas).
 //! * **Anti-cycling**: the active set of this method can cycle where `A` is not an
 //!   M-matrix. Each row counts its switches; after [`SWITCHES`] it is *held* active
 //!   (an equality for the rest of the solve, whatever its multiplier: the rule the
