@@ -156,6 +156,7 @@ fn rests_on_the_wall<T: Real, const N: usize, const B: usize>(
                     .iter()
                     .any(|b| (b.i, b.j) == (i, j) || (b.i, b.j) == (j, i))
             };
+            let mut last = StepReport::default();
             for k in 0..10 {
                 let mut squeeze = |_: &[T::V3], _: &[T], f: &mut [T::V3]| {
                     for (f, q) in f.iter_mut().zip(push) {
@@ -167,7 +168,10 @@ fn rests_on_the_wall<T: Real, const N: usize, const B: usize>(
                 // Every touching pair starts active (the first round solves the whole
                 // dependent set); a contact may then be released: the multipliers of
                 // a dependent set are not unique, and one set leaves it unloaded.
-                assert!(r.contacts <= held.0 && r.wall_contacts == held.1, "{what}");
+                // Rows the solve leaves unloaded (dependent, zero multiplier) are not
+                // held.
+                assert!(r.contacts <= held.0 && r.wall_contacts <= held.1, "{what}");
+                last = r;
                 let v = worst_violation(&ps, n, wall, &bonded);
                 assert!(v <= slack(&p, wall), "{what} step {k}: violation {v}");
             }
@@ -176,7 +180,7 @@ fn rests_on_the_wall<T: Real, const N: usize, const B: usize>(
                 assert!(d <= pick::<T>(1e-4, 1e-9), "{what}: sphere {i} moved {d}");
             }
             if method == Method::Overdamped {
-                let rows = bonds.len() + (held.0 + held.1) as usize;
+                let rows = bonds.len() + (last.contacts + last.wall_contacts) as usize;
                 let (imbalance, carried) = balance(&ps, n, &mut store, rows, push);
                 let tol = pick::<T>(1e-4, 1e-9);
                 assert!(imbalance <= tol, "{what}: force imbalance {imbalance}");
@@ -281,36 +285,34 @@ fn braced_square_sediments_f32() {
 
 /// Sphere 1 at the midpoint of spheres 0 and 2, bonded at 3.5 (the spheres need 4):
 /// the contacts and the bond are collinear, dependent, and ask for opposite things.
+/// Every solver refuses with `Infeasible`, naming the bond and both contacts, and the
+/// state is kept.
 #[test]
 fn squeezed_sphere_is_infeasible() {
-    let s = |x: f64| Sphere {
-        pos: [x, 0.0, 5.0],
-        radius: 1.0,
-        density: RHO,
-    };
-    let spheres = [s(0.0), s(1.75), s(3.5)];
-    let list: Vec<_> = spheres
-        .iter()
-        .map(|s| hydrorattle::Particle::new(v3::<f64>(s.pos[0], 0.0, 5.0), 1.0, RHO))
-        .collect();
-    let mut ps = ParticleSet::<f64, 3>::from_slice(&list, true).unwrap();
-    let mut bonds = BondSet::<f64, 1>::new();
-    bonds.push_current(0, 2, &ps.pos[..3]).unwrap();
-    let mut p = params::<f64>(0.1, Method::Overdamped, SolverKind::Newton);
-    p.contacts = Some(Contacts::new(4));
-    p.allow_overlap = true;
-    let mut store = Buffers::<f64>::new(Layout::for_params(&p, 3, 1));
-    let before = snapshot(&ps);
-    let e = one_step(&mut ps, &bonds, &p, &mut store).unwrap_err();
-    assert_eq!(snapshot(&ps), before, "state kept");
-    assert!(matches!(e, StepError::Infeasible { .. }), "{e}");
-    // The bond (0) and the two contacts (1, 2: the step's one-sided constraints 0, 1).
-    assert_eq!(
-        (e.constraints(), e.count()),
-        (&[0, 1, 2][..], Some(3)),
-        "{e}"
-    );
-    assert_eq!(e.kind(), "infeasible");
+    for kind in [SolverKind::Newton, SolverKind::Krylov, SolverKind::Sweep] {
+        let list: Vec<_> = [0.0, 1.75, 3.5]
+            .iter()
+            .map(|&x| hydrorattle::Particle::new(v3::<f64>(x, 0.0, 5.0), 1.0, RHO))
+            .collect();
+        let mut ps = ParticleSet::<f64, 3>::from_slice(&list, true).unwrap();
+        let mut bonds = BondSet::<f64, 1>::new();
+        bonds.push_current(0, 2, &ps.pos[..3]).unwrap();
+        let mut p = params::<f64>(0.1, Method::Overdamped, kind);
+        p.contacts = Some(Contacts::new(4));
+        p.allow_overlap = true;
+        let mut store = Buffers::<f64>::new(Layout::for_params(&p, 3, 1));
+        let before = snapshot(&ps);
+        let e = one_step(&mut ps, &bonds, &p, &mut store).unwrap_err();
+        assert_eq!(snapshot(&ps), before, "{kind:?}: state kept");
+        assert!(matches!(e, StepError::Infeasible { .. }), "{kind:?}: {e}");
+        // The bond (0) and the two contacts (1, 2: the step's one-sided constraints 0, 1).
+        assert_eq!(
+            (e.constraints(), e.count()),
+            (&[0, 1, 2][..], Some(3)),
+            "{kind:?}: {e}"
+        );
+        assert_eq!(e.kind(), "infeasible");
+    }
 }
 
 /// Spheres on a jittered column lattice `side x side x layers`, spacing 2.3, above the
@@ -336,98 +338,161 @@ fn column(side: usize, layers: usize, h: f64, rng: &mut Rng) -> Vec<Sphere> {
     out
 }
 
-/// Drops a column of `side^2 layers` spheres onto the wall and runs it to rest: no
-/// violation beyond the tolerance at any step, the wall carrying the total weight at
-/// rest, and one step from the rest state the same with every solver.
-fn pile_settles<T: Real, const N: usize>(side: usize, layers: usize, steps: usize) {
+/// A ring of `fence` spheres of radius 1.5 on the wall at `h`, 0.002 apart (bonded by
+/// the caller: the fence of `host-demo/scenes/pile.toml`).
+fn ring(fence: usize, h: f64) -> Vec<Sphere> {
+    let r = 1.501 / (PI / fence as f64).sin();
+    (0..fence)
+        .map(|i| {
+            let a = 2.0 * PI * i as f64 / fence as f64;
+            Sphere {
+                pos: [r * a.cos(), r * a.sin(), h + 1.5],
+                radius: 1.5,
+                density: RHO,
+            }
+        })
+        .collect()
+}
+
+/// Drops a column of `side^2 layers` spheres inside a fence of `fence` bonded spheres
+/// (none: `0`) onto the wall and runs it to rest with
+/// `kind`: no violation beyond the tolerance at any step, the wall carrying the total
+/// weight at rest. Returns the rest positions.
+fn pile_to_rest<T: Real, const N: usize>(
+    (fence, side, layers): (usize, usize, usize),
+    steps: usize,
+    kind: SolverKind,
+) -> Vec<[f64; 3]> {
     let h = -2.0;
-    let spheres = column(side, layers, h, &mut Rng(7));
+    let mut spheres = ring(fence, h);
+    let offset = 1.15 * (side as f64 - 1.0);
+    let inner = column(side, layers, h, &mut Rng(7))
+        .into_iter()
+        .map(|s| Sphere {
+            pos: [s.pos[0] - offset, s.pos[1] - offset, s.pos[2]],
+            ..s
+        });
+    spheres.extend(inner);
     let n = spheres.len();
     let total: f64 = spheres.iter().map(|s| weight(s.radius)).sum();
-    let mut p = jam_params::<T>(0.2, Method::Overdamped, SolverKind::Newton, h);
+    let mut p = jam_params::<T>(0.2, Method::Overdamped, kind, h);
     p.contacts = Some(Contacts::new(6 * n));
-    let bonds = BondSet::<T, 1>::new();
+    p.solver.max_iterations = 20000;
     let mut ps = particles::<T, N>(&spheres);
-    let mut store = Buffers::<T>::new(Layout::for_params(&p, n, 0));
-    let none = |_: usize, _: usize| false;
+    let mut bonds = BondSet::<T, 16>::new();
+    for i in 0..fence {
+        bonds
+            .push_current(i, (i + 1) % fence, &ps.pos[..n])
+            .unwrap();
+    }
+    let mut store = Buffers::<T>::new(Layout::for_params(&p, n, bonds.len()));
+    let none = |i: usize, j: usize| {
+        i < fence && j < fence && ((i + 1) % fence == j || (j + 1) % fence == i)
+    };
     let mut last = StepReport::default();
     let mut still = 0;
+    let mut taken = 0;
     for k in 0..steps {
         let before: Vec<[f64; 3]> = (0..n).map(|i| f64s::<T>(ps.pos[i])).collect();
         last = one_step(&mut ps, &bonds, &p, &mut store)
-            .unwrap_or_else(|e| panic!("pile step {k}: {e}"));
+            .unwrap_or_else(|e| panic!("pile {kind:?} step {k}: {e}"));
         let v = worst_violation(&ps, n, h, &none);
-        assert!(v <= slack(&p, h), "pile step {k}: violation {v}");
+        assert!(v <= slack(&p, h), "pile {kind:?} step {k}: violation {v}");
         let moved = (0..n)
             .map(|i| norm(sub(f64s::<T>(ps.pos[i]), before[i])))
             .fold(0.0, f64::max);
-        still = if moved <= pick::<T>(1e-5, 1e-11) {
+        // At rest: no sphere moves by more than ten times the solve's tolerance (a
+        // Krylov solve stopped at the tolerance leaves that much jitter per step).
+        still = if moved <= pick::<T>(1e-5, 1e-9) {
             still + 1
         } else {
             0
         };
+        taken = k + 1;
         if still == 3 {
             break;
         }
     }
-    assert_eq!(still, 3, "pile not at rest after {steps} steps");
+    assert_eq!(still, 3, "pile {kind:?} not at rest after {steps} steps");
     eprintln!(
-        "pile of {n}: at rest, {} contacts, {} on the wall",
-        last.contacts, last.wall_contacts
+        "pile of {n}, {kind:?}: at rest after {taken} steps (t = {:.1}), {} contacts, {} on the wall",
+        taken as f64 * 0.2,
+        last.contacts,
+        last.wall_contacts
     );
-    let rows = (last.contacts + last.wall_contacts) as usize;
+    let rows = bonds.len() + (last.contacts + last.wall_contacts) as usize;
     let (imbalance, carried) = balance(&ps, n, &mut store, rows, &vec![[0.0; 3]; n]);
     let tol = pick::<T>(1e-4, 1e-9);
+    eprintln!(
+        "  wall carries {carried} of {total} (relative {:.1e}), force imbalance {imbalance:.1e}",
+        (carried - total).abs() / total
+    );
     assert!(
         (carried - total).abs() <= tol * total,
-        "wall carries {carried}, weight {total} ({} on the wall, {} contacts)",
+        "{kind:?}: wall carries {carried}, weight {total} ({} on the wall, {} contacts)",
         last.wall_contacts,
         last.contacts
     );
-    assert!(imbalance <= tol, "force imbalance {imbalance}");
-    // One step from the rest state with each solver: the same positions.
-    let rest = ps.clone();
-    let mut out = Vec::new();
-    for kind in SOLVERS {
-        let mut q = p;
-        q.solver.kind = kind;
-        let mut ps = rest.clone();
-        let mut store = Buffers::<T>::new(Layout::for_params(&q, n, 0));
-        one_step(&mut ps, &bonds, &q, &mut store).unwrap_or_else(|e| panic!("{kind:?}: {e}"));
-        out.push((0..n).map(|i| f64s::<T>(ps.pos[i])).collect::<Vec<_>>());
-    }
-    let tol = 4.0 * slack(&p, h);
-    for (s, o) in out.iter().enumerate().skip(1) {
-        for i in 0..n {
-            let d = norm(sub(o[i], out[0][i]));
-            assert!(
-                d <= tol,
-                "{:?} vs Sweep: sphere {i} differs by {d}",
-                SOLVERS[s]
-            );
-        }
+    assert!(imbalance <= tol, "{kind:?}: force imbalance {imbalance}");
+    (0..n).map(|i| f64s::<T>(ps.pos[i])).collect()
+}
+
+/// The pile run to rest with every solver (contacts as inequalities inside each
+/// solve): the rest states agree to `tol` (a whole run, not one step).
+fn pile_settles<T: Real, const N: usize>(shape: (usize, usize, usize), steps: usize, tol: f64) {
+    pile_settles_with::<T, N>(&SOLVERS, shape, steps, tol);
+}
+
+fn pile_settles_with<T: Real, const N: usize>(
+    solvers: &[SolverKind],
+    shape: (usize, usize, usize),
+    steps: usize,
+    tol: f64,
+) {
+    let rest: Vec<_> = solvers
+        .iter()
+        .map(|&kind| pile_to_rest::<T, N>(shape, steps, kind))
+        .collect();
+    for (s, o) in rest.iter().enumerate().skip(1) {
+        let d = (0..o.len())
+            .map(|i| norm(sub(o[i], rest[0][i])))
+            .fold(0.0, f64::max);
+        let (a, b) = (solvers[s], solvers[0]);
+        eprintln!("{a:?} vs {b:?}: largest difference {d:.3e}");
+        assert!(d <= tol, "{a:?} vs {b:?}: rest states differ by {d}");
     }
 }
 
 #[test]
 fn pile_of_20_settles_f64() {
-    pile_settles::<f64, 20>(2, 5, 600);
+    pile_settles::<f64, 20>((0, 2, 5), 600, 1e-6);
+}
+
+/// 24 spheres in a fence of 10: a pile about three layers deep at rest, dependent
+/// contacts carrying the load.
+#[test]
+fn fenced_pile_settles_f64() {
+    pile_settles::<f64, 34>((10, 2, 6), 1000, 1e-6);
 }
 
 #[test]
 fn pile_of_20_settles_f32() {
-    pile_settles::<f32, 20>(2, 5, 600);
+    pile_settles::<f32, 20>((0, 2, 5), 600, 1e-2);
 }
 
 #[test]
-#[ignore = "about a minute in release: cargo test --release --features contacts --test jam -- --ignored"]
+#[ignore = "minutes in release: cargo test --release --test jam -- --ignored --nocapture"]
 fn pile_of_100_settles_f64() {
-    pile_settles::<f64, 100>(5, 4, 2000);
+    // Not the sweep: projected Gauss-Seidel converges too slowly on this jammed set
+    // (20 000 sweeps leave 5e-9 at step 163, docs/CONTACTS.md).
+    let solvers = [SolverKind::Newton, SolverKind::Krylov];
+    pile_settles_with::<f64, 115>(&solvers, (15, 3, 11), 2000, 1e-6);
 }
 
 /// Random piles: random radii in `[0.5, 1.5]`, spheres scattered over a small region
-/// just above a random wall (not overlapping), random solver and method, one step of
-/// random `dt`. The step keeps every constraint within the tolerance or refuses with a
+/// just above a random wall (not overlapping), up to three random bonds, random solver
+/// and method, six steps of random `dt` (contacts and wall links inequalities inside
+/// the solve). The step keeps every constraint within the tolerance or refuses with a
 /// typed error other than a factorisation failure, and a refusal keeps the state.
 #[test]
 fn random_piles_hold_or_refuse() {
@@ -461,15 +526,37 @@ fn random_piles_hold_or_refuse() {
         let dt = [0.05, 0.3, 1.5][rng.below(3)];
         let p = jam_params::<f64>(dt, method, kind, h);
         let mut ps = particles::<f64, N>(&spheres);
-        let bonds = BondSet::<f64, 1>::new();
-        let mut store = Buffers::<f64>::new(Layout::for_params(&p, n, 0));
-        let what = format!("case {case}: {n} spheres, {kind:?} {method:?} dt {dt}");
+        // Up to three random bonds at their current lengths: equalities beside the
+        // one-sided rows.
+        let mut bonds = BondSet::<f64, 4>::new();
+        for _ in 0..rng.below(4) {
+            let (i, j) = (rng.below(n), rng.below(n));
+            if i != j {
+                let _ = bonds.push_current(i, j, &ps.pos[..n]);
+            }
+        }
+        let bonded = |i: usize, j: usize| {
+            bonds
+                .as_slice()
+                .iter()
+                .any(|b| (b.i, b.j) == (i, j) || (b.i, b.j) == (j, i))
+        };
+        let mut store = Buffers::<f64>::new(Layout::for_params(&p, n, bonds.len()));
+        let what = format!(
+            "case {case}: {n} spheres, {} bonds, {kind:?} {method:?} dt {dt}",
+            bonds.len()
+        );
         for k in 0..6 {
             let before = snapshot(&ps);
             match one_step(&mut ps, &bonds, &p, &mut store) {
                 Ok(_) => {
-                    let v = worst_violation(&ps, n, h, &|_, _| false);
+                    let v = worst_violation(&ps, n, h, &bonded);
                     assert!(v <= slack(&p, h), "{what} step {k}: violation {v}");
+                    let (_, r) = bonds.max_residual(&ps.pos[..n]);
+                    assert!(
+                        r <= p.solver.tolerance,
+                        "{what} step {k}: bond residual {r}"
+                    );
                 }
                 Err(e) => {
                     assert!(

@@ -37,7 +37,13 @@ pub(super) fn infeasible<T: Real>(
     fac: &[T],
     work: &mut [T],
 ) -> StepError {
-    let n = bonds.len();
+    self_stress(metric, null_vector(fac, bonds.len(), work))
+}
+
+/// The self-stress `v` (signed, `v_first = 1`) of the first dependent row of a
+/// rank-deficient [`cholesky_dense`](crate::linalg::cholesky_dense) factor of `n`
+/// rows, in `work` (`n` scalars).
+pub(super) fn null_vector<'w, T: Real>(fac: &[T], n: usize, work: &'w mut [T]) -> &'w mut [T] {
     let first = (0..n).find(|&k| fac[k * n + k] == T::ZERO).unwrap_or(0);
     let v = &mut work[..n];
     v.fill(T::ZERO);
@@ -51,7 +57,7 @@ pub(super) fn infeasible<T: Real>(
         }
         v[j] = -s * fac[j * n + j];
     }
-    self_stress(metric, v)
+    v
 }
 
 /// The [`StepError::Infeasible`] of the self-stress `v` (multipliers with no net
@@ -90,4 +96,33 @@ fn listed<T: Real>(v: &mut [T]) -> StepError {
         shown,
         count,
     }
+}
+
+/// Whether the multipliers `v` are a self-stress to `share`: their net force on every
+/// bead at most `share` times the largest force of one constraint `|v_l| |g_l|`. The
+/// sweep's multipliers on an inconsistent dependent set grow along its self-stress by
+/// the same amount each sweep while their net force stays bounded (`sweep.rs`).
+pub(super) fn is_self_stress<T: Real>(
+    metric: &Metric<'_, T>,
+    bonds: &[Bond<T>],
+    beads: usize,
+    v: &[T],
+    share: T,
+) -> bool {
+    let largest =
+        (0..bonds.len()).fold(T::ZERO, |m, l| m.max(v[l].abs() * T::norm(metric.grad(l))));
+    if !(largest > T::ZERO) {
+        return false;
+    }
+    (0..beads).all(|p| {
+        let mut f = T::V3_ZERO;
+        for (l, b) in bonds.iter().enumerate() {
+            if b.i == p {
+                f += metric.grad(l) * v[l];
+            } else if b.j == p && !b.is_wall() {
+                f -= metric.grad(l) * v[l];
+            }
+        }
+        T::norm(f) <= share * largest
+    })
 }

@@ -20,8 +20,12 @@
 //! * With a compact metric (`Metric::Mobility::compact`) the products read an `f32`
 //!   copy of the mobility; the residual is still evaluated on the positions in `f64`, so the
 //!   tolerance holds as it does for the `f64` products.
+//! * One-sided rows (contacts, wall links) are inequalities: each chord iteration
+//!   decides which are equalities (`onesided.rs`, the primal-dual active set); the
+//!   others are masked out of the conjugate gradients (zero residual, zero product
+//!   rows, a diagonal row of the preconditioner, rebuilt when the set changes).
 
-use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided};
 use crate::bonds::Bond;
 use crate::error::{LinalgError, StepError};
 use crate::linalg::band;
@@ -67,7 +71,16 @@ pub fn krylov<T: Real>(
     let delta = &mut rest[..nb];
     let (w, rest) = scratch.beads.split_at_mut(n);
     let (acc, tmp) = rest.split_at_mut(n);
-    precondition(metric, bonds, c, pre);
+    // One-sided rows from `from` on (`usize::MAX`: none, the equality solve as it
+    // always was).
+    let from = problem.one_sided(nb);
+    let one_sided = from < nb;
+    let state = &mut scratch.piv[..if one_sided { nb } else { 0 }];
+    if one_sided {
+        onesided::reset(state);
+    } else {
+        precondition(metric, bonds, c, pre, (nb, state));
+    }
     let mut products = 0u32;
     let mut outer = 0u32;
     let mut initial = None;
@@ -81,6 +94,13 @@ pub fn krylov<T: Real>(
     let mut null = false;
     let mut stalls = 0;
     loop {
+        let (mut changed, mut pushes) = (false, true);
+        if one_sided {
+            changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
+            if changed || outer == 0 {
+                precondition(metric, bonds, c, pre, (from, state));
+            }
+        }
         // Nonlinear residual of the chord iteration.
         let mut worst = T::ZERO;
         for (k, b) in bonds.iter().enumerate() {
@@ -88,10 +108,19 @@ pub fn krylov<T: Real>(
             r[k] = -value;
             worst = worst.max_sticky(norm);
         }
+        if one_sided {
+            let (w, p) = onesided::residual(&problem, bonds, from, x, mult, state);
+            (worst, pushes) = (w, p);
+            for k in from..nb {
+                if !onesided::active(state[k]) {
+                    r[k] = T::ZERO;
+                }
+            }
+        }
         if !worst.is_finite() {
             return Err(problem.no_convergence(products, worst));
         }
-        if worst <= solver.tolerance {
+        if worst <= solver.tolerance && pushes {
             return Ok(SolveStats {
                 iterations: products,
                 residual: worst,
@@ -100,10 +129,20 @@ pub fn krylov<T: Real>(
         // Chord steps stopped by a self-stress that then fail to halve the residual,
         // three in a row: the dependent constraints ask for what the others forbid
         // (one such step may be a nonlinear remainder the next removes).
-        stalls = match null && previous.is_some_and(|p| worst > p * T::HALF) {
+        stalls = match null && !changed && previous.is_some_and(|p| worst > p * T::HALF) {
             true => stalls + 1,
             false => 0,
         };
+        if stalls > 0 && one_sided {
+            // An active contact that the contradiction asks to open is let go
+            // (`onesided.rs`); the set changes at the next update.
+            if onesided::let_go(&problem, metric, bonds, from, p, x, state) {
+                (previous, stalls, null) = (None, 0, false);
+                continue;
+            }
+            // No active contact can open: infeasible to first order (Farkas).
+            return Err(dependent::self_stress(metric, p));
+        }
         if stalls == 3 {
             return Err(dependent::self_stress(metric, p));
         }
@@ -122,6 +161,26 @@ pub fn krylov<T: Real>(
         // PCG on A delta = r from delta = 0.
         delta.fill(T::ZERO);
         acc.fill(T::V3_ZERO);
+        if one_sided && (from..nb).any(|k| !onesided::active(state[k]) && mult[k] != T::ZERO) {
+            // Rows released since the last solve: `delta_k = -lambda_k`, solved with
+            // the active rows (their right-hand side gains `A_:k lambda_k`,
+            // `onesided.rs`).
+            for k in 0..nb {
+                let off = k >= from && !onesided::active(state[k]);
+                z[k] = if off { mult[k] } else { T::ZERO };
+                delta[k] = -z[k];
+            }
+            metric.apply_all(bonds, z, w, tmp);
+            products += 1;
+            for (k, b) in bonds.iter().enumerate() {
+                if k < from || onesided::active(state[k]) {
+                    r[k] += T::dot(metric.grad(k), b.relative(w)) * c;
+                }
+            }
+            for (a, &wi) in acc.iter_mut().zip(w.iter()) {
+                *a -= wi;
+            }
+        }
         z.copy_from_slice(r);
         band::solve(pre, nb, BAND, z);
         p.copy_from_slice(z);
@@ -131,6 +190,11 @@ pub fn krylov<T: Real>(
             products += 1;
             for (k, b) in bonds.iter().enumerate() {
                 q[k] = T::dot(metric.grad(k), b.relative(w)) * c;
+            }
+            for k in from..nb {
+                if !onesided::active(state[k]) {
+                    q[k] = T::ZERO;
+                }
             }
             let pq = dot(p, q);
             // `p A p` against `p diag(A) p`: zero curvature along a self-stress of
@@ -189,14 +253,30 @@ pub fn krylov<T: Real>(
 }
 
 /// Band of `A` factorised into `pre` (regularised where rows are dependent); its
-/// diagonal square roots when the band is not positive semi-definite.
-fn precondition<T: Real>(metric: &Metric<'_, T>, bonds: &[Bond<T>], c: T, pre: &mut [T]) {
+/// diagonal square roots when the band is not positive semi-definite. `mask`: the
+/// first one-sided row and the rows' states; an inactive row keeps only its diagonal.
+fn precondition<T: Real>(
+    metric: &Metric<'_, T>,
+    bonds: &[Bond<T>],
+    c: T,
+    pre: &mut [T],
+    mask: (usize, &[usize]),
+) {
     let nb = bonds.len();
     let entry = |k: usize, l: usize| T::dot(metric.grad(k), metric.relative(bonds, k, l)) * c;
+    let (from, state) = mask;
+    let off = |k: usize| k >= from && !onesided::active(state[k]);
     for k in 0..nb {
         let first = k.saturating_sub(BAND);
         let row = &mut pre[band::at(BAND, k, first)..=band::at(BAND, k, k)];
         metric.jacobian_row(bonds, k, metric.grad(k) * c, first, row);
+        if from < nb {
+            for l in first..k {
+                if off(k) || off(l) {
+                    row[l - first] = T::ZERO;
+                }
+            }
+        }
     }
     // Dependent constraints (`docs/CONTACTS.md`) make `A` singular: their pivots are
     // replaced by their diagonals, which keeps the preconditioner positive definite;

@@ -17,6 +17,7 @@ mod dependent;
 mod krylov;
 mod metric;
 mod newton;
+mod onesided;
 mod sweep;
 
 pub use krylov::{BAND, krylov};
@@ -103,6 +104,10 @@ pub enum Problem<'a, T: Real> {
     Positions {
         /// The periodic box, if any ([`Params::periodic`](crate::Params::periodic)).
         cell: Option<Periodic<T>>,
+        /// The rows from this one on are one-sided (contacts and wall links:
+        /// `sigma >= 0`, a non-negative multiplier, complementary; `docs/CONTACTS.md`),
+        /// the rows before it equalities. `usize::MAX`: none.
+        one_sided: usize,
     },
     /// `b_k . (x_i - x_j) = 0` with `b_k` the new bond vectors (RATTLE); `dt` scales the
     /// residual to a relative length change per step.
@@ -120,7 +125,7 @@ impl<T: Real> Problem<'_, T> {
     #[inline]
     fn eval(&self, b: &Bond<T>, k: usize, x: &[T::V3]) -> (T, T::V3, T) {
         let rel = match *self {
-            Problem::Positions { cell } => b.separation(x, cell.as_ref()),
+            Problem::Positions { cell, .. } => b.separation(x, cell.as_ref()),
             Problem::Velocities { .. } => b.relative(x),
         };
         let d2 = b.length * b.length;
@@ -171,6 +176,21 @@ impl<T: Real> Problem<'_, T> {
         }
     }
 
+    /// The first one-sided row of `rows`: `usize::MAX` where there is none (a
+    /// constant where contacts are compiled out, so that every one-sided branch folds
+    /// away).
+    #[inline(always)]
+    fn one_sided(&self, rows: usize) -> usize {
+        match *self {
+            Problem::Positions { one_sided, .. }
+                if cfg!(feature = "contacts") && one_sided < rows =>
+            {
+                one_sided
+            }
+            _ => usize::MAX,
+        }
+    }
+
     fn stage(&self) -> Stage {
         match self {
             Problem::Positions { .. } => Stage::Positions,
@@ -217,20 +237,34 @@ pub struct Scratch<'a, T: Real> {
 /// of the mobility and `bonds` bonds.
 pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) -> [usize; 3] {
     match kind.resolve(bonds) {
-        SolverKind::Newton => [bonds * bonds + bonds, 0, bonds],
+        SolverKind::Newton => [
+            bonds * bonds + bonds,
+            0,
+            index_scratch(SolverKind::Newton, bonds),
+        ],
         SolverKind::Krylov => [
             krylov::SCALARS_PER_BOND * bonds,
             2 * n + 2 * m + crate::parallel::band_scratch(m),
-            0,
+            index_scratch(SolverKind::Krylov, bonds),
         ],
         _ => [0, 0, 0],
+    }
+}
+
+/// Index scratch of `kind` (resolved) for `bonds` rows: Newton's LU pivots, and with
+/// contacts compiled in the one-sided rows' states (Newton, Krylov).
+pub(crate) const fn index_scratch(kind: SolverKind, bonds: usize) -> usize {
+    match kind {
+        SolverKind::Newton => bonds + onesided::STATE_PER_ROW * bonds,
+        SolverKind::Krylov => onesided::STATE_PER_ROW * bonds,
+        _ => 0,
     }
 }
 
 /// Largest normalised residual over all bonds (positions: two square roots, see
 /// [`max_residual`](crate::bonds::max_residual)).
 fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T {
-    if let Problem::Positions { cell } = problem {
+    if let Problem::Positions { cell, .. } = problem {
         return crate::bonds::max_residual_in(bonds, x, cell.as_ref()).1;
     }
     let mut w = T::ZERO;

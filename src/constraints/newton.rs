@@ -1,7 +1,7 @@
 //! Newton on the dense `bonds x bonds` Jacobian, solved by LU: quadratic convergence,
 //! `O(B^3)` per factorisation. The choice for small bond counts.
 
-use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, worst};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided, worst};
 use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::linalg;
@@ -28,6 +28,11 @@ use crate::real::Real;
 ///   [`StepError::Infeasible`], naming the dependent set (on the chord such a stall is
 ///   first taken for the chord's own slowness on a large move, and the Jacobian at the
 ///   iterate takes over as without dependent rows).
+/// * One-sided rows (contacts, wall links: [`Problem::Positions`]) are inequalities:
+///   each iteration decides which of them are equalities (`onesided.rs`, the
+///   primal-dual active set); the others get a zero update on a decoupled diagonal
+///   row. A change of the set refactorises. Without one-sided rows nothing of this
+///   runs.
 pub fn newton<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,
@@ -38,11 +43,18 @@ pub fn newton<T: Real>(
     scratch: &mut Scratch<'_, T>,
 ) -> Result<SolveStats<T>, StepError> {
     let nb = bonds.len();
-    let (jac, rhs, piv) = (
-        &mut scratch.jac[..nb * nb],
-        &mut scratch.rhs[..nb],
-        &mut scratch.piv[..nb],
-    );
+    // One-sided rows from `from` on (`usize::MAX`: none, the equality solve as it
+    // always was); their states after the pivots.
+    let from = problem.one_sided(nb);
+    #[cfg(feature = "contacts")]
+    let (piv, state) = scratch.piv.split_at_mut(nb);
+    #[cfg(not(feature = "contacts"))]
+    let (piv, state): (_, &mut [usize]) = (&mut scratch.piv[..nb], &mut []);
+    let (jac, rhs) = (&mut scratch.jac[..nb * nb], &mut scratch.rhs[..nb]);
+    let one_sided = from < nb;
+    if one_sided {
+        onesided::reset(&mut state[..nb]);
+    }
     // Positions start on the chord; every solve falls back to the Jacobian at the
     // iterate, refreshed whenever the residual falls less than tenfold.
     let mut chord = matches!(problem, Problem::Positions { .. });
@@ -50,12 +62,23 @@ pub fn newton<T: Real>(
     let floor = dependent::rank_floor::<T>();
     // Dependent rows found by the last factorisation.
     let mut deficient = 0;
+    // The chord is kept to the end (one-sided rows dependent at the iterate only).
+    let mut stay = false;
     for it in 0..=solver.max_iterations {
-        let residual = worst(&problem, bonds, x);
+        let (mut changed, mut pushes) = (false, true);
+        let residual = match one_sided {
+            false => worst(&problem, bonds, x),
+            true => {
+                changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
+                let (r, p) = onesided::residual(&problem, bonds, from, x, mult, state);
+                pushes = p;
+                r
+            }
+        };
         if !residual.is_finite() {
             return Err(problem.no_convergence(it, residual));
         }
-        if residual <= solver.tolerance {
+        if residual <= solver.tolerance && pushes {
             return Ok(SolveStats {
                 iterations: it,
                 residual,
@@ -65,7 +88,12 @@ pub fn newton<T: Real>(
             return Err(problem.no_convergence(it, residual));
         }
         let fast = previous.is_some_and(|p| residual <= p * T::from_f64(0.1));
-        if deficient > 0 && !chord && previous.is_some_and(|p| residual > p * T::HALF) {
+        // One-sided rows never leave the chord: their stall is judged on it.
+        if deficient > 0
+            && (!chord || one_sided)
+            && !changed
+            && previous.is_some_and(|p| residual > p * T::HALF)
+        {
             // Named by the chord's self-stress (an LU factor shows only which columns
             // it skipped): refactorised here, on the way out.
             let c = problem.chord_factor();
@@ -73,11 +101,29 @@ pub fn newton<T: Real>(
                 let row = &mut jac[k * nb..k * nb + k + 1];
                 metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
             }
-            let _ = linalg::cholesky_dense(jac, nb, floor);
+            if one_sided {
+                decouple(jac, rhs, nb, (from, state), mult, true);
+            }
+            let chord_deficient = linalg::cholesky_dense(jac, nb, floor);
+            if one_sided && chord_deficient == Ok(0) {
+                // Dependent at the iterate only (a pair turned far within the step):
+                // no self-stress to name; the chord, which has none, goes on alone.
+                (chord, stay, previous) = (true, true, None);
+                continue;
+            }
+            if one_sided {
+                // An active contact that the contradiction asks to open is let go
+                // (`onesided.rs`); the set changed: refactorised.
+                let v = dependent::null_vector(jac, nb, rhs);
+                if onesided::let_go(&problem, metric, bonds, from, v, x, state) {
+                    previous = None;
+                    continue;
+                }
+            }
             return Err(dependent::infeasible(metric, bonds, jac, rhs));
         }
-        let refresh = previous.is_none() || !fast;
-        if refresh && previous.is_some() {
+        let refresh = previous.is_none() || !fast || changed;
+        if refresh && previous.is_some() && !changed && !stay && !one_sided {
             chord = false;
         }
         previous = Some(residual);
@@ -93,6 +139,9 @@ pub fn newton<T: Real>(
                 };
                 metric.jacobian_row(bonds, k, dir, 0, &mut jac[k * nb..k * nb + len]);
             }
+        }
+        if one_sided {
+            decouple(jac, rhs, nb, (from, state), mult, refresh);
         }
         let fail = |error| StepError::Linalg {
             stage: problem.stage(),
@@ -114,6 +163,14 @@ pub fn newton<T: Real>(
             *m += r;
         }
         metric.apply_each(bonds, rhs, x);
+        if one_sided {
+            // Released: exactly zero (the solve gives `-lambda_k` to rounding).
+            for k in from..nb {
+                if !onesided::active(state[k]) {
+                    mult[k] = T::ZERO;
+                }
+            }
+        }
     }
     // The loop returns on its last pass (it == max_iterations).
     Err(StepError::NoConvergence {
@@ -121,6 +178,43 @@ pub fn newton<T: Real>(
         iterations: solver.max_iterations,
         residual: f64::NAN,
     })
+}
+
+/// The inactive one-sided rows' equations (of the chord's lower triangle) replaced by
+/// `A_kk delta_k = -A_kk lambda_k`: their row and column zeroed but the diagonal, the
+/// active rows' right-hand side corrected by `A_jk lambda_k` (the release of `lambda_k`
+/// solved with them, `onesided.rs`). `refresh`: the triangle was just built (otherwise
+/// it is the factor of the same set, every inactive multiplier already zero).
+fn decouple<T: Real>(
+    jac: &mut [T],
+    rhs: &mut [T],
+    nb: usize,
+    (from, state): (usize, &[usize]),
+    mult: &[T],
+    refresh: bool,
+) {
+    for k in from..nb {
+        if onesided::active(state[k]) {
+            continue;
+        }
+        if !refresh {
+            rhs[k] = T::ZERO;
+            continue;
+        }
+        let l = mult[k];
+        for j in 0..nb {
+            if j == k {
+                continue;
+            }
+            let at = if j < k { k * nb + j } else { j * nb + k };
+            rhs[j] += jac[at] * l;
+            jac[at] = T::ZERO;
+        }
+        if !(jac[k * nb + k] > T::ZERO) {
+            jac[k * nb + k] = T::ONE;
+        }
+        rhs[k] = -jac[k * nb + k] * l;
+    }
 }
 
 /// Largest `|A_kk|`: the scale of the LU rank tolerance (the rows of one problem share

@@ -159,7 +159,8 @@ pub(super) fn project_overdamped<'l, T: Real>(
         );
         free(x);
         shift(x, wall, -T::ONE);
-        let stats = project_positions(p, active, &metric, x, lambda, scratch)?;
+        // Contacts and wall links are inequalities inside the solve (`docs/CONTACTS.md`).
+        let stats = project_positions(p, active, &metric, x, lambda, scratch, nb)?;
         let Some(c) = one_sided else {
             return Ok(Projected {
                 stats,
@@ -187,6 +188,18 @@ pub(super) fn project_overdamped<'l, T: Real>(
                 }
             }
             shift(x, wall, T::ONE);
+            // The rows the solve let go (zero multipliers: apart, or dependent and
+            // unloaded) are not held.
+            let mut kept = 0;
+            for k in nb..nb + nc {
+                if lambda[k] != T::ZERO {
+                    links[nb + kept] = links[k];
+                    grad[nb + kept] = grad[k];
+                    lambda[nb + kept] = lambda[k];
+                    kept += 1;
+                }
+            }
+            nc = kept;
             let links: &'l [Bond<T>] = links;
             let held = &links[..nb + nc];
             let walls = held.iter().filter(|l| l.is_wall()).count();

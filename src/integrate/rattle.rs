@@ -90,7 +90,10 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
         scale: half_dt2,
     };
     let stats = constraints::solve(
-        Problem::Positions { cell: cell(p) },
+        Problem::Positions {
+            cell: cell(p),
+            one_sided: usize::MAX,
+        },
         &metric,
         bonds,
         &p.solver,

@@ -305,7 +305,8 @@ pub(super) fn spin<T: Real>(
 }
 
 /// Projects `x` onto the bonds along `metric`; the multipliers start from zero and end
-/// in `lambda`. Inlined into every projection, so that the solver choice folds where
+/// in `lambda`. The rows from `one_sided` on (contacts and wall links; `usize::MAX`:
+/// none) are inequalities ([`Problem::Positions`]). Inlined into every projection, so that the solver choice folds where
 /// the parameters are constant ([`constraints::solve`]).
 #[inline(always)]
 pub(super) fn project_positions<T: Real>(
@@ -315,10 +316,14 @@ pub(super) fn project_positions<T: Real>(
     x: &mut [T::V3],
     lambda: &mut [T],
     scratch: &mut Scratch<'_, T>,
+    one_sided: usize,
 ) -> Result<SolveStats<T>, StepError> {
     lambda.fill(T::ZERO);
     constraints::solve(
-        Problem::Positions { cell: cell(p) },
+        Problem::Positions {
+            cell: cell(p),
+            one_sided,
+        },
         metric,
         bonds,
         &p.solver,

@@ -4,7 +4,7 @@
 use super::{Layout, Workspace};
 use crate::bonds::Bond;
 use crate::constraints::Scratch;
-use crate::constraints::{SolverKind, krylov_scratch_per_bond};
+use crate::constraints::{SolverKind, index_scratch, krylov_scratch_per_bond};
 use crate::error::StepError;
 use crate::linalg::tri;
 use crate::noise::lanczos::{scalars as lanczos_scalars, vectors as lanczos_vectors};
@@ -160,7 +160,10 @@ impl<T: Real> Workspace<'_, T> {
         let scratch = Scratch {
             jac: sc.take(if newton { nb * nb } else { 0 }),
             rhs: sc.take(if newton { nb } else { 0 }),
-            piv: ix.take(if newton { nb } else { 0 }),
+            piv: ix.take(match (constrained, kind) {
+                (true, SolverKind::Newton | SolverKind::Krylov) => index_scratch(kind, nb),
+                _ => 0,
+            }),
             krylov: sc.take(if constrained && krylov {
                 krylov_scratch_per_bond() * nb
             } else {
