@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use serde_json::Value as Json;
 
-use super::{Point, SWEEP_JSON, Sweep};
+use super::{SWEEP_JSON, Sweep};
 use crate::output::fnv1a64;
 use crate::scene::Scene;
 
@@ -56,13 +56,19 @@ pub struct PointRecord {
 }
 
 /// The sweep's digest: FNV-1a 64 of its resolved base scene, keys, replica count and
-/// point ids in order. With the ids (MD5s of the parameters) it covers every point's
-/// whole resolved scene, and it costs one pass over the ids, not a scene per point.
-pub fn digest(base: &Scene, keys: &[String], replicas: usize, points: &[Point]) -> String {
+/// point ids (`ids`) in order. With the ids (MD5s of the parameters) it covers every
+/// point's whole resolved scene, and it costs one pass over the ids, not a scene per
+/// point.
+pub fn digest<'a>(
+    base: &Scene,
+    keys: &[String],
+    replicas: usize,
+    ids: impl IntoIterator<Item = &'a str>,
+) -> String {
     let mut text = serde_json::to_vec(base).unwrap_or_default();
     text.extend_from_slice(format!("\n{keys:?}\n{replicas}\n").as_bytes());
-    for p in points {
-        text.extend_from_slice(p.id.as_bytes());
+    for id in ids {
+        text.extend_from_slice(id.as_bytes());
         text.push(b'\n');
     }
     fnv1a64(&text)
