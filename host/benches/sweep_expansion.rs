@@ -50,12 +50,32 @@ fn expansion(c: &mut Criterion) {
     });
     let dir = std::env::temp_dir().join(format!("sweep-bench-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let big_file = dir.join("big.toml");
+    std::fs::write(&big_file, &big).unwrap();
+    g.bench_function("check 99856 points (dry-run: each scene let go)", |b| {
+        b.iter(|| Sweep::check_path(&big_file).unwrap().len())
+    });
+    let middle = Sweep::check_path(&big_file).unwrap()[99856 / 2].0.clone();
+    g.bench_function("find one point of 99856 (sweep file)", |b| {
+        b.iter(|| {
+            Sweep::point_from_path(&big_file, &middle)
+                .unwrap()
+                .unwrap()
+                .count
+        })
+    });
     let sweep = Sweep::parse(&grid(142), "bench.toml", Path::new(".")).unwrap(); // 20 164
     hydrorattle_host::sweep::claim::claim(&sweep, &dir).unwrap();
     let id = sweep.points[sweep.points.len() / 2].id.clone();
     let one = Selection::Point(id.clone());
     g.bench_function("find one point of 20164 (frozen)", |b| {
         b.iter(|| frozen::load(&dir, &one).unwrap().1.len())
+    });
+    let file = dir.join("grid.toml");
+    std::fs::write(&file, grid(142)).unwrap();
+    g.bench_function("find one point of 20164 (sweep file)", |b| {
+        b.iter(|| Sweep::point_from_path(&file, &id).unwrap().unwrap().count)
     });
     g.bench_function("expand 20164 points (sweep file)", |b| {
         b.iter(|| {

@@ -135,6 +135,9 @@ struct Tracks<'a, 's, T: Real> {
     /// The last frame's observables.
     last: Observables,
     total_iterations: u64,
+    /// The last step's constraint iterations and largest tension (what a closing row
+    /// records).
+    solve: (u32, T),
 }
 
 impl<'a, 's, T: Real> Tracks<'a, 's, T> {
@@ -196,6 +199,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             first: 1,
             last: Observables::default(),
             total_iterations: 0,
+            solve: (0, T::ZERO),
         };
         match from {
             Some(c) => {
@@ -209,6 +213,9 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
                 (tracks.first, tracks.last) = (c.step as usize + 1, c.last);
                 tracks.landing = c.landing.map(|t| T::from_f64(f64::from_bits(t)));
                 tracks.total_iterations = c.total_iterations;
+                if let Some(s) = c.last_step {
+                    tracks.solve = (s.iterations, T::from_f64(f64::from_bits(s.max_tension)));
+                }
             }
             None => {
                 tracks.last = tracks.frame(0, beads, T::ZERO, 0, T::ZERO)?;
@@ -314,6 +321,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         let gravity = self.gravity;
         self.keeper.take(s, beads);
         self.total_iterations += u64::from(rep.iterations);
+        self.solve = (rep.iterations, rep.max_tension);
         if self.landing.is_none() && rep.wall_contacts > 0 {
             self.landing = Some(beads.time);
         }
@@ -353,6 +361,10 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             c.lanczos = Some(engine.lanczos);
         }
         c.landing = self.landing.map(|t| t.to_f64().to_bits());
+        c.last_step = Some(super::checkpoint::StepSolve {
+            iterations: self.solve.0,
+            max_tension: self.solve.1.to_f64().to_bits(),
+        });
         c.save(dir)
     }
 
@@ -393,8 +405,15 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
     ) -> Result<RunResult> {
         let beads = &engine.beads;
         if self.last.time != beads.time.to_f64() {
+            // A run that ended between frames without a closing row: one resumed at
+            // its last step (the row its step wrote, from the checkpoint's solve), or
+            // one whose step failed (no solve to record).
+            let (iterations, tension) = match failure {
+                None => self.solve,
+                Some(_) => (0, T::ZERO),
+            };
             let total = self.twist.total;
-            self.last = self.frame(done, beads, total, 0, T::ZERO)?;
+            self.last = self.frame(done, beads, total, iterations, tension)?;
         }
         let outcome = match (&failure, self.tail.late_state()) {
             (None, Some(s)) => s.name().to_string(),

@@ -255,8 +255,7 @@ pub fn run_point_of_file(file: &Path, dir: &Path, id: &str, opts: Options) -> Re
     let Some(found) = Sweep::point_from_path(file, id)? else {
         bail!("the sweep has no point {id:?} (see sweep.json)");
     };
-    let record = super::record::SweepRecord::read(dir)?;
-    if record.is_some_and(|r| r.digest.as_deref() == Some(found.digest.as_str())) {
+    if super::record::SweepRecord::read_digest(dir)?.as_ref() == Some(&found.digest) {
         return run_selected(&[&found.point], dir, opts, Vec::new());
     }
     let sweep = Sweep::from_path(file)?;
