@@ -28,7 +28,10 @@
 //!   points. An unknown key, an empty list, a value the scene refuses, a
 //!   point given twice (numbers compared as numbers), a base that is itself a sweep, a
 //!   misspelled table or setting, or more than [`MAX_POINTS`] points is an error at its
-//!   file, line and column (`sweep.toml:4:21: ...`), as for scenes.
+//!   file, line and column (`sweep.toml:4:21: ...`), as for scenes. (One point run
+//!   from the sweep file in a folder that already holds the sweep, whose points were
+//!   all checked when it claimed the folder, is the only one resolved:
+//!   [`Sweep::point_from_path`], [`run::run_point_of_file`].)
 //!
 //! # Points
 //!
