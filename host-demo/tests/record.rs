@@ -180,6 +180,17 @@ fn a_run_resumed_from_its_checkpoint_writes_the_same_bytes_as_one_run() {
     }
 }
 
+/// The files of the finished run in `dir` as a run killed after its checkpoint leaves
+/// them: under their temporary names, with what it wrote past the checkpoint.
+fn as_if_killed(dir: &Path) {
+    for f in TRAJECTORY_FILES {
+        let mut partial = bytes(dir, f);
+        partial.extend_from_slice(b"frames written after the checkpoint, then killed");
+        std::fs::write(dir.join(format!("{f}.tmp")), partial).unwrap();
+        std::fs::remove_file(dir.join(f)).unwrap();
+    }
+}
+
 #[test]
 fn a_killed_run_resumes_from_the_files_it_left() {
     // A killed run leaves its files under their temporary names, with frames past the
@@ -203,17 +214,75 @@ fn a_killed_run_resumes_from_the_files_it_left() {
         &killed,
         &["--checkpoint-every", "2"],
     );
-    for f in TRAJECTORY_FILES {
-        // What the killed run had written past its checkpoint, under the .tmp name.
-        let mut partial = bytes(&killed, f);
-        partial.extend_from_slice(b"frames written after the checkpoint, then killed");
-        std::fs::write(killed.join(format!("{f}.tmp")), partial).unwrap();
-        std::fs::remove_file(killed.join(f)).unwrap();
-    }
+    as_if_killed(&killed);
     cli(&["resume", killed.to_str().unwrap(), "--until", "4"]);
     for f in TRAJECTORY_FILES {
         assert!(bytes(&one, f) == bytes(&killed, f), "{f} differs");
         assert!(!killed.join(format!("{f}.tmp")).exists());
+    }
+}
+
+#[test]
+fn a_run_killed_after_a_checkpoint_on_its_last_step_resumes_to_one_run() {
+    // A dimer of 95 steps, a frame every 10, a checkpoint every 19: the last checkpoint
+    // is on the last step, which is no frame step, so the run's closing row comes after
+    // it. Killed there (files under their temporary names, no summary), the run is
+    // finished by `resume --until` its own end, with the closing row of the
+    // uninterrupted run (that step's iterations and tension, not zeros), and goes on
+    // from there as one longer run.
+    let dir = scratch("last-step");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(manifest().join("scenes/dimer.toml")).unwrap();
+    let scene = |name: &str, duration: &str| {
+        let path = dir.join(name);
+        std::fs::write(
+            &path,
+            text.replace("duration = 20.0", &format!("duration = {duration}")),
+        )
+        .unwrap();
+        path
+    };
+    let (one, longer) = (dir.join("one"), dir.join("longer"));
+    run(&scene("one.toml", "0.95"), &one, &[]);
+    run(&scene("longer.toml", "1.33"), &longer, &[]);
+    let killed = dir.join("killed");
+    run(
+        &scene("killed.toml", "0.95"),
+        &killed,
+        &["--checkpoint-every", "0.19"],
+    );
+    assert_eq!(json(&killed.join("checkpoint.json"))["step"], 95);
+    std::fs::remove_file(killed.join("summary.json")).unwrap();
+    as_if_killed(&killed);
+    cli(&["resume", killed.to_str().unwrap(), "--until", "0.95"]);
+    let rows = String::from_utf8(bytes(&killed, "observables.csv")).unwrap();
+    let last: Vec<&str> = rows.lines().last().unwrap().split(',').collect();
+    assert!(
+        last[10] != "0",
+        "the closing row records its step's solve: {last:?}"
+    );
+    for (done, until) in [(&one, "0.95"), (&longer, "1.33")] {
+        if until != "0.95" {
+            cli(&["resume", killed.to_str().unwrap(), "--until", until]);
+        }
+        for f in TRAJECTORY_FILES {
+            assert!(
+                bytes(done, f) == bytes(&killed, f),
+                "{f} differs at {until}"
+            );
+        }
+        let (s1, s2) = (
+            json(&done.join("summary.json")),
+            json(&killed.join("summary.json")),
+        );
+        for key in [
+            "final_observables",
+            "twist_rate",
+            "steps_done",
+            "mean_iterations",
+        ] {
+            assert_eq!(s1[key], s2[key], "{key} at {until}");
+        }
     }
 }
 

@@ -55,7 +55,7 @@ pub fn scene_colors(scene: &Scene) -> Vec<RGBColor> {
     let mut seen: Vec<&str> = Vec::new();
     (0..n)
         .map(|i| {
-            let s = scene.species.get(i).map_or("P", String::as_str);
+            let s = scene.species.get(i).map_or("P", |s| s.as_ref());
             let k = seen.iter().position(|&t| t == s).unwrap_or_else(|| {
                 seen.push(s);
                 seen.len() - 1

@@ -110,24 +110,19 @@ impl SweepArgs {
         let t = Instant::now();
         let report = match &self.file {
             None => hydrorattle_host::sweep::run_frozen(&self.out, &selection, opts)?,
-            Some(file) => {
-                let sweep = Sweep::from_path(file)?;
-                if self.dry_run {
-                    for p in &sweep.points {
-                        let json = hydrorattle_host::sweep::id::canonical_json(&p.statepoint);
-                        println!("{} {json}", p.id);
-                    }
-                    eprintln!(
-                        "{} points, all valid; nothing run or written",
-                        sweep.points.len()
-                    );
-                    return Ok(());
+            Some(file) if self.dry_run => return list(file),
+            Some(file) => match (&selection, self.emit) {
+                (Selection::Point(id), None) => {
+                    hydrorattle_host::sweep::run_point_of_file(file, &self.out, id, opts)?
                 }
-                if let Some(engine) = self.emit {
-                    return self.emit(engine, &sweep, file, verbose);
+                (_, Some(engine)) => {
+                    return self.emit(engine, &Sweep::from_path(file)?, file, verbose);
                 }
-                hydrorattle_host::sweep::run_points(&sweep, &self.out, &selection, opts)?
-            }
+                (_, None) => {
+                    let sweep = Sweep::from_path(file)?;
+                    hydrorattle_host::sweep::run_points(&sweep, &self.out, &selection, opts)?
+                }
+            },
         };
         println!(
             "{report} in {:.1} s; wrote {}",
@@ -173,4 +168,18 @@ impl SweepArgs {
         );
         Ok(())
     }
+}
+
+/// `--dry-run`: checks every point of the sweep file (each scene resolved and let go)
+/// and lists their ids and state points in sweep order.
+fn list(file: &std::path::Path) -> Result<()> {
+    use std::io::Write;
+    let points = Sweep::check_path(file)?;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    for (id, statepoint) in &points {
+        writeln!(out, "{id} {statepoint}")?;
+    }
+    out.flush()?;
+    eprintln!("{} points, all valid; nothing run or written", points.len());
+    Ok(())
 }

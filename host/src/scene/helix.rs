@@ -151,6 +151,17 @@ impl Helix {
 
     /// Checks the numbers (ranges, finiteness) and the geometry.
     pub fn check(&self) -> Result<(), String> {
+        self.check_numbers()?;
+        self.geometry()
+            .positions()
+            .map(|_| ())
+            .map_err(|e| self.describe(e))
+    }
+
+    /// Checks the numbers (ranges, finiteness); the geometry is checked where the
+    /// positions are made (once: its angular step is a bisection, a sweep's helices
+    /// each make one).
+    fn check_numbers(&self) -> Result<(), String> {
         if self.tails < 1 {
             return Err(self.describe(HelixError::NoTails));
         }
@@ -163,16 +174,13 @@ impl Helix {
         ] {
             check_number(name, value, min, strict)?;
         }
-        self.geometry()
-            .positions()
-            .map(|_| ())
-            .map_err(|e| self.describe(e))
+        Ok(())
     }
 
     /// Generates the chain: bead 0 is the head, beads `1..=tails` the tails, bonds
     /// `(k, k + 1, dhat (a_k + a_{k+1}))`.
     pub fn generate(&self) -> Result<Chain, String> {
-        self.check()?;
+        self.check_numbers()?;
         let h = self.geometry();
         let n = self.tails + 1;
         Ok(Chain {

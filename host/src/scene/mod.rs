@@ -80,8 +80,11 @@ pub use suspension::{GAP, MAX_FRACTION, Suspension, TRIALS_PER_SPHERE};
 pub use thermal::{DEFAULT_SEED, Drift, Sqrt, Thermal};
 pub use wall::Wall;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 use std::path::Path;
+use toml::Spanned;
+use toml::de::DeTable;
 
 use crate::output::Topology;
 use crate::sizing::{DEFAULT_LIMIT, Limits};
@@ -175,8 +178,10 @@ pub struct Scene {
     pub suspension: Option<Suspension>,
     /// Species (type name) of each particle: `head` and `tail` for a helix; the
     /// `species` key, or one name per distinct radius and density, for explicit
-    /// particles.
-    pub species: Vec<String>,
+    /// particles. The generators' names are borrowed: a sweep resolves a scene per
+    /// point, and a name allocated per bead was half the cost of its scenes (many
+    /// small allocations freed between larger ones: glibc's slow path).
+    pub species: Vec<Cow<'static, str>>,
 }
 
 impl Scene {
@@ -244,7 +249,7 @@ impl Scene {
     /// [`parse`](Self::parse) under `limits`, checked from the counts before any bead is
     /// generated or any pair is checked.
     pub fn parse_limited(text: &str, origin: &str, limits: Limits) -> Result<Scene, SceneError> {
-        let raw: RawScene = toml::from_str(text).map_err(|e| {
+        let toml_error = |e: toml::de::Error| {
             let start = e.span().map_or(0, |s| s.start);
             let mut message = e.message().trim_end().replace('\n', " ");
             // A missing key is reported at its table's header: name the table.
@@ -261,18 +266,34 @@ impl Scene {
                 message,
                 too_large: None,
             }
-        })?;
-        let method_at = raw.periodic.as_ref().and_then(|b| b.get_ref().method_at());
-        let mut scene = raw.resolve(limits).map_err(|i| SceneError {
-            origin: origin.to_string(),
-            location: Some(i.span.map_or((1, 1), |s| line_col(text, s.start))),
-            message: i.message,
-            too_large: i.too_large,
+        };
+        let doc = DeTable::parse(text).map_err(toml_error)?;
+        let (mut scene, method_at) = resolve_document(doc, limits).map_err(|e| match e {
+            Unresolved::Toml(e) => toml_error(e),
+            Unresolved::Issue(i) => SceneError {
+                origin: origin.to_string(),
+                location: Some(i.span.map_or((1, 1), |s| line_col(text, s.start))),
+                message: i.message,
+                too_large: i.too_large,
+            },
         })?;
         if let Some(b) = scene.periodic.as_mut() {
             b.method_line = method_at.map(|at| line_col(text, at).0);
         }
         Ok(scene)
+    }
+
+    /// The scene of a TOML document already parsed, and the offset of its `[box]`
+    /// `method` in the text its spans refer to: [`parse_limited`](Self::parse_limited)
+    /// after its parse, and what a sweep resolves for each point (its base parsed once,
+    /// the point's values set in a copy of the document: no text written or read per
+    /// point). `None` when the document is not a scene: the caller parses its text for
+    /// the error, placed.
+    pub(crate) fn from_document(
+        doc: Spanned<DeTable<'_>>,
+        limits: Limits,
+    ) -> Option<(Scene, Option<usize>)> {
+        resolve_document(doc, limits).ok()
     }
 
     /// The embedded Figure 1 scenes, parsed: `(case, scene)` for cases a, b, c.
@@ -300,7 +321,7 @@ impl Scene {
 
     /// Species (type name) of each particle.
     pub fn species(&self) -> Vec<&str> {
-        self.species.iter().map(String::as_str).collect()
+        self.species.iter().map(|s| s.as_ref()).collect()
     }
 
     /// Types, radii, masses and bonds, for the trajectory files. Types are numbered
@@ -310,7 +331,7 @@ impl Scene {
         // A scene edited in code may have fewer names than particles: the rest are "P".
         let typeid = (0..self.particles.len())
             .map(|k| {
-                let s = self.species.get(k).map_or("P", String::as_str);
+                let s = self.species.get(k).map_or("P", |s| s.as_ref());
                 types.iter().position(|t| t == s).unwrap_or_else(|| {
                     types.push(s.to_string());
                     types.len() - 1
@@ -330,4 +351,22 @@ impl Scene {
             cell: self.periodic.map(|b| b.size),
         }
     }
+}
+
+/// Why a parsed document is not a scene, before it is placed in its text.
+enum Unresolved {
+    Toml(toml::de::Error),
+    Issue(error::Issue),
+}
+
+/// A parsed document deserialized and resolved (the one way from a document to a
+/// [`Scene`]); with the offset of its `[box]` `method`.
+fn resolve_document(
+    doc: Spanned<DeTable<'_>>,
+    limits: Limits,
+) -> Result<(Scene, Option<usize>), Unresolved> {
+    let raw = RawScene::deserialize(toml::de::Deserializer::from(doc)).map_err(Unresolved::Toml)?;
+    let method_at = raw.periodic.as_ref().and_then(|b| b.get_ref().method_at());
+    let scene = raw.resolve(limits).map_err(Unresolved::Issue)?;
+    Ok((scene, method_at))
 }

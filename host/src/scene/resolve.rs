@@ -2,6 +2,7 @@
 //! the helix generated, each error placed at the value at fault. The storage a scene
 //! needs is checked from its counts before anything is generated or pair-checked.
 
+use std::borrow::Cow;
 use std::ops::Range;
 
 use super::bodies::{
@@ -137,7 +138,7 @@ impl RawScene {
             _ if self.suspension.is_some() => {
                 let (s, (particles, edge)) = self.generate_suspension(&plans, limits, every)?;
                 suspension = Some((s, edge));
-                let species = vec!["sphere".to_string(); particles.len()];
+                let species = vec![Cow::Borrowed("sphere"); particles.len()];
                 let spans = BodySpans::Helix(self.suspension.as_ref().map_or(0..0, |s| s.span()));
                 (particles, Vec::new(), None, spans, species)
             }
@@ -164,7 +165,7 @@ impl RawScene {
                 let chain = helix.generate().map_err(|m| issue(h.span(), m))?;
                 let (particles, bonds) = (chain.particles(), chain.scene_bonds());
                 let species = (0..=helix.tails)
-                    .map(|k| if k == 0 { "head" } else { "tail" }.to_string())
+                    .map(|k| Cow::Borrowed(if k == 0 { "head" } else { "tail" }))
                     .collect();
                 let spans = BodySpans::Helix(h.span());
                 (particles, bonds, Some(helix), spans, species)
@@ -175,6 +176,7 @@ impl RawScene {
                 check_output(&integrator, every, ps.get_ref().len(), limits.output)
                     .map_err(|m| issue(output_span.clone(), m))?;
                 let (particles, spans, species) = resolve_particles(ps)?;
+                let species = species.into_iter().map(Cow::Owned).collect();
                 let (bonds, bond_spans) =
                     resolve_bonds(self.bonds.as_ref(), &particles, &integrator)?;
                 let spans = BodySpans::Particles(spans, bond_spans);

@@ -71,6 +71,21 @@ pub struct Checkpoint {
     /// from one counts from the checkpoint on).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lanczos: Option<super::LanczosTally>,
+    /// The solve of step `step` itself. A run that ends there between frames closes
+    /// with a row after the checkpoint; a run resumed there writes that row again from
+    /// these (absent in checkpoints written before they were kept: such a checkpoint
+    /// is not resumed at the last step of its run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub last_step: Option<StepSolve>,
+}
+
+/// The constraint solve of one step, as its row in `observables.csv` records it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct StepSolve {
+    /// Constraint iterations.
+    pub iterations: u32,
+    /// The largest bond tension, `f64` bits.
+    pub max_tension: u64,
 }
 
 fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
@@ -124,6 +139,7 @@ impl Checkpoint {
             retries: super::retry::Retries::default(),
             landing: None,
             lanczos: None,
+            last_step: None,
         }
     }
 

@@ -31,7 +31,7 @@ pub mod stop;
 mod tail;
 
 pub use crate::scene::{Beads, BuildError, bonds, params};
-pub use checkpoint::{CHECKPOINT, Checkpoint, NoCheckpoint};
+pub use checkpoint::{CHECKPOINT, Checkpoint, NoCheckpoint, StepSolve};
 pub use columns::{ColumnsMismatch, check_columns};
 pub use engine::{Engine, Extra};
 pub use frames::{KeepFrames, MAX_FRAME_BEADS, MAX_FRAMES, step_at_or_after};
@@ -381,7 +381,9 @@ pub fn scene_name(path: &Path) -> String {
 
 /// Continues the run whose files are in `dir` from its checkpoint to simulated time
 /// `until`, under `limits`: the files are cut back to the checkpoint and continued, the
-/// summary and `scene.toml` rewritten (with the new duration). The scene to `until` is
+/// summary and `scene.toml` rewritten (with the new duration). `until` may be the
+/// checkpoint's own time: a run killed after its last checkpoint (taken on its last
+/// step) is finished there, its closing row written as the uninterrupted run wrote it. The scene to `until` is
 /// read under `limits` as `run` reads a scene file (storage, output size, step count).
 /// A folder without a checkpoint is refused with a [`NoCheckpoint`], and a run whose
 /// `observables.csv` has other columns than this program's (another version's) with a
@@ -402,8 +404,10 @@ pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Resul
     let mut scene = Scene::from_path_limited(&scene_path, unlimited)?;
     let at = checkpoint.time();
     let dt = scene.integrator.dt;
-    if !(until.is_finite() && until > at) {
-        bail!("--until {until} must be a time after the checkpoint's t = {at}");
+    // Compared in whole steps below (the checkpoint's time is a sum of steps, a few
+    // ulps off the multiple of dt that `until` names).
+    if !(until.is_finite() && until > 0.0) {
+        bail!("--until {until} must be a time at or after the checkpoint's t = {at}");
     }
     if checkpoint.precision != scene.integrator.precision {
         bail!(
@@ -418,8 +422,20 @@ pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Resul
     let origin = scene_path.display().to_string();
     let scene = Scene::parse_limited(&scene.to_toml(), &origin, limits)
         .with_context(|| format!("resuming to --until {until}"))?;
-    if scene.integrator.steps() as u64 <= checkpoint.step {
-        bail!("--until {until} is not a whole step (dt = {dt}) after the checkpoint's t = {at}");
+    let steps = scene.integrator.steps() as u64;
+    if steps < checkpoint.step {
+        bail!(
+            "--until {until} must be a time at or after the checkpoint's t = {at} (step {} of dt = {dt})",
+            checkpoint.step
+        );
+    }
+    // Ending at the checkpoint's step: its closing row is written from the solve the
+    // checkpoint records, which an older checkpoint lacks.
+    if steps == checkpoint.step && checkpoint.last_step.is_none() {
+        bail!(
+            "{}: this checkpoint (of an older host-demo) does not record its step's solve, which a run ending at t = {at} writes: resume to a later time, or run scene.toml again",
+            dir.join(CHECKPOINT).display()
+        );
     }
     let name = dir
         .file_name()

@@ -9,6 +9,8 @@
 //! 4. [`Tracks::close`]: the closing row, the summary, the files under their final names
 //!    with `summary.json` (and a resumed run's `scene.toml`; a run from the start writes
 //!    it before its first step, so that it can be resumed however it stops).
+//!
+//! Stage 4, the checkpoints and the stop on request are in [`end`].
 
 use std::path::Path;
 use std::time::Instant;
@@ -20,18 +22,13 @@ use hydrorattle::{Real, StepReport};
 use super::checkpoint::{Checkpoint, ready_folder};
 use super::engine::Engine;
 use super::frames::Keeper;
-use super::record::{
-    NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, TRAJECTORY_GSD, TRAJECTORY_XYZ,
-    WallGauge, each_row,
-};
-use super::stop::Interrupted;
+use super::record::{NEAR_VERTICAL_COS, OBSERVABLES_CSV, Observer, Recorder, WallGauge, each_row};
 use super::tail::TailSlope;
-use super::{
-    Beads, Front, Observables, RunOptions, RunResult, SCENE_TOML, SUMMARY_JSON, Summary, snapshot,
-};
-use crate::output::{write_atomic, write_json};
+use super::{Beads, Observables, RunOptions, RunResult, snapshot};
 use crate::progress::Progress;
-use crate::scene::{Level, Scene};
+use crate::scene::Scene;
+
+mod end;
 
 /// What a run records about where it came from.
 pub(super) struct Origin<'a> {
@@ -135,6 +132,9 @@ struct Tracks<'a, 's, T: Real> {
     /// The last frame's observables.
     last: Observables,
     total_iterations: u64,
+    /// The last step's constraint iterations and largest tension (what a closing row
+    /// records).
+    solve: (u32, T),
 }
 
 impl<'a, 's, T: Real> Tracks<'a, 's, T> {
@@ -196,6 +196,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             first: 1,
             last: Observables::default(),
             total_iterations: 0,
+            solve: (0, T::ZERO),
         };
         match from {
             Some(c) => {
@@ -209,6 +210,9 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
                 (tracks.first, tracks.last) = (c.step as usize + 1, c.last);
                 tracks.landing = c.landing.map(|t| T::from_f64(f64::from_bits(t)));
                 tracks.total_iterations = c.total_iterations;
+                if let Some(s) = c.last_step {
+                    tracks.solve = (s.iterations, T::from_f64(f64::from_bits(s.max_tension)));
+                }
             }
             None => {
                 tracks.last = tracks.frame(0, beads, T::ZERO, 0, T::ZERO)?;
@@ -314,6 +318,7 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
         let gravity = self.gravity;
         self.keeper.take(s, beads);
         self.total_iterations += u64::from(rep.iterations);
+        self.solve = (rep.iterations, rep.max_tension);
         if self.landing.is_none() && rep.wall_contacts > 0 {
             self.landing = Some(beads.time);
         }
@@ -337,138 +342,5 @@ impl<'a, 's, T: Real> Tracks<'a, 's, T> {
             self.last = self.frame(s, beads, tw, rep.iterations, rep.max_tension)?;
         }
         Ok(())
-    }
-
-    /// Writes `DIR/checkpoint.json` after step `s` (twist so far `tw`).
-    fn checkpoint(&mut self, s: usize, engine: &Engine<T>, tw: T, dir: &Path) -> Result<()> {
-        let marks = self.rec.marks()?;
-        let precision = self.scene.integrator.precision;
-        let trackers = (tw, self.front.times());
-        let its = self.total_iterations;
-        let beads = &engine.beads;
-        let mut c = Checkpoint::of(s as u64, precision, beads, trackers, its, marks, self.last);
-        if self.thermal() {
-            c.noise = Some(engine.noise.save());
-            c.retries = engine.retries;
-            c.lanczos = Some(engine.lanczos);
-        }
-        c.landing = self.landing.map(|t| t.to_f64().to_bits());
-        c.save(dir)
-    }
-
-    /// Ends a run stopped on request after step `done`: a checkpoint there, the files
-    /// left under their temporary names (what it marks), and [`Interrupted`].
-    fn interrupt(mut self, engine: &Engine<T>, done: usize, signal: usize) -> anyhow::Error {
-        let tw = self.twist.total;
-        let checkpoint = self.out.map(|dir| {
-            self.checkpoint(done, engine, tw, dir)
-                .map(|()| dir.join(super::CHECKPOINT))
-        });
-        let checkpoint = match checkpoint.transpose() {
-            Ok(c) => c,
-            Err(e) => return e.context("checkpointing a run stopped on request"),
-        };
-        if let Err(e) = self.rec.suspend() {
-            return e.context("keeping the files of a run stopped on request");
-        }
-        Interrupted {
-            signal,
-            step: done as u64,
-            time: engine.beads.time.to_f64(),
-            checkpoint,
-        }
-        .into()
-    }
-
-    /// Closes the run after step `done`: a final row when it stopped between frames,
-    /// the summary, the files renamed, and the record (`scene.toml`, `summary.json`).
-    fn close(
-        mut self,
-        engine: Engine<T>,
-        done: usize,
-        failure: Option<String>,
-        wall: f64,
-        name: &str,
-        origin: Origin,
-    ) -> Result<RunResult> {
-        let beads = &engine.beads;
-        if self.last.time != beads.time.to_f64() {
-            let total = self.twist.total;
-            self.last = self.frame(done, beads, total, 0, T::ZERO)?;
-        }
-        let outcome = match (&failure, self.tail.late_state()) {
-            (None, Some(s)) => s.name().to_string(),
-            _ => "failed".to_string(),
-        };
-        let order = self.front.order();
-        let front = Front {
-            cos_min: NEAR_VERTICAL_COS,
-            count: order.count,
-            correlation: order.correlation.to_f64(),
-            first_vertical: self
-                .front
-                .times()
-                .iter()
-                .map(|t| (*t >= T::ZERO).then(|| t.to_f64()))
-                .collect(),
-        };
-        let stepped = done + 1 - self.first;
-        let mut summary = Summary {
-            scene_path: origin.scene_path,
-            particles: beads.len(),
-            bonds: self.bonds.len(),
-            tolerance_used: engine.params.solver.tolerance.to_f64(),
-            steps: self.steps,
-            steps_done: done,
-            resumed_from: origin.checkpoint.map(Checkpoint::time),
-            wall_time_s: wall,
-            steps_per_second: stepped as f64 / wall.max(1e-12),
-            mean_iterations: self.total_iterations as f64 / (done.max(1) as f64),
-            final_observables: self.last,
-            twist_rate: self.tail.slope(),
-            outcome,
-            front,
-            failure,
-            retries: engine.retries,
-            noise_iterations: self
-                .thermal()
-                .then(|| engine.lanczos.record(&engine.params, beads.len())),
-            landing_time: self.landing.map(T::to_f64),
-            level_choice: origin.level_choice,
-            ..Summary::for_scene(self.scene, name)
-        };
-        summary.resolved_scene.model.level = Level::Manual;
-        self.rec.commit()?;
-        if let Some(dir) = self.out {
-            // A resumed run's duration is new; a run from the start wrote its scene
-            // before the first step.
-            if origin.checkpoint.is_some() {
-                let resolved = &summary.resolved_scene;
-                write_atomic(&dir.join(SCENE_TOML), resolved.to_toml().as_bytes())?;
-            }
-            // Read back after the rename: what a reader of the folder will find.
-            let data = [OBSERVABLES_CSV, TRAJECTORY_XYZ, TRAJECTORY_GSD];
-            summary.files = crate::output::check_files(dir, &data)?;
-            write_json(&dir.join(SUMMARY_JSON), &summary)?;
-        }
-        let (mut frames, mut at) = self.keeper.finish(done, beads);
-        let (mut initial, mut last) = (
-            self.initial,
-            snapshot::<T>(&beads.pos, &beads.radius, beads.time),
-        );
-        // The pictures draw the wall.
-        let wall = self.wall.map(|w| w.height.to_f64());
-        let kept = frames.iter_mut().chain(at.iter_mut().flatten());
-        for s in kept.chain([&mut initial, &mut last]) {
-            s.wall = wall;
-        }
-        Ok(RunResult {
-            summary,
-            initial,
-            last,
-            series: self.series,
-            frames,
-            at,
-        })
     }
 }

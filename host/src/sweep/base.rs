@@ -2,56 +2,72 @@
 //! the point's values set at their dotted paths, resolved by the scene parser, and an
 //! error placed at the sweep value that caused it (or else in the base scene).
 
+use std::borrow::Cow;
 use std::ops::Range;
 use std::path::Path;
 
+use serde::Deserialize;
 use toml::de::{DeTable, DeValue};
-use toml::{Table, Value};
+use toml::{Spanned, Table, Value};
 
 use super::file::{Source, at, describe, in_file_order};
 use crate::scene::{Scene, SceneError, line_col};
 use crate::sizing::Limits;
 
-/// Sets the value at a dotted path (numbers index arrays, as `particle.1.radius`);
-/// tables on the way are made when missing.
-pub(super) fn set_path(table: &mut Table, key: &str, value: Value) -> Result<(), String> {
+/// Sets the value at a dotted path of a parsed document (numbers index arrays, as
+/// `particle.1.radius`); tables on the way are made when missing.
+pub(super) fn set_path<'i>(
+    table: &mut DeTable<'i>,
+    key: &str,
+    value: DeValue<'i>,
+) -> Result<(), String> {
     let parts: Vec<&str> = key.split('.').collect();
     let (last, head) = parts.split_last().ok_or("an empty key")?;
-    let mut node: &mut Value = table
-        .entry(head.first().copied().unwrap_or(last).to_string())
-        .or_insert_with(|| Value::Table(Table::new()));
+    let first = head.first().copied().unwrap_or(last);
+    let mut node: &mut DeValue<'i> = child(table, first).get_mut();
     if head.is_empty() {
         *node = value;
         return Ok(());
     }
     for (k, p) in parts.iter().enumerate().skip(1) {
-        let so_far = parts[..k].join(".");
+        let so_far = || parts[..k].join(".");
         let next = match node {
-            Value::Table(t) => t
-                .entry(p.to_string())
-                .or_insert_with(|| Value::Table(Table::new())),
-            Value::Array(a) => {
+            DeValue::Table(t) => child(t, p),
+            DeValue::Array(a) => {
                 let n = a.len();
                 let i: usize = p.parse().map_err(|_| {
+                    let so_far = so_far();
                     format!("{so_far} is a list: index it with a number, as {so_far}.0")
                 })?;
                 a.get_mut(i).ok_or_else(|| {
                     format!(
-                        "{so_far} has {n} entries (indices 0 to {}), not {i}",
+                        "{} has {n} entries (indices 0 to {}), not {i}",
+                        so_far(),
                         n.max(1) - 1
                     )
                 })?
             }
             _ => {
                 return Err(format!(
-                    "{so_far} is a value, not a table: {key} cannot be set"
+                    "{} is a value, not a table: {key} cannot be set",
+                    so_far()
                 ));
             }
         };
-        node = next;
+        node = next.get_mut();
     }
     *node = value;
     Ok(())
+}
+
+/// The entry `key` of a table, an empty table put there when missing (looked up
+/// first: a point sets keys the base mostly has, and a key is allocated only to add it).
+fn child<'a, 'i>(t: &'a mut DeTable<'i>, key: &str) -> &'a mut Spanned<DeValue<'i>> {
+    if !t.contains_key(key) {
+        let table = Spanned::new(0..0, DeValue::Table(DeTable::new()));
+        t.insert(Spanned::new(0..0, Cow::Owned(key.to_string())), table);
+    }
+    t.get_mut(key).expect("the entry was just put there")
 }
 
 /// The base scene: its table, its text and origin (errors in it are placed there), and
@@ -109,34 +125,71 @@ impl<'a> Base<'a> {
             limits,
         };
         // The base on its own must be a scene: its errors are its own.
-        let scene = base.scene_with(src, &[], &[])?;
+        let scene = base.scene_with(src, &base.document()?, &[], &[], Vec::new)?;
         Ok((base, scene))
     }
 
-    /// The scene of a point: the base with `params` set, resolved; an error is placed
-    /// at the value of the sweep that caused it, or else in the base scene.
-    pub(super) fn scene_with(
+    /// The base scene parsed, without `[sweep]` (its spans are in the base's text):
+    /// parsed once, a copy per point.
+    pub(super) fn document(&self) -> Result<Spanned<DeTable<'_>>, SceneError> {
+        let mut doc = DeTable::parse(&self.text).map_err(|e| SceneError {
+            origin: self.origin.clone(),
+            location: e.span().map(|s| line_col(&self.text, s.start)),
+            message: e.message().trim_end().replace('\n', " "),
+            too_large: None,
+        })?;
+        doc.get_mut().remove("sweep");
+        Ok(doc)
+    }
+
+    /// The scene of a point: the base document `doc` with `params` set (`values`: each
+    /// parameter's value parsed), resolved; an error is placed at the value of the sweep
+    /// that caused it (`spans`: each value's place in the sweep file), or else in the
+    /// base scene.
+    pub(super) fn scene_with<'d>(
         &self,
         src: &Source<'_>,
+        doc: &Spanned<DeTable<'d>>,
         params: &[(String, Value)],
-        spans: &[(String, Range<usize>)],
+        values: &[&DeValue<'d>],
+        spans: impl FnOnce() -> Vec<(String, Range<usize>)>,
     ) -> Result<Scene, SceneError> {
-        let mut table = self.table.clone();
-        for (key, value) in params {
-            set_path(&mut table, key, value.clone()).map_err(|m| SceneError {
-                origin: src.origin.to_string(),
-                location: None,
-                message: m,
-                too_large: None,
-            })?;
+        let point = || {
+            let mut point = doc.clone();
+            for ((key, _), value) in params.iter().zip(values) {
+                set_path(point.get_mut(), key, (*value).clone()).map_err(|m| SceneError {
+                    origin: src.origin.to_string(),
+                    location: None,
+                    message: m,
+                    too_large: None,
+                })?;
+            }
+            Ok::<_, SceneError>(point)
+        };
+        if let Some((mut scene, method_at)) = Scene::from_document(point()?, self.limits) {
+            // The line of the box's method in the base, unless the point sets it.
+            let swept = params
+                .iter()
+                .any(|(k, _)| k == "box" || k.starts_with("box."));
+            if let Some(b) = scene.periodic.as_mut() {
+                b.method_line = method_at
+                    .filter(|_| !swept)
+                    .map(|at| line_col(&self.text, at).0);
+            }
+            return Ok(scene);
         }
-        let text = toml::to_string(&table).map_err(|e| SceneError {
+        // Refused: the point's scene written as text and parsed, to place the error.
+        let unwritable = |e: String| SceneError {
             origin: src.origin.to_string(),
             location: None,
             message: format!("the point's scene cannot be written: {e}"),
             too_large: None,
-        })?;
+        };
+        let table = Table::deserialize(toml::de::Deserializer::from(point()?))
+            .map_err(|e| unwritable(e.to_string()))?;
+        let text = toml::to_string(&table).map_err(|e| unwritable(e.to_string()))?;
         Scene::parse_limited(&text, &self.origin, self.limits).map_err(|e| {
+            let spans = spans();
             let path = e.line().map(|l| path_at_line(&text, l)).unwrap_or_default();
             // The swept key the error is about: the same path, or the nearest one.
             let culprit = spans

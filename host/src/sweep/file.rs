@@ -8,7 +8,8 @@ use toml::de::{DeTable, DeValue};
 use toml::{Spanned, Table, Value};
 
 use super::base::{Base, set_path};
-use super::{MAX_POINTS, SEED_KEY, Sweep, expand, hints, record};
+use super::expand::Plan;
+use super::{MAX_POINTS, SEED_KEY, Sweep, hints};
 use crate::scene::{SceneError, line_col};
 use crate::sizing::Limits;
 
@@ -95,6 +96,19 @@ pub(super) fn in_file_order<'a, 'i>(
 
 /// Reads and expands a sweep file (see the module documentation of [`super`]).
 pub(super) fn parse(src: &Source<'_>, limits: Limits) -> Result<Sweep, SceneError> {
+    let mut plan = plan(src, limits)?;
+    let points = plan.resolve_all(src)?;
+    Ok(Sweep {
+        keys: plan.keys,
+        replicas: plan.replicas.0,
+        points,
+        digest: plan.digest,
+    })
+}
+
+/// Reads a sweep file and plans its points: every point's parameters and id, no scene
+/// resolved but the base's.
+pub(super) fn plan<'a>(src: &Source<'a>, limits: Limits) -> Result<Plan<'a>, SceneError> {
     let doc = DeTable::parse(src.text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
         src.err(span, e.message().trim_end().replace('\n', " "))
@@ -190,24 +204,21 @@ pub(super) fn parse(src: &Source<'_>, limits: Limits) -> Result<Sweep, SceneErro
                 "brownian.seed is set by replicas (seed, seed + 1, ...): vary it or give replicas, not both",
             ));
     }
+    let doc = base.document()?;
     for f in &factors {
         for (key, span) in &f.keys {
-            set_path(&mut base.table.clone(), key, Value::Boolean(false))
+            set_path(&mut doc.get_ref().clone(), key, DeValue::Boolean(false))
                 .map_err(|m| src.err(span.clone(), m))?;
         }
     }
-    let points = expand::points(src, &factors, &base, count, (replicas, replicas_span))?;
-    let keys: Vec<String> = points
-        .first()
-        .map(|p| p.params.iter().map(|(k, _)| k.clone()).collect())
-        .unwrap_or_default();
-    let digest = record::digest(&base_scene, &keys, replicas, &points);
-    Ok(Sweep {
-        keys,
-        replicas,
-        points,
-        digest,
-    })
+    drop(doc);
+    Plan::new(
+        src,
+        factors,
+        (base, base_scene),
+        count,
+        (replicas, replicas_span),
+    )
 }
 
 /// The number of points, refused past [`MAX_POINTS`] before anything is expanded (at

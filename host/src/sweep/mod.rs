@@ -28,7 +28,10 @@
 //!   points. An unknown key, an empty list, a value the scene refuses, a
 //!   point given twice (numbers compared as numbers), a base that is itself a sweep, a
 //!   misspelled table or setting, or more than [`MAX_POINTS`] points is an error at its
-//!   file, line and column (`sweep.toml:4:21: ...`), as for scenes.
+//!   file, line and column (`sweep.toml:4:21: ...`), as for scenes. (One point run
+//!   from the sweep file in a folder that already holds the sweep, whose points were
+//!   all checked when it claimed the folder, is the only one resolved:
+//!   [`Sweep::point_from_path`], [`run::run_point_of_file`].)
 //!
 //! # Points
 //!
@@ -60,6 +63,7 @@ pub mod frozen;
 mod hints;
 pub mod id;
 pub mod record;
+mod report;
 pub mod run;
 mod state;
 
@@ -74,7 +78,7 @@ use crate::sizing::Limits;
 pub use claim::AnotherSweep;
 pub use emit::{Engine, SlurmOptions, emit};
 pub use file::linspace;
-pub use run::{RunReport, Selection, run_frozen, run_points, run_sweep};
+pub use run::{RunReport, Selection, run_frozen, run_point_of_file, run_points, run_sweep};
 
 /// Most points a sweep may have (replicas counted).
 pub const MAX_POINTS: usize = 100_000;
@@ -118,17 +122,48 @@ pub struct Sweep {
     pub digest: String,
 }
 
+/// One point of a sweep file, found and resolved alone ([`Sweep::point_from_path`]).
+#[derive(Debug, Clone)]
+pub struct Found {
+    /// The point, its scene resolved.
+    pub point: Point,
+    /// The sweep's digest ([`record::digest`]).
+    pub digest: String,
+    /// The sweep's number of points.
+    pub count: usize,
+}
+
+/// The text of a sweep file, and its name and folder.
+fn read(path: &Path) -> Result<(String, String, &Path), SceneError> {
+    let origin = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        origin: origin.clone(),
+        location: None,
+        message: format!("cannot read sweep file: {e}"),
+        too_large: None,
+    })?;
+    Ok((text, origin, path.parent().unwrap_or(Path::new("."))))
+}
+
+/// `then` of a sweep file's plan (every point's id, no scene but the base's resolved).
+fn planned<R>(
+    path: &Path,
+    then: impl FnOnce(&file::Source<'_>, expand::Plan<'_>) -> Result<R, SceneError>,
+) -> Result<R, SceneError> {
+    let (text, origin, dir) = read(path)?;
+    let src = file::Source {
+        text: &text,
+        origin: &origin,
+        dir,
+    };
+    let plan = file::plan(&src, Limits::default())?;
+    then(&src, plan)
+}
+
 impl Sweep {
     /// Reads, expands and validates a sweep file.
     pub fn from_path(path: &Path) -> Result<Sweep, SceneError> {
-        let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
-            origin: origin.clone(),
-            location: None,
-            message: format!("cannot read sweep file: {e}"),
-            too_large: None,
-        })?;
-        let dir = path.parent().unwrap_or(Path::new("."));
+        let (text, origin, dir) = read(path)?;
         Sweep::parse(&text, &origin, dir)
     }
 
@@ -137,6 +172,36 @@ impl Sweep {
     pub fn parse(text: &str, origin: &str, dir: &Path) -> Result<Sweep, SceneError> {
         let src = file::Source { text, origin, dir };
         file::parse(&src, Limits::default())
+    }
+
+    /// Reads, expands and validates a sweep file as [`from_path`](Self::from_path)
+    /// does, but lets each point's scene go once it is checked: the ids and state
+    /// points (canonical JSON, [`id::canonical_json`]) of the points, in sweep order,
+    /// in the memory of a few scenes (what `--dry-run` lists).
+    pub fn check_path(path: &Path) -> Result<Vec<(String, String)>, SceneError> {
+        planned(path, |src, plan| {
+            plan.check_all(src)?;
+            let drafts = plan.drafts.into_iter();
+            Ok(drafts.map(|d| (d.id, d.canonical)).collect())
+        })
+    }
+
+    /// The point of a sweep file with this id (or a unique prefix of it, at least 4
+    /// characters), resolved alone: every point's parameters and id are computed (an
+    /// MD5 each), no other scene is resolved; None when no point has the id. The
+    /// sweep's digest says whether a folder already holds this sweep (whose points were
+    /// all checked when it claimed the folder).
+    pub fn point_from_path(path: &Path, id: &str) -> Result<Option<Found>, SceneError> {
+        planned(path, |src, plan| {
+            let Some(k) = plan.find(id) else {
+                return Ok(None);
+            };
+            Ok(Some(Found {
+                point: plan.resolve_one(src, k)?,
+                count: plan.drafts.len(),
+                digest: plan.digest,
+            }))
+        })
     }
 
     /// The point with this id (or a unique prefix of it, at least 4 characters).

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use serde_json::Value as Json;
 
-use super::{Point, SWEEP_JSON, Sweep};
+use super::{SWEEP_JSON, Sweep};
 use crate::output::fnv1a64;
 use crate::scene::Scene;
 
@@ -56,13 +56,19 @@ pub struct PointRecord {
 }
 
 /// The sweep's digest: FNV-1a 64 of its resolved base scene, keys, replica count and
-/// point ids in order. With the ids (MD5s of the parameters) it covers every point's
-/// whole resolved scene, and it costs one pass over the ids, not a scene per point.
-pub fn digest(base: &Scene, keys: &[String], replicas: usize, points: &[Point]) -> String {
+/// point ids (`ids`) in order. With the ids (MD5s of the parameters) it covers every
+/// point's whole resolved scene, and it costs one pass over the ids, not a scene per
+/// point.
+pub fn digest<'a>(
+    base: &Scene,
+    keys: &[String],
+    replicas: usize,
+    ids: impl IntoIterator<Item = &'a str>,
+) -> String {
     let mut text = serde_json::to_vec(base).unwrap_or_default();
     text.extend_from_slice(format!("\n{keys:?}\n{replicas}\n").as_bytes());
-    for p in points {
-        text.extend_from_slice(p.id.as_bytes());
+    for id in ids {
+        text.extend_from_slice(id.as_bytes());
         text.push(b'\n');
     }
     fnv1a64(&text)
@@ -101,6 +107,25 @@ impl Sweep {
 }
 
 impl SweepRecord {
+    /// The digest of the sweep recorded in `dir` (None when there is no record, or a
+    /// record without one), read without the points (`sweep.json` of 10^5 points is
+    /// 40 MB: its points parsed cost more than finding one point of the sweep file).
+    pub fn read_digest(dir: &Path) -> Result<Option<String>> {
+        #[derive(Deserialize)]
+        struct Digest {
+            #[serde(default)]
+            digest: Option<String>,
+        }
+        let path = dir.join(SWEEP_JSON);
+        let bytes = match std::fs::read(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            b => b.with_context(|| format!("reading {}", path.display()))?,
+        };
+        let d: Digest = serde_json::from_slice(&bytes)
+            .with_context(|| format!("{}: not a sweep record", path.display()))?;
+        Ok(d.digest)
+    }
+
     /// The record in `dir`, or None when there is none.
     pub fn read(dir: &Path) -> Result<Option<SweepRecord>> {
         let path = dir.join(SWEEP_JSON);

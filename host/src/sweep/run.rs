@@ -19,12 +19,12 @@ use std::sync::Mutex;
 use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 
-use super::file::describe;
+pub use super::report::{Outcome, RunReport};
 use super::state::{RUN_FILES, State, state};
 use super::{POINTS, Point, STATEPOINT_JSON, Sweep, claim, frozen, id::canonical_json};
 use crate::output::{FolderLock, tmp_path};
 use crate::scene::{Level, Scene};
-use crate::sim::{Interrupted, SCENE_TOML, Start, Stop, Summary};
+use crate::sim::{Interrupted, SCENE_TOML, Start, Stop};
 
 /// A failed start, written in the point's folder (removed when the point runs again).
 pub const ERROR_TXT: &str = "error.txt";
@@ -84,76 +84,6 @@ pub struct Options {
     pub wait: bool,
     /// Stop on request: running points checkpoint, no other starts.
     pub stop: Stop,
-}
-
-/// What happened to one point.
-#[derive(Debug, Clone)]
-pub enum Outcome {
-    /// Already finished: not run.
-    Skipped,
-    /// Another process holds the point's lock (it is running it): not run.
-    Locked,
-    /// Run, from the start or from its checkpoint (`resumed_from`).
-    Ran(Box<Summary>),
-    /// Could not be run (the message is also in the folder's `error.txt`, unless the
-    /// folder is another sweep's).
-    Failed(String),
-    /// Stopped on request (by this signal) and checkpointed.
-    Interrupted(usize),
-    /// Not started: a stop was requested before its turn.
-    NotStarted,
-}
-
-/// What a process did.
-#[derive(Debug, Clone, Default)]
-pub struct RunReport {
-    /// Points selected.
-    pub selected: usize,
-    /// Already finished.
-    pub skipped: usize,
-    /// Skipped: another process was running them.
-    pub locked: usize,
-    /// Run from the start.
-    pub ran: usize,
-    /// Continued from a checkpoint.
-    pub resumed: usize,
-    /// Runs that stopped early (a step failed): finished, with their failure recorded.
-    pub stopped_early: Vec<String>,
-    /// Points that could not be run, with why.
-    pub failed: Vec<(String, String)>,
-    /// Points stopped on request and checkpointed (they resume when run again).
-    pub interrupted: usize,
-    /// Points not started because a stop was requested.
-    pub not_started: usize,
-    /// The signal that asked this process to stop, if one did.
-    pub signal: Option<usize>,
-}
-
-impl std::fmt::Display for RunReport {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "ran {} of {} points ({} from the start, {} resumed from their checkpoints), {} already finished, {} stopped early, {} failed",
-            self.ran + self.resumed,
-            self.selected,
-            self.ran,
-            self.resumed,
-            self.skipped,
-            self.stopped_early.len(),
-            self.failed.len()
-        )?;
-        if self.locked > 0 {
-            write!(f, ", {} skipped: locked by another process", self.locked)?;
-        }
-        if let Some(sig) = self.signal {
-            write!(
-                f,
-                "; stopped by signal {sig}: {} checkpointed, {} not started (run again to go on)",
-                self.interrupted, self.not_started
-            )?;
-        }
-        Ok(())
-    }
 }
 
 /// The folder of point `id` under the sweep folder `dir`.
@@ -316,6 +246,22 @@ pub fn run_points(
     run_selected(&points, dir, opts, Vec::new())
 }
 
+/// Runs point `id` (or a unique prefix of it) of the sweep file `file` in `dir`. When
+/// `dir` holds this sweep already (its `sweep.json` has the sweep's digest: every point
+/// was checked when the sweep claimed the folder), only that point's scene is resolved
+/// ([`Sweep::point_from_path`]: the cost of the ids, an MD5 a point); otherwise the
+/// sweep is expanded whole and claims the folder first ([`run_points`]).
+pub fn run_point_of_file(file: &Path, dir: &Path, id: &str, opts: Options) -> Result<RunReport> {
+    let Some(found) = Sweep::point_from_path(file, id)? else {
+        bail!("the sweep has no point {id:?} (see sweep.json)");
+    };
+    if super::record::SweepRecord::read_digest(dir)?.as_ref() == Some(&found.digest) {
+        return run_selected(&[&found.point], dir, opts, Vec::new());
+    }
+    let sweep = Sweep::from_path(file)?;
+    run_points(&sweep, dir, &Selection::Point(id.to_string()), opts)
+}
+
 /// Runs the `selection` of the sweep frozen in `dir` ([`frozen::load`]): neither the
 /// sweep file nor its base scenes are read. A point whose frozen scene was changed is
 /// refused (counted failed) and the others run.
@@ -350,44 +296,7 @@ fn run_selected(
                 None => run_point(p, dir, opts),
             };
             let mut r = report.lock().unwrap_or_else(|e| e.into_inner());
-            let what = describe(&p.params);
-            match outcome {
-                Outcome::Skipped => r.skipped += 1,
-                Outcome::Locked => {
-                    r.locked += 1;
-                    println!("{} {what}: skipped: locked by another process", p.id);
-                }
-                Outcome::Ran(s) => {
-                    let how = match s.resumed_from {
-                        Some(t) => {
-                            r.resumed += 1;
-                            format!("resumed from t = {t}")
-                        }
-                        None => {
-                            r.ran += 1;
-                            "ran".to_string()
-                        }
-                    };
-                    if let Some(f) = &s.failure {
-                        r.stopped_early.push(p.id.clone());
-                        println!("{} {what}: {how}, stopped early: {f}", p.id);
-                    } else {
-                        println!(
-                            "{} {what}: {how}, {} steps at {:.0} steps/s, outcome {}",
-                            p.id, s.steps_done, s.steps_per_second, s.outcome
-                        );
-                    }
-                }
-                Outcome::Failed(why) => {
-                    println!("{} {what}: FAILED: {why}", p.id);
-                    r.failed.push((p.id.clone(), why));
-                }
-                Outcome::Interrupted(sig) => {
-                    r.interrupted += 1;
-                    println!("{} {what}: stopped by signal {sig}, checkpointed", p.id);
-                }
-                Outcome::NotStarted => r.not_started += 1,
-            }
+            r.tally(p, outcome);
         });
     });
     let mut report = report.into_inner().unwrap_or_else(|e| e.into_inner());

@@ -7,8 +7,9 @@
 //! * *Finished*: the point's `scene.toml` and a `summary.json` whose data files are
 //!   those it records (size and digest).
 //! * *Resumable*: the point's `scene.toml`, a readable `checkpoint.json` before the last
-//!   step, and each data file (its `.tmp` or final name) holding at least the bytes
-//!   the checkpoint marks.
+//!   step or at it (one that records its step's solve, for the closing row), and each
+//!   data file (its `.tmp` or final name) holding at least the bytes the checkpoint
+//!   marks.
 //! * *New*: anything else (no `scene.toml`, no usable checkpoint, a data file short
 //!   or missing): the run files are removed and the point runs from the start.
 
@@ -74,7 +75,13 @@ fn finished(pdir: &Path) -> bool {
 
 /// A checkpoint of this scene before its last step, whose files hold what it marks.
 fn resumable(pdir: &Path, c: &Checkpoint, scene: &Scene) -> bool {
-    if c.precision != scene.integrator.precision || c.step >= scene.integrator.steps() as u64 {
+    // At the last step: resumed to write the closing row, from the step's solve that
+    // the checkpoint records (an older one does not: run again).
+    let steps = scene.integrator.steps() as u64;
+    if c.precision != scene.integrator.precision
+        || c.step > steps
+        || (c.step == steps && c.last_step.is_none())
+    {
         return false;
     }
     let gsd = crate::output::gsd::data_end(&scene.topology(), c.marks.frames);

@@ -137,3 +137,186 @@ fn errors_name_the_line_of_the_value_at_fault() {
     let e = parse(include_str!("../../../host-demo/scenes/dimer.toml")).unwrap_err();
     assert!(e.to_string().contains("no [sweep] table"), "{e}");
 }
+
+/// Sets `value` at a dotted path of a TOML table (numbers index lists), making tables on
+/// the way: how a point's scene was written before it was resolved from the parsed
+/// base, kept here as the reference.
+fn set_in_table(table: &mut toml::Table, key: &str, value: toml::Value) {
+    let parts: Vec<&str> = key.split('.').collect();
+    let mut node = table
+        .entry(parts[0].to_string())
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    for p in &parts[1..] {
+        node = match node {
+            toml::Value::Array(a) => &mut a[p.parse::<usize>().unwrap()],
+            toml::Value::Table(t) => t
+                .entry(p.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new())),
+            other => panic!("{key}: {other} is not a table"),
+        };
+    }
+    *node = value;
+}
+
+#[test]
+fn each_point_is_the_scene_its_text_would_give() {
+    // The base's parsed document with each point's values set, resolved, against the
+    // scene of the text written from the base's table with the values set.
+    let scenes = [
+        (
+            "dimer",
+            include_str!("../../../host-demo/scenes/dimer.toml"),
+        ),
+        (
+            "figure1a",
+            include_str!("../../../host-demo/scenes/figure1a.toml"),
+        ),
+        (
+            "chain",
+            include_str!("../../../host-demo/scenes/periodic_chain.toml"),
+        ),
+        (
+            "brownian",
+            include_str!("../../../host-demo/scenes/brownian_chain.toml"),
+        ),
+    ];
+    let sweeps = [
+        (
+            "dimer",
+            "\"integrator.dt\" = [0.01, 0.02]\n\"particle.1.radius\" = [1, 1.1]\n\"fluid.density\" = [0, 0.5]\n",
+        ),
+        (
+            "figure1a",
+            "\"helix.dhat\" = { linspace = [1.05, 2.0, 3] }\n[[sweep.zip]]\n\"helix.head_end\" = [\"top\", \"bottom\"]\n\"model.hydrodynamics\" = [\"oseen\", \"free-draining\"]\n",
+        ),
+        (
+            "chain",
+            "\"box.size\" = [[16.0, 16.0, 24.0], [20, 20, 20]]\n\"box.method\" = [\"ewald\", \"auto\"]\n",
+        ),
+        (
+            "brownian",
+            "replicas = 3\n\"brownian.temperature\" = [0.5, 2]\n\"brownian.drift\" = [\"midpoint\", \"uncorrected\"]\n",
+        ),
+    ];
+    for (name, sweep) in sweeps {
+        let base = scenes.iter().find(|s| s.0 == name).unwrap().1;
+        let s = parse(&format!("{base}\n[sweep]\n{sweep}")).unwrap();
+        assert!(s.points.len() >= 4, "{name}");
+        let table: toml::Table = toml::from_str(base).unwrap();
+        for p in &s.points {
+            let mut t = table.clone();
+            for (k, v) in &p.params {
+                set_in_table(&mut t, k, v.clone());
+            }
+            let want = Scene::parse(&toml::to_string(&t).unwrap(), name).unwrap();
+            assert_eq!(p.scene, want, "{name}: {}", p.id);
+            let json = |s: &Scene| serde_json::to_string(s).unwrap();
+            assert_eq!(json(&p.scene), json(&want), "{name}: {}", p.id);
+        }
+    }
+}
+
+#[test]
+fn one_point_found_alone_is_the_point_of_the_whole_sweep() {
+    let dir = std::env::temp_dir().join(format!("sweep-one-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("s.toml");
+    let text = format!(
+        "{}\n[brownian]\ntemperature = 0.5\n\n[sweep]\nreplicas = 2\n\"integrator.dt\" = [0.01, 0.02, 0.04]\n\"particle.1.radius\" = [1, 0.5]\n",
+        include_str!("../../../host-demo/scenes/dimer.toml")
+    );
+    std::fs::write(&file, text).unwrap();
+    let all = Sweep::from_path(&file).unwrap();
+    for p in &all.points {
+        for id in [p.id.as_str(), &p.id[..8]] {
+            let found = Sweep::point_from_path(&file, id).unwrap().unwrap();
+            assert_eq!(found.digest, all.digest);
+            assert_eq!(found.count, all.points.len());
+            let q = found.point;
+            assert_eq!((q.index, &q.id, &q.params), (p.index, &p.id, &p.params));
+            assert_eq!((q.replica, &q.statepoint), (p.replica, &p.statepoint));
+            assert_eq!(q.scene, p.scene);
+        }
+    }
+    assert!(
+        Sweep::point_from_path(&file, "0123456789abcdef")
+            .unwrap()
+            .is_none()
+    );
+    let listed = Sweep::check_path(&file).unwrap();
+    let ids: Vec<&str> = listed.iter().map(|(id, _)| id.as_str()).collect();
+    let want: Vec<&str> = all.points.iter().map(|p| p.id.as_str()).collect();
+    assert_eq!(ids, want);
+    for ((_, json), p) in listed.iter().zip(&all.points) {
+        assert_eq!(*json, super::id::canonical_json(&p.statepoint));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Equal as numbers (integers and floats alike), element by element.
+fn same(a: &toml::Value, b: &toml::Value) -> bool {
+    let num = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+    match (num(a), num(b)) {
+        (Some(x), Some(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+#[test]
+fn the_first_repeated_point_is_named_as_a_search_of_all_points_names_it() {
+    // Lists with repeats in several factors (and a zip group): the error names the
+    // first point, in sweep order, equal to an earlier one, and that earlier one, as a
+    // comparison of every pair of points finds them.
+    let cases: [&[&[&str]]; 5] = [
+        &[&["1", "2", "1.0"], &["3", "3.0", "4"]],
+        &[&["1", "2", "3"], &["4", "5", "4.0"]],
+        &[&["1", "2"], &["7", "8", "9"], &["4", "5", "5"]],
+        &[&["2", "1", "2.0", "1"], &["7", "8"]],
+        &[&["1", "2"], &["3", "4"]],
+    ];
+    for lists in cases {
+        let keys = ["fluid.viscosity", "fluid.density", "integrator.tolerance"];
+        let body: String = lists
+            .iter()
+            .zip(keys)
+            .map(|(l, k)| format!("\"{k}\" = [{}]\n", l.join(", ")))
+            .collect();
+        let value =
+            |v: &str| toml::from_str::<toml::Table>(&format!("v = {v}")).unwrap()["v"].clone();
+        let values: Vec<Vec<toml::Value>> = lists
+            .iter()
+            .map(|l| l.iter().map(|v| value(v)).collect())
+            .collect();
+        // Every point in sweep order (the last list fastest).
+        let mut points: Vec<Vec<&toml::Value>> = vec![vec![]];
+        for l in &values {
+            points = points
+                .into_iter()
+                .flat_map(|p| l.iter().map(move |v| [p.clone(), vec![v]].concat()))
+                .collect();
+        }
+        let first = (0..points.len()).find_map(|k| {
+            (0..k)
+                .find(|&j| points[j].iter().zip(&points[k]).all(|(a, b)| same(a, b)))
+                .map(|j| (k, j))
+        });
+        let text = dimer_with(&body);
+        match first {
+            None => assert!(parse(&text).is_ok(), "{lists:?}"),
+            Some((later, earlier)) => {
+                let e = parse(&text).unwrap_err().to_string();
+                assert!(
+                    e.contains(&format!("it is point {earlier} already")),
+                    "{lists:?}: {e}"
+                );
+                let said: Vec<String> = keys
+                    .iter()
+                    .zip(&points[later])
+                    .map(|(k, v)| format!("{k} = {v}"))
+                    .collect();
+                let said = format!("the point ({}) is given twice", said.join(", "));
+                assert!(e.contains(&said), "{lists:?}: {e} (want {said})");
+            }
+        }
+    }
+}
