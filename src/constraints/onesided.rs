@@ -97,7 +97,17 @@ pub(super) fn update<T: Real>(
             continue;
         }
         let (value, _, _) = problem.eval(&bonds[k], k, x);
-        let slack = mult[k] * diagonal(metric, bonds, c, k) - value;
+        // A matrix-free metric that forms no blocks (the spectral Ewald sum, PSE) has
+        // no diagonal to read (zero): the test is then the multiplier's sign alone (the
+        // limit of a large scale). With the zero diagonal read as is, the test was
+        // `sigma_k >= 0`, which a pushing row that the chord left open by its
+        // residual (1e-8) meets: the suspension released and re-took loaded contacts
+        // until they were held (13 contacts: 75 products instead of 5).
+        let a = diagonal(metric, bonds, c, k);
+        let slack = match a > T::ZERO && a.is_finite() {
+            true => mult[k] * a - value,
+            false => mult[k],
+        };
         if !(slack > T::ZERO) && worst.is_none_or(|(_, w)| slack < w) {
             worst = Some((k, slack));
         }
