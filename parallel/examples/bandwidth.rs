@@ -20,6 +20,8 @@
 
 use std::time::Instant;
 
+mod common;
+
 use hydrorattle::glam::DVec3;
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{self, Parallel, Serial, band_scratch};
@@ -76,13 +78,7 @@ fn stream(pool: &rayon::ThreadPool, a: &mut [f64], b: &[f64], c: &[f64]) -> (f64
 
 /// Seconds per product of each path (stored, compact, recompute) at `n` beads on `par`.
 fn paths(n: usize, par: &dyn Parallel) -> [f64; 3] {
-    let phi = 2.0 * ((9.0f64 - 6.25).sqrt() / 6.0).asin();
-    let pos: Vec<DVec3> = (0..n)
-        .map(|k| {
-            let a = phi * k as f64;
-            DVec3::new(3.0 * a.cos(), 3.0 * a.sin(), 2.5 * k as f64)
-        })
-        .collect();
+    let pos = common::helix(n);
     let radius = vec![1.0; n];
     let x: Vec<DVec3> = (0..n)
         .map(|i| DVec3::new((i as f64).sin(), 0.5, 1.0))

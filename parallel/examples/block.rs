@@ -27,16 +27,8 @@ use hydrorattle_parallel::{Threads, wide};
 /// The three paths and their bytes per pair (0: nothing read).
 const PATHS: [(&str, f64); 3] = [("stored", 72.0), ("compact", 24.0), ("recompute", 0.0)];
 
-/// Nanoseconds the process's threads have run on a CPU (0 where `/proc` is absent).
-fn cpu_ns() -> u64 {
-    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
-        return 0;
-    };
-    tasks
-        .filter_map(|t| std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok())
-        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
-        .sum()
-}
+mod common;
+use common::cpu_ns;
 
 struct Data {
     n: usize,
@@ -87,14 +79,7 @@ fn main() {
     };
     let (n, threads, rounds) = (arg(1, 4096), arg(2, 2), arg(3, 3));
     let only = std::env::args().nth(4).unwrap_or_default();
-    // Radius-1 beads on a helix (radius 3, rise 2.5 per bead).
-    let phi = 2.0 * ((9.0f64 - 6.25).sqrt() / 6.0).asin();
-    let pos: Vec<DVec3> = (0..n)
-        .map(|k| {
-            let a = phi * k as f64;
-            DVec3::new(3.0 * a.cos(), 3.0 * a.sin(), 2.5 * k as f64)
-        })
-        .collect();
+    let pos = common::helix(n);
     let radius = vec![1.0; n];
     let xs: Vec<Vec<DVec3>> = (0..4)
         .map(|q| {

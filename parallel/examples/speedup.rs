@@ -13,51 +13,22 @@
 
 use std::time::Instant;
 
+mod common;
+
 use hydrorattle::glam::DVec3;
-use hydrorattle::{
-    Bond, Brownian, Layout, NoForce, Noise, Parallel, Params, Serial, State, StepReport,
-    step_slices,
-};
+use hydrorattle::{Layout, NoForce, Noise, Parallel, Serial, State, StepReport, step_slices};
 use hydrorattle_heap::Buffers;
 use hydrorattle_parallel::Threads;
 
 fn main() {
-    let arg = |k: usize, d: usize| {
-        std::env::args()
-            .nth(k)
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(d)
-    };
+    let arg = common::arg;
     let (n, steps, threads) = (arg(1, 2048), arg(2, 5), arg(3, 2));
     let mode = std::env::args().nth(4).unwrap_or_else(|| "plain".into());
-    // Radius-1 beads on a helix (radius 3, rise 2.5 per bead), bonds of length 3.
-    let phi = 2.0 * ((9.0f64 - 6.25).sqrt() / 6.0).asin();
-    let start: Vec<DVec3> = (0..n)
-        .map(|k| {
-            let a = phi * k as f64;
-            DVec3::new(3.0 * a.cos(), 3.0 * a.sin(), 2.5 * k as f64)
-        })
-        .collect();
-    let bonds: Vec<Bond<f64>> = (1..n)
-        .map(|i| Bond {
-            i: i - 1,
-            j: i,
-            length: (start[i] - start[i - 1]).length(),
-        })
-        .collect();
+    let start = common::helix(n);
+    let bonds = common::chain(&start);
     let radius = vec![1.0; n];
     let density = vec![4.5; n];
-    let mut p = Params::<f64>::new(0.01);
-    match mode.as_str() {
-        "plain" => {}
-        "compact" => p.compact_products = true,
-        "free" => p.matrix_free = true,
-        "brownian" => p.brownian = Some(Brownian::new(1.0)),
-        other => {
-            eprintln!("unknown mode {other:?}: plain, compact, free or brownian");
-            std::process::exit(2);
-        }
-    }
+    let p = common::params(&mode);
     let mut store = Buffers::<f64>::new(Layout::for_params(&p, n, n - 1));
     let run = |par: &dyn Parallel, store: &mut Buffers<f64>| {
         let mut ws = store.workspace().with_parallel(par);

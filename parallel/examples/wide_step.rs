@@ -13,6 +13,8 @@
 
 use std::time::Instant;
 
+mod common;
+
 use hydrorattle::glam::DVec3;
 use hydrorattle::{Bond, Layout, NoForce, Params, State, step_slices};
 use hydrorattle_heap::Buffers;
@@ -62,20 +64,8 @@ fn main() {
             .unwrap_or(d)
     };
     let (n, steps, rounds) = (arg(1, 25), arg(2, 2000), arg(3, 5));
-    let phi = 2.0 * ((9.0f64 - 6.25).sqrt() / 6.0).asin();
-    let start: Vec<DVec3> = (0..n)
-        .map(|k| {
-            let a = phi * k as f64;
-            DVec3::new(3.0 * a.cos(), 3.0 * a.sin(), 2.5 * k as f64)
-        })
-        .collect();
-    let bonds: Vec<Bond<f64>> = (1..n)
-        .map(|i| Bond {
-            i: i - 1,
-            j: i,
-            length: (start[i] - start[i - 1]).length(),
-        })
-        .collect();
+    let start = common::helix(n);
+    let bonds = common::chain(&start);
     let p = Params::<f64>::new(0.01);
     let avx2 = hydrorattle_parallel::wide::avx2();
     let (mut best, mut same) = ([f64::INFINITY; 2], true);

@@ -435,7 +435,10 @@ impl<T: Real> Metric<'_, T> {
                 // Nested pairs were refused by the product at these positions.
                 #[cfg(feature = "periodic")]
                 if let Some(sums) = ewald {
-                    if sums.product(eta, pos, radius, f, out).is_err() {
+                    if sums
+                        .product(eta, pos, radius, f, out, (par, bands))
+                        .is_err()
+                    {
                         out.fill(T::V3_ZERO);
                     }
                     return;

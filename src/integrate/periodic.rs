@@ -7,8 +7,9 @@
 //! ([`super::stages::Sums`]): they depend on the box and the radii only, which a step
 //! does not change. Not held in the parameters: the largest radius is the state's (a
 //! radius above a stored one would be refused) and `Params` stays small and `Copy`.
-//! The assembly is serial (the banded assembly of [`crate::parallel`] is free space's);
-//! the products over the assembled matrix still run in bands.
+//! The assembly and the products run in the bands of [`crate::parallel`] (each block
+//! summed on its own, so the same bits on any number of threads); so does the
+//! matrix-free product's real-space half ([`periodic::free_product`]).
 
 use crate::cell::Periodic;
 use crate::error::StepError;
@@ -62,15 +63,17 @@ pub(super) fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>
     Ok(Ewald::new(cell, a_max(radius))?)
 }
 
-/// `mu_tt` of the box into the packed lower triangle `mu` ([`periodic::assemble_tt`]).
+/// `mu_tt` of the box into the packed lower triangle `mu`, in bands through `par`
+/// ([`periodic::assemble`]: the blocks of [`periodic::assemble_tt`]).
 pub(super) fn assemble<T: Real>(
     p: &Params<T>,
     ew: &Ewald<T>,
     pos: &[T::V3],
     radius: &[T],
     mu: &mut [T::M3],
+    par: &dyn crate::parallel::Parallel,
 ) -> Result<(), StepError> {
-    Ok(periodic::assemble_tt(ew, p.viscosity, pos, radius, mu)?)
+    Ok(periodic::assemble(par, ew, p.viscosity, pos, radius, mu)?)
 }
 
 /// The caller's PSE arrays as the step's storage, after checking them against the

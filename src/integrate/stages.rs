@@ -72,8 +72,9 @@ pub(super) fn mobility_product<T: Real>(
     }
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
-        // In a box: assembled serially, then applied in bands (`integrate/periodic.rs`).
-        assemble_tt(p, Some(e), pos, radius, mu)?;
+        // In a box: assembled and applied in bands (`integrate/periodic.rs`).
+        let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
+        super::periodic::assemble(p, e, pos, radius, mu, par)?;
         crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
         return Ok(());
     }
@@ -155,7 +156,7 @@ pub(super) fn free_product<T: Real>(
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
-        return e.product(p.viscosity, pos, radius, f, u);
+        return e.product(p.viscosity, pos, radius, f, u, (par, bands));
     }
     let _ = ew; // Read above only with the `periodic` feature.
     let (level, eta) = (p.hydro, p.viscosity);
@@ -206,7 +207,7 @@ pub(super) fn assemble_tt<T: Real>(
     if let Some(e) = ew {
         // PSE has no blocks; the checks refuse it wherever the step assembles.
         let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-        return super::periodic::assemble(p, e, pos, radius, mu);
+        return super::periodic::assemble(p, e, pos, radius, mu, &crate::parallel::Serial);
     }
     let _ = ew; // Read above only with the `periodic` feature.
     if let Some(h) = wall_height(p) {

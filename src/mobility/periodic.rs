@@ -38,6 +38,7 @@ pub use rot::{RotBlocks, add_spin, assemble_grand, pair_rot, self_rr};
 pub use crate::cell::{Periodic, PeriodicError};
 use crate::error::ParticleError;
 use crate::linalg::tri;
+use crate::parallel::{Parallel, band_blocks, band_start, by_bands, by_bands_then_reduce};
 use crate::real::Real;
 
 /// Largest image or wave-vector index per axis that the sums visit (a bound on their
@@ -206,9 +207,41 @@ pub fn assemble_tt<T: Real>(
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), PeriodicError> {
+    assemble(&crate::parallel::Serial, ew, eta, pos, radius, out)
+}
+
+/// [`assemble_tt`] in the bands of [`crate::parallel`] through `par`: the same blocks
+/// (each pair is summed on its own) and the same first error, on any number of threads.
+pub fn assemble<T: Real>(
+    par: &dyn Parallel,
+    ew: &Ewald<T>,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    out: &mut [T::M3],
+) -> Result<(), PeriodicError> {
     check(ew, pos, radius)?;
-    for i in 0..pos.len() {
-        let row = tri(i);
+    let n = pos.len();
+    let out = &mut out[..tri(n)];
+    by_bands::<T, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
+        let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
+        rows(ew, eta, pos, radius, b0..b1, rows_t)
+    })
+}
+
+/// Packed rows `range` of the periodic `mu_tt` into `out` (which starts at row
+/// `range.start`): each row's self block, then its pairs in column order.
+fn rows<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    range: core::ops::Range<usize>,
+    out: &mut [T::M3],
+) -> Result<(), PeriodicError> {
+    let base = tri(range.start);
+    for i in range {
+        let row = tri(i) - base;
         out[row + i] = self_tt(ew, eta, radius[i]);
         for j in 0..i {
             out[row + j] = pair_tt(ew, eta, radius[i], radius[j], pos[i] - pos[j]).ok_or(
@@ -222,7 +255,9 @@ pub fn assemble_tt<T: Real>(
 /// `y = mu_tt x` without storing `mu_tt`: the real-space blocks pair by pair (each
 /// evaluated once, used for both rows), the wave-space part through structure factors
 /// (`O(N K)` for `K` wave vectors). Agrees with [`assemble_tt`] followed by
-/// [`sym_matvec`](crate::linalg::sym_matvec) to rounding, not bit for bit.
+/// [`sym_matvec`](crate::linalg::sym_matvec) to rounding, not bit for bit. One thread
+/// and one band: [`free_product`] gives its bits below
+/// [`BANDED_MIN`](crate::parallel::BANDED_MIN) rows.
 pub fn tt_product<T: Real>(
     ew: &Ewald<T>,
     eta: T,
@@ -232,27 +267,65 @@ pub fn tt_product<T: Real>(
     y: &mut [T::V3],
 ) -> Result<(), PeriodicError> {
     check(ew, pos, radius)?;
+    let (diag, block) = real_blocks(ew, eta, pos, radius);
     let n = pos.len();
-    for i in 0..n {
-        let a = radius[i];
-        // The self block's real part (a < L/2: never `None`, see `self_tt`).
-        let b = real::real_sum(&ew.split, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
-        y[i] = b * x[i];
-    }
-    for i in 0..n {
-        let mut acc = T::V3_ZERO;
-        for j in 0..i {
-            let r0 = ew.cell.minimum_image(pos[i] - pos[j]);
-            let b = real::real_sum(&ew.split, eta, radius[i], radius[j], r0, false).ok_or(
-                PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
-            )?;
-            acc += b * x[j];
-            y[j] += T::m3_tmul(b, x[i]);
-        }
-        y[i] += acc;
-    }
+    band_blocks::<T, _>(0, diag, block, &x[..n], &mut y[..n], &mut [])?;
     wave::wave_product(ew, eta, pos, radius, x, y);
     Ok(())
+}
+
+/// [`tt_product`] with its real-space half in the bands of
+/// [`crate::parallel::product`] through `par` (`z`: at least
+/// [`band_scratch`](crate::parallel::band_scratch)`(n)` vectors), the same bits on any
+/// number of threads (and [`tt_product`]'s below
+/// [`BANDED_MIN`](crate::parallel::BANDED_MIN) rows); the same first error. The
+/// wave-space half, `O(N K)` against the real half's `O(N^2)` image sums, stays on the
+/// calling thread (its structure factors are sums over every sphere, in order).
+#[allow(clippy::too_many_arguments)]
+pub fn free_product<T: Real>(
+    par: &dyn Parallel,
+    ew: &Ewald<T>,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) -> Result<(), PeriodicError> {
+    check(ew, pos, radius)?;
+    let (diag, block) = real_blocks(ew, eta, pos, radius);
+    let n = pos.len();
+    by_bands_then_reduce::<T, _, 1>(par, n, [&mut *y], z, |t, [yt], [zt]| {
+        band_blocks::<T, _>(band_start(n, t), diag, block, &x[..n], yt, zt)
+    })?;
+    wave::wave_product(ew, eta, pos, radius, x, y);
+    Ok(())
+}
+
+/// The real-space self block of sphere `i` and pair block `(i, j)`, `j < i` (nested
+/// spheres the error of [`assemble_tt`]), as the matrix-free products read them.
+#[allow(clippy::type_complexity)]
+fn real_blocks<'a, T: Real>(
+    ew: &'a Ewald<T>,
+    eta: T,
+    pos: &'a [T::V3],
+    radius: &'a [T],
+) -> (
+    impl Fn(usize) -> T::M3 + Copy + Sync + 'a,
+    impl Fn(usize, usize) -> Result<T::M3, PeriodicError> + Copy + Sync + 'a,
+) {
+    // a < L/2: no image of a sphere lies inside it, so the self sum is never `None`.
+    let diag = move |i: usize| {
+        let a = radius[i];
+        real::real_sum(&ew.split, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO)
+    };
+    let block = move |i: usize, j: usize| {
+        let r0 = ew.cell.minimum_image(pos[i] - pos[j]);
+        real::real_sum(&ew.split, eta, radius[i], radius[j], r0, false).ok_or(
+            PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
+        )
+    };
+    (diag, block)
 }
 
 /// Block `(p, q)` of the matrix [`assemble_tt`] stores (the pair evaluated from the

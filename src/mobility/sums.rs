@@ -24,6 +24,7 @@ use crate::mobility::periodic::{self, Ewald};
 use crate::mobility::pse::{Part, Pse, PseStorage};
 #[cfg(feature = "pse")]
 use crate::noise::{Noise, lanczos::Lanczos};
+use crate::parallel::Parallel;
 use crate::real::Real;
 
 /// The step's periodic sums: Ewald's parameters, or PSE's with the caller's storage.
@@ -159,7 +160,10 @@ impl<'a, T: Real> BoxSums<'a, T> {
         }
     }
 
-    /// `u = M f`, the box's translational mobility (viscosity `eta`) by the step's sums.
+    /// `u = M f`, the box's translational mobility (viscosity `eta`) by the step's sums:
+    /// Ewald's real-space half in bands through `par` (`bands`: their scratch,
+    /// [`periodic::free_product`]), PSE's through its storage's own.
+    #[allow(clippy::too_many_arguments)]
     pub fn product(
         self,
         eta: T,
@@ -167,9 +171,12 @@ impl<'a, T: Real> BoxSums<'a, T> {
         radius: &[T],
         f: &[T::V3],
         u: &mut [T::V3],
+        (par, bands): (&dyn Parallel, &mut [T::V3]),
     ) -> Result<(), StepError> {
         match self {
-            Self::Ewald(e) => Ok(periodic::tt_product(e, eta, pos, radius, f, u)?),
+            Self::Ewald(e) => Ok(periodic::free_product(
+                par, e, eta, pos, radius, f, u, bands,
+            )?),
             #[cfg(feature = "pse")]
             Self::Pse(p) => p.product(eta, pos, radius, f, u),
         }
