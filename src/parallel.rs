@@ -28,7 +28,7 @@ pub(crate) use free::band_blocks;
 pub use free::{free_band, free_product, free_products};
 #[cfg(feature = "pse")]
 pub(crate) use jobs::{Jobs, run_all};
-pub(crate) use jobs::{Packed, by_bands, by_bands_and, by_bands_k, map_bands, reduce};
+pub(crate) use jobs::{Packed, by_bands, by_bands_and, by_bands_k, by_rows, map_bands, reduce};
 
 use crate::error::ParticleError;
 use crate::linalg::tri;

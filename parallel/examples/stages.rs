@@ -157,6 +157,15 @@ fn main() {
         let rounds = merge(&timed.log.lock().unwrap());
         taken.push(Step { rounds, wall, cpu });
     }
+    // FNV-1a over the final positions' bits: the same digest from every build and thread
+    // count that keeps the bits.
+    let digest = pos
+        .iter()
+        .flat_map(|v| v.to_array())
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, x| {
+            (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3)
+        });
+    println!("positions after {} steps: digest {digest:016x}", steps + 1);
     let pairs = (n * (n + 1) / 2) as f64;
     let best = taken[1..].iter().min_by_key(|s| s.cpu).unwrap();
     let ms = |ns: u64| ns as f64 * 1e-6;

@@ -29,6 +29,7 @@ use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided};
 use crate::bonds::Bond;
 use crate::error::{LinalgError, StepError};
 use crate::linalg::band;
+use crate::parallel::{BANDED_MIN, by_rows};
 use crate::real::Real;
 
 /// Half-bandwidth of the preconditioner, in bonds. 10 rather than 3 holds the coupling
@@ -76,10 +77,12 @@ pub fn krylov<T: Real>(
     let from = problem.one_sided(nb);
     let one_sided = from < nb;
     let state = &mut scratch.piv[..if one_sided { nb } else { 0 }];
+    // The band's largest diagonal entry: a bound on the curvature test below.
+    let mut top = T::ZERO;
     if one_sided {
         onesided::reset(state);
     } else {
-        precondition(metric, bonds, c, pre, (nb, state));
+        top = precondition(metric, bonds, c, pre, (nb, state));
     }
     let mut products = 0u32;
     let mut outer = 0u32;
@@ -98,7 +101,7 @@ pub fn krylov<T: Real>(
         if one_sided {
             changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
             if changed || outer == 0 {
-                precondition(metric, bonds, c, pre, (from, state));
+                top = precondition(metric, bonds, c, pre, (from, state));
             }
         }
         // Nonlinear residual of the chord iteration.
@@ -199,11 +202,18 @@ pub fn krylov<T: Real>(
             let pq = dot(p, q);
             // `p A p` against `p diag(A) p`: zero curvature along a self-stress of
             // dependent constraints (`docs/CONTACTS.md`). What is left of `r` along it
-            // is the part no move can meet: the step is done.
-            let curvature = (0..nb).fold(T::ZERO, |s, k| {
-                s + p[k] * p[k] * T::dot(metric.grad(k), metric.relative(bonds, k, k)) * c
-            });
-            if pq.is_finite() && pq <= floor * curvature {
+            // is the part no move can meet: the step is done. `p diag(A) p` is at most
+            // `top |p|^2`: where `pq` clears twice that (rounding aside), the test
+            // cannot hold and its reads of every bond's diagonal blocks, a cache miss
+            // each in a large mobility (1 % of a 4096-bead step), are skipped.
+            let clear = pq > floor * top.max(T::ZERO) * dot(p, p) * T::TWO;
+            let curvature = match clear {
+                true => T::ZERO,
+                false => (0..nb).fold(T::ZERO, |s, k| {
+                    s + p[k] * p[k] * T::dot(metric.grad(k), metric.relative(bonds, k, k)) * c
+                }),
+            };
+            if !clear && pq.is_finite() && pq <= floor * curvature {
                 null = true;
                 break;
             }
@@ -255,36 +265,48 @@ pub fn krylov<T: Real>(
 /// Band of `A` factorised into `pre` (regularised where rows are dependent); its
 /// diagonal square roots when the band is not positive semi-definite. `mask`: the
 /// first one-sided row and the rows' states; an inactive row keeps only its diagonal.
+/// Returns the band's largest diagonal entry (NaN-sticky).
 fn precondition<T: Real>(
     metric: &Metric<'_, T>,
     bonds: &[Bond<T>],
     c: T,
     pre: &mut [T],
     mask: (usize, &[usize]),
-) {
+) -> T {
     let nb = bonds.len();
     let entry = |k: usize, l: usize| T::dot(metric.grad(k), metric.relative(bonds, k, l)) * c;
-    let (from, state) = mask;
-    let off = |k: usize| k >= from && !onesided::active(state[k]);
-    for k in 0..nb {
-        let first = k.saturating_sub(BAND);
-        let row = &mut pre[band::at(BAND, k, first)..=band::at(BAND, k, k)];
-        metric.jacobian_row(bonds, k, metric.grad(k) * c, first, row);
-        if from < nb {
-            for l in first..k {
-                if off(k) || off(l) {
-                    row[l - first] = T::ZERO;
-                }
-            }
-        }
+    match *metric {
+        // A stored mobility's rows read blocks near its diagonal, a cache miss each at
+        // large N (1 % of a 4096-bead step on one thread): in bands through the step's
+        // `par`, each with a metric of its own on the same blocks (the metric holds
+        // `par`, which need not cross threads). Rows are independent: the same bits.
+        Metric::Mobility {
+            mu,
+            grad,
+            scale,
+            par,
+            compact,
+        } => by_rows(par, nb, BAND + 1, BANDED_MIN, pre, |k0, rows| {
+            let serial = &crate::parallel::Serial;
+            let own = Metric::Mobility {
+                mu,
+                grad,
+                scale,
+                par: serial,
+                compact,
+            };
+            band_rows(&own, bonds, c, mask, k0, rows);
+        }),
+        _ => band_rows(metric, bonds, c, mask, 0, &mut pre[..nb * (BAND + 1)]),
     }
+    let top = (0..nb).fold(T::ZERO, |m, k| m.max_sticky(pre[band::at(BAND, k, k)]));
     // Dependent constraints (`docs/CONTACTS.md`) make `A` singular: their pivots are
     // replaced by their diagonals, which keeps the preconditioner positive definite;
     // conjugate gradients on the singular but consistent `A delta = r` still converge
     // (to the solution in the range of `A`: the minimum-norm multipliers).
     let floor = super::dependent::rank_floor::<T>();
     if band::regularised(pre, nb, BAND, floor).is_ok() {
-        return;
+        return top;
     }
     log::debug!("krylov: band preconditioner not positive definite, using Jacobi");
     for k in 0..nb {
@@ -298,6 +320,34 @@ fn precondition<T: Real>(
         } else {
             T::ONE
         };
+    }
+    top
+}
+
+/// Rows `k0..` of [`precondition`]'s band into `rows` (whole rows of `BAND + 1` from
+/// row `k0`), masked as there.
+fn band_rows<T: Real>(
+    metric: &Metric<'_, T>,
+    bonds: &[Bond<T>],
+    c: T,
+    (from, state): (usize, &[usize]),
+    k0: usize,
+    rows: &mut [T],
+) {
+    let nb = bonds.len();
+    let off = |k: usize| k >= from && !onesided::active(state[k]);
+    let base = band::at(BAND, k0, k0) - BAND;
+    for k in k0..k0 + rows.len() / (BAND + 1) {
+        let first = k.saturating_sub(BAND);
+        let row = &mut rows[band::at(BAND, k, first) - base..=band::at(BAND, k, k) - base];
+        metric.jacobian_row(bonds, k, metric.grad(k) * c, first, row);
+        if from < nb {
+            for l in first..k {
+                if off(k) || off(l) {
+                    row[l - first] = T::ZERO;
+                }
+            }
+        }
     }
 }
 

@@ -18,6 +18,32 @@ pub(crate) fn run_all<F: FnMut() + Send>(par: &dyn Parallel, jobs: &mut Jobs<F>)
     par.run(&mut refs);
 }
 
+/// Runs `job(k0, chunk)` through `par` over `items` cut into chunks of whole rows of
+/// `per` items (`count` rows; [`BANDS`] chunks of about equal rows, one below
+/// `min_rows` rows), `k0` the chunk's first row: for work whose rows are independent
+/// of each other, so that any cut gives the same result.
+pub(crate) fn by_rows<X: Send, J>(
+    par: &dyn Parallel,
+    count: usize,
+    per: usize,
+    min_rows: usize,
+    items: &mut [X],
+    job: J,
+) where
+    J: Fn(usize, &mut [X]) + Sync,
+{
+    let chunks = if count < min_rows { 1 } else { BANDS };
+    let mut jobs = Jobs::new();
+    let (mut rest, job) = (&mut items[..count * per], &job);
+    for c in 0..chunks {
+        let (k0, k1) = (count * c / chunks, count * (c + 1) / chunks);
+        let (chunk, tail) = core::mem::take(&mut rest).split_at_mut((k1 - k0) * per);
+        rest = tail;
+        let _ = jobs.push(move || job(k0, chunk));
+    }
+    run_all(par, &mut jobs);
+}
+
 /// Runs `job(t)` for every band of `n` rows through `par`; the results in band order
 /// (`None` past the last band).
 pub(crate) fn map_bands<R: Send, J>(par: &dyn Parallel, n: usize, job: J) -> [Option<R>; BANDS]
