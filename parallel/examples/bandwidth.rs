@@ -9,14 +9,19 @@
 //! 2. Each product path at N beads on 1 and THREADS threads, best of five: the stored
 //!    `f64` blocks (72 bytes and 36 flops a pair), the compact `f32` copy (24 bytes, 36
 //!    `f32` flops) and the recompute path (no bytes, 63 + 36 flops): ns per pair and the
-//!    bytes per second each stream drew.
-//! 3. The model (`hydrorattle_parallel::model`): a path's time per pair on `t` threads is the larger of its bytes over
-//!    the bandwidth of `t` threads and its one-thread compute time over `t`; the
-//!    bandwidth of `t` threads is `min(t b1, B)` (`b1` one thread's read rate measured,
-//!    `B` the machine's: measured here; for a machine of CORES cores `SAT b1`, or when
-//!    SAT is 0 fitted to the issue's 16-core measurement of the stored path). The
-//!    predicted speedup of the Overdamped step (one fused assembly and `k` products,
-//!    `k` read from a step) at N = 2048 and 4096 on 2 and CORES cores.
+//!    bytes per second each stream drew; and the assembly pass (the stored blocks
+//!    written, 72 bytes a pair, and applied once).
+//! 3. The plain step on one thread, round by round (`examples/stages.rs`): its
+//!    constraint products `k` and its serial rest, and the model's step beside it.
+//! 4. The model (`hydrorattle_parallel::model`): a pass's time per pair on `t` threads
+//!    is the larger of its bytes over the bandwidth of `t` threads and its one-thread
+//!    compute time over `t` (the one-thread times by CPU time, which a shared machine's
+//!    queue does not inflate); the assembly moves twice what it writes
+//!    (write-allocate); the serial rest does not shrink. The bandwidth of `t` threads is
+//!    `min(t b1, B)` (`b1` one thread's read rate measured, `B` the machine's: measured
+//!    here; for a machine of CORES cores `SAT b1`, or when SAT is 0 fitted to the
+//!    issue's 16-core measurement of the stored path). The predicted speedup of the
+//!    Overdamped step on each path on THREADS and CORES threads.
 
 use std::time::Instant;
 
@@ -34,11 +39,18 @@ use rayon::prelude::*;
 const LEN: usize = 32 << 20;
 
 /// Best of `k` runs of `f`, in seconds.
-fn best(k: usize, mut f: impl FnMut()) -> f64 {
-    (0..k).fold(f64::INFINITY, |b, _| {
-        let t0 = Instant::now();
+fn best(k: usize, f: impl FnMut()) -> f64 {
+    best_both(k, f)[0]
+}
+
+/// Best of `k` runs of `f`, in seconds of the wall clock and of the process's CPU
+/// time (each the best of its own).
+fn best_both(k: usize, mut f: impl FnMut()) -> [f64; 2] {
+    (0..k).fold([f64::INFINITY; 2], |b, _| {
+        let (t0, c0) = (Instant::now(), common::cpu_ns());
         f();
-        b.min(t0.elapsed().as_secs_f64())
+        let cpu = (common::cpu_ns() - c0) as f64 * 1e-9;
+        [b[0].min(t0.elapsed().as_secs_f64()), b[1].min(cpu)]
     })
 }
 
@@ -76,8 +88,10 @@ fn stream(pool: &rayon::ThreadPool, a: &mut [f64], b: &[f64], c: &[f64]) -> (f64
     )
 }
 
-/// Seconds per product of each path (stored, compact, recompute) at `n` beads on `par`.
-fn paths(n: usize, par: &dyn Parallel) -> [f64; 3] {
+/// Seconds per product of each path (stored, compact, recompute) and of the assembly
+/// pass (stored blocks and a first product, `parallel::assemble_apply`) at `n` beads on
+/// `par`, by the wall clock and by CPU time.
+fn paths(n: usize, par: &dyn Parallel) -> [[f64; 2]; 4] {
     let pos = common::helix(n);
     let radius = vec![1.0; n];
     let x: Vec<DVec3> = (0..n)
@@ -91,14 +105,19 @@ fn paths(n: usize, par: &dyn Parallel) -> [f64; 3] {
     let packed = best(3, || {
         reduced::copy_apply::<f64>(par, &mu, n, &mut copy, &x, &mut y, &mut z)
     });
-    let stored = best(5, || {
+    let stored = best_both(5, || {
         parallel::product::<f64>(par, &mu, n, &x, &mut y, &mut z)
     });
-    let compact = best(5, || {
+    let compact = best_both(5, || {
         reduced::apply::<f64>(par, &copy, n, &x, &mut y, &mut z)
     });
-    let free = best(3, || {
+    let free = best_both(3, || {
         parallel::free_product::<f64>(par, Hydro::Rpy, 1.0, &pos, &radius, &x, &mut y, &mut z)
+            .unwrap()
+    });
+    let (f, rad) = (&x[..], &radius[..]);
+    let assembly = best_both(3, || {
+        parallel::assemble_apply::<f64>(par, Hydro::Rpy, 1.0, &pos, rad, &mut mu, f, &mut y, &mut z)
             .unwrap()
     });
     eprintln!(
@@ -106,7 +125,7 @@ fn paths(n: usize, par: &dyn Parallel) -> [f64; 3] {
         par.threads(),
         packed / (n * (n + 1) / 2) as f64 * 1e9
     );
-    [stored, compact, free]
+    [stored, compact, free, assembly]
 }
 
 fn main() {
@@ -140,26 +159,69 @@ fn main() {
     drop((a, b, c));
     let (b1, bmax) = (bw[0], bw.iter().cloned().fold(0.0, f64::max));
     let pairs = (n * (n + 1) / 2) as f64;
+    let ns = |s: f64| s / pairs * 1e9;
     let one = paths(n, &Serial);
     let many = paths(n, pools.last().unwrap());
     for (k, path) in Path::ALL.into_iter().enumerate() {
-        let (ns1, nst) = (one[k] / pairs * 1e9, many[k] / pairs * 1e9);
+        let (ns1, nst) = (ns(one[k][0]), ns(many[k][0]));
         println!(
-            "N = {n} {path:?}: 1 thread {ns1:.2} ns/pair {:.1} GB/s; {threads} threads {nst:.2} ns/pair {:.1} GB/s ({:.2}x)",
+            "N = {n} {path:?}: 1 thread {ns1:.2} ns/pair {:.1} GB/s ({:.2} ns CPU); \
+             {threads} threads {nst:.2} ns/pair {:.1} GB/s ({:.2}x)",
             path.bytes() / ns1,
+            ns(one[k][1]),
             path.bytes() / nst,
             ns1 / nst
         );
     }
-    // The Overdamped step (`hydrorattle_parallel::model`): one assembly pass and `k`
-    // products (the bench helix takes 4 to 5 at N = 1024 to 4096).
-    let k = 5.0;
+    let (a1, at) = (ns(one[3][0]), ns(many[3][0]));
+    println!(
+        "N = {n} assembly pass (stored, fused first product): 1 thread {a1:.2} ns/pair \
+         ({:.2} ns CPU, writes {:.1} GB/s); {threads} threads {at:.2} ns/pair, writes {:.1} GB/s \
+         ({:.2}x)",
+        ns(one[3][1]),
+        72.0 / a1,
+        72.0 / at,
+        a1 / at
+    );
+    // The step on one thread, round by round (`examples/stages.rs`): its products `k`
+    // and its serial rest, for the model; and the model checked against it.
+    let (steps, _, report) = common::timed::run(n, 2, "plain", &Serial);
+    let step = steps[1..].iter().min_by_key(|s| s.cpu).unwrap();
+    let in_rounds: u64 = step.rounds.iter().map(|r| r.cpu).sum();
+    let k = report.iterations as f64;
+    let serial = ns(step.cpu.saturating_sub(in_rounds) as f64 * 1e-9);
+    // One-thread inputs by CPU time (which a shared machine's queue does not inflate).
     let here = Machine {
         b1,
         b: bmax,
-        ns: one.map(|s| s / pairs * 1e9),
+        ns: [0, 1, 2].map(|q| ns(one[q][1])),
+        assembly: ns(one[3][1]),
+        serial,
     };
+    let products: Vec<f64> = step.rounds[1..]
+        .iter()
+        .filter(|r| r.cpu * 3 > step.rounds[1].cpu)
+        .map(|r| ns(r.cpu as f64 * 1e-9))
+        .collect();
+    println!(
+        "step, 1 thread (CPU ns a pair): measured {:.2} = assembly {:.2} + {} products of {:.2} \
+         (mean) + serial {serial:.2}; MODEL {:.2} = {:.2} + {k} x {:.2} + {serial:.2}",
+        ns(step.cpu as f64 * 1e-9),
+        ns(step.rounds[0].cpu as f64 * 1e-9),
+        products.len(),
+        products.iter().sum::<f64>() / products.len().max(1) as f64,
+        here.step(Path::Stored, 1.0, k),
+        here.assembly(Path::Stored, 1.0),
+        here.product(Path::Stored, 1.0)
+    );
     let speedup = |m: &Machine, path: Path, t: f64| m.step(path, 1.0, k) / m.step(path, t, k);
+    println!(
+        "model: a thread's share of the step, stored path: assembly {:.0} %, products {:.0} %, \
+         serial {:.1} %",
+        100.0 * here.assembly(Path::Stored, 1.0) / here.step(Path::Stored, 1.0, k),
+        100.0 * k * here.product(Path::Stored, 1.0) / here.step(Path::Stored, 1.0, k),
+        100.0 * serial / here.step(Path::Stored, 1.0, k)
+    );
     // The model machine's bandwidth in units of one thread's (`SAT`), or else fitted to
     // the issue's 16-core Xeon: stored f64 at N = 4096, 4.87x on 16 threads.
     let with = |sat: f64| Machine {

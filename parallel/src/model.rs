@@ -1,11 +1,15 @@
 //! The product-path model: which way of applying the mobility is fastest for a bead
 //! count and a thread count (docs/BENCHMARKS.md, "Every core and every lane").
 //!
-//! A product reads `bytes` per pair from memory and does `ns` of one core's work per
-//! pair. On `t` threads it takes `max(bytes / bw(t), ns / t)` per pair, with
-//! `bw(t) = min(t b1, b)`: one thread draws `b1` bytes per ns, the machine `b` at most.
-//! An Overdamped step is one assembly pass (the pair work of [`Path::Recompute`],
-//! writing what the path stores) and `k` products. All three paths exist in the kernel:
+//! A pass over the pairs moves `bytes` per pair to or from memory and does `ns` of one
+//! core's work per pair. On `t` threads it takes `max(bytes / bw(t), ns / t)` per pair,
+//! with `bw(t) = min(t b1, b)`: one thread moves `b1` bytes per ns, the machine `b` at
+//! most. An Overdamped step ([`Machine::step`]) is one assembly pass, `k` products and
+//! a serial rest that no thread count shortens. The assembly pass evaluates every pair
+//! and applies it once (the fused first product); it writes what the path stores, and
+//! every byte written is also read first (the cache's write-allocate: the line is
+//! fetched before it is overwritten), so it moves twice [`Path::written`]. All three
+//! paths exist in the kernel:
 //! [`Path::Stored`] is the default, [`Path::Compact`] is
 //! `Params::compact_products`, [`Path::Recompute`] is `Params::matrix_free`; the first
 //! and last give the same bits.
@@ -44,7 +48,7 @@ impl Path {
     }
 }
 
-/// What the model knows of a machine (measured by `examples/bandwidth.rs`).
+/// What the model knows of a machine and a step (measured by `examples/bandwidth.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Machine {
     /// One thread's read bandwidth, bytes per ns (GB/s).
@@ -53,6 +57,14 @@ pub struct Machine {
     pub b: f64,
     /// One thread's time per pair of a product on each path ([`Path::ALL`] order), ns.
     pub ns: [f64; 3],
+    /// One thread's time per pair of the assembly pass that stores the blocks and
+    /// applies them once (`parallel::assemble_apply`), ns; the compact path's packing of
+    /// its copy, row by row in cache, is taken as free (measured within 2 % of it at
+    /// N = 4096, docs/BENCHMARKS.md). The recompute path's pass is a product.
+    pub assembly: f64,
+    /// The step's serial work per pair (the Krylov vectors, the band Cholesky, the
+    /// forces, the copies), ns: the same on any number of threads.
+    pub serial: f64,
 }
 
 impl Machine {
@@ -67,10 +79,20 @@ impl Machine {
         (bytes / bw).max(ns / t)
     }
 
-    /// ns per pair of an Overdamped step on `path` with `t` threads and `k` products.
+    /// ns per pair of the assembly pass on `path` with `t` threads: its blocks'
+    /// evaluation and first product, and twice the bytes it stores (write-allocate).
+    pub fn assembly(&self, path: Path, t: f64) -> f64 {
+        let ns = match path {
+            Path::Recompute => self.ns[Path::Recompute as usize],
+            _ => self.assembly,
+        };
+        self.pass(ns, 2.0 * path.written(), t)
+    }
+
+    /// ns per pair of an Overdamped step on `path` with `t` threads and `k` products
+    /// after the assembly pass.
     pub fn step(&self, path: Path, t: f64, k: f64) -> f64 {
-        let assembly = self.pass(self.ns[Path::Recompute as usize], path.written(), t);
-        assembly + k * self.product(path, t)
+        self.assembly(path, t) + k * self.product(path, t) + self.serial
     }
 
     /// The fastest path for `t` threads and `k` products a step.
@@ -95,20 +117,31 @@ mod tests {
             b1: 10.0,
             b: 30.0,
             ns: [6.0, 3.0, 15.0],
+            assembly: 16.0,
+            serial: 0.5,
         };
         // Stored, 1 thread: max(72 / 10, 6) = 7.2; 16 threads: max(72 / 30, 6 / 16) = 2.4.
         assert_eq!(m.product(Path::Stored, 1.0), 7.2);
         assert_eq!(m.product(Path::Stored, 16.0), 2.4);
         // Recompute: 15 / t, whatever the bandwidth.
         assert_eq!(m.product(Path::Recompute, 16.0), 15.0 / 16.0);
-        // A step of 5 products, 1 thread: stored 15 + 5 x 7.2 = 51, compact
-        // max(9.6, 15) + 5 x max(2.4, 3) = 30, recompute 6 x 15 = 90.
-        assert_eq!(m.step(Path::Stored, 1.0, 5.0), 51.0);
-        assert_eq!(m.step(Path::Compact, 1.0, 5.0), 30.0);
-        assert_eq!(m.step(Path::Recompute, 1.0, 5.0), 90.0);
+        // The assembly moves twice what it stores: stored 144 bytes, 1 thread
+        // max(14.4, 16) = 16; 16 threads max(144 / 30, 1) = 4.8. Compact 192 bytes.
+        assert_eq!(m.assembly(Path::Stored, 1.0), 16.0);
+        assert_eq!(m.assembly(Path::Stored, 16.0), 4.8);
+        assert_eq!(m.assembly(Path::Compact, 1.0), 19.2);
+        // A step of 5 products, 1 thread: stored 16 + 5 x 7.2 + 0.5 = 52.5, compact
+        // 19.2 + 5 x max(2.4, 3) + 0.5 = 34.7, recompute 6 x 15 + 0.5 = 90.5.
+        assert_eq!(m.step(Path::Stored, 1.0, 5.0), 52.5);
+        assert!((m.step(Path::Compact, 1.0, 5.0) - 34.7).abs() < 1e-12);
+        assert_eq!(m.step(Path::Recompute, 1.0, 5.0), 90.5);
         assert_eq!(m.fastest(1.0, 5.0), Path::Compact);
-        // 64 threads: stored 2.4 + 5 x 2.4 = 14.4, compact 3.2 + 5 x 0.8 = 7.2,
-        // recompute 90 / 64 = 1.41: the pair work wins once it is spread thin enough.
+        // 64 threads: stored 4.8 + 5 x 2.4 + 0.5 = 17.3, compact 6.4 + 5 x 0.8 + 0.5
+        // = 10.9, recompute 90 / 64 + 0.5 = 1.91: the pair work wins once it is spread
+        // thin enough; the serial rest bounds every speedup (recompute 90.5 / 1.91 =
+        // 47x, not 64x).
         assert_eq!(m.fastest(64.0, 5.0), Path::Recompute);
+        let speedup = m.step(Path::Recompute, 1.0, 5.0) / m.step(Path::Recompute, 64.0, 5.0);
+        assert!((speedup - 90.5 / (90.0 / 64.0 + 0.5)).abs() < 1e-12);
     }
 }

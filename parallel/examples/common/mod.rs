@@ -3,6 +3,8 @@
 
 #![allow(dead_code)] // Each example uses a part.
 
+pub mod timed;
+
 use hydrorattle::glam::DVec3;
 use hydrorattle::{Bond, Brownian, Params};
 
