@@ -160,6 +160,16 @@ fn step_benches<T: Real, const N: usize, const B: usize>(
     prec: &str,
     methods: &[Method],
 ) {
+    solver_step_benches::<T, N, B>(c, ("step", SolverKind::Auto), prec, methods);
+}
+
+/// [`step_benches`] with the solver `kind`, in the group `name/method/prec/N`.
+fn solver_step_benches<T: Real, const N: usize, const B: usize>(
+    c: &mut Criterion,
+    (name, kind): (&str, SolverKind),
+    prec: &str,
+    methods: &[Method],
+) {
     let (p, r) = chain_geometry(N);
     let mut init = ParticleSet::<T, N>::new();
     for (x, a) in p.iter().zip(&r) {
@@ -173,11 +183,12 @@ fn step_benches<T: Real, const N: usize, const B: usize>(
     for &method in methods {
         let mut params = Params::new(T::from_f64(0.01));
         params.method = method;
+        params.solver.kind = kind;
         // The run must succeed; check once outside the timing.
         let mut probe = init.clone();
         step(&mut probe, &bonds, &params, &mut ws, &mut NoForce)
             .unwrap_or_else(|e| panic!("{method:?} N = {N}: {e}"));
-        let mut g = c.benchmark_group(format!("step/{method:?}/{prec}"));
+        let mut g = c.benchmark_group(format!("{name}/{method:?}/{prec}"));
         g.bench_function(BenchmarkId::from_parameter(N), |b| {
             b.iter_batched_ref(
                 || init.clone(),
@@ -198,6 +209,12 @@ fn all_steps<T: Real>(c: &mut Criterion, prec: &str) {
     step_benches::<T, 128, 127>(c, prec, &METHODS);
     step_benches::<T, 256, 255>(c, prec, &METHODS);
     step_benches::<T, 512, 511>(c, prec, &overdamped);
+    // The paper's sweep on bonds alone (no contacts: never over-relaxed, the firmware's
+    // solver): its cost is unchanged by the contact sweep's over-relaxation.
+    let sweep = ("step_sweep", SolverKind::Sweep);
+    let bonded = [Method::Overdamped, Method::Rattle];
+    solver_step_benches::<T, 25, 24>(c, sweep, prec, &bonded);
+    solver_step_benches::<T, 64, 63>(c, sweep, prec, &bonded);
 }
 
 /// `step_slices` on runtime-sized state (no compile-time capacity), f64: the scaling

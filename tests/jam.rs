@@ -392,10 +392,15 @@ fn pile_to_rest<T: Real, const N: usize>(
     let mut last = StepReport::default();
     let mut still = 0;
     let mut taken = 0;
+    // Iterations of each step's last solve: total and largest (printed, not asserted).
+    let (mut iterations, mut most) = (0u64, 0u32);
+    let clock = std::time::Instant::now();
     for k in 0..steps {
         let before: Vec<[f64; 3]> = (0..n).map(|i| f64s::<T>(ps.pos[i])).collect();
         last = one_step(&mut ps, &bonds, &p, &mut store)
             .unwrap_or_else(|e| panic!("pile {kind:?} step {k}: {e}"));
+        iterations += u64::from(last.iterations);
+        most = most.max(last.iterations);
         let v = worst_violation(&ps, n, h, &none);
         assert!(v <= slack(&p, h), "pile {kind:?} step {k}: violation {v}");
         let moved = (0..n)
@@ -415,10 +420,14 @@ fn pile_to_rest<T: Real, const N: usize>(
     }
     assert_eq!(still, 3, "pile {kind:?} not at rest after {steps} steps");
     eprintln!(
-        "pile of {n}, {kind:?}: at rest after {taken} steps (t = {:.1}), {} contacts, {} on the wall",
+        "pile of {n}, {kind:?}: at rest after {taken} steps (t = {:.1}), {} contacts, {} on the wall; \
+         iterations a step {:.0} mean, {most} most, {} at rest; {:.1} ms a step",
         taken as f64 * 0.2,
         last.contacts,
-        last.wall_contacts
+        last.wall_contacts,
+        iterations as f64 / taken as f64,
+        last.iterations,
+        clock.elapsed().as_secs_f64() * 1e3 / taken as f64
     );
     let rows = bonds.len() + (last.contacts + last.wall_contacts) as usize;
     let (imbalance, carried) = balance(&ps, n, &mut store, rows, &vec![[0.0; 3]; n]);
@@ -433,7 +442,14 @@ fn pile_to_rest<T: Real, const N: usize>(
         last.wall_contacts,
         last.contacts
     );
-    assert!(imbalance <= tol, "{kind:?}: force imbalance {imbalance}");
+    // Every sphere's balance: a solve stopped at the tolerance leaves the pile creeping
+    // by about the tolerance a step (within the 1e-9 "at rest" above), the force that
+    // drives that creep through the mobility. The over-relaxed sweep's iterate stops
+    // just inside the tolerance: 3.2e-9 of the largest weight on the fenced pile, a
+    // fence sphere pushed sideways (Newton's and Krylov's overshoot the tolerance:
+    // below 1e-9).
+    let each = pick::<T>(1e-4, 1e-8);
+    assert!(imbalance <= each, "{kind:?}: force imbalance {imbalance}");
     (0..n).map(|i| f64s::<T>(ps.pos[i])).collect()
 }
 
@@ -483,9 +499,9 @@ fn pile_of_20_settles_f32() {
 #[test]
 #[ignore = "minutes in release: cargo test --release --test jam -- --ignored --nocapture"]
 fn pile_of_100_settles_f64() {
-    // Not the sweep: projected Gauss-Seidel converges too slowly on this jammed set
-    // (20 000 sweeps leave 5e-9 at step 163, docs/CONTACTS.md).
-    let solvers = [SolverKind::Newton, SolverKind::Krylov];
+    // The sweep too: over-relaxed from its 16th sweep on (plain projected Gauss-Seidel
+    // left 5e-9 after 20 000 sweeps at step 163, docs/CONTACTS.md).
+    let solvers = [SolverKind::Newton, SolverKind::Krylov, SolverKind::Sweep];
     pile_settles_with::<f64, 115>(&solvers, (15, 3, 11), 2000, 1e-6);
 }
 
