@@ -102,7 +102,8 @@ pub fn sweep<T: Real>(
         if it == solver.max_iterations {
             // With one-sided rows: multipliers grown into a self-stress (net force on
             // every bead below 5 % of the largest constraint force) name an infeasible
-            // dependent set (`docs/CONTACTS.md`).
+            // dependent set (`docs/CONTACTS.md`, "The sweep's infeasibility
+            // criterion": why 5 %, and where it can misname a slow solve).
             let share = T::from_f64(0.05);
             if from < bonds.len() && dependent::is_self_stress(metric, bonds, x.len(), mult, share)
             {
