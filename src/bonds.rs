@@ -64,7 +64,11 @@ impl<T: Real> Bond<T> {
 
     /// The three pin rows that hold sphere `i` fixed (x, y, z).
     pub const fn pins(i: usize, scale: T) -> [Self; 3] {
-        [Self::pin(i, 0, scale), Self::pin(i, 1, scale), Self::pin(i, 2, scale)]
+        [
+            Self::pin(i, 0, scale),
+            Self::pin(i, 1, scale),
+            Self::pin(i, 2, scale),
+        ]
     }
 
     /// `true` for a pin row ([`Bond::pin`]); always `false` without the `pins` feature

@@ -24,8 +24,8 @@ use std::f64::consts::PI;
 use common::*;
 use hydrorattle::linalg::tri;
 use hydrorattle::{
-    Bond, BondError, BondSet, Brownian, Contacts, Layout, Method, NoForce, Params,
-    ParticleError, ParticleSet, Periodic, Real, SolverKind, StepError, StepReport, step,
+    Bond, BondError, BondSet, Brownian, Contacts, Layout, Method, NoForce, Params, ParticleError,
+    ParticleSet, Periodic, Real, SolverKind, StepError, StepReport, step,
 };
 use hydrorattle_heap::Buffers;
 
@@ -101,7 +101,10 @@ fn lone_pin<T: Real>(tol: f64) {
             let f = pin_forces(&mut store, bonds.as_slice(), 1)[0];
             let w = buoyant(s.radius, RHO);
             let err = norm(sub(f, [0.0, 0.0, w])) / w;
-            assert!(err < tol, "{kind:?} {l:?}: pin force {f:?}, weight {w} ({err:e})");
+            assert!(
+                err < tol,
+                "{kind:?} {l:?}: pin force {f:?}, weight {w} ({err:e})"
+            );
         }
     }
 }
@@ -262,7 +265,10 @@ fn free_sphere_beside_a_pinned_one_free_space() {
     for kind in SOLVERS {
         let (du, df) = beside::<f64>(kind, None, closed_form::<f64>);
         eprintln!("free space {kind:?}: velocity {du:.1e}, pin force {df:.1e} (relative)");
-        assert!(du < 1e-9 && df < 1e-9, "{kind:?}: velocity {du:e}, pin force {df:e}");
+        assert!(
+            du < 1e-9 && df < 1e-9,
+            "{kind:?}: velocity {du:e}, pin force {df:e}"
+        );
         let (du, df) = beside::<f32>(kind, None, closed_form::<f32>);
         assert!(du < 1e-4 && df < 1e-4, "{kind:?} f32: {du:e}, {df:e}");
     }
@@ -273,6 +279,212 @@ fn free_sphere_beside_a_pinned_one_periodic() {
     for kind in SOLVERS {
         let (du, df) = beside::<f64>(kind, Some(9.0), ewald_blocks::<f64>);
         eprintln!("box {kind:?}: velocity {du:.1e}, pin force {df:.1e} (relative)");
-        assert!(du < 1e-9 && df < 1e-9, "{kind:?}: velocity {du:e}, pin force {df:e}");
+        assert!(
+            du < 1e-9 && df < 1e-9,
+            "{kind:?}: velocity {du:e}, pin force {df:e}"
+        );
     }
+}
+
+/// Asserts that a step with `rows` is refused as `want` says and keeps the state.
+fn refused<T: Real, const N: usize>(
+    ps: &mut ParticleSet<T, N>,
+    rows: &[Bond<T>],
+    p: &Params<T>,
+    want: impl Fn(&StepError) -> bool,
+    what: &str,
+) {
+    let mut store = Buffers::<T>::new(Layout::for_params(p, ps.len(), rows.len()).max(
+        Layout::for_params(
+            &params::<T>(0.1, Method::Overdamped, SolverKind::Auto),
+            ps.len(),
+            rows.len(),
+        ),
+    ));
+    let before = snapshot(ps);
+    let r = hydrorattle::step_slices(ps.state(), rows, p, &mut store.workspace(), &mut NoForce);
+    assert_failed_unchanged(&before, ps, &r, want, what);
+}
+
+#[test]
+fn bad_pins_are_refused_and_the_state_kept() {
+    let spheres = [
+        Sphere {
+            pos: [0.0, 0.0, 0.0],
+            radius: 1.0,
+            density: RHO,
+        },
+        Sphere {
+            pos: [2.5, 0.0, 0.0],
+            radius: 1.0,
+            density: RHO,
+        },
+    ];
+    let p = pin_params::<f64>(SolverKind::Newton, None);
+    let mut ps = particles::<f64, 2>(&spheres);
+    let pins0 = Bond::pins(0, 1.0);
+    let range = |e: &StepError| {
+        matches!(
+            e,
+            StepError::Bond(BondError::OutOfRange {
+                bond: 1,
+                particle: 5
+            })
+        )
+    };
+    refused(
+        &mut ps,
+        &[pins0[0], Bond::pin(5, 1, 1.0)],
+        &p,
+        range,
+        "out of range",
+    );
+    let axis = |e: &StepError| matches!(e, StepError::Bond(BondError::OutOfRange { bond: 0, .. }));
+    refused(&mut ps, &[Bond::pin(0, 3, 1.0)], &p, axis, "axis 3");
+    let twice = |e: &StepError| {
+        matches!(
+            e,
+            StepError::Bond(BondError::Duplicate { bond: 3, other: 0 })
+        )
+    };
+    let mut rows = pins0.to_vec();
+    rows.push(Bond::pin(0, 0, 1.5));
+    refused(&mut ps, &rows, &p, twice, "pinned twice");
+    for scale in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let bad = |e: &StepError| matches!(e, StepError::Bond(BondError::BadLength { bond: 0 }));
+        refused(&mut ps, &[Bond::pin(0, 2, scale)], &p, bad, "scale");
+    }
+    // The anchor is the sphere's position: a non-finite one is refused as such.
+    let mut nan = ps.clone();
+    nan.pos[0] = v3::<f64>(f64::NAN, 0.0, 0.0);
+    let nonfinite = |e: &StepError| {
+        matches!(
+            e,
+            StepError::Particle(ParticleError::NonFinite { particle: 0 })
+        )
+    };
+    refused(&mut nan, &pins0, &p, nonfinite, "non-finite anchor");
+    // Two pinned spheres that overlap (the second moved into the first).
+    let mut close = ps.clone();
+    close.pos[1] = v3::<f64>(1.5, 0.0, 0.0);
+    let mut rows = pins0.to_vec();
+    rows.extend(Bond::pins(1, 1.0));
+    let overlap = |e: &StepError| {
+        matches!(
+            e,
+            StepError::Particle(ParticleError::Overlap { i: 0, j: 1 })
+        )
+    };
+    refused(&mut close, &rows, &p, overlap, "pinned overlap");
+    // Methods without pins.
+    for method in [Method::Rattle, Method::RattleStable, Method::Springs] {
+        let q = Params { method, ..p };
+        let unsupported = |e: &StepError| matches!(e, StepError::Unsupported(_));
+        refused(&mut ps, &pins0, &q, unsupported, "method");
+    }
+    let mut q = p;
+    q.brownian = Some(Brownian {
+        temperature: 1.0,
+        drift: Default::default(),
+    });
+    ps.noise = Some(hydrorattle::Noise::new(1));
+    let unsupported = |e: &StepError| matches!(e, StepError::Unsupported(_));
+    refused(&mut ps, &pins0, &q, unsupported, "thermal");
+}
+
+/// A bed on a pinned floor in a periodic box: a 3 x 3 floor of touching unit spheres
+/// (holes of radius 0.41: no sphere falls through) under 8 spheres of radii 0.9 to
+/// 1.1 dropped from above, with hard contacts, settles to rest; no overlap beyond the
+/// tolerance at any step; at rest the pins carry the buoyant weight of all 17 spheres
+/// (the floor's own included) to 1e-9, and the floor has not moved by a bit.
+fn bed_settles(kind: SolverKind) {
+    let mut p = pin_params::<f64>(kind, None);
+    p.periodic = Some(Periodic::new([6.0, 6.0, 14.0]).unwrap());
+    p.contacts = Some(Contacts::new(96));
+    p.dt = 0.2;
+    let mut spheres = Vec::new();
+    for i in 0..3 {
+        for j in 0..3 {
+            spheres.push(Sphere {
+                pos: [1.0 + 2.0 * i as f64, 1.0 + 2.0 * j as f64, 1.0],
+                radius: 1.0,
+                density: RHO,
+            });
+        }
+    }
+    let free = [
+        ([1.4, 1.6, 4.2], 1.0),
+        ([4.5, 1.3, 4.6], 0.9),
+        ([1.7, 4.4, 5.0], 1.1),
+        ([4.3, 4.6, 5.4], 1.0),
+        ([3.1, 2.9, 7.8], 0.95),
+        ([0.3, 3.2, 8.3], 1.05),
+        ([3.2, 0.2, 10.6], 0.9),
+        ([5.2, 5.1, 11.0], 1.1),
+    ];
+    for (pos, radius) in free {
+        spheres.push(Sphere {
+            pos,
+            radius,
+            density: RHO,
+        });
+    }
+    let n = spheres.len();
+    let radius: Vec<f64> = spheres.iter().map(|s| s.radius).collect();
+    let mut ps = particles::<f64, 17>(&spheres);
+    let bonds = pinned_set::<f64, 27>(&(0..9).collect::<Vec<_>>(), &radius);
+    let mut store = Buffers::<f64>::new(Layout::for_params(&p, n, 27));
+    let floor = snapshot(&ps)[2..2 + 27].to_vec();
+    let total: f64 = radius.iter().map(|&a| buoyant(a, RHO)).sum();
+    let tol = p.solver.tolerance;
+    let (mut still, mut steps, mut contacts) = (0, 0, 0);
+    while still < 3 {
+        assert!(steps < 400, "{kind:?}: not at rest after {steps} steps");
+        let before = ps.pos;
+        let r = one_step(&mut ps, &bonds, &p, &mut store);
+        steps += 1;
+        let r = r.unwrap_or_else(|e| panic!("{kind:?}: step {steps}: {e}"));
+        contacts = r.contacts;
+        let moved = (0..n)
+            .map(|i| (ps.pos[i] - before[i]).length())
+            .fold(0.0, f64::max);
+        still = if moved < 1e-9 { still + 1 } else { 0 };
+        for i in 0..n {
+            for j in 0..i {
+                let d = (ps.pos[i] - ps.pos[j]).to_array();
+                let d: [f64; 3] = std::array::from_fn(|k| {
+                    let l = [6.0, 6.0, 14.0][k];
+                    d[k] - l * (d[k] / l).round()
+                });
+                let gap = norm(d) / (radius[i] + radius[j]) - 1.0;
+                assert!(
+                    gap > -2.0 * tol,
+                    "{kind:?}: {i}, {j} overlap {gap:e} at step {steps}"
+                );
+            }
+        }
+    }
+    assert_eq!(
+        snapshot(&ps)[2..2 + 27],
+        floor[..],
+        "{kind:?}: the floor moved"
+    );
+    let load: f64 = pin_forces(&mut store, bonds.as_slice(), n)
+        .iter()
+        .map(|f| f[2])
+        .sum();
+    let err = (load - total).abs() / total;
+    assert!(
+        err < 1e-9,
+        "{kind:?}: pins carry {load}, weight {total} ({err:e})"
+    );
+    eprintln!(
+        "{kind:?}: at rest after {steps} steps, {contacts} contacts, pins carry the weight to {err:.1e}"
+    );
+}
+
+/// Newton only: Krylov stalls on this jammed set (`docs/CONTACTS.md`, pins).
+#[test]
+fn bed_on_a_pinned_floor_rests_on_it() {
+    bed_settles(SolverKind::Newton);
 }

@@ -255,7 +255,11 @@ impl<T: Real> Metric<'_, T> {
                     _ => tt_block_at(level, eta, pos, radius, p, q),
                 };
                 let block = |q| block(q).unwrap_or(T::M3_ZERO);
-                let mu_pj = if b.one_sphere() { T::M3_ZERO } else { block(b.j) };
+                let mu_pj = if b.one_sphere() {
+                    T::M3_ZERO
+                } else {
+                    block(b.j)
+                };
                 sym_diff_mul::<T>(block(b.i), mu_pj, grad[l] * scale, false)
             }
             Metric::Drag {
@@ -589,6 +593,10 @@ fn periodic_at<T: Real>(
     p: usize,
 ) -> T::V3 {
     let block = |q| periodic::tt_block_at(ew, eta, pos, radius, p, q).unwrap_or(T::M3_ZERO);
-    let mu_pj = if b.one_sphere() { T::M3_ZERO } else { block(b.j) };
+    let mu_pj = if b.one_sphere() {
+        T::M3_ZERO
+    } else {
+        block(b.j)
+    };
     sym_diff_mul::<T>(block(b.i), mu_pj, g, true)
 }

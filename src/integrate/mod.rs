@@ -19,9 +19,9 @@ mod checks;
 mod contacts;
 pub mod geometry;
 mod overdamped;
-mod pins;
 #[cfg(feature = "periodic")]
 mod periodic;
+mod pins;
 #[cfg(feature = "pse")]
 mod pse_noise;
 mod rattle;

@@ -10,11 +10,12 @@
 
 use crate::bonds::Bond;
 use crate::cell::image;
-use crate::error::{ParticleError, StepError};
+use crate::error::{BondError, ParticleError, StepError};
 use crate::params::{Method, Params};
 use crate::real::Real;
 
-/// Refuses pin rows where they are not implemented, and two pinned spheres that
+/// Refuses pin rows where they are not implemented, a sphere pinned twice along one
+/// axis ([`BondError::Duplicate`]: dependent rows), and two pinned spheres that
 /// overlap (neither can move, so no step could part them): `O(B + P^2)` for `P` pin
 /// rows, nothing without any.
 pub(super) fn check<T: Real>(
@@ -34,6 +35,13 @@ pub(super) fn check<T: Real>(
     }
     if thermal {
         return Err(StepError::Unsupported("pinned spheres with thermal noise"));
+    }
+    let pins = || bonds.iter().enumerate().filter(|(_, b)| b.is_pin());
+    for (k, b) in pins() {
+        let same = |(_, o): &(usize, &Bond<T>)| o.i == b.i && o.j == b.j;
+        if let Some((other, _)) = pins().take_while(|&(l, _)| l < k).find(same) {
+            return Err(BondError::Duplicate { bond: k, other }.into());
+        }
     }
     if p.allow_overlap {
         return Ok(());

@@ -50,6 +50,7 @@ mod bodies;
 mod box_tests;
 mod contact;
 mod error;
+mod floor;
 mod helix;
 mod kernel;
 mod model;
@@ -66,9 +67,10 @@ mod thermal;
 mod wall;
 mod write;
 
-pub use beads::{Beads, BuildError, bonds, params};
+pub use beads::{Beads, BuildError, bonds, params, pins};
 pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE, SOFT_DT, SOFT_STIFFNESS};
 pub use error::{SceneError, line_col};
+pub use floor::{Floor, slab_fraction};
 pub use helix::{Chain, HeadEnd, Helix};
 pub use model::{
     Bond, Flow, Fluid, Hydrodynamics, Integrator, Level, Method, Model, Output, Overlap, Particle,
@@ -176,6 +178,13 @@ pub struct Scene {
     /// The suspension generator's settings, when the scene used one (`[suspension]`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub suspension: Option<Suspension>,
+    /// The pinned floor under the suspension, when the scene lays one (`[floor]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub floor: Option<Floor>,
+    /// The pinned spheres (ascending indices): held at their positions by the kernel's
+    /// pin rows (`fixed = true` on a `[[particle]]`, or the `[floor]`'s spheres).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pinned: Vec<usize>,
     /// Species (type name) of each particle: `head` and `tail` for a helix; the
     /// `species` key, or one name per distinct radius and density, for explicit
     /// particles. The generators' names are borrowed: a sweep resolves a scene per
