@@ -51,6 +51,8 @@ mod box_tests;
 mod contact;
 mod error;
 mod floor;
+#[cfg(test)]
+mod floor_tests;
 mod helix;
 mod kernel;
 mod model;
