@@ -17,6 +17,8 @@
 //!   pinned twice, a bad axis or scale, a non-finite anchor, overlapping pinned
 //!   spheres, and the methods pins do not support.
 
+#![allow(clippy::needless_range_loop)] // 3x3 matrices indexed as written.
+
 mod common;
 
 use std::f64::consts::PI;

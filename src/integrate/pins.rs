@@ -68,15 +68,13 @@ pub(super) fn check<T: Real>(
 
 /// Puts every pinned coordinate of the candidate back on its anchor (`start`), with a
 /// zero velocity along it (the solve left it within the tolerance).
+#[cfg(feature = "pins")]
 pub(super) fn restore<T: Real>(
     bonds: &[Bond<T>],
     start: &[T::V3],
     pos: &mut [T::V3],
     vel: &mut [T::V3],
 ) {
-    if !cfg!(feature = "pins") {
-        return;
-    }
     for b in bonds.iter().filter(|b| b.is_pin()) {
         let e = b.axis();
         let (mut x, mut v) = (T::xyz(pos[b.i]), T::xyz(vel[b.i]));

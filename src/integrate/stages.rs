@@ -310,6 +310,7 @@ pub(super) fn spin<T: Real>(
 /// at their spheres' positions in `anchor` (the step's start). Inlined into every projection, so that the solver choice folds where
 /// the parameters are constant ([`constraints::solve`]).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn project_positions<T: Real>(
     p: &Params<T>,
     bonds: &[Bond<T>],

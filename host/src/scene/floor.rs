@@ -73,7 +73,7 @@ impl Floor {
     ) -> Result<(Vec<Particle>, [f64; 3]), String> {
         let a = self.radius;
         let k = (edge / (2.0 * a)).floor();
-        if !(k >= 1.0) {
+        if k.is_nan() || k < 1.0 {
             return Err(format!(
                 "a floor sphere of radius {a} does not fit across the box's edge {edge}"
             ));
@@ -86,7 +86,7 @@ impl Floor {
                 (lo.min(p.radius), hi.max(p.radius))
             });
         let hole = (std::f64::consts::SQRT_2 * spacing - 2.0 * a) / 2.0;
-        if !(hole < lo) {
+        if hole.is_nan() || hole >= lo {
             return Err(format!(
                 "spheres of radius {lo} would fall through the floor: its lattice ({k} x {k} spheres of radius {a}, spacing {spacing}) leaves holes of radius {hole}; give the floor a larger radius"
             ));

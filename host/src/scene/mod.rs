@@ -14,7 +14,7 @@
 //! | `[fluid]` | `viscosity` (> 0), `density` (>= 0) | 1, 0 |
 //! | `[gravity]` | `acceleration = [x, y, z]` | `[0, 0, -1]` |
 //! | `[flow]` | `velocity = [..]`, `vorticity = [..]` (uniform flow plus rigid rotation; at most [`MAX_TURN_PER_STEP`] radians a step: `\|vorticity\| dt <= 1`) | zeros |
-//! | `[[particle]]` | `position = [..]` (required), `radius` (required, > 0), `density` (>= 0), `velocity = [..]`, `angular_velocity = [..]`, `species` (a type name) | density 4.5, at rest, one species per radius and density |
+//! | `[[particle]]` | `position = [..]` (required), `radius` (required, > 0), `density` (>= 0), `velocity = [..]`, `angular_velocity = [..]`, `species` (a type name), `fixed` (`true`: pinned where it is) | density 4.5, at rest, one species per radius and density |
 //! | `[[bond]]` | `between = [i, j]` (required, 0-based), `length` (> 0; >= 0 with `method = "springs"`: a spring's rest length) | initial distance |
 //! | `[helix]` | `tails`, `head_ratio`, `dhat`, `head_end`, `radius`, `pitch`, `density` | see [`Helix`] |
 //! | `[model]` | `hydrodynamics = "rpy"\|"oseen"\|"free-draining"`, `inertia`, `rotation`, `level = "auto"\|"manual"`, `overlap = "reject"\|"allow"` | rpy, false, false, manual, reject |
@@ -24,6 +24,7 @@
 //! | `[wall]` | `height` (required, finite): a no-slip plane `z = height` below every sphere (`method = "overdamped"` or `"overdamped2"`, level manual; see [`Wall`]) | no wall |
 //! | `[box]` | `size = [Lx, Ly, Lz]` (required unless `[suspension]` sets it; finite, > 0), `method = "ewald"\|"pse"\|"auto"`, `tolerance` (`1e-12` to `0.1`): a periodic box (see [`PeriodicBox`]) | no box; auto, 1e-6 |
 //! | `[suspension]` | `count` (required, >= 1), `fraction` (required, `0 < phi <=` [`MAX_FRACTION`]), `radius`, `polydispersity` (`0 <= p < 1`), `density`, `seed`: spheres placed at random in a cubic box (see [`Suspension`]) | 1, 0, 4.5, 1 |
+//! | `[floor]` | `radius` (> 0), `density` (>= 0): a pinned square lattice under the `[suspension]` (see [`Floor`]) | the suspension's radius and density |
 //!
 //! A scene gives one of a `[helix]` table, a `[suspension]` table (which needs a
 //! `[box]` table, without `size`) or explicit `[[particle]]` (and optionally
