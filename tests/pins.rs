@@ -4,7 +4,7 @@
 //!
 //! * a lone pinned sphere under gravity does not move (bit for bit) and its pin force
 //!   is minus its buoyant weight `4/3 pi a^3 (rho - rho_f) g`, with every solver, in
-//!   free space and in a periodic box;
+//!   free space and in a periodic box (and stays put with `Overdamped2`);
 //! * a free sphere beside a pinned one (free space): the free sphere's velocity is
 //!   `(M11 - M12 M22^-1 M21) F` and the pin's force `-M22^-1 M21 F`, with `M` the
 //!   two-sphere RPY tensors written here from the closed form (Rotne and Prager 1969;
@@ -82,9 +82,15 @@ fn pinned_set<T: Real, const B: usize>(spheres: &[usize], radius: &[f64]) -> Bon
 }
 
 fn lone_pin<T: Real>(tol: f64) {
-    for l in [None, Some(8.0)] {
+    for (l, method) in [None, Some(8.0)].into_iter().zip([Method::Overdamped2; 2]).chain([
+        (None, Method::Overdamped),
+        (Some(8.0), Method::Overdamped),
+    ]) {
         for kind in SOLVERS {
-            let p = pin_params::<T>(kind, l);
+            let p = Params {
+                method,
+                ..pin_params::<T>(kind, l)
+            };
             let s = Sphere {
                 pos: [0.3, -0.2, 1.7],
                 radius: 1.3,
@@ -99,7 +105,12 @@ fn lone_pin<T: Real>(tol: f64) {
             }
             let after = snapshot(&ps);
             // Positions bit for bit (the state's positions follow n and time).
-            assert_eq!(before[2..5], after[2..5], "{kind:?} {l:?}: moved");
+            assert_eq!(before[2..5], after[2..5], "{method:?} {kind:?} {l:?}: moved");
+            // Overdamped2's last projection's multipliers are a correction to the
+            // predictor's (`Engine::tensions`): its force is not the holding force.
+            if method == Method::Overdamped2 {
+                continue;
+            }
             let f = pin_forces(&mut store, bonds.as_slice(), 1)[0];
             let w = buoyant(s.radius, RHO);
             let err = norm(sub(f, [0.0, 0.0, w])) / w;
