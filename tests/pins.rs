@@ -82,10 +82,11 @@ fn pinned_set<T: Real, const B: usize>(spheres: &[usize], radius: &[f64]) -> Bon
 }
 
 fn lone_pin<T: Real>(tol: f64) {
-    for (l, method) in [None, Some(8.0)].into_iter().zip([Method::Overdamped2; 2]).chain([
-        (None, Method::Overdamped),
-        (Some(8.0), Method::Overdamped),
-    ]) {
+    for (l, method) in [None, Some(8.0)]
+        .into_iter()
+        .zip([Method::Overdamped2; 2])
+        .chain([(None, Method::Overdamped), (Some(8.0), Method::Overdamped)])
+    {
         for kind in SOLVERS {
             let p = Params {
                 method,
@@ -105,7 +106,11 @@ fn lone_pin<T: Real>(tol: f64) {
             }
             let after = snapshot(&ps);
             // Positions bit for bit (the state's positions follow n and time).
-            assert_eq!(before[2..5], after[2..5], "{method:?} {kind:?} {l:?}: moved");
+            assert_eq!(
+                before[2..5],
+                after[2..5],
+                "{method:?} {kind:?} {l:?}: moved"
+            );
             // Overdamped2's last projection's multipliers are a correction to the
             // predictor's (`Engine::tensions`): its force is not the holding force.
             if method == Method::Overdamped2 {

@@ -237,11 +237,15 @@ impl<T: Real> Engine<T> {
     }
 
     /// The total force the pins exert on the pinned spheres after the last accepted
-    /// step (`sum lambda s e` over the pin rows), `None` before the first step or
-    /// without pins. At rest it carries the buoyant weight of everything on them.
+    /// step (`sum lambda s e` over the pin rows), `None` before the first step,
+    /// without pins, and for `Overdamped2` (its last projection's multipliers are a
+    /// correction to the predictor's, as for [`Engine::tensions`]). At rest it carries
+    /// the buoyant weight of everything on them.
     pub fn pin_load(&self) -> Option<[T; 3]> {
         let first = self.bonds.len();
-        if self.pins.is_empty() || self.multipliers.len() != first + self.pins.len() {
+        let rows = first + self.pins.len();
+        let method = self.params.method;
+        if self.pins.is_empty() || self.multipliers.len() != rows || method == Method::Overdamped2 {
             return None;
         }
         let mut f = [T::ZERO; 3];
