@@ -460,15 +460,15 @@ def test_a_fixed_sphere_holds_still_and_slows_its_neighbour():
 density = 1.0
 
 [gravity]
-acceleration = {list(g)}
+acceleration = {g.tolist()}
 
 [[particle]]
-position = {list(r1)}
+position = {r1.tolist()}
 radius = {a1}
 density = {RHO}
 
 [[particle]]
-position = {list(r2)}
+position = {r2.tolist()}
 radius = {a2}
 density = 1.0
 fixed = true
