@@ -12,6 +12,15 @@
 //! along the wall and takes no force. The projection runs in the wall's frame (the plane
 //! is `z = 0` there), so the link's relative vector is the normal component
 //! `(0, 0, z_i)` ([`Bond::relative`]); its length is the sphere's radius (touching).
+//!
+//! A caller's list may hold **pin rows** ([`Bond::pin`], `docs/CONTACTS.md`): sphere
+//! `i` held along axis `e` at its *anchor*, its position at the start of the step
+//! (`x_i . e = anchor . e`), a linear equality that pushes on that sphere alone along
+//! `e`. Three rows (x, y, z: [`Bond::pins`]) hold a sphere fixed; the multipliers are
+//! the force that holds it. Their `j` is a tag past every particle index
+//! ([`PIN`] + axis), their length a scale (the sphere's radius: the residual is the
+//! anchor's error in radii). The step puts a pinned coordinate back on its anchor bit
+//! for bit after the solve, so a pinned sphere never drifts.
 
 use crate::cell::Periodic;
 use crate::error::BondError;
@@ -42,6 +51,46 @@ impl<T: Real> Bond<T> {
         }
     }
 
+    /// Pin row of sphere `i` along `axis` (0, 1, 2: x, y, z; see the module), `scale`
+    /// its length (> 0; the sphere's radius). An axis past 2 makes a row that
+    /// [`validate`] refuses ([`BondError::OutOfRange`]).
+    pub const fn pin(i: usize, axis: usize, scale: T) -> Self {
+        Self {
+            i,
+            j: PIN.wrapping_add(if axis < 3 { axis } else { 3 }),
+            length: scale,
+        }
+    }
+
+    /// The three pin rows that hold sphere `i` fixed (x, y, z).
+    pub const fn pins(i: usize, scale: T) -> [Self; 3] {
+        [
+            Self::pin(i, 0, scale),
+            Self::pin(i, 1, scale),
+            Self::pin(i, 2, scale),
+        ]
+    }
+
+    /// `true` for a pin row ([`Bond::pin`]); always `false` without the `pins` feature
+    /// (firmware: every pin branch compiles away).
+    #[inline(always)]
+    pub const fn is_pin(&self) -> bool {
+        cfg!(feature = "pins") && self.j >= PIN && self.j < PIN + 3
+    }
+
+    /// `true` for a link that pushes on sphere `i` alone: a wall link or a pin row (`j`
+    /// names no sphere).
+    #[inline(always)]
+    pub const fn one_sphere(&self) -> bool {
+        self.is_wall() || self.is_pin()
+    }
+
+    /// The axis a one-sphere link holds: `z` for a wall link, the pin row's axis.
+    #[inline(always)]
+    pub const fn axis(&self) -> usize {
+        if self.is_pin() { self.j - PIN } else { 2 }
+    }
+
     /// `true` for a wall link ([`Bond::wall`]).
     #[inline(always)]
     pub const fn is_wall(&self) -> bool {
@@ -52,11 +101,13 @@ impl<T: Real> Bond<T> {
 
     /// `v_i - v_j` over per-particle vectors `v` (positions, displacements): for a
     /// wall link, the normal component `(0, 0, v_i.z)` (its other end, the foot on the
-    /// wall, moves with the sphere along the wall).
+    /// wall, moves with the sphere along the wall); for a pin row, the component of
+    /// `v_i` along its axis (a displacement or a velocity; a position's error is
+    /// measured from the anchor by the solve).
     #[inline(always)]
     pub fn relative(&self, v: &[T::V3]) -> T::V3 {
-        if self.is_wall() {
-            normal::<T>(v[self.i])
+        if self.one_sphere() {
+            component::<T>(v[self.i], self.axis())
         } else {
             v[self.i] - v[self.j]
         }
@@ -65,20 +116,36 @@ impl<T: Real> Bond<T> {
 
 impl<T: Real> Bond<T> {
     /// The link's relative position `x_i - x_j` ([`Bond::relative`]), in a periodic box
-    /// its minimum image ([`crate::cell::image`]; a wall link has none to take).
+    /// its minimum image ([`crate::cell::image`]; a wall link or a pin row has none to
+    /// take: a pin's anchor is the unwrapped start position).
     #[inline(always)]
     pub fn separation(&self, pos: &[T::V3], cell: Option<&Periodic<T>>) -> T::V3 {
-        match self.is_wall() {
+        match self.one_sphere() {
             true => self.relative(pos),
             false => crate::cell::image(cell, pos[self.i] - pos[self.j]),
         }
     }
 }
 
-/// `(0, 0, v.z)`: the component along the wall's normal.
+/// The first of the `j` tags of pin rows ([`Bond::pin`]): `PIN + axis`. Past any
+/// particle index a step can hold.
+pub const PIN: usize = usize::MAX - 3;
+
+/// The component of `v` along coordinate axis `axis` (a vector along it).
 #[inline(always)]
-pub(crate) fn normal<T: Real>(v: T::V3) -> T::V3 {
-    T::v3(T::ZERO, T::ZERO, T::xyz(v)[2])
+pub(crate) fn component<T: Real>(v: T::V3, axis: usize) -> T::V3 {
+    let c = T::xyz(v);
+    let mut e = [T::ZERO; 3];
+    e[axis] = c[axis];
+    T::v3(e[0], e[1], e[2])
+}
+
+/// The unit vector of coordinate axis `axis` times `s`.
+#[inline(always)]
+pub(crate) fn along<T: Real>(axis: usize, s: T) -> T::V3 {
+    let mut e = [T::ZERO; 3];
+    e[axis] = s;
+    T::v3(e[0], e[1], e[2])
 }
 
 /// Relative length error of link `b` whose relative vector is `r`:
@@ -222,7 +289,8 @@ pub fn validate<T: Real>(bonds: &[Bond<T>], n: usize) -> Result<(), BondError> {
 /// Largest relative length error `| |r_ij| - d | / d` over `bonds` and the bond where it
 /// occurs. NaN is sticky (a NaN residual is never hidden), and a bond naming a particle
 /// beyond `pos` counts as infinitely violated. A bond of length zero (a spring's rest
-/// length) has no relative error and is skipped. A wall link ([`Bond::wall`]) counts its
+/// length) has no relative error and is skipped, as is a pin row (its error is
+/// measured from the anchor by the solve, [`Bond::pin`]). A wall link ([`Bond::wall`]) counts its
 /// height error `|z_i - a| / a` (positions in the wall's frame).
 ///
 /// Two square roots, not one per bond: the error grows with `|r_ij|^2 / d^2` away from 1
@@ -243,6 +311,11 @@ pub fn max_residual_in<T: Real>(
     let (mut hi, mut lo) = ((0, T::ZERO), (0, T::ZERO));
     let mut first = true;
     for (k, b) in bonds.iter().enumerate() {
+        // A pin row's error is its anchor's, which the solve measures (the step puts
+        // the coordinate back on it after the solve): none here.
+        if b.is_pin() && b.i < pos.len() {
+            continue;
+        }
         if b.i >= pos.len() || b.j >= pos.len() {
             return max_residual_each(bonds, pos, cell);
         }
@@ -291,8 +364,8 @@ fn max_residual_each<T: Real>(
 ) -> (usize, T) {
     let mut worst = (0, T::ZERO);
     for (k, b) in bonds.iter().enumerate() {
-        let r = match b.i < pos.len() && b.j < pos.len() {
-            true if b.length == T::ZERO => continue,
+        let r = match b.i < pos.len() && (b.j < pos.len() || b.is_pin()) {
+            true if b.length == T::ZERO || b.is_pin() => continue,
             true => link_error(b, b.separation(pos, cell)),
             false => T::ONE / T::ZERO,
         };
@@ -320,6 +393,19 @@ fn check_bond<T: Real>(
 /// Bond `k` on its own against `n` particles: range, self-bond, length (finite, >= 0;
 /// `O(1)`).
 pub(crate) fn check_one<T: Real>(k: usize, b: &Bond<T>, n: usize) -> Result<(), BondError> {
+    // A pin row's `j` is its axis tag (no particle); its scale must be > 0.
+    if b.is_pin() {
+        if b.i >= n {
+            return Err(BondError::OutOfRange {
+                bond: k,
+                particle: b.i,
+            });
+        }
+        if !(b.length > T::ZERO && (b.length * b.length).is_finite()) {
+            return Err(BondError::BadLength { bond: k });
+        }
+        return Ok(());
+    }
     for p in [b.i, b.j] {
         if p >= n {
             return Err(BondError::OutOfRange {

@@ -447,3 +447,48 @@ def test_compact_products_keep_the_bonds_and_stay_near_the_f64_run():
     # Different storage, so not the same bits; f32's rounding of the matrix, 6e-8
     # relative, bounds how far the constrained velocities may differ.
     assert 0 < gap < 1e-5 * moved, (gap, moved)
+
+
+def test_a_fixed_sphere_holds_still_and_slows_its_neighbour():
+    """A pinned sphere (``fixed = true``, the kernel's pin rows) does not move, and a
+    free sphere beside it settles at ``(M11 - M12 M22^-1 M21) F``, the two-sphere RPY
+    tensors written here from the closed form (docs/CONTACTS.md, pinned spheres)."""
+    r1, r2 = np.array([0.2, 0.1, 0.3]), np.array([3.1, 0.8, -0.6])
+    a1, a2, g = 1.0, 1.5, np.array([0.3, -0.5, -1.0])
+    text = f"""
+[fluid]
+density = 1.0
+
+[gravity]
+acceleration = {g.tolist()}
+
+[[particle]]
+position = {r1.tolist()}
+radius = {a1}
+density = {RHO}
+
+[[particle]]
+position = {r2.tolist()}
+radius = {a2}
+density = 1.0
+fixed = true
+
+[integrator]
+method = "overdamped"
+dt = 0.1
+duration = 0.1
+"""
+    s = hr.System.from_scene_text(text, "fixed.toml")
+    before = s.positions
+    s.step()
+    after = s.positions
+    assert np.array_equal(after[1], before[1])
+    r = r1 - r2
+    d = np.linalg.norm(r)
+    q = (a1 * a1 + a2 * a2) / (d * d)
+    m12 = ((1 + q / 3) * np.eye(3) + (1 - q) * np.outer(r, r) / (d * d)) / (8 * math.pi * d)
+    m11, m22 = np.eye(3) / (6 * math.pi * a1), np.eye(3) / (6 * math.pi * a2)
+    force = 4.0 / 3.0 * math.pi * a1**3 * (RHO - 1.0) * g
+    want = (m11 - m12 @ np.linalg.solve(m22, m12.T)) @ force
+    got = (after[0] - before[0]) / 0.1
+    assert np.allclose(got, want, rtol=1e-10, atol=0.0)

@@ -119,7 +119,7 @@ pub(super) fn is_self_stress<T: Real>(
         for (l, b) in bonds.iter().enumerate() {
             if b.i == p {
                 f += metric.grad(l) * v[l];
-            } else if b.j == p && !b.is_wall() {
+            } else if b.j == p && !b.one_sphere() {
                 f -= metric.grad(l) * v[l];
             }
         }

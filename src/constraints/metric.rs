@@ -8,7 +8,8 @@
 //!
 //! A wall link ([`Bond::wall`]) pushes on its sphere alone: its `j` term is absent
 //! (`D_l(p) = scale mu_pi g_l`), and the change of its relative vector is the normal
-//! component of its sphere's displacement ([`Bond::relative`]).
+//! component of its sphere's displacement ([`Bond::relative`]). A pin row
+//! ([`Bond::pin`]) is the same along its axis.
 
 use crate::bonds::Bond;
 use crate::linalg::{self, tri};
@@ -220,7 +221,7 @@ impl<T: Real> Metric<'_, T> {
                 mu, grad, scale, ..
             } => {
                 let g = grad[l] * scale;
-                let mu_pj = match b.is_wall() {
+                let mu_pj = match b.one_sphere() {
                     true => T::M3_ZERO,
                     false => sym_block::<T>(mu, p, b.j),
                 };
@@ -254,7 +255,11 @@ impl<T: Real> Metric<'_, T> {
                     _ => tt_block_at(level, eta, pos, radius, p, q),
                 };
                 let block = |q| block(q).unwrap_or(T::M3_ZERO);
-                let mu_pj = if b.is_wall() { T::M3_ZERO } else { block(b.j) };
+                let mu_pj = if b.one_sphere() {
+                    T::M3_ZERO
+                } else {
+                    block(b.j)
+                };
                 sym_diff_mul::<T>(block(b.i), mu_pj, grad[l] * scale, false)
             }
             Metric::Drag {
@@ -277,8 +282,8 @@ impl<T: Real> Metric<'_, T> {
     #[inline(always)]
     pub fn relative(&self, bonds: &[Bond<T>], k: usize, l: usize) -> T::V3 {
         let b = bonds[k];
-        if b.is_wall() {
-            return crate::bonds::normal::<T>(self.at(bonds, l, b.i));
+        if b.one_sphere() {
+            return crate::bonds::component::<T>(self.at(bonds, l, b.i), b.axis());
         }
         self.at(bonds, l, b.i) - self.at(bonds, l, b.j)
     }
@@ -298,7 +303,7 @@ impl<T: Real> Metric<'_, T> {
         match *self {
             Metric::Dense { disp, n, .. } => {
                 let rows = disp[first * n..].chunks_exact(n);
-                if b.is_wall() {
+                if b.one_sphere() {
                     // A wall link moves its sphere alone.
                     for (r, d) in row.iter_mut().zip(rows) {
                         *r = T::dot(dir, d[b.i]);
@@ -323,7 +328,7 @@ impl<T: Real> Metric<'_, T> {
             Metric::Mass { .. } => {
                 let b = bonds[l];
                 x[b.i] += self.at(bonds, l, b.i) * c;
-                if !b.is_wall() {
+                if !b.one_sphere() {
                     x[b.j] += self.at(bonds, l, b.j) * c;
                 }
             }
@@ -395,7 +400,7 @@ impl<T: Real> Metric<'_, T> {
                 for (l, b) in bonds.iter().enumerate() {
                     let g = grad[l] * (c[l] * scale);
                     out[b.i] += g * inv_mass[b.i];
-                    if !b.is_wall() {
+                    if !b.one_sphere() {
                         out[b.j] -= g * inv_mass[b.j];
                     }
                 }
@@ -526,7 +531,7 @@ fn table<T: Real, const SYM: bool>(
         let g = grad[l] * scale;
         // Bead `q`'s entry of this bond is `disp[l * n + q]` (bond-major).
         let out = &mut disp[l * n..(l + 1) * n];
-        if b.is_wall() {
+        if b.one_sphere() {
             for (q, o) in out.iter_mut().enumerate() {
                 *o = sym_diff_mul::<T>(sym_block::<T>(mu, q, b.i), T::M3_ZERO, g, false);
             }
@@ -571,7 +576,7 @@ fn spread<T: Real>(bonds: &[Bond<T>], grad: &[T::V3], c: &[T], scale: T, f: &mut
     for (l, b) in bonds.iter().enumerate() {
         let g = grad[l] * (c[l] * scale);
         f[b.i] += g;
-        if !b.is_wall() {
+        if !b.one_sphere() {
             f[b.j] -= g;
         }
     }
@@ -591,6 +596,10 @@ fn periodic_at<T: Real>(
     p: usize,
 ) -> T::V3 {
     let block = |q| periodic::tt_block_at(ew, eta, pos, radius, p, q).unwrap_or(T::M3_ZERO);
-    let mu_pj = if b.is_wall() { T::M3_ZERO } else { block(b.j) };
+    let mu_pj = if b.one_sphere() {
+        T::M3_ZERO
+    } else {
+        block(b.j)
+    };
     sym_diff_mul::<T>(block(b.i), mu_pj, g, true)
 }

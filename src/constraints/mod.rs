@@ -11,7 +11,9 @@
 //! radius above the plane `z = 0` (positions in the wall's frame) by the linear
 //! constraint `2 a (z_i - a) = 0`. Its multiplier pushes on the sphere alone, along
 //! `g = (0, 0, a)`; everything else (metrics, Jacobians, solvers) treats it as a link
-//! whose other end does not move along the normal ([`Bond::relative`]).
+//! whose other end does not move along the normal ([`Bond::relative`]). Pin rows
+//! ([`Bond::pin`]) are such links along x, y or z, measured from their anchors
+//! ([`Problem::Positions`]), and are equalities among the bonds.
 
 mod dependent;
 mod krylov;
@@ -108,6 +110,10 @@ pub enum Problem<'a, T: Real> {
         /// `sigma >= 0`, a non-negative multiplier, complementary; `docs/CONTACTS.md`),
         /// the rows before it equalities. `usize::MAX`: none.
         one_sided: usize,
+        /// The anchors of the pin rows ([`Bond::pin`]): the positions at the start of
+        /// the step, indexed by sphere (empty where no row is a pin).
+        #[cfg(feature = "pins")]
+        anchor: &'a [T::V3],
     },
     /// `b_k . (x_i - x_j) = 0` with `b_k` the new bond vectors (RATTLE); `dt` scales the
     /// residual to a relative length change per step.
@@ -130,6 +136,19 @@ impl<T: Real> Problem<'_, T> {
         };
         let d2 = b.length * b.length;
         match *self {
+            // A pin row's linear constraint `2 s (x_i - anchor_i) . e` (see [`Bond::pin`]):
+            // the wall link's with the anchor in place of the plane (no image taken).
+            #[cfg(feature = "pins")]
+            Problem::Positions { anchor, .. } if b.is_pin() => {
+                let e = b.axis();
+                let off = T::xyz(x[b.i])[e] - T::xyz(anchor[b.i])[e];
+                let two_s = T::TWO * b.length;
+                (
+                    two_s * off,
+                    crate::bonds::along::<T>(e, two_s),
+                    (off / b.length).abs(),
+                )
+            }
             // A wall link's linear constraint `2 d (z - d)` (see [`Bond::wall`]); its
             // gradient `(0, 0, 2 d)` is the chord's `c g` (`g = (0, 0, d)`).
             Problem::Positions { .. } if b.is_wall() => {
@@ -265,7 +284,14 @@ pub(crate) const fn index_scratch(kind: SolverKind, bonds: usize) -> usize {
 /// [`max_residual`](crate::bonds::max_residual)).
 fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T {
     if let Problem::Positions { cell, .. } = problem {
-        return crate::bonds::max_residual_in(bonds, x, cell.as_ref()).1;
+        let mut w = crate::bonds::max_residual_in(bonds, x, cell.as_ref()).1;
+        // Pin rows (skipped above): their anchors' errors.
+        if cfg!(feature = "pins") {
+            for (k, b) in bonds.iter().enumerate().filter(|(_, b)| b.is_pin()) {
+                w = w.max_sticky(problem.eval(b, k, x).2);
+            }
+        }
+        return w;
     }
     let mut w = T::ZERO;
     for (k, b) in bonds.iter().enumerate() {

@@ -243,6 +243,7 @@ pub(super) fn check_all<T: Real>(
 ) -> Result<(Option<crate::params::Brownian<T>>, HeldSums<T>), StepError> {
     check_inputs(state, bonds, p)?;
     let thermal = check_thermal(p, has_generator)?;
+    super::pins::check(p, bonds, state.pos, state.radius, thermal.is_some())?;
     check_contacts(p, thermal.is_some())?;
     // The box first: a box with a wall is refused as such, not by the wall's check.
     let sums = check_periodic(p, state, bonds)?;

@@ -160,7 +160,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
         free(x);
         shift(x, wall, -T::ONE);
         // Contacts and wall links are inequalities inside the solve (`docs/CONTACTS.md`).
-        let stats = project_positions(p, active, &metric, x, lambda, scratch, nb)?;
+        let stats = project_positions(p, active, &metric, x, lambda, scratch, nb, start)?;
         let Some(c) = one_sided else {
             return Ok(Projected {
                 stats,
@@ -390,7 +390,9 @@ fn add_pairs<T: Real>(
             return Ok(());
         }
         let joins = |b: &Bond<T>| (b.i == i && b.j == j) || (b.i == j && b.j == i);
-        if bonds.iter().any(joins) || set.held().iter().any(joins) {
+        // Two pinned spheres cannot move apart: no contact between them.
+        let pinned = |s| bonds.iter().any(|b| b.is_pin() && b.i == s);
+        if bonds.iter().any(joins) || set.held().iter().any(joins) || pinned(i) && pinned(j) {
             return Ok(());
         }
         set.push(Bond {

@@ -21,6 +21,7 @@ pub mod geometry;
 mod overdamped;
 #[cfg(feature = "periodic")]
 mod periodic;
+mod pins;
 #[cfg(feature = "pse")]
 mod pse_noise;
 mod rattle;
@@ -210,6 +211,12 @@ fn advance<T: Real, E: ExternalForce<T>>(
             (Method::Springs, ..) => springs(p, &s, bonds, v, ext, None),
         }
     };
+    // Pinned coordinates back on their anchors (`pins.rs`).
+    #[cfg(feature = "pins")]
+    if integrated.is_ok() {
+        let (pos, rest) = ws.vectors.split_at_mut(n);
+        pins::restore(bonds, state.pos, pos, &mut rest[..n]);
+    }
     // 3. Accept. The candidate state heads the vector storage (see `Workspace::views`).
     // Every index of the workspace is free by now: the pair check's cell list.
     let (par, cells) = (ws.parallel, &mut *ws.indices);

@@ -93,6 +93,9 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
         Problem::Positions {
             cell: cell(p),
             one_sided: usize::MAX,
+            // Pins are refused with this method (`integrate::checks`).
+            #[cfg(feature = "pins")]
+            anchor: &[],
         },
         &metric,
         bonds,

@@ -161,7 +161,7 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
         let disp = &disp[..n * bonds.len()];
         Metric::Dense { disp, n, grad }
     };
-    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut sc, usize::MAX)?;
+    let stats = project_positions(p, bonds, &metric, new_pos, lambda, &mut sc, usize::MAX, &[])?;
     step_velocity(s.pos, new_pos, dt, new_vel);
     // The unconstrained displacement `u dt` for the tensions (`u` is the spin's next).
     for (d, &w) in t[..n].iter_mut().zip(u[..n].iter()) {

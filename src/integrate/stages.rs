@@ -221,7 +221,7 @@ pub(super) fn assemble_tt<T: Real>(
 
 /// `g_l = r_i - r_j` for every bond (its minimum image in a periodic box `cell`);
 /// `(0, 0, a)` for a wall link (the wall's normal, scaled as the link's relative vector
-/// at contact: [`Bond::wall`]).
+/// at contact: [`Bond::wall`]); `s e` for a pin row along axis `e` ([`Bond::pin`]).
 pub(super) fn bond_vectors<T: Real>(
     bonds: &[Bond<T>],
     pos: &[T::V3],
@@ -229,8 +229,8 @@ pub(super) fn bond_vectors<T: Real>(
     out: &mut [T::V3],
 ) {
     for (g, b) in out.iter_mut().zip(bonds) {
-        *g = match b.is_wall() {
-            true => T::v3(T::ZERO, T::ZERO, b.length),
+        *g = match b.one_sphere() {
+            true => crate::bonds::along::<T>(b.axis(), b.length),
             false => crate::cell::image(cell.as_ref(), pos[b.i] - pos[b.j]),
         };
     }
@@ -260,7 +260,7 @@ pub(super) fn add_constraint_forces<T: Real>(
 ) {
     for (l, b) in bonds.iter().enumerate() {
         f[b.i] += grad[l] * lambda[l];
-        if !b.is_wall() {
+        if !b.one_sphere() {
             f[b.j] -= grad[l] * lambda[l];
         }
     }
@@ -307,9 +307,11 @@ pub(super) fn spin<T: Real>(
 
 /// Projects `x` onto the bonds along `metric`; the multipliers start from zero and end
 /// in `lambda`. The rows from `one_sided` on (contacts and wall links; `usize::MAX`:
-/// none) are inequalities ([`Problem::Positions`]). Inlined into every projection, so that the solver choice folds where
+/// none) are inequalities ([`Problem::Positions`]); pin rows ([`Bond::pin`]) are held
+/// at their spheres' positions in `anchor` (the step's start). Inlined into every projection, so that the solver choice folds where
 /// the parameters are constant ([`constraints::solve`]).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn project_positions<T: Real>(
     p: &Params<T>,
     bonds: &[Bond<T>],
@@ -318,12 +320,16 @@ pub(super) fn project_positions<T: Real>(
     lambda: &mut [T],
     scratch: &mut Scratch<'_, T>,
     one_sided: usize,
+    anchor: &[T::V3],
 ) -> Result<SolveStats<T>, StepError> {
     lambda.fill(T::ZERO);
+    let _ = anchor; // Read only with the `pins` feature.
     constraints::solve(
         Problem::Positions {
             cell: cell(p),
             one_sided,
+            #[cfg(feature = "pins")]
+            anchor,
         },
         metric,
         bonds,

@@ -110,6 +110,17 @@ pub fn bonds<T: Real>(bonds: &[scene::Bond], n: usize) -> Result<Vec<Bond<T>>, B
     Ok(out)
 }
 
+/// The kernel's pin rows of `scene`: three per pinned sphere ([`Bond::pins`], the
+/// sphere's radius as their scale), to follow the bonds in the step's list.
+pub fn pins<T: Real>(scene: &Scene) -> Vec<Bond<T>> {
+    let radius = |k: usize| T::from_f64(scene.particles.get(k).map_or(1.0, |p| p.radius));
+    scene
+        .pinned
+        .iter()
+        .flat_map(|&k| Bond::pins(k, radius(k)))
+        .collect()
+}
+
 /// Why a run cannot start: the kernel refuses a particle or a bond, or the storage
 /// would exceed the limit.
 #[derive(Clone, Copy, Debug, PartialEq)]

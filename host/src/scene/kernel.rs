@@ -69,6 +69,7 @@ impl KeySpans {
             span(raw.contact.as_ref().map(|c| c.span()), "contacts"),
             span(box_span(raw), "a periodic box"),
             span(box_span(raw), "periodic"),
+            span(pinned_span(raw), "pinned"),
         ];
         KeySpans {
             keys: keys.into_iter().flatten().collect(),
@@ -91,6 +92,16 @@ fn box_span(raw: &RawScene) -> Option<Range<usize>> {
     let size = table.and_then(|b| b.get_ref().size_span());
     size.or(table.map(|b| b.span()))
         .or(raw.suspension.as_ref().map(|s| s.span()))
+}
+
+/// The `[floor]` table, or the first `fixed` key.
+fn pinned_span(raw: &RawScene) -> Option<Range<usize>> {
+    let fixed = raw.particles.as_ref().and_then(|ps| {
+        ps.get_ref()
+            .iter()
+            .find_map(|p| p.fixed.as_ref().map(|f| f.span()))
+    });
+    raw.floor.as_ref().map(|f| f.span()).or(fixed)
 }
 
 fn sp<T>(v: &super::raw::S<T>) -> Option<Range<usize>> {
@@ -177,7 +188,9 @@ pub(super) fn check(scene: &Scene, keys: &KeySpans, body: &BodySpans) -> Result<
 fn first_step<T: Real>(scene: &Scene) -> Result<(), StepError> {
     let p = super::beads::params::<T>(scene);
     let mut beads = Beads::<T>::new(&scene.particles, 1.0)?;
-    let bonds = bonds::<T>(&scene.bonds, beads.len())?;
+    let mut bonds = bonds::<T>(&scene.bonds, beads.len())?;
+    let springs = bonds.len();
+    bonds.extend(super::beads::pins::<T>(scene));
     let mut noise = Noise::new(0);
     let mut state = beads.state();
     if scene.brownian.is_some() {
@@ -186,7 +199,13 @@ fn first_step<T: Real>(scene: &Scene) -> Result<(), StepError> {
     hydrorattle::check_step(&state, &bonds, &p)?;
     if p.fene.is_some() {
         let mut force = vec![T::V3_ZERO; state.len()];
-        hydrorattle::forces::springs(&bonds, p.spring_stiffness, p.fene, state.pos, &mut force)?;
+        hydrorattle::forces::springs(
+            &bonds[..springs],
+            p.spring_stiffness,
+            p.fene,
+            state.pos,
+            &mut force,
+        )?;
     }
     Ok(())
 }

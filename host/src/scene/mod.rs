@@ -14,7 +14,7 @@
 //! | `[fluid]` | `viscosity` (> 0), `density` (>= 0) | 1, 0 |
 //! | `[gravity]` | `acceleration = [x, y, z]` | `[0, 0, -1]` |
 //! | `[flow]` | `velocity = [..]`, `vorticity = [..]` (uniform flow plus rigid rotation; at most [`MAX_TURN_PER_STEP`] radians a step: `\|vorticity\| dt <= 1`) | zeros |
-//! | `[[particle]]` | `position = [..]` (required), `radius` (required, > 0), `density` (>= 0), `velocity = [..]`, `angular_velocity = [..]`, `species` (a type name) | density 4.5, at rest, one species per radius and density |
+//! | `[[particle]]` | `position = [..]` (required), `radius` (required, > 0), `density` (>= 0), `velocity = [..]`, `angular_velocity = [..]`, `species` (a type name), `fixed` (`true`: pinned where it is) | density 4.5, at rest, one species per radius and density |
 //! | `[[bond]]` | `between = [i, j]` (required, 0-based), `length` (> 0; >= 0 with `method = "springs"`: a spring's rest length) | initial distance |
 //! | `[helix]` | `tails`, `head_ratio`, `dhat`, `head_end`, `radius`, `pitch`, `density` | see [`Helix`] |
 //! | `[model]` | `hydrodynamics = "rpy"\|"oseen"\|"free-draining"`, `inertia`, `rotation`, `level = "auto"\|"manual"`, `overlap = "reject"\|"allow"` | rpy, false, false, manual, reject |
@@ -24,6 +24,7 @@
 //! | `[wall]` | `height` (required, finite): a no-slip plane `z = height` below every sphere (`method = "overdamped"` or `"overdamped2"`, level manual; see [`Wall`]) | no wall |
 //! | `[box]` | `size = [Lx, Ly, Lz]` (required unless `[suspension]` sets it; finite, > 0), `method = "ewald"\|"pse"\|"auto"`, `tolerance` (`1e-12` to `0.1`): a periodic box (see [`PeriodicBox`]) | no box; auto, 1e-6 |
 //! | `[suspension]` | `count` (required, >= 1), `fraction` (required, `0 < phi <=` [`MAX_FRACTION`]), `radius`, `polydispersity` (`0 <= p < 1`), `density`, `seed`: spheres placed at random in a cubic box (see [`Suspension`]) | 1, 0, 4.5, 1 |
+//! | `[floor]` | `radius` (> 0), `density` (>= 0): a pinned square lattice under the `[suspension]` (see [`Floor`]) | the suspension's radius and density |
 //!
 //! A scene gives one of a `[helix]` table, a `[suspension]` table (which needs a
 //! `[box]` table, without `size`) or explicit `[[particle]]` (and optionally
@@ -50,6 +51,9 @@ mod bodies;
 mod box_tests;
 mod contact;
 mod error;
+mod floor;
+#[cfg(test)]
+mod floor_tests;
 mod helix;
 mod kernel;
 mod model;
@@ -66,9 +70,10 @@ mod thermal;
 mod wall;
 mod write;
 
-pub use beads::{Beads, BuildError, bonds, params};
+pub use beads::{Beads, BuildError, bonds, params, pins};
 pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE, SOFT_DT, SOFT_STIFFNESS};
 pub use error::{SceneError, line_col};
+pub use floor::{Floor, slab_fraction};
 pub use helix::{Chain, HeadEnd, Helix};
 pub use model::{
     Bond, Flow, Fluid, Hydrodynamics, Integrator, Level, Method, Model, Output, Overlap, Particle,
@@ -176,6 +181,13 @@ pub struct Scene {
     /// The suspension generator's settings, when the scene used one (`[suspension]`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub suspension: Option<Suspension>,
+    /// The pinned floor under the suspension, when the scene lays one (`[floor]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub floor: Option<Floor>,
+    /// The pinned spheres (ascending indices): held at their positions by the kernel's
+    /// pin rows (`fixed = true` on a `[[particle]]`, or the `[floor]`'s spheres).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pinned: Vec<usize>,
     /// Species (type name) of each particle: `head` and `tail` for a helix; the
     /// `species` key, or one name per distinct radius and density, for explicit
     /// particles. The generators' names are borrowed: a sweep resolves a scene per

@@ -29,6 +29,7 @@ pub(super) struct RawScene {
     #[serde(rename = "box")]
     pub(super) periodic: S<super::periodic::RawBox>,
     pub(super) suspension: S<super::suspension::RawSuspension>,
+    pub(super) floor: S<super::floor::RawFloor>,
 }
 
 #[derive(Deserialize)]
@@ -60,6 +61,7 @@ pub(super) struct RawParticle {
     pub(super) velocity: S<[f64; 3]>,
     pub(super) angular_velocity: S<[f64; 3]>,
     pub(super) species: S<String>,
+    pub(super) fixed: S<bool>,
 }
 
 #[derive(Deserialize)]

@@ -134,11 +134,28 @@ impl RawScene {
         let output_span = every_span.unwrap_or_else(|| raw_int.get_ref().duration.span());
 
         let mut suspension = None;
+        let (mut floor, mut pinned) = (None, Vec::new());
+        if let (Some(f), None) = (&self.floor, &self.suspension) {
+            return Err(issue(
+                f.span(),
+                "a [floor] lays a pinned layer under a [suspension]: give one (or pin [[particle]] tables with `fixed = true`)",
+            ));
+        }
         let (particles, bonds, helix, body_span, species) = match (&self.helix, &self.particles) {
             _ if self.suspension.is_some() => {
-                let (s, (particles, edge)) = self.generate_suspension(&plans, limits, every)?;
-                suspension = Some((s, edge));
-                let species = vec![Cow::Borrowed("sphere"); particles.len()];
+                let (s, (mut particles, edge)) = self.generate_suspension(&plans, limits, every)?;
+                let mut size = [edge; 3];
+                let mut species = vec![Cow::Borrowed("sphere"); particles.len()];
+                if let Some(raw) = &self.floor {
+                    let f = super::floor::resolve(raw, s.radius, s.density)?;
+                    let at = super::floor::radius_span(raw);
+                    (particles, size) = f.lay(&particles, edge).map_err(|m| issue(at, m))?;
+                    let k = f.count(edge);
+                    pinned = (0..k).collect();
+                    species.splice(0..0, vec![Cow::Borrowed("floor"); k]);
+                    floor = Some(f);
+                }
+                suspension = Some((s, size));
                 let spans = BodySpans::Helix(self.suspension.as_ref().map_or(0..0, |s| s.span()));
                 (particles, Vec::new(), None, spans, species)
             }
@@ -176,6 +193,10 @@ impl RawScene {
                 check_output(&integrator, every, ps.get_ref().len(), limits.output)
                     .map_err(|m| issue(output_span.clone(), m))?;
                 let (particles, spans, species) = resolve_particles(ps)?;
+                pinned = (ps.get_ref().iter().enumerate())
+                    .filter(|(_, p)| p.fixed.as_ref().is_some_and(|f| *f.get_ref()))
+                    .map(|(k, _)| k)
+                    .collect();
                 let species = species.into_iter().map(Cow::Owned).collect();
                 let (bonds, bond_spans) =
                     resolve_bonds(self.bonds.as_ref(), &particles, &integrator)?;
@@ -190,9 +211,9 @@ impl RawScene {
         };
 
         let periodic = match (&self.periodic, suspension) {
-            (Some(b), s) => Some(super::periodic::resolve(b, s.map(|(_, e)| [e; 3]))?),
+            (Some(b), s) => Some(super::periodic::resolve(b, s.map(|(_, e)| e))?),
             (None, Some((_, e))) => Some(super::PeriodicBox {
-                size: [e; 3],
+                size: e,
                 method: super::BoxMethod::Auto,
                 tolerance: super::DEFAULT_BOX_TOLERANCE,
                 method_line: None,
@@ -239,6 +260,8 @@ impl RawScene {
             wall,
             periodic,
             suspension: suspension.map(|(s, _)| s),
+            floor,
+            pinned,
         };
         // "pse" where the scene needs the assembled mobility: placed at the method.
         if let (Err(e), Some(raw)) = (scene.check_box_runs(None), &self.periodic) {

@@ -128,6 +128,12 @@ impl Scene {
                         ("seed", value(s.seed as i64)),
                     ]),
                 );
+                if let Some(f) = self.floor {
+                    t.insert(
+                        "floor".into(),
+                        table([("radius", value(f.radius)), ("density", value(f.density))]),
+                    );
+                }
             }
             (Some(h), None) => {
                 t.insert(
@@ -144,15 +150,20 @@ impl Scene {
                 );
             }
             (None, None) => {
-                let particles = self.particles.iter().zip(&self.species).map(|(p, s)| {
-                    table([
+                let particles = self.particles.iter().zip(&self.species).enumerate();
+                let particles = particles.map(|(k, (p, s))| {
+                    let mut pt = table([
                         ("position", value(p.position)),
                         ("radius", value(p.radius)),
                         ("density", value(p.density)),
                         ("velocity", value(p.velocity)),
                         ("angular_velocity", value(p.angular_velocity)),
                         ("species", value(s)),
-                    ])
+                    ]);
+                    if let (Value::Table(m), true) = (&mut pt, self.pinned.contains(&k)) {
+                        m.insert("fixed".into(), value(true));
+                    }
+                    pt
                 });
                 t.insert("particle".into(), Value::Array(particles.collect()));
                 let bonds = self.bonds.iter().map(|b| {

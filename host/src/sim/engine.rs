@@ -30,6 +30,12 @@ pub struct Engine<T: Real> {
     pub beads: Beads<T>,
     /// Bonds (validated against the particles).
     pub bonds: Vec<Bond<T>>,
+    /// Pin rows ([`Bond::pin`]: three per pinned sphere), solved after the bonds;
+    /// empty without pinned spheres.
+    pub pins: Vec<Bond<T>>,
+    /// The step's constraint list when there are pins: the bonds, then the pins
+    /// (rebuilt each step from both, so that neither can go stale).
+    rows: Vec<Bond<T>>,
     /// Kernel parameters.
     pub params: Params<T>,
     /// Thermal noise generator (drawn from only when `params.brownian` is on).
@@ -57,7 +63,8 @@ impl<T: Real> Engine<T> {
     /// `O(N^2)` work.
     pub fn new(scene: &Scene, limit: usize) -> Result<Self, BuildError> {
         let p = params::<T>(scene);
-        let (n, b) = (scene.particles.len(), scene.bonds.len());
+        let pins = crate::scene::pins::<T>(scene);
+        let (n, b) = (scene.particles.len(), scene.bonds.len() + pins.len());
         // The plan sizes thermal noise too (the factor or the Lanczos basis).
         let layout = Plan::of(scene).check(n, b, limit)?;
         let beads = Beads::<T>::new(&scene.particles, 1.0)?;
@@ -67,7 +74,10 @@ impl<T: Real> Engine<T> {
         let contact = scene.contact.and_then(|c| c.soft()).map(|k| SoftContact {
             stiffness: T::from_f64(k),
         });
-        Self::with_layout(beads, bonds, p, noise, contact, layout, limit)
+        let mut e = Self::with_layout(beads, bonds, p, noise, contact, layout, limit)?;
+        hydrorattle::bonds::validate(&pins, n)?;
+        e.pins = pins;
+        Ok(e)
     }
 
     /// A system from its parts (checked by the caller), with storage sized by the
@@ -123,6 +133,8 @@ impl<T: Real> Engine<T> {
         Ok(Engine {
             beads,
             bonds,
+            pins: Vec::new(),
+            rows: Vec::new(),
             params,
             noise,
             contact,
@@ -161,7 +173,16 @@ impl<T: Real> Engine<T> {
         self.beads.check_pairs(self.params.allow_overlap)?;
         let mut state = self.beads.state();
         state.noise = Some(&mut self.noise);
-        hydrorattle::check_step(&state, &self.bonds, &self.params)
+        let rows = match self.pins.is_empty() {
+            true => &self.bonds[..],
+            false => {
+                self.rows.clear();
+                self.rows.extend_from_slice(&self.bonds);
+                self.rows.extend_from_slice(&self.pins);
+                &self.rows[..]
+            }
+        };
+        hydrorattle::check_step(&state, rows, &self.params)
     }
 
     /// One step with the scene's forces only.
@@ -186,9 +207,18 @@ impl<T: Real> Engine<T> {
         };
         let (c, i, v) = &mut self.pse;
         let mut ws = ws.with_pse(c, i, v);
+        if !self.pins.is_empty() {
+            self.rows.clear();
+            self.rows.extend_from_slice(&self.bonds);
+            self.rows.extend_from_slice(&self.pins);
+        }
+        let rows = match self.pins.is_empty() {
+            true => &self.bonds[..],
+            false => &self.rows[..],
+        };
         let report = retry::step(
             &mut self.beads,
-            &self.bonds,
+            rows,
             &self.params,
             &mut ws,
             &mut ext,
@@ -202,8 +232,27 @@ impl<T: Real> Engine<T> {
         // leave them partial: keep the accepted step's.
         self.multipliers.clear();
         self.multipliers
-            .extend_from_slice(ws.multipliers(self.bonds.len()));
+            .extend_from_slice(ws.multipliers(rows.len()));
         Ok(report)
+    }
+
+    /// The total force the pins exert on the pinned spheres after the last accepted
+    /// step (`sum lambda s e` over the pin rows), `None` before the first step,
+    /// without pins, and for `Overdamped2` (its last projection's multipliers are a
+    /// correction to the predictor's, as for [`Engine::tensions`]). At rest it carries
+    /// the buoyant weight of everything on them.
+    pub fn pin_load(&self) -> Option<[T; 3]> {
+        let first = self.bonds.len();
+        let rows = first + self.pins.len();
+        let method = self.params.method;
+        if self.pins.is_empty() || self.multipliers.len() != rows || method == Method::Overdamped2 {
+            return None;
+        }
+        let mut f = [T::ZERO; 3];
+        for (b, &l) in self.pins.iter().zip(&self.multipliers[first..]) {
+            f[b.axis()] += l * b.length;
+        }
+        Some(f)
     }
 
     /// The tension of every bond after the last accepted step (force; positive when the
@@ -218,7 +267,7 @@ impl<T: Real> Engine<T> {
         match self.params.method {
             Method::Overdamped2 => None,
             Method::Springs => self.spring_tensions(),
-            _ if self.multipliers.len() != self.bonds.len() => None,
+            _ if self.multipliers.len() != self.bonds.len() + self.pins.len() => None,
             _ => Some(
                 self.bonds
                     .iter()
