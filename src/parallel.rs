@@ -405,7 +405,7 @@ pub fn assemble_apply<T: Real>(
     if n < blocked::RUNS_MIN {
         // Pairs side by side where there are vector lanes to fill: not on 32-bit Arm
         // (the Cortex-M4F's FPU is scalar, and the lanes' arrays would cost its stack
-        // ~6 kB), which keeps the row-by-row band and its instruction count.
+        // ~3 kB), which keeps the row-by-row band and its instruction count.
         if level == Hydro::Rpy && n <= lanes::MAX && !cfg!(target_arch = "arm") {
             return lanes::band_lanes::<T>(src, out, x, &mut y[..n]);
         }
