@@ -22,6 +22,7 @@
 mod blocked;
 mod free;
 mod jobs;
+mod lanes;
 
 pub(crate) use blocked::assemble_apply_then;
 pub(crate) use free::band_blocks;
@@ -402,6 +403,12 @@ pub fn assemble_apply<T: Real>(
         radius,
     };
     if n < blocked::RUNS_MIN {
+        // Pairs side by side where there are vector lanes to fill: not on 32-bit Arm
+        // (the Cortex-M4F's FPU is scalar, and the lanes' arrays would cost its stack
+        // ~3 kB), which keeps the row-by-row band and its instruction count.
+        if level == Hydro::Rpy && n <= lanes::MAX && !cfg!(target_arch = "arm") {
+            return lanes::band_lanes::<T>(src, out, x, &mut y[..n]);
+        }
         return band_fused::<T>(src, out, 0, x, &mut y[..n], &mut []);
     }
     if bands(n) == 1 {

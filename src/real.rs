@@ -95,6 +95,14 @@ pub trait Real:
     /// there, these steps ~15. Other inputs (zero, subnormal, infinite, NaN) go through
     /// libm.
     fn root_and_inverse(self) -> (Self, Self);
+    /// [`Real::root_and_inverse`] of each `x[k]` into `s[k]` and `inv[k]` (the same
+    /// bits), as loops the compiler may vectorise (the `f64` divisions).
+    #[inline(always)]
+    fn roots_and_inverses(x: &[Self], s: &mut [Self], inv: &mut [Self]) {
+        for ((&x, s), inv) in x.iter().zip(s).zip(inv) {
+            (*s, *inv) = x.root_and_inverse();
+        }
+    }
     /// Absolute value.
     fn abs(self) -> Self;
     /// Sine (libm).
@@ -207,7 +215,7 @@ pub trait Real:
 }
 
 macro_rules! impl_real {
-    ($t:ty, $v:ty, $m:ty, $sqrt:path, $rootinv:path, $sin:path, $cos:path, $atan2:path, $acos:path, $exp:path, $erf:path) => {
+    ($t:ty, $v:ty, $m:ty, $sqrt:path, $rootinv:path, $rootsinv:path, $sin:path, $cos:path, $atan2:path, $acos:path, $exp:path, $erf:path) => {
         impl Real for $t {
             type V3 = $v;
             type M3 = $m;
@@ -237,6 +245,10 @@ macro_rules! impl_real {
             #[inline]
             fn root_and_inverse(self) -> (Self, Self) {
                 $rootinv(self)
+            }
+            #[inline(always)]
+            fn roots_and_inverses(x: &[Self], s: &mut [Self], inv: &mut [Self]) {
+                $rootsinv(x, s, inv)
             }
             #[inline]
             fn abs(self) -> Self {
@@ -339,6 +351,7 @@ impl_real!(
     glam::Mat3,
     sqrt_f32,
     root_and_inverse_f32,
+    roots_and_inverses_f32,
     libm::sinf,
     libm::cosf,
     libm::atan2f,
@@ -352,6 +365,7 @@ impl_real!(
     glam::DMat3,
     libm::sqrt,
     root_and_inverse_f64,
+    roots_and_inverses_f64,
     libm::sin,
     libm::cos,
     libm::atan2,
@@ -364,6 +378,27 @@ impl_real!(
 fn root_and_inverse_f64(x: f64) -> (f64, f64) {
     let s = libm::sqrt(x);
     (s, 1.0 / s)
+}
+
+/// [`root_and_inverse_f64`] of each entry: the roots first, then the divisions, which
+/// (unlike the roots, an instruction libm emits itself) the compiler packs.
+#[inline(always)]
+fn roots_and_inverses_f64(x: &[f64], s: &mut [f64], inv: &mut [f64]) {
+    let (s, inv) = (&mut s[..x.len()], &mut inv[..x.len()]);
+    for (s, &x) in s.iter_mut().zip(x) {
+        *s = libm::sqrt(x);
+    }
+    for (inv, &s) in inv.iter_mut().zip(&*s) {
+        *inv = 1.0 / s;
+    }
+}
+
+/// [`root_and_inverse_f32`] of each entry.
+#[inline(always)]
+fn roots_and_inverses_f32(x: &[f32], s: &mut [f32], inv: &mut [f32]) {
+    for ((&x, s), inv) in x.iter().zip(s).zip(inv) {
+        (*s, *inv) = root_and_inverse_f32(x);
+    }
 }
 
 /// libm's `sqrtf`, called rather than inlined on 32-bit Arm: there it is ~220 bytes of

@@ -105,14 +105,19 @@ pub fn lu_solve<T: Real>(a: &[T], n: usize, piv: &[usize], x: &mut [T]) {
 }
 
 /// In-place Cholesky factorisation `A = L L^T` of the symmetric positive definite
-/// `n x n` row-major `a`, reading and writing only the lower triangle (the upper one is
-/// never touched, so the caller fills only `l <= k`). Row by row, each entry one
-/// contiguous dot product, two rows at a time: their entries are independent up to the
-/// first row's diagonal, so the two dot products' addition chains overlap (each entry's
-/// arithmetic is that of one row at a time: the same bits). The diagonal holds
-/// `1 / L_kk`, so solves only multiply. A pivot that is not positive and finite is
-/// [`LinalgError::NotPositiveDefinite`]. Cost: about `n^3 / 6` multiply-adds, half of
-/// [`lu`]'s, and no pivot search.
+/// `n x n` row-major `a`, reading only the lower triangle (the caller fills only
+/// `l <= k`). `L` is written into the lower triangle and, transposed, into the strict
+/// upper one (`a[j n + k] = L_kj`, `k > j`), where [`cholesky_dense_solve`] reads it.
+/// The diagonal holds `1 / L_kk`, so solves only multiply. A pivot that is not positive
+/// and finite is [`LinalgError::NotPositiveDefinite`]. Cost: about `n^3 / 6`
+/// multiply-adds, half of [`lu`]'s, and no pivot search.
+///
+/// Column by column: `L_kj = (A_kj - sum_m L_km L_jm) * (1 / L_jj)`, the sum from zero
+/// in `m` order, and `L_kk^2 = A_kk - L_k0^2 - L_k1^2 - ...` in that order, as a row at a
+/// time would form them (the same bits); but the entries of one column are independent,
+/// so their sums run side by side, over contiguous rows of the transposed copy, which
+/// the compiler vectorises (the sums of one row were one latency-bound chain after
+/// another).
 ///
 /// Semi-definite matrices: a pivot `d <= floor A_kk` (negative ones included: a
 /// Gram matrix has none but by rounding) marks row `k` dependent (a Gram matrix `G M G^T` whose row `k` of `G` lies in the span of the rows
@@ -124,33 +129,58 @@ pub fn lu_solve<T: Real>(a: &[T], n: usize, piv: &[usize], x: &mut [T]) {
 /// still not positive definite.
 pub fn cholesky_dense<T: Real>(a: &mut [T], n: usize, floor: T) -> Result<usize, LinalgError> {
     let a = &mut a[..n * n];
-    let mut k = 0;
-    while k + 1 < n {
-        let (done, rest) = a.split_at_mut(k * n);
-        let (row_k, row_m) = rest.split_at_mut(n);
-        let (row_k, row_m) = (&mut row_k[..=k], &mut row_m[..=k + 1]);
-        // L_kj and L_(k+1)j for j < k, both from row j.
-        for (j, row_j) in done.chunks_exact(n).enumerate() {
-            let (s, t) = dot2(&row_k[..j], &row_m[..j], &row_j[..j]);
-            row_k[j] = (row_k[j] - s) * row_j[j];
-            row_m[j] = (row_m[j] - t) * row_j[j];
+    for j in 0..n {
+        let (done, rest) = a.split_at_mut(j * n);
+        let (row_j, below) = rest.split_at_mut(n);
+        let inv = pivot(&mut row_j[..=j], j, floor)?;
+        // The column's sums `s_k = sum_m L_km L_jm` for 8 rows `k` at a time (then 4, 2,
+        // 1), held in registers over `m`, then `L_kj` into both triangles.
+        let (head, upper) = row_j.split_at_mut(j + 1);
+        let mut k0 = j + 1;
+        while k0 < n {
+            let at = (&*done, &head[..j], k0, j, inv);
+            // Four rows at a time and one by one on 32-bit Arm: the Cortex-M4F has no
+            // vector lanes, and each width is its own copy of the loop (flash).
+            let arm = cfg!(target_arch = "arm");
+            k0 += match n - k0 {
+                4.. if arm => column_rows::<T, 4>(at, below, upper),
+                _ if arm => column_rows::<T, 1>(at, below, upper),
+                8.. => column_rows::<T, 8>(at, below, upper),
+                4.. => column_rows::<T, 4>(at, below, upper),
+                2.. => column_rows::<T, 2>(at, below, upper),
+                _ => column_rows::<T, 1>(at, below, upper),
+            };
         }
-        let inv = pivot(row_k, k, floor)?;
-        row_m[k] = (row_m[k] - dot(&row_m[..k], &row_k[..k])) * inv;
-        pivot(row_m, k + 1, floor)?;
-        k += 2;
-    }
-    if k < n {
-        let (done, rest) = a.split_at_mut(k * n);
-        let row_k = &mut rest[..=k];
-        for (j, row_j) in done.chunks_exact(n).enumerate() {
-            let (head, tail) = row_k.split_at_mut(j);
-            tail[0] = (tail[0] - dot(head, &row_j[..j])) * row_j[j];
-        }
-        pivot(row_k, k, floor)?;
     }
     // The dependent rows' stored `1 / L_kk` is exactly zero (a regular one is > 0).
     Ok((0..n).filter(|&k| a[k * n + k] == T::ZERO).count())
+}
+
+/// `L_kj` for the `W` rows `k0..k0 + W` of column `j` (`(done, l_j, k0, j, 1 / L_jj)`:
+/// the rows above `j`, row `j`'s `L_jm`); `below` holds the rows from `j + 1` on,
+/// `upper` row `j`'s strict upper part. Each sum runs from zero in `m` order, the `W`
+/// of them side by side in registers (fixed `W`: no masked lanes). Returns `W`.
+#[inline(always)]
+fn column_rows<T: Real, const W: usize>(
+    (done, l_j, k0, j, inv): (&[T], &[T], usize, usize, T),
+    below: &mut [T],
+    upper: &mut [T],
+) -> usize {
+    let n = upper.len() + j + 1;
+    let mut s = [T::ZERO; W];
+    for (row_m, &l_jm) in done.chunks_exact(n).zip(l_j) {
+        let l_k = &row_m[k0..k0 + W];
+        for (s, &l_km) in s.iter_mut().zip(l_k) {
+            *s += l_km * l_jm;
+        }
+    }
+    for (q, &s) in s.iter().enumerate() {
+        let (k, row_k) = (k0 + q, &mut below[(k0 + q - j - 1) * n..]);
+        let l = (row_k[j] - s) * inv;
+        row_k[j] = l;
+        upper[k - j - 1] = l;
+    }
+    W
 }
 
 /// `L_kk = sqrt(A_kk - sum_j L_kj^2)` for `row = [L_k0, .., L_k(k-1), A_kk]`; stores and
@@ -170,13 +200,29 @@ fn pivot<T: Real>(row: &mut [T], k: usize, floor: T) -> Result<T, LinalgError> {
     Ok(last[0])
 }
 
-/// Solves `A x = b` in place with the factor from [`cholesky_dense`].
+/// Solves `A x = b` in place with the factor from [`cholesky_dense`] (both triangles).
 pub fn cholesky_dense_solve<T: Real>(a: &[T], n: usize, x: &mut [T]) {
     let x = &mut x[..n];
-    // L y = b, row by row.
-    for r in 0..n {
-        let row = &a[r * n..r * n + r + 1];
-        x[r] = sub_dot(x[r], &row[..r], &x[..r]) * row[r];
+    // L y = b, column by column of L (rows of the transposed copy): y_m final, then
+    // taken off the rows below, each of which subtracts its terms in `m` order, as a
+    // row at a time would.
+    // The loop over the rows below starts at the next multiple of 4 (those before it one
+    // by one), so that its vector loads of `y` meet the previous column's vector stores
+    // at the same addresses (a load that straddles two stores waits for both to retire).
+    for m in 0..n {
+        let row = &a[m * n..m * n + n];
+        let (done, rest) = x.split_at_mut(m + 1);
+        let v = done[m] * row[m];
+        done[m] = v;
+        let head = (3 - m % 4).min(rest.len());
+        let (rest_head, rest_body) = rest.split_at_mut(head);
+        let (row_head, row_body) = row[m + 1..].split_at(head);
+        for (y, &l) in rest_head.iter_mut().zip(row_head) {
+            *y -= l * v;
+        }
+        for (y, &l) in rest_body.iter_mut().zip(row_body) {
+            *y -= l * v;
+        }
     }
     // L^T x = y, column by column of L^T (rows of L): x_r final, then taken off the rest.
     for r in (0..n).rev() {
@@ -190,44 +236,99 @@ pub fn cholesky_dense_solve<T: Real>(a: &[T], n: usize, x: &mut [T]) {
     }
 }
 
-/// `sum a_i b_i` from zero in index order, four terms per loop pass (the same bits as
-/// the plain loop; fewer loop instructions on cores without SIMD floats).
-#[inline(always)]
-fn dot<T: Real>(a: &[T], b: &[T]) -> T {
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (a4.remainder(), b4.remainder());
-    let mut s = T::ZERO;
-    for (x, y) in a4.zip(b4) {
-        s += x[0] * y[0];
-        s += x[1] * y[1];
-        s += x[2] * y[2];
-        s += x[3] * y[3];
-    }
-    ra.iter().zip(rb).fold(s, |s, (&x, &y)| s + x * y)
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// `s - a_0 b_0 - a_1 b_1 - ...` in index order, four terms per loop pass (the bits of
-/// the plain loop).
-#[inline(always)]
-fn sub_dot<T: Real>(mut s: T, a: &[T], b: &[T]) -> T {
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (a4.remainder(), b4.remainder());
-    for (x, y) in a4.zip(b4) {
-        s -= x[0] * y[0];
-        s -= x[1] * y[1];
-        s -= x[2] * y[2];
-        s -= x[3] * y[3];
-    }
-    ra.iter().zip(rb).fold(s, |s, (&x, &y)| s - x * y)
-}
+    const MAX: usize = 30;
 
-/// `(sum a_i c_i, sum b_i c_i)`, each from zero in index order (the bits of [`dot`]).
-#[inline(always)]
-fn dot2<T: Real>(a: &[T], b: &[T], c: &[T]) -> (T, T) {
-    let (mut s, mut t) = (T::ZERO, T::ZERO);
-    for ((&x, &y), &z) in a.iter().zip(b).zip(c) {
-        s += x * z;
-        t += y * z;
+    /// The row-at-a-time factorisation, written plainly: each `L_kj` a dot product from
+    /// zero in index order, each pivot `A_kk` minus the squares in order.
+    fn rows(a: &mut [f64], n: usize, floor: f64) -> Result<usize, LinalgError> {
+        for k in 0..n {
+            for j in 0..k {
+                let mut s = 0.0;
+                for m in 0..j {
+                    s += a[k * n + m] * a[j * n + m];
+                }
+                a[k * n + j] = (a[k * n + j] - s) * a[j * n + j];
+            }
+            pivot(&mut a[k * n..=k * n + k], k, floor)?;
+        }
+        Ok((0..n).filter(|&k| a[k * n + k] == 0.0).count())
     }
-    (s, t)
+
+    /// Forward substitution row by row, then the back substitution.
+    fn solve_rows(a: &[f64], n: usize, x: &mut [f64]) {
+        for r in 0..n {
+            let mut s = x[r];
+            for m in 0..r {
+                s -= a[r * n + m] * x[m];
+            }
+            x[r] = s * a[r * n + r];
+        }
+        for r in (0..n).rev() {
+            let v = x[r] * a[r * n + r];
+            x[r] = v;
+            for y in 0..r {
+                x[y] -= v * a[r * n + y];
+            }
+        }
+    }
+
+    /// Gram matrices `G G^T` (regular, with dependent rows, or made indefinite), every
+    /// size up to `MAX`: the column-wise factor and solve give the row-wise bits and the
+    /// same error.
+    #[test]
+    fn columns_give_the_bits_of_rows() {
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut v = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for n in 0..MAX {
+            for case in 0..3 {
+                let mut g = [[0.0; MAX]; MAX];
+                for row in g.iter_mut().take(n) {
+                    row.iter_mut().take(n).for_each(|x| *x = v());
+                }
+                if case == 1 && n > 3 {
+                    // Row 2 a combination of rows 0 and 1: dependent.
+                    for c in 0..n {
+                        g[2][c] = 0.5 * g[0][c] - 2.0 * g[1][c];
+                    }
+                }
+                let mut a = [0.0; MAX * MAX];
+                for i in 0..n {
+                    for j in 0..=i {
+                        a[i * n + j] = (0..n).map(|c| g[i][c] * g[j][c]).sum::<f64>();
+                    }
+                    a[i * n + i] += if case == 2 && i == n / 2 { -50.0 } else { 0.0 };
+                }
+                let floor = if case == 1 { 1e-8 } else { 0.0 };
+                let (mut a0, mut a1) = (a, a);
+                let (r0, r1) = (rows(&mut a0, n, floor), cholesky_dense(&mut a1, n, floor));
+                assert_eq!(r0, r1, "n = {n}, case {case}");
+                if r0.is_err() {
+                    continue;
+                }
+                for i in 0..n {
+                    for j in 0..=i {
+                        let (l, t) = (a1[i * n + j], a1[j * n + i]);
+                        assert_eq!(a0[i * n + j].to_bits(), l.to_bits(), "{n}: {i} {j}");
+                        // The transposed copy.
+                        assert_eq!(l.to_bits(), t.to_bits(), "{n}: {i} {j}");
+                    }
+                }
+                let mut b = [0.0; MAX];
+                b.iter_mut().take(n).for_each(|x| *x = v());
+                let (mut x0, mut x1) = (b, b);
+                solve_rows(&a0, n, &mut x0);
+                cholesky_dense_solve(&a1, n, &mut x1);
+                assert_eq!(x0.map(f64::to_bits), x1.map(f64::to_bits), "solve, n = {n}");
+            }
+        }
+    }
 }
