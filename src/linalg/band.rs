@@ -18,11 +18,13 @@ pub fn cholesky<T: Real>(a: &mut [T], n: usize, w: usize) -> Result<(), LinalgEr
     regularised(a, n, w, T::ZERO).map(|_| ())
 }
 
-/// [`cholesky`] of a positive semi-definite matrix for a preconditioner: a pivot at or
-/// below `floor` times its row's diagonal (a row dependent on the ones before it) is
+/// [`cholesky`] of a positive semi-definite matrix for a preconditioner: a pivot within
+/// `floor` times its row's diagonal of zero (a row dependent on the ones before it) is
 /// replaced by that diagonal, so the factor is that of `A` plus a positive diagonal
-/// where `A` is singular: positive definite, and `A` itself elsewhere. Returns how
-/// many pivots were replaced. With `floor = 0` it is [`cholesky`].
+/// where `A` is singular: positive definite, and `A` itself elsewhere. A pivot below
+/// that is an error: the band is indefinite (the band of a positive definite matrix
+/// need not be), and replacing its pivots would make a factor far from `A`. Returns
+/// how many pivots were replaced. With `floor = 0` it is [`cholesky`].
 pub fn regularised<T: Real>(
     a: &mut [T],
     n: usize,
@@ -41,7 +43,11 @@ pub fn regularised<T: Real>(
                 a[at(w, k, l)] = s / a[at(w, l, l)];
             } else if s > floor * diagonal && s.is_finite() {
                 a[at(w, k, k)] = s.sqrt();
-            } else if floor > T::ZERO && diagonal > T::ZERO && s.is_finite() {
+            } else if floor > T::ZERO
+                && diagonal > T::ZERO
+                && s > -floor * diagonal
+                && s.is_finite()
+            {
                 a[at(w, k, k)] = diagonal.sqrt();
                 replaced += 1;
             } else {
