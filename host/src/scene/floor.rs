@@ -111,10 +111,11 @@ impl Floor {
         Ok((out, [edge, edge, edge + lift + hi + gap]))
     }
 
-    /// Spheres in the floor of a box of edge `edge` (the first indices).
+    /// Spheres in the floor of a box of edge `edge` (the first indices); saturates at
+    /// `usize::MAX` (a count no storage limit passes).
     pub fn count(&self, edge: f64) -> usize {
         let k = (edge / (2.0 * self.radius)).floor().max(0.0) as usize;
-        k * k
+        k.saturating_mul(k)
     }
 }
 

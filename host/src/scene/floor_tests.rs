@@ -134,6 +134,11 @@ duration = 1
         wide.starts_with("f.toml:8:10: a floor sphere of radius 9"),
         "{wide}"
     );
+    // A tiny radius asks for about 1.4e13 floor spheres: refused by the storage limit
+    // at the radius, before any is laid (a fuzz case once ran out of memory here).
+    let tiny = refused(&FLOORED.replace("radius = 1.1", "radius = 1e-6"));
+    assert!(tiny.starts_with("f.toml:8:10: "), "{tiny}");
+    assert!(tiny.contains("particles and 0 bonds"), "{tiny}");
     let negative = refused(&FLOORED.replace("radius = 1.1", "radius = -1"));
     assert!(
         negative.starts_with("f.toml:8:10: floor radius"),

@@ -149,8 +149,14 @@ impl RawScene {
                 if let Some(raw) = &self.floor {
                     let f = super::floor::resolve(raw, s.radius, s.density)?;
                     let at = super::floor::radius_span(raw);
-                    (particles, size) = f.lay(&particles, edge).map_err(|m| issue(at, m))?;
+                    // Sized before it is laid, like the suspension: a small floor
+                    // radius asks for k^2 spheres, which must not reach the allocator.
                     let k = f.count(edge);
+                    let n = k.saturating_add(particles.len());
+                    fits(&plans, n, 0, limits.storage).map_err(|e| too_large(at.clone(), e))?;
+                    check_output(&integrator, every, n, limits.output)
+                        .map_err(|m| issue(at.clone(), m))?;
+                    (particles, size) = f.lay(&particles, edge).map_err(|m| issue(at, m))?;
                     pinned = (0..k).collect();
                     species.splice(0..0, vec![Cow::Borrowed("floor"); k]);
                     floor = Some(f);
