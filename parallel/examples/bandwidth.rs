@@ -33,7 +33,6 @@ use hydrorattle::parallel::{self, Parallel, Serial, band_scratch};
 use hydrorattle::{Hydro, Real};
 use hydrorattle_parallel::Threads;
 use hydrorattle_parallel::model::{Machine, Path};
-use rayon::prelude::*;
 
 /// Doubles per probe array (256 MB: far beyond any last-level cache here).
 const LEN: usize = 32 << 20;
@@ -54,9 +53,10 @@ fn best_both(k: usize, mut f: impl FnMut()) -> [f64; 2] {
     })
 }
 
-/// Read and triad bandwidth (GB/s) on `pool`.
-fn stream(pool: &rayon::ThreadPool, a: &mut [f64], b: &[f64], c: &[f64]) -> (f64, f64) {
+/// Read and triad bandwidth (GB/s) on `pool`, in 64 chunks handed out as jobs.
+fn stream(pool: &Threads, a: &mut [f64], b: &[f64], c: &[f64]) -> (f64, f64) {
     let chunk = LEN / 64;
+    let mut sums = vec![0.0; LEN.div_ceil(chunk)];
     let read = best(5, || {
         // Eight running sums a chunk: the adds' latency must not be what is measured.
         let sum = |x: &[f64]| {
@@ -68,24 +68,39 @@ fn stream(pool: &rayon::ThreadPool, a: &mut [f64], b: &[f64], c: &[f64]) -> (f64
             });
             lanes.iter().sum::<f64>()
         };
-        let s: f64 = pool.install(|| b.par_chunks(chunk).map(sum).sum());
-        std::hint::black_box(s);
+        let mut jobs: Vec<_> = sums
+            .iter_mut()
+            .zip(b.chunks(chunk))
+            .map(|(s, x)| move || *s = sum(x))
+            .collect();
+        pool.run(&mut jobs_of(&mut jobs));
+        std::hint::black_box(sums.iter().sum::<f64>());
     });
     let triad = best(5, || {
-        pool.install(|| {
-            a.par_chunks_mut(chunk)
-                .zip(b.par_chunks(chunk).zip(c.par_chunks(chunk)))
-                .for_each(|(a, (b, c))| {
+        let mut jobs: Vec<_> = a
+            .chunks_mut(chunk)
+            .zip(b.chunks(chunk).zip(c.chunks(chunk)))
+            .map(|(a, (b, c))| {
+                move || {
                     for ((a, &b), &c) in a.iter_mut().zip(b).zip(c) {
                         *a = b + 3.0 * c;
                     }
-                })
-        })
+                }
+            })
+            .collect();
+        pool.run(&mut jobs_of(&mut jobs));
     });
     (
         8.0 * LEN as f64 / read / 1e9,
         24.0 * LEN as f64 / triad / 1e9,
     )
+}
+
+/// `jobs` as the [`Parallel`] interface takes them.
+fn jobs_of<F: FnMut() + Send>(jobs: &mut [F]) -> Vec<&mut (dyn FnMut() + Send)> {
+    jobs.iter_mut()
+        .map(|j| j as &mut (dyn FnMut() + Send))
+        .collect()
 }
 
 /// Seconds per product of each path (stored, compact, recompute) and of the assembly
@@ -145,11 +160,7 @@ fn main() {
     let (mut a, b, c) = (vec![0.0; LEN], vec![1.0; LEN], vec![2.0; LEN]);
     let mut bw = Vec::new();
     for pool in &pools {
-        let raw = rayon::ThreadPoolBuilder::new()
-            .num_threads(pool.threads())
-            .build()
-            .unwrap();
-        let (read, triad) = stream(&raw, &mut a, &b, &c);
+        let (read, triad) = stream(pool, &mut a, &b, &c);
         println!(
             "stream {} threads: read {read:.1} GB/s, triad {triad:.1} GB/s",
             pool.threads()

@@ -154,7 +154,7 @@ impl<T: Real> Engine<T> {
     /// This system with `threads` threads (0: every core) for the mobility's bands where
     /// the kernel cuts it into bands ([`hydrorattle::parallel::BANDED_MIN`] beads on);
     /// smaller systems stay on the calling thread. The bits do not depend on it.
-    pub fn with_threads(mut self, threads: usize) -> Result<Self, rayon::ThreadPoolBuildError> {
+    pub fn with_threads(mut self, threads: usize) -> std::io::Result<Self> {
         let banded = hydrorattle::parallel::bands(self.beads.len()) > 1;
         self.threads = match banded && threads != 1 {
             true => Some(Arc::new(Threads::new(threads)?)),
