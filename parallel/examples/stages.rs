@@ -9,7 +9,9 @@
 //!
 //! Every round is timed by the wall clock and by the CPU time the process's threads ran
 //! (`/proc/self/task/*/schedstat`; a thread waiting for a core on a shared machine adds
-//! wall time, not CPU time). A round of bands is followed by the round that adds the
+//! wall time, not CPU time; a pool thread spinning for the next round adds CPU time).
+//! Per step: the rounds' latency (wall time beyond the busiest thread's jobs, summed)
+//! and, outside the rounds, the stepping thread's own CPU time beside the process's. A round of bands is followed by the round that adds the
 //! bands' partial sums (a few microseconds); the two are reported as one. The rounds of
 //! the best step (by CPU time) are printed in order with what the step does there, read
 //! from the integrator (`src/integrate/overdamped.rs`, `brownian.rs`): the first round
@@ -43,11 +45,12 @@ fn main() {
             .unwrap_or_default()
             .trim()
     );
-    let (mut in_wall, mut in_cpu, mut in_busiest) = (0, 0, 0);
+    let (mut in_wall, mut in_cpu, mut in_busiest, mut in_caller) = (0, 0, 0, 0);
     for (k, r) in best.rounds.iter().enumerate() {
         in_wall += r.wall;
         in_cpu += r.cpu;
         in_busiest += r.busiest;
+        in_caller += r.caller;
         println!(
             "  round {k:2} ({:2} jobs): {:8.2} ms wall {:8.2} ms CPU {:6.2} ns CPU a pair, \
              {:5.1} % of the step's CPU; busiest thread {:8.2} ms CPU ({:.2} of the even share)",
@@ -71,10 +74,20 @@ fn main() {
     );
     println!(
         "  outside the rounds (serial): {:.2} ms wall {:.2} ms CPU, {:.1} % of the step's CPU \
-         ({:.1} % of its wall)",
+         ({:.1} % of its wall); the stepping thread's CPU there {:.2} ms",
         ms(out_wall),
         ms(out_cpu),
         100.0 * out_cpu as f64 / best.cpu as f64,
-        100.0 * out_wall as f64 / best.wall as f64
+        100.0 * out_wall as f64 / best.wall as f64,
+        ms(best.caller.saturating_sub(in_caller))
+    );
+    // What the rounds cost beyond their busiest thread's jobs: hand-out, wake-ups,
+    // waiting for the last job, and (on a shared machine) waiting for a core.
+    println!(
+        "  round latency (wall - busiest thread's CPU) summed over the step's {} rounds: {:.2} ms \
+         ({:.1} % of the step's wall)",
+        best.rounds.len(),
+        ms(in_wall.saturating_sub(in_busiest)),
+        100.0 * in_wall.saturating_sub(in_busiest) as f64 / best.wall as f64
     );
 }

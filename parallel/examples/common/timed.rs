@@ -11,7 +11,7 @@ use hydrorattle_heap::Buffers;
 use super::cpu_ns;
 
 /// Nanoseconds the calling thread has run on a CPU.
-fn thread_ns() -> u64 {
+pub fn thread_ns() -> u64 {
     std::fs::read_to_string("/proc/thread-self/schedstat")
         .ok()
         .and_then(|s| s.split_whitespace().next()?.parse().ok())
@@ -30,6 +30,8 @@ pub struct Round {
     pub cpu: u64,
     /// CPU nanoseconds of the thread that ran the most of the round's jobs.
     pub busiest: u64,
+    /// CPU nanoseconds of the calling thread (the one that steps) in the round.
+    pub caller: u64,
 }
 
 /// A [`Parallel`] that runs its rounds on `inner` and logs each.
@@ -61,9 +63,10 @@ impl Parallel for Timed<'_> {
             .iter_mut()
             .map(|j| j as &mut (dyn FnMut() + Send))
             .collect();
-        let (t0, c0) = (Instant::now(), cpu_ns());
+        let (t0, c0, m0) = (Instant::now(), cpu_ns(), thread_ns());
         self.inner.run(&mut refs);
         let (wall, cpu) = (t0.elapsed().as_nanos() as u64, cpu_ns() - c0);
+        let caller = thread_ns() - m0;
         let busiest = by_thread
             .into_inner()
             .unwrap()
@@ -75,6 +78,7 @@ impl Parallel for Timed<'_> {
             wall,
             cpu,
             busiest,
+            caller,
         };
         self.log.lock().unwrap().push(round);
     }
@@ -92,6 +96,8 @@ pub struct Step {
     pub wall: u64,
     /// CPU nanoseconds.
     pub cpu: u64,
+    /// CPU nanoseconds of the calling thread.
+    pub caller: u64,
 }
 
 /// The band rounds of `log`, each with the reduction round after it (a round of bands
@@ -104,6 +110,7 @@ fn merge(log: &[Round]) -> Vec<Round> {
                 last.wall += r.wall;
                 last.cpu += r.cpu;
                 last.busiest += r.busiest;
+                last.caller += r.caller;
             }
             _ => out.push(r),
         }
@@ -137,7 +144,7 @@ pub fn run(
     let (mut taken, mut report) = (Vec::new(), StepReport::default());
     for _ in 0..=steps {
         timed.log.lock().unwrap().clear();
-        let (t0, c0) = (Instant::now(), cpu_ns());
+        let (t0, c0, m0) = (Instant::now(), cpu_ns(), thread_ns());
         let state = State {
             pos: &mut pos,
             vel: &mut vel,
@@ -149,8 +156,14 @@ pub fn run(
         };
         report = step_slices(state, &bonds, &p, &mut ws, &mut NoForce).unwrap();
         let (wall, cpu) = (t0.elapsed().as_nanos() as u64, cpu_ns() - c0);
+        let caller = thread_ns() - m0;
         let rounds = merge(&timed.log.lock().unwrap());
-        taken.push(Step { rounds, wall, cpu });
+        taken.push(Step {
+            rounds,
+            wall,
+            cpu,
+            caller,
+        });
     }
     let digest = pos
         .iter()
