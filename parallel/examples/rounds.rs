@@ -38,6 +38,8 @@ fn main() {
     };
     let pool = Threads::new(threads).unwrap();
     let (mut walls, mut best_cpu) = (Vec::new(), f64::INFINITY);
+    let caller = std::thread::current().id();
+    let elsewhere = std::sync::atomic::AtomicUsize::new(0);
     for _ in 0..15 {
         let c0 = common::cpu_ns();
         for _ in 0..rounds {
@@ -45,6 +47,9 @@ fn main() {
                 .map(|_| {
                     || {
                         std::hint::black_box(work(work_us as f64, per_us));
+                        if std::thread::current().id() != caller {
+                            elsewhere.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        }
                     }
                 })
                 .collect();
@@ -67,11 +72,12 @@ fn main() {
     println!(
         "{} threads, {jobs} jobs of {work_us} us, gap {gap_us} us: a round's wall least {least:.1} us, \
          median {median:.1} us (ideal {ideal:.0}: {:+.1}, {:+.1} us); CPU {best_cpu:.1} us a round \
-         (jobs {cpu_ideal:.0}: {:+.1} us, best batch); load {}",
+         (jobs {cpu_ideal:.0}: {:+.1} us, best batch); {:.0} % of the jobs on other threads; load {}",
         Parallel::threads(&pool),
         least - ideal,
         median - ideal,
         best_cpu - cpu_ideal,
+        100.0 * elsewhere.into_inner() as f64 / (15 * rounds * jobs) as f64,
         std::fs::read_to_string("/proc/loadavg")
             .unwrap_or_default()
             .trim()
