@@ -12,7 +12,8 @@
 //!   thread asks first. The jobs share no mutable state, so any schedule gives the same
 //!   bits.
 //! * **Idle workers spin, then sleep.** After a round a worker spins on the round
-//!   counter for [`SPIN`] (back-to-back rounds pay no wake-up), then sleeps on a
+//!   counter for [`SPIN`] (back-to-back rounds pay no wake-up; `HYDRORATTLE_SPIN_US`
+//!   sets it), then sleeps on a
 //!   condition variable (an idle pool burns no CPU); a new round wakes every sleeper
 //!   with one broadcast. The caller waits for the last job the same way.
 //!
@@ -35,10 +36,21 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::thread::{self, JoinHandle};
 use std::time::{Duration, Instant};
 
-/// How long an idle thread spins before it sleeps: the kernel's gaps between rounds
-/// (Krylov and Lanczos vector work) are mostly shorter, the serial preconditioner's
-/// longer; a futex wake-up costs tens of microseconds.
+/// How long an idle thread spins before it sleeps, unless `HYDRORATTLE_SPIN_US` sets it
+/// (microseconds, read when a pool is built; 0 sleeps after a few checks, for a machine shared
+/// with other work, where a spinning thread spends its share of a core): the kernel's
+/// gaps between rounds (a band round's reduction, Krylov and Lanczos vector work) are
+/// mostly shorter, the serial preconditioner's longer; a futex wake-up costs tens of
+/// microseconds.
 pub const SPIN: Duration = Duration::from_micros(200);
+
+/// [`SPIN`], or `HYDRORATTLE_SPIN_US` where it is a count of microseconds.
+fn spin_time() -> Duration {
+    std::env::var("HYDRORATTLE_SPIN_US")
+        .ok()
+        .and_then(|s| s.trim().parse().ok())
+        .map_or(SPIN, Duration::from_micros)
+}
 
 /// Low bits of the round counter that index the round's jobs.
 pub const INDEX_BITS: u32 = 24;
@@ -69,6 +81,8 @@ struct Shared {
     done: AtomicUsize,
     /// The pool is being dropped: workers leave at the next round.
     stop: AtomicBool,
+    /// How long an idle thread spins before it sleeps.
+    spin: Duration,
     /// The first panic payload of the round in progress.
     panic: Mutex<Option<Box<dyn Any + Send>>>,
     /// Workers asleep (or about to sleep) on `wake`.
@@ -93,8 +107,8 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// Spins until `ready` gives `Some` or [`SPIN`] has passed.
-fn spin<T>(mut ready: impl FnMut() -> Option<T>) -> Option<T> {
+/// Spins until `ready` gives `Some` or `time` has passed (asks once at least).
+fn spin<T>(time: Duration, mut ready: impl FnMut() -> Option<T>) -> Option<T> {
     let start = Instant::now();
     loop {
         for _ in 0..SPINS_PER_CHECK {
@@ -103,7 +117,7 @@ fn spin<T>(mut ready: impl FnMut() -> Option<T>) -> Option<T> {
             }
             std::hint::spin_loop();
         }
-        if start.elapsed() >= SPIN {
+        if start.elapsed() >= time {
             return None;
         }
     }
@@ -162,7 +176,7 @@ impl Shared {
     /// Waits (spinning, then asleep) for a round after `seen`; its ticket.
     fn next_round(&self, seen: u64) -> u64 {
         let fresh = || Some(self.ticket.load(Acquire)).filter(|&t| epoch(t) != seen);
-        if let Some(t) = spin(fresh) {
+        if let Some(t) = spin(self.spin, fresh) {
             return t;
         }
         let mut guard = lock(&self.lock);
@@ -193,7 +207,7 @@ impl Shared {
 
     /// Waits (spinning, then asleep) until `len` jobs of the round have finished.
     fn wait_done(&self, len: usize) {
-        if spin(|| (self.done.load(Acquire) >= len).then_some(())).is_some() {
+        if spin(self.spin, || (self.done.load(Acquire) >= len).then_some(())).is_some() {
             return;
         }
         let mut guard = lock(&self.lock);
@@ -248,6 +262,7 @@ impl Pool {
             base: AtomicPtr::new(std::ptr::null_mut()),
             done: AtomicUsize::new(0),
             stop: AtomicBool::new(false),
+            spin: spin_time(),
             panic: Mutex::new(None),
             sleepers: AtomicUsize::new(0),
             waiting: AtomicBool::new(false),
