@@ -5,7 +5,8 @@
 //! `y = mu_tt x` into independent jobs and hands them to the workspace's [`Parallel`]
 //! ([`Workspace::with_parallel`](crate::Workspace::with_parallel); [`Serial`], one job
 //! after the other, by default). A host implements [`Parallel`] with a thread pool (the
-//! host crate `hydrorattle-parallel` does, with rayon).
+//! host crate `hydrorattle-parallel` does, with a pool in which the calling thread takes
+//! part).
 //!
 //! **Same bits on any number of threads.** The bands depend on the row count alone
 //! ([`band_start`]): below [`BANDED_MIN`] rows there is one band and the arithmetic is

@@ -13,6 +13,14 @@
 //! [`Path::Stored`] is the default, [`Path::Compact`] is
 //! `Params::compact_products`, [`Path::Recompute`] is `Params::matrix_free`; the first
 //! and last give the same bits.
+//!
+//! Two things the model leaves out, both measured on a 16-core Xeon (docs/BENCHMARKS.md,
+//! "The pool behind `Threads`"): the rounds' own cost (with rayon 1.5-3 ms a round
+//! beyond the busiest thread and 3.8 ms of waiting outside the rounds, a fifth of the
+//! matrix-free step; with this crate's [`pool`](crate::pool) a few microseconds a
+//! round, a prediction not yet measured there), and the rise of one core's time a pair
+//! when every core runs (1.4x for the recompute path there), which bounds the
+//! recompute path's speedup at `t / 1.4` where the model says `t`.
 
 /// A way to apply the mobility.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
