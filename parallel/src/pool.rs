@@ -135,7 +135,7 @@ impl Shared {
     unsafe fn call(&self, base: *mut (), i: usize) {
         // SAFETY: see above; the job is reached by no other thread.
         let job: &mut Job<'_> = unsafe { &mut *base.cast::<Job<'_>>().add(i) };
-        if let Err(payload) = panic::catch_unwind(AssertUnwindSafe(|| job())) {
+        if let Err(payload) = panic::catch_unwind(AssertUnwindSafe(job)) {
             lock(&self.panic).get_or_insert(payload);
         }
     }
