@@ -130,6 +130,14 @@ impl<T: Real> Problem<'_, T> {
     /// normalised magnitude compared with the tolerance.
     #[inline]
     fn eval(&self, b: &Bond<T>, k: usize, x: &[T::V3]) -> (T, T::V3, T) {
+        self.eval_with::<true>(b, k, x)
+    }
+
+    /// [`Problem::eval`], its magnitude (a square root and a division a bond) only with
+    /// `NORM` (zero without): the Newton right-hand sides, which do not read it, call
+    /// it out of line, where it was computed and discarded.
+    #[inline]
+    fn eval_with<const NORM: bool>(&self, b: &Bond<T>, k: usize, x: &[T::V3]) -> (T, T::V3, T) {
         let rel = match *self {
             Problem::Positions { cell, .. } => b.separation(x, cell.as_ref()),
             Problem::Velocities { .. } => b.relative(x),
@@ -146,7 +154,7 @@ impl<T: Real> Problem<'_, T> {
                 (
                     two_s * off,
                     crate::bonds::along::<T>(e, two_s),
-                    (off / b.length).abs(),
+                    lazy::<T, NORM>(|| (off / b.length).abs()),
                 )
             }
             // A wall link's linear constraint `2 d (z - d)` (see [`Bond::wall`]); its
@@ -157,7 +165,7 @@ impl<T: Real> Problem<'_, T> {
                 (
                     two_d * (z - b.length),
                     T::v3(T::ZERO, T::ZERO, two_d),
-                    ((z - b.length) / b.length).abs(),
+                    lazy::<T, NORM>(|| ((z - b.length) / b.length).abs()),
                 )
             }
             Problem::Positions { .. } => {
@@ -167,12 +175,12 @@ impl<T: Real> Problem<'_, T> {
                 (
                     r2 - d2,
                     rel * T::TWO,
-                    (r2.sqrt() - b.length).abs() / b.length,
+                    lazy::<T, NORM>(|| (r2.sqrt() - b.length).abs() / b.length),
                 )
             }
             Problem::Velocities { bond, dt } => {
                 let c = T::dot(bond[k], rel);
-                (c, bond[k], (c * dt).abs() / d2)
+                (c, bond[k], lazy::<T, NORM>(|| (c * dt).abs() / d2))
             }
         }
     }
@@ -298,6 +306,12 @@ fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T
         w = w.max_sticky(problem.eval(b, k, x).2);
     }
     w
+}
+
+/// `f()` with `NORM`, zero without ([`Problem::eval_with`]).
+#[inline(always)]
+fn lazy<T: Real, const NORM: bool>(f: impl FnOnce() -> T) -> T {
+    if NORM { f() } else { T::ZERO }
 }
 
 /// Solves for the multipliers, accumulating them into `mult` and moving `x`. The
