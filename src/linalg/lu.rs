@@ -205,27 +205,18 @@ pub fn cholesky_dense_solve<T: Real>(a: &[T], n: usize, x: &mut [T]) {
     let x = &mut x[..n];
     // L y = b, column by column of L (rows of the transposed copy): y_m final, then
     // taken off the rows below, each of which subtracts its terms in `m` order, as a
-    // row at a time would. The next row's `y_(m+1)` is taken off first and carried in
-    // a register to the next column: the chain from one `y_m` to the next is then two
-    // multiplications and a subtraction, not also a store and its reload (a row's
-    // value was last written by the vector loop below, ~20 % of the solve's time).
-    // The loop over the other rows starts at the next multiple of 4 (those before it
-    // one by one), so that its vector loads of `y` meet the previous column's vector
-    // stores at the same addresses (a load that straddles two stores waits for both).
-    let mut next = x.first().copied().unwrap_or(T::ZERO);
+    // row at a time would.
+    // The loop over the rows below starts at the next multiple of 4 (those before it one
+    // by one), so that its vector loads of `y` meet the previous column's vector stores
+    // at the same addresses (a load that straddles two stores waits for both to retire).
     for m in 0..n {
         let row = &a[m * n..m * n + n];
         let (done, rest) = x.split_at_mut(m + 1);
-        let v = next * row[m];
+        let v = done[m] * row[m];
         done[m] = v;
-        let Some((first, rest)) = rest.split_first_mut() else {
-            break;
-        };
-        next = *first - row[m + 1] * v;
-        *first = next;
-        let head = ((4 - (m + 2) % 4) % 4).min(rest.len());
+        let head = (3 - m % 4).min(rest.len());
         let (rest_head, rest_body) = rest.split_at_mut(head);
-        let (row_head, row_body) = row[m + 2..].split_at(head);
+        let (row_head, row_body) = row[m + 1..].split_at(head);
         for (y, &l) in rest_head.iter_mut().zip(row_head) {
             *y -= l * v;
         }
@@ -233,20 +224,13 @@ pub fn cholesky_dense_solve<T: Real>(a: &[T], n: usize, x: &mut [T]) {
             *y -= l * v;
         }
     }
-    // L^T x = y, column by column of L^T (rows of L): x_r final, then taken off the
-    // rest, `x_(r-1)` first and carried in a register, as above.
-    let mut next = x.last().copied().unwrap_or(T::ZERO);
+    // L^T x = y, column by column of L^T (rows of L): x_r final, then taken off the rest.
     for r in (0..n).rev() {
         let row = &a[r * n..r * n + r + 1];
         let (rest, done) = x.split_at_mut(r);
-        let v = next * row[r];
+        let v = done[0] * row[r];
         done[0] = v;
-        let Some((last, rest)) = rest.split_last_mut() else {
-            break;
-        };
-        next = *last - v * row[r - 1];
-        *last = next;
-        for (y, &l) in rest.iter_mut().zip(&row[..r - 1]) {
+        for (y, &l) in rest.iter_mut().zip(&row[..r]) {
             *y -= v * l;
         }
     }

@@ -63,8 +63,6 @@ struct Work<T: Real> {
     b: [Col<T>; 6],
     /// `B x_j`, summed into the row in column order afterwards.
     u: Soa<T>,
-    /// The six entries of the blocks of pairs outside the far branch (`pair_tt`'s).
-    p: [Col<T>; 6],
 }
 
 /// [`band_fused`](super::band_fused) of all `y.len()` rows (`b0 = 0`, at most [`MAX`]
@@ -95,7 +93,6 @@ pub(super) fn band_lanes<T: Real>(
         inv: z,
         b: [z; 6],
         u: Soa::new(&[]),
-        p: [z; 6],
     };
     for i in 0..n {
         let (row, _) = rows[tri(i)..].split_at_mut(i);
@@ -122,8 +119,9 @@ fn row_lanes<T: Real>(
     w: &mut Work<T>,
     row: &mut [T::M3],
 ) -> Result<[T; 3], ParticleError> {
-    let a = &src.radius[..i];
+    let (eta, a) = (src.eta, &src.radius[..i]);
     let [pix, piy, piz] = T::xyz(src.pos[i]);
+    let [xix, xiy, xiz] = T::xyz(xs_at(xs, i));
     let ai = src.radius[i];
     // `r = r_i - r_j`, `s^2 = |r|^2`; whether any pair is nested (`s^2 <= (a_i - a_j)^2`),
     // found as one flag so that the loop stays a vector loop.
@@ -147,68 +145,11 @@ fn row_lanes<T: Real>(
     T::roots_and_inverses(&w.s2[..i], &mut w.s[..i], &mut w.inv[..i]);
     let mut near = false;
     for (&s, &aj) in w.s[..i].iter().zip(a) {
-        near |= !s_far(s, ai, aj);
+        near |= !(s > ai + aj);
     }
     if near {
-        // The few pairs outside the far branch (overlapping spheres, NaN) get
-        // `pair_tt`'s block in place of the far branch's; a block that is not
-        // symmetric bit for bit (none is known) takes the whole row pair by pair.
-        if !patch(src, i, &w.s[..i], &mut w.p) {
-            return row_pairs(src, i, xs, ys, row);
-        }
-        return Ok(fused::<T, true>(src, i, xs, ys, w, row));
+        return row_pairs(src, i, xs, ys, row);
     }
-    Ok(fused::<T, false>(src, i, xs, ys, w, row))
-}
-
-/// `pair_tt`'s blocks of row `i`'s pairs outside the far branch (`s_j > a_i + a_j`
-/// false), their six entries into `p`; `false` where one is not symmetric bit for bit.
-#[cold]
-fn patch<T: Real>(src: Pairs<'_, T>, i: usize, s: &[T], p: &mut [Col<T>; 6]) -> bool {
-    let (eta, pos, radius) = (src.eta, src.pos, src.radius);
-    let ai = radius[i];
-    for (j, (&sj, &aj)) in s.iter().zip(radius).enumerate() {
-        if s_far(sj, ai, aj) {
-            continue;
-        }
-        // Not nested (the row's flag): a block.
-        let Some(b) = pair_tt(Hydro::Rpy, eta, ai, aj, pos[i] - pos[j]) else {
-            return false;
-        };
-        let m = |r, c| T::m3_get(b, r, c).to_f64().to_bits();
-        if m(1, 0) != m(0, 1) || m(2, 0) != m(0, 2) || m(2, 1) != m(1, 2) {
-            return false;
-        }
-        for (k, (r, c)) in [(0, 0), (1, 0), (2, 0), (1, 1), (2, 1), (2, 2)]
-            .into_iter()
-            .enumerate()
-        {
-            p[k][j] = T::m3_get(b, r, c);
-        }
-    }
-    true
-}
-
-/// Whether a pair at distance `s` is in `pair_tt`'s far branch.
-#[inline(always)]
-fn s_far<T: Real>(s: T, ai: T, aj: T) -> bool {
-    s > ai + aj
-}
-
-/// Row `i`'s blocks from the far branch (with `PATCH`, those of the pairs outside it
-/// from `w.p`) into `row`, `B^T x_i` added to `y_j`, and the sum of the `B x_j`.
-#[inline(always)]
-fn fused<T: Real, const PATCH: bool>(
-    src: Pairs<'_, T>,
-    i: usize,
-    xs: &Soa<T>,
-    ys: &mut Soa<T>,
-    w: &mut Work<T>,
-    row: &mut [T::M3],
-) -> [T; 3] {
-    let (eta, a) = (src.eta, &src.radius[..i]);
-    let [xix, xiy, xiz] = T::xyz(xs_at(xs, i));
-    let ai = src.radius[i];
     // `tt_block`'s far branch, its constants formed as it forms them: `e = r / s`,
     // `c = 1 / (8 pi eta s)`, `q = (a_i^2 + a_j^2) / s^2`,
     // `B = c (1 - q) e e^T + c (1 + q / 3) I`; then `B x_j` and `B^T x_i` (glam's
@@ -223,19 +164,14 @@ fn fused<T: Real, const PATCH: bool>(
         let (b11, b21, b22) = (&mut b11[..i], &mut b21[..i], &mut b22[..i]);
         let (ux, uy, uz) = (&mut w.u.x[..i], &mut w.u.y[..i], &mut w.u.z[..i]);
         let (yx, yy, yz) = (&mut ys.x[..i], &mut ys.y[..i], &mut ys.z[..i]);
-        let (s, p) = (&w.s[..i], &w.p);
         for j in 0..i {
             let v = inv[j];
             let (ex, ey, ez) = (rx[j] * v, ry[j] * v, rz[j] * v);
             let c = v * k8;
             let q = (ai * ai + a[j] * a[j]) * (v * v);
             let (f, d) = (c * (T::ONE - q), c * (T::ONE + q * third));
-            let (mut m00, mut m10, mut m20) = (ex * ex * f + d, ey * ex * f, ez * ex * f);
-            let (mut m11, mut m21, mut m22) = (ey * ey * f + d, ez * ey * f, ez * ez * f + d);
-            if PATCH && !s_far(s[j], ai, a[j]) {
-                (m00, m10, m20) = (p[0][j], p[1][j], p[2][j]);
-                (m11, m21, m22) = (p[3][j], p[4][j], p[5][j]);
-            }
+            let (m00, m10, m20) = (ex * ex * f + d, ey * ex * f, ez * ex * f);
+            let (m11, m21, m22) = (ey * ey * f + d, ez * ey * f, ez * ez * f + d);
             (b00[j], b10[j], b20[j], b11[j], b21[j], b22[j]) = (m00, m10, m20, m11, m21, m22);
             let (x, y, z) = (xjx[j], xjy[j], xjz[j]);
             ux[j] = m00 * x + m10 * y + m20 * z;
@@ -260,7 +196,7 @@ fn fused<T: Real, const PATCH: bool>(
         acc[1] += w.u.y[j];
         acc[2] += w.u.z[j];
     }
-    acc
+    Ok(acc)
 }
 
 /// Vector `i` of a [`Soa`].
