@@ -341,3 +341,60 @@ pub fn solve<T: Real>(
         _ => newton(problem, metric, bonds, solver, x, mult, scratch),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// `eval_with::<false>` (the Newton right-hand sides) gives `eval`'s residual and
+    /// direction bit for bit, and no magnitude, for every kind of row: bonds (stretched,
+    /// compressed, NaN), wall links, pins; positions and velocities.
+    #[test]
+    fn eval_without_the_magnitude_keeps_the_residual_and_direction() {
+        let x = [
+            DVec3::new(0.1, -0.3, 1.7),
+            DVec3::new(1.9, 0.4, 2.2),
+            DVec3::new(0.2, 0.1, -0.4),
+            DVec3::new(f64::NAN, 0.0, 1.0),
+        ];
+        let bond = |i, j, length: f64| Bond { i, j, length };
+        let mut rows = [
+            bond(0, 1, 1.5),
+            bond(1, 2, 3.5),
+            bond(2, 3, 1.0),
+            Bond::wall(2, 0.7),
+            Bond::wall(0, 0.9),
+            bond(0, 2, 0.3),
+        ]
+        .to_vec();
+        if cfg!(feature = "pins") {
+            rows.extend(Bond::pins(1, 0.8));
+        }
+        let anchor = [DVec3::new(0.0, 0.2, 1.5), DVec3::new(1.7, 0.5, 2.0)];
+        let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+        let positions = Problem::Positions {
+            cell: None,
+            one_sided: usize::MAX,
+            #[cfg(feature = "pins")]
+            anchor: &anchor,
+        };
+        let _ = anchor;
+        let grad: [DVec3; 9] = core::array::from_fn(|k| DVec3::new(0.3, -0.2 * k as f64, 1.1));
+        let velocities = Problem::Velocities {
+            bond: &grad,
+            dt: 0.01,
+        };
+        for problem in [positions, velocities] as [Problem<f64>; 2] {
+            for (k, b) in rows.iter().enumerate() {
+                let (v0, d0, m0) = problem.eval(b, k, &x);
+                let (v1, d1, m1) = problem.eval_with::<false>(b, k, &x);
+                assert_eq!(v0.to_bits(), v1.to_bits(), "row {k}");
+                assert_eq!(bits(d0), bits(d1), "row {k}");
+                assert_eq!(m1, 0.0);
+                // The full form does compute a magnitude.
+                assert!(m0 != 0.0, "row {k}");
+            }
+        }
+    }
+}
