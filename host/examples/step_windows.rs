@@ -23,8 +23,10 @@ fn main() {
     let scene = Scene::parse(&text, path).expect("scene");
     let mut e = Engine::<f64>::new(&scene, usize::MAX).expect("system");
     let ticks0 = cpu_ticks();
-    let mut per = Vec::with_capacity(steps / window);
-    for _ in 0..steps / window {
+    // At least one window, however few the steps.
+    let windows = (steps / window).max(1);
+    let mut per = Vec::with_capacity(windows);
+    for _ in 0..windows {
         let t = Instant::now();
         for _ in 0..window {
             e.step().expect("step");
