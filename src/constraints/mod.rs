@@ -130,6 +130,14 @@ impl<T: Real> Problem<'_, T> {
     /// normalised magnitude compared with the tolerance.
     #[inline]
     fn eval(&self, b: &Bond<T>, k: usize, x: &[T::V3]) -> (T, T::V3, T) {
+        self.eval_with::<true>(b, k, x)
+    }
+
+    /// [`Problem::eval`], its magnitude (a square root and a division a bond) only with
+    /// `NORM` (zero without): the Newton right-hand sides, which do not read it, call
+    /// it out of line, where it was computed and discarded.
+    #[inline]
+    fn eval_with<const NORM: bool>(&self, b: &Bond<T>, k: usize, x: &[T::V3]) -> (T, T::V3, T) {
         let rel = match *self {
             Problem::Positions { cell, .. } => b.separation(x, cell.as_ref()),
             Problem::Velocities { .. } => b.relative(x),
@@ -146,7 +154,7 @@ impl<T: Real> Problem<'_, T> {
                 (
                     two_s * off,
                     crate::bonds::along::<T>(e, two_s),
-                    (off / b.length).abs(),
+                    lazy::<T, NORM>(|| (off / b.length).abs()),
                 )
             }
             // A wall link's linear constraint `2 d (z - d)` (see [`Bond::wall`]); its
@@ -157,7 +165,7 @@ impl<T: Real> Problem<'_, T> {
                 (
                     two_d * (z - b.length),
                     T::v3(T::ZERO, T::ZERO, two_d),
-                    ((z - b.length) / b.length).abs(),
+                    lazy::<T, NORM>(|| ((z - b.length) / b.length).abs()),
                 )
             }
             Problem::Positions { .. } => {
@@ -167,12 +175,12 @@ impl<T: Real> Problem<'_, T> {
                 (
                     r2 - d2,
                     rel * T::TWO,
-                    (r2.sqrt() - b.length).abs() / b.length,
+                    lazy::<T, NORM>(|| (r2.sqrt() - b.length).abs() / b.length),
                 )
             }
             Problem::Velocities { bond, dt } => {
                 let c = T::dot(bond[k], rel);
-                (c, bond[k], (c * dt).abs() / d2)
+                (c, bond[k], lazy::<T, NORM>(|| (c * dt).abs() / d2))
             }
         }
     }
@@ -300,6 +308,12 @@ fn worst<T: Real>(problem: &Problem<'_, T>, bonds: &[Bond<T>], x: &[T::V3]) -> T
     w
 }
 
+/// `f()` with `NORM`, zero without ([`Problem::eval_with`]).
+#[inline(always)]
+fn lazy<T: Real, const NORM: bool>(f: impl FnOnce() -> T) -> T {
+    if NORM { f() } else { T::ZERO }
+}
+
 /// Solves for the multipliers, accumulating them into `mult` and moving `x`. The
 /// implicit-drag metric has no cheap single-bond form and is always solved by Krylov.
 ///
@@ -325,5 +339,62 @@ pub fn solve<T: Real>(
         SolverKind::Sweep => sweep(problem, metric, bonds, solver, x, mult),
         SolverKind::Krylov => krylov(problem, metric, bonds, solver, x, mult, scratch),
         _ => newton(problem, metric, bonds, solver, x, mult, scratch),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// `eval_with::<false>` (the Newton right-hand sides) gives `eval`'s residual and
+    /// direction bit for bit, and no magnitude, for every kind of row: bonds (stretched,
+    /// compressed, NaN), wall links, pins; positions and velocities.
+    #[test]
+    fn eval_without_the_magnitude_keeps_the_residual_and_direction() {
+        let x = [
+            DVec3::new(0.1, -0.3, 1.7),
+            DVec3::new(1.9, 0.4, 2.2),
+            DVec3::new(0.2, 0.1, -0.4),
+            DVec3::new(f64::NAN, 0.0, 1.0),
+        ];
+        let bond = |i, j, length: f64| Bond { i, j, length };
+        let mut rows = [
+            bond(0, 1, 1.5),
+            bond(1, 2, 3.5),
+            bond(2, 3, 1.0),
+            Bond::wall(2, 0.7),
+            Bond::wall(0, 0.9),
+            bond(0, 2, 0.3),
+        ]
+        .to_vec();
+        if cfg!(feature = "pins") {
+            rows.extend(Bond::pins(1, 0.8));
+        }
+        let anchor = [DVec3::new(0.0, 0.2, 1.5), DVec3::new(1.7, 0.5, 2.0)];
+        let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+        let positions = Problem::Positions {
+            cell: None,
+            one_sided: usize::MAX,
+            #[cfg(feature = "pins")]
+            anchor: &anchor,
+        };
+        let _ = anchor;
+        let grad: [DVec3; 9] = core::array::from_fn(|k| DVec3::new(0.3, -0.2 * k as f64, 1.1));
+        let velocities = Problem::Velocities {
+            bond: &grad,
+            dt: 0.01,
+        };
+        for problem in [positions, velocities] as [Problem<f64>; 2] {
+            for (k, b) in rows.iter().enumerate() {
+                let (v0, d0, m0) = problem.eval(b, k, &x);
+                let (v1, d1, m1) = problem.eval_with::<false>(b, k, &x);
+                assert_eq!(v0.to_bits(), v1.to_bits(), "row {k}");
+                assert_eq!(bits(d0), bits(d1), "row {k}");
+                assert_eq!(m1, 0.0);
+                // The full form does compute a magnitude.
+                assert!(m0 != 0.0, "row {k}");
+            }
+        }
     }
 }

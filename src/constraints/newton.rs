@@ -128,7 +128,12 @@ pub fn newton<T: Real>(
         }
         previous = Some(residual);
         for (k, b) in bonds.iter().enumerate() {
-            let (value, dir, _) = problem.eval(b, k, x);
+            // Without the magnitude (not read here) off 32-bit Arm; the firmware keeps
+            // the one copy of `eval` it has (flash).
+            let (value, dir, _) = match cfg!(target_arch = "arm") {
+                true => problem.eval(b, k, x),
+                false => problem.eval_with::<false>(b, k, x),
+            };
             rhs[k] = -value;
             if refresh {
                 // The chord's lower triangle, or the whole row at the iterate (one call
