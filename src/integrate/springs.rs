@@ -50,7 +50,9 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         super::cell(p),
         force,
     )?;
-    mobility_product(p, s.ewald, s.pos, s.radius, mu, force, u, par, bands)?;
+    let mut mu = mu;
+    mobility_product(p, s.ewald, s.pos, s.radius, mu.reborrow(), force, u, par, bands)?;
+    let mu = mu.into_ref();
     add_flow(p, s.pos, u);
     let mut noise_iterations = 0;
     match thermal {
