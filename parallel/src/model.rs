@@ -25,6 +25,11 @@ pub enum Path {
     Compact,
     /// Evaluate every pair where it is used: no bytes, 63 + 36 flops a pair.
     Recompute,
+    /// Stream general `f64` blocks (nine entries): 72 bytes and 36 flops a pair. A
+    /// wall's and a box's mobility, and the free-space one before it was stored
+    /// symmetric (what the 16-core measurement ran). Not among [`Path::ALL`]:
+    /// in free space the symmetric blocks do the same work on fewer bytes.
+    General,
 }
 
 impl Path {
@@ -37,6 +42,7 @@ impl Path {
             Path::Stored => 48.0,
             Path::Compact => 24.0,
             Path::Recompute => 0.0,
+            Path::General => 72.0,
         }
     }
 
@@ -46,6 +52,7 @@ impl Path {
             Path::Stored => 48.0,
             Path::Compact => 72.0,
             Path::Recompute => 0.0,
+            Path::General => 72.0,
         }
     }
 }
@@ -57,8 +64,9 @@ pub struct Machine {
     pub b1: f64,
     /// The machine's read bandwidth, bytes per ns (GB/s).
     pub b: f64,
-    /// One thread's time per pair of a product on each path ([`Path::ALL`] order), ns.
-    pub ns: [f64; 3],
+    /// One thread's time per pair of a product on each path ([`Path::ALL`] order, then
+    /// [`Path::General`]), ns.
+    pub ns: [f64; 4],
     /// One thread's time per pair of the assembly pass that stores the blocks and
     /// applies them once (`parallel::assemble_apply`), ns; the compact path's packing of
     /// its copy, row by row in cache, is taken as free (measured within 2 % of it at
@@ -118,13 +126,16 @@ mod tests {
         let m = Machine {
             b1: 10.0,
             b: 30.0,
-            ns: [6.0, 3.0, 15.0],
+            ns: [6.0, 3.0, 15.0, 6.0],
             assembly: 16.0,
             serial: 0.5,
         };
         // Stored, 1 thread: max(48 / 10, 6) = 6; 16 threads: max(48 / 30, 6 / 16) = 1.6.
         assert_eq!(m.product(Path::Stored, 1.0), 6.0);
         assert_eq!(m.product(Path::Stored, 16.0), 1.6);
+        // General blocks: max(72 / 10, 6) = 7.2 and max(72 / 30, 6 / 16) = 2.4.
+        assert_eq!(m.product(Path::General, 1.0), 7.2);
+        assert_eq!(m.product(Path::General, 16.0), 2.4);
         // Recompute: 15 / t, whatever the bandwidth.
         assert_eq!(m.product(Path::Recompute, 16.0), 15.0 / 16.0);
         // The assembly moves twice what it stores: stored 96 bytes, 1 thread

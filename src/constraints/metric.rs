@@ -423,7 +423,9 @@ impl<T: Real> Metric<'_, T> {
                 spread(bonds, grad, c, scale, f);
                 match compact {
                     Some(copy) => crate::noise::reduced::apply::<T>(par, copy, n, f, out, bands),
-                    None => with_blocks!(mu, a => crate::parallel::product::<T>(par, a, n, f, out, bands)),
+                    None => {
+                        with_blocks!(mu, a => crate::parallel::product::<T>(par, a, n, f, out, bands))
+                    }
                 }
             }
             Metric::Free {

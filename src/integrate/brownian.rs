@@ -86,7 +86,8 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         })
         .map_err(StepError::from)?;
     } else {
-        mobility_product(p, s.ewald, s.pos, s.radius, mu.reborrow(), force, u, par, bands)?;
+        let at_start = mu.reborrow();
+        mobility_product(p, s.ewald, s.pos, s.radius, at_start, force, u, par, bands)?;
     }
     let mu = mu.into_ref();
     add_flow(p, s.pos, u);

@@ -57,7 +57,11 @@ impl<T: Real> Block<T> for Sym<T> {
     fn mul(self, x: T::V3) -> T::V3 {
         let [a, b, c, d, e, f] = self;
         let [x, y, z] = T::xyz(x);
-        T::v3(a * x + b * y + c * z, b * x + d * y + e * z, c * x + e * y + f * z)
+        T::v3(
+            a * x + b * y + c * z,
+            b * x + d * y + e * z,
+            c * x + e * y + f * z,
+        )
     }
 
     /// Entry `c` is the dot of column `c` with `x`, `(m_0c x + m_1c y) + m_2c z`: for a
@@ -179,7 +183,7 @@ pub(crate) use with_blocks;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::{DMat3, DVec3, Mat3, Vec3};
+    use glam::{DMat3, DVec3, Vec3};
 
     /// Deterministic values in [-0.5, 0.5) (a linear congruential sequence), with
     /// zeros, huge and tiny values mixed in.
@@ -223,7 +227,7 @@ mod tests {
             let bits = |u: Vec3| u.to_array().map(f32::to_bits);
             assert_eq!(bits(s.mul(x)), bits(m * x));
             assert_eq!(bits(s.tmul(x)), bits(<f32 as Real>::m3_tmul(m, x)));
-            assert_eq!(Mat3::from(Block::<f32>::full(s)), m);
+            assert_eq!(Block::<f32>::full(s), m);
         }
     }
 

@@ -21,8 +21,8 @@ pub mod band;
 mod block;
 mod lu;
 
-pub use block::{Block, Mob, MobMut, Sym};
 pub(crate) use block::with_blocks;
+pub use block::{Block, Mob, MobMut, Sym};
 
 pub use lu::{cholesky_dense, cholesky_dense_solve, lu, lu_ranked, lu_solve};
 

@@ -109,9 +109,8 @@ pub(crate) fn by_bands<T: Real, X: Send, E: Send, J>(
 where
     J: Fn(usize, &mut [X], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
 {
-    let job = |t, rows: &mut [X], _: &mut [X], yt: &mut [T::V3], zt: &mut [T::V3]| {
-        job(t, rows, yt, zt)
-    };
+    let job =
+        |t, rows: &mut [X], _: &mut [X], yt: &mut [T::V3], zt: &mut [T::V3]| job(t, rows, yt, zt);
     by_bands_and::<T, X, X, E, _>(par, n, (out, start), (&mut [], start), y, z, job)
 }
 
@@ -132,11 +131,10 @@ pub(crate) fn by_bands_and<T: Real, X: Send, S: Send, E: Send, J>(
 where
     J: Fn(usize, &mut [X], &mut [S], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
 {
-    let job = |t,
-               rows: &mut [X],
-               side: &mut [S],
-               [yt]: [&mut [T::V3]; 1],
-               [zt]: [&mut [T::V3]; 1]| { job(t, rows, side, yt, zt) };
+    let job =
+        |t, rows: &mut [X], side: &mut [S], [yt]: [&mut [T::V3]; 1], [zt]: [&mut [T::V3]; 1]| {
+            job(t, rows, side, yt, zt)
+        };
     by_bands_k::<T, X, S, E, _, 1>(par, n, out, side, [y], [z], job)
 }
 

@@ -142,7 +142,11 @@ impl<T: Real> Workspace<'_, T> {
         // The stored mobilities: symmetric blocks of six scalars in free space, else
         // blocks of nine (`Layout::for_params`).
         let second = matches!(method, Method::Overdamped2);
-        let (one, two) = (if stored { tri(m) } else { 0 }, if second { tri(m) } else { 0 });
+        let (one, two) = (
+            if stored { tri(m) } else { 0 },
+            if second { tri(m) } else { 0 },
+        );
+        // (`as_chunks_mut`, Rust 1.88: the kernel's minimum since this storage.)
         let (mu, mu2) = if super::symmetric(p) {
             let mut sym = |k: usize| MobMut::Sym(sc.take(6 * k).as_chunks_mut::<6>().0);
             (sym(one), sym(two))
