@@ -428,7 +428,7 @@ fn contact_benches(c: &mut Criterion) {
 const PATH_SIZES: [usize; 3] = [1024, 4096, 8192];
 
 /// One product `y = mu_tt x` by each path on one thread (`products/{stored_f64,
-/// compact_f32,recompute}/N`): the stored `f64` blocks (72 bytes a pair), the compact
+/// compact_f32,recompute}/N`): the stored `f64` blocks (symmetric: 48 bytes a pair), the compact
 /// `f32` copy (24 bytes) and the recompute path (pairs evaluated, nothing read).
 /// Criterion reports the bytes a product streams as its throughput (the recompute
 /// path's as pairs); ns per pair is the time over `N (N + 1) / 2`.
@@ -447,12 +447,12 @@ fn product_paths(c: &mut Criterion) {
             vec![glam::DVec3::ZERO; band_scratch(n)],
         );
         let pairs = (n * (n + 1) / 2) as u64;
-        let mut mu = vec![f64::M3_ZERO; n * (n + 1) / 2];
+        let mut mu: Vec<hydrorattle::linalg::Sym<f64>> = vec![[0.0; 6]; n * (n + 1) / 2];
         parallel::assemble::<f64>(&Serial, Hydro::Rpy, 1.0, &pos, &rad, &mut mu).unwrap();
         let mut copy = vec![f64::M3_ZERO; reduced::slots(n)];
         reduced::copy_apply::<f64>(&Serial, &mu, n, &mut copy, &x, &mut y, &mut z);
         let mut g = c.benchmark_group("products/stored_f64");
-        g.throughput(Throughput::Bytes(72 * pairs));
+        g.throughput(Throughput::Bytes(48 * pairs));
         g.bench_function(BenchmarkId::from_parameter(n), |b| {
             b.iter(|| parallel::product::<f64>(&Serial, black_box(&mu), n, &x, &mut y, &mut z))
         });

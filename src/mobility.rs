@@ -290,7 +290,7 @@ pub fn assemble_tt<T: Real>(
     eta: T,
     pos: &[T::V3],
     radius: &[T],
-    out: &mut [T::M3],
+    out: &mut [impl crate::linalg::Block<T>],
 ) -> Result<(), ParticleError> {
     crate::parallel::assemble(&crate::parallel::Serial, level, eta, pos, radius, out)
 }

@@ -33,7 +33,7 @@ pub(crate) use jobs::{Jobs, run_all};
 pub(crate) use jobs::{Packed, by_bands, by_bands_and, by_bands_k, by_rows, map_bands, reduce};
 
 use crate::error::ParticleError;
-use crate::linalg::tri;
+use crate::linalg::{Block, tri};
 use crate::mobility::{Hydro, pair_tt, self_tt};
 use crate::real::Real;
 
@@ -120,33 +120,46 @@ pub const fn band_scratch(n: usize) -> usize {
 /// below in row order. With `b0 = 0` this is the one-pass
 /// [`sym_matvec`](crate::linalg::sym_matvec).
 #[inline(always)]
-pub(crate) fn band<T: Real>(a: &[T::M3], b0: usize, x: &[T::V3], y: &mut [T::V3], z: &mut [T::V3]) {
+pub(crate) fn band<T: Real, B: Block<T>>(
+    a: &[B],
+    b0: usize,
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) {
     z.fill(T::V3_ZERO);
     for (k, yk) in y.iter_mut().enumerate() {
         let i = b0 + k;
-        *yk = a[tri(i) + i] * x[i];
+        *yk = a[tri(i) + i].mul(x[i]);
     }
     for k in 0..y.len() {
-        row::<T>(a, b0, k, x, y, z);
+        row::<T, B>(a, b0, k, x, y, z);
     }
 }
 
 /// Row `b0 + k` of a [`band`]: its lower blocks' products summed in order into `y_k`,
 /// their transposed products added to `z` (left of the band) and `y` (inside it).
 #[inline(always)]
-fn row<T: Real>(a: &[T::M3], b0: usize, k: usize, x: &[T::V3], y: &mut [T::V3], z: &mut [T::V3]) {
+fn row<T: Real, B: Block<T>>(
+    a: &[B],
+    b0: usize,
+    k: usize,
+    x: &[T::V3],
+    y: &mut [T::V3],
+    z: &mut [T::V3],
+) {
     let i = b0 + k;
     let (left, inside) = a[tri(i)..tri(i) + i].split_at(b0);
     let xi = x[i];
     let mut acc = T::V3_ZERO;
     for ((&b, zj), &xj) in left.iter().zip(z.iter_mut()).zip(x) {
-        acc += b * xj;
-        *zj += T::m3_tmul(b, xi);
+        acc += b.mul(xj);
+        *zj += b.tmul(xi);
     }
     let (ys, yi) = y[..=k].split_at_mut(k);
     for ((&b, yj), &xj) in inside.iter().zip(ys).zip(&x[b0..]) {
-        acc += b * xj;
-        *yj += T::m3_tmul(b, xi);
+        acc += b.mul(xj);
+        *yj += b.tmul(xi);
     }
     yi[0] += acc;
 }
@@ -164,13 +177,20 @@ impl<T: Real> Pairs<'_, T> {
     /// The diagonal blocks of rows `b0..b0 + y.len()` into `rows` (the packed rows from
     /// `b0` on), `y` started from their products, `z` zeroed: a fused band's first step.
     #[inline(always)]
-    fn start(&self, rows: &mut [T::M3], b0: usize, x: &[T::V3], y: &mut [T::V3], z: &mut [T::V3]) {
+    fn start<B: Block<T>>(
+        &self,
+        rows: &mut [B],
+        b0: usize,
+        x: &[T::V3],
+        y: &mut [T::V3],
+        z: &mut [T::V3],
+    ) {
         let base = tri(b0);
         z.fill(T::V3_ZERO);
         for (k, yk) in y.iter_mut().enumerate() {
             let i = b0 + k;
             let diag = T::m3_diag(self_tt(self.eta, self.radius[i]));
-            rows[tri(i) - base + i] = diag;
+            rows[tri(i) - base + i] = B::store(diag);
             *yk = diag * x[i];
         }
     }
@@ -180,9 +200,9 @@ impl<T: Real> Pairs<'_, T> {
 /// rows from `b0` on) and applied at once, in the same order, so the product's bits are
 /// those of [`band`] on the stored blocks.
 #[inline(always)]
-fn band_fused<T: Real>(
+fn band_fused<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
-    rows: &mut [T::M3],
+    rows: &mut [B],
     b0: usize,
     x: &[T::V3],
     y: &mut [T::V3],
@@ -197,9 +217,9 @@ fn band_fused<T: Real>(
 
 /// Row `b0 + k` of a [`band_fused`]: [`row`] on blocks evaluated and stored on the way.
 #[inline(always)]
-fn row_fused<T: Real>(
+fn row_fused<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
-    rows: &mut [T::M3],
+    rows: &mut [B],
     b0: usize,
     k: usize,
     x: &[T::V3],
@@ -226,7 +246,7 @@ fn row_fused<T: Real>(
     let others = left.iter_mut().zip(z.iter_mut()).zip(pos).zip(radius);
     for (j, (((o, zj), &pj), &aj)) in others.enumerate() {
         let b = pair::<T>(level, eta, ai, aj, pi - pj, i, j)?;
-        *o = b;
+        *o = B::store(b);
         acc += b * x[j];
         *zj += T::m3_tmul(b, xi);
     }
@@ -234,7 +254,7 @@ fn row_fused<T: Real>(
     let others = inside.iter_mut().zip(ys).zip(&pos[b0..]).zip(&radius[b0..]);
     for (j, (((o, yj), &pj), &aj)) in others.enumerate() {
         let b = pair::<T>(level, eta, ai, aj, pi - pj, i, b0 + j)?;
-        *o = b;
+        *o = B::store(b);
         acc += b * x[b0 + j];
         *yj += T::m3_tmul(b, xi);
     }
@@ -248,14 +268,14 @@ fn row_fused<T: Real>(
 /// same bits on any number of threads.
 pub fn product<T: Real>(
     par: &dyn Parallel,
-    a: &[T::M3],
+    a: &[impl Block<T>],
     n: usize,
     x: &[T::V3],
     y: &mut [T::V3],
     z: &mut [T::V3],
 ) {
     if bands(n) == 1 {
-        band::<T>(a, 0, x, &mut y[..n], &mut []);
+        band::<T, _>(a, 0, x, &mut y[..n], &mut []);
         return;
     }
     products::<T, 1>(par, a, n, [x], [y], z);
@@ -267,7 +287,7 @@ pub fn product<T: Real>(
 /// [`band_scratch`]`(n)` vectors.
 pub fn products<T: Real, const K: usize>(
     par: &dyn Parallel,
-    a: &[T::M3],
+    a: &[impl Block<T>],
     n: usize,
     x: [&[T::V3]; K],
     y: [&mut [T::V3]; K],
@@ -286,14 +306,14 @@ pub fn products<T: Real, const K: usize>(
 /// are the same.
 #[inline(always)]
 pub fn product_band<T: Real, const K: usize>(
-    a: &[T::M3],
+    a: &[impl Block<T>],
     n: usize,
     t: usize,
     x: [&[T::V3]; K],
     y: [&mut [T::V3]; K],
     z: [&mut [T::V3]; K],
 ) {
-    blocked::band_rows_k::<T, K>(a, band_start(n, t), x, y, z);
+    blocked::band_rows_k::<T, _, K>(a, band_start(n, t), x, y, z);
 }
 
 /// The `K` products `y` of [`products`] and its kin: `band(t, y_t, z_t)` for every band
@@ -317,7 +337,7 @@ pub fn by_bands_then_reduce<T: Real, E: Send, const K: usize>(
     }
     let none = || (&mut [][..], tri as fn(usize) -> usize);
     let zs = scratches::<T, K>(n, z);
-    by_bands_k::<T, E, _, K>(par, n, none(), none(), ys, zs, |t, _, _, yt, zt| {
+    by_bands_k::<T, (), (), E, _, K>(par, n, none(), none(), ys, zs, |t, _, _, yt, zt| {
         band(t, yt, zt)
     })?;
     let zs = scratches::<T, K>(n, z);
@@ -346,36 +366,38 @@ pub fn assemble<T: Real>(
     eta: T,
     pos: &[T::V3],
     radius: &[T],
-    out: &mut [T::M3],
+    out: &mut [impl Block<T>],
 ) -> Result<(), ParticleError> {
     let n = pos.len();
     let out = &mut out[..tri(n)];
     if bands(n) == 1 {
-        return rows::<T>(level, eta, pos, radius, 0..n, out);
+        return rows::<T, _>(level, eta, pos, radius, 0..n, out);
     }
-    by_bands::<T, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
+    by_bands::<T, _, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
         let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-        rows::<T>(level, eta, pos, radius, b0..b1, rows_t)
+        rows::<T, _>(level, eta, pos, radius, b0..b1, rows_t)
     })
 }
 
 /// Packed rows `range` of `mu_tt` into `out` (which starts at row `range.start`).
-fn rows<T: Real>(
+fn rows<T: Real, B: Block<T>>(
     level: Hydro,
     eta: T,
     pos: &[T::V3],
     radius: &[T],
     range: core::ops::Range<usize>,
-    out: &mut [T::M3],
+    out: &mut [B],
 ) -> Result<(), ParticleError> {
     let base = tri(range.start);
     for i in range {
         let (pairs, diag) = out[tri(i) - base..=tri(i) - base + i].split_at_mut(i);
         for (j, o) in pairs.iter_mut().enumerate() {
-            *o = pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
-                .ok_or(ParticleError::Nested { i: j, j: i })?;
+            *o = B::store(
+                pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
+                    .ok_or(ParticleError::Nested { i: j, j: i })?,
+            );
         }
-        diag[0] = T::m3_diag(self_tt(eta, radius[i]));
+        diag[0] = B::store(T::m3_diag(self_tt(eta, radius[i])));
     }
     Ok(())
 }
@@ -390,7 +412,7 @@ pub fn assemble_apply<T: Real>(
     eta: T,
     pos: &[T::V3],
     radius: &[T],
-    out: &mut [T::M3],
+    out: &mut [impl Block<T>],
     x: &[T::V3],
     y: &mut [T::V3],
     z: &mut [T::V3],
@@ -408,15 +430,15 @@ pub fn assemble_apply<T: Real>(
         // (the Cortex-M4F's FPU is scalar, and the lanes' arrays would cost its stack
         // ~3 kB), which keeps the row-by-row band and its instruction count.
         if level == Hydro::Rpy && n <= lanes::MAX && !cfg!(target_arch = "arm") {
-            return lanes::band_lanes::<T>(src, out, x, &mut y[..n]);
+            return lanes::band_lanes::<T, _>(src, out, x, &mut y[..n]);
         }
-        return band_fused::<T>(src, out, 0, x, &mut y[..n], &mut []);
+        return band_fused::<T, _>(src, out, 0, x, &mut y[..n], &mut []);
     }
     if bands(n) == 1 {
-        return blocked::fused_rows::<T>(src, out, 0, x, &mut y[..n], &mut []);
+        return blocked::fused_rows::<T, _>(src, out, 0, x, &mut y[..n], &mut []);
     }
-    by_bands::<T, _, _>(par, n, out, tri, y, z, |t, rows_t, yt, zt| {
-        blocked::fused_rows::<T>(src, rows_t, band_start(n, t), x, yt, zt)
+    by_bands::<T, _, _, _>(par, n, out, tri, y, z, |t, rows_t, yt, zt| {
+        blocked::fused_rows::<T, _>(src, rows_t, band_start(n, t), x, yt, zt)
     })?;
     reduce::<T>(n, y, z, par);
     Ok(())

@@ -55,7 +55,8 @@ pub trait Real:
         + Mul<Self::V3, Output = Self::V3>
         + Mul<Self, Output = Self::M3>
         + AddAssign
-        + SubAssign;
+        + SubAssign
+        + crate::linalg::Block<Self>;
 
     /// 0.
     const ZERO: Self;
@@ -340,6 +341,27 @@ macro_rules! impl_real {
                 m.y_axis.y += s;
                 m.z_axis.z += s;
                 m
+            }
+        }
+
+        /// The general block: glam's product, the kernel's transposed product.
+        impl crate::linalg::Block<$t> for $m {
+            const SCALARS: usize = 9;
+            #[inline(always)]
+            fn store(m: $m) -> Self {
+                m
+            }
+            #[inline(always)]
+            fn full(self) -> $m {
+                self
+            }
+            #[inline(always)]
+            fn mul(self, x: $v) -> $v {
+                self * x
+            }
+            #[inline(always)]
+            fn tmul(self, x: $v) -> $v {
+                <$t as Real>::m3_tmul(self, x)
             }
         }
     };

@@ -115,7 +115,7 @@ fn chain_r2(l: f64, dt: f64, seed: u64, steps: usize, burn: usize, every: usize)
     let mut out = Vec::new();
     for k in 0..steps {
         step_retrying(&mut ps, &bonds, &p, &mut ws);
-        if k >= burn && (k - burn) % every == 0 {
+        if k >= burn && (k - burn).is_multiple_of(every) {
             let r = (1..N).fold([0.0; 3], |acc, j| {
                 add(
                     acc,

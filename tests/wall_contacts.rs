@@ -396,7 +396,10 @@ fn layout_counts_one_link_per_sphere() {
     assert_eq!(p.constraints(10, 9), 19);
     let wall = Layout::for_params(&p, 10, 9);
     assert_eq!(wall.links, 19);
-    assert!(wall.scalars > none.scalars);
+    // More constraints: more bond vectors; and above the wall the mobility keeps
+    // general blocks (`tri(10)`) where free space stores symmetric ones in scalars.
+    assert!(wall.vectors > none.vectors);
+    assert_eq!(wall.blocks, none.blocks + 55);
     p.contacts = Some(Contacts::new(30));
     assert_eq!(Layout::for_params(&p, 10, 9).links, 49);
 }

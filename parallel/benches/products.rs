@@ -1,12 +1,13 @@
 //! Criterion benchmarks of the product paths (issue 31), `f64` kernel, on the kernel
 //! bench's N-bead chain (`benches/kernel.rs`: head 2^(1/3), tails 1, bonds 1.5 (a_i + a_j)):
 //!
-//! * `block/{stored,compact,recompute}/k{1,2,4}/N` (N = 1024, 4096, one thread): one
-//!   block product of `k` vectors (`parallel::products`, `noise::reduced::apply_k`,
-//!   `parallel::free_products`). Per vector it reads `1 / k` of the bytes (stored: 72
-//!   a pair, compact: 24) or evaluates `1 / k` of the pair blocks (recompute: 63 flops
-//!   a pair, then 36 a vector).
-//! * `paths/{stored,compact,recompute}/{portable,avx2}/t{1,2}/N` (N = 1024, 4096, 8192):
+//! * `block/{stored,stored9,compact,recompute}/k{1,2,4}/N` (N = 1024, 4096, one thread):
+//!   one block product of `k` vectors (`parallel::products`, `noise::reduced::apply_k`,
+//!   `parallel::free_products`). Per vector it reads `1 / k` of the bytes (stored: the
+//!   free-space symmetric blocks, 48 a pair; stored9: the same blocks in nine entries,
+//!   as a wall's are stored, 72; compact: 24) or evaluates `1 / k` of the pair blocks
+//!   (recompute: 63 flops a pair, then 36 a vector).
+//! * `paths/{stored,stored9,compact,recompute}/{portable,avx2}/t{1,2}/N` (N = 1024, 4096, 8192):
 //!   one product by each path, the portable kernel function or the runtime-selected AVX2
 //!   copy (`hydrorattle_parallel::wide`), on 1 and 2 threads.
 //!
@@ -16,6 +17,7 @@
 
 use criterion::{BenchmarkId, Criterion, SamplingMode, Throughput};
 use hydrorattle::glam::DVec3;
+use hydrorattle::linalg::Sym;
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{self, Parallel, Serial, band_scratch};
 use hydrorattle::{Hydro, Real};
@@ -45,7 +47,8 @@ struct Data {
     n: usize,
     pos: Vec<DVec3>,
     rad: Vec<f64>,
-    mu: Vec<<f64 as Real>::M3>,
+    mu: Vec<Sym<f64>>,
+    mu9: Vec<<f64 as Real>::M3>,
     copy: Vec<<f64 as Real>::M3>,
     xs: [Vec<DVec3>; 4],
 }
@@ -58,8 +61,10 @@ impl Data {
                 .map(|i| DVec3::new((i as f64 + q as f64).sin(), 0.5, 1.0 - q as f64))
                 .collect()
         });
-        let mut mu = vec![f64::M3_ZERO; n * (n + 1) / 2];
+        let mut mu = vec![[0.0; 6]; n * (n + 1) / 2];
         parallel::assemble::<f64>(&Serial, Hydro::Rpy, 1.0, &pos, &rad, &mut mu).unwrap();
+        let mut mu9 = vec![f64::M3_ZERO; n * (n + 1) / 2];
+        parallel::assemble::<f64>(&Serial, Hydro::Rpy, 1.0, &pos, &rad, &mut mu9).unwrap();
         let mut copy = vec![f64::M3_ZERO; reduced::slots(n)];
         let (mut y, mut z) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; band_scratch(n)]);
         reduced::copy_apply::<f64>(&Serial, &mu, n, &mut copy, &xs[0], &mut y, &mut z);
@@ -68,6 +73,7 @@ impl Data {
             pos,
             rad,
             mu,
+            mu9,
             copy,
             xs,
         }
@@ -93,6 +99,8 @@ impl Data {
         match (path, avx2) {
             ("stored", false) => parallel::products::<f64, K>(par, mu, n, x, y, z),
             ("stored", true) => wide::products::<K>(par, mu, n, x, y, z),
+            ("stored9", false) => parallel::products::<f64, K>(par, &self.mu9, n, x, y, z),
+            ("stored9", true) => wide::products::<K>(par, &self.mu9, n, x, y, z),
             ("compact", false) => reduced::apply_k::<f64, K>(par, copy, n, x, y, z),
             ("compact", true) => wide::compact_products::<K>(par, copy, n, x, y, z),
             ("recompute", false) => {
@@ -118,7 +126,12 @@ impl Out {
     }
 }
 
-const PATHS: [(&str, u64); 3] = [("stored", 72), ("compact", 24), ("recompute", 0)];
+const PATHS: [(&str, u64); 4] = [
+    ("stored", 48),
+    ("stored9", 72),
+    ("compact", 24),
+    ("recompute", 0),
+];
 
 fn block(c: &mut Criterion) {
     for n in [1024, 4096] {

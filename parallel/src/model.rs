@@ -25,12 +25,19 @@
 /// A way to apply the mobility.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Path {
-    /// Stream the stored `f64` blocks: 72 bytes and 36 flops a pair.
+    /// Stream the stored `f64` blocks, symmetric (free space: six entries a block,
+    /// `hydrorattle::linalg::Sym`): 48 bytes and 36 flops a pair. (A wall's or a box's
+    /// general blocks take 72 bytes.)
     Stored,
     /// Stream the compact `f32` copy: 24 bytes and 36 `f32` flops a pair.
     Compact,
     /// Evaluate every pair where it is used: no bytes, 63 + 36 flops a pair.
     Recompute,
+    /// Stream general `f64` blocks (nine entries): 72 bytes and 36 flops a pair. A
+    /// wall's and a box's mobility, and the free-space one before it was stored
+    /// symmetric (what the 16-core measurement ran). Not among [`Path::ALL`]:
+    /// in free space the symmetric blocks do the same work on fewer bytes.
+    General,
 }
 
 impl Path {
@@ -40,18 +47,20 @@ impl Path {
     /// Bytes a product reads per pair.
     pub const fn bytes(self) -> f64 {
         match self {
-            Path::Stored => 72.0,
+            Path::Stored => 48.0,
             Path::Compact => 24.0,
             Path::Recompute => 0.0,
+            Path::General => 72.0,
         }
     }
 
     /// Bytes the assembly pass writes per pair (the stored blocks, and the copy).
     pub const fn written(self) -> f64 {
         match self {
-            Path::Stored => 72.0,
-            Path::Compact => 96.0,
+            Path::Stored => 48.0,
+            Path::Compact => 72.0,
             Path::Recompute => 0.0,
+            Path::General => 72.0,
         }
     }
 }
@@ -63,8 +72,9 @@ pub struct Machine {
     pub b1: f64,
     /// The machine's read bandwidth, bytes per ns (GB/s).
     pub b: f64,
-    /// One thread's time per pair of a product on each path ([`Path::ALL`] order), ns.
-    pub ns: [f64; 3],
+    /// One thread's time per pair of a product on each path ([`Path::ALL`] order, then
+    /// [`Path::General`]), ns.
+    pub ns: [f64; 4],
     /// One thread's time per pair of the assembly pass that stores the blocks and
     /// applies them once (`parallel::assemble_apply`), ns; the compact path's packing of
     /// its copy, row by row in cache, is taken as free (measured within 2 % of it at
@@ -124,28 +134,31 @@ mod tests {
         let m = Machine {
             b1: 10.0,
             b: 30.0,
-            ns: [6.0, 3.0, 15.0],
+            ns: [6.0, 3.0, 15.0, 6.0],
             assembly: 16.0,
             serial: 0.5,
         };
-        // Stored, 1 thread: max(72 / 10, 6) = 7.2; 16 threads: max(72 / 30, 6 / 16) = 2.4.
-        assert_eq!(m.product(Path::Stored, 1.0), 7.2);
-        assert_eq!(m.product(Path::Stored, 16.0), 2.4);
+        // Stored, 1 thread: max(48 / 10, 6) = 6; 16 threads: max(48 / 30, 6 / 16) = 1.6.
+        assert_eq!(m.product(Path::Stored, 1.0), 6.0);
+        assert_eq!(m.product(Path::Stored, 16.0), 1.6);
+        // General blocks: max(72 / 10, 6) = 7.2 and max(72 / 30, 6 / 16) = 2.4.
+        assert_eq!(m.product(Path::General, 1.0), 7.2);
+        assert_eq!(m.product(Path::General, 16.0), 2.4);
         // Recompute: 15 / t, whatever the bandwidth.
         assert_eq!(m.product(Path::Recompute, 16.0), 15.0 / 16.0);
-        // The assembly moves twice what it stores: stored 144 bytes, 1 thread
-        // max(14.4, 16) = 16; 16 threads max(144 / 30, 1) = 4.8. Compact 192 bytes.
+        // The assembly moves twice what it stores: stored 96 bytes, 1 thread
+        // max(9.6, 16) = 16; 16 threads max(96 / 30, 1) = 3.2. Compact 144 bytes.
         assert_eq!(m.assembly(Path::Stored, 1.0), 16.0);
-        assert_eq!(m.assembly(Path::Stored, 16.0), 4.8);
-        assert_eq!(m.assembly(Path::Compact, 1.0), 19.2);
-        // A step of 5 products, 1 thread: stored 16 + 5 x 7.2 + 0.5 = 52.5, compact
-        // 19.2 + 5 x max(2.4, 3) + 0.5 = 34.7, recompute 6 x 15 + 0.5 = 90.5.
-        assert_eq!(m.step(Path::Stored, 1.0, 5.0), 52.5);
-        assert!((m.step(Path::Compact, 1.0, 5.0) - 34.7).abs() < 1e-12);
+        assert_eq!(m.assembly(Path::Stored, 16.0), 3.2);
+        assert_eq!(m.assembly(Path::Compact, 1.0), 16.0);
+        // A step of 5 products, 1 thread: stored 16 + 5 x 6 + 0.5 = 46.5, compact
+        // 16 + 5 x max(2.4, 3) + 0.5 = 31.5, recompute 6 x 15 + 0.5 = 90.5.
+        assert_eq!(m.step(Path::Stored, 1.0, 5.0), 46.5);
+        assert!((m.step(Path::Compact, 1.0, 5.0) - 31.5).abs() < 1e-12);
         assert_eq!(m.step(Path::Recompute, 1.0, 5.0), 90.5);
         assert_eq!(m.fastest(1.0, 5.0), Path::Compact);
-        // 64 threads: stored 4.8 + 5 x 2.4 + 0.5 = 17.3, compact 6.4 + 5 x 0.8 + 0.5
-        // = 10.9, recompute 90 / 64 + 0.5 = 1.91: the pair work wins once it is spread
+        // 64 threads: stored 3.2 + 5 x 1.6 + 0.5 = 11.7, compact 4.8 + 5 x 0.8 + 0.5
+        // = 9.3, recompute 90 / 64 + 0.5 = 1.91: the pair work wins once it is spread
         // thin enough; the serial rest bounds every speedup (recompute 90.5 / 1.91 =
         // 47x, not 64x).
         assert_eq!(m.fastest(64.0, 5.0), Path::Recompute);

@@ -21,11 +21,12 @@
 //! happens to inline, so whole steps get AVX2 from the x86-64-v3 build
 //! (`.cargo/x86-64-v3.toml`, docs/BENCHMARKS.md) instead.
 
+use hydrorattle::linalg::Block;
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{self, Parallel};
 use hydrorattle::{Hydro, ParticleError};
 
-/// Vectors of `f64` (`glam::DVec3`) and blocks (`glam::DMat3`).
+/// Vectors of `f64` (`glam::DVec3`) and blocks (`glam::DMat3`, the compact copy's slots).
 type V3 = <f64 as hydrorattle::Real>::V3;
 type M3 = <f64 as hydrorattle::Real>::M3;
 
@@ -45,11 +46,11 @@ pub fn avx2() -> bool {
     false
 }
 
-/// [`parallel::products`] in `f64`, each band in the AVX2 copy when [`avx2`] holds: the
-/// same bits.
+/// [`parallel::products`] in `f64` (symmetric blocks, `hydrorattle::linalg::Sym`, or
+/// general ones), each band in the AVX2 copy when [`avx2`] holds: the same bits.
 pub fn products<const K: usize>(
     par: &dyn Parallel,
-    a: &[M3],
+    a: &[impl Block<f64>],
     n: usize,
     x: [&[V3]; K],
     y: [&mut [V3]; K],
@@ -59,7 +60,7 @@ pub fn products<const K: usize>(
     if avx2() {
         let _ = parallel::by_bands_then_reduce::<f64, (), K>(par, n, y, z, |t, yt, zt| {
             // SAFETY: `avx2()` checked that this CPU has AVX2.
-            unsafe { x86::product_band::<K>(a, n, t, x, yt, zt) };
+            unsafe { x86::product_band::<_, K>(a, n, t, x, yt, zt) };
             Ok(())
         });
         return;
@@ -117,14 +118,15 @@ pub fn compact_products<const K: usize>(
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::{M3, V3};
+    use hydrorattle::linalg::Block;
     use hydrorattle::noise::reduced;
     use hydrorattle::parallel;
     use hydrorattle::{Hydro, ParticleError};
 
     /// [`parallel::product_band`] with AVX2. Safety: the CPU must have AVX2.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn product_band<const K: usize>(
-        a: &[M3],
+    pub(super) unsafe fn product_band<B: Block<f64>, const K: usize>(
+        a: &[B],
         n: usize,
         t: usize,
         x: [&[V3]; K],

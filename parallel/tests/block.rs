@@ -3,7 +3,8 @@
 //! blocks, the compact `f32` copy and the recompute path, with one band and with
 //! sixteen, on one thread and on a pool.
 
-use hydrorattle::glam::DVec3;
+use hydrorattle::glam::{DMat3, DVec3};
+use hydrorattle::linalg::Sym;
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{self, Parallel, Serial, band_scratch};
 use hydrorattle::{Hydro, Real};
@@ -84,6 +85,17 @@ fn all_paths<const K: usize>(n: usize, par: &dyn Parallel) {
         &|p, x, y, z| parallel::product::<f64>(p, &mu, n, x, y, z),
         &|p, x, y, z| parallel::products::<f64, K>(p, &mu, n, x, y, z),
     );
+    // The same mobility stored as symmetric blocks (six entries, as free-space steps
+    // store it): each vector gets the nine-entry product's bits.
+    let mut sym: Vec<Sym<f64>> = vec![[0.0; 6]; n * (n + 1) / 2];
+    parallel::assemble::<f64>(&Serial, Hydro::Rpy, 1.0, &pos, &radius, &mut sym).unwrap();
+    check::<K>(
+        n,
+        par,
+        "stored, symmetric blocks",
+        &|p, x, y, z| parallel::product::<f64>(p, &mu, n, x, y, z),
+        &|p, x, y, z| parallel::products::<f64, K>(p, &sym, n, x, y, z),
+    );
     let (pos, radius) = (&pos[..], &radius[..]);
     check::<K>(
         n,
@@ -103,6 +115,19 @@ fn all_paths<const K: usize>(n: usize, par: &dyn Parallel) {
         vec![DVec3::ZERO; band_scratch(n)],
     );
     reduced::copy_apply::<f64>(&Serial, &mu, n, &mut copy, &x, &mut y, &mut z);
+    // Packed from the symmetric blocks: the same copy, bit for bit.
+    let mut from_sym = vec![f64::M3_ZERO; reduced::slots(n)];
+    reduced::copy_apply::<f64>(&Serial, &sym, n, &mut from_sym, &x, &mut y, &mut z);
+    let entries = |c: &[DMat3]| -> Vec<u64> {
+        c.iter()
+            .flat_map(|m| m.to_cols_array().map(f64::to_bits))
+            .collect()
+    };
+    assert_eq!(
+        entries(&from_sym),
+        entries(&copy),
+        "copy from symmetric blocks"
+    );
     check::<K>(
         n,
         par,
@@ -171,6 +196,8 @@ fn the_avx2_copies_give_the_portable_bits() {
         let (pos, radius) = helix(n);
         let mut mu = vec![f64::M3_ZERO; n * (n + 1) / 2];
         parallel::assemble::<f64>(&Serial, Hydro::Rpy, 1.0, &pos, &radius, &mut mu).unwrap();
+        let mut sym: Vec<Sym<f64>> = vec![[0.0; 6]; n * (n + 1) / 2];
+        parallel::assemble::<f64>(&Serial, Hydro::Rpy, 1.0, &pos, &radius, &mut sym).unwrap();
         let (pos, radius, mu) = (&pos[..], &radius[..], &mu[..]);
         check::<2>(
             n,
@@ -178,6 +205,13 @@ fn the_avx2_copies_give_the_portable_bits() {
             "stored, AVX2",
             &|p, x, y, z| parallel::product::<f64>(p, mu, n, x, y, z),
             &|p, x, y, z| wide::products::<2>(p, mu, n, x, y, z),
+        );
+        check::<2>(
+            n,
+            &pool,
+            "stored, symmetric blocks, AVX2",
+            &|p, x, y, z| parallel::product::<f64>(p, mu, n, x, y, z),
+            &|p, x, y, z| wide::products::<2>(p, &sym, n, x, y, z),
         );
         check::<1>(
             n,

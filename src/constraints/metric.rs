@@ -12,7 +12,7 @@
 //! ([`Bond::pin`]) is the same along its axis.
 
 use crate::bonds::Bond;
-use crate::linalg::{self, tri};
+use crate::linalg::{self, Block, Mob, tri, with_blocks};
 use crate::mobility::{Hydro, tt_block_at, wall};
 #[cfg(feature = "periodic")]
 use crate::mobility::{periodic, sums::BoxSums};
@@ -35,8 +35,8 @@ pub enum Metric<'a, T: Real> {
     /// Hydrodynamic metric from the packed translational mobility:
     /// `D_l(p) = (mu_pi - mu_pj) (scale g_l)`, read block by block where it is used.
     Mobility {
-        /// Packed `mu_tt` (`tri(n)` blocks).
-        mu: &'a [T::M3],
+        /// Packed `mu_tt` (`tri(n)` blocks, symmetric in free space).
+        mu: Mob<'a, T>,
         /// Constraint gradients, one per bond.
         grad: &'a [T::V3],
         /// Overall factor (`dt` for positions).
@@ -113,17 +113,18 @@ pub enum Metric<'a, T: Real> {
 /// this is their stored block bit for bit, while a wall's pair blocks are not,
 /// [`wall`]).
 #[inline(always)]
-fn sym_block<T: Real>(mu: &[T::M3], p: usize, q: usize) -> T::M3 {
+fn sym_block<T: Real, B: Block<T>>(mu: &[B], p: usize, q: usize) -> T::M3 {
     if q <= p {
-        // Without the `wall` feature every block is symmetric: no transpose needed.
-        let b = mu[tri(p) + q];
-        if cfg!(feature = "wall") {
+        // Symmetric blocks (and every block without the `wall` feature): no transpose
+        // needed.
+        let b = mu[tri(p) + q].full();
+        if cfg!(feature = "wall") && B::SCALARS == 9 {
             T::transpose(b)
         } else {
             b
         }
     } else {
-        mu[tri(q) + p]
+        mu[tri(q) + p].full()
     }
 }
 
@@ -221,11 +222,13 @@ impl<T: Real> Metric<'_, T> {
                 mu, grad, scale, ..
             } => {
                 let g = grad[l] * scale;
-                let mu_pj = match b.one_sphere() {
-                    true => T::M3_ZERO,
-                    false => sym_block::<T>(mu, p, b.j),
-                };
-                sym_diff_mul::<T>(sym_block::<T>(mu, p, b.i), mu_pj, g, false)
+                with_blocks!(mu, mu => {
+                    let mu_pj = match b.one_sphere() {
+                        true => T::M3_ZERO,
+                        false => sym_block::<T, _>(mu, p, b.j),
+                    };
+                    sym_diff_mul::<T>(sym_block::<T, _>(mu, p, b.i), mu_pj, g, false)
+                })
             }
             Metric::Free {
                 level,
@@ -420,7 +423,9 @@ impl<T: Real> Metric<'_, T> {
                 spread(bonds, grad, c, scale, f);
                 match compact {
                     Some(copy) => crate::noise::reduced::apply::<T>(par, copy, n, f, out, bands),
-                    None => crate::parallel::product::<T>(par, mu, n, f, out, bands),
+                    None => {
+                        with_blocks!(mu, a => crate::parallel::product::<T>(par, a, n, f, out, bands))
+                    }
                 }
             }
             Metric::Free {
@@ -491,7 +496,7 @@ impl<T: Real> Metric<'_, T> {
 /// (`mobility_metric`), the table is the same code at each.
 #[inline(never)]
 pub(crate) fn tabulate<T: Real>(
-    mu: &[T::M3],
+    mu: Mob<'_, T>,
     bonds: &[Bond<T>],
     grad: &[T::V3],
     scale: T,
@@ -500,17 +505,19 @@ pub(crate) fn tabulate<T: Real>(
     disp: &mut [T::V3],
 ) {
     // One body per case, so that the block reads branch on nothing at run time.
-    if sym || !cfg!(feature = "wall") {
-        table::<T, true>(mu, bonds, grad, scale, n, disp);
-    } else {
-        table::<T, false>(mu, bonds, grad, scale, n, disp);
+    match mu {
+        Mob::Sym(mu) => table::<T, _, true>(mu, bonds, grad, scale, n, disp),
+        Mob::Full(mu) if sym || !cfg!(feature = "wall") => {
+            table::<T, _, true>(mu, bonds, grad, scale, n, disp)
+        }
+        Mob::Full(mu) => table::<T, _, false>(mu, bonds, grad, scale, n, disp),
     }
 }
 
 /// [`tabulate`] with the blocks known symmetric (`SYM`) or not.
 #[inline(always)]
-fn table<T: Real, const SYM: bool>(
-    mu: &[T::M3],
+fn table<T: Real, B: Block<T>, const SYM: bool>(
+    mu: &[B],
     bonds: &[Bond<T>],
     grad: &[T::V3],
     scale: T,
@@ -533,7 +540,7 @@ fn table<T: Real, const SYM: bool>(
         let out = &mut disp[l * n..(l + 1) * n];
         if b.one_sphere() {
             for (q, o) in out.iter_mut().enumerate() {
-                *o = sym_diff_mul::<T>(sym_block::<T>(mu, q, b.i), T::M3_ZERO, g, false);
+                *o = sym_diff_mul::<T>(sym_block::<T, B>(mu, q, b.i), T::M3_ZERO, g, false);
             }
             continue;
         }
@@ -546,13 +553,13 @@ fn table<T: Real, const SYM: bool>(
         let (ri, rj) = (tri(i), tri(j));
         let mut at = 0;
         for (&a, &c) in mu[ri..=ri + lo].iter().zip(&mu[rj..=rj + lo]) {
-            out[at] = sym_diff_mul::<T>(a, c, g, sym);
+            out[at] = sym_diff_mul::<T>(a.full(), c.full(), g, sym);
             at += 1;
         }
         let row_hi = &mu[tri(hi)..tri(hi) + hi + 1];
         let mut rq = tri(lo + 1);
         for q in lo + 1..=hi {
-            let (on_row, on_col) = (row_hi[q], mu[rq + lo]);
+            let (on_row, on_col) = (row_hi[q].full(), mu[rq + lo].full());
             let on_col = tr(on_col);
             out[at] = if i == hi {
                 sym_diff_mul::<T>(on_row, on_col, g, sym)
@@ -563,7 +570,7 @@ fn table<T: Real, const SYM: bool>(
             at += 1;
         }
         for q in hi + 1..n {
-            out[at] = sym_diff_mul::<T>(tr(mu[rq + i]), tr(mu[rq + j]), g, sym);
+            out[at] = sym_diff_mul::<T>(tr(mu[rq + i].full()), tr(mu[rq + j].full()), g, sym);
             rq += q + 1;
             at += 1;
         }

@@ -27,7 +27,7 @@ use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
-use crate::linalg;
+use crate::linalg::{self, Block, Mob, MobMut, with_blocks};
 use crate::mobility::Hydro;
 use crate::noise::Noise;
 use crate::noise::lanczos::{self, LanczosError};
@@ -51,7 +51,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     // The normal deviates and the midpoint borrow the candidate velocities and spins,
     // which are written only at the end.
     let Views {
-        mu,
+        mut mu,
         fac,
         force,
         work_a: u,
@@ -80,12 +80,16 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     if copied {
         let pairs = (p.hydro, p.viscosity, s.pos, s.radius);
         let copy = (&mut *fac, reduced::copy_start as fn(usize) -> usize);
-        let pack = reduced::pack_rows::<T>;
-        parallel::assemble_apply_then(par, pairs, mu, force, u, bands, copy, pack)
-            .map_err(StepError::from)?;
+        with_blocks!(mut mu.reborrow(), a => {
+            let pack = reduced::pack_rows::<T, _>;
+            parallel::assemble_apply_then(par, pairs, a, force, u, bands, copy, pack)
+        })
+        .map_err(StepError::from)?;
     } else {
-        mobility_product(p, s.ewald, s.pos, s.radius, mu, force, u, par, bands)?;
+        let at_start = mu.reborrow();
+        mobility_product(p, s.ewald, s.pos, s.radius, at_start, force, u, par, bands)?;
     }
+    let mu = mu.into_ref();
     add_flow(p, s.pos, u);
     let held = Held {
         bonds,
@@ -184,7 +188,7 @@ pub(super) fn kick<T: Real>(
     p: &Params<T>,
     b: Brownian<T>,
     s: &Start<'_, T>,
-    mu: &[T::M3],
+    mu: Mob<'_, T>,
     fac: &mut [T::M3],
     xi: &mut [T::V3],
     mid: &mut [T::V3],
@@ -197,7 +201,11 @@ pub(super) fn kick<T: Real>(
     let lanczos = p.lanczos_noise(n);
     if !lanczos {
         // L L^T = mu.
-        fac.copy_from_slice(mu);
+        with_blocks!(mu, a => {
+            for (f, b) in fac.iter_mut().zip(a) {
+                *f = b.full();
+            }
+        });
         linalg::cholesky::<T>(fac, n).map_err(|error| StepError::Linalg {
             stage: Stage::Mobility,
             error,
@@ -248,10 +256,10 @@ pub(super) fn kick<T: Real>(
         } else if reduced && copied {
             reduced::apply::<T>(par, fac, n, v, w, bands);
         } else if reduced {
-            reduced::copy_apply::<T>(par, mu, n, fac, v, w, bands);
+            with_blocks!(mu, a => reduced::copy_apply::<T>(par, a, n, fac, v, w, bands));
             copied = true;
         } else {
-            parallel::product::<T>(par, mu, n, v, w, bands);
+            with_blocks!(mu, a => parallel::product::<T>(par, a, n, v, w, bands));
         }
     };
     let (mut iterations, mut projected) = (0, 0);
@@ -296,7 +304,7 @@ fn midpoint<T: Real>(
     b: Brownian<T>,
     s: &Start<'_, T>,
     (mu, fac, xi, mid, dx): (
-        &[T::M3],
+        Mob<'_, T>,
         &mut [T::M3],
         &mut [T::V3],
         &mut [T::V3],
@@ -321,12 +329,13 @@ fn midpoint<T: Real>(
     // not assembled again.
     let mid = &*mid;
     let same = p.hydro == Hydro::FreeDraining && p.wall.is_none() && !p.matrix_free;
-    let mu_mid: &[T::M3] = if same {
-        parallel::product::<T>(par, mu, n, xi, dx, bands);
+    let mu_mid: Mob<'_, T> = if same {
+        with_blocks!(mu, a => parallel::product::<T>(par, a, n, xi, dx, bands));
         mu
     } else {
-        mobility_product(p, s.ewald, mid, s.radius, fac, xi, dx, par, bands)?;
-        if p.matrix_free { &[] } else { fac }
+        let at_mid = MobMut::Full(&mut *fac);
+        mobility_product(p, s.ewald, mid, s.radius, at_mid, xi, dx, par, bands)?;
+        Mob::Full(if p.matrix_free { &[] } else { fac })
     };
     let Some(h) = held else {
         return Ok(0);

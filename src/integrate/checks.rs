@@ -389,10 +389,10 @@ pub(super) fn accept<T: Real>(
             return Err(StepError::NonFinite { particle: i });
         }
     }
-    if let Some(w) = p.wall {
-        if let Some(particle) = below_wall(pos, radius, w.height, p.solver.tolerance) {
-            return Err(ParticleError::BelowWall { particle }.into());
-        }
+    if let Some(w) = p.wall
+        && let Some(particle) = below_wall(pos, radius, w.height, p.solver.tolerance)
+    {
+        return Err(ParticleError::BelowWall { particle }.into());
     }
     let n = pos.len();
     // Without the `cells` feature (firmware) this is the all-pairs check alone.

@@ -45,6 +45,7 @@ use crate::cell::{Periodic, image};
 use crate::cell_list::{self, CellList};
 use crate::constraints::{Scratch, SolveStats};
 use crate::error::{Stage, StepError};
+use crate::linalg::Mob;
 use crate::params::{Contacts, Params, Wall};
 use crate::real::Real;
 use crate::workspace::Links;
@@ -92,7 +93,7 @@ pub(super) fn project_overdamped<'l, T: Real>(
     bonds: &'l [Bond<T>],
     start: &[T::V3],
     radius: &[T],
-    mu: &[T::M3],
+    mu: Mob<'_, T>,
     v: Projection<'l, '_, '_, T>,
     x: &mut [T::V3],
     free: impl Fn(&mut [T::V3]),

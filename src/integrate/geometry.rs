@@ -41,7 +41,7 @@ pub fn mobility_tt<T: Real>(
         held_ewald(&sums),
         pos,
         radius,
-        &mut out[..tri(pos.len())],
+        crate::linalg::MobMut::Full(&mut out[..tri(pos.len())]),
     )
 }
 

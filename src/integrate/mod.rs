@@ -246,10 +246,10 @@ fn advance<T: Real, E: ExternalForce<T>>(
     state.vel.copy_from_slice(new_vel);
     state.omega.copy_from_slice(new_omega);
     *state.time += p.dt;
-    if let (Some(g), Some(d)) = (noise, drawn) {
-        if thermal.is_some() {
-            *g = d;
-        }
+    if let (Some(g), Some(d)) = (noise, drawn)
+        && thermal.is_some()
+    {
+        *g = d;
     }
     Ok(report)
 }

@@ -11,7 +11,7 @@ use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch, SolveStats};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
-use crate::linalg;
+use crate::linalg::{self, Mob, with_blocks};
 use crate::noise::reduced;
 use crate::parallel;
 use crate::params::Params;
@@ -28,7 +28,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
 ) -> Result<StepReport<T>, StepError> {
     let (n, dt) = (s.pos.len(), p.dt);
     let Views {
-        mu,
+        mut mu,
         fac: copy,
         force,
         work_a: u,
@@ -52,12 +52,16 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     if compact {
         let pairs = (p.hydro, p.viscosity, s.pos, s.radius);
         let side = (&mut *copy, reduced::copy_start as fn(usize) -> usize);
-        let pack = reduced::pack_rows::<T>;
-        parallel::assemble_apply_then(par, pairs, mu, force, u, bands, side, pack)
-            .map_err(StepError::from)?;
+        with_blocks!(mut mu.reborrow(), a => {
+            let pack = reduced::pack_rows::<T, _>;
+            parallel::assemble_apply_then(par, pairs, a, force, u, bands, side, pack)
+        })
+        .map_err(StepError::from)?;
     } else {
-        mobility_product(p, s.ewald, s.pos, s.radius, mu, force, u, par, bands)?;
+        let at_start = mu.reborrow();
+        mobility_product(p, s.ewald, s.pos, s.radius, at_start, force, u, par, bands)?;
     }
+    let mu = mu.into_ref();
     add_flow(p, s.pos, u);
     // Unconstrained move r* = r + dt (U_inf + mu F), then the constraint move through
     // the full mobility: r' = r* + dt mu G^T lambda (bonds, and contacts if on).
@@ -98,7 +102,7 @@ fn projected_velocity<T: Real>(
     ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
-    mu: &[T::M3],
+    mu: Mob<'_, T>,
     force: &[T::V3],
     bonds: &[Bond<T>],
     grad: &mut [T::V3],
@@ -108,7 +112,7 @@ fn projected_velocity<T: Real>(
     u: &mut [T::V3],
 ) -> Result<SolveStats<T>, StepError> {
     let n = pos.len();
-    linalg::sym_matvec::<T>(mu, n, force, u);
+    with_blocks!(mu, a => linalg::sym_matvec::<T>(a, n, force, u));
     add_flow(p, pos, u);
     bond_vectors(bonds, pos, super::cell(p), grad);
     kappa.fill(T::ZERO);
@@ -143,8 +147,8 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
 ) -> Result<StepReport<T>, StepError> {
     let (n, dt) = (s.pos.len(), p.dt);
     let Views {
-        mu: mu0,
-        fac: mu1,
+        mu: mut mu0,
+        mu2: mut mu1,
         force,
         work_a: f0,
         work_b: f1,
@@ -162,7 +166,8 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         ..
     } = v;
     // Predictor: projected velocity at r, one projected Euler step.
-    assemble_tt(p, s.ewald, s.pos, s.radius, mu0)?;
+    assemble_tt(p, s.ewald, s.pos, s.radius, mu0.reborrow())?;
+    let mu0 = mu0.into_ref();
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     projected_velocity(
         p, s.ewald, s.pos, s.radius, mu0, force, bonds, grad, disp, kappa, &mut sc, f0,
@@ -188,7 +193,8 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     };
     project_overdamped(p, bonds, s.pos, s.radius, mu0, views, x_p, predict)?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
-    assemble_tt(p, s.ewald, x_p, s.radius, mu1)?;
+    assemble_tt(p, s.ewald, x_p, s.radius, mu1.reborrow())?;
+    let mu1 = mu1.into_ref();
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
     projected_velocity(
         p, s.ewald, x_p, s.radius, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1,

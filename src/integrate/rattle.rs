@@ -12,7 +12,7 @@ use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
-use crate::linalg;
+use crate::linalg::{self, MobMut};
 use crate::params::Params;
 use crate::particles::sphere_volume;
 use crate::real::Real;
@@ -52,9 +52,10 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
         scratch: mut sc,
         ..
     } = v;
+    let mu = mu.general();
     inverse_masses(s.radius, s.density, inv_mass);
     // Resistance through the Cholesky factor of mu_tt: R dv = mu^-1 (v - U_inf).
-    assemble_tt(p, s.ewald, s.pos, s.radius, mu)?;
+    assemble_tt(p, s.ewald, s.pos, s.radius, MobMut::Full(&mut *mu))?;
     fac.copy_from_slice(mu);
     linalg::cholesky::<T>(fac, n).map_err(|error| StepError::Linalg {
         stage: Stage::Mobility,

@@ -27,7 +27,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
     // `fac` and `dx` are empty without noise; the deviates and the midpoint borrow the
     // candidate velocities and spins, written at the end.
     let Views {
-        mu,
+        mut mu,
         fac,
         force,
         work_a: u,
@@ -50,7 +50,9 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
         super::cell(p),
         force,
     )?;
-    mobility_product(p, s.ewald, s.pos, s.radius, mu, force, u, par, bands)?;
+    let at_start = mu.reborrow();
+    mobility_product(p, s.ewald, s.pos, s.radius, at_start, force, u, par, bands)?;
+    let mu = mu.into_ref();
     add_flow(p, s.pos, u);
     let mut noise_iterations = 0;
     match thermal {

@@ -34,7 +34,7 @@ use crate::bonds::Bond;
 use crate::constraints::{self, Metric, Problem, SolverKind, apply_drag};
 use crate::error::{Stage, StepError};
 use crate::forces::{self, ExternalForce};
-use crate::linalg::{self, tri};
+use crate::linalg::{self, MobMut, tri};
 use crate::noise::Noise;
 use crate::params::{Brownian, Params};
 use crate::particles::sphere_volume;
@@ -75,11 +75,12 @@ pub(super) fn rattle_stable<T: Real, E: ExternalForce<T>>(
         scratch: mut sc,
         ..
     } = v;
+    let mu = mu.general();
     // Mobility (translation or grand) and the drag operator K = dt I + S mu S.
     if p.rotation {
         super::geometry::grand(p, s.ewald, s.pos, s.radius, mu)?;
     } else {
-        assemble_tt(p, s.ewald, s.pos, s.radius, mu)?;
+        assemble_tt(p, s.ewald, s.pos, s.radius, MobMut::Full(&mut *mu))?;
     }
     for i in 0..n {
         let mass = sphere_volume(s.radius[i]) * s.density[i];

@@ -7,6 +7,7 @@ use crate::bonds::Bond;
 use crate::cell::Periodic;
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind};
 use crate::error::{ParticleError, StepError};
+use crate::linalg::{Mob, MobMut, with_blocks};
 use crate::mobility::{self, Hydro};
 use crate::parallel::Parallel;
 use crate::params::Params;
@@ -61,7 +62,7 @@ pub(super) fn mobility_product<T: Real>(
     ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
-    mu: &mut [T::M3],
+    mu: MobMut<'_, T>,
     f: &[T::V3],
     u: &mut [T::V3],
     par: &dyn Parallel,
@@ -74,19 +75,23 @@ pub(super) fn mobility_product<T: Real>(
     if let Some(e) = ew {
         // In a box: assembled and applied in bands (`integrate/periodic.rs`).
         let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
+        let mu = mu.general();
         super::periodic::assemble(p, e, pos, radius, mu, par)?;
         crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
         return Ok(());
     }
     if let Some(h) = wall_height(p) {
         // Above a wall: assembled, then applied (`mobility::wall`).
-        let (level, eta) = (p.hydro, p.viscosity);
+        let (level, eta, mu) = (p.hydro, p.viscosity, mu.general());
         mobility::wall::assemble(par, level, eta, h, pos, radius, mu)?;
         crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
         return Ok(());
     }
-    crate::parallel::assemble_apply(par, p.hydro, p.viscosity, pos, radius, mu, f, u, bands)
-        .map_err(StepError::from)
+    let (level, eta) = (p.hydro, p.viscosity);
+    with_blocks!(mut mu, a => {
+        crate::parallel::assemble_apply(par, level, eta, pos, radius, a, f, u, bands)
+    })
+    .map_err(StepError::from)
 }
 
 /// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`: matrix-free when asked;
@@ -102,7 +107,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
     bonds: &[Bond<T>],
     pos: &'a [T::V3],
     radius: &'a [T],
-    mu: &'a [T::M3],
+    mu: Mob<'a, T>,
     grad: &'a [T::V3],
     scale: T,
     disp: &'a mut [T::V3],
@@ -201,22 +206,26 @@ pub(super) fn assemble_tt<T: Real>(
     ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
-    mu: &mut [T::M3],
+    mu: MobMut<'_, T>,
 ) -> Result<(), StepError> {
     #[cfg(feature = "periodic")]
     if let Some(e) = ew {
         // PSE has no blocks; the checks refuse it wherever the step assembles.
         let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-        return super::periodic::assemble(p, e, pos, radius, mu, &crate::parallel::Serial);
+        let (mu, serial) = (mu.general(), &crate::parallel::Serial);
+        return super::periodic::assemble(p, e, pos, radius, mu, serial);
     }
     let _ = ew; // Read above only with the `periodic` feature.
     if let Some(h) = wall_height(p) {
         let (level, eta, serial) = (p.hydro, p.viscosity, &crate::parallel::Serial);
+        let mu = mu.general();
         return Ok(mobility::wall::assemble(
             serial, level, eta, h, pos, radius, mu,
         )?);
     }
-    mobility::assemble_tt(p.hydro, p.viscosity, pos, radius, mu).map_err(StepError::from)
+    let (level, eta) = (p.hydro, p.viscosity);
+    with_blocks!(mut mu, a => mobility::assemble_tt(level, eta, pos, radius, a))
+        .map_err(StepError::from)
 }
 
 /// `g_l = r_i - r_j` for every bond (its minimum image in a periodic box `cell`);

@@ -18,7 +18,11 @@
 //! input reaches these with a wrong length.
 
 pub mod band;
+mod block;
 mod lu;
+
+pub(crate) use block::with_blocks;
+pub use block::{Block, Mob, MobMut, Sym};
 
 pub use lu::{cholesky_dense, cholesky_dense_solve, lu, lu_ranked, lu_solve};
 
@@ -62,8 +66,8 @@ pub fn sym3_mul<T: Real>(b: T::M3, x: T::V3) -> T::V3 {
 /// order; the transposed products reach `y_j` from the rows below, in row order. In one
 /// pass on one thread at any size; [`crate::parallel::product`] is the same arithmetic
 /// cut into bands (the same bits below [`crate::parallel::BANDED_MIN`] rows).
-pub fn sym_matvec<T: Real>(a: &[T::M3], n: usize, x: &[T::V3], y: &mut [T::V3]) {
-    crate::parallel::band::<T>(a, 0, x, &mut y[..n], &mut []);
+pub fn sym_matvec<T: Real>(a: &[impl Block<T>], n: usize, x: &[T::V3], y: &mut [T::V3]) {
+    crate::parallel::band::<T, _>(a, 0, x, &mut y[..n], &mut []);
 }
 
 /// Lower Cholesky factor of a symmetric 3x3 block; `row0` names the block's first row

@@ -223,7 +223,7 @@ pub fn assemble<T: Real>(
     check(ew, pos, radius)?;
     let n = pos.len();
     let out = &mut out[..tri(n)];
-    by_bands::<T, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
+    by_bands::<T, _, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
         let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
         rows(ew, eta, pos, radius, b0..b1, rows_t)
     })

@@ -230,7 +230,7 @@ pub fn assemble<T: Real>(
     if bands(n) == 1 {
         return rows(level, eta, height, pos, radius, 0..n, out);
     }
-    by_bands::<T, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
+    by_bands::<T, _, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
         let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
         rows(level, eta, height, pos, radius, b0..b1, rows_t)
     })

@@ -29,7 +29,7 @@
 //! after the noise is drawn. `T` must be `f64` ([`usable`]); an `f32` kernel reads the
 //! mobility itself.
 
-use crate::linalg::tri;
+use crate::linalg::{Block, tri};
 use crate::parallel::{self, Parallel, band_start};
 use crate::real::Real;
 use glam::Vec4;
@@ -108,7 +108,7 @@ pub(crate) const fn copy_start(i: usize) -> usize {
 
 /// Packs rows `b0..b1` of the packed mobility (`mu`: those rows, from `tri(b0)`) into
 /// `out` (their groups, from [`copy_start`]`(b0)`).
-pub(crate) fn pack_rows<T: Real>(b0: usize, b1: usize, mu: &[T::M3], out: &mut [T::M3]) {
+pub(crate) fn pack_rows<T: Real, B: Block<T>>(b0: usize, b1: usize, mu: &[B], out: &mut [T::M3]) {
     let base = BLOCK_SLOTS * row_start(b0);
     for i in b0..b1 {
         let row = &mu[tri(i) - tri(b0)..=tri(i) - tri(b0) + i];
@@ -124,7 +124,8 @@ pub(crate) fn pack_rows<T: Real>(b0: usize, b1: usize, mu: &[T::M3], out: &mut [
                     if j > i {
                         break;
                     }
-                    let a = T::m3_entries(&row[j]);
+                    let full = row[j].full();
+                    let a = T::m3_entries(&full);
                     let half = if j == i { 0.5 } else { 1.0 };
                     // Column-major: xx, yy, zz, then xy (row 1, col 0), xz, yz.
                     for (k, &at) in [0, 4, 8, 1, 2, 5].iter().enumerate() {
@@ -294,7 +295,7 @@ pub fn apply_band<T: Real, const K: usize>(
 /// copy (so the product is the copy's, bit for bit).
 pub fn copy_apply<T: Real>(
     par: &dyn Parallel,
-    mu: &[T::M3],
+    mu: &[impl Block<T>],
     n: usize,
     copy: &mut [T::M3],
     x: &[T::V3],
@@ -302,9 +303,9 @@ pub fn copy_apply<T: Real>(
     z: &mut [T::V3],
 ) {
     let (x, copy) = (&x[..n], &mut copy[..slots(n)]);
-    let _ = parallel::by_bands::<T, (), _>(par, n, copy, copy_start, y, z, |t, rows, yt, zt| {
+    let _ = parallel::by_bands::<T, _, (), _>(par, n, copy, copy_start, y, z, |t, rows, yt, zt| {
         let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-        pack_rows::<T>(b0, b1, &mu[tri(b0)..tri(b1)], rows);
+        pack_rows::<T, _>(b0, b1, &mu[tri(b0)..tri(b1)], rows);
         band::<T, 1>(rows, b0, [x], [yt], [zt]);
         Ok(())
     });

@@ -18,7 +18,7 @@
 
 use super::{Packed, Pairs, Parallel, band_start, bands, by_bands_and, reduce};
 use crate::error::ParticleError;
-use crate::linalg::tri;
+use crate::linalg::{Block, tri};
 use crate::mobility::{Hydro, pair_norm2, pair_tt_from};
 use crate::real::Real;
 
@@ -30,8 +30,8 @@ pub(super) const ROWS: usize = 8;
 /// `r` of the group, then `out_q += B_rj^T x_qr` in row order, for each vector `q` (each
 /// sum in the order of one vector's product: the vectors only share the block's load).
 #[inline(always)]
-fn column<T: Real, const R: usize, const K: usize>(
-    rows: &[&[T::M3]; R],
+fn column<T: Real, B: Block<T>, const R: usize, const K: usize>(
+    rows: &[&[B]; R],
     j: usize,
     xj: [T::V3; K],
     xs: &[[T::V3; K]; R],
@@ -42,8 +42,8 @@ fn column<T: Real, const R: usize, const K: usize>(
     for r in 0..R {
         let b = rows[r][j];
         for q in 0..K {
-            acc[r][q] += b * xj[q];
-            o[q] += T::m3_tmul(b, xs[r][q]);
+            acc[r][q] += b.mul(xj[q]);
+            o[q] += b.tmul(xs[r][q]);
         }
     }
     for (dst, v) in out.into_iter().zip(o) {
@@ -55,8 +55,8 @@ fn column<T: Real, const R: usize, const K: usize>(
 /// blocks (a block product), [`ROWS`] rows at a time, the rows left over at the band's
 /// end one by one: output `q` gets the bits [`band`](super::band) gives it alone.
 #[inline(always)]
-pub(crate) fn band_rows_k<T: Real, const K: usize>(
-    a: &[T::M3],
+pub(crate) fn band_rows_k<T: Real, B: Block<T>, const K: usize>(
+    a: &[B],
     b0: usize,
     x: [&[T::V3]; K],
     mut y: [&mut [T::V3]; K],
@@ -69,7 +69,7 @@ pub(crate) fn band_rows_k<T: Real, const K: usize>(
     for k in 0..m {
         let i = b0 + k;
         for q in 0..K {
-            y[q][k] = a[tri(i) + i] * x[q][i];
+            y[q][k] = a[tri(i) + i].mul(x[q][i]);
         }
     }
     // Rows a group walks: `ROWS` for one vector, `ROWS / 2` for two, one row from four
@@ -78,16 +78,16 @@ pub(crate) fn band_rows_k<T: Real, const K: usize>(
     // rows spilled: 0.71 of four single products' time at N = 1024; with one row, 0.77
     // to 0.93 in CPU time, docs/BENCHMARKS.md.)
     match K {
-        1 => groups::<T, ROWS, K>(a, b0, x, &mut y, &mut z),
-        2 => groups::<T, { ROWS / 2 }, K>(a, b0, x, &mut y, &mut z),
-        _ => groups::<T, 1, K>(a, b0, x, &mut y, &mut z),
+        1 => groups::<T, B, ROWS, K>(a, b0, x, &mut y, &mut z),
+        2 => groups::<T, B, { ROWS / 2 }, K>(a, b0, x, &mut y, &mut z),
+        _ => groups::<T, B, 1, K>(a, b0, x, &mut y, &mut z),
     }
 }
 
 /// The rows of a [`band_rows_k`] in groups of `R`, the rows left over one by one.
 #[inline(always)]
-fn groups<T: Real, const R: usize, const K: usize>(
-    a: &[T::M3],
+fn groups<T: Real, B: Block<T>, const R: usize, const K: usize>(
+    a: &[B],
     b0: usize,
     x: [&[T::V3]; K],
     y: &mut [&mut [T::V3]; K],
@@ -96,18 +96,18 @@ fn groups<T: Real, const R: usize, const K: usize>(
     let m = y[0].len();
     let mut k = 0;
     while k + R <= m {
-        group::<T, R, K>(a, b0, k, x, y, z);
+        group::<T, B, R, K>(a, b0, k, x, y, z);
         k += R;
     }
     for k in k..m {
-        group::<T, 1, K>(a, b0, k, x, y, z);
+        group::<T, B, 1, K>(a, b0, k, x, y, z);
     }
 }
 
 /// Rows `b0 + k..b0 + k + R` of a [`band_rows_k`], walked column by column.
 #[inline(always)]
-fn group<T: Real, const R: usize, const K: usize>(
-    a: &[T::M3],
+fn group<T: Real, B: Block<T>, const R: usize, const K: usize>(
+    a: &[B],
     b0: usize,
     k: usize,
     x: [&[T::V3]; K],
@@ -115,16 +115,16 @@ fn group<T: Real, const R: usize, const K: usize>(
     z: &mut [&mut [T::V3]; K],
 ) {
     let i = b0 + k;
-    let rows: [&[T::M3]; R] = core::array::from_fn(|r| &a[tri(i + r)..=tri(i + r) + i + r]);
+    let rows: [&[B]; R] = core::array::from_fn(|r| &a[tri(i + r)..=tri(i + r) + i + r]);
     let xs: [[T::V3; K]; R] = core::array::from_fn(|r| x.map(|xq| xq[i + r]));
     let mut acc = [[T::V3_ZERO; K]; R];
     for j in 0..b0 {
         let out = z.each_mut().map(|zq| &mut zq[j]);
-        column::<T, R, K>(&rows, j, x.map(|xq| xq[j]), &xs, &mut acc, out);
+        column::<T, B, R, K>(&rows, j, x.map(|xq| xq[j]), &xs, &mut acc, out);
     }
     for c in 0..k {
         let out = y.each_mut().map(|yq| &mut yq[c]);
-        column::<T, R, K>(&rows, b0 + c, x.map(|xq| xq[b0 + c]), &xs, &mut acc, out);
+        column::<T, B, R, K>(&rows, b0 + c, x.map(|xq| xq[b0 + c]), &xs, &mut acc, out);
     }
     // The group's own triangle, row by row: row `i + r` meets columns `i..i + r`,
     // whose sums are complete before it adds to them.
@@ -132,8 +132,8 @@ fn group<T: Real, const R: usize, const K: usize>(
         for c in 0..r {
             let b = rows[r][i + c];
             for q in 0..K {
-                acc_r[q] += b * x[q][i + c];
-                y[q][k + c] += T::m3_tmul(b, xr[q]);
+                acc_r[q] += b.mul(x[q][i + c]);
+                y[q][k + c] += b.tmul(xr[q]);
             }
         }
         for q in 0..K {
@@ -156,9 +156,9 @@ const RUN: usize = 8;
 /// latency, not by memory, so rows are taken one at a time (walking [`ROWS`] at once did
 /// not pay here: 15.0 -> 16.3 ns per block at N = 1024).
 #[inline(always)]
-pub(super) fn fused_rows<T: Real>(
+pub(super) fn fused_rows<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
-    out: &mut [T::M3],
+    out: &mut [B],
     b0: usize,
     x: &[T::V3],
     y: &mut [T::V3],
@@ -171,14 +171,14 @@ pub(super) fn fused_rows<T: Real>(
 /// soon as they are written, while they are still in the core's cache (a band of a
 /// large mobility is not: 38 MB at N = 4096).
 #[inline(always)]
-fn fused_rows_then<T: Real>(
+fn fused_rows_then<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
-    out: &mut [T::M3],
+    out: &mut [B],
     b0: usize,
     x: &[T::V3],
     y: &mut [T::V3],
     z: &mut [T::V3],
-    mut row_done: impl FnMut(usize, &[T::M3]),
+    mut row_done: impl FnMut(usize, &[B]),
 ) -> Result<(), ParticleError> {
     src.start(out, b0, x, y, z);
     let base = tri(b0);
@@ -206,18 +206,18 @@ fn fused_rows_then<T: Real>(
 /// (`assemble_apply` itself does not go through here: as a generic over `then` it
 /// cost the Brownian firmware 3.7 kB of flash.)
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn assemble_apply_then<T: Real, F>(
+pub(crate) fn assemble_apply_then<T: Real, B: Block<T>, F>(
     par: &dyn Parallel,
     (level, eta, pos, radius): (Hydro, T, &[T::V3], &[T]),
-    out: &mut [T::M3],
+    out: &mut [B],
     x: &[T::V3],
     y: &mut [T::V3],
     z: &mut [T::V3],
-    (side, side_start): Packed<'_, T>,
+    (side, side_start): Packed<'_, T::M3>,
     then: F,
 ) -> Result<(), ParticleError>
 where
-    F: Fn(usize, usize, &[T::M3], &mut [T::M3]) + Sync,
+    F: Fn(usize, usize, &[B], &mut [T::M3]) + Sync,
 {
     let n = pos.len();
     let out = &mut out[..tri(n)];
@@ -233,7 +233,7 @@ where
         radius,
     };
     let bands = (out, tri as fn(usize) -> usize);
-    by_bands_and::<T, _, _>(
+    by_bands_and::<T, _, _, _, _>(
         par,
         n,
         bands,
@@ -244,7 +244,7 @@ where
             // Each row goes to `then` as soon as it is written (still in cache).
             let b0 = band_start(n, t);
             let first = side_start(b0);
-            fused_rows_then::<T>(src, rows, b0, x, yt, zt, |i, row| {
+            fused_rows_then::<T, B>(src, rows, b0, x, yt, zt, |i, row| {
                 then(i, i + 1, row, &mut st[side_start(i) - first..]);
             })
         },
@@ -257,17 +257,17 @@ where
 /// (which starts at column `j0`) summed into `acc` in column order, their transposed
 /// products with `x_i` added to `outs`.
 #[inline(always)]
-pub(super) fn runs<T: Real>(
+pub(super) fn runs<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
     i: usize,
     j0: usize,
-    blocks: &mut [T::M3],
+    blocks: &mut [B],
     outs: &mut [T::V3],
     x: &[T::V3],
     acc: &mut T::V3,
 ) -> Result<(), ParticleError> {
     let mut a = [*acc];
-    runs_k::<T, 1>(src, i, j0, blocks, [outs], [x], &mut a)?;
+    runs_k::<T, B, 1>(src, i, j0, blocks, [outs], [x], &mut a)?;
     *acc = a[0];
     Ok(())
 }
@@ -276,11 +276,11 @@ pub(super) fn runs<T: Real>(
 /// into `acc_q`) and, transposed, to every `x_qi` (into `outs_q`), each in the order
 /// [`runs`] sums it alone.
 #[inline(always)]
-pub(super) fn runs_k<T: Real, const K: usize>(
+pub(super) fn runs_k<T: Real, B: Block<T>, const K: usize>(
     src: Pairs<'_, T>,
     i: usize,
     j0: usize,
-    blocks: &mut [T::M3],
+    blocks: &mut [B],
     outs: [&mut [T::V3]; K],
     x: [&[T::V3]; K],
     acc: &mut [T::V3; K],
@@ -301,23 +301,24 @@ pub(super) fn runs_k<T: Real, const K: usize>(
         if K == 1 {
             // Each block applied as soon as it is built.
             for (k, (b, (&pj, &aj))) in cols.enumerate() {
-                *b = pair_tt_from(level, eta, ai, aj, pi - pj, s2[k], roots[k]);
+                let m = pair_tt_from(level, eta, ai, aj, pi - pj, s2[k], roots[k]);
+                *b = B::store(m);
                 let col = c * RUN + k;
-                acc[0] += *b * x[0][col];
-                outs[0][col] += T::m3_tmul(*b, xi[0]);
+                acc[0] += m * x[0][col];
+                outs[0][col] += T::m3_tmul(m, xi[0]);
             }
             continue;
         }
         // Several vectors: the run's blocks first, then each vector's sums over them
         // (the same order per vector; a vector at a time keeps its sums in registers).
         for (k, (b, (&pj, &aj))) in cols.enumerate() {
-            *b = pair_tt_from(level, eta, ai, aj, pi - pj, s2[k], roots[k]);
+            *b = B::store(pair_tt_from(level, eta, ai, aj, pi - pj, s2[k], roots[k]));
         }
         for q in 0..K {
             for (k, &b) in bs.iter().enumerate() {
                 let col = c * RUN + k;
-                acc[q] += b * x[q][col];
-                outs[q][col] += T::m3_tmul(b, xi[q]);
+                acc[q] += b.mul(x[q][col]);
+                outs[q][col] += b.tmul(xi[q]);
             }
         }
     }
@@ -360,8 +361,8 @@ mod tests {
             let (mut z0, mut z1) = ([DVec3::ONE; N], [DVec3::ONE; N]);
             let (y0, y1) = (&mut y0[..b1 - b0], &mut y1[..b1 - b0]);
             let (z0, z1) = (&mut z0[..b0], &mut z1[..b0]);
-            super::super::band::<f64>(&a, b0, &x, y0, z0);
-            band_rows_k::<f64, 1>(&a, b0, [&x], [y1], [z1]);
+            super::super::band::<f64, _>(&a, b0, &x, y0, z0);
+            band_rows_k::<f64, _, 1>(&a, b0, [&x], [y1], [z1]);
             assert!(same(y0, y1, DVec3::to_array), "rows {b0}..{b1}");
             assert!(same(z0, z1, DVec3::to_array), "rows {b0}..{b1}");
         }
@@ -398,8 +399,8 @@ mod tests {
                     let (o0, o1) = (&mut o0[..rows], &mut o1[..rows]);
                     let (y0, y1) = (&mut y0[..b1 - b0], &mut y1[..b1 - b0]);
                     let (z0, z1) = (&mut z0[..b0], &mut z1[..b0]);
-                    let r0 = super::super::band_fused::<f64>(src, o0, b0, &x, y0, z0);
-                    let r1 = fused_rows::<f64>(src, o1, b0, &x, y1, z1);
+                    let r0 = super::super::band_fused::<f64, DMat3>(src, o0, b0, &x, y0, z0);
+                    let r1 = fused_rows::<f64, DMat3>(src, o1, b0, &x, y1, z1);
                     assert_eq!(r0, r1, "{level:?} rows {b0}..{b1}");
                     assert_eq!(r0.is_err(), nested && b1 > 33, "{level:?} rows {b0}..{b1}");
                     if r0.is_ok() {

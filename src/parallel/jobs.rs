@@ -97,64 +97,61 @@ pub(crate) fn reduce<T: Real>(n: usize, y: &mut [T::V3], z: &[T::V3], par: &dyn 
 /// of `y` (or nothing) and its partial-sum slice of `z` (or nothing), runs
 /// `job(t, rows, y_t, z_t)` for every band through `par`, and returns the first error
 /// in band order (the one a single pass in row order meets first).
-pub(crate) fn by_bands<T: Real, E: Send, J>(
+pub(crate) fn by_bands<T: Real, X: Send, E: Send, J>(
     par: &dyn Parallel,
     n: usize,
-    out: &mut [T::M3],
+    out: &mut [X],
     start: fn(usize) -> usize,
     y: &mut [T::V3],
     z: &mut [T::V3],
     job: J,
 ) -> Result<(), E>
 where
-    J: Fn(usize, &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
+    J: Fn(usize, &mut [X], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
 {
-    let job = |t, rows: &mut [T::M3], _: &mut [T::M3], yt: &mut [T::V3], zt: &mut [T::V3]| {
-        job(t, rows, yt, zt)
-    };
-    by_bands_and::<T, E, _>(par, n, (out, start), (&mut [], start), y, z, job)
+    let job =
+        |t, rows: &mut [X], _: &mut [X], yt: &mut [T::V3], zt: &mut [T::V3]| job(t, rows, yt, zt);
+    by_bands_and::<T, X, X, E, _>(par, n, (out, start), (&mut [], start), y, z, job)
 }
 
-/// A packed output and the entry its row `i` starts at.
-pub(crate) type Packed<'a, T> = (&'a mut [<T as Real>::M3], fn(usize) -> usize);
+/// A packed output (of blocks `X`) and the entry its row `i` starts at.
+pub(crate) type Packed<'a, X> = (&'a mut [X], fn(usize) -> usize);
 
 /// [`by_bands`] with a second packed output, `side`, of which each band gets its rows
 /// too: `job(t, rows, side_rows, y_t, z_t)`.
-pub(crate) fn by_bands_and<T: Real, E: Send, J>(
+pub(crate) fn by_bands_and<T: Real, X: Send, S: Send, E: Send, J>(
     par: &dyn Parallel,
     n: usize,
-    out: Packed<'_, T>,
-    side: Packed<'_, T>,
+    out: Packed<'_, X>,
+    side: Packed<'_, S>,
     y: &mut [T::V3],
     z: &mut [T::V3],
     job: J,
 ) -> Result<(), E>
 where
-    J: Fn(usize, &mut [T::M3], &mut [T::M3], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
+    J: Fn(usize, &mut [X], &mut [S], &mut [T::V3], &mut [T::V3]) -> Result<(), E> + Sync,
 {
-    let job = |t,
-               rows: &mut [T::M3],
-               side: &mut [T::M3],
-               [yt]: [&mut [T::V3]; 1],
-               [zt]: [&mut [T::V3]; 1]| { job(t, rows, side, yt, zt) };
-    by_bands_k::<T, E, _, 1>(par, n, out, side, [y], [z], job)
+    let job =
+        |t, rows: &mut [X], side: &mut [S], [yt]: [&mut [T::V3]; 1], [zt]: [&mut [T::V3]; 1]| {
+            job(t, rows, side, yt, zt)
+        };
+    by_bands_k::<T, X, S, E, _, 1>(par, n, out, side, [y], [z], job)
 }
 
 /// [`by_bands_and`] for `K` products at once: every band gets its rows of each of the
 /// `K` outputs `y` and its partial-sum slice of each of the `K` scratches `z` (each
 /// empty, or as [`by_bands`] cuts it).
-pub(crate) fn by_bands_k<T: Real, E: Send, J, const K: usize>(
+pub(crate) fn by_bands_k<T: Real, X: Send, S: Send, E: Send, J, const K: usize>(
     par: &dyn Parallel,
     n: usize,
-    (out, start): Packed<'_, T>,
-    (side, side_start): Packed<'_, T>,
+    (out, start): Packed<'_, X>,
+    (side, side_start): Packed<'_, S>,
     y: [&mut [T::V3]; K],
     z: [&mut [T::V3]; K],
     job: J,
 ) -> Result<(), E>
 where
-    J: Fn(usize, &mut [T::M3], &mut [T::M3], [&mut [T::V3]; K], [&mut [T::V3]; K]) -> Result<(), E>
-        + Sync,
+    J: Fn(usize, &mut [X], &mut [S], [&mut [T::V3]; K], [&mut [T::V3]; K]) -> Result<(), E> + Sync,
 {
     let k = bands(n);
     let mut results: [Option<Result<(), E>>; BANDS] = core::array::from_fn(|_| None);
@@ -165,11 +162,11 @@ where
         for (t, result) in results.iter_mut().take(k).enumerate() {
             let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
             // Slices given empty stay empty for every band.
-            let rows = |s: &[T::M3], f: fn(usize) -> usize| match s.is_empty() {
+            let rows = |empty: bool, f: fn(usize) -> usize| match empty {
                 true => 0,
                 false => f(b1) - f(b0),
             };
-            let (lo, ls) = (rows(os, start), rows(ss, side_start));
+            let (lo, ls) = (rows(os.is_empty(), start), rows(ss.is_empty(), side_start));
             let (ot, rest) = core::mem::take(&mut os).split_at_mut(lo);
             os = rest;
             let (st, rest) = core::mem::take(&mut ss).split_at_mut(ls);

@@ -20,7 +20,7 @@
 
 use super::Pairs;
 use crate::error::ParticleError;
-use crate::linalg::tri;
+use crate::linalg::{Block, tri};
 use crate::mobility::{Hydro, pair_tt, self_tt};
 use crate::real::Real;
 
@@ -69,9 +69,9 @@ struct Work<T: Real> {
 /// rows, `Hydro::Rpy`) column-wise: the same blocks into `rows`, the same product bits
 /// in `y`, the same first error.
 #[inline(always)]
-pub(super) fn band_lanes<T: Real>(
+pub(super) fn band_lanes<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
-    rows: &mut [T::M3],
+    rows: &mut [B],
     x: &[T::V3],
     y: &mut [T::V3],
 ) -> Result<(), ParticleError> {
@@ -82,7 +82,7 @@ pub(super) fn band_lanes<T: Real>(
     let mut ys = Soa::<T>::new(&[]);
     for i in 0..n {
         let diag = T::m3_diag(self_tt(eta, radius[i]));
-        rows[tri(i) + i] = diag;
+        rows[tri(i) + i] = B::store(diag);
         [ys.x[i], ys.y[i], ys.z[i]] = T::xyz(diag * x[i]);
     }
     let z = [T::ZERO; MAX];
@@ -110,14 +110,14 @@ pub(super) fn band_lanes<T: Real>(
 /// Row `i`: its blocks into `row`, their transposed products with `x_i` added to `y_j`,
 /// and the sum of their products with `x_j` in column order (returned).
 #[inline(always)]
-fn row_lanes<T: Real>(
+fn row_lanes<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
     i: usize,
     p: &Soa<T>,
     xs: &Soa<T>,
     ys: &mut Soa<T>,
     w: &mut Work<T>,
-    row: &mut [T::M3],
+    row: &mut [B],
 ) -> Result<[T; 3], ParticleError> {
     let (eta, a) = (src.eta, &src.radius[..i]);
     let [pix, piy, piz] = T::xyz(src.pos[i]);
@@ -184,11 +184,11 @@ fn row_lanes<T: Real>(
     }
     let [b00, b10, b20, b11, b21, b22] = &w.b;
     for (j, o) in row.iter_mut().enumerate() {
-        *o = T::m3_cols(
+        *o = B::store(T::m3_cols(
             T::v3(b00[j], b10[j], b20[j]),
             T::v3(b10[j], b11[j], b21[j]),
             T::v3(b20[j], b21[j], b22[j]),
-        );
+        ));
     }
     let mut acc = [T::ZERO; 3];
     for j in 0..i {
@@ -209,12 +209,12 @@ fn xs_at<T: Real>(s: &Soa<T>, i: usize) -> T::V3 {
 /// first error in column order): what [`row_lanes`] does, as
 /// [`band_fused`](super::band_fused)'s row does it.
 #[cold]
-fn row_pairs<T: Real>(
+fn row_pairs<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
     i: usize,
     xs: &Soa<T>,
     ys: &mut Soa<T>,
-    row: &mut [T::M3],
+    row: &mut [B],
 ) -> Result<[T; 3], ParticleError> {
     let (eta, pos, radius) = (src.eta, src.pos, src.radius);
     let xi = xs_at(xs, i);
@@ -222,7 +222,7 @@ fn row_pairs<T: Real>(
     for (j, o) in row.iter_mut().enumerate() {
         let b = pair_tt(Hydro::Rpy, eta, radius[i], radius[j], pos[i] - pos[j])
             .ok_or(ParticleError::Nested { i: j, j: i })?;
-        *o = b;
+        *o = B::store(b);
         acc += b * xs_at(xs, j);
         let [tx, ty, tz] = T::xyz(T::m3_tmul(b, xi));
         ys.x[j] += tx;
@@ -259,8 +259,8 @@ mod tests {
         let (mut o0, mut o1) = ([T::M3_ZERO; tri(MAX)], [T::M3_ZERO; tri(MAX)]);
         let (mut y0, mut y1) = ([T::V3_ZERO; MAX], [T::V3_ZERO; MAX]);
         let (y0, y1) = (&mut y0[..n], &mut y1[..n]);
-        let r0 = super::super::band_fused::<T>(src, &mut o0, 0, x, y0, &mut []);
-        let r1 = band_lanes::<T>(src, &mut o1, x, y1);
+        let r0 = super::super::band_fused::<T, T::M3>(src, &mut o0, 0, x, y0, &mut []);
+        let r1 = band_lanes::<T, T::M3>(src, &mut o1, x, y1);
         assert_eq!(r0, r1, "n = {n}");
         if r0.is_ok() {
             let m = |b: &T::M3| T::m3_entries(b).map(|e| e.to_f64().to_bits());

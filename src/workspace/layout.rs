@@ -9,15 +9,34 @@ use crate::parallel::band_scratch;
 use crate::params::{Method, Params};
 use crate::real::Real;
 
+/// Scalars a symmetric 3x3 block of a stored mobility takes ([`Sym`](crate::linalg::Sym)).
+const SYM: usize = 6;
+
+/// Whether a step of `p` stores its mobility as symmetric blocks, six scalars each in
+/// the scalar array ([`Sym`](crate::linalg::Sym)): the overdamped methods in free space,
+/// whose translational blocks are symmetric in bits. Above a wall, in a box, and for
+/// the inertial methods (whose factors and rotational blocks are not symmetric) the
+/// stored mobility keeps nine-scalar blocks in the block array.
+pub(crate) const fn symmetric<T: Real>(p: &Params<T>) -> bool {
+    p.wall.is_none()
+        && p.periodic.is_none()
+        && matches!(
+            p.method,
+            Method::Overdamped | Method::Overdamped2 | Method::Springs
+        )
+}
+
 /// Element counts of the storage arrays one step uses: four numeric arrays, and the
 /// constraint list of a step with contacts or a wall (`links`, zero otherwise).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Layout {
-    /// 3x3 blocks (packed mobilities and factors).
+    /// 3x3 blocks (factors; the packed mobility above a wall, in a box and of the
+    /// inertial methods).
     pub blocks: usize,
     /// 3-vectors (forces, velocities, candidate state, bond vectors, solver vectors).
     pub vectors: usize,
-    /// Scalars (multipliers, masses, solver matrices).
+    /// Scalars (multipliers, masses, solver matrices; the overdamped methods' packed
+    /// mobility in free space, six scalars a symmetric block).
     pub scalars: usize,
     /// Indices (LU pivots).
     pub indices: usize,
@@ -47,7 +66,9 @@ impl Layout {
     ///
     /// Every method stores the candidate state (`3n` vectors), the forces (`m`), the bond
     /// vectors and multipliers (`B` each), and:
-    /// * `Overdamped`, `Springs`: one packed mobility `tri(n)` blocks;
+    /// * `Overdamped`, `Springs`: one packed mobility `tri(n)` symmetric blocks, `6 tri(n)`
+    ///   scalars (in free space; [`Layout::for_params`] moves it to `tri(n)` blocks of
+    ///   nine above a wall or in a box);
     /// * `Overdamped2`: two (start and predicted point);
     /// * `Overdamped`, `Overdamped2` with a dense solver (sweep, Newton): the `n x B`
     ///   table of constraint displacements, which those solvers read at every
@@ -82,13 +103,12 @@ impl Layout {
         };
         match method {
             Method::Overdamped | Method::Springs => {
-                l.blocks = tri(n);
+                l.scalars += SYM * tri(n);
                 l.vectors += n + band_scratch(n);
             }
             Method::Overdamped2 => {
-                l.blocks = 2 * tri(n);
+                l.scalars += 2 * SYM * tri(n) + b;
                 l.vectors += 3 * n + b;
-                l.scalars += b;
             }
             Method::Rattle | Method::RattleStable => {}
         }
@@ -147,10 +167,31 @@ impl Layout {
         } else {
             l
         };
-        if p.matrix_free {
+        let l = if p.matrix_free {
             l.matrix_free(p.method, p.solver_kind(n, bonds), n, c)
         } else {
             l
+        };
+        if symmetric(p) {
+            return l;
+        }
+        // Above a wall or in a box: the stored mobilities in blocks of nine.
+        let stored = match p.method {
+            Method::Overdamped | Method::Springs if p.matrix_free => 0,
+            Method::Overdamped | Method::Springs => 1,
+            Method::Overdamped2 => 2,
+            Method::Rattle | Method::RattleStable => 0,
+        };
+        l.general(stored, n)
+    }
+
+    /// This layout with `k` stored mobilities of `n` block rows in general blocks
+    /// (`k tri(n)` blocks) instead of symmetric ones (`6 k tri(n)` scalars).
+    const fn general(self, k: usize, n: usize) -> Self {
+        Self {
+            blocks: self.blocks + k * tri(n),
+            scalars: self.scalars - SYM * k * tri(n),
+            ..self
         }
     }
 
@@ -209,7 +250,7 @@ impl Layout {
         }
     }
 
-    /// This layout without the stored mobility (and without the displacement table of
+    /// This layout without the stored (symmetric) mobility (and without the displacement table of
     /// the dense solvers), for the methods that run matrix-free
     /// ([`Params::matrix_free`]: `Overdamped`, `Springs`); unchanged for the others.
     pub const fn matrix_free(
@@ -227,7 +268,7 @@ impl Layout {
         };
         match method {
             Method::Overdamped | Method::Springs => Self {
-                blocks: self.blocks - tri(n),
+                scalars: self.scalars - SYM * tri(n),
                 vectors: self.vectors - table,
                 ..self
             },
@@ -235,7 +276,8 @@ impl Layout {
         }
     }
 
-    /// Storage for every method, with and without rotation, with every solver: one
+    /// Storage for every method, with and without rotation, with every solver, in free
+    /// space (symmetric blocks) and above a wall or in a box (general blocks): one
     /// workspace a host can switch methods on.
     pub const fn all(n: usize, bonds: usize) -> Self {
         let methods = [
@@ -256,7 +298,13 @@ impl Layout {
         let mut i = 0;
         while i < methods.len() * kinds.len() * 2 {
             let (method, kind) = (methods[i / 6], kinds[(i / 2) % 3]);
-            l = l.max(Self::with_solver(method, i % 2 == 1, kind, n, bonds));
+            let one = Self::with_solver(method, i % 2 == 1, kind, n, bonds);
+            let stored = match method {
+                Method::Overdamped | Method::Springs => 1,
+                Method::Overdamped2 => 2,
+                Method::Rattle | Method::RattleStable => 0,
+            };
+            l = l.max(one).max(one.general(stored, n));
             i += 1;
         }
         l

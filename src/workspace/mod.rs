@@ -21,7 +21,7 @@ mod layout;
 mod views;
 
 pub use layout::Layout;
-pub(crate) use layout::block_rows;
+pub(crate) use layout::{block_rows, symmetric};
 pub(crate) use views::{Links, Views};
 
 use crate::bonds::Bond;

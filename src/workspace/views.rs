@@ -6,7 +6,7 @@ use crate::bonds::Bond;
 use crate::constraints::Scratch;
 use crate::constraints::{SolverKind, index_scratch, krylov_scratch_per_bond};
 use crate::error::StepError;
-use crate::linalg::tri;
+use crate::linalg::{MobMut, tri};
 use crate::noise::lanczos::{scalars as lanczos_scalars, vectors as lanczos_vectors};
 use crate::parallel::{Parallel, band_scratch};
 use crate::params::{Method, Params};
@@ -14,7 +14,10 @@ use crate::real::Real;
 
 /// Named slices for one step of `n` particles, `nb` bonds, `m` block rows.
 pub(crate) struct Views<'a, T: Real> {
-    pub mu: &'a mut [T::M3],
+    /// The stored mobility (symmetric blocks in free space, [`super::symmetric`]).
+    pub mu: MobMut<'a, T>,
+    /// `Overdamped2`'s mobility at the predicted point (as `mu`).
+    pub mu2: MobMut<'a, T>,
     pub fac: &'a mut [T::M3],
     pub disp: &'a mut [T::V3],
     pub force: &'a mut [T::V3],
@@ -136,8 +139,21 @@ impl<T: Real> Workspace<'_, T> {
             Method::Rattle => (2, [n, n, n], nb, n, 0, 0),
             Method::RattleStable => (2, [m, m, 0], nb, 0, m, table),
         };
-        let mu = bl.take(if stored { tri(m) } else { 0 });
-        let factor = mats == 2 && !(lanczos && (uncorrected || !stored));
+        // The stored mobilities: symmetric blocks of six scalars in free space, else
+        // blocks of nine (`Layout::for_params`).
+        let second = matches!(method, Method::Overdamped2);
+        let (one, two) = (
+            if stored { tri(m) } else { 0 },
+            if second { tri(m) } else { 0 },
+        );
+        // (`as_chunks_mut`, Rust 1.88: the kernel's minimum since this storage.)
+        let (mu, mu2) = if super::symmetric(p) {
+            let mut sym = |k: usize| MobMut::Sym(sc.take(6 * k).as_chunks_mut::<6>().0);
+            (sym(one), sym(two))
+        } else {
+            (MobMut::Full(bl.take(one)), MobMut::Full(bl.take(two)))
+        };
+        let factor = mats == 2 && !second && !(lanczos && (uncorrected || !stored));
         // The compact copy of the mobility lives where a factor would
         // (`Params::compact_products`: first-order Overdamped without noise, no factor).
         let compact = p.compact_copy(n, bonds);
@@ -183,6 +199,7 @@ impl<T: Real> Workspace<'_, T> {
         let krylov_t = sc.take(if lanczos { lanczos_scalars(cap) } else { 0 });
         Ok(Views {
             mu,
+            mu2,
             fac,
             disp,
             force,

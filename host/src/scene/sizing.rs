@@ -1,7 +1,8 @@
 //! How much kernel storage a run needs, and the limit a run must stay under.
 //!
 //! Every method stores the `N x N` mobility (packed 3x3 blocks), so storage grows as
-//! `N^2`: 604 MB for 4096 beads overdamped in f64, 4.8 GB for the stable inertial method
+//! `N^2`: 403 MB for 4096 beads overdamped in f64 (symmetric blocks, 48 bytes a pair;
+//! 604 MB above a wall or in a box), 4.8 GB for the stable inertial method
 //! with rotation. A scene file is checked against the limit from its counts alone,
 //! while it is read and before any bead is generated or any pair checked, so an
 //! oversized scene is refused at once, at the line that set its size.
@@ -231,9 +232,9 @@ mod tests {
             let p = plan(method, true, Precision::F64);
             assert!(p.check(4096, 4095, DEFAULT_LIMIT).is_ok(), "{method:?}");
         }
-        // The mobility alone: tri(4096) blocks of 72 bytes.
+        // The mobility alone: tri(4096) symmetric blocks of 48 bytes.
         let od = plan(Method::Overdamped, false, Precision::F64);
-        assert!(od.bytes(4096, 4095).unwrap() > 4096 * 4097 / 2 * 72);
+        assert!(od.bytes(4096, 4095).unwrap() > 4096 * 4097 / 2 * 48);
     }
 
     #[test]

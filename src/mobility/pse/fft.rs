@@ -37,7 +37,7 @@ impl Factors {
             count: 0,
         };
         for r in [4usize, 2, 3, 5] {
-            while n % r == 0 && n > 1 {
+            while n.is_multiple_of(r) && n > 1 {
                 if f.count == MAX_STAGES {
                     return None;
                 }
@@ -54,7 +54,7 @@ impl Factors {
 pub fn good_size(n: usize) -> usize {
     let mut m = n.max(2);
     loop {
-        if m % 2 == 0 && Factors::new(m).is_some() {
+        if m.is_multiple_of(2) && Factors::new(m).is_some() {
             return m;
         }
         m += 1;

@@ -84,10 +84,10 @@ impl<T: Real> Pse<T> {
         rng.fill_parts::<T>(z, &mut store.complex[..3 * mx * my * mz]);
         let mut failed = None;
         let product = |v: &[T::V3], w: &mut [T::V3]| {
-            if failed.is_none() {
-                if let Err(e) = self.apply(Part::Near, eta, pos, radius, v, w, store) {
-                    failed = Some(e);
-                }
+            if failed.is_none()
+                && let Err(e) = self.apply(Part::Near, eta, pos, radius, v, w, store)
+            {
+                failed = Some(e);
             }
         };
         let result = lanczos::sqrt(s, product, z, basis, work, out, None);
