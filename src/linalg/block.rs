@@ -181,19 +181,27 @@ macro_rules! with_blocks {
 pub(crate) use with_blocks;
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use glam::{DMat3, DVec3, Vec3};
 
-    /// Deterministic values in [-0.5, 0.5) (a linear congruential sequence), with
-    /// zeros, huge and tiny values mixed in.
-    fn values(seed: u64) -> impl FnMut() -> f64 {
+    /// Deterministic values in [-0.5, 0.5) (a linear congruential sequence) and the
+    /// state each came from.
+    pub(crate) fn lcg(seed: u64) -> impl FnMut() -> (f64, u64) {
         let mut s = seed;
         move || {
             s = s
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
-            let v = (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            ((s >> 11) as f64 / (1u64 << 53) as f64 - 0.5, s)
+        }
+    }
+
+    /// [`lcg`]'s values with zeros, huge and tiny values mixed in.
+    fn values(seed: u64) -> impl FnMut() -> f64 {
+        let mut next = lcg(seed);
+        move || {
+            let (v, s) = next();
             match s % 17 {
                 0 => 0.0,
                 1 => v * 1e300,

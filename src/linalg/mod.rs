@@ -18,7 +18,7 @@
 //! input reaches these with a wrong length.
 
 pub mod band;
-mod block;
+pub(crate) mod block;
 mod lu;
 
 pub(crate) use block::with_blocks;

@@ -332,13 +332,8 @@ mod tests {
 
     /// Deterministic values in [-0.5, 0.5).
     fn values(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        }
+        let mut next = crate::linalg::block::tests::lcg(seed);
+        move || next().0
     }
 
     /// Whether two runs of vectors (or blocks) hold the same bits.
