@@ -70,7 +70,7 @@ pub(super) fn assemble<T: Real>(
     ew: &Ewald<T>,
     pos: &[T::V3],
     radius: &[T],
-    mu: &mut [T::M3],
+    mu: &mut [impl crate::linalg::Block<T>],
     par: &dyn crate::parallel::Parallel,
 ) -> Result<(), StepError> {
     Ok(periodic::assemble(par, ew, p.viscosity, pos, radius, mu)?)

@@ -75,10 +75,11 @@ pub(super) fn mobility_product<T: Real>(
     if let Some(e) = ew {
         // In a box: assembled and applied in bands (`integrate/periodic.rs`).
         let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-        let mu = mu.general();
-        super::periodic::assemble(p, e, pos, radius, mu, par)?;
-        crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
-        return Ok(());
+        return with_blocks!(mut mu, mu => {
+            super::periodic::assemble(p, e, pos, radius, mu, par)?;
+            crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
+            Ok(())
+        });
     }
     if let Some(h) = wall_height(p) {
         // Above a wall: assembled, then applied (`mobility::wall`).
@@ -212,8 +213,8 @@ pub(super) fn assemble_tt<T: Real>(
     if let Some(e) = ew {
         // PSE has no blocks; the checks refuse it wherever the step assembles.
         let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-        let (mu, serial) = (mu.general(), &crate::parallel::Serial);
-        return super::periodic::assemble(p, e, pos, radius, mu, serial);
+        let serial = &crate::parallel::Serial;
+        return with_blocks!(mut mu, mu => super::periodic::assemble(p, e, pos, radius, mu, serial));
     }
     let _ = ew; // Read above only with the `periodic` feature.
     if let Some(h) = wall_height(p) {

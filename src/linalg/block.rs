@@ -5,9 +5,11 @@
 //! Why: the stored products stream the packed mobility from memory (604 MB in `f64` at
 //! N = 4096), so they are bound by bandwidth, not arithmetic. The free-space
 //! translational blocks are symmetric in bits (`a I + b e e^T`, `e e^T` formed as
-//! `e_r e_c`, the same product either way round; the diagonal `s I`), so their lower
-//! triangles carry all of them: 48 bytes a pair in `f64` instead of 72. A wall's
-//! blocks and the rotational couplings are not symmetric and keep nine scalars.
+//! `e_r e_c`, the same product either way round; the diagonal `s I`), and so are a
+//! periodic box's Ewald blocks (sums of such blocks and of mirrored entries,
+//! `mobility::periodic`), so their lower triangles carry all of them: 48 bytes a pair
+//! in `f64` instead of 72. A wall's blocks and the rotational couplings are not
+//! symmetric and keep nine scalars.
 //!
 //! **Same bits.** [`Block::mul`] and [`Block::tmul`] of a [`Sym`] do the arithmetic of
 //! glam's `M3 * V3` (`(c0 x + c1 y) + c2 z`, column by column) and of
@@ -76,16 +78,16 @@ impl<T: Real> Block<T> for Sym<T> {
 /// triangle, [`tri`](super::tri)`(n)` blocks; empty when nothing is stored).
 #[derive(Clone, Copy, Debug)]
 pub enum Mob<'a, T: Real> {
-    /// Six scalars a block (free space).
+    /// Six scalars a block (free space, a periodic box).
     Sym(&'a [Sym<T>]),
-    /// Nine scalars a block (above a wall, in a box, the rotational mobility).
+    /// Nine scalars a block (above a wall, the rotational mobility).
     Full(&'a [T::M3]),
 }
 
 /// A stored mobility to write ([`Mob`]).
 #[derive(Debug)]
 pub enum MobMut<'a, T: Real> {
-    /// Six scalars a block (free space).
+    /// Six scalars a block (free space, a periodic box).
     Sym(&'a mut [Sym<T>]),
     /// Nine scalars a block.
     Full(&'a mut [T::M3]),
@@ -152,7 +154,7 @@ impl<'a, T: Real> MobMut<'a, T> {
     }
 
     /// The general blocks (empty for symmetric ones: the steps that need general
-    /// blocks, the inertial ones, above a wall, in a box, are given them,
+    /// blocks, the inertial ones and those above a wall, are given them,
     /// [`Layout::for_params`](crate::Layout::for_params)).
     pub fn general(self) -> &'a mut [T::M3] {
         match self {

@@ -37,7 +37,7 @@ pub use rot::{RotBlocks, add_spin, assemble_grand, pair_rot, self_rr};
 
 pub use crate::cell::{Periodic, PeriodicError};
 use crate::error::ParticleError;
-use crate::linalg::tri;
+use crate::linalg::{Block, tri};
 use crate::parallel::{Parallel, band_blocks, band_start, by_bands, by_bands_then_reduce};
 use crate::real::Real;
 
@@ -199,13 +199,17 @@ fn check<T: Real>(ew: &Ewald<T>, pos: &[T::V3], radius: &[T]) -> Result<(), Peri
 }
 
 /// Assembles the `n x n` periodic `mu_tt`, packed lower triangle ([`tri`]`(n)` blocks
-/// into `out`), in the layout of [`crate::mobility::assemble_tt`].
+/// into `out`), in the layout of [`crate::mobility::assemble_tt`]: general blocks or
+/// symmetric ones ([`Sym`](crate::linalg::Sym)), the same bits, since every Ewald
+/// block is symmetric in bits (the real-space images' free-space blocks and
+/// `A I + B e e^T` with `e e^T` formed as `e_r e_c` either way round; the wave-space
+/// sum's six mirrored entries; tested below).
 pub fn assemble_tt<T: Real>(
     ew: &Ewald<T>,
     eta: T,
     pos: &[T::V3],
     radius: &[T],
-    out: &mut [T::M3],
+    out: &mut [impl Block<T>],
 ) -> Result<(), PeriodicError> {
     assemble(&crate::parallel::Serial, ew, eta, pos, radius, out)
 }
@@ -218,7 +222,7 @@ pub fn assemble<T: Real>(
     eta: T,
     pos: &[T::V3],
     radius: &[T],
-    out: &mut [T::M3],
+    out: &mut [impl Block<T>],
 ) -> Result<(), PeriodicError> {
     check(ew, pos, radius)?;
     let n = pos.len();
@@ -231,22 +235,24 @@ pub fn assemble<T: Real>(
 
 /// Packed rows `range` of the periodic `mu_tt` into `out` (which starts at row
 /// `range.start`): each row's self block, then its pairs in column order.
-fn rows<T: Real>(
+fn rows<T: Real, B: Block<T>>(
     ew: &Ewald<T>,
     eta: T,
     pos: &[T::V3],
     radius: &[T],
     range: core::ops::Range<usize>,
-    out: &mut [T::M3],
+    out: &mut [B],
 ) -> Result<(), PeriodicError> {
     let base = tri(range.start);
     for i in range {
         let row = tri(i) - base;
-        out[row + i] = self_tt(ew, eta, radius[i]);
+        out[row + i] = B::store(self_tt(ew, eta, radius[i]));
         for j in 0..i {
-            out[row + j] = pair_tt(ew, eta, radius[i], radius[j], pos[i] - pos[j]).ok_or(
-                PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
-            )?;
+            out[row + j] = B::store(
+                pair_tt(ew, eta, radius[i], radius[j], pos[i] - pos[j]).ok_or(
+                    PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
+                )?,
+            );
         }
     }
     Ok(())
@@ -343,5 +349,88 @@ pub fn tt_block_at<T: Real>(
     match hi == lo {
         true => Some(self_tt(ew, eta, radius[hi])),
         false => pair_tt(ew, eta, radius[hi], radius[lo], pos[hi] - pos[lo]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Ewald, Periodic, pair_tt, self_tt};
+    use crate::linalg::block::tests::lcg;
+    use crate::real::Real;
+
+    /// Whether `m` equals its transpose bit for bit.
+    fn symmetric_in_bits<T: Real>(m: T::M3) -> bool {
+        let e = T::m3_entries(&m);
+        (0..3).all(|r| {
+            (0..3).all(|c| e[3 * c + r].to_f64().to_bits() == e[3 * r + c].to_f64().to_bits())
+        })
+    }
+
+    /// Every stored Ewald block, self and pair, is symmetric in bits, so a box's
+    /// mobility may be stored as six-scalar blocks (`linalg::Sym`) with the same bits:
+    /// the real-space images add free-space RPY blocks (symmetric in bits, tested in
+    /// `linalg::block`) minus `A I + B e e^T` with `e e^T` formed as `e_r e_c` either
+    /// way round; the wave-space sum accumulates six entries and mirrors them. Random
+    /// boxes (elongated too), radii, positions (overlapping pairs included), splitting
+    /// parameters and tolerances, in both precisions.
+    #[test]
+    fn ewald_blocks_are_symmetric_in_bits() {
+        fn check<T: Real>(seed: u64) -> usize {
+            let mut v = lcg(seed);
+            let mut u = move || v().0 + 0.5;
+            let mut checked = 0;
+            for case in 0..12 {
+                let size = [0; 3].map(|_| 6.0 + 8.0 * u());
+                let cell = Periodic::new(size.map(T::from_f64)).unwrap();
+                let a_max = 0.3 + 1.2 * u();
+                let a = T::from_f64(a_max);
+                let vol = size[0] * size[1] * size[2];
+                let ew = match case % 3 {
+                    0 => Ewald::new(cell, a),
+                    // xi V^(1/3) from 1 to 4, tolerances from 1e-4 down to eps/8.
+                    k => {
+                        let xi = (1.0 + 3.0 * u()) / libm::cbrt(vol);
+                        let tol = if k == 1 {
+                            1e-4
+                        } else {
+                            T::EPSILON.to_f64() / 8.0
+                        };
+                        Ewald::with_xi(cell, a, T::from_f64(xi), T::from_f64(tol))
+                    }
+                };
+                let Ok(ew) = ew else { continue };
+                let eta = T::from_f64(0.5 + u());
+                for _ in 0..40 {
+                    let ai = T::from_f64(a_max * (0.2 + 0.8 * u()));
+                    let aj = T::from_f64(a_max * (0.2 + 0.8 * u()));
+                    // Separations across the box and beyond (any image), some close.
+                    let scale = if u() < 0.3 {
+                        2.0 * a_max
+                    } else {
+                        2.0 * size[0]
+                    };
+                    let r = T::v3(
+                        T::from_f64(scale * (u() - 0.5)),
+                        T::from_f64(scale * (u() - 0.5)),
+                        T::from_f64(scale * (u() - 0.5)),
+                    );
+                    assert!(symmetric_in_bits::<T>(self_tt(&ew, eta, ai)));
+                    if let Some(m) = pair_tt(&ew, eta, ai, aj, r) {
+                        assert!(T::m3_entries(&m).iter().all(|x| x.is_finite()));
+                        assert!(symmetric_in_bits::<T>(m), "case {case} r {r:?}");
+                        checked += 1;
+                    }
+                }
+            }
+            checked
+        }
+        // The check itself sees an asymmetry of one entry.
+        let mut m = <f64 as Real>::m3_diag(1.0);
+        <f64 as Real>::m3_entries_mut(&mut m)[1] = f64::EPSILON;
+        assert!(!symmetric_in_bits::<f64>(m));
+        for seed in 1..4 {
+            assert!(check::<f64>(seed) > 200);
+            assert!(check::<f32>(seed) > 200);
+        }
     }
 }

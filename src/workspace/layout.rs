@@ -13,13 +13,13 @@ use crate::real::Real;
 const SYM: usize = 6;
 
 /// Whether a step of `p` stores its mobility as symmetric blocks, six scalars each in
-/// the scalar array ([`Sym`](crate::linalg::Sym)): the overdamped methods in free space,
-/// whose translational blocks are symmetric in bits. Above a wall, in a box, and for
-/// the inertial methods (whose factors and rotational blocks are not symmetric) the
-/// stored mobility keeps nine-scalar blocks in the block array.
+/// the scalar array ([`Sym`](crate::linalg::Sym)): the overdamped methods in free space
+/// and in a periodic box, whose translational blocks are symmetric in bits (the Ewald
+/// blocks tested in `mobility::periodic`). Above a wall, and for the inertial methods
+/// (whose factors and rotational blocks are not symmetric) the stored mobility keeps
+/// nine-scalar blocks in the block array.
 pub(crate) const fn symmetric<T: Real>(p: &Params<T>) -> bool {
     p.wall.is_none()
-        && p.periodic.is_none()
         && matches!(
             p.method,
             Method::Overdamped | Method::Overdamped2 | Method::Springs
@@ -30,8 +30,8 @@ pub(crate) const fn symmetric<T: Real>(p: &Params<T>) -> bool {
 /// constraint list of a step with contacts or a wall (`links`, zero otherwise).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Layout {
-    /// 3x3 blocks (factors; the packed mobility above a wall, in a box and of the
-    /// inertial methods).
+    /// 3x3 blocks (factors; the packed mobility above a wall and of the inertial
+    /// methods).
     pub blocks: usize,
     /// 3-vectors (forces, velocities, candidate state, bond vectors, solver vectors).
     pub vectors: usize,
@@ -67,8 +67,8 @@ impl Layout {
     /// Every method stores the candidate state (`3n` vectors), the forces (`m`), the bond
     /// vectors and multipliers (`B` each), and:
     /// * `Overdamped`, `Springs`: one packed mobility `tri(n)` symmetric blocks, `6 tri(n)`
-    ///   scalars (in free space; [`Layout::for_params`] moves it to `tri(n)` blocks of
-    ///   nine above a wall or in a box);
+    ///   scalars (in free space and in a box; [`Layout::for_params`] moves it to
+    ///   `tri(n)` blocks of nine above a wall);
     /// * `Overdamped2`: two (start and predicted point);
     /// * `Overdamped`, `Overdamped2` with a dense solver (sweep, Newton): the `n x B`
     ///   table of constraint displacements, which those solvers read at every
@@ -175,7 +175,7 @@ impl Layout {
         if symmetric(p) {
             return l;
         }
-        // Above a wall or in a box: the stored mobilities in blocks of nine.
+        // Above a wall: the stored mobilities in blocks of nine.
         let stored = match p.method {
             Method::Overdamped | Method::Springs if p.matrix_free => 0,
             Method::Overdamped | Method::Springs => 1,
@@ -277,7 +277,7 @@ impl Layout {
     }
 
     /// Storage for every method, with and without rotation, with every solver, in free
-    /// space (symmetric blocks) and above a wall or in a box (general blocks): one
+    /// space and in a box (symmetric blocks) and above a wall (general blocks): one
     /// workspace a host can switch methods on.
     pub const fn all(n: usize, bonds: usize) -> Self {
         let methods = [
