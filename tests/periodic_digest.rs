@@ -65,6 +65,32 @@ fn digest<T: Real>(method: Method, kind: SolverKind) -> u64 {
     state_digest(&ps)
 }
 
+/// The box stores its mobility as free space does (six scalars a block): the same
+/// layout, and the bytes of both, before (nine scalars a block) and now.
+#[test]
+fn box_layout_is_the_free_space_layout() {
+    for method in [Method::Overdamped, Method::Overdamped2] {
+        for n in [25, 4096] {
+            let free = params::<f64>(DT, method, SolverKind::Krylov);
+            let mut p = free;
+            p.periodic = Some(Periodic::new([20.0; 3]).unwrap());
+            let (boxed, open) = (Layout::for_params(&p, n, 0), Layout::for_params(&free, n, 0));
+            assert_eq!(boxed, open, "{method:?} n {n}");
+            let k = if method == Method::Overdamped2 { 2 } else { 1 };
+            let nine = Layout {
+                blocks: boxed.blocks + k * n * (n + 1) / 2,
+                scalars: boxed.scalars - 6 * k * n * (n + 1) / 2,
+                ..boxed
+            };
+            eprintln!(
+                "{method:?} n {n}: {} bytes (f64) in a box, {} with nine-scalar blocks",
+                boxed.bytes::<f64>(),
+                nine.bytes::<f64>()
+            );
+        }
+    }
+}
+
 fn golden<T: Real>() {
     let precision = if is_single::<T>() { "f32" } else { "f64" };
     let mut mismatches = Vec::new();
