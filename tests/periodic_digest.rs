@@ -74,7 +74,10 @@ fn box_layout_is_the_free_space_layout() {
             let free = params::<f64>(DT, method, SolverKind::Krylov);
             let mut p = free;
             p.periodic = Some(Periodic::new([20.0; 3]).unwrap());
-            let (boxed, open) = (Layout::for_params(&p, n, 0), Layout::for_params(&free, n, 0));
+            let (boxed, open) = (
+                Layout::for_params(&p, n, 0),
+                Layout::for_params(&free, n, 0),
+            );
             assert_eq!(boxed, open, "{method:?} n {n}");
             let k = if method == Method::Overdamped2 { 2 } else { 1 };
             let nine = Layout {

@@ -429,8 +429,9 @@ mod tests {
         <f64 as Real>::m3_entries_mut(&mut m)[1] = f64::EPSILON;
         assert!(!symmetric_in_bits::<f64>(m));
         for seed in 1..4 {
-            assert!(check::<f64>(seed) > 200);
-            assert!(check::<f32>(seed) > 200);
+            let (d, s) = (check::<f64>(seed), check::<f32>(seed));
+            // 476 of 480 pairs a seed (the rest nested through the boundary).
+            assert!(d > 400 && s > 400, "seed {seed}: {d} f64, {s} f32 pairs");
         }
     }
 }
