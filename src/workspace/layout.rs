@@ -10,7 +10,7 @@ use crate::params::{Method, Params};
 use crate::real::Real;
 
 /// Scalars a symmetric 3x3 block of a stored mobility takes ([`Sym`](crate::linalg::Sym)).
-const SYM: usize = 6;
+pub(crate) const SYM: usize = 6;
 
 /// Whether a step of `p` stores its mobility as symmetric blocks, six scalars each in
 /// the scalar array ([`Sym`](crate::linalg::Sym)): the overdamped methods in free space
@@ -24,6 +24,16 @@ pub(crate) const fn symmetric<T: Real>(p: &Params<T>) -> bool {
             p.method,
             Method::Overdamped | Method::Overdamped2 | Method::Springs
         )
+}
+
+/// Stored mobilities a method keeps as symmetric blocks when it stores them (the start's,
+/// and `Overdamped2`'s at the predicted point).
+const fn symmetric_mobilities(method: Method) -> usize {
+    match method {
+        Method::Overdamped | Method::Springs => 1,
+        Method::Overdamped2 => 2,
+        Method::Rattle | Method::RattleStable => 0,
+    }
 }
 
 /// Element counts of the storage arrays one step uses: four numeric arrays, and the
@@ -178,9 +188,7 @@ impl Layout {
         // Above a wall: the stored mobilities in blocks of nine.
         let stored = match p.method {
             Method::Overdamped | Method::Springs if p.matrix_free => 0,
-            Method::Overdamped | Method::Springs => 1,
-            Method::Overdamped2 => 2,
-            Method::Rattle | Method::RattleStable => 0,
+            method => symmetric_mobilities(method),
         };
         l.general(stored, n)
     }
@@ -299,12 +307,8 @@ impl Layout {
         while i < methods.len() * kinds.len() * 2 {
             let (method, kind) = (methods[i / 6], kinds[(i / 2) % 3]);
             let one = Self::with_solver(method, i % 2 == 1, kind, n, bonds);
-            let stored = match method {
-                Method::Overdamped | Method::Springs => 1,
-                Method::Overdamped2 => 2,
-                Method::Rattle | Method::RattleStable => 0,
-            };
-            l = l.max(one).max(one.general(stored, n));
+            let general = one.general(symmetric_mobilities(method), n);
+            l = l.max(one).max(general);
             i += 1;
         }
         l

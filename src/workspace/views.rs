@@ -147,8 +147,9 @@ impl<T: Real> Workspace<'_, T> {
             if second { tri(m) } else { 0 },
         );
         // (`as_chunks_mut`, Rust 1.88: the kernel's minimum since this storage.)
+        use super::layout::SYM;
         let (mu, mu2) = if super::symmetric(p) {
-            let mut sym = |k: usize| MobMut::Sym(sc.take(6 * k).as_chunks_mut::<6>().0);
+            let mut sym = |k: usize| MobMut::Sym(sc.take(SYM * k).as_chunks_mut::<SYM>().0);
             (sym(one), sym(two))
         } else {
             (MobMut::Full(bl.take(one)), MobMut::Full(bl.take(two)))
