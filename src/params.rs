@@ -258,19 +258,20 @@ pub struct Params<T: Real> {
     /// ([`BondError::BadLength`](crate::BondError::BadLength)). Default `None`.
     pub periodic: Option<Periodic<T>>,
     /// Mixed-precision constraint products: the Krylov constraint solve's products read
-    /// a compact `f32` copy of the stored mobility (24 bytes a block instead of 72,
-    /// written by the assembly's pass, `noise::reduced`; each product right to about
-    /// `1e-7` relative, the approximation the Lanczos noise already makes). The
-    /// residual that must meet [`Solver::tolerance`] is still evaluated in `f64` on the
-    /// positions, so the tolerance holds as with `f64` products; the constraint move is
+    /// a compact `f32` copy of the stored mobility (24 bytes a block instead of the 48
+    /// of the stored symmetric `f64` block, `linalg::Sym`; written by the assembly's
+    /// pass, `noise::reduced`; each product right to about `1e-7` relative, the
+    /// approximation the Lanczos noise already makes). The residual that must meet
+    /// [`Solver::tolerance`] is still evaluated in `f64` on the positions, so the
+    /// tolerance holds as with `f64` products; the constraint move is
     /// `dt M~ G^T lambda` with `M~` the rounded mobility (the unconstrained move stays
-    /// `f64`). A third of the bytes per product: the products stop being bound by
-    /// memory bandwidth on many cores. Taken where [`Params::compact_copy`] says
-    /// (first-order deterministic [`Method::Overdamped`], an `f64` kernel, a stored
-    /// free-space mobility of at least
-    /// [`REDUCED_MIN`](crate::noise::reduced::REDUCED_MIN) beads, the Krylov solver);
-    /// ignored elsewhere. The same bits on any number of threads, not the bits of the
-    /// `f64` products (docs/BENCHMARKS.md, "Product paths"). Default false.
+    /// `f64`). Half the bytes per product: the products stop being bound by memory
+    /// bandwidth on many cores. Taken where [`Params::compact_copy`] says (first-order
+    /// deterministic [`Method::Overdamped`], an `f64` kernel, a stored mobility with
+    /// symmetric blocks, in free space or in a periodic box with the Ewald sums, of at
+    /// least [`REDUCED_MIN`](crate::noise::reduced::REDUCED_MIN) beads, the Krylov
+    /// solver); ignored elsewhere. The same bits on any number of threads, not the
+    /// bits of the `f64` products (docs/BENCHMARKS.md, "Product paths"). Default false.
     pub compact_products: bool,
     /// Solve the inertial methods' ([`Method::Rattle`], [`Method::RattleStable`]) bond
     /// tensions again from the step's displacements instead of reading them off the
@@ -381,8 +382,10 @@ impl<T: Real> Params<T> {
 
     /// Whether a step of `n` beads and `bonds` bonds keeps the compact `f32` copy of
     /// the mobility for its constraint products ([`Params::compact_products`]): asked
-    /// for, first-order [`Method::Overdamped`] without noise, a stored free-space
-    /// mobility (no wall, no box), an `f64` kernel, at least
+    /// for, first-order [`Method::Overdamped`] without noise, a stored mobility of
+    /// symmetric blocks (free space, or a periodic box summed by Ewald; not above a
+    /// wall, whose blocks are not symmetric, nor with [`Params::pse`] in a box, which
+    /// stores nothing), an `f64` kernel, at least
     /// [`REDUCED_MIN`](crate::noise::reduced::REDUCED_MIN) beads, the Krylov solver.
     pub const fn compact_copy(&self, n: usize, bonds: usize) -> bool {
         self.compact_products
@@ -390,7 +393,7 @@ impl<T: Real> Params<T> {
             && self.brownian.is_none()
             && !self.matrix_free
             && self.wall.is_none()
-            && self.periodic.is_none()
+            && !(self.periodic.is_some() && self.pse.is_some())
             && core::mem::size_of::<T>() == 8
             && n >= crate::noise::reduced::REDUCED_MIN
             && matches!(self.solver_kind(n, bonds), SolverKind::Krylov)

@@ -11,9 +11,9 @@ use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch, SolveStats};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
-use crate::linalg::{self, Mob, with_blocks};
+use crate::linalg::{self, Mob, MobMut, with_blocks};
 use crate::noise::reduced;
-use crate::parallel;
+use crate::parallel::{self, Parallel};
 use crate::params::Params;
 use crate::real::Real;
 use crate::workspace::Views;
@@ -50,13 +50,16 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     // copy (in `fac`) while the row's blocks are in cache.
     let compact = p.compact_copy(n, bonds.len());
     if compact {
-        let pairs = (p.hydro, p.viscosity, s.pos, s.radius);
-        let side = (&mut *copy, reduced::copy_start as fn(usize) -> usize);
-        with_blocks!(mut mu.reborrow(), a => {
-            let pack = reduced::pack_rows::<T, _>;
-            parallel::assemble_apply_then(par, pairs, a, force, u, bands, side, pack)
-        })
-        .map_err(StepError::from)?;
+        let spheres = (s.pos, s.radius);
+        compact_product(
+            p,
+            s.ewald,
+            spheres,
+            mu.reborrow(),
+            (force, u),
+            (par, bands),
+            copy,
+        )?;
     } else {
         let at_start = mu.reborrow();
         mobility_product(p, s.ewald, s.pos, s.radius, at_start, force, u, par, bands)?;
@@ -89,6 +92,37 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         contact_rounds: r.rounds,
         ..report(r.stats, 0, bonds, lambda)
     })
+}
+
+/// `u = mu_tt f` as [`mobility_product`] gives it, the assembly's pass also writing
+/// each row of the compact copy `copy` of `mu` ([`Params::compact_products`]) while the
+/// row's blocks are in cache: fused with the product in free space, with the Ewald
+/// assembly in a box (with the step's sums `ew`; PSE stores no blocks to copy).
+fn compact_product<T: Real>(
+    p: &Params<T>,
+    ew: Sums<'_, T>,
+    (pos, radius): (&[T::V3], &[T]),
+    mu: MobMut<'_, T>,
+    (f, u): (&[T::V3], &mut [T::V3]),
+    (par, bands): (&dyn Parallel, &mut [T::V3]),
+    copy: &mut [T::M3],
+) -> Result<(), StepError> {
+    #[cfg(feature = "periodic")]
+    if let Some(e) = ew {
+        let e = e
+            .ewald()
+            .ok_or(StepError::Unsupported(super::stages::PSE_ASSEMBLED))?;
+        let work = (par, bands);
+        return super::periodic::assemble_apply(p, e, (pos, radius), mu, (f, u), work, Some(copy));
+    }
+    let _ = ew; // Read above only with the `periodic` feature.
+    let pairs = (p.hydro, p.viscosity, pos, radius);
+    let side = (copy, reduced::copy_start as fn(usize) -> usize);
+    with_blocks!(mut mu, a => {
+        let pack = reduced::pack_rows::<T, _>;
+        parallel::assemble_apply_then(par, pairs, a, f, u, bands, side, pack)
+    })
+    .map_err(StepError::from)
 }
 
 /// Projected overdamped velocity at `pos`: `U = U_inf + mu (F + G^T kappa)` with `kappa`

@@ -75,11 +75,15 @@ pub(super) fn mobility_product<T: Real>(
     if let Some(e) = ew {
         // In a box: assembled and applied in bands (`integrate/periodic.rs`).
         let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-        return with_blocks!(mut mu, mu => {
-            super::periodic::assemble(p, e, pos, radius, mu, par)?;
-            crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
-            Ok(())
-        });
+        return super::periodic::assemble_apply(
+            p,
+            e,
+            (pos, radius),
+            mu,
+            (f, u),
+            (par, bands),
+            None,
+        );
     }
     if let Some(h) = wall_height(p) {
         // Above a wall: assembled, then applied (`mobility::wall`).
@@ -213,8 +217,8 @@ pub(super) fn assemble_tt<T: Real>(
     if let Some(e) = ew {
         // PSE has no blocks; the checks refuse it wherever the step assembles.
         let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-        let serial = &crate::parallel::Serial;
-        return with_blocks!(mut mu, mu => super::periodic::assemble(p, e, pos, radius, mu, serial));
+        let (serial, eta) = (&crate::parallel::Serial, p.viscosity);
+        return with_blocks!(mut mu, mu => Ok(mobility::periodic::assemble(serial, e, eta, pos, radius, mu)?));
     }
     let _ = ew; // Read above only with the `periodic` feature.
     if let Some(h) = wall_height(p) {

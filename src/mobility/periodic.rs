@@ -38,7 +38,9 @@ pub use rot::{RotBlocks, add_spin, assemble_grand, pair_rot, self_rr};
 pub use crate::cell::{Periodic, PeriodicError};
 use crate::error::ParticleError;
 use crate::linalg::{Block, tri};
-use crate::parallel::{Parallel, band_blocks, band_start, by_bands, by_bands_then_reduce};
+use crate::parallel::{
+    Packed, Parallel, band_blocks, band_start, by_bands_and, by_bands_then_reduce,
+};
 use crate::real::Real;
 
 /// Largest image or wave-vector index per axis that the sums visit (a bound on their
@@ -224,17 +226,50 @@ pub fn assemble<T: Real>(
     radius: &[T],
     out: &mut [impl Block<T>],
 ) -> Result<(), PeriodicError> {
+    let none = (&mut [][..], tri as fn(usize) -> usize);
+    assemble_then(par, ew, eta, pos, radius, out, none, |_, _, _, _| {})
+}
+
+/// [`assemble`], handing each row `i` of the mobility, just written and still in the
+/// core's cache, to `then(i, i + 1, row, side_rows)` with `side` from its row `i` on
+/// (empty where `side` is): a second use of the blocks without a second pass over
+/// memory (the compact copy of
+/// [`Params::compact_products`](crate::Params::compact_products) in a box, as
+/// [`assemble_apply_then`](crate::parallel::assemble_apply_then) writes it in free
+/// space). The same blocks and the same first error.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn assemble_then<T: Real, B: Block<T>, F>(
+    par: &dyn Parallel,
+    ew: &Ewald<T>,
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    out: &mut [B],
+    side: Packed<'_, T::M3>,
+    then: F,
+) -> Result<(), PeriodicError>
+where
+    F: Fn(usize, usize, &[B], &mut [T::M3]) + Sync,
+{
     check(ew, pos, radius)?;
     let n = pos.len();
     let out = &mut out[..tri(n)];
-    by_bands::<T, _, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
+    let side_start = side.1;
+    let bands = (out, tri as fn(usize) -> usize);
+    let job = |t, rows_t: &mut [B], st: &mut [T::M3], _: &mut [T::V3], _: &mut [T::V3]| {
         let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-        rows(ew, eta, pos, radius, b0..b1, rows_t)
-    })
+        let first = side_start(b0);
+        rows(ew, eta, pos, radius, b0..b1, rows_t, |i, row| {
+            let rest = st.get_mut(side_start(i) - first..).unwrap_or_default();
+            then(i, i + 1, row, rest);
+        })
+    };
+    by_bands_and::<T, _, _, _, _>(par, n, bands, side, &mut [], &mut [], job)
 }
 
 /// Packed rows `range` of the periodic `mu_tt` into `out` (which starts at row
-/// `range.start`): each row's self block, then its pairs in column order.
+/// `range.start`): each row's self block, then its pairs in column order; each row
+/// handed to `row_done(i, blocks)` once written.
 fn rows<T: Real, B: Block<T>>(
     ew: &Ewald<T>,
     eta: T,
@@ -242,6 +277,7 @@ fn rows<T: Real, B: Block<T>>(
     radius: &[T],
     range: core::ops::Range<usize>,
     out: &mut [B],
+    mut row_done: impl FnMut(usize, &[B]),
 ) -> Result<(), PeriodicError> {
     let base = tri(range.start);
     for i in range {
@@ -254,6 +290,7 @@ fn rows<T: Real, B: Block<T>>(
                 )?,
             );
         }
+        row_done(i, &out[row..=row + i]);
     }
     Ok(())
 }

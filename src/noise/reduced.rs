@@ -3,8 +3,10 @@
 //!
 //! The noise is right only to the Lanczos tolerance (`1e-3` by default), so its
 //! products need neither the full `f64` mobility nor `f64` arithmetic. Each free-space
-//! block is symmetric (`a I + b r r^T` for RPY and Oseen, scalar on the diagonal), so
-//! the copy keeps its six distinct entries rounded to `f32` (24 bytes instead of 72),
+//! block is symmetric (`a I + b r r^T` for RPY and Oseen, scalar on the diagonal), and
+//! so is each Ewald block of a periodic box (in bits, `mobility::periodic`'s tests), so
+//! the copy keeps its six distinct entries rounded to `f32` (24 bytes instead of the 48
+//! of a stored symmetric `f64` block, `linalg::Sym`, or the 72 of a general one),
 //! and the products run in `f32`, four blocks of a row at once (`glam::Vec4`: SSE2
 //! does four `f32` operations where it does two `f64`, and the `f64` walk was compute
 //! bound at 3.4 ns a block; this one takes 1.3 at N = 1024). Lanczos then computes
