@@ -13,7 +13,9 @@
 //! with `--profile profiling`: release code with symbols).
 //! `CHAIN=1` takes the kernel bench's chain (`benches/kernel.rs`, `brownian/...`)
 //! instead of the helix. `BOX=L` runs in a cubic periodic box of edge `L` (the Ewald
-//! mobility, `docs/PERIODIC.md`). Each line ends with a digest of the final positions'
+//! mobility, `docs/PERIODIC.md`). `COMPACT=1` sets `Params::compact_products` (the
+//! Krylov constraint products from the compact `f32` copy, where the kernel takes it:
+//! Overdamped, N >= 700, free space or a box). Each line ends with a digest of the final positions'
 //! bits (the same on every build that keeps the arithmetic).
 
 use hydrorattle::*;
@@ -97,6 +99,7 @@ fn main() {
         p.solver.kind = kind;
         p.allow_overlap = true;
         p.matrix_free = std::env::var("MF").is_ok();
+        p.compact_products = std::env::var("COMPACT").is_ok();
         let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
         if let Some(l) = env("BOX") {
             p.periodic = Some(Periodic::new([l; 3]).unwrap());

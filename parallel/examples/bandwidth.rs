@@ -11,7 +11,10 @@
 //!    bytes, 36 `f32` flops) and the recompute path (no bytes, 63 + 36 flops): ns per
 //!    pair and the bytes per second each stream drew; the assembly pass (the stored
 //!    blocks written, 48 bytes a pair, and applied once); and for comparison the
-//!    product from general blocks (72 bytes a pair: a wall's, a box's; the same bits).
+//!    product from general blocks (72 bytes a pair: a wall's; the same bits). `BOX=L`:
+//!    the stored blocks and the compact copy packed from them are those of a cubic
+//!    periodic box of edge `L` (the Ewald mobility, also six scalars a pair; its
+//!    assembly takes about 10 us a pair on one thread); the other rows stay free space.
 //! 3. The plain step on one thread, round by round (`examples/stages.rs`): its
 //!    constraint products `k` and its serial rest, and the model's step beside it.
 //! 4. The model (`hydrorattle_parallel::model`): a pass's time per pair on `t` threads
@@ -30,6 +33,7 @@ mod common;
 
 use hydrorattle::glam::DVec3;
 use hydrorattle::linalg::Sym;
+use hydrorattle::mobility::periodic::{self, Ewald, Periodic};
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{self, Parallel, Serial, band_scratch};
 use hydrorattle::{Hydro, Real};
@@ -116,7 +120,21 @@ fn paths(n: usize, par: &dyn Parallel) -> [[f64; 2]; 5] {
         .collect();
     let (mut y, mut z) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; band_scratch(n)]);
     let mut mu: Vec<Sym<f64>> = vec![[0.0; 6]; n * (n + 1) / 2];
-    parallel::assemble::<f64>(par, Hydro::Rpy, 1.0, &pos, &radius, &mut mu).unwrap();
+    match std::env::var("BOX").ok().and_then(|s| s.parse::<f64>().ok()) {
+        // The box's Ewald blocks (symmetric too: the same six scalars a pair).
+        Some(l) => {
+            let ew = Ewald::new(Periodic::new([l; 3]).unwrap(), 1.0).unwrap();
+            let t0 = Instant::now();
+            periodic::assemble(par, &ew, 1.0, &pos, &radius, &mut mu).unwrap();
+            eprintln!(
+                "  ({} threads: stored and compact from the box of edge {l}, Ewald assembly \
+                 {:.0} ns/pair)",
+                par.threads(),
+                t0.elapsed().as_secs_f64() / (n * (n + 1) / 2) as f64 * 1e9
+            );
+        }
+        None => parallel::assemble::<f64>(par, Hydro::Rpy, 1.0, &pos, &radius, &mut mu).unwrap(),
+    }
     let general = {
         let mut mu9 = vec![f64::M3_ZERO; n * (n + 1) / 2];
         parallel::assemble::<f64>(par, Hydro::Rpy, 1.0, &pos, &radius, &mut mu9).unwrap();
