@@ -120,7 +120,10 @@ fn paths(n: usize, par: &dyn Parallel) -> [[f64; 2]; 5] {
         .collect();
     let (mut y, mut z) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; band_scratch(n)]);
     let mut mu: Vec<Sym<f64>> = vec![[0.0; 6]; n * (n + 1) / 2];
-    match std::env::var("BOX").ok().and_then(|s| s.parse::<f64>().ok()) {
+    match std::env::var("BOX")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+    {
         // The box's Ewald blocks (symmetric too: the same six scalars a pair).
         Some(l) => {
             let ew = Ewald::new(Periodic::new([l; 3]).unwrap(), 1.0).unwrap();

@@ -250,9 +250,9 @@ pub struct Integrator {
     pub matrix_free: bool,
     /// Mixed-precision constraint products (the kernel's `Params::compact_products`:
     /// the Krylov solve's products read an `f32` copy of the stored mobility, the
-    /// residual stays `f64`; a third of the bytes per product). The kernel takes it
-    /// where it applies (deterministic overdamped, `f64`, free space, at least 700
-    /// beads, Krylov) and ignores it elsewhere.
+    /// residual stays `f64`; half the bytes per product). The kernel takes it where it
+    /// applies (deterministic overdamped, `f64`, free space or an Ewald box, at least
+    /// 700 beads, Krylov) and ignores it elsewhere (a wall, PSE, noise).
     pub compact_products: bool,
 }
 
