@@ -218,7 +218,8 @@ pub(super) fn assemble_tt<T: Real>(
         // PSE has no blocks; the checks refuse it wherever the step assembles.
         let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
         let (serial, eta) = (&crate::parallel::Serial, p.viscosity);
-        return with_blocks!(mut mu, mu => Ok(mobility::periodic::assemble(serial, e, eta, pos, radius, mu)?));
+        use mobility::periodic::assemble;
+        return Ok(with_blocks!(mut mu, mu => assemble(serial, e, eta, pos, radius, mu))?);
     }
     let _ = ew; // Read above only with the `periodic` feature.
     if let Some(h) = wall_height(p) {
