@@ -98,6 +98,28 @@ fn pse_runs_where_products_suffice_and_is_refused_at_its_line_elsewhere() {
     assert!(!run.integrator.matrix_free);
 }
 
+/// `compact_products` in a box: with `method = "ewald"` the kernel keeps the compact copy
+/// (at the 700 beads it needs: `Params::compact_copy`); `"auto"` resolves a
+/// deterministic overdamped scene to PSE, which stores nothing, and the flag is ignored.
+#[test]
+fn compact_products_in_a_box_take_the_ewald_path_only() {
+    let with = |m: &str| {
+        let text = BOXED
+            .replace(
+                "size = [10, 10, 12]",
+                &format!("size = [10, 10, 12]\nmethod = \"{m}\""),
+            )
+            .replace("duration = 1\n", "duration = 1\ncompact_products = true\n");
+        Scene::parse(&text, "b.toml").unwrap().with_box_resolved()
+    };
+    let ewald = params::<f64>(&with("ewald"));
+    assert!(ewald.periodic.is_some() && ewald.pse.is_none() && ewald.compact_products);
+    assert!(ewald.compact_copy(700, 699));
+    let auto = params::<f64>(&with("auto"));
+    assert!(auto.pse.is_some() && auto.matrix_free && auto.compact_products);
+    assert!(!auto.compact_copy(700, 699));
+}
+
 #[test]
 fn bad_boxes_are_refused_at_their_line() {
     let cases: [(&str, &str, usize, &str); 10] = [
