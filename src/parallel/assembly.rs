@@ -9,9 +9,9 @@ use crate::linalg::{Block, tri};
 use crate::mobility::{Hydro, pair_tt, self_tt};
 use crate::real::Real;
 
-/// [`band`] while assembling: each block is evaluated, stored into `rows` (the packed
-/// rows from `b0` on) and applied at once, in the same order, so the product's bits are
-/// those of [`band`] on the stored blocks.
+/// [`band`](super::band) while assembling: each block is evaluated, stored into `rows`
+/// (the packed rows from `b0` on) and applied at once, in the same order, so the
+/// product's bits are those of [`band`](super::band) on the stored blocks.
 #[inline(always)]
 pub(super) fn band_fused<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
@@ -28,7 +28,8 @@ pub(super) fn band_fused<T: Real, B: Block<T>>(
     Ok(())
 }
 
-/// Row `b0 + k` of a [`band_fused`]: [`row`] on blocks evaluated and stored on the way.
+/// Row `b0 + k` of a [`band_fused`]: [`row`](super::row) on blocks evaluated and stored
+/// on the way.
 #[inline(always)]
 fn row_fused<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
@@ -119,9 +120,9 @@ fn rows<T: Real, B: Block<T>>(
     Ok(())
 }
 
-/// [`assemble`] and [`product`] `y = mu_tt x` in one pass over the pairs (each band
-/// computes its blocks, stores them and applies them at once): the same blocks and the
-/// same bits as the two in turn, without reading the blocks back.
+/// [`assemble`] and [`product`](super::product) `y = mu_tt x` in one pass over the pairs
+/// (each band computes its blocks, stores them and applies them at once): the same
+/// blocks and the same bits as the two in turn, without reading the blocks back.
 #[allow(clippy::too_many_arguments)]
 pub fn assemble_apply<T: Real>(
     par: &dyn Parallel,

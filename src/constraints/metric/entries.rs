@@ -1,9 +1,9 @@
 //! The metric read one entry at a time: `D_l(p)` for a bond and a bead, a bond's
 //! relative change, a row of the constraint Jacobian, and the moves of one or every
 //! multiplier added bond after bond. The sweep, the dense Newton solve and the Krylov
-//! preconditioner's band read these; they are inlined at each call site (the
-//! Jacobian rows, the moves), which is why the metrics that compute an entry from
-//! blocks sit behind `at_far`.
+//! preconditioner's band read these, inlined at each call site (the Jacobian rows, the
+//! moves); the metrics that compute an entry from blocks sit behind `at_far`, which is
+//! called, not inlined, on 32-bit Arm.
 
 use super::{Metric, sym_block, sym_diff_mul};
 use crate::bonds::Bond;

@@ -1,8 +1,9 @@
 //! The metric applied to a whole multiplier vector at once, `sum_l c_l D_l`: the
-//! Krylov solver's product. It spreads the multipliers into forces and makes one
-//! mobility product (stored, compact, matrix-free, or in the box) and, for the
-//! implicit drag, one Cholesky solve; it never forms an entry `D_l(p)`, so it is kept
-//! apart from the entry reads.
+//! Krylov solver's product. The hydrodynamic metrics spread the multipliers into forces
+//! and make one mobility product (stored, its compact copy, matrix-free, or in the
+//! box), the implicit drag one more Cholesky solve; the mass and dense metrics add the
+//! moves directly. It never forms an entry `D_l(p)` of a hydrodynamic metric, so it is
+//! kept apart from the entry reads.
 
 use super::Metric;
 use crate::bonds::Bond;
