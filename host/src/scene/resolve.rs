@@ -17,7 +17,6 @@ mod integrator;
 pub(super) use body::BodySpans;
 pub use integrator::MAX_TURN_PER_STEP;
 
-use body::Body;
 use budget::plans;
 use integrator::{check_turn, resolve_integrator};
 
@@ -143,18 +142,9 @@ impl RawScene {
             .and_then(|o| o.every.as_ref())
             .map(|e| e.span());
         let output_span = every_span.unwrap_or_else(|| raw_int.get_ref().duration.span());
-        let Body {
-            particles,
-            bonds,
-            helix,
-            spans: body_span,
-            species,
-            suspension,
-            floor,
-            pinned,
-        } = self.body(&plans, limits, &integrator, every, output_span)?;
+        let body = self.body(&plans, limits, &integrator, every, output_span)?;
 
-        let periodic = match (&self.periodic, suspension) {
+        let periodic = match (&self.periodic, body.suspension) {
             (Some(b), s) => Some(super::periodic::resolve(b, s.map(|(_, e)| e))?),
             (None, Some((_, e))) => Some(super::PeriodicBox {
                 size: e,
@@ -165,25 +155,38 @@ impl RawScene {
             (None, None) => None,
         };
         if let Some(b) = &periodic {
-            super::periodic::check_particles(b, &particles, &body_span)?;
+            super::periodic::check_particles(b, &body.particles, &body.spans)?;
         }
-        check_geometry(&particles, model.overlap, periodic.as_ref(), &body_span)?;
+        check_geometry(
+            &body.particles,
+            model.overlap,
+            periodic.as_ref(),
+            &body.spans,
+        )?;
         if let Some(w) = wall {
-            super::wall::check_particles(w, &particles, &body_span)?;
+            super::wall::check_particles(w, &body.particles, &body.spans)?;
         }
-        super::precision::check(&particles, &bonds, integrator.precision, &body_span)?;
+        super::precision::check(
+            &body.particles,
+            &body.bonds,
+            integrator.precision,
+            &body.spans,
+        )?;
         if let (Some(raw), Some(thermal)) = (&self.brownian, &brownian) {
-            let min_radius = particles.iter().fold(f64::INFINITY, |m, p| m.min(p.radius));
+            let min_radius = body
+                .particles
+                .iter()
+                .fold(f64::INFINITY, |m, p| m.min(p.radius));
             raw.check_precision(thermal, &integrator, fluid.viscosity, min_radius)?;
         }
         if integrator.method.is_inertial()
-            && let Some(k) = particles.iter().position(|p| p.density <= 0.0)
+            && let Some(k) = body.particles.iter().position(|p| p.density <= 0.0)
         {
             return Err(issue(
-                body_span.density(k),
+                body.spans.density(k),
                 format!(
                     "particle {k} has density {} but the inertial method needs positive masses",
-                    particles[k].density
+                    body.particles[k].density
                 ),
             ));
         }
@@ -192,20 +195,20 @@ impl RawScene {
             fluid,
             gravity,
             flow,
-            particles,
-            bonds,
-            helix,
+            particles: body.particles,
+            bonds: body.bonds,
+            helix: body.helix,
             model,
             integrator,
             output: Output { every },
             contact,
             brownian,
-            species,
+            species: body.species,
             wall,
             periodic,
-            suspension: suspension.map(|(s, _)| s),
-            floor,
-            pinned,
+            suspension: body.suspension.map(|(s, _)| s),
+            floor: body.floor,
+            pinned: body.pinned,
         };
         // "pse" where the scene needs the assembled mobility: placed at the method.
         if let (Err(e), Some(raw)) = (scene.check_box_runs(None), &self.periodic) {
@@ -213,7 +216,7 @@ impl RawScene {
             return Err(issue(at.unwrap_or(raw.span()), e.to_string()));
         }
         let keys = super::kernel::KeySpans::of(&self, raw_int.span());
-        super::kernel::check(&scene, &keys, &body_span)?;
+        super::kernel::check(&scene, &keys, &body.spans)?;
         Ok(scene)
     }
 }

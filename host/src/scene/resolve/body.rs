@@ -17,7 +17,7 @@ use crate::scene::{Bond, Floor, Helix, Integrator, Particle, Suspension};
 use crate::sizing::{Limits, Plan};
 
 /// What [`RawScene::body`] resolves, for the [`Scene`](crate::scene::Scene) and its
-/// later checks.
+/// later checks (read field by field where the scene is made).
 pub(super) struct Body {
     /// Every sphere (generated, or from the tables).
     pub(super) particles: Vec<Particle>,
