@@ -12,7 +12,7 @@ use crate::real::Real;
 
 /// The step's bond tensions (force units, as the position multipliers) solved again
 /// from the step's displacements, into `spare`; `false` if the solve fails (then the
-/// position multipliers stay). [`start_velocity_correction`] completes them.
+/// position multipliers stay). The inertial steps call it after [`project_velocity`].
 ///
 /// Why: an inertial step's constraint displacement is `O(dt^2 F / m)`, below the
 /// rounding of an f32 position (`eps |x|`) once `dt` is small, so the position
