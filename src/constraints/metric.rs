@@ -50,7 +50,7 @@ pub enum Metric<'a, T: Real> {
     /// Hydrodynamic metric from the packed translational mobility:
     /// `D_l(p) = (mu_pi - mu_pj) (scale g_l)`, read block by block where it is used.
     Mobility {
-        /// Packed `mu_tt` (`tri(n)` blocks, symmetric in free space).
+        /// Packed `mu_tt` (`tri(n)` blocks, symmetric in free space and in a box).
         mu: Mob<'a, T>,
         /// Constraint gradients, one per bond.
         grad: &'a [T::V3],
