@@ -16,6 +16,7 @@
 mod common;
 
 use common::*;
+use hydrorattle::noise::reduced;
 use hydrorattle::{
     BondSet, Brownian, Drift, Layout, Method, NoForce, Noise, NoiseSqrt, Params, ParticleSet,
     Periodic, Real, SolverKind, Wall, Workspace,
@@ -221,4 +222,72 @@ fn golden<T: Real>() {
 
 both_precisions! {
     midpoint_golden_digest => golden;
+}
+
+/// The midpoint's storage by Lanczos noise: six scalars a pair where the mobility's
+/// blocks are symmetric (free space, a box) instead of the nine of a Cholesky factor's
+/// block, nine above a wall, the reduced copy (an `f64` kernel of `REDUCED_MIN` beads
+/// and more, free space) in slots of its own; by Cholesky the factor's blocks as
+/// before. Prints the bytes of each workspace, and those of the nine-scalar midpoint.
+#[test]
+fn midpoint_storage_is_sized_for_its_blocks() {
+    fn check<T: Real>(place: Place, method: Method, n: usize) {
+        let tri = n * (n + 1) / 2;
+        let mut p = thermal::<T>(place, method, SolverKind::Krylov);
+        let lanczos = Layout::for_params(&p, n, n - 1);
+        p.noise_sqrt = NoiseSqrt::Cholesky;
+        let cholesky = Layout::for_params(&p, n, n - 1);
+        p.brownian = p.brownian.map(|b| Brownian {
+            drift: Drift::Uncorrected,
+            ..b
+        });
+        p.noise_sqrt = NoiseSqrt::Lanczos;
+        // By Lanczos without a midpoint: no factor, no midpoint storage, no copy.
+        let bare = Layout::for_params(&p, n, n - 1);
+        assert_eq!(
+            cholesky.blocks,
+            bare.blocks + tri,
+            "{place:?} {method:?} {n}"
+        );
+        let copy = match place {
+            Place::Free if !is_single::<T>() && n >= reduced::REDUCED_MIN => reduced::slots(n),
+            _ => 0,
+        };
+        let nine = Layout {
+            blocks: bare.blocks + tri + copy.saturating_sub(tri),
+            scalars: lanczos.scalars - if place == Place::Wall { 0 } else { 6 * tri },
+            ..lanczos
+        };
+        let (mid_blocks, mid_scalars) = match place {
+            Place::Wall => (tri, 0),
+            _ => (0, 6 * tri),
+        };
+        assert_eq!(lanczos.blocks, bare.blocks + mid_blocks + copy);
+        assert_eq!(lanczos.scalars, bare.scalars + mid_scalars);
+        // The copy: 24 bytes a pair (three `f64` slot entries) and at most eleven
+        // blocks of padding a row.
+        assert!(
+            9 * copy <= 3 * tri + 33 * n,
+            "copy {copy} slots for {tri} pairs"
+        );
+        eprintln!(
+            "{place:?} {method:?} n {n} {}: {} bytes by Lanczos and the midpoint \
+             ({} with its mobility in the factor's nine-scalar blocks), {} by Cholesky",
+            core::any::type_name::<T>(),
+            lanczos.bytes::<T>(),
+            nine.bytes::<T>(),
+            cholesky.bytes::<T>()
+        );
+    }
+    for n in [25, 4096] {
+        for (place, method) in [
+            (Place::Free, Method::Overdamped),
+            (Place::Free, Method::Springs),
+            (Place::Box, Method::Overdamped),
+            (Place::Wall, Method::Overdamped),
+        ] {
+            check::<f64>(place, method, n);
+            check::<f32>(place, method, n);
+        }
+    }
 }
