@@ -167,7 +167,12 @@ pub(super) struct Krylov<'a, T: Real> {
 /// tested first, so that an `f32` kernel (firmware) links no copy.
 #[inline(always)]
 fn reads_copy<T: Real>(p: &Params<T>, n: usize) -> bool {
-    reduced::for_noise(p, n)
+    let copy = reduced::for_noise(p, n);
+    // The `const` test agrees with the step's own tests of the wall and the Ewald box
+    // (which also heed the kernel's features: a step they refuse never gets here).
+    let symmetric = super::wall_height(p).is_none() && super::ewald_cell(p).is_none();
+    debug_assert!(!copy || symmetric);
+    copy
 }
 
 /// The thermal displacement `dx` of one step from the packed mobility `mu` at the
@@ -424,3 +429,6 @@ fn midpoint_solver<T: Real>(
 fn refused(e: LanczosError) -> StepError {
     e.into()
 }
+
+#[cfg(test)]
+mod tests;
