@@ -26,7 +26,7 @@
 //! time, the tile's `x` and partial sums in lanes on the stack; its partial sums over
 //! all columns are kept in `f64`. The storage, [`slots`]`(n)`, is the factor's slice
 //! of the workspace, which a step by Lanczos noise does not need for a factor
-//! ([`for_noise`]). `T` must be `f64` ([`usable`]); an `f32` kernel reads the mobility
+//! (`for_noise`). `T` must be `f64` ([`usable`]); an `f32` kernel reads the mobility
 //! itself.
 
 use crate::linalg::{Block, tri};
