@@ -18,13 +18,19 @@
 //!
 //! Products go through [`product`], assemblies through [`assemble`] and [`assemble_apply`]:
 //! the one place where the stored mobility meets a vector (the integrators, the Krylov
-//! metric).
+//! metric). This file holds the bands and the products of stored blocks; the assembly,
+//! which evaluates the pair blocks (and may apply them on the way), is in
+//! `parallel/assembly.rs`, apart because it is where the blocks come from, not how they
+//! are read: it can fail on a nested pair, and its fused form follows the product's
+//! order so that its bits are the product's.
 
+mod assembly;
 mod blocked;
 mod free;
 mod jobs;
 mod lanes;
 
+pub use assembly::{assemble, assemble_apply};
 pub(crate) use blocked::assemble_apply_then;
 pub(crate) use free::band_blocks;
 pub use free::{free_band, free_product, free_products};
@@ -32,9 +38,8 @@ pub use free::{free_band, free_product, free_products};
 pub(crate) use jobs::{Jobs, run_all};
 pub(crate) use jobs::{Packed, by_bands, by_bands_and, by_bands_k, by_rows, map_bands, reduce};
 
-use crate::error::ParticleError;
 use crate::linalg::{Block, tri};
-use crate::mobility::{Hydro, pair_tt, self_tt};
+use crate::mobility::{Hydro, self_tt};
 use crate::real::Real;
 
 /// A way to run independent jobs, possibly at the same time.
@@ -196,72 +201,6 @@ impl<T: Real> Pairs<'_, T> {
     }
 }
 
-/// [`band`] while assembling: each block is evaluated, stored into `rows` (the packed
-/// rows from `b0` on) and applied at once, in the same order, so the product's bits are
-/// those of [`band`] on the stored blocks.
-#[inline(always)]
-fn band_fused<T: Real, B: Block<T>>(
-    src: Pairs<'_, T>,
-    rows: &mut [B],
-    b0: usize,
-    x: &[T::V3],
-    y: &mut [T::V3],
-    z: &mut [T::V3],
-) -> Result<(), ParticleError> {
-    src.start(rows, b0, x, y, z);
-    for k in 0..y.len() {
-        row_fused(src, rows, b0, k, x, y, z)?;
-    }
-    Ok(())
-}
-
-/// Row `b0 + k` of a [`band_fused`]: [`row`] on blocks evaluated and stored on the way.
-#[inline(always)]
-fn row_fused<T: Real, B: Block<T>>(
-    src: Pairs<'_, T>,
-    rows: &mut [B],
-    b0: usize,
-    k: usize,
-    x: &[T::V3],
-    y: &mut [T::V3],
-    z: &mut [T::V3],
-) -> Result<(), ParticleError> {
-    let (base, i) = (tri(b0), b0 + k);
-    let (level, eta, pos, radius) = (src.level, src.eta, src.pos, src.radius);
-    let (pi, ai, xi) = (pos[i], radius[i], x[i]);
-    #[inline(always)]
-    fn pair<T: Real>(
-        l: Hydro,
-        eta: T,
-        ai: T,
-        aj: T,
-        r: T::V3,
-        i: usize,
-        j: usize,
-    ) -> Result<T::M3, ParticleError> {
-        pair_tt(l, eta, ai, aj, r).ok_or(ParticleError::Nested { i: j, j: i })
-    }
-    let (left, inside) = rows[tri(i) - base..tri(i) - base + i].split_at_mut(b0);
-    let mut acc = T::V3_ZERO;
-    let others = left.iter_mut().zip(z.iter_mut()).zip(pos).zip(radius);
-    for (j, (((o, zj), &pj), &aj)) in others.enumerate() {
-        let b = pair::<T>(level, eta, ai, aj, pi - pj, i, j)?;
-        *o = B::store(b);
-        acc += b * x[j];
-        *zj += T::m3_tmul(b, xi);
-    }
-    let (ys, yi) = y[..=k].split_at_mut(k);
-    let others = inside.iter_mut().zip(ys).zip(&pos[b0..]).zip(&radius[b0..]);
-    for (j, (((o, yj), &pj), &aj)) in others.enumerate() {
-        let b = pair::<T>(level, eta, ai, aj, pi - pj, i, b0 + j)?;
-        *o = B::store(b);
-        acc += b * x[b0 + j];
-        *yj += T::m3_tmul(b, xi);
-    }
-    yi[0] += acc;
-    Ok(())
-}
-
 /// `y = A x` for the packed symmetric `A` of `n` block rows, in bands through `par`;
 /// `z` holds at least [`band_scratch`]`(n)` vectors. Bit-identical to
 /// [`sym_matvec`](crate::linalg::sym_matvec) below [`BANDED_MIN`] rows; from there on the
@@ -356,90 +295,4 @@ fn scratches<T: Real, const K: usize>(n: usize, z: &mut [T::V3]) -> [&mut [T::V3
         rest = tail;
         head
     })
-}
-
-/// [`assemble_tt`](crate::mobility::assemble_tt) in bands through `par`: the same blocks
-/// (each pair is evaluated on its own), the same first error.
-pub fn assemble<T: Real>(
-    par: &dyn Parallel,
-    level: Hydro,
-    eta: T,
-    pos: &[T::V3],
-    radius: &[T],
-    out: &mut [impl Block<T>],
-) -> Result<(), ParticleError> {
-    let n = pos.len();
-    let out = &mut out[..tri(n)];
-    if bands(n) == 1 {
-        return rows::<T, _>(level, eta, pos, radius, 0..n, out);
-    }
-    by_bands::<T, _, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
-        let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-        rows::<T, _>(level, eta, pos, radius, b0..b1, rows_t)
-    })
-}
-
-/// Packed rows `range` of `mu_tt` into `out` (which starts at row `range.start`).
-fn rows<T: Real, B: Block<T>>(
-    level: Hydro,
-    eta: T,
-    pos: &[T::V3],
-    radius: &[T],
-    range: core::ops::Range<usize>,
-    out: &mut [B],
-) -> Result<(), ParticleError> {
-    let base = tri(range.start);
-    for i in range {
-        let (pairs, diag) = out[tri(i) - base..=tri(i) - base + i].split_at_mut(i);
-        for (j, o) in pairs.iter_mut().enumerate() {
-            *o = B::store(
-                pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
-                    .ok_or(ParticleError::Nested { i: j, j: i })?,
-            );
-        }
-        diag[0] = B::store(T::m3_diag(self_tt(eta, radius[i])));
-    }
-    Ok(())
-}
-
-/// [`assemble`] and [`product`] `y = mu_tt x` in one pass over the pairs (each band
-/// computes its blocks, stores them and applies them at once): the same blocks and the
-/// same bits as the two in turn, without reading the blocks back.
-#[allow(clippy::too_many_arguments)]
-pub fn assemble_apply<T: Real>(
-    par: &dyn Parallel,
-    level: Hydro,
-    eta: T,
-    pos: &[T::V3],
-    radius: &[T],
-    out: &mut [impl Block<T>],
-    x: &[T::V3],
-    y: &mut [T::V3],
-    z: &mut [T::V3],
-) -> Result<(), ParticleError> {
-    let n = pos.len();
-    let out = &mut out[..tri(n)];
-    let src = Pairs {
-        level,
-        eta,
-        pos,
-        radius,
-    };
-    if n < blocked::RUNS_MIN {
-        // Pairs side by side where there are vector lanes to fill: not on 32-bit Arm
-        // (the Cortex-M4F's FPU is scalar, and the lanes' arrays would cost its stack
-        // ~3 kB), which keeps the row-by-row band and its instruction count.
-        if level == Hydro::Rpy && n <= lanes::MAX && !cfg!(target_arch = "arm") {
-            return lanes::band_lanes::<T, _>(src, out, x, &mut y[..n]);
-        }
-        return band_fused::<T, _>(src, out, 0, x, &mut y[..n], &mut []);
-    }
-    if bands(n) == 1 {
-        return blocked::fused_rows::<T, _>(src, out, 0, x, &mut y[..n], &mut []);
-    }
-    by_bands::<T, _, _, _>(par, n, out, tri, y, z, |t, rows_t, yt, zt| {
-        blocked::fused_rows::<T, _>(src, rows_t, band_start(n, t), x, yt, zt)
-    })?;
-    reduce::<T>(n, y, z, par);
-    Ok(())
 }

@@ -274,7 +274,7 @@ pub struct Params<T: Real> {
     pub compact_products: bool,
     /// Solve the inertial methods' ([`Method::Rattle`], [`Method::RattleStable`]) bond
     /// tensions again from the step's displacements instead of reading them off the
-    /// position solve (`displacement_tensions` in `integrate/stages.rs`): their
+    /// position solve (`displacement_tensions` in `integrate/tensions.rs`): their
     /// constraint displacement `dt^2 F / m` falls below an `f32` position's rounding
     /// once `dt` is small, and the position multipliers are then rounding noise. Costs
     /// two more constraint solves per step (and a Cholesky solve for `Rattle`); the

@@ -16,12 +16,22 @@ checked to write a byte-identical trajectory and timed against the same peer run
    `summary.json` times it; process wall time printed too) and the peer for `--peer-steps`
    steps, alternately, `--rounds` times; the best of each is compared.
 
+3. Fraction of the peak: where a binary's target directory holds `examples/peak` (built
+   by `cargo build --release --example peak`, with the same config as the binary), it
+   runs once a round beside the timings, and its best f64 rate is the peak the step's
+   rate is read against. The peak is measured in the same minutes as the step because
+   on a shared VM both move together (docs/BENCHMARKS.md: the vCPU's physical core is
+   sometimes shared, which halves both). The step's rate is `--flops` (floating-point
+   operations a step, counted by stage from the code for the 25-bead helix at its 3.3
+   chord iterations a step: docs/BENCHMARKS.md) over the best run-loop time.
+
 Needs numpy and pygrpy (`pip install numpy pygrpy`). Prints a table and the ratio.
 """
 
 import argparse
 import json
 import pathlib
+import re
 import subprocess
 import sys
 import tempfile
@@ -64,6 +74,18 @@ def demo_run(demo, scene_path, out, threads=None):
     return summary, wall
 
 
+def peak_of(demo):
+    """The `peak` example beside a host-demo binary (same target directory), or None."""
+    exe = pathlib.Path(demo).resolve().parent / "examples" / "peak"
+    return exe if exe.is_file() else None
+
+
+def peak_rate(exe):
+    """The f64 GFLOP/s one run of the `peak` example prints."""
+    out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
+    return float(re.search(r"f64 ([0-9.]+) GFLOP/s", out).group(1))
+
+
 def peer_from(frame, cfg):
     _, pos, radius, mass = frame
     g = np.array(cfg["gravity"]["acceleration"], dtype=float)
@@ -88,6 +110,9 @@ def main():
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--peer-steps", type=int, default=500)
     ap.add_argument("--threads", type=int, default=None, help="passed to host-demo run")
+    ap.add_argument("--flops", type=float, default=66.9e3,
+                    help="floating-point operations a step of the scene (default: the "
+                         "25-bead helix's count, docs/BENCHMARKS.md)")
     args = ap.parse_args()
     demos = args.demo or [str(ROOT / "target/release/host-demo")]
     text = pathlib.Path(args.scene).read_text()
@@ -122,8 +147,12 @@ def main():
         demo_best = [np.inf] * len(demos)
         wall_best = [np.inf] * len(demos)
         peer_best = np.inf
+        peaks = [peak_of(d) for d in demos]
+        peak_best = [0.0] * len(demos)
         for _ in range(args.rounds):
             for k, demo in enumerate(demos):
+                if peaks[k] is not None:
+                    peak_best[k] = max(peak_best[k], peak_rate(peaks[k]))
                 s, wall = demo_run(demo, args.scene, tmp / "full", args.threads)
                 demo_best[k] = min(demo_best[k], s["wall_time_s"] / s["steps_done"])
                 wall_best[k] = min(wall_best[k], wall / s["steps_done"])
@@ -142,6 +171,15 @@ def main():
         print(f"  host-demo run (process wall, with start-up) {wall_best[k] * 1e6:9.2f} us/step")
         print(f"  ratio peer / host-demo: {peer_best / demo_best[k]:.1f}x (run loop), "
               f"{peer_best / wall_best[k]:.1f}x (process wall)")
+        rate = args.flops / demo_best[k] / 1e9
+        if peaks[k] is None:
+            print(f"  {rate:.2f} GFLOP/s at {args.flops:.0f} flops a step (no examples/peak "
+                  "beside this binary: no fraction of the peak)")
+        else:
+            print(f"  {rate:.2f} GFLOP/s at {args.flops:.0f} flops a step = "
+                  f"{100 * rate / peak_best[k]:.1f} % of this build's f64 peak, "
+                  f"{peak_best[k]:.2f} GFLOP/s (examples/peak, best of {args.rounds}, "
+                  "same minutes)")
 
 
 if __name__ == "__main__":

@@ -1,14 +1,24 @@
 //! The first and third stages of a step: checking the inputs (parameters, particles,
 //! bonds, thermal noise, contacts) before anything is touched, and accepting the
 //! candidate state before it is committed.
+//!
+//! This file holds the input checks that read the parameters and the spheres one by
+//! one; the periodic box's checks, which also derive the step's Ewald or PSE sums, are
+//! in `checks/periodic_box.rs`, and the acceptance of a candidate (a pair search, in
+//! bands through the host's threads) in `checks/acceptance.rs`. The seam is what each
+//! costs and what it hands on: `O(N + B)` checks that return nothing, the box's sums
+//! that every product of the step reads, and the `O(N^2)` (or cell-list) pair search.
+
+mod acceptance;
+mod periodic_box;
+
+pub(super) use acceptance::accept;
+pub(super) use periodic_box::check_box;
+use periodic_box::check_periodic;
 
 use crate::bonds::Bond;
-use crate::cell::{Periodic, image};
-use crate::cell_list::CellList;
 use crate::constraints::Solver;
 use crate::error::{ParticleError, StepError};
-use crate::mobility::Hydro;
-use crate::parallel::{BANDS, Parallel, band_start, bands, map_bands};
 use crate::params::{Method, Params};
 use crate::particles::{State, sphere_volume};
 use crate::real::Real;
@@ -96,126 +106,6 @@ pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result
     match below_wall(state.pos, state.radius, w.height, p.solver.tolerance) {
         Some(particle) => Err(ParticleError::BelowWall { particle }.into()),
         None => Ok(()),
-    }
-}
-
-/// Checks the periodic box: every radius, the box itself ([`check_box`]), every bond
-/// (and FENE's maximum extension) shorter than half the smallest edge, so that the
-/// minimum image of a bond at its length is the bond; then the step's sums, Ewald or PSE
-/// ([`Params::pse`]), derived here once and held for every product, assembly and metric
-/// block of the step (`None` without a box, or with free draining).
-pub(super) fn check_periodic<T: Real>(
-    p: &Params<T>,
-    state: &State<'_, T>,
-    bonds: &[Bond<T>],
-) -> Result<HeldSums<T>, StepError> {
-    let Some(c) = p.periodic else {
-        return Ok(None);
-    };
-    let summed = box_geometry(p, state.radius)?;
-    let [x, y, z] = c.size();
-    let half = x.min(y).min(z) * T::HALF;
-    if let Some(bond) = bonds.iter().position(|b| !(b.length < half)) {
-        return Err(crate::error::BondError::BadLength { bond }.into());
-    }
-    if p.method == Method::Springs && p.fene.is_some_and(|q| !(q < half)) {
-        return Err(StepError::BadParameter(
-            "fene (maximum extension below half the periodic box's smallest edge)",
-        ));
-    }
-    match (summed, p.pse) {
-        (None, _) => Ok(None),
-        (Some(c), None) => ewald_sums(c, state.radius),
-        (Some(c), Some(tol)) => pse_sums(p, c, state, bonds.len(), tol),
-    }
-}
-
-/// The box's part of [`check_periodic`] that needs no bonds (the mobility alone,
-/// `integrate::geometry`, asks it too), with the box's Ewald sums.
-pub(super) fn check_box<T: Real>(p: &Params<T>, radius: &[T]) -> Result<HeldSums<T>, StepError> {
-    match box_geometry(p, radius)? {
-        Some(c) => ewald_sums(c, radius),
-        None => Ok(None),
-    }
-}
-
-/// The kernel built with its `periodic` feature; no wall (its image system is free
-/// space's); not the Oseen level (the Ewald sum is RPY's); every radius below half the
-/// smallest edge. The box when its images interact (not with free draining, which has
-/// no pair blocks).
-fn box_geometry<T: Real>(p: &Params<T>, radius: &[T]) -> Result<Option<Periodic<T>>, StepError> {
-    let Some(c) = p.periodic else {
-        return Ok(None);
-    };
-    if !cfg!(feature = "periodic") {
-        return Err(StepError::Unsupported(
-            "a periodic box: the kernel was built without its `periodic` feature",
-        ));
-    }
-    if p.wall.is_some() {
-        return Err(StepError::Unsupported("a periodic box with a wall"));
-    }
-    if p.hydro == Hydro::Oseen {
-        return Err(StepError::Unsupported(
-            "a periodic box with Hydro::Oseen (the Ewald sum is RPY's)",
-        ));
-    }
-    let [x, y, z] = c.size();
-    let half = x.min(y).min(z) * T::HALF;
-    if let Some(particle) = radius.iter().position(|&a| !(a < half)) {
-        return Err(StepError::Particle(ParticleError::BadRadius { particle }));
-    }
-    Ok((p.hydro != Hydro::FreeDraining).then_some(c))
-}
-
-/// The step's Ewald parameters.
-#[cfg(feature = "periodic")]
-fn ewald_sums<T: Real>(c: Periodic<T>, radius: &[T]) -> Result<HeldSums<T>, StepError> {
-    let e = super::periodic::ewald(c, radius)?;
-    Ok(Some(super::periodic::Held::Ewald(e)))
-}
-
-/// Without the `periodic` feature the box was refused above.
-#[cfg(not(feature = "periodic"))]
-fn ewald_sums<T: Real>(_: Periodic<T>, _: &[T]) -> Result<HeldSums<T>, StepError> {
-    Ok(None)
-}
-
-/// PSE ([`Params::pse`]): products only, so the step must need nothing else (matrix
-/// free; with constraints the Krylov solver; no Cholesky noise, which `matrix_free`
-/// refuses already); then its parameters from the tolerance.
-fn pse_sums<T: Real>(
-    p: &Params<T>,
-    c: Periodic<T>,
-    state: &State<'_, T>,
-    bonds: usize,
-    tol: f64,
-) -> Result<HeldSums<T>, StepError> {
-    if !cfg!(feature = "pse") {
-        return Err(StepError::Unsupported(
-            "PSE (Params::pse): the kernel was built without its `pse` feature",
-        ));
-    }
-    let constrained = p.method != Method::Springs && p.constraints(state.len(), bonds) > 0;
-    let krylov = p.solver_kind(state.len(), bonds) == crate::constraints::SolverKind::Krylov;
-    if !p.matrix_free || (constrained && !krylov) {
-        return Err(StepError::Unsupported(super::stages::PSE_ASSEMBLED));
-    }
-    if p.rotation {
-        return Err(StepError::Unsupported(
-            "PSE with rotation (its rt and rr products are not built: Ewald sums them)",
-        ));
-    }
-    #[cfg(feature = "pse")]
-    return Ok(Some(super::periodic::Held::Pse(super::periodic::pse(
-        c,
-        state.radius,
-        tol,
-    )?)));
-    #[cfg(not(feature = "pse"))]
-    {
-        let _ = (c, tol);
-        Ok(None)
     }
 }
 
@@ -364,189 +254,4 @@ pub(super) fn check_inputs<T: Real>(
         }
     }
     Ok(())
-}
-
-/// Finite, no nested spheres, no overlap unless allowed (squared distances: no sqrt;
-/// the minimum image in a periodic box), no sphere below the wall. With contacts, spheres touch to within the solver's
-/// tolerance, which is accepted; so do spheres on the wall. The pair check
-/// runs in the mobility's bands through `par` (it was the step's largest serial part,
-/// ~4 % at N = 4096 on one thread) and reports the pair a single pass in order meets
-/// first, on any number of threads: over every pair, or from
-/// [`CELLS_MIN`](crate::cell_list::CELLS_MIN) spheres on over the neighbours a cell list
-/// in `cells` finds ([`crate::cell_list`], cells as wide as the largest contact
-/// distance), which is the same pair.
-pub(super) fn accept<T: Real>(
-    pos: &[T::V3],
-    vel: &[T::V3],
-    omega: &[T::V3],
-    radius: &[T],
-    p: &Params<T>,
-    par: &dyn Parallel,
-    cells: &mut [usize],
-) -> Result<(), StepError> {
-    for i in 0..pos.len() {
-        if !(T::v3_is_finite(pos[i]) && T::v3_is_finite(vel[i]) && T::v3_is_finite(omega[i])) {
-            return Err(StepError::NonFinite { particle: i });
-        }
-    }
-    if let Some(w) = p.wall
-        && let Some(particle) = below_wall(pos, radius, w.height, p.solver.tolerance)
-    {
-        return Err(ParticleError::BelowWall { particle }.into());
-    }
-    let n = pos.len();
-    // Without the `cells` feature (firmware) this is the all-pairs check alone.
-    let list = if cfg!(feature = "cells") && n >= crate::cell_list::CELLS_MIN {
-        let cutoff = crate::cell_list::largest(radius) * T::TWO;
-        CellList::build(pos, super::cell(p).as_ref(), cutoff, cells)
-    } else {
-        None
-    };
-    let first = if let Some((list, _)) = list {
-        let rows = |t: usize| n * t / BANDS..n * (t + 1) / BANDS;
-        match bands(n) {
-            1 => first_near(pos, radius, p, &list, 0..n),
-            _ => map_bands(par, n, |t| first_near(pos, radius, p, &list, rows(t)))
-                .into_iter()
-                .flatten()
-                .flatten()
-                .min(),
-        }
-    } else if bands(n) == 1 {
-        first_clash(pos, radius, p, 0..n)
-    } else {
-        // Each band's first pair in the order `(i, j)`, `i < j`, then the first of those.
-        let found = map_bands(par, n, |t| {
-            first_clash(pos, radius, p, band_start(n, t)..band_start(n, t + 1))
-        });
-        found.into_iter().flatten().flatten().min()
-    };
-    match first {
-        Some((i, j)) => Err(StepError::Overlap { i, j }),
-        None => Ok(()),
-    }
-}
-
-/// The first pair `(i, j)`, `i < j`, in that order, of nested (or, unless allowed,
-/// overlapping) spheres among the pairs whose later sphere `j` is in `rows`.
-fn first_clash<T: Real>(
-    pos: &[T::V3],
-    radius: &[T],
-    p: &Params<T>,
-    rows: core::ops::Range<usize>,
-) -> Option<(usize, usize)> {
-    let allow_overlap = p.allow_overlap;
-    let cell = super::cell(p);
-    let reach = match p.contacts {
-        Some(_) => T::ONE - p.solver.tolerance * T::TWO,
-        None => T::ONE,
-    };
-    let mut first: Option<(usize, usize)> = None;
-    for j in rows {
-        let (pj, aj) = (pos[j], radius[j]);
-        // A later row can only improve on `first` with a smaller `i`.
-        let end = first.map_or(j, |(i, _)| i.min(j));
-        for (i, (&pi, &ai)) in pos[..end].iter().zip(radius).enumerate() {
-            let s2 = T::norm2(image(cell.as_ref(), pi - pj));
-            let (dif, sum) = (ai - aj, (ai + aj) * reach);
-            if s2 <= dif * dif || (!allow_overlap && s2 < sum * sum) {
-                first = Some((i, j));
-                break;
-            }
-        }
-    }
-    first
-}
-
-/// [`first_clash`] over the cell list's neighbours (the same test, kept beside the
-/// all-pairs loop rather than shared so that firmware's code stays as it was): the
-/// first pair `(i, j)`, `i < j`, whose earlier sphere `i` is in `rows` (the smallest
-/// `i` with a clash, then its smallest `j`).
-fn first_near<T: Real>(
-    pos: &[T::V3],
-    radius: &[T],
-    p: &Params<T>,
-    list: &CellList<'_>,
-    rows: core::ops::Range<usize>,
-) -> Option<(usize, usize)> {
-    let (allow_overlap, cell) = (p.allow_overlap, super::cell(p));
-    let reach = match p.contacts {
-        Some(_) => T::ONE - p.solver.tolerance * T::TWO,
-        None => T::ONE,
-    };
-    let clashes = |(pi, ai): (T::V3, T), (pj, aj): (T::V3, T)| {
-        let s2 = T::norm2(image(cell.as_ref(), pi - pj));
-        let (dif, sum) = (ai - aj, (ai + aj) * reach);
-        s2 <= dif * dif || (!allow_overlap && s2 < sum * sum)
-    };
-    for i in rows {
-        let mut first: Option<usize> = None;
-        let (pi, ai) = (pos[i], radius[i]);
-        list.near::<T>(pi, |j| {
-            let later = j > i && first.is_none_or(|f| j < f);
-            if later && clashes((pi, ai), (pos[j], radius[j])) {
-                first = Some(j);
-            }
-        });
-        if let Some(j) = first {
-            return Some((i, j));
-        }
-    }
-    None
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::parallel::Serial;
-    use glam::DVec3;
-
-    /// The banded pair check (600 spheres: 16 bands) reports the pair a single pass in
-    /// the order `(i, j)`, `i < j`, meets first (a brute-force loop here), also when a
-    /// later band holds it and an earlier band holds another; with and without the cell
-    /// list, in free space and in a box.
-    #[test]
-    fn banded_check_reports_the_first_pair_in_order() {
-        const N: usize = 600;
-        assert!(bands(N) > 1);
-        let line: [DVec3; N] = core::array::from_fn(|k| DVec3::new(3.0 * k as f64, 0.0, 0.0));
-        let (radius, zero) = ([1.0; N], [DVec3::ZERO; N]);
-        let p = Params::<f64>::new(0.01);
-        // A box long enough that no image comes near (the line is 1800 long).
-        let boxed = crate::cell::Periodic::new([4000.0, 17.0, 17.0]).unwrap();
-        let first = |pos: &[DVec3]| {
-            (0..N)
-                .flat_map(|i| (i + 1..N).map(move |j| (i, j)))
-                .find(|&(i, j)| (pos[i] - pos[j]).length_squared() < 4.0)
-        };
-        let cases: [&[(usize, usize)]; 5] = [
-            &[],
-            &[(300, 200)],
-            &[(300, 200), (590, 10)],
-            &[(590, 10), (599, 10)],
-            &[(599, 11), (598, 10), (40, 30)],
-        ];
-        for moves in cases {
-            let mut pos = line;
-            for &(m, to) in moves {
-                pos[m] = line[to] + DVec3::new(0.0, 1.5, 0.0);
-            }
-            let want = first(&pos).map_or(Ok(()), |(i, j)| Err(StepError::Overlap { i, j }));
-            // With a cell list (free space, and a box of 8 cells per axis), and
-            // without one (no storage: every pair).
-            let mut cells = [0; 3 * N + 1];
-            for q in [
-                p,
-                Params {
-                    periodic: Some(boxed),
-                    ..p
-                },
-            ] {
-                for store in [&mut cells[..], &mut []] {
-                    let got = accept(&pos, &zero, &zero, &radius, &q, &Serial, store);
-                    assert_eq!(got, want, "{moves:?}");
-                }
-            }
-        }
-    }
 }

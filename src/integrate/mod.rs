@@ -8,7 +8,8 @@
 //! order), `integrate/rattle.rs` (the paper's velocity-Verlet HydroRATTLE),
 //! `integrate/stable.rs` (implicit drag, optional rotation), `integrate/springs.rs`.
 //! This file holds `step`; `checks.rs` the input checks and the acceptance of a
-//! candidate, `stages.rs` the stages the integrators share, `contacts.rs` the hard
+//! candidate, `stages.rs` the stages the integrators share, `tensions.rs` the inertial
+//! step's tensions solved again (reported, never integrated), `contacts.rs` the hard
 //! contacts of the position projection.
 
 #[cfg(feature = "pse")]
@@ -28,6 +29,7 @@ mod rattle;
 mod springs;
 mod stable;
 mod stages;
+mod tensions;
 
 use brownian::overdamped_thermal;
 use overdamped::{overdamped, overdamped2};
@@ -35,6 +37,7 @@ use rattle::rattle_explicit;
 use springs::springs;
 use stable::rattle_stable;
 use stages::*;
+use tensions::{displacement_tensions, project_velocity};
 
 use checks::{accept, check_all};
 use contacts::{Projection, project_overdamped};

@@ -6,7 +6,7 @@
 //!   of a full matrix. The blocks themselves are symmetric on the diagonal.
 //! * Block Cholesky of such a matrix; resistance products `R x = mu^-1 x` go through
 //!   the factor, never an explicit inverse.
-//! * LU with partial pivoting of a small scalar matrix ([`lu`]), and a banded Cholesky
+//! * LU with partial pivoting of a small scalar matrix ([`lu()`]), and a banded Cholesky
 //!   ([`band`]) for the Krylov solver's preconditioner.
 //!
 //! Loops run in a fixed order and use plain multiply-add (no `mul_add`), so results are

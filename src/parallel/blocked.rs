@@ -1,9 +1,9 @@
 //! The banded product walking [`ROWS`] block rows at once, and the fused assembly taking
 //! its square roots in runs of [`RUN`] pairs: the same arithmetic, in the same order for
 //! every entry of the result, as the row-by-row [`band`](super::band) and
-//! [`band_fused`](super::band_fused), so the same bits. The product is used from
-//! [`BANDED_MIN`](super::BANDED_MIN) rows on, where the packed mobility no longer fits in
-//! cache; the runs from [`RUNS_MIN`] beads on.
+//! [`band_fused`](super::assembly::band_fused), so the same bits. The product is used
+//! from [`BANDED_MIN`](super::BANDED_MIN) rows on, where the packed mobility no longer
+//! fits in cache; the runs from [`RUNS_MIN`] beads on.
 //!
 //! Why: out of cache the row-by-row product waits on one stream of blocks at a time
 //! (N = 1024, 38 MB: 6.2 ns per block against 2.9 ns in cache). Walking [`ROWS`] rows
@@ -144,17 +144,18 @@ fn group<T: Real, B: Block<T>, const R: usize, const K: usize>(
 
 /// Beads from which the fused assembly takes its square roots in runs ([`fused_rows`];
 /// 14.0 -> 10.7 ns per block from N = 64 to 256). Below, the row-by-row
-/// [`super::band_fused`]: the firmware's N = 25 keeps its code and instruction count.
+/// [`band_fused`](super::assembly::band_fused): the firmware's N = 25 keeps its code and
+/// instruction count.
 pub(super) const RUNS_MIN: usize = 64;
 
 /// Columns a fused row evaluates together: their square roots and divisions first, then
 /// their blocks (see [`pair_norm2`]).
 const RUN: usize = 8;
 
-/// [`super::band_fused`] with the same blocks and bits, each row taking the square roots
-/// of [`RUN`] pairs before building their blocks. The assembly is bound by those roots'
-/// latency, not by memory, so rows are taken one at a time (walking [`ROWS`] at once did
-/// not pay here: 15.0 -> 16.3 ns per block at N = 1024).
+/// [`band_fused`](super::assembly::band_fused) with the same blocks and bits, each row
+/// taking the square roots of [`RUN`] pairs before building their blocks. The assembly
+/// is bound by those roots' latency, not by memory, so rows are taken one at a time
+/// (walking [`ROWS`] at once did not pay here: 15.0 -> 16.3 ns per block at N = 1024).
 #[inline(always)]
 pub(super) fn fused_rows<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
@@ -394,7 +395,8 @@ mod tests {
                     let (o0, o1) = (&mut o0[..rows], &mut o1[..rows]);
                     let (y0, y1) = (&mut y0[..b1 - b0], &mut y1[..b1 - b0]);
                     let (z0, z1) = (&mut z0[..b0], &mut z1[..b0]);
-                    let r0 = super::super::band_fused::<f64, DMat3>(src, o0, b0, &x, y0, z0);
+                    let r0 =
+                        super::super::assembly::band_fused::<f64, DMat3>(src, o0, b0, &x, y0, z0);
                     let r1 = fused_rows::<f64, DMat3>(src, o1, b0, &x, y1, z1);
                     assert_eq!(r0, r1, "{level:?} rows {b0}..{b1}");
                     assert_eq!(r0.is_err(), nested && b1 > 33, "{level:?} rows {b0}..{b1}");

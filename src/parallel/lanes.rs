@@ -1,7 +1,7 @@
 //! The fused assembly and first product of a small free-space RPY mobility (at most
 //! [`MAX`] beads: the paper's 25-bead chain) with its
 //! pairs side by side, in structure-of-arrays form: the same bits as the row-by-row
-//! [`band_fused`](super::band_fused).
+//! [`band_fused`](super::assembly::band_fused).
 //!
 //! Why: glam's `DVec3`/`DMat3` are scalar code, so a pair at a time leaves all but one
 //! lane of every vector register empty. Here row `i` is evaluated column-wise over all
@@ -65,9 +65,9 @@ struct Work<T: Real> {
     u: Soa<T>,
 }
 
-/// [`band_fused`](super::band_fused) of all `y.len()` rows (`b0 = 0`, at most [`MAX`]
-/// rows, `Hydro::Rpy`) column-wise: the same blocks into `rows`, the same product bits
-/// in `y`, the same first error.
+/// [`band_fused`](super::assembly::band_fused) of all `y.len()` rows (`b0 = 0`, at most
+/// [`MAX`] rows, `Hydro::Rpy`) column-wise: the same blocks into `rows`, the same
+/// product bits in `y`, the same first error.
 #[inline(always)]
 pub(super) fn band_lanes<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
@@ -207,7 +207,7 @@ fn xs_at<T: Real>(s: &Soa<T>, i: usize) -> T::V3 {
 
 /// Row `i` pair by pair ([`pair_tt`]; a pair outside the far branch, or nested: the
 /// first error in column order): what [`row_lanes`] does, as
-/// [`band_fused`](super::band_fused)'s row does it.
+/// [`band_fused`](super::assembly::band_fused)'s row does it.
 #[cold]
 fn row_pairs<T: Real, B: Block<T>>(
     src: Pairs<'_, T>,
@@ -259,7 +259,7 @@ mod tests {
         let (mut o0, mut o1) = ([T::M3_ZERO; tri(MAX)], [T::M3_ZERO; tri(MAX)]);
         let (mut y0, mut y1) = ([T::V3_ZERO; MAX], [T::V3_ZERO; MAX]);
         let (y0, y1) = (&mut y0[..n], &mut y1[..n]);
-        let r0 = super::super::band_fused::<T, T::M3>(src, &mut o0, 0, x, y0, &mut []);
+        let r0 = super::super::assembly::band_fused::<T, T::M3>(src, &mut o0, 0, x, y0, &mut []);
         let r1 = band_lanes::<T, T::M3>(src, &mut o1, x, y1);
         assert_eq!(r0, r1, "n = {n}");
         if r0.is_ok() {

@@ -1,0 +1,140 @@
+//! The periodic box's part of a step's checks: the box against the kernel's features,
+//! the wall, the hydrodynamic level, the radii and the bonds; then the step's sums
+//! (Ewald, or PSE with its own conditions), derived here once and held for every
+//! product, assembly and metric block of the step. Apart from the other input checks
+//! because it is the one check that hands something on, and the mobility alone
+//! (`integrate::geometry`) asks it too ([`check_box`]).
+
+use crate::bonds::Bond;
+use crate::cell::Periodic;
+use crate::error::{ParticleError, StepError};
+#[cfg(feature = "periodic")]
+use crate::integrate::periodic;
+use crate::integrate::stages::{HeldSums, PSE_ASSEMBLED};
+use crate::mobility::Hydro;
+use crate::params::{Method, Params};
+use crate::particles::State;
+use crate::real::Real;
+
+/// Checks the periodic box: every radius, the box itself ([`check_box`]), every bond
+/// (and FENE's maximum extension) shorter than half the smallest edge, so that the
+/// minimum image of a bond at its length is the bond; then the step's sums, Ewald or PSE
+/// ([`Params::pse`]), derived here once and held for every product, assembly and metric
+/// block of the step (`None` without a box, or with free draining).
+pub(super) fn check_periodic<T: Real>(
+    p: &Params<T>,
+    state: &State<'_, T>,
+    bonds: &[Bond<T>],
+) -> Result<HeldSums<T>, StepError> {
+    let Some(c) = p.periodic else {
+        return Ok(None);
+    };
+    let summed = box_geometry(p, state.radius)?;
+    let [x, y, z] = c.size();
+    let half = x.min(y).min(z) * T::HALF;
+    if let Some(bond) = bonds.iter().position(|b| !(b.length < half)) {
+        return Err(crate::error::BondError::BadLength { bond }.into());
+    }
+    if p.method == Method::Springs && p.fene.is_some_and(|q| !(q < half)) {
+        return Err(StepError::BadParameter(
+            "fene (maximum extension below half the periodic box's smallest edge)",
+        ));
+    }
+    match (summed, p.pse) {
+        (None, _) => Ok(None),
+        (Some(c), None) => ewald_sums(c, state.radius),
+        (Some(c), Some(tol)) => pse_sums(p, c, state, bonds.len(), tol),
+    }
+}
+
+/// The box's part of [`check_periodic`] that needs no bonds (the mobility alone,
+/// `integrate::geometry`, asks it too), with the box's Ewald sums.
+pub(in crate::integrate) fn check_box<T: Real>(
+    p: &Params<T>,
+    radius: &[T],
+) -> Result<HeldSums<T>, StepError> {
+    match box_geometry(p, radius)? {
+        Some(c) => ewald_sums(c, radius),
+        None => Ok(None),
+    }
+}
+
+/// The kernel built with its `periodic` feature; no wall (its image system is free
+/// space's); not the Oseen level (the Ewald sum is RPY's); every radius below half the
+/// smallest edge. The box when its images interact (not with free draining, which has
+/// no pair blocks).
+fn box_geometry<T: Real>(p: &Params<T>, radius: &[T]) -> Result<Option<Periodic<T>>, StepError> {
+    let Some(c) = p.periodic else {
+        return Ok(None);
+    };
+    if !cfg!(feature = "periodic") {
+        return Err(StepError::Unsupported(
+            "a periodic box: the kernel was built without its `periodic` feature",
+        ));
+    }
+    if p.wall.is_some() {
+        return Err(StepError::Unsupported("a periodic box with a wall"));
+    }
+    if p.hydro == Hydro::Oseen {
+        return Err(StepError::Unsupported(
+            "a periodic box with Hydro::Oseen (the Ewald sum is RPY's)",
+        ));
+    }
+    let [x, y, z] = c.size();
+    let half = x.min(y).min(z) * T::HALF;
+    if let Some(particle) = radius.iter().position(|&a| !(a < half)) {
+        return Err(StepError::Particle(ParticleError::BadRadius { particle }));
+    }
+    Ok((p.hydro != Hydro::FreeDraining).then_some(c))
+}
+
+/// The step's Ewald parameters.
+#[cfg(feature = "periodic")]
+fn ewald_sums<T: Real>(c: Periodic<T>, radius: &[T]) -> Result<HeldSums<T>, StepError> {
+    let e = periodic::ewald(c, radius)?;
+    Ok(Some(periodic::Held::Ewald(e)))
+}
+
+/// Without the `periodic` feature the box was refused above.
+#[cfg(not(feature = "periodic"))]
+fn ewald_sums<T: Real>(_: Periodic<T>, _: &[T]) -> Result<HeldSums<T>, StepError> {
+    Ok(None)
+}
+
+/// PSE ([`Params::pse`]): products only, so the step must need nothing else (matrix
+/// free; with constraints the Krylov solver; no Cholesky noise, which `matrix_free`
+/// refuses already); then its parameters from the tolerance.
+fn pse_sums<T: Real>(
+    p: &Params<T>,
+    c: Periodic<T>,
+    state: &State<'_, T>,
+    bonds: usize,
+    tol: f64,
+) -> Result<HeldSums<T>, StepError> {
+    if !cfg!(feature = "pse") {
+        return Err(StepError::Unsupported(
+            "PSE (Params::pse): the kernel was built without its `pse` feature",
+        ));
+    }
+    let constrained = p.method != Method::Springs && p.constraints(state.len(), bonds) > 0;
+    let krylov = p.solver_kind(state.len(), bonds) == crate::constraints::SolverKind::Krylov;
+    if !p.matrix_free || (constrained && !krylov) {
+        return Err(StepError::Unsupported(PSE_ASSEMBLED));
+    }
+    if p.rotation {
+        return Err(StepError::Unsupported(
+            "PSE with rotation (its rt and rr products are not built: Ewald sums them)",
+        ));
+    }
+    #[cfg(feature = "pse")]
+    return Ok(Some(periodic::Held::Pse(periodic::pse(
+        c,
+        state.radius,
+        tol,
+    )?)));
+    #[cfg(not(feature = "pse"))]
+    {
+        let _ = (c, tol);
+        Ok(None)
+    }
+}
