@@ -265,7 +265,7 @@ impl Layout {
             0
         };
         Self {
-            blocks: self.blocks - tri(n) + mid_blocks + copy,
+            blocks: self.blocks.saturating_sub(tri(n)) + mid_blocks + copy,
             vectors: self.vectors + lanczos::vectors(cap, n),
             scalars: self.scalars + lanczos::scalars(cap) + mid_scalars,
             ..self
