@@ -21,7 +21,6 @@
 use super::{
     Projection, Start, StepReport, add_constraint_forces, add_flow, bond_vectors, free_product,
     mobility_metric, mobility_product, project_overdamped, report, spin, step_velocity,
-    wall_height,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch};
@@ -52,6 +51,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     // which are written only at the end.
     let Views {
         mut mu,
+        mu2,
         fac,
         force,
         work_a: u,
@@ -76,7 +76,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     // read the reduced copy of `mu`, each band of the assembly writes its part of the
     // copy while its blocks are in cache.
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
-    let copied = reads_copy(p, n, fac.len());
+    let copied = reads_copy(p, n);
     if copied {
         let pairs = (p.hydro, p.viscosity, s.pos, s.radius);
         let copy = (&mut *fac, reduced::copy_start as fn(usize) -> usize);
@@ -104,6 +104,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         par,
         bands,
         copied,
+        at_mid: mu2,
     };
     let (noise_iterations, midpoint) =
         kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held), krylov)?;
@@ -148,33 +149,37 @@ pub(super) struct Held<'a, 'b, T: Real> {
 /// The Lanczos basis and its scalars ([`Views::basis`], [`Views::krylov_t`]; empty with
 /// the Cholesky factor), how the stored mobility's products run ([`Views::par`],
 /// [`Views::bands`]; the start's product is done with them when the noise is drawn),
-/// and whether the factor's storage already holds the reduced copy of `mu`
-/// ([`reads_copy`]).
+/// whether the factor's storage already holds the reduced copy of `mu`
+/// ([`reads_copy`]), and the storage of the midpoint's mobility with Lanczos noise
+/// ([`Views::mu2`]; empty with the Cholesky factor, whose blocks take it).
 pub(super) struct Krylov<'a, T: Real> {
     pub(super) basis: &'a mut [T::V3],
     pub(super) work: &'a mut [T],
     pub(super) par: &'a dyn Parallel,
     pub(super) bands: &'a mut [T::V3],
     pub(super) copied: bool,
+    pub(super) at_mid: MobMut<'a, T>,
 }
 
 /// Whether the noise's products read the reduced copy of the stored mobility
-/// (`noise::reduced`), kept in the factor's storage of `fac` slots: Lanczos, a stored
-/// free-space mobility (symmetric blocks), an `f64` kernel of enough beads. Inlined,
-/// with the precision tested first, so that an `f32` kernel (firmware) links no copy.
+/// (`noise::reduced`), kept in the factor's storage (a step by Lanczos has no factor):
+/// [`reduced::for_noise`], which sizes that storage too. Inlined, with the precision
+/// tested first, so that an `f32` kernel (firmware) links no copy.
 #[inline(always)]
-fn reads_copy<T: Real>(p: &Params<T>, n: usize, fac: usize) -> bool {
-    reduced::usable::<T>(n)
-        && p.lanczos_noise(n)
-        && !p.matrix_free
-        && wall_height(p).is_none()
-        && super::ewald_cell(p).is_none()
-        && fac >= reduced::slots(n)
+fn reads_copy<T: Real>(p: &Params<T>, n: usize) -> bool {
+    let copy = reduced::for_noise(p, n);
+    // The `const` test agrees with the step's own tests of the wall and the Ewald box
+    // (which also heed the kernel's features: a step they refuse never gets here).
+    let symmetric = super::wall_height(p).is_none() && super::ewald_cell(p).is_none();
+    debug_assert!(!copy || symmetric);
+    copy
 }
 
 /// The thermal displacement `dx` of one step from the packed mobility `mu` at the
 /// start (see the module): `fac` takes its Cholesky factor (then, with the midpoint,
-/// the mobility at the midpoint), `xi` the deviates, `mid` the midpoint. With `held`
+/// the mobility at the midpoint in its nine-scalar blocks) or, by Lanczos, the reduced
+/// copy of `mu` ([`reads_copy`]; the midpoint's mobility then goes to
+/// `krylov.at_mid`), `xi` the deviates, `mid` the midpoint. With `held`
 /// the midpoint's noise is projected onto its bonds; without (springs), it is
 /// `sqrt(2 kT dt) mu(x~) L^-T xi`, whose mean is `kT dt div mu` (zero for RPY).
 /// With the Lanczos square root ([`Params::lanczos_noise`]) `L` is the symmetric
@@ -218,7 +223,9 @@ pub(super) fn kick<T: Real>(
         par,
         bands,
         copied,
+        at_mid,
     } = krylov;
+
     // On the PSE path the noise is PSE's own (`pse_noise`): no product with the whole
     // mobility but the midpoint's solve. Without bonds to project onto, the midpoint's
     // mean is `kT dt div M`, zero for the box's RPY mobility (each Fourier mode is
@@ -236,7 +243,7 @@ pub(super) fn kick<T: Real>(
                 0
             }
             Drift::Midpoint => {
-                let mids = (mu, fac, xi, mid, dx);
+                let mids = (mu, storage_at_mid(lanczos, at_mid, fac), xi, mid, dx);
                 midpoint(p, b, s, mids, held, (par, bands), lanczos)?
             }
         };
@@ -248,7 +255,7 @@ pub(super) fn kick<T: Real>(
     // space (symmetric blocks) a large f64 mobility is read from a reduced copy instead
     // (`noise::reduced`) in the factor's storage, written there by the start's assembly
     // (`krylov.copied`) or else by the first product.
-    let reduced = reads_copy(p, n, fac.len());
+    let reduced = reads_copy(p, n);
     let mut copied = reduced && copied;
     let product = |v: &[T::V3], w: &mut [T::V3]| {
         if p.matrix_free {
@@ -286,26 +293,51 @@ pub(super) fn kick<T: Real>(
                 linalg::lower_mul::<T>(fac, n, xi, mid);
                 linalg::solve_upper::<T>(fac, n, xi);
             }
-            let mids = (mu, &mut *fac, xi, mid, dx);
+            let mids = (mu, storage_at_mid(lanczos, at_mid, fac), xi, mid, dx);
             projected = midpoint(p, b, s, mids, held, (par, bands), lanczos)?;
         }
     }
     Ok((iterations, projected))
 }
 
+/// Where the midpoint's mobility is assembled: `at_mid` by Lanczos, the factor's
+/// blocks `fac` by Cholesky.
+///
+/// Why: the Cholesky factor's nine-scalar blocks are free once `L xi` and `L^-T xi`
+/// are drawn, so a step by Cholesky (at most [`LANCZOS_CROSSOVER`] beads by default:
+/// the mobility sits in cache, and bandwidth is no matter) assembles `mu(x~)` there and
+/// needs no more storage. By Lanczos there is no factor: the midpoint has storage of
+/// its own ([`Views::mu2`], sized by [`Layout::noise_sqrt`](crate::Layout::noise_sqrt)),
+/// symmetric six-scalar blocks where the mobility's are (free space, a box), so that
+/// the midpoint's products stream 48 bytes a pair in `f64` instead of 72 (with the
+/// same bits, `linalg::block`), and nine-scalar blocks above a wall. It cannot share
+/// `fac`, which holds the reduced copy of `mu` until the midpoint ([`reads_copy`]):
+/// the kernel views blocks as scalars nowhere (that would need `unsafe`), and the
+/// copy's slots and the symmetric blocks are of different types.
+///
+/// [`LANCZOS_CROSSOVER`]: crate::params::LANCZOS_CROSSOVER
+fn storage_at_mid<'a, T: Real>(
+    lanczos: bool,
+    at_mid: MobMut<'a, T>,
+    fac: &'a mut [T::M3],
+) -> MobMut<'a, T> {
+    if lanczos { at_mid } else { MobMut::Full(fac) }
+}
+
 /// The midpoint's half of [`kick`], from `mid = L xi` and `xi = L^-T xi` (any `L` with
 /// `L L^T = mu` and the same draws: `E[(L xi) (L^-T xi)^T] = I` is what the drift
 /// needs): `mid` becomes `x~ = x + sqrt(kT dt / 2) L xi`, `xi` is scaled by
-/// `sqrt(2 kT dt)`, and `dx = P(x~) mu(x~) xi` (without `held`, unprojected). Returns
-/// the projection's iterations.
+/// `sqrt(2 kT dt)`, and `dx = P(x~) mu(x~) xi` (without `held`, unprojected), with
+/// `mu(x~)` assembled into `at_mid` (empty matrix-free). Returns the projection's
+/// iterations.
 #[allow(clippy::type_complexity)]
 fn midpoint<T: Real>(
     p: &Params<T>,
     b: Brownian<T>,
     s: &Start<'_, T>,
-    (mu, fac, xi, mid, dx): (
+    (mu, mut at_mid, xi, mid, dx): (
         Mob<'_, T>,
-        &mut [T::M3],
+        MobMut<'_, T>,
         &mut [T::V3],
         &mut [T::V3],
         &mut [T::V3],
@@ -323,8 +355,8 @@ fn midpoint<T: Real>(
     for z in xi.iter_mut() {
         *z *= amplitude;
     }
-    // dx = P(x~) mu(x~) xi: the factor's storage takes mu(x~), assembled and applied
-    // (matrix-free: applied only), above the wall if there is one. Free draining's
+    // dx = P(x~) mu(x~) xi: `at_mid` takes mu(x~), assembled and applied (matrix-free:
+    // applied only), above the wall if there is one. Free draining's
     // mobility without a wall does not depend on the positions: mu(x~) is mu, and is
     // not assembled again.
     let mid = &*mid;
@@ -333,9 +365,9 @@ fn midpoint<T: Real>(
         with_blocks!(mu, a => parallel::product::<T>(par, a, n, xi, dx, bands));
         mu
     } else {
-        let at_mid = MobMut::Full(&mut *fac);
-        mobility_product(p, s.ewald, mid, s.radius, at_mid, xi, dx, par, bands)?;
-        Mob::Full(if p.matrix_free { &[] } else { fac })
+        let assembled = at_mid.reborrow();
+        mobility_product(p, s.ewald, mid, s.radius, assembled, xi, dx, par, bands)?;
+        at_mid.into_ref()
     };
     let Some(h) = held else {
         return Ok(0);
@@ -397,3 +429,6 @@ fn midpoint_solver<T: Real>(
 fn refused(e: LanczosError) -> StepError {
     e.into()
 }
+
+#[cfg(test)]
+mod tests;

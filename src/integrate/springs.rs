@@ -28,6 +28,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
     // candidate velocities and spins, written at the end.
     let Views {
         mut mu,
+        mu2,
         fac,
         force,
         work_a: u,
@@ -69,6 +70,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
                 par,
                 bands,
                 copied: false,
+                at_mid: mu2,
             };
             (noise_iterations, _) = kick(
                 p, b, s, mu, fac, new_vel, new_omega, dx, noise, None, krylov,

@@ -26,10 +26,10 @@
 //! block), the blocks past the diagonal as zeros: 24 bytes a block and at most eleven
 //! blocks of padding a row. A band walks its rows one column tile (480 beads) at a
 //! time, the tile's `x` and partial sums in lanes on the stack; its partial sums over
-//! all columns are kept in `f64`. The storage, [`slots`]`(n)`, is the Cholesky
-//! factor's (a third of it), free until the midpoint's mobility is assembled there
-//! after the noise is drawn. `T` must be `f64` ([`usable`]); an `f32` kernel reads the
-//! mobility itself.
+//! all columns are kept in `f64`. The storage, [`slots`]`(n)`, is the factor's slice
+//! of the workspace, which a step by Lanczos noise does not need for a factor
+//! (`for_noise`). `T` must be `f64` ([`usable`]); an `f32` kernel reads the mobility
+//! itself.
 
 use crate::linalg::{Block, tri};
 use crate::parallel::{self, Parallel, band_start};
@@ -53,8 +53,26 @@ const BLOCK_SLOTS: usize = 4;
 /// Whether the reduced copy applies to `n` block rows: an `f64` kernel (two `f32` per
 /// slot entry) and at least [`REDUCED_MIN`] rows.
 #[inline(always)]
-pub fn usable<T: Real>(n: usize) -> bool {
+pub const fn usable<T: Real>(n: usize) -> bool {
     core::mem::size_of::<T>() == 8 && n >= REDUCED_MIN
+}
+
+/// Whether the Lanczos noise of a thermal step of `p` at `n` beads reads the copy
+/// ([`slots`]`(n)` slots of its own, [`Layout`](crate::Layout)): an `f64` kernel of
+/// enough beads ([`usable`], tested first, so that an `f32` kernel links no copy), a
+/// stored mobility with symmetric blocks (no wall, no Ewald sums: free space, or free
+/// draining in a box), and the midpoint drift (the uncorrected draw, a few products,
+/// keeps no storage for it).
+#[inline(always)]
+pub(crate) const fn for_noise<T: Real>(p: &crate::Params<T>, n: usize) -> bool {
+    let ewald = p.periodic.is_some() && !matches!(p.hydro, crate::Hydro::FreeDraining);
+    usable::<T>(n)
+        && matches!(p.method, crate::Method::Overdamped | crate::Method::Springs)
+        && matches!(p.brownian, Some(b) if matches!(b.drift, crate::Drift::Midpoint))
+        && p.lanczos_noise(n)
+        && !p.matrix_free
+        && p.wall.is_none()
+        && !ewald
 }
 
 /// Groups of row `i` (blocks `0 ..= i`).

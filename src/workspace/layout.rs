@@ -234,10 +234,14 @@ impl Layout {
     /// This thermal layout ([`Layout::thermal`]) adjusted for the square root
     /// [`Params::noise_sqrt`] picks at `n` beads: with Lanczos, the basis
     /// (`(cap + 1) n` vectors) and its small matrices (`2 cap^2 + 8 cap + 1` scalars),
-    /// and no Cholesky factor with [`Drift::Uncorrected`](crate::Drift::Uncorrected)
-    /// (the midpoint keeps its storage for the mobility at the midpoint, except with
-    /// [`Params::matrix_free`], whose products at the midpoint store nothing). Unchanged with
-    /// Cholesky and for methods without noise.
+    /// and no Cholesky factor. The midpoint's mobility then has storage of its own:
+    /// `6 tri(n)` scalars of symmetric blocks where the stored mobility has them (free
+    /// space, a box), `tri(n)` blocks above a wall, none with
+    /// [`Drift::Uncorrected`](crate::Drift::Uncorrected) or [`Params::matrix_free`]
+    /// (whose products at the midpoint store nothing); and an `f64` kernel of enough
+    /// beads the reduced copy its noise reads (`noise::reduced`, about `tri(n) / 3`
+    /// blocks). Unchanged with Cholesky (whose factor's blocks take the midpoint's
+    /// mobility) and for methods without noise.
     pub const fn noise_sqrt<T: Real>(self, p: &Params<T>, n: usize) -> Self {
         let thermal = matches!(p.method, Method::Overdamped | Method::Springs);
         if !thermal || !p.lanczos_noise(n) {
@@ -250,10 +254,20 @@ impl Layout {
         };
         // Matrix-free, the midpoint's mobility is not stored either.
         let unstored = uncorrected || p.matrix_free;
+        let (mid_blocks, mid_scalars) = match (unstored, symmetric(p)) {
+            (true, _) => (0, 0),
+            (false, true) => (0, SYM * tri(n)),
+            (false, false) => (tri(n), 0),
+        };
+        let copy = if crate::noise::reduced::for_noise(p, n) {
+            crate::noise::reduced::slots(n)
+        } else {
+            0
+        };
         Self {
-            blocks: self.blocks - if unstored { tri(n) } else { 0 },
+            blocks: self.blocks.saturating_sub(tri(n)) + mid_blocks + copy,
             vectors: self.vectors + lanczos::vectors(cap, n),
-            scalars: self.scalars + lanczos::scalars(cap),
+            scalars: self.scalars + lanczos::scalars(cap) + mid_scalars,
             ..self
         }
     }

@@ -16,7 +16,9 @@ use crate::real::Real;
 pub(crate) struct Views<'a, T: Real> {
     /// The stored mobility (symmetric blocks in free space, [`super::symmetric`]).
     pub mu: MobMut<'a, T>,
-    /// `Overdamped2`'s mobility at the predicted point (as `mu`).
+    /// A second stored mobility (as `mu`): `Overdamped2`'s at the predicted point, or
+    /// the Brownian midpoint's by Lanczos noise (by Cholesky it takes the factor's
+    /// blocks, `integrate::brownian`).
     pub mu2: MobMut<'a, T>,
     pub fac: &'a mut [T::M3],
     pub disp: &'a mut [T::V3],
@@ -142,9 +144,10 @@ impl<T: Real> Workspace<'_, T> {
         // The stored mobilities: symmetric blocks of six scalars in free space, else
         // blocks of nine (`Layout::for_params`).
         let second = matches!(method, Method::Overdamped2);
+        let midpoint = lanczos && stored && !uncorrected;
         let (one, two) = (
             if stored { tri(m) } else { 0 },
-            if second { tri(m) } else { 0 },
+            if second || midpoint { tri(m) } else { 0 },
         );
         // (`as_chunks_mut`, Rust 1.88: the kernel's minimum since this storage.)
         use super::layout::SYM;
@@ -154,10 +157,12 @@ impl<T: Real> Workspace<'_, T> {
         } else {
             (MobMut::Full(bl.take(one)), MobMut::Full(bl.take(two)))
         };
-        let factor = mats == 2 && !second && !(lanczos && (uncorrected || !stored));
+        // The Cholesky factor of the noise (Lanczos needs none).
+        let factor = mats == 2 && !second && !lanczos;
         // The compact copy of the mobility lives where a factor would
-        // (`Params::compact_products`: first-order Overdamped without noise, no factor).
-        let compact = p.compact_copy(n, bonds);
+        // (`Params::compact_products`: first-order Overdamped without noise, no factor;
+        // the Lanczos noise's reduced copy, `noise::reduced::for_noise`).
+        let compact = p.compact_copy(n, bonds) || crate::noise::reduced::for_noise(p, n);
         let fac = bl.take(match (factor, compact) {
             (true, _) => tri(m),
             (false, true) => crate::noise::reduced::slots(n),
