@@ -267,7 +267,9 @@ pub struct Params<T: Real> {
     /// `dt M~ G^T lambda` with `M~` the rounded mobility (the unconstrained move stays
     /// `f64`). Half the bytes per product: the products stop being bound by memory
     /// bandwidth on many cores. Taken where [`Params::compact_copy`] says (first-order
-    /// deterministic [`Method::Overdamped`], an `f64` kernel, a stored mobility with
+    /// [`Method::Overdamped`], deterministic or with the thermal noise whose Lanczos
+    /// products read the same copy already, whose step then reuses that copy for its
+    /// projection: docs/BROWNIAN.md; an `f64` kernel, a stored mobility with
     /// symmetric blocks, in free space or in a periodic box with the Ewald sums, of at
     /// least [`REDUCED_MIN`](crate::noise::reduced::REDUCED_MIN) beads, the Krylov
     /// solver); ignored elsewhere. The same bits on any number of threads, not the
@@ -382,7 +384,9 @@ impl<T: Real> Params<T> {
 
     /// Whether a step of `n` beads and `bonds` bonds keeps the compact `f32` copy of
     /// the mobility for its constraint products ([`Params::compact_products`]): asked
-    /// for, first-order [`Method::Overdamped`] without noise, a stored mobility of
+    /// for, first-order [`Method::Overdamped`] without noise or with the noise that
+    /// reads the reduced copy already (`noise::reduced::for_noise`: the midpoint drift,
+    /// Lanczos noise, no Ewald sums; its copy is reused, not made twice), a stored mobility of
     /// symmetric blocks (free space, or a periodic box summed by Ewald; not above a
     /// wall, whose blocks are not symmetric, nor with [`Params::pse`] in a box, which
     /// stores nothing), an `f64` kernel, at least
@@ -390,7 +394,7 @@ impl<T: Real> Params<T> {
     pub const fn compact_copy(&self, n: usize, bonds: usize) -> bool {
         self.compact_products
             && matches!(self.method, Method::Overdamped)
-            && self.brownian.is_none()
+            && (self.brownian.is_none() || crate::noise::reduced::for_noise(self, n))
             && !self.matrix_free
             && self.wall.is_none()
             && !(self.periodic.is_some() && self.pse.is_some())

@@ -6,7 +6,9 @@
 //! parameters); `compact`: with [`Params::compact_products`] (the constraint products
 //! from the `f32` copy); `free`: [`Params::matrix_free`] (every product recomputes its
 //! pairs: compute-bound, the path that scales with cores); `brownian`: the thermal step (kT = 1, midpoint drift, Lanczos
-//! noise from the reduced copy; the same noise seed on every run), the Brownian twin.
+//! noise from the reduced copy; the same noise seed on every run), the Brownian twin;
+//! `brownian-compact`: that with [`Params::compact_products`] (its constraint products
+//! from the noise's copy too).
 //! Each thread count runs the same steps from the same start three times; the best time
 //! is kept (the machine may be shared). The constraint products (and Lanczos
 //! iterations) of the last step are printed: counts beside the times.

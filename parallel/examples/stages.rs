@@ -5,7 +5,7 @@
 //!
 //! `cargo run --release -p hydrorattle-parallel --example stages -- [N] [STEPS] [THREADS] [MODE]`
 //! (defaults 4096, 3, 1, `plain`; MODE as in `examples/speedup.rs`: `plain`, `compact`,
-//! `free`, `brownian`).
+//! `free`, `brownian`, `brownian-compact`).
 //!
 //! Every round is timed by the wall clock and by the CPU time the process's threads ran
 //! (`/proc/self/task/*/schedstat`; a thread waiting for a core on a shared machine adds

@@ -3,7 +3,8 @@
 //! (`Params::compact_products`: `f32` products, `f64` residuals) meets the solver's tolerance, measured here from the
 //! positions, and gives the same bits on any thread count: in free space and in a
 //! periodic box with the stored Ewald mobility, where its trajectory also stays within
-//! a stated bound of the `f64` products' (pinned digest). Above a wall and with PSE the
+//! a stated bound of the `f64` products' (pinned digest); in thermal steps, from the
+//! Lanczos noise's reduced copy. Above a wall and with PSE the
 //! flag is ignored (`Params::compact_copy`): the `f64` products' bits and storage.
 //!
 //! The box's runs assemble the Ewald mobility of 700 spheres at every step (about
@@ -13,7 +14,8 @@ use hydrorattle::glam::DVec3;
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{self, Parallel, Serial, band_scratch, bands};
 use hydrorattle::{
-    Bond, Hydro, Layout, NoForce, Params, Periodic, Real, State, StepReport, Wall, step_slices,
+    Bond, Brownian, Drift, Hydro, Layout, NoForce, Noise, Params, Periodic, Real, State,
+    StepReport, Wall, step_slices,
 };
 use hydrorattle_heap::Buffers;
 use hydrorattle_parallel::Threads;
@@ -127,6 +129,8 @@ fn chain_steps(
     let mut ws = store.workspace().with_parallel(par);
     let mut pos = start.to_vec();
     let (mut vel, mut omega, mut time) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n], 0.0);
+    // Thermal runs draw from the same seed.
+    let mut noise = Noise::new(11);
     let mut last = None;
     for _ in 0..steps {
         let state = State {
@@ -136,7 +140,7 @@ fn chain_steps(
             radius: &radius,
             density: &density,
             time: &mut time,
-            noise: None,
+            noise: p.brownian.map(|_| &mut noise),
         };
         last = Some(step_slices(state, &bonds, p, &mut ws, &mut NoForce).unwrap());
     }
@@ -174,6 +178,61 @@ fn mixed_precision_constraints_meet_the_tolerance_with_the_same_bits_on_any_thre
         let (threaded, _) = settle(n, 3, (true, false), &pool);
         assert_eq!(bits(&threaded), bits(&serial), "{t} threads");
     }
+}
+
+/// Thermal steps (kT = 1, midpoint drift, Lanczos noise from the reduced copy of the
+/// mobility, `noise::reduced::for_noise`): with `compact_products` the projection's
+/// Krylov products read that same copy. No second copy (the layout is the one without
+/// the flag); the bonds meet the tolerance (`chain_steps`); the same bits on 1 and 2
+/// threads; the trajectory near the `f64` products' from the same seed. The uncorrected
+/// drift keeps no copy: the flag changes no bit there.
+#[test]
+fn thermal_steps_reuse_the_noises_copy_for_their_constraint_products() {
+    let (n, steps) = (N, 3);
+    let thermal = |compact: bool, drift: Drift| {
+        let mut p = Params::<f64>::new(0.05);
+        let mut b = Brownian::new(1.0);
+        b.drift = drift;
+        p.brownian = Some(b);
+        p.compact_products = compact;
+        p
+    };
+    let (exact, compact) = (
+        thermal(false, Drift::Midpoint),
+        thermal(true, Drift::Midpoint),
+    );
+    assert!(compact.compact_copy(n, n - 1) && !exact.compact_copy(n, n - 1));
+    assert_eq!(
+        Layout::for_params(&compact, n, n - 1),
+        Layout::for_params(&exact, n, n - 1),
+        "the noise's copy is reused, not made twice"
+    );
+    let two = Threads::new(2).unwrap();
+    let (reference, exact_report) = chain_steps(&exact, &helix(n), steps, &two);
+    let (serial, report) = chain_steps(&compact, &helix(n), steps, &Serial);
+    let (threaded, _) = chain_steps(&compact, &helix(n), steps, &two);
+    assert_eq!(bits(&threaded), bits(&serial), "1 and 2 threads");
+    // Pinned on this branch (`bcompact`); regenerate only for a deliberate change of
+    // the arithmetic.
+    assert_eq!(
+        digest(&serial),
+        0x6c18_a207_f97b_c634,
+        "golden digest of the compact thermal steps"
+    );
+    // The noise is the same draw in both runs (both read the copy for it); they differ
+    // by the rounded mobility's share of the constraint moves, each product right to
+    // ~3e-7 relative, bounded as in the box: `steps x 1e-6 x moved`.
+    let runs = (&reference[..], &serial[..], exact_report, report);
+    near_f64("thermal", &helix(n), steps, runs);
+    // The uncorrected drift: no copy, the f64 products' bits.
+    let (on, off) = (
+        thermal(true, Drift::Uncorrected),
+        thermal(false, Drift::Uncorrected),
+    );
+    assert!(!on.compact_copy(n, n - 1));
+    let (with, _) = chain_steps(&on, &helix(n), 1, &two);
+    let (without, _) = chain_steps(&off, &helix(n), 1, &two);
+    assert_eq!(bits(&with), bits(&without));
 }
 
 #[test]
@@ -219,6 +278,16 @@ fn boxed(compact: bool) -> Params<f64> {
     p
 }
 
+/// FNV-1a over the coordinates' bits: a golden digest of a configuration.
+fn digest(v: &[DVec3]) -> u64 {
+    bits(v)
+        .iter()
+        .flatten()
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, &c| {
+            (h ^ c).wrapping_mul(0x100_0000_01b3)
+        })
+}
+
 /// Largest coordinate difference of two configurations.
 fn largest_gap(a: &[DVec3], b: &[DVec3]) -> f64 {
     a.iter()
@@ -240,14 +309,9 @@ fn compact_products_in_a_box_meet_the_tolerance_near_the_f64_trajectory_with_the
     assert_eq!(bits(&threaded), bits(&serial), "1 and 2 threads");
     // Pinned on this branch (`boxcompact`); regenerate only for a deliberate change of
     // the arithmetic.
-    let digest = bits(&serial)
-        .iter()
-        .flatten()
-        .fold(0xcbf2_9ce4_8422_2325u64, |h, &c| {
-            (h ^ c).wrapping_mul(0x100_0000_01b3)
-        });
     assert_eq!(
-        digest, 0xd5a7_0ab3_ec8f_03a3,
+        digest(&serial),
+        0xd5a7_0ab3_ec8f_03a3,
         "golden digest of the compact steps in the box"
     );
     // The two trajectories differ by the rounded mobility's share of the constraint
@@ -255,20 +319,35 @@ fn compact_products_in_a_box_meet_the_tolerance_near_the_f64_trajectory_with_the
     // constraint moves are at most the beads' moves, `moved`, so after `steps` steps
     // the gap is bounded by `steps x 1e-6 x moved` (a factor of three over the product
     // error for the solve's amplification).
-    let start = snake(N);
-    let moved = largest_gap(&reference, &start);
-    let apart = largest_gap(&serial, &reference);
+    let runs = (&reference[..], &serial[..], exact_report, report);
+    near_f64("box", &snake(N), steps, runs);
+}
+
+/// The compact run `compact` of `steps` steps from `start` within
+/// `steps x 1e-6 x moved` of the `f64` products' run `exact` (`moved`: the largest
+/// move of a coordinate in `exact`, at least 1e-3), and not equal to it (the compact
+/// path was taken); prints both runs' constraint products of the last step.
+fn near_f64(
+    what: &str,
+    start: &[DVec3],
+    steps: usize,
+    (exact, compact, exact_report, report): (&[DVec3], &[DVec3], StepReport<f64>, StepReport<f64>),
+) {
+    let moved = largest_gap(exact, start);
+    let apart = largest_gap(compact, exact);
     eprintln!(
-        "box, N = {N}, {steps} steps: moved {moved:.3e}, compact vs f64 {apart:.2e}; \
+        "{what}, N = {}, {steps} steps: moved {moved:.3e}, compact vs f64 {apart:.2e}; \
          constraint products last step {} (f64) and {} (f32)",
-        exact_report.iterations, report.iterations
+        start.len(),
+        exact_report.iterations,
+        report.iterations
     );
-    assert!(moved > 1e-3, "the beads must have moved: {moved:e}");
+    assert!(moved > 1e-3, "{what}: the beads must have moved: {moved:e}");
     assert!(
         apart <= steps as f64 * 1e-6 * moved,
-        "compact vs f64 trajectory {apart:e} (moved {moved:e})"
+        "{what}: compact vs f64 trajectory {apart:e} (moved {moved:e})"
     );
-    assert!(apart > 0.0, "the compact path must have been taken");
+    assert!(apart > 0.0, "{what}: the compact path must have been taken");
 }
 
 #[test]

@@ -109,7 +109,11 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     let (noise_iterations, midpoint) =
         kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held), krylov)?;
     // r* = r + dt (U_inf + mu F) + noise, projected as in the deterministic step (with
-    // the wall's links when there is one).
+    // the wall's links when there is one). With `Params::compact_products` the
+    // projection's Krylov products read the reduced copy of `mu` the noise has read
+    // (still in `fac`: the midpoint's mobility went to `mu2`), not a second copy.
+    let compact = p.compact_copy(n, bonds.len());
+    debug_assert!(!compact || copied);
     let free = |x: &mut [T::V3]| {
         for i in 0..n {
             x[i] = s.pos[i] + u[i] * dt + dx[i];
@@ -122,7 +126,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         lambda: &mut *lambda,
         scratch: &mut scratch,
         ewald: s.ewald,
-        compact: &[],
+        compact: if compact { &*fac } else { &[] },
     };
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, xi);

@@ -168,8 +168,9 @@ impl Layout {
         } else {
             l
         };
-        let l = if p.compact_copy(n, bonds) {
-            // The compact copy of the mobility (`Params::compact_products`).
+        let l = if p.compact_copy(n, bonds) && !crate::noise::reduced::for_noise(p, n) {
+            // The compact copy of the mobility (`Params::compact_products`), unless the
+            // thermal noise's reduced copy is there already (`noise_sqrt`): it is reused.
             Self {
                 blocks: l.blocks + crate::noise::reduced::slots(n),
                 ..l

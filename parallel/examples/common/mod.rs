@@ -32,7 +32,8 @@ pub fn chain(start: &[DVec3]) -> Vec<Bond<f64>> {
 
 /// The parameters of a step MODE (`dt` 0.01): `plain` (the defaults), `compact`
 /// ([`Params::compact_products`]), `free` ([`Params::matrix_free`]) or `brownian`
-/// (kT = 1: midpoint drift, Lanczos noise); exits with a message on another.
+/// (kT = 1: midpoint drift, Lanczos noise), `brownian-compact` (that with
+/// `compact_products`); exits with a message on another.
 pub fn params(mode: &str) -> Params<f64> {
     let mut p = Params::<f64>::new(0.01);
     match mode {
@@ -40,8 +41,12 @@ pub fn params(mode: &str) -> Params<f64> {
         "compact" => p.compact_products = true,
         "free" => p.matrix_free = true,
         "brownian" => p.brownian = Some(Brownian::new(1.0)),
+        "brownian-compact" => {
+            p.brownian = Some(Brownian::new(1.0));
+            p.compact_products = true;
+        }
         other => {
-            eprintln!("unknown mode {other:?}: plain, compact, free or brownian");
+            eprintln!("unknown mode {other:?}: plain, compact, free, brownian or brownian-compact");
             std::process::exit(2);
         }
     }

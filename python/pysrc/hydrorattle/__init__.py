@@ -347,8 +347,9 @@ class System:
     ("rpy"), ``rotation`` (False), ``matrix_free`` (False), ``compact_products`` (False: the
     Krylov constraint products read an f32 copy of the mobility, a third of the bytes,
     with the residual kept in f64 so the bonds still meet ``tolerance``; taken only by
-    f64 "overdamped" without noise, wall or box, from 700 beads, and ignored
-    elsewhere), ``solver`` ("auto",
+    f64 "overdamped" from 700 beads without a wall (nor PSE in a box), deterministic or
+    thermal with the midpoint drift and Lanczos noise (no Ewald box), whose reduced copy
+    it reuses, and ignored elsewhere), ``solver`` ("auto",
     "sweep", "newton", "krylov"), ``tolerance`` (1e-10 in f64, 1e-5 in f32),
     ``max_iterations`` (100), ``allow_overlap`` (False), ``spring_stiffness`` (1e3), ``fene`` (None:
     Hookean springs; ``Q0``: FENE springs of maximum extension ``Q0``),
