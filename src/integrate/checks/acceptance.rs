@@ -153,14 +153,14 @@ mod tests {
     /// later band holds it and an earlier band holds another; with and without the cell
     /// list, in free space and in a box.
     #[test]
-    fn banded_check_reports_the_first_pair_in_order() {
+    fn banded_check_reports_the_first_pair_in_order() -> Result<(), crate::cell::PeriodicError> {
         const N: usize = 600;
         assert!(bands(N) > 1);
         let line: [DVec3; N] = core::array::from_fn(|k| DVec3::new(3.0 * k as f64, 0.0, 0.0));
         let (radius, zero) = ([1.0; N], [DVec3::ZERO; N]);
         let p = Params::<f64>::new(0.01);
         // A box long enough that no image comes near (the line is 1800 long).
-        let boxed = crate::cell::Periodic::new([4000.0, 17.0, 17.0]).unwrap();
+        let boxed = crate::cell::Periodic::new([4000.0, 17.0, 17.0])?;
         let first = |pos: &[DVec3]| {
             (0..N)
                 .flat_map(|i| (i + 1..N).map(move |j| (i, j)))
@@ -195,5 +195,6 @@ mod tests {
                 }
             }
         }
+        Ok(())
     }
 }
