@@ -303,11 +303,35 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
 
 /// [`max_residual`] in a periodic box: each bond's length is that of its minimum image
 /// ([`Bond::separation`]).
+///
+/// For a type of several lanes ([`Real::LANES`]) the search runs once per lane, on
+/// that lane's values ([`Real::broadcast`]): each lane finds its own extreme bonds,
+/// and no comparison differs between lanes. The index is lane 0's.
 pub fn max_residual_in<T: Real>(
     bonds: &[Bond<T>],
     pos: &[T::V3],
     cell: Option<&Periodic<T>>,
 ) -> (usize, T) {
+    if T::LANES == 1 {
+        return extremes(bonds, pos, cell, 0);
+    }
+    let mut out = (0, T::ZERO);
+    for lane in 0..T::LANES {
+        let (k, r) = extremes(bonds, pos, cell, lane);
+        out = (if lane == 0 { k } else { out.0 }, out.1.with_lane(lane, r));
+    }
+    out
+}
+
+/// [`max_residual_in`] on lane `lane`'s values (every value for one lane).
+#[inline(always)]
+fn extremes<T: Real>(
+    bonds: &[Bond<T>],
+    pos: &[T::V3],
+    cell: Option<&Periodic<T>>,
+    lane: usize,
+) -> (usize, T) {
+    let separation = |b: &Bond<T>| T::v3_broadcast(b.separation(pos, cell), lane);
     let (mut hi, mut lo) = ((0, T::ZERO), (0, T::ZERO));
     let mut first = true;
     for (k, b) in bonds.iter().enumerate() {
@@ -319,14 +343,15 @@ pub fn max_residual_in<T: Real>(
         if b.i >= pos.len() || b.j >= pos.len() {
             return max_residual_each(bonds, pos, cell);
         }
-        if b.length == T::ZERO {
+        let length = b.length.broadcast(lane);
+        if length == T::ZERO {
             continue;
         }
-        let r = b.separation(pos, cell);
-        let mut ratio = T::norm2(r) / (b.length * b.length);
+        let r = separation(b);
+        let mut ratio = T::norm2(r) / (length * length);
         // A wall link's centre at or below the plane has the error of a bond stretched
         // to `(2 - z/a) d`: the ratio that orders it with the others.
-        let h = T::xyz(r)[2] / b.length;
+        let h = T::xyz(r)[2] / length;
         if b.is_wall() && !(h > T::ZERO) {
             ratio = (T::TWO - h) * (T::TWO - h);
         }
@@ -343,7 +368,11 @@ pub fn max_residual_in<T: Real>(
     }
     let at = |k: usize| {
         let b = &bonds[k];
-        (k, link_error(b, b.separation(pos, cell)))
+        let b = Bond {
+            length: b.length.broadcast(lane),
+            ..*b
+        };
+        (k, link_error(&b, separation(&b)))
     };
     if first {
         return (0, T::ZERO);
