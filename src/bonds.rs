@@ -341,7 +341,7 @@ fn extremes<T: Real>(
             continue;
         }
         if b.i >= pos.len() || b.j >= pos.len() {
-            return max_residual_each(bonds, pos, cell);
+            return max_residual_each(bonds, pos, cell, lane);
         }
         let length = b.length.broadcast(lane);
         if length == T::ZERO {
@@ -356,7 +356,7 @@ fn extremes<T: Real>(
             ratio = (T::TWO - h) * (T::TWO - h);
         }
         if ratio.is_nan() {
-            return max_residual_each(bonds, pos, cell);
+            return max_residual_each(bonds, pos, cell, lane);
         }
         if first || ratio > hi.1 {
             hi = (k, ratio);
@@ -385,17 +385,23 @@ fn extremes<T: Real>(
     }
 }
 
-/// [`max_residual`] bond by bond, for the rare lists with a NaN or a bond out of range.
+/// [`max_residual`] bond by bond, for the rare lists with a NaN or a bond out of range
+/// (on lane `lane`'s values, as [`extremes`]).
 fn max_residual_each<T: Real>(
     bonds: &[Bond<T>],
     pos: &[T::V3],
     cell: Option<&Periodic<T>>,
+    lane: usize,
 ) -> (usize, T) {
     let mut worst = (0, T::ZERO);
     for (k, b) in bonds.iter().enumerate() {
+        let b = &Bond {
+            length: b.length.broadcast(lane),
+            ..*b
+        };
         let r = match b.i < pos.len() && (b.j < pos.len() || b.is_pin()) {
             true if b.length == T::ZERO || b.is_pin() => continue,
-            true => link_error(b, b.separation(pos, cell)),
+            true => link_error(b, T::v3_broadcast(b.separation(pos, cell), lane)),
             false => T::ONE / T::ZERO,
         };
         if !worst.1.is_nan() && (r.is_nan() || r > worst.1) {

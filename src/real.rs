@@ -226,6 +226,25 @@ pub trait Real:
         let [x, y, z] = Self::xyz(v);
         Self::v3(x.broadcast(k), y.broadcast(k), z.broadcast(k))
     }
+    /// `if a > b { then() } else { otherwise() }`, lane by lane: a lane type whose
+    /// lanes disagree evaluates both and takes each lane's values from its own side;
+    /// `f32` and `f64` branch. For choices of values whose two sides take no decision.
+    #[inline(always)]
+    fn if_gt<const M: usize>(
+        a: Self,
+        b: Self,
+        then: impl FnOnce() -> [Self; M],
+        otherwise: impl FnOnce() -> [Self; M],
+    ) -> [Self; M] {
+        if a > b { then() } else { otherwise() }
+    }
+    /// `a > b` on every lane (`a > b` for one lane), for a choice between two paths
+    /// that give the same bits (the vector loop or pair by pair): no lane's own
+    /// decision, so no divergence.
+    #[inline(always)]
+    fn all_gt(a: Self, b: Self) -> bool {
+        a > b
+    }
     /// `self` with lane `k` taken from `from` (`from` for one lane).
     #[inline(always)]
     fn with_lane(self, k: usize, from: Self) -> Self {

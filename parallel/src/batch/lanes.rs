@@ -5,8 +5,8 @@
 //! `sqrtpd`), so lane `k` of a result has the bits the scalar operation gives on lane
 //! `k`'s operands. What cannot be lane-wise (a comparison that steers a branch, a
 //! single `f64` taken out) is decided per lane; where the lanes disagree the answer is
-//! lane 0's and the thread's divergence flag ([`diverged`]) is raised, so that the
-//! caller knows the other lanes did not follow their own path and throws them away.
+//! lane 0's and the lanes that answered otherwise are marked in the thread's
+//! divergence mask ([`diverged`]), so that the caller throws those lanes' values away.
 
 use core::cell::Cell;
 use core::cmp::Ordering;
@@ -14,34 +14,43 @@ use core::fmt;
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
 thread_local! {
-    /// Raised when the lanes of a decision disagreed on this thread.
-    static DIVERGED: Cell<bool> = const { Cell::new(false) };
+    /// The lanes (bit `k` for lane `k`) whose answer to a decision differed from lane
+    /// 0's on this thread.
+    static DIVERGED: Cell<u64> = const { Cell::new(0) };
 }
 
-/// Clears this thread's divergence flag (before a lane step).
+/// Most lanes a [`Lanes`] may have: one bit each in the divergence mask.
+pub const MAX_LANES: usize = 64;
+
+/// Clears this thread's divergence mask (before a lane step).
 pub fn clear_divergence() {
-    DIVERGED.with(|d| d.set(false));
+    DIVERGED.with(|d| d.set(0));
 }
 
-/// Whether a decision's lanes disagreed on this thread since [`clear_divergence`].
-pub fn diverged() -> bool {
+/// The lanes whose answer to some decision differed from lane 0's on this thread
+/// since [`clear_divergence`] (bit `k` for lane `k`; 0 when every lane followed its own
+/// path). A lane whose bit is clear took, at every decision, the side it would have
+/// taken alone, so its values are its own step's.
+pub fn diverged() -> u64 {
     DIVERGED.with(|d| d.get())
 }
 
-/// Lane 0's answer; raises the flag unless every lane gave it.
+/// Lane 0's answer; marks every lane that gave another.
 #[inline(always)]
 pub(super) fn agree<X: PartialEq + Copy, const K: usize>(x: [X; K]) -> X {
+    const { assert!(K <= MAX_LANES, "at most 64 lanes") };
     let first = x[0];
-    if x.iter().any(|&y| y != first) {
-        if std::env::var_os("BATCH_TRACE").is_some() && !diverged() {
-            eprintln!("{}", std::backtrace::Backtrace::force_capture());
-        }
-        DIVERGED.with(|d| d.set(true));
+    let mut mask = 0u64;
+    for (k, y) in x.iter().enumerate() {
+        mask |= u64::from(*y != first) << k;
+    }
+    if mask != 0 {
+        DIVERGED.with(|d| d.set(d.get() | mask));
     }
     first
 }
 
-/// `K` `f64` values, lane `k` belonging to system `k`.
+/// `K` `f64` values, lane `k` belonging to system `k` (`K` at most [`MAX_LANES`]).
 #[derive(Clone, Copy)]
 #[repr(transparent)]
 pub struct Lanes<const K: usize>(pub [f64; K]);

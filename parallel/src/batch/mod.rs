@@ -15,10 +15,19 @@
 //! ([`LV3`], [`LM3`]). So as long as every decision the step takes (a comparison, a
 //! finiteness check, a value taken out as one `f64`) comes out the same on all lanes,
 //! lane `k` computes exactly what system `k`'s own `f64` step computes. Where the
-//! lanes disagree, the decision follows lane 0 and the thread's divergence flag is
-//! raised ([`diverged`]); [`Batch::step`] then throws the lane step away and steps
-//! each system by itself in `f64`. A lane step that fails is redone the same way, so
-//! that each system gets its own result or its own error, with its state as it was.
+//! lanes disagree, the decision follows lane 0 and the lanes that answered otherwise
+//! are marked ([`diverged`]); [`Batch::step`] keeps the unmarked lanes (at every
+//! decision they took their own side, so their values are their own steps') and steps
+//! each marked system by itself in `f64`. A lane step that fails is redone system by
+//! system, so that each system gets its own result or its own error, with its state
+//! as it was.
+//!
+//! Two choices that differ between lanes without changing any lane's bits are made
+//! per lane instead of raising a divergence (kernel hooks of [`Real`]): the RPY
+//! block's far or overlapping branch (both evaluated, each lane taking its own), and
+//! the search for the bond of largest error (run once per lane). What still diverges
+//! is what changes a lane's path: mostly one system converging in fewer Newton
+//! iterations than another (docs/BENCHMARKS.md, "Several systems in the lanes").
 //!
 //! ```
 //! use hydrorattle::{Bond, Layout, Method, NoForce, Params, Particle, ParticleSet};
@@ -63,7 +72,7 @@ use core::fmt;
 use hydrorattle::forces::NoForce;
 use hydrorattle::{Bond, Params, Real, State, StepError, StepReport, Workspace};
 
-pub use lanes::{Lanes, clear_divergence, diverged};
+pub use lanes::{Lanes, MAX_LANES, clear_divergence, diverged};
 pub use vec::{LM3, LV3};
 
 /// `f64` vectors, as the kernel's `f64` steps use them.
@@ -141,23 +150,23 @@ impl<const K: usize> Forces<K> for NoForce {
 /// What a batch did so far.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Counts {
-    /// Lane steps kept (each advanced all `K` systems).
+    /// Steps of the batch (each one step in the lanes).
     pub lane_steps: u64,
-    /// Lane steps thrown away because a decision's lanes disagreed.
+    /// Lane steps in which some lane's decision differed from lane 0's.
     pub diverged: u64,
-    /// Lane steps thrown away because the step failed (some system's error).
+    /// Lane steps that failed (every system then stepped alone).
     pub failed: u64,
-    /// Systems stepped alone in `f64` after a thrown-away lane step (`K` each).
+    /// Systems stepped alone in `f64` after a lane step (the marked lanes of a
+    /// diverged step, all `K` of a failed one).
     pub fallback_steps: u64,
 }
 
 impl Counts {
-    /// The share of system steps that ran alone: `fallback_steps / (K * batch steps)`.
+    /// The share of system steps that ran alone: `fallback_steps / (K lane_steps)`.
     pub fn fallback_rate(&self, k: usize) -> f64 {
-        let all = (self.lane_steps + self.diverged + self.failed) * k as u64;
-        match all {
+        match self.lane_steps * k as u64 {
             0 => 0.0,
-            _ => self.fallback_steps as f64 / all as f64,
+            all => self.fallback_steps as f64 / all as f64,
         }
     }
 }
@@ -205,8 +214,8 @@ impl<const K: usize> Batch<K> {
         bonds: [&[Bond<f64>]; K],
         params: [&Params<f64>; K],
     ) -> Result<Self, BatchError> {
-        if K == 0 {
-            return Err(BatchError::Unsupported("no lanes"));
+        if K == 0 || K > MAX_LANES {
+            return Err(BatchError::Unsupported("no lanes, or more than 64"));
         }
         let topology = |b: &[Bond<f64>]| b.iter().map(|b| (b.i, b.j)).collect::<Vec<_>>();
         if let Some(system) = (1..K).find(|&k| topology(bonds[k]) != topology(bonds[0])) {
@@ -264,8 +273,9 @@ impl<const K: usize> Batch<K> {
         &self.params
     }
 
-    /// One step of every system: once in the lanes, and where that step's decisions
-    /// diverged or it failed, again system by system in `f64` (with `one`). System
+    /// One step of every system: once in the lanes, and for each system whose lane
+    /// diverged (or all, where the lane step failed) again by itself in `f64` (with
+    /// `one`). System
     /// `k`'s result is what [`hydrorattle::step_slices`] returns for it alone, its
     /// state advanced by exactly that step or, on error, untouched.
     ///
@@ -278,7 +288,7 @@ impl<const K: usize> Batch<K> {
     /// (nothing is stepped).
     pub fn step<E: Forces<K>>(
         &mut self,
-        mut systems: [State<'_, f64>; K],
+        systems: [State<'_, f64>; K],
         lanes: &mut Workspace<'_, Lanes<K>>,
         one: &mut Workspace<'_, f64>,
         ext: &mut E,
@@ -307,22 +317,30 @@ impl<const K: usize> Batch<K> {
         clear_divergence();
         let mut add = |p: &[LV3<K>], r: &[Lanes<K>], f: &mut [LV3<K>]| ext.lanes(p, r, f);
         let result = hydrorattle::step_slices(state, &self.bonds, &self.params, lanes, &mut add);
-        match result {
-            Ok(report) if !diverged() => {
-                self.counts.lane_steps += 1;
-                self.unpack(&mut systems, time);
-                return Ok(core::array::from_fn(|k| Ok(lane_report(&report, k))));
-            }
-            Ok(_) => self.counts.diverged += 1,
-            Err(_) => self.counts.failed += 1,
-        }
-        self.counts.fallback_steps += K as u64;
+        self.counts.lane_steps += 1;
+        // The lanes to redo alone: those marked, or all when the step failed.
+        let (redo, report) = match result {
+            Ok(report) => (diverged(), Some(report)),
+            Err(_) => (u64::MAX, None),
+        };
+        self.counts.diverged += u64::from(redo != 0 && report.is_some());
+        self.counts.failed += u64::from(report.is_none());
         let mut k = 0;
-        Ok(systems.map(|s| {
-            let mut add = |p: &[V3], r: &[f64], f: &mut [V3]| ext.system(k, p, r, f);
-            let r = hydrorattle::step_slices(s, &self.one_bonds[k], &self.one_params[k], one, &mut add);
+        Ok(systems.map(|mut s| {
+            let lane = k;
             k += 1;
-            r
+            match report {
+                Some(r) if redo >> lane & 1 == 0 => {
+                    self.unpack(lane, &mut s, time);
+                    Ok(lane_report(&r, lane))
+                }
+                _ => {
+                    self.counts.fallback_steps += 1;
+                    let mut add = |p: &[V3], r: &[f64], f: &mut [V3]| ext.system(lane, p, r, f);
+                    let (b, p) = (&self.one_bonds[lane], &self.one_params[lane]);
+                    hydrorattle::step_slices(s, b, p, one, &mut add)
+                }
+            }
         }))
     }
 
@@ -339,16 +357,14 @@ impl<const K: usize> Batch<K> {
         }
     }
 
-    /// The lanes back into the systems' states.
-    fn unpack(&self, systems: &mut [State<'_, f64>; K], time: Lanes<K>) {
-        for (k, s) in systems.iter_mut().enumerate() {
-            for i in 0..self.n {
-                s.pos[i] = V3::from_array(self.pos[i].lane(k));
-                s.vel[i] = V3::from_array(self.vel[i].lane(k));
-                s.omega[i] = V3::from_array(self.omega[i].lane(k));
-            }
-            *s.time = time.0[k];
+    /// Lane `k` back into its system's state.
+    fn unpack(&self, k: usize, s: &mut State<'_, f64>, time: Lanes<K>) {
+        for i in 0..self.n {
+            s.pos[i] = V3::from_array(self.pos[i].lane(k));
+            s.vel[i] = V3::from_array(self.vel[i].lane(k));
+            s.omega[i] = V3::from_array(self.omega[i].lane(k));
         }
+        *s.time = time.0[k];
     }
 }
 

@@ -43,6 +43,27 @@ impl<const K: usize> Real for Lanes<K> {
         self
     }
     #[inline(always)]
+    fn if_gt<const M: usize>(
+        a: Self,
+        b: Self,
+        then: impl FnOnce() -> [Self; M],
+        otherwise: impl FnOnce() -> [Self; M],
+    ) -> [Self; M] {
+        let m: [bool; K] = core::array::from_fn(|k| a.0[k] > b.0[k]);
+        if m.iter().all(|&x| x) {
+            return then();
+        }
+        if !m.iter().any(|&x| x) {
+            return otherwise();
+        }
+        let (t, o) = (then(), otherwise());
+        core::array::from_fn(|i| Lanes(core::array::from_fn(|k| if m[k] { t[i].0[k] } else { o[i].0[k] })))
+    }
+    #[inline(always)]
+    fn all_gt(a: Self, b: Self) -> bool {
+        a.0.iter().zip(&b.0).all(|(x, y)| x > y)
+    }
+    #[inline(always)]
     fn from_f64(x: f64) -> Self {
         Lanes::splat(x)
     }

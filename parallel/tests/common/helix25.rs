@@ -24,28 +24,41 @@ pub const HELIX: Helix = Helix {
     head_end: HeadEnd::Bottom,
 };
 
-/// The helix's beads, rotated by `tilt` (radians) about the `x` axis, every bead of
-/// density `density` (the scene's is 4.5) and the head's radius times `head_scale`
-/// (1 for the scene; the bonds keep the scene's lengths, so a head scaled a little
-/// leaves the chain valid).
-pub fn beads(tilt: f64, density: f64, head_scale: f64) -> ParticleSet<f64, N> {
+/// The scene's head radius over the tails'.
+pub const HEAD_RATIO: f64 = HELIX.head_ratio;
+
+/// The helix with head ratio `head_ratio`.
+fn helix(head_ratio: f64) -> Helix {
+    Helix {
+        head_ratio,
+        ..HELIX
+    }
+}
+
+/// The beads of the helix of head ratio `head_ratio` (the scene's: [`HEAD_RATIO`]),
+/// rotated by `tilt` (radians) about the `x` axis, every bead of density `density`
+/// (the scene's is 4.5).
+pub fn beads(tilt: f64, density: f64, head_ratio: f64) -> ParticleSet<f64, N> {
+    let h = helix(head_ratio);
     let (s, c) = (libm::sin(tilt), libm::cos(tilt));
     let mut set = ParticleSet::new();
-    for (k, [x, y, z]) in HELIX.positions().expect("helix").enumerate() {
+    for (k, [x, y, z]) in h.positions().expect("helix").enumerate() {
         let at = DVec3::new(x, c * y - s * z, s * y + c * z);
-        let radius = HELIX.bead_radius(k) * if k == 0 { head_scale } else { 1.0 };
-        set.push(Particle::new(at, radius, density)).expect("bead");
+        set.push(Particle::new(at, h.bead_radius(k), density))
+            .expect("bead");
     }
     set
 }
 
-/// The scene's bonds: bead `k` to `k + 1` at `dhat (a_k + a_{k+1})`.
-pub fn bonds() -> Vec<Bond<f64>> {
-    (0..HELIX.tails)
+/// The bonds of the helix of head ratio `head_ratio`: bead `k` to `k + 1` at
+/// `dhat (a_k + a_{k+1})`.
+pub fn bonds(head_ratio: f64) -> Vec<Bond<f64>> {
+    let h = helix(head_ratio);
+    (0..h.tails)
         .map(|k| Bond {
             i: k,
             j: k + 1,
-            length: HELIX.bond_length(k),
+            length: h.bond_length(k),
         })
         .collect()
 }
