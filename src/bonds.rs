@@ -304,35 +304,43 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
 /// [`max_residual`] in a periodic box: each bond's length is that of its minimum image
 /// ([`Bond::separation`]).
 ///
-/// For a type of several lanes ([`Real::LANES`]) the search runs once per lane, on
-/// that lane's values ([`Real::broadcast`]): each lane finds its own extreme bonds,
-/// and no comparison differs between lanes. The index is lane 0's.
+/// For a type of several lanes ([`Real::LANES`]) each lane keeps its own extreme
+/// bonds: the ratios are formed for all lanes at once, then compared lane by lane on
+/// [`Real::broadcast`] values, so that no comparison differs between lanes. The index
+/// is lane 0's.
 pub fn max_residual_in<T: Real>(
     bonds: &[Bond<T>],
     pos: &[T::V3],
     cell: Option<&Periodic<T>>,
 ) -> (usize, T) {
-    if T::LANES == 1 {
-        return extremes(bonds, pos, cell, 0);
+    match T::LANES {
+        1 => extremes::<T, 1>(bonds, pos, cell),
+        _ => extremes::<T, LANES_MAX>(bonds, pos, cell),
     }
-    let mut out = (0, T::ZERO);
-    for lane in 0..T::LANES {
-        let (k, r) = extremes(bonds, pos, cell, lane);
-        out = (if lane == 0 { k } else { out.0 }, out.1.with_lane(lane, r));
-    }
-    out
 }
 
-/// [`max_residual_in`] on lane `lane`'s values (every value for one lane).
+/// Most lanes [`max_residual_in`] keeps apart (a lane type's divergence mask has as
+/// many bits).
+const LANES_MAX: usize = 64;
+
+/// Lane `lane`'s answer `r` into `out` (the index: lane 0's).
 #[inline(always)]
-fn extremes<T: Real>(
+fn gather<T: Real>(out: (usize, T), lane: usize, (k, r): (usize, T)) -> (usize, T) {
+    (if lane == 0 { k } else { out.0 }, out.1.with_lane(lane, r))
+}
+
+/// [`max_residual_in`] for up to `L` lanes.
+#[inline(always)]
+fn extremes<T: Real, const L: usize>(
     bonds: &[Bond<T>],
     pos: &[T::V3],
     cell: Option<&Periodic<T>>,
-    lane: usize,
 ) -> (usize, T) {
-    let separation = |b: &Bond<T>| T::v3_broadcast(b.separation(pos, cell), lane);
-    let (mut hi, mut lo) = ((0, T::ZERO), (0, T::ZERO));
+    let lanes = T::LANES.min(L);
+    let each = |out, lane| gather(out, lane, max_residual_each(bonds, pos, cell, lane));
+    let (mut hi, mut lo) = ([(0, T::ZERO); L], [(0, T::ZERO); L]);
+    // Lanes with a NaN ratio: bond by bond (for one lane, at once).
+    let mut nan = [false; L];
     let mut first = true;
     for (k, b) in bonds.iter().enumerate() {
         // A pin row's error is its anchor's, which the solve measures (the step puts
@@ -341,48 +349,58 @@ fn extremes<T: Real>(
             continue;
         }
         if b.i >= pos.len() || b.j >= pos.len() {
-            return max_residual_each(bonds, pos, cell, lane);
+            return (0..lanes).fold((0, T::ZERO), each);
         }
-        let length = b.length.broadcast(lane);
-        if length == T::ZERO {
+        if b.length == T::ZERO {
             continue;
         }
-        let r = separation(b);
-        let mut ratio = T::norm2(r) / (length * length);
+        let r = b.separation(pos, cell);
+        let mut ratio = T::norm2(r) / (b.length * b.length);
         // A wall link's centre at or below the plane has the error of a bond stretched
         // to `(2 - z/a) d`: the ratio that orders it with the others.
-        let h = T::xyz(r)[2] / length;
+        let h = T::xyz(r)[2] / b.length;
         if b.is_wall() && !(h > T::ZERO) {
             ratio = (T::TWO - h) * (T::TWO - h);
         }
-        if ratio.is_nan() {
-            return max_residual_each(bonds, pos, cell, lane);
-        }
-        if first || ratio > hi.1 {
-            hi = (k, ratio);
-        }
-        if first || ratio < lo.1 {
-            lo = (k, ratio);
+        for lane in 0..lanes {
+            let q = ratio.broadcast(lane);
+            if q.is_nan() {
+                if L == 1 {
+                    return each((0, T::ZERO), 0);
+                }
+                nan[lane] = true;
+            }
+            if first || q > hi[lane].1 {
+                hi[lane] = (k, q);
+            }
+            if first || q < lo[lane].1 {
+                lo[lane] = (k, q);
+            }
         }
         first = false;
     }
-    let at = |k: usize| {
-        let b = &bonds[k];
-        let b = Bond {
-            length: b.length.broadcast(lane),
-            ..*b
-        };
-        (k, link_error(&b, separation(&b)))
-    };
     if first {
         return (0, T::ZERO);
     }
-    let (h, l) = (at(hi.0), at(lo.0));
-    if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
-        l
-    } else {
-        h
+    let at = |k: usize, lane: usize| {
+        let b = &bonds[k];
+        (k, link_error(b, b.separation(pos, cell)).broadcast(lane))
+    };
+    let mut out = (0, T::ZERO);
+    for lane in 0..lanes {
+        if nan[lane] {
+            out = each(out, lane);
+            continue;
+        }
+        let (h, l) = (at(hi[lane].0, lane), at(lo[lane].0, lane));
+        let worst = if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
+            l
+        } else {
+            h
+        };
+        out = gather(out, lane, worst);
     }
+    out
 }
 
 /// [`max_residual`] bond by bond, for the rare lists with a NaN or a bond out of range

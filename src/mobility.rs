@@ -166,8 +166,7 @@ fn tt_block<T: Real>(level: Hydro, eta: T, ai: T, aj: T, g: &Geometry<T>) -> T::
         || {
             // Overlapping branch (Zuk et al. 2014, eq. 2.7): stays positive definite.
             let s3 = s2 * s;
-            let k =
-                T::ONE / (T::from_f64(6.0) * T::PI * eta * ai * aj * T::from_f64(32.0) * s3);
+            let k = T::ONE / (T::from_f64(6.0) * T::PI * eta * ai * aj * T::from_f64(32.0) * s3);
             let p = dif * dif + T::from_f64(3.0) * s2;
             let iso = T::from_f64(16.0) * s3 * sum - p * p;
             let q = dif * dif - s2;

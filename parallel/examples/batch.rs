@@ -3,13 +3,15 @@
 //! on one thread, timed in short windows as `host/examples/step_windows.rs` does (the
 //! fastest windows are the ones no other process preempted).
 //!
-//! `cargo run --release -p hydrorattle-parallel --example batch -- [STEPS] [WINDOW] [SWEEP]`
-//! (default 20000 steps in windows of 100, sweep `tilt`). System `k` of a batch is the
+//! `cargo run --release -p hydrorattle-parallel --example batch -- [STEPS] [WINDOW] [SWEEP] [K]`
+//! (default 20000 steps in windows of 100, sweep `tilt`, every `K`). System `k` of a batch is the
 //! scene's helix:
 //! * `tilt`: tilted by `0.1 k` rad about the `x` axis (reorientation under gravity
 //!   from several starting angles);
 //! * `density`: of density `4.5 (1 + k / 4)` (lanes sink at different speeds);
-//! * `head`: with head ratio `1.26 + 0.05 k` (other radii and bond lengths).
+//! * `head`: with head ratio `1.26 + 0.05 k` (other radii and bond lengths);
+//! * `same`: the scene in every lane (no lane ever diverges: the lane step's own
+//!   speed).
 //!
 //! Prints, for `K = 1, 2, 4, 8`: microseconds a system-step (best window, and the
 //! median), the share of system steps that fell back to their own `f64` step, GFLOP/s
@@ -40,7 +42,8 @@ fn system(sweep: &str, k: usize) -> (Set, f64) {
         "tilt" => (0.1 * k as f64, 4.5, helix25::HEAD_RATIO),
         "density" => (0.0, 4.5 * (1.0 + 0.25 * k as f64), helix25::HEAD_RATIO),
         "head" => (0.0, 4.5, helix25::HEAD_RATIO + 0.05 * k as f64),
-        _ => panic!("sweep: tilt, density or head"),
+        "same" => (0.0, 4.5, helix25::HEAD_RATIO),
+        _ => panic!("sweep: tilt, density, head or same"),
     };
     (helix25::beads(tilt, density, head), head)
 }
@@ -53,8 +56,8 @@ fn run<const K: usize>(sweep: &str, steps: usize, window: usize) -> (f64, f64, f
     let layout = Layout::for_params(&p, helix25::N, bonds[0].len());
     let mut one = Buffers::<f64>::new(layout);
     let mut lanes = Buffers::<Lanes<K>>::new(layout);
-    let mut batch = Batch::<K>::new(helix25::N, bonds.each_ref().map(|b| &b[..]), [&p; K])
-        .expect("batch");
+    let mut batch =
+        Batch::<K>::new(helix25::N, bonds.each_ref().map(|b| &b[..]), [&p; K]).expect("batch");
     let windows = (steps / window).max(1);
     let mut per = Vec::with_capacity(windows);
     for _ in 0..windows {
@@ -63,8 +66,14 @@ fn run<const K: usize>(sweep: &str, steps: usize, window: usize) -> (f64, f64, f
             if K == 1 {
                 // The baseline: the plain f64 step.
                 let s = &mut sets[0];
-                hydrorattle::step_slices(s.state(), &bonds[0], &p, &mut one.workspace(), &mut NoForce)
-                    .expect("step");
+                hydrorattle::step_slices(
+                    s.state(),
+                    &bonds[0],
+                    &p,
+                    &mut one.workspace(),
+                    &mut NoForce,
+                )
+                .expect("step");
             } else {
                 let r = batch
                     .step(
@@ -82,8 +91,16 @@ fn run<const K: usize>(sweep: &str, steps: usize, window: usize) -> (f64, f64, f
         per.push(t.elapsed().as_secs_f64() * 1e6 / (window * K) as f64);
     }
     per.sort_by(f64::total_cmp);
-    let digests = sets.iter().map(|s| helix25::digest(&s.pos[..helix25::N])).collect();
-    (per[0], per[per.len() / 2], batch.counts().fallback_rate(K), digests)
+    let digests = sets
+        .iter()
+        .map(|s| helix25::digest(&s.pos[..helix25::N]))
+        .collect();
+    (
+        per[0],
+        per[per.len() / 2],
+        batch.counts().fallback_rate(K),
+        digests,
+    )
 }
 
 fn main() {
@@ -91,16 +108,28 @@ fn main() {
     let arg = |k: usize, d: usize| args.get(k).and_then(|s| s.parse().ok()).unwrap_or(d);
     let (steps, window) = (arg(1, 20000), arg(2, 100).max(1));
     let sweep = args.get(3).map_or("tilt", String::as_str);
-    let build = if cfg!(target_feature = "avx2") { "AVX2" } else { "SSE2" };
+    let build = if cfg!(target_feature = "avx2") {
+        "AVX2"
+    } else {
+        "SSE2"
+    };
     let before = peak::f64_peak();
-    let results = [
-        (1, run::<1>(sweep, steps, window)),
-        (2, run::<2>(sweep, steps, window)),
-        (4, run::<4>(sweep, steps, window)),
-        (8, run::<8>(sweep, steps, window)),
-    ];
+    // A fourth argument runs that `K` alone (for a profiler).
+    let only = args.get(4).and_then(|s| s.parse::<usize>().ok());
+    let mut results = Vec::new();
+    let mut take = |k: usize, f: &dyn Fn() -> (f64, f64, f64, Vec<u64>)| {
+        if only.is_none_or(|o| o == k) {
+            results.push((k, f()));
+        }
+    };
+    take(1, &|| run::<1>(sweep, steps, window));
+    take(2, &|| run::<2>(sweep, steps, window));
+    take(4, &|| run::<4>(sweep, steps, window));
+    take(8, &|| run::<8>(sweep, steps, window));
     let peak = before.max(peak::f64_peak());
-    println!("{build} build, sweep {sweep}, {steps} steps in windows of {window}; peak f64 {peak:.1} GFLOP/s (before {before:.1})");
+    println!(
+        "{build} build, sweep {sweep}, {steps} steps in windows of {window}; peak f64 {peak:.1} GFLOP/s (before {before:.1})"
+    );
     for (k, (best, median, fallback, digests)) in results {
         let rate = FLOPS / best / 1e3;
         let d: Vec<String> = digests.iter().map(|d| format!("{d:016x}")).collect();

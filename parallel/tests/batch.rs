@@ -62,12 +62,23 @@ fn compare_with<const K: usize>(
                 &mut alone_ws.workspace(),
                 &mut add,
             );
-            assert_eq!(same(&got[k], &want), true, "step {step}, system {k}: {:?} against {want:?}", got[k]);
+            assert!(
+                same(&got[k], &want),
+                "step {step}, system {k}: {:?} against {want:?}",
+                got[k]
+            );
             let bits = |s: &Set| {
-                let v = |x: &[DVec3]| x.iter().flat_map(|v| v.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+                let v = |x: &[DVec3]| {
+                    x.iter()
+                        .flat_map(|v| v.to_array().map(f64::to_bits))
+                        .collect::<Vec<_>>()
+                };
                 (v(&s.pos[..N]), v(&s.vel[..N]), s.time.to_bits())
             };
-            assert!(bits(&batched[k]) == bits(&alone[k]), "step {step}, system {k}: bits differ");
+            assert!(
+                bits(&batched[k]) == bits(&alone[k]),
+                "step {step}, system {k}: bits differ"
+            );
         }
     }
     batch.counts()
@@ -137,7 +148,13 @@ fn per_system_head_ratio() {
     let heads = [1.2, 1.26, 1.3, 1.35];
     let bonds = heads.map(helix25::bonds);
     let sets = heads.map(|h| helix25::beads(0.05, 4.5, h));
-    let c = compare_with::<4>(sets, bonds.each_ref().map(|b| &b[..]), [&p; 4], 300, &mut NoForce);
+    let c = compare_with::<4>(
+        sets,
+        bonds.each_ref().map(|b| &b[..]),
+        [&p; 4],
+        300,
+        &mut NoForce,
+    );
     assert!(c.lane_steps == 300 && c.failed == 0, "{c:?}");
 }
 
@@ -152,7 +169,10 @@ fn divergence_falls_back_with_the_same_bits() {
     let c = compare::<4>(sets, [&p; 4], 300, &mut NoForce);
     assert!(c.diverged > 0 && c.failed == 0, "{c:?}");
     // Only the lanes that left lane 0's path are redone.
-    assert!(c.fallback_steps >= c.diverged && c.fallback_steps <= 3 * c.diverged, "{c:?}");
+    assert!(
+        c.fallback_steps >= c.diverged && c.fallback_steps <= 3 * c.diverged,
+        "{c:?}"
+    );
 }
 
 /// A force that pushes one system's bead 7 sideways, hard: that system's chain bends
@@ -178,7 +198,10 @@ impl<const K: usize> Forces<K> for Kick {
 fn a_force_on_one_lane() {
     let p = helix25::params();
     let sets = [0.0; 4].map(|t| helix25::beads(t, 4.5, helix25::HEAD_RATIO));
-    let mut kick = Kick { lane: 2, size: 50.0 };
+    let mut kick = Kick {
+        lane: 2,
+        size: 50.0,
+    };
     let c = compare::<4>(sets, [&p; 4], 200, &mut kick);
     assert!(c.lane_steps == 200 && c.failed == 0, "{c:?}");
 }
@@ -206,9 +229,17 @@ fn a_bad_lane_gets_its_error_the_others_advance() {
         .unwrap();
     assert_eq!(
         got[1],
-        Err(StepError::Particle(ParticleError::NonFinite { particle: 3 }))
+        Err(StepError::Particle(ParticleError::NonFinite {
+            particle: 3
+        }))
     );
-    assert!(sets[1].pos.iter().zip(&before).all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits)));
+    assert!(
+        sets[1]
+            .pos
+            .iter()
+            .zip(&before)
+            .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits))
+    );
     assert!(got[0].is_ok() && got[2].is_ok() && got[3].is_ok());
     // Bit for bit against each system alone, over further steps.
     let mut fresh = tilts::<4>().map(|t| helix25::beads(t, 4.5, helix25::HEAD_RATIO));
@@ -273,7 +304,8 @@ fn mismatched_systems_are_refused() {
     let mut a = helix25::beads(0.0, 4.5, helix25::HEAD_RATIO);
     let mut b: ParticleSet<f64, 30> = ParticleSet::new();
     for i in 0..24 {
-        b.push(hydrorattle::Particle::new(a.pos[i], a.radius[i], 4.5)).unwrap();
+        b.push(hydrorattle::Particle::new(a.pos[i], a.radius[i], 4.5))
+            .unwrap();
     }
     let start = a.pos;
     let layout = Layout::for_params(&p, N, bonds.len());

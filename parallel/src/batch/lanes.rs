@@ -65,27 +65,21 @@ impl<const K: usize> Lanes<K> {
     /// `f` lane by lane.
     #[inline(always)]
     pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
-        let mut out = self.0;
-        for x in &mut out {
-            *x = f(*x);
-        }
-        Self(out)
+        Self(core::array::from_fn(|k| f(self.0[k])))
     }
 
     /// `f` of the two operands' lanes, lane by lane.
     #[inline(always)]
     pub fn zip(self, other: Self, f: impl Fn(f64, f64) -> f64) -> Self {
-        let mut out = self.0;
-        for (x, &y) in out.iter_mut().zip(&other.0) {
-            *x = f(*x, y);
-        }
-        Self(out)
+        Self(core::array::from_fn(|k| f(self.0[k], other.0[k])))
     }
 
     /// A decision taken per lane ([`agree`]).
     #[inline(always)]
     pub(super) fn decide<X: PartialEq + Copy>(self, other: Self, f: impl Fn(f64, f64) -> X) -> X {
-        agree(core::array::from_fn::<X, K, _>(|k| f(self.0[k], other.0[k])))
+        agree(core::array::from_fn::<X, K, _>(|k| {
+            f(self.0[k], other.0[k])
+        }))
     }
 }
 

@@ -113,10 +113,7 @@ impl fmt::Display for BatchError {
                 system,
                 len,
                 expected,
-            } => write!(
-                f,
-                "system {system} has {len} spheres, the batch {expected}"
-            ),
+            } => write!(f, "system {system} has {len} spheres, the batch {expected}"),
             Self::Bonds { system } => write!(
                 f,
                 "system {system}'s bonds join other spheres than system 0's"
@@ -195,7 +192,11 @@ impl<const K: usize> Batch<K> {
     ///
     /// # Errors
     /// As [`Batch::new`].
-    pub fn uniform(n: usize, bonds: &[Bond<f64>], params: &Params<f64>) -> Result<Self, BatchError> {
+    pub fn uniform(
+        n: usize,
+        bonds: &[Bond<f64>],
+        params: &Params<f64>,
+    ) -> Result<Self, BatchError> {
         Self::new(n, [bonds; K], [params; K])
     }
 
@@ -226,7 +227,10 @@ impl<const K: usize> Batch<K> {
         if let Some(system) = (1..K).find(|&k| shape(params[k]) != shape(params[0])) {
             return Err(BatchError::Params { system });
         }
-        if params.iter().any(|p| p.brownian.is_some_and(|b| b.temperature != 0.0)) {
+        if params
+            .iter()
+            .any(|p| p.brownian.is_some_and(|b| b.temperature != 0.0))
+        {
             return Err(BatchError::Unsupported(
                 "thermal noise (each system draws from its own generator)",
             ));

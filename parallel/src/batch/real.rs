@@ -57,7 +57,11 @@ impl<const K: usize> Real for Lanes<K> {
             return otherwise();
         }
         let (t, o) = (then(), otherwise());
-        core::array::from_fn(|i| Lanes(core::array::from_fn(|k| if m[k] { t[i].0[k] } else { o[i].0[k] })))
+        core::array::from_fn(|i| {
+            Lanes(core::array::from_fn(|k| {
+                if m[k] { t[i].0[k] } else { o[i].0[k] }
+            }))
+        })
     }
     #[inline(always)]
     fn all_gt(a: Self, b: Self) -> bool {

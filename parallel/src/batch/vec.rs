@@ -215,7 +215,7 @@ impl<const K: usize> Mul<LV3<K>> for LM3<K> {
     #[inline(always)]
     fn mul(self, v: LV3<K>) -> LV3<K> {
         let mut r = self.col(0) * v.x;
-        r = r + self.col(1) * v.y;
+        r += self.col(1) * v.y;
         r + self.col(2) * v.z
     }
 }
