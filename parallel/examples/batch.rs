@@ -13,9 +13,10 @@
 //! * `same`: the scene in every lane (no lane ever diverges: the lane step's own
 //!   speed).
 //!
-//! Prints, for `K = 1, 2, 4, 8`: microseconds a system-step (best window, and the
-//! median), the share of system steps that fell back to their own `f64` step, GFLOP/s
-//! at 66.9k flops a system-step (docs/BENCHMARKS.md, "The 25-bead step, fourth pass"),
+//! Prints, for `K = 1, 2, 4, 8`: microseconds a system-step (best window, median
+//! window, and the whole run: the best windows are the ones with the fewest systems
+//! stepped alone, so the run's mean is the one that counts the fallbacks), the share of system steps that fell back to their own `f64` step, GFLOP/s
+//! at 66.9k flops a system-step (best window, and over the run; docs/BENCHMARKS.md, "The 25-bead step, fourth pass"),
 //! the fraction of this build's peak measured in the same run (`examples/peak`'s probe,
 //! before and after the timings, the best of both), and each lane's positions digest
 //! (lane 0 is the scene itself: its digest is `step_windows`'s after the same steps).
@@ -48,8 +49,12 @@ fn system(sweep: &str, k: usize) -> (Set, f64) {
     (helix25::beads(tilt, density, head), head)
 }
 
-/// Best and median microseconds a system-step, the fallback rate, the lanes' digests.
-fn run<const K: usize>(sweep: &str, steps: usize, window: usize) -> (f64, f64, f64, Vec<u64>) {
+/// Microseconds a system-step (best window, median window, the whole run), the
+/// fallback rate, the lanes' digests.
+type Run = (f64, f64, f64, f64, Vec<u64>);
+
+/// [`Run`] of `K` systems of `sweep`.
+fn run<const K: usize>(sweep: &str, steps: usize, window: usize) -> Run {
     let p = helix25::params();
     let mut sets: [Set; K] = core::array::from_fn(|k| system(sweep, k).0);
     let bonds: [_; K] = core::array::from_fn(|k| helix25::bonds(system(sweep, k).1));
@@ -90,17 +95,14 @@ fn run<const K: usize>(sweep: &str, steps: usize, window: usize) -> (f64, f64, f
         }
         per.push(t.elapsed().as_secs_f64() * 1e6 / (window * K) as f64);
     }
+    let mean = per.iter().sum::<f64>() / per.len() as f64;
     per.sort_by(f64::total_cmp);
     let digests = sets
         .iter()
         .map(|s| helix25::digest(&s.pos[..helix25::N]))
         .collect();
-    (
-        per[0],
-        per[per.len() / 2],
-        batch.counts().fallback_rate(K),
-        digests,
-    )
+    let fallback = batch.counts().fallback_rate(K);
+    (per[0], per[per.len() / 2], mean, fallback, digests)
 }
 
 fn main() {
@@ -117,7 +119,7 @@ fn main() {
     // A fourth argument runs that `K` alone (for a profiler).
     let only = args.get(4).and_then(|s| s.parse::<usize>().ok());
     let mut results = Vec::new();
-    let mut take = |k: usize, f: &dyn Fn() -> (f64, f64, f64, Vec<u64>)| {
+    let mut take = |k: usize, f: &dyn Fn() -> Run| {
         if only.is_none_or(|o| o == k) {
             results.push((k, f()));
         }
@@ -130,12 +132,13 @@ fn main() {
     println!(
         "{build} build, sweep {sweep}, {steps} steps in windows of {window}; peak f64 {peak:.1} GFLOP/s (before {before:.1})"
     );
-    for (k, (best, median, fallback, digests)) in results {
+    for (k, (best, median, mean, fallback, digests)) in results {
         let rate = FLOPS / best / 1e3;
         let d: Vec<String> = digests.iter().map(|d| format!("{d:016x}")).collect();
         println!(
-            "K = {k}: best {best:.3} us, median {median:.3} us a system-step; fallback {:.2} %; {rate:.1} GFLOP/s, {:.0} % of the peak; digests {}",
+            "K = {k}: best {best:.3} us, median {median:.3} us, run {mean:.3} us a system-step; fallback {:.2} %; {rate:.1} GFLOP/s ({:.1} over the run), {:.0} % of the peak; digests {}",
             100.0 * fallback,
+            FLOPS / mean / 1e3,
             100.0 * rate / peak,
             d.join(" ")
         );
