@@ -308,6 +308,9 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
 /// bonds: the ratios are formed for all lanes at once, then compared lane by lane on
 /// [`Real::broadcast`] values, so that no comparison differs between lanes. The index
 /// is lane 0's.
+// Called, not inlined, on 32-bit Arm: as before the lanes, a function of its own there
+// (inlining it moved the springs firmware's other inlining choices: 3 kB of flash).
+#[cfg_attr(target_arch = "arm", inline(never))]
 pub fn max_residual_in<T: Real>(
     bonds: &[Bond<T>],
     pos: &[T::V3],
@@ -362,20 +365,18 @@ fn extremes<T: Real, const L: usize>(
         if b.is_wall() && !(h > T::ZERO) {
             ratio = (T::TWO - h) * (T::TWO - h);
         }
-        for lane in 0..lanes {
+        each_lane::<L>(lanes, |lane| {
             let q = ratio.broadcast(lane);
-            if q.is_nan() {
-                if L == 1 {
-                    return each((0, T::ZERO), 0);
-                }
-                nan[lane] = true;
-            }
+            nan[lane] |= q.is_nan();
             if first || q > hi[lane].1 {
                 hi[lane] = (k, q);
             }
             if first || q < lo[lane].1 {
                 lo[lane] = (k, q);
             }
+        });
+        if L == 1 && nan[0] {
+            return each((0, T::ZERO), 0);
         }
         first = false;
     }
@@ -387,10 +388,10 @@ fn extremes<T: Real, const L: usize>(
         (k, link_error(b, b.separation(pos, cell)).broadcast(lane))
     };
     let mut out = (0, T::ZERO);
-    for lane in 0..lanes {
+    each_lane::<L>(lanes, |lane| {
         if nan[lane] {
             out = each(out, lane);
-            continue;
+            return;
         }
         let (h, l) = (at(hi[lane].0, lane), at(lo[lane].0, lane));
         let worst = if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
@@ -399,8 +400,19 @@ fn extremes<T: Real, const L: usize>(
             h
         };
         out = gather(out, lane, worst);
-    }
+    });
     out
+}
+
+/// `f` of each of `lanes` lanes; for one lane `f(0)` alone, no loop (a size-optimised
+/// build, the firmware's, would keep a loop of one pass).
+#[inline(always)]
+fn each_lane<const L: usize>(lanes: usize, mut f: impl FnMut(usize)) {
+    if L == 1 {
+        f(0);
+    } else {
+        (0..lanes).for_each(f);
+    }
 }
 
 /// [`max_residual`] bond by bond, for the rare lists with a NaN or a bond out of range

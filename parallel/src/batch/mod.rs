@@ -10,6 +10,13 @@
 //! values, system `k` in lane `k`), and every `+ - * /` and root becomes one packed
 //! instruction for all `K` systems.
 //!
+//! **Measured, it does not pay** (docs/BENCHMARKS.md, "Several systems in the
+//! lanes"): the `f64` step's heavy loops are already vector loops across beads and
+//! pairs, so the lanes add moves, not width (9.0 us a system-step at `K = 4` in the
+//! AVX2 build against 8.0 us for one `f64` step, with no divergence at all), and
+//! lanes that converge in different Newton iteration counts fall back. It is kept as
+//! a bit-exact way to step lockstep systems together.
+//!
 //! **Same bits.** Every arithmetic operation of [`Lanes`] is the `f64` operation lane
 //! by lane, and its vectors and matrices repeat glam's order of operations
 //! ([`LV3`], [`LM3`]). So as long as every decision the step takes (a comparison, a
@@ -30,7 +37,7 @@
 //! iterations than another (docs/BENCHMARKS.md, "Several systems in the lanes").
 //!
 //! ```
-//! use hydrorattle::{Bond, Layout, Method, NoForce, Params, Particle, ParticleSet};
+//! use hydrorattle::{Bond, Layout, NoForce, Params, Particle, ParticleSet};
 //! use hydrorattle_heap::Buffers;
 //! use hydrorattle_parallel::batch::{Batch, Lanes};
 //!
