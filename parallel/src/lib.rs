@@ -28,6 +28,7 @@
 
 use hydrorattle::Parallel;
 
+pub mod batch;
 pub mod model;
 pub mod pool;
 pub mod wide;

@@ -1,0 +1,51 @@
+//! This machine's practical peak floating-point rate for the build it is compiled as
+//! (shared by `examples/peak.rs` and the examples that read a step's rate against the
+//! peak measured in the same run, e.g. `parallel/examples/batch.rs`): independent
+//! multiply-adds on data that stays in L1, which the compiler vectorises, without FMA
+//! (Rust fuses nothing it is not told to).
+
+#![allow(dead_code)] // Each example uses a part.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+/// GFLOP/s of `L` independent multiply-add chains `y = y a + b` (two flops each), the
+/// best of five runs.
+pub fn rate<T, const L: usize>(zero: T, a: T, b: T) -> f64
+where
+    T: Copy + std::ops::Mul<Output = T> + std::ops::Add<Output = T>,
+{
+    // L independent chains held in registers: enough parallelism to hide the latency
+    // of the multiply and the add, no loads or stores in the loop.
+    let reps = 20_000_000;
+    let mut best = f64::INFINITY;
+    let mut y = [zero; L];
+    for _ in 0..5 {
+        y = black_box([zero; L]);
+        let t = Instant::now();
+        for _ in 0..reps {
+            for v in y.iter_mut() {
+                *v = *v * a + b;
+            }
+        }
+        black_box(&y);
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    black_box(&y);
+    (2.0 * L as f64 * reps as f64) / best / 1e9
+}
+
+/// Independent `f64` chains: twelve registers' worth of lanes (two lanes each with SSE2,
+/// four with AVX), enough to hide a multiply's and an add's latency on two pipes each,
+/// few enough to stay in the sixteen registers.
+pub const CHAINS: usize = if cfg!(target_feature = "avx") { 48 } else { 24 };
+
+/// The peak `f64` rate in GFLOP/s (the best of five runs of [`rate`]).
+pub fn f64_peak() -> f64 {
+    rate::<f64, CHAINS>(0.0, black_box(0.999_999), black_box(1e-9))
+}
+
+/// The peak `f32` rate in GFLOP/s.
+pub fn f32_peak() -> f64 {
+    rate::<f32, { 2 * CHAINS }>(0.0, black_box(0.999_9), black_box(1e-7))
+}
