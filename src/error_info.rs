@@ -360,38 +360,39 @@ mod tests {
     }
 
     #[test]
-    fn the_parts_are_the_payloads() {
+    fn the_parts_are_the_payloads() -> Result<(), &'static str> {
         let all = every();
-        let at = |kind: &str| *all.iter().find(|e| e.kind() == kind).unwrap();
-        let e = at("particle_overlap");
+        // A kind missing from `every` is that kind, as the error.
+        let at = |kind: &'static str| all.iter().find(|e| e.kind() == kind).copied().ok_or(kind);
+        let e = at("particle_overlap")?;
         assert_eq!(
             (e.index(), e.other(), e.pair()),
             (Some(3), Some(5), Some((3, 5)))
         );
-        let e = at("bond_self_bond");
+        let e = at("bond_self_bond")?;
         assert_eq!((e.index(), e.other(), e.pair()), (Some(7), Some(3), None));
-        assert_eq!(at("bond_duplicate").other(), Some(2));
-        assert_eq!(at("bond_violated").value(), Some(0.5));
-        assert_eq!(at("bond_overstretched").value(), Some(1.5));
-        assert_eq!(at("bond_bad_tree").index(), Some(3));
-        let e = at("linalg_singular");
+        assert_eq!(at("bond_duplicate")?.other(), Some(2));
+        assert_eq!(at("bond_violated")?.value(), Some(0.5));
+        assert_eq!(at("bond_overstretched")?.value(), Some(1.5));
+        assert_eq!(at("bond_bad_tree")?.index(), Some(3));
+        let e = at("linalg_singular")?;
         assert_eq!((e.stage(), e.index()), (Some(Stage::Drag), Some(11)));
-        let e = at("no_convergence");
+        let e = at("no_convergence")?;
         assert_eq!(
             (e.stage(), e.count(), e.value()),
             (Some(Stage::Positions), Some(100), Some(1e-3))
         );
-        let e = at("unstable");
+        let e = at("unstable")?;
         assert_eq!((e.value(), e.limit()), (Some(0.1), Some(0.05)));
-        assert_eq!(at("contacts_full").count(), Some(9));
-        let e = at("infeasible");
+        assert_eq!(at("contacts_full")?.count(), Some(9));
+        let e = at("infeasible")?;
         assert_eq!(
             (e.index(), e.other(), e.count(), e.constraints()),
             (Some(2), Some(5), Some(6), &[2, 5, 7][..])
         );
-        assert_eq!(at("overlap").pair(), Some((3, 5)));
-        assert_eq!(at("bad_parameter").detail(), Some("tolerance"));
-        assert_eq!(at("unsupported").detail(), Some("noise"));
+        assert_eq!(at("overlap")?.pair(), Some((3, 5)));
+        assert_eq!(at("bad_parameter")?.detail(), Some("tolerance"));
+        assert_eq!(at("unsupported")?.detail(), Some("noise"));
         for kind in [
             "bad_time_step",
             "storage",
@@ -399,7 +400,7 @@ mod tests {
             "particle_full",
             "bond_full",
         ] {
-            let e = at(kind);
+            let e = at(kind)?;
             assert_eq!(
                 (
                     e.stage(),
@@ -413,5 +414,6 @@ mod tests {
                 "{kind}"
             );
         }
+        Ok(())
     }
 }

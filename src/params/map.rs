@@ -101,104 +101,75 @@ mod tests {
     use crate::params::{Contacts, Drift, Method, NoiseSqrt};
 
     /// Every field set away from its default, so that a field `map` dropped or crossed
-    /// would show.
-    fn odd() -> Params<f64> {
-        let mut p = Params::new(0.125);
-        p.viscosity = 2.5;
-        p.fluid_density = 0.75;
-        p.gravity = glam::DVec3::new(0.1, -0.2, -9.75);
-        p.flow_velocity = glam::DVec3::new(1.0, 2.0, 3.0);
-        p.vorticity = glam::DVec3::new(-4.0, 5.0, -6.0);
+    /// would show; in any precision, each real built from its `f64` literal.
+    fn odd<T: Real>() -> Result<Params<T>, PeriodicError> {
+        let r = T::from_f64;
+        let mut p = Params::new(r(0.125));
+        p.viscosity = r(2.5);
+        p.fluid_density = r(0.75);
+        p.gravity = T::v3_from([0.1, -0.2, -9.75]);
+        p.flow_velocity = T::v3_from([1.0, 2.0, 3.0]);
+        p.vorticity = T::v3_from([-4.0, 5.0, -6.0]);
         p.hydro = crate::Hydro::Oseen;
         p.method = Method::Springs;
         p.rotation = true;
         p.matrix_free = true;
-        p.solver.tolerance = 1e-9;
+        p.solver.tolerance = r(1e-9);
         p.solver.max_iterations = 7;
         p.allow_overlap = true;
-        p.spring_stiffness = 321.0;
-        p.fene = Some(3.5);
+        p.spring_stiffness = r(321.0);
+        p.fene = Some(r(3.5));
         p.stability_guard = true;
         p.brownian = Some(Brownian {
-            temperature: 0.01,
+            temperature: r(0.01),
             drift: Drift::Uncorrected,
         });
         p.noise_sqrt = NoiseSqrt::Lanczos;
-        p.lanczos.tolerance = 1e-5;
+        p.lanczos.tolerance = r(1e-5);
         p.lanczos.max_iterations = 9;
         p.contacts = Some(Contacts::new(11));
-        p.wall = Some(Wall::new(-7.0));
-        p.periodic = Some(Periodic::new([10.0, 20.0, 30.0]).unwrap());
+        p.wall = Some(Wall::new(r(-7.0)));
+        p.periodic = Some(Periodic::new([10.0, 20.0, 30.0].map(r))?);
         p.compact_products = true;
         p.resolve_tensions = true;
         p.pse = Some(1e-4);
-        p
+        Ok(p)
     }
 
     /// The identity gives the parameters back; every real field is visited once, in
     /// the documented order (the values written above, read off in that order).
     #[test]
-    fn identity_and_order() {
-        let p = odd();
+    fn identity_and_order() -> Result<(), PeriodicError> {
+        let p = odd::<f64>()?;
         let mut seen = [0.0; 21];
         let mut k = 0;
-        let q = p
-            .map(|x: f64| {
-                seen[k] = x;
-                k += 1;
-                x
-            })
-            .unwrap();
+        let q = p.map(|x: f64| {
+            seen[k] = x;
+            k += 1;
+            x
+        })?;
         assert_eq!(q, p);
         let want = [
             0.125, 2.5, 0.75, 0.1, -0.2, -9.75, 1.0, 2.0, 3.0, -4.0, 5.0, -6.0, 1e-9, 321.0, 3.5,
             0.01, 1e-5, -7.0, 10.0, 20.0, 30.0,
         ];
         assert_eq!((k, seen), (want.len(), want));
+        Ok(())
     }
 
-    /// To `f32`: each real rounded once, the rest copied (against parameters set in
-    /// `f32` field by field).
+    /// To `f32`: each real rounded once, the rest copied (against the same parameters
+    /// built in `f32` field by field).
     #[test]
-    fn cast_to_f32() {
-        let q = odd().map(|x: f64| x as f32).unwrap();
-        let mut want = Params::<f32>::new(0.125);
-        want.viscosity = 2.5;
-        want.fluid_density = 0.75;
-        want.gravity = glam::Vec3::new(0.1, -0.2, -9.75);
-        want.flow_velocity = glam::Vec3::new(1.0, 2.0, 3.0);
-        want.vorticity = glam::Vec3::new(-4.0, 5.0, -6.0);
-        want.hydro = crate::Hydro::Oseen;
-        want.method = Method::Springs;
-        want.rotation = true;
-        want.matrix_free = true;
-        want.solver.tolerance = 1e-9;
-        want.solver.max_iterations = 7;
-        want.allow_overlap = true;
-        want.spring_stiffness = 321.0;
-        want.fene = Some(3.5);
-        want.stability_guard = true;
-        want.brownian = Some(Brownian {
-            temperature: 0.01,
-            drift: Drift::Uncorrected,
-        });
-        want.noise_sqrt = NoiseSqrt::Lanczos;
-        want.lanczos.tolerance = 1e-5;
-        want.lanczos.max_iterations = 9;
-        want.contacts = Some(Contacts::new(11));
-        want.wall = Some(Wall::new(-7.0));
-        want.periodic = Some(Periodic::new([10.0, 20.0, 30.0]).unwrap());
-        want.compact_products = true;
-        want.resolve_tensions = true;
-        want.pse = Some(1e-4);
-        assert_eq!(q, want);
+    fn cast_to_f32() -> Result<(), PeriodicError> {
+        assert_eq!(odd::<f64>()?.map(|x: f64| x as f32)?, odd::<f32>()?);
+        Ok(())
     }
 
     /// An edge mapped out of range is the box's own error, with its axis.
     #[test]
-    fn bad_edge_is_refused() {
-        let p = odd();
-        let r = p.map(|x: f64| if x == 20.0 { -1.0 } else { x });
+    fn bad_edge_is_refused() -> Result<(), PeriodicError> {
+        let r = odd::<f64>()?.map(|x: f64| if x == 20.0 { -1.0 } else { x });
         assert_eq!(r, Err(PeriodicError::BadEdge { axis: 1 }));
+        Ok(())
     }
 }
