@@ -86,7 +86,7 @@ impl<const K: usize> Real for Lanes<K> {
     }
     #[inline(always)]
     fn abs(self) -> Self {
-        self.map(|x| if x < 0.0 { -x } else { x })
+        self.map(<f64 as Real>::abs)
     }
     #[inline]
     fn sin(self) -> Self {
@@ -132,15 +132,7 @@ impl<const K: usize> Real for Lanes<K> {
     /// lane's residual is the larger and another's the smaller.
     #[inline(always)]
     fn max_sticky(self, other: Self) -> Self {
-        self.zip(other, |a, b| {
-            if a.is_nan() {
-                a
-            } else if b.is_nan() || b > a {
-                b
-            } else {
-                a
-            }
-        })
+        self.zip(other, <f64 as Real>::max_sticky)
     }
     #[inline(always)]
     fn v3_is_finite(v: LV3<K>) -> bool {

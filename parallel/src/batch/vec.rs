@@ -140,16 +140,11 @@ impl<const K: usize> LM3<K> {
         Self([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z])
     }
 
-    /// Column `i` (0, 1 or 2; glam panics beyond, as this does).
+    /// Column `i` (0, 1 or 2; beyond, an index out of bounds, as glam's).
     #[inline(always)]
     pub fn col(&self, i: usize) -> LV3<K> {
-        let e = &self.0;
-        match i {
-            0 => LV3::new(e[0], e[1], e[2]),
-            1 => LV3::new(e[3], e[4], e[5]),
-            2 => LV3::new(e[6], e[7], e[8]),
-            _ => panic!("column index out of bounds: {i}"),
-        }
+        let c = &self.0[3 * i..3 * i + 3];
+        LV3::new(c[0], c[1], c[2])
     }
 
     /// glam's `transpose`.
