@@ -303,47 +303,12 @@ pub fn max_residual<T: Real>(bonds: &[Bond<T>], pos: &[T::V3]) -> (usize, T) {
 
 /// [`max_residual`] in a periodic box: each bond's length is that of its minimum image
 /// ([`Bond::separation`]).
-///
-/// For a type of several lanes ([`Real::LANES`]) each lane keeps its own extreme
-/// bonds: the ratios are formed for all lanes at once, then compared lane by lane on
-/// [`Real::broadcast`] values, so that no comparison differs between lanes. The index
-/// is lane 0's.
-// Called, not inlined, on 32-bit Arm: as before the lanes, a function of its own there
-// (inlining it moved the springs firmware's other inlining choices: 3 kB of flash).
-#[cfg_attr(target_arch = "arm", inline(never))]
 pub fn max_residual_in<T: Real>(
     bonds: &[Bond<T>],
     pos: &[T::V3],
     cell: Option<&Periodic<T>>,
 ) -> (usize, T) {
-    match T::LANES {
-        1 => extremes::<T, 1>(bonds, pos, cell),
-        _ => extremes::<T, LANES_MAX>(bonds, pos, cell),
-    }
-}
-
-/// Most lanes [`max_residual_in`] keeps apart (a lane type's divergence mask has as
-/// many bits).
-const LANES_MAX: usize = 64;
-
-/// Lane `lane`'s answer `r` into `out` (the index: lane 0's).
-#[inline(always)]
-fn gather<T: Real>(out: (usize, T), lane: usize, (k, r): (usize, T)) -> (usize, T) {
-    (if lane == 0 { k } else { out.0 }, out.1.with_lane(lane, r))
-}
-
-/// [`max_residual_in`] for up to `L` lanes.
-#[inline(always)]
-fn extremes<T: Real, const L: usize>(
-    bonds: &[Bond<T>],
-    pos: &[T::V3],
-    cell: Option<&Periodic<T>>,
-) -> (usize, T) {
-    let lanes = T::LANES.min(L);
-    let each = |out, lane| gather(out, lane, max_residual_each(bonds, pos, cell, lane));
-    let (mut hi, mut lo) = ([(0, T::ZERO); L], [(0, T::ZERO); L]);
-    // Lanes with a NaN ratio: bond by bond (for one lane, at once).
-    let mut nan = [false; L];
+    let (mut hi, mut lo) = ((0, T::ZERO), (0, T::ZERO));
     let mut first = true;
     for (k, b) in bonds.iter().enumerate() {
         // A pin row's error is its anchor's, which the solve measures (the step puts
@@ -352,7 +317,7 @@ fn extremes<T: Real, const L: usize>(
             continue;
         }
         if b.i >= pos.len() || b.j >= pos.len() {
-            return (0..lanes).fold((0, T::ZERO), each);
+            return max_residual_each(bonds, pos, cell);
         }
         if b.length == T::ZERO {
             continue;
@@ -365,73 +330,43 @@ fn extremes<T: Real, const L: usize>(
         if b.is_wall() && !(h > T::ZERO) {
             ratio = (T::TWO - h) * (T::TWO - h);
         }
-        each_lane::<L>(lanes, |lane| {
-            let q = ratio.broadcast(lane);
-            nan[lane] |= q.is_nan();
-            if first || q > hi[lane].1 {
-                hi[lane] = (k, q);
-            }
-            if first || q < lo[lane].1 {
-                lo[lane] = (k, q);
-            }
-        });
-        if L == 1 && nan[0] {
-            return each((0, T::ZERO), 0);
+        if ratio.is_nan() {
+            return max_residual_each(bonds, pos, cell);
+        }
+        if first || ratio > hi.1 {
+            hi = (k, ratio);
+        }
+        if first || ratio < lo.1 {
+            lo = (k, ratio);
         }
         first = false;
     }
+    let at = |k: usize| {
+        let b = &bonds[k];
+        (k, link_error(b, b.separation(pos, cell)))
+    };
     if first {
         return (0, T::ZERO);
     }
-    let at = |k: usize, lane: usize| {
-        let b = &bonds[k];
-        (k, link_error(b, b.separation(pos, cell)).broadcast(lane))
-    };
-    let mut out = (0, T::ZERO);
-    each_lane::<L>(lanes, |lane| {
-        if nan[lane] {
-            out = each(out, lane);
-            return;
-        }
-        let (h, l) = (at(hi[lane].0, lane), at(lo[lane].0, lane));
-        let worst = if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
-            l
-        } else {
-            h
-        };
-        out = gather(out, lane, worst);
-    });
-    out
-}
-
-/// `f` of each of `lanes` lanes; for one lane `f(0)` alone, no loop (a size-optimised
-/// build, the firmware's, would keep a loop of one pass).
-#[inline(always)]
-fn each_lane<const L: usize>(lanes: usize, mut f: impl FnMut(usize)) {
-    if L == 1 {
-        f(0);
+    let (h, l) = (at(hi.0), at(lo.0));
+    if l.1 > h.1 || (l.1 == h.1 && l.0 < h.0) {
+        l
     } else {
-        (0..lanes).for_each(f);
+        h
     }
 }
 
-/// [`max_residual`] bond by bond, for the rare lists with a NaN or a bond out of range
-/// (on lane `lane`'s values, as [`extremes`]).
+/// [`max_residual`] bond by bond, for the rare lists with a NaN or a bond out of range.
 fn max_residual_each<T: Real>(
     bonds: &[Bond<T>],
     pos: &[T::V3],
     cell: Option<&Periodic<T>>,
-    lane: usize,
 ) -> (usize, T) {
     let mut worst = (0, T::ZERO);
     for (k, b) in bonds.iter().enumerate() {
-        let b = &Bond {
-            length: b.length.broadcast(lane),
-            ..*b
-        };
         let r = match b.i < pos.len() && (b.j < pos.len() || b.is_pin()) {
             true if b.length == T::ZERO || b.is_pin() => continue,
-            true => link_error(b, T::v3_broadcast(b.separation(pos, cell), lane)),
+            true => link_error(b, b.separation(pos, cell)),
             false => T::ONE / T::ZERO,
         };
         if !worst.1.is_nan() && (r.is_nan() || r > worst.1) {

@@ -153,28 +153,20 @@ fn tt_block<T: Real>(level: Hydro, eta: T, ai: T, aj: T, g: &Geometry<T>) -> T::
     }
     let sum = ai + aj;
     let dif = ai - aj;
-    // Both branches are `ee x + y I`: only the two scalars differ, chosen per lane
-    // for a lane type ([`Real::if_gt`]; a branch for `f32` and `f64`).
-    let [x, y] = T::if_gt(
-        s,
-        sum,
-        || {
-            let q = (ai * ai + aj * aj) * (g.inv_s * g.inv_s);
-            let third = T::ONE / T::from_f64(3.0);
-            [c * (T::ONE - q), c * (T::ONE + q * third)]
-        },
-        || {
-            // Overlapping branch (Zuk et al. 2014, eq. 2.7): stays positive definite.
-            let s3 = s2 * s;
-            let k = T::ONE / (T::from_f64(6.0) * T::PI * eta * ai * aj * T::from_f64(32.0) * s3);
-            let p = dif * dif + T::from_f64(3.0) * s2;
-            let iso = T::from_f64(16.0) * s3 * sum - p * p;
-            let q = dif * dif - s2;
-            let aniso = T::from_f64(3.0) * q * q;
-            [k * aniso, k * iso]
-        },
-    );
-    T::m3_add_diag(ee * x, y)
+    if s > sum {
+        let q = (ai * ai + aj * aj) * (g.inv_s * g.inv_s);
+        let third = T::ONE / T::from_f64(3.0);
+        T::m3_add_diag(ee * (c * (T::ONE - q)), c * (T::ONE + q * third))
+    } else {
+        // Overlapping branch (Zuk et al. 2014, eq. 2.7): stays positive definite.
+        let s3 = s2 * s;
+        let k = T::ONE / (T::from_f64(6.0) * T::PI * eta * ai * aj * T::from_f64(32.0) * s3);
+        let p = dif * dif + T::from_f64(3.0) * s2;
+        let iso = T::from_f64(16.0) * s3 * sum - p * p;
+        let q = dif * dif - s2;
+        let aniso = T::from_f64(3.0) * q * q;
+        T::m3_add_diag(ee * (k * aniso), k * iso)
+    }
 }
 
 /// All blocks for the pair `(i, j)`, `i != j` (rotation couplings included).

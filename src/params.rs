@@ -6,8 +6,6 @@ use crate::mobility::Hydro;
 use crate::noise::lanczos::Lanczos;
 use crate::real::Real;
 
-mod map;
-
 /// Which integrator [`step`](crate::integrate::step) runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Method {

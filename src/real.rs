@@ -207,50 +207,6 @@ pub trait Real:
     fn m3_get(m: Self::M3, r: usize, c: usize) -> Self {
         Self::xyz(Self::m3_col(m, c))[r]
     }
-    /// Values held side by side in one `Self`: 1 for `f32` and `f64`; more for a host's
-    /// lane type that steps several systems at once (`hydrorattle-parallel`'s batch),
-    /// whose every operation acts lane by lane. The few searches whose choice differs
-    /// between lanes (which bond has the largest error) run once per lane on
-    /// [`Real::broadcast`] values, so that every comparison they make agrees across
-    /// the lanes, and gather the lanes' answers with [`Real::with_lane`].
-    const LANES: usize = 1;
-    /// Every lane set to lane `k`'s value (`self` for one lane).
-    #[inline(always)]
-    fn broadcast(self, k: usize) -> Self {
-        let _ = k;
-        self
-    }
-    /// [`Real::broadcast`] of each component.
-    #[inline(always)]
-    fn v3_broadcast(v: Self::V3, k: usize) -> Self::V3 {
-        let [x, y, z] = Self::xyz(v);
-        Self::v3(x.broadcast(k), y.broadcast(k), z.broadcast(k))
-    }
-    /// `if a > b { then() } else { otherwise() }`, lane by lane: a lane type whose
-    /// lanes disagree evaluates both and takes each lane's values from its own side;
-    /// `f32` and `f64` branch. For choices of values whose two sides take no decision.
-    #[inline(always)]
-    fn if_gt<const M: usize>(
-        a: Self,
-        b: Self,
-        then: impl FnOnce() -> [Self; M],
-        otherwise: impl FnOnce() -> [Self; M],
-    ) -> [Self; M] {
-        if a > b { then() } else { otherwise() }
-    }
-    /// `a > b` on every lane (`a > b` for one lane), for a choice between two paths
-    /// that give the same bits (the vector loop or pair by pair): no lane's own
-    /// decision, so no divergence.
-    #[inline(always)]
-    fn all_gt(a: Self, b: Self) -> bool {
-        a > b
-    }
-    /// `self` with lane `k` taken from `from` (`from` for one lane).
-    #[inline(always)]
-    fn with_lane(self, k: usize, from: Self) -> Self {
-        let _ = (self, k);
-        from
-    }
     /// The matrix of `x -> v x x` (cross-product matrix `[v]x`).
     fn m3_cross(v: Self::V3) -> Self::M3 {
         let [x, y, z] = Self::xyz(v);

@@ -28,7 +28,6 @@
 
 use hydrorattle::Parallel;
 
-pub mod batch;
 pub mod model;
 pub mod pool;
 pub mod wide;

@@ -145,9 +145,7 @@ fn row_lanes<T: Real, B: Block<T>>(
     T::roots_and_inverses(&w.s2[..i], &mut w.s[..i], &mut w.inv[..i]);
     let mut near = false;
     for (&s, &aj) in w.s[..i].iter().zip(a) {
-        // On every lane of a lane type: one lane near takes them all pair by pair
-        // (`tt_block` chooses its branch per lane there).
-        near |= !T::all_gt(s, ai + aj);
+        near |= !(s > ai + aj);
     }
     if near {
         return row_pairs(src, i, xs, ys, row);
