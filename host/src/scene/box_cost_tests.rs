@@ -102,6 +102,7 @@ fn pse_is_sized_without_the_dense_mobility() {
         let mut plan = sizing::Plan::of(&run);
         plan.brownian = brownian;
         let bytes = plan.bytes(100_000, 0).unwrap();
+        eprintln!("N = 1e5, {brownian:?}: {}", sizing::human(bytes as u64));
         assert!(
             bytes < 1 << 30,
             "{brownian:?}: {}",
