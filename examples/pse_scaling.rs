@@ -76,28 +76,9 @@ fn apart(n: usize, phi: f64, seed: u64) -> (f64, Vec<V>) {
 mod cpu;
 use cpu::cpu;
 
-/// Best of `reps` measurements of `f`, seconds per call: this thread's CPU time where
-/// the machine tells it (each measurement repeats `f` until at least 0.3 s of it, for
-/// the 10 ms ticks), else the wall clock.
-fn best(reps: usize, mut f: impl FnMut()) -> f64 {
-    (0..reps)
-        .map(|_| {
-            let (t, c) = (Instant::now(), cpu());
-            let mut calls = 0;
-            loop {
-                f();
-                calls += 1;
-                let used = match (c, cpu()) {
-                    (Some(a), Some(b)) => b - a,
-                    _ => t.elapsed().as_secs_f64(),
-                };
-                if used >= 0.3 {
-                    return used / calls as f64;
-                }
-            }
-        })
-        .fold(f64::INFINITY, f64::min)
-}
+#[path = "shared/best.rs"]
+mod best;
+use best::best;
 
 /// Heap storage for one `Pse` and `n` spheres, and the product into `out`.
 struct Store(Vec<[f64; 2]>, Vec<usize>, Vec<V>);

@@ -27,6 +27,9 @@
 use crate::cell::Periodic;
 use crate::real::Real;
 
+mod pairs;
+pub use pairs::{PairOrder, check_pairs_in, first_pair};
+
 /// Spheres from which the pair searches use a cell list; below, every pair is visited.
 /// Measured (`examples/pair_search.rs`: a step with contacts on, CPU time): the cell
 /// list costs more at 16 spheres (17-19 against 14.5-15 us a step), the same at 32 and

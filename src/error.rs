@@ -445,6 +445,12 @@ impl From<crate::mobility::pse::PseError> for StepError {
                 "a PSE tolerance whose grid exceeds the bounds (mobility::pse::MAX_GRID, MAX_SUPPORT)",
             ),
             E::Length => Self::BadParameter("PSE: positions, radii and forces differ in length"),
+            E::LargeSphere => Self::Unsupported(
+                "PSE with a sphere's radius at least a third of the box's smallest edge (mobility::pse::MAX_RADIUS_FRACTION): it misses its tolerance there",
+            ),
+            E::Precision { .. } => Self::BadParameter(
+                "a PSE tolerance below what the precision can reach (mobility::pse::min_tolerance)",
+            ),
             E::Lanczos(e) => e.into(),
             E::Storage { .. } => Self::BadParameter(
                 "the workspace's PSE storage (Workspace::with_pse, at least integrate::pse_storage)",

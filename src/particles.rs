@@ -218,26 +218,13 @@ pub fn check_one<T: Real>(i: usize, p: &Particle<T>) -> Result<(), ParticleError
 }
 
 /// Pair checks on positions and radii: nesting always fails, overlap when not allowed.
-/// Fixed order (i ascending, then j), so the reported pair is deterministic.
+/// Fixed order (i ascending, then j), so the reported pair is deterministic. Visits
+/// every pair; [`check_pairs_in`](crate::cell_list::check_pairs_in) gives the same
+/// answer over a cell list.
 pub fn check_pairs<T: Real>(
     pos: &[T::V3],
     radius: &[T],
     allow_overlap: bool,
 ) -> Result<(), ParticleError> {
-    for i in 0..pos.len() {
-        for j in i + 1..pos.len() {
-            let s = T::norm(pos[i] - pos[j]);
-            let (ai, aj) = (radius[i], radius[j]);
-            if s == T::ZERO {
-                return Err(ParticleError::Coincident { i, j });
-            }
-            if s <= (ai - aj).abs() {
-                return Err(ParticleError::Nested { i, j });
-            }
-            if !allow_overlap && s < ai + aj {
-                return Err(ParticleError::Overlap { i, j });
-            }
-        }
-    }
-    Ok(())
+    crate::cell_list::check_pairs_in(pos, radius, allow_overlap, &mut [])
 }

@@ -4,7 +4,7 @@
 //! (every method, solver and mobility; NaN, negative and huge time steps, tolerances,
 //! viscosities, gravity, time; rest length zero), every table of the step (rotation,
 //! matrix-free products, hard contacts with capacities past `DENSE_BONDS_MAX` rows, a
-//! wall, a periodic box, FENE springs, thermal noise by Cholesky, Lanczos or `Auto` with either drift)
+//! wall, a periodic box (its mobility by the Ewald sum or by PSE), FENE springs, thermal noise by Cholesky, Lanczos or `Auto` with either drift)
 //! and mismatched or undersized storage. Every call must return without a panic; a
 //! refused step must leave the state and the noise generator bit-identical; an
 //! accepted one must leave it finite with the time advanced.
@@ -91,9 +91,33 @@ fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
         .collect()
 }
 
-/// One fuzz case in precision `T`: whether the step was accepted, or `Err` describing
-/// a broken promise.
-fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
+/// PSE's arrays (complex values, indices, vectors) as the step sizes them, when the box
+/// is summed by PSE; a grid past a few million points gets none (the step refuses that,
+/// typed).
+type PseArrays<T> = (Vec<[T; 2]>, Vec<usize>, Vec<<T as Real>::V3>);
+
+#[cfg(feature = "pse")]
+fn pse_arrays<T: Real>(p: &Params<T>, radius: &[T]) -> Option<PseArrays<T>> {
+    let s = hydrorattle::integrate::pse_storage(p, radius)
+        .ok()
+        .flatten()?;
+    (s.complex <= 1 << 22).then(|| {
+        (
+            vec![[T::ZERO; 2]; s.complex],
+            vec![0usize; s.index],
+            vec![T::V3_ZERO; s.vectors],
+        )
+    })
+}
+
+#[cfg(not(feature = "pse"))]
+fn pse_arrays<T: Real>(_: &Params<T>, _: &[T]) -> Option<PseArrays<T>> {
+    None
+}
+
+/// One fuzz case in precision `T`: whether the step was accepted and whether it had
+/// PSE's storage, or `Err` describing a broken promise.
+fn case<T: Real>(rng: &mut Draw) -> Result<(bool, bool), String> {
     // Mostly small; one case in eight long enough for more than `DENSE_BONDS_MAX` rows.
     let n = if rng.below(8) == 0 {
         1 + rng.below(40) as usize
@@ -227,8 +251,22 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
                 }
             }
         }
+        // Summed by PSE on half of the boxes: a usual tolerance, one below f32's floor,
+        // or a hostile one (refused, typed: out of range, a sphere of a third of the
+        // edge, a grid past its bounds).
+        if rng.below(2) == 0 {
+            p.pse = Some(match rng.below(4) {
+                0 => 1e-9,
+                1 if hostile => rng.value(1e-4),
+                _ => [1e-3, 1e-5][rng.below(2) as usize],
+            });
+        }
     }
     p.matrix_free = free_ok && rng.below(6) == 0;
+    if p.pse.is_some() && !hostile {
+        // PSE gives products only.
+        p.matrix_free = true;
+    }
     // FENE springs on a sixth: a limit beyond the bonds, or a hostile one.
     if rng.below(6) == 0 {
         p.fene = Some(T::from_f64(rng.value(6.0)));
@@ -260,7 +298,15 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
         _ => (n, nb),
     };
     let mut store = Buffers::<T>::new(Layout::for_params(&p, ln, lb));
-    let mut ws = store.workspace();
+    let mut arrays = pse_arrays(&p, &radius);
+    let on_pse = arrays.is_some();
+    let ws = store.workspace();
+    #[cfg(feature = "pse")]
+    let ws = match arrays.as_mut() {
+        Some((cx, ix, vx)) => ws.with_pse(cx, ix, vx),
+        None => ws,
+    };
+    let mut ws = ws;
     // Sometimes a slice of the wrong length.
     let short = rng.below(40) == 0 && n > 1;
     let mut noise = Noise::new(rng.next());
@@ -313,14 +359,14 @@ fn case<T: Real>(rng: &mut Draw) -> Result<bool, String> {
             }
         }
     }
-    Ok(accepted)
+    Ok((accepted, on_pse))
 }
 
 fn fuzz<T: Real>(salt: u64) {
     let (cases, seed) = settings(0x5EED_0011);
     let seed = seed ^ salt;
     let mut failures = Vec::new();
-    let mut accepted = 0u64;
+    let (mut accepted, mut on_pse) = (0u64, 0u64);
     for k in 0..cases {
         let mut rng = Draw(Rng::case(seed, k), false);
         // Half the cases clean (they should mostly step), half hostile.
@@ -328,12 +374,19 @@ fn fuzz<T: Real>(salt: u64) {
         let outcome =
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| case::<T>(&mut rng)));
         match outcome {
-            Ok(Ok(true)) => accepted += 1,
-            Ok(Ok(false)) => {}
+            Ok(Ok((stepped, pse))) => {
+                accepted += u64::from(stepped);
+                on_pse += u64::from(stepped && pse);
+            }
             Ok(Err(m)) => failures.push(format!("case {k}: {m}")),
             Err(_) => failures.push(format!("case {k}: panicked")),
         }
     }
+    // The default run must step on PSE too (a short `FUZZ_CASES` run may not).
+    if cfg!(feature = "pse") && cases >= 10_000 && on_pse == 0 {
+        failures.push("no accepted step on PSE".into());
+    }
+    eprintln!("fuzz_step: {on_pse} accepted steps on PSE");
     let name = format!("fuzz_step {}", core::any::type_name::<T>());
     report(&name, cases, seed, accepted, &failures);
 }

@@ -12,6 +12,12 @@
 //! midpoint no longer uses, the start's mobility instead of the midpoint's) turns the
 //! positions to NaN or moves the digest: the midpoint must read the mobility it
 //! assembled at `x~`. Regenerate only for a deliberate change of the arithmetic.
+//!
+//! `Springs` in the box has no constraints to project the noise onto, so its
+//! `Drift::Midpoint` is the uncorrected draw there (the box's mobility has zero
+//! divergence; `tests/periodic_brownian.rs`): its two digests were re-pinned when that
+//! change was made, from `0xd827b534df4945db` (f64) and `0xebff16e658b99548` (f32), and
+//! they now pin the uncorrected Lanczos draw on a poisoned workspace.
 
 mod common;
 
@@ -89,7 +95,7 @@ const PINS: [(Place, Method, SolverKind, &str, u64); 16] = [
         Method::Springs,
         SolverKind::Auto,
         "f64",
-        0xd827_b534_df49_45db,
+        0xcdba_9f3e_e939_d44d,
     ),
     (
         Place::Free,
@@ -145,7 +151,7 @@ const PINS: [(Place, Method, SolverKind, &str, u64); 16] = [
         Method::Springs,
         SolverKind::Auto,
         "f32",
-        0xebff_16e6_58b9_9548,
+        0x07dc_97ba_29af_64f9,
     ),
 ];
 

@@ -174,3 +174,48 @@ fn chain_check(chains: u64, steps: usize, max_se: f64) {
     assert!(se < max_se * exact, "too few samples: se {se}");
     assert!((m - exact).abs() < 3.0 * se, "<R^2> {m} vs {exact}");
 }
+
+/// In a box without bonds the midpoint's mean `kT dt div M` is zero (the box's RPY
+/// mobility is divergence-free), so `Drift::Midpoint` takes the explicit
+/// Euler-Maruyama draw `sqrt(2 kT dt) L xi` (one assembly a step, not two): the same
+/// bits as `Drift::Uncorrected`, step after step, with the Cholesky and the Lanczos
+/// noise and with the springs method's forces. In free space the two differ (the
+/// midpoint is kept there), so the comparison has power.
+#[test]
+fn midpoint_in_a_box_without_bonds_is_euler_maruyama() {
+    use hydrorattle::{Method, NoiseSqrt};
+    let spheres = [
+        ([0.3, -1.2, 2.0], 1.0),
+        ([2.9, 0.4, 1.1], 0.8),
+        ([-1.7, 1.5, -2.2], 1.2),
+    ];
+    let run = |drift: Drift, boxed: bool, sqrt: NoiseSqrt, method: Method| {
+        let mut ps: ParticleSet<f64, 3> = particles(&spheres.map(|(pos, radius)| Sphere {
+            pos,
+            radius,
+            density: 0.0,
+        }));
+        let bonds: BondSet<f64, 1> = BondSet::new();
+        let mut p = thermal::<f64>(0.05, 1.0 / (6.0 * PI), Hydro::Rpy, drift);
+        p.noise_sqrt = sqrt;
+        p.method = method;
+        if boxed {
+            p.periodic = Some(Periodic::new([9.0, 10.0, 11.0]).unwrap());
+        }
+        let mut states = Vec::new();
+        sample(&mut ps, &bonds, &p, 7, 20, |ps| states.push(snapshot(ps)));
+        states
+    };
+    for sqrt in [NoiseSqrt::Cholesky, NoiseSqrt::Lanczos] {
+        for method in [Method::Overdamped, Method::Springs] {
+            let mid = run(Drift::Midpoint, true, sqrt, method);
+            let em = run(Drift::Uncorrected, true, sqrt, method);
+            assert!(mid == em, "{sqrt:?} {method:?}: box");
+        }
+        let free = |d| run(d, false, sqrt, Method::Overdamped);
+        assert!(
+            free(Drift::Midpoint) != free(Drift::Uncorrected),
+            "{sqrt:?}: free space"
+        );
+    }
+}

@@ -1,7 +1,8 @@
 //! Fuzzing the scene parser with a fixed seed: mutated copies of every shipped scene,
 //! every bad scene and the seeds of `tests/data/fuzz` (which cover every table: the
 //! wall, Brownian noise by Cholesky and by Lanczos, FENE, rest length 0, matrix-free,
-//! rotation, hard contacts, f32; each must be among the accepted cases) (lines deleted, duplicated, swapped or cut; numbers replaced by
+//! rotation, hard contacts, f32, a periodic box by the Ewald sum and by PSE, a
+//! suspension; each must be among the accepted cases) (lines deleted, duplicated, swapped or cut; numbers replaced by
 //! hostile ones; keys, tables and bytes, invalid UTF-8 included, inserted). Every case
 //! must return without a panic; a refusal must name the origin and a line inside the
 //! text, in one line; an accepted scene must hold its invariants and write itself
@@ -12,7 +13,7 @@
 
 use std::path::PathBuf;
 
-use hydrorattle_host::scene::{Level, Precision, Scene, Sqrt};
+use hydrorattle_host::scene::{BoxMethod, Level, Precision, Scene, Sqrt};
 use hydrorattle_host::sizing::Limits;
 
 #[path = "../../tests/common/fuzz.rs"]
@@ -58,8 +59,14 @@ const NUMBERS: [&str; 24] = [
     "true",
 ];
 
-const SNIPPETS: [&str; 22] = [
+const SNIPPETS: [&str; 28] = [
     "[wall]\nheight = -5\n",
+    "[box]\nsize = [12, 12, 12]\nmethod = \"pse\"\ntolerance = 1e-4\n",
+    "[box]\nmethod = \"ewald\"\n",
+    "[suspension]\ncount = 20\nfraction = 0.1\npolydispersity = 0.3\n",
+    "method = \"pse\"\n",
+    "tolerance = 1e-9\n",
+    "fraction = 0.34\n",
     "sqrt = \"lanczos\"\n",
     "sqrt = \"cholesky\"\n",
     "fene = 4.0\n",
@@ -147,7 +154,7 @@ fn corpus() -> Vec<String> {
 /// The features the accepted cases must cover, and whether scene `s` has each.
 type Feature = (&'static str, fn(&Scene) -> bool);
 
-const FEATURES: [Feature; 9] = [
+const FEATURES: [Feature; 12] = [
     ("wall", |s| s.wall.is_some()),
     ("noise by Cholesky", |s| noise(s, Sqrt::Cholesky)),
     ("noise by Lanczos", |s| noise(s, Sqrt::Lanczos)),
@@ -157,6 +164,11 @@ const FEATURES: [Feature; 9] = [
     ("rotation", |s| s.model.rotation),
     ("contacts", |s| s.contact.is_some()),
     ("f32", |s| s.integrator.precision == Precision::F32),
+    ("periodic box", |s| s.periodic.is_some()),
+    ("box by PSE", |s| {
+        s.periodic.is_some_and(|b| b.method == BoxMethod::Pse)
+    }),
+    ("suspension", |s| s.suspension.is_some()),
 ];
 
 fn noise(s: &Scene, sqrt: Sqrt) -> bool {

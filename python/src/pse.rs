@@ -1,11 +1,11 @@
 //! `mobility_dot` in a periodic box by the positively split Ewald fast path (the
 //! kernel's `mobility::pse`, `O(N log N)`), and the choice between it and the Ewald sum
-//! by the host library's rule (`hydrorattle_host::scene::pse_fits` and
+//! by the host library's rule (`hydrorattle_host::scene::pse_pays` and
 //! `BoxMethod::resolve`, the rule a scene's `method = "auto"` follows).
 
 use hydrorattle::mobility::pse::{Part, Pse, PseStorage};
 use hydrorattle::{Hydro, Parallel, Periodic, Real, Serial, StepError};
-use hydrorattle_host::scene::{BoxMethod, DEFAULT_BOX_TOLERANCE, pse_fits};
+use hydrorattle_host::scene::{BoxMethod, DEFAULT_BOX_TOLERANCE, pse_pays};
 use hydrorattle_parallel::Threads;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -27,8 +27,8 @@ pub fn method(method: &str, tolerance: Option<f64>) -> PyResult<(BoxMethod, f64)
 }
 
 /// Whether the product runs by PSE: in a box, `"pse"`, or `"auto"` where the product
-/// needs translation only with the RPY level (what PSE gives) and PSE's parameters fit
-/// the kernel's bounds. `"pse"` where PSE cannot serve is a `ValueError` saying why.
+/// needs translation only with the RPY level (what PSE gives) and PSE runs there and
+/// costs less than the Ewald sum (the measured cost model, `pse_pays`). `"pse"` where PSE cannot serve is a `ValueError` saying why.
 pub fn uses_pse(
     (m, tolerance): (BoxMethod, f64),
     cell: Option<[f64; 3]>,
@@ -61,7 +61,7 @@ pub fn uses_pse(
             range.end()
         )));
     }
-    let fits = products && pse_fits(size, a_max, tolerance);
+    let fits = products && pse_pays(size, radii.len(), a_max, tolerance);
     Ok(m.resolve(fits) == BoxMethod::Pse)
 }
 

@@ -230,15 +230,20 @@ pub(super) fn kick<T: Real>(
         at_mid,
     } = krylov;
 
+    // In a box without bonds to project onto, the midpoint's mean is `kT dt div M`,
+    // zero for the box's RPY mobility (each Fourier mode is transverse, `P(k) k = 0`),
+    // so the midpoint (a second assembly on the Ewald path, a solve of some 30 to 50
+    // products on PSE's) is left out: the uncorrected draw, whose covariance is `M`
+    // exactly. In free space the midpoint stays (the run's bits are kept there).
+    let bonded = held.as_ref().is_some_and(|h| !h.bonds.is_empty());
+    let drift = match s.ewald.is_some() && !bonded {
+        true => Drift::Uncorrected,
+        false => b.drift,
+    };
     // On the PSE path the noise is PSE's own (`pse_noise`): no product with the whole
-    // mobility but the midpoint's solve. Without bonds to project onto, the midpoint's
-    // mean is `kT dt div M`, zero for the box's RPY mobility (each Fourier mode is
-    // transverse, `P(k) k = 0`), so the midpoint (a solve of some 30 to 50 products)
-    // is left out: the uncorrected draw, whose covariance is `M` exactly.
+    // mobility but the midpoint's solve.
     #[cfg(feature = "pse")]
     if let Some(sums) = s.ewald.and_then(|e| e.pse()) {
-        let bonded = held.as_ref().is_some_and(|h| !h.bonds.is_empty());
-        let drift = if bonded { b.drift } else { Drift::Uncorrected };
         let vectors = (&mut *xi, &mut *mid, &mut *dx);
         let iterations = super::pse_noise::draw(p, drift, s, sums, noise, vectors, basis, work)?;
         let projected = match drift {
@@ -274,7 +279,7 @@ pub(super) fn kick<T: Real>(
         }
     };
     let (mut iterations, mut projected) = (0, 0);
-    match b.drift {
+    match drift {
         Drift::Uncorrected => {
             if lanczos {
                 iterations = lanczos::sqrt(p.lanczos, product, xi, basis, work, dx, None)

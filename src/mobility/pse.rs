@@ -52,6 +52,25 @@ pub const MIN_TOLERANCE: f64 = 1e-12;
 /// See [`MIN_TOLERANCE`].
 pub const MAX_TOLERANCE: f64 = 0.1;
 
+/// The largest sphere PSE takes, as a fraction of the box's smallest edge (radius
+/// below it): from a third of the edge on, the rule's parameters miss the tolerance
+/// against the Ewald sum (measured error over tolerance, one to three spheres: at most
+/// 0.26 at 0.3 of the edge, 0.90 at 0.35, 1.19 at 0.38, 2.2 at 0.42, 4.5 at 0.48;
+/// `tests/pse.rs`). The Ewald path takes any sphere below half the edge.
+pub const MAX_RADIUS_FRACTION: f64 = 1.0 / 3.0;
+
+/// Machine epsilons of the precision below which no tolerance is accepted: the FFTs'
+/// and sums' rounding leaves a relative error of about 4 to 7 epsilons in `f32`
+/// (4e-7 to 7e-7 against the Ewald sum whatever the tolerance asked below 1e-6), so
+/// `f32` takes tolerances from 1.9e-6 on; `f64`'s floor is [`MIN_TOLERANCE`].
+pub const EPSILONS: f64 = 16.0;
+
+/// The smallest tolerance PSE accepts in precision `T`: [`MIN_TOLERANCE`], or
+/// [`EPSILONS`] epsilons of `T` where that is larger (`f32`).
+pub fn min_tolerance<T: Real>() -> f64 {
+    MIN_TOLERANCE.max(EPSILONS * T::EPSILON.to_f64())
+}
+
 /// A rejected PSE parameter, configuration or storage.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PseError {
@@ -65,6 +84,15 @@ pub enum PseError {
     /// The real-space noise's Lanczos square root failed (not converged, or the near
     /// field not positive definite: `docs/PERIODIC.md`, section PSE).
     Lanczos(LanczosError),
+    /// The largest radius is at least [`MAX_RADIUS_FRACTION`] of the box's smallest
+    /// edge, where PSE misses its tolerance (the Ewald path is the tool there).
+    LargeSphere,
+    /// The tolerance is below what the precision can reach ([`min_tolerance`], the
+    /// floor given).
+    Precision {
+        /// The smallest tolerance this precision accepts.
+        floor: f64,
+    },
     /// Caller storage too small (`need` and `have` per array).
     Storage {
         /// Values needed: complex values, indices and vectors ([`Pse::storage`]); for
@@ -81,6 +109,14 @@ impl fmt::Display for PseError {
             Self::Periodic(e) => write!(f, "{e}"),
             Self::GridTooLarge => write!(f, "the PSE tolerance needs too large a grid"),
             Self::Lanczos(e) => write!(f, "PSE real-space noise: {e}"),
+            Self::LargeSphere => write!(
+                f,
+                "a sphere's radius is at least a third of the box's smallest edge, where PSE misses its tolerance: use the Ewald sum"
+            ),
+            Self::Precision { floor } => write!(
+                f,
+                "the PSE tolerance is below what this precision can reach ({floor:e})"
+            ),
             Self::Length => write!(
                 f,
                 "PSE: positions, radii, forces and output differ in length"

@@ -5,7 +5,7 @@
 
 use std::fmt;
 
-use hydrorattle::particles::{check_pairs, sphere_volume};
+use hydrorattle::particles::sphere_volume;
 use hydrorattle::{Bond, BondError, Params, ParticleError, Real, Solver, State};
 
 use super::sizing::TooLarge;
@@ -61,9 +61,11 @@ impl<T: Real> Beads<T> {
         Ok(beads)
     }
 
-    /// Nested spheres are refused; overlapping ones unless `allow_overlap`.
+    /// Nested spheres are refused; overlapping ones unless `allow_overlap`: the
+    /// kernel's `check_pairs` over its cell list (`O(N)` pairs, the same error).
     pub fn check_pairs(&self, allow_overlap: bool) -> Result<(), ParticleError> {
-        check_pairs(&self.pos, &self.radius, allow_overlap)
+        let mut store = vec![0; hydrorattle::cell_list::indices(self.len())];
+        hydrorattle::cell_list::check_pairs_in(&self.pos, &self.radius, allow_overlap, &mut store)
     }
 
     /// Number of particles.

@@ -179,43 +179,127 @@ pub(super) fn resolve_bonds(
 }
 
 /// Refuses nested spheres, and overlapping ones unless `overlap` allows them, at the
-/// later sphere; in a periodic box through the minimum image.
+/// later sphere; in a periodic box through the minimum image. The pairs come from the
+/// kernel's cell list (`O(N)` of them; the first in the order "later sphere, then
+/// earlier", as the all-pairs loop meets them).
 pub(super) fn check_geometry(
     particles: &[Particle],
     overlap: Overlap,
     periodic: Option<&super::PeriodicBox>,
     spans: &BodySpans,
 ) -> Result<(), Issue> {
+    use hydrorattle::cell_list::{PairOrder, first_pair, indices};
     let cell = periodic.and_then(super::PeriodicBox::kernel);
-    for j in 0..particles.len() {
-        for i in 0..j {
-            let (p, q) = (&particles[i], &particles[j]);
-            let s = match cell {
-                None => distance(p.position, q.position),
-                Some(c) => {
-                    let d = DVec3::from(q.position) - DVec3::from(p.position);
-                    c.minimum_image(d).length()
-                }
-            };
-            if s <= (p.radius - q.radius).abs() {
-                return Err(issue(
-                    spans.position(j),
-                    format!(
-                        "particle {j} and particle {i} are nested (centre distance {s}, radii {} and {}): one sphere inside another is not a valid configuration",
-                        q.radius, p.radius
-                    ),
-                ));
-            }
-            if overlap == Overlap::Reject && s < p.radius + q.radius {
-                return Err(issue(
-                    spans.position(j),
-                    format!(
-                        "particle {j} overlaps particle {i} at t = 0 (centre distance {s} < {}); if that is meant, say so with [model] overlap = \"allow\"",
-                        p.radius + q.radius
-                    ),
-                ));
+    let sep = |i: usize, j: usize| {
+        let (p, q) = (&particles[i], &particles[j]);
+        match cell {
+            None => distance(p.position, q.position),
+            Some(c) => {
+                let d = DVec3::from(q.position) - DVec3::from(p.position);
+                c.minimum_image(d).length()
             }
         }
+    };
+    let nested =
+        |i: usize, j: usize, s: f64| s <= (particles[i].radius - particles[j].radius).abs();
+    let overlaps = |i: usize, j: usize, s: f64| {
+        overlap == Overlap::Reject && s < particles[i].radius + particles[j].radius
+    };
+    let pos: Vec<DVec3> = particles.iter().map(|p| DVec3::from(p.position)).collect();
+    // Either test needs `s <= |a_i| + |a_j|`.
+    let reach = 2.0
+        * particles
+            .iter()
+            .fold(0.0, |m: f64, p| m.max(p.radius.abs()));
+    let mut store = vec![0; indices(particles.len())];
+    let order = PairOrder::LaterFirst;
+    let found = first_pair(&pos, cell.as_ref(), reach, order, &mut store, |i, j| {
+        let s = sep(i, j);
+        nested(i, j, s) || overlaps(i, j, s)
+    });
+    let Some((i, j)) = found else {
+        return Ok(());
+    };
+    let (p, q, s) = (&particles[i], &particles[j], sep(i, j));
+    let message = match nested(i, j, s) {
+        true => format!(
+            "particle {j} and particle {i} are nested (centre distance {s}, radii {} and {}): one sphere inside another is not a valid configuration",
+            q.radius, p.radius
+        ),
+        false => format!(
+            "particle {j} overlaps particle {i} at t = 0 (centre distance {s} < {}); if that is meant, say so with [model] overlap = \"allow\"",
+            p.radius + q.radius
+        ),
+    };
+    Err(issue(spans.position(j), message))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{BoxMethod, PeriodicBox};
+
+    /// Random configurations (dilute to crowded, nested spheres planted in some), in
+    /// free space and in a box: the cell list's verdict is the all-pairs loop's (written
+    /// here: the first pair by later sphere, then earlier), the same pair and message.
+    #[test]
+    fn geometry_check_agrees_with_every_pair() {
+        let mut g = hydrorattle::Noise::new(3);
+        let (mut refused, mut passed) = (0, 0);
+        for case in 0..60 {
+            let n = [70, 150][case % 2];
+            let spread = [6.0, 12.0, 25.0][case % 3];
+            let mut particles: Vec<Particle> = (0..n)
+                .map(|_| Particle {
+                    position: [0; 3].map(|_| g.uniform() * spread),
+                    radius: 0.2 + g.uniform(),
+                    ..Particle::default()
+                })
+                .collect();
+            if case % 4 == 1 {
+                particles[n - 2].position = particles[3].position;
+                particles[n - 2].position[0] += 0.05;
+                (particles[3].radius, particles[n - 2].radius) = (1.2, 0.3);
+            }
+            let boxed = PeriodicBox {
+                size: [spread, spread * 0.8, spread * 1.3],
+                method: BoxMethod::Ewald,
+                tolerance: 1e-6,
+                method_line: None,
+            };
+            let cell = boxed.kernel();
+            let spans = BodySpans::Helix(case..case + 1);
+            for periodic in [None, Some(&boxed)] {
+                for overlap in [Overlap::Reject, Overlap::Allow] {
+                    let sep = |p: &Particle, q: &Particle| match periodic.and(cell) {
+                        None => distance(p.position, q.position),
+                        Some(c) => c
+                            .minimum_image(DVec3::from(q.position) - DVec3::from(p.position))
+                            .length(),
+                    };
+                    let want = (0..n)
+                        .flat_map(|j| (0..j).map(move |i| (i, j)))
+                        .find(|&(i, j)| {
+                            let (p, q) = (&particles[i], &particles[j]);
+                            let s = sep(p, q);
+                            s <= (p.radius - q.radius).abs()
+                                || (overlap == Overlap::Reject && s < p.radius + q.radius)
+                        });
+                    let got = check_geometry(&particles, overlap, periodic, &spans);
+                    match (want, got) {
+                        (None, Ok(())) => passed += 1,
+                        (Some((i, j)), Err(e)) => {
+                            let names = format!("particle {j} ");
+                            let m = &e.message;
+                            assert!(m.starts_with(&names), "{m} vs {i}, {j}");
+                            assert!(m.contains(&format!("particle {i} ")), "{m}");
+                            refused += 1;
+                        }
+                        (w, r) => panic!("case {case}: {w:?} vs {:?}", r.err().map(|e| e.message)),
+                    }
+                }
+            }
+        }
+        assert!(refused > 40 && passed > 20, "{refused} / {passed}");
     }
-    Ok(())
 }

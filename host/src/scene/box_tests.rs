@@ -64,19 +64,19 @@ fn pse_runs_where_products_suffice_and_is_refused_at_its_line_elsewhere() {
     };
     let s = with("pse", "");
     let why = s.needs_matrix();
-    // "pse" and "auto" run on PSE where products suffice (matrix-free, written back).
+    // "pse" runs on PSE where products suffice (matrix-free, written back); "auto"
+    // takes it where it is also the cheaper path, not for two spheres (the cost model).
     assert_eq!(why, None);
-    {
-        for m in ["pse", "auto"] {
-            let s = with(m, "");
-            assert!(s.check_box_runs(None).is_ok());
-            let run = s.with_box_resolved();
-            assert_eq!(run.periodic.unwrap().method, BoxMethod::Pse, "{m}");
-            assert!(run.integrator.matrix_free);
-            assert!(run.to_toml().contains("method = \"pse\""));
-            assert!(run.to_toml().contains("matrix_free = true"));
-        }
-    }
+    let s = with("pse", "");
+    assert!(s.check_box_runs(None).is_ok());
+    let run = s.with_box_resolved();
+    assert_eq!(run.periodic.unwrap().method, BoxMethod::Pse);
+    assert!(run.integrator.matrix_free);
+    assert!(run.to_toml().contains("method = \"pse\""));
+    assert!(run.to_toml().contains("matrix_free = true"));
+    let run = with("auto", "").with_box_resolved();
+    assert_eq!(run.periodic.unwrap().method, BoxMethod::Ewald);
+    assert!(!run.integrator.matrix_free);
     // A scene that needs the assembled matrix: "pse" refused at its line, "auto" is Ewald.
     let mut s = with("pse", "");
     s.integrator.method = super::Method::RattleStable;
@@ -99,8 +99,8 @@ fn pse_runs_where_products_suffice_and_is_refused_at_its_line_elsewhere() {
 }
 
 /// `compact_products` in a box: with `method = "ewald"` the kernel keeps the compact copy
-/// (at the 700 beads it needs: `Params::compact_copy`); `"auto"` resolves a
-/// deterministic overdamped scene to PSE, which stores nothing, and the flag is ignored.
+/// (at the 700 beads it needs: `Params::compact_copy`); on PSE, which stores nothing,
+/// the flag is ignored.
 #[test]
 fn compact_products_in_a_box_take_the_ewald_path_only() {
     let with = |m: &str| {
@@ -115,9 +115,9 @@ fn compact_products_in_a_box_take_the_ewald_path_only() {
     let ewald = params::<f64>(&with("ewald"));
     assert!(ewald.periodic.is_some() && ewald.pse.is_none() && ewald.compact_products);
     assert!(ewald.compact_copy(700, 699));
-    let auto = params::<f64>(&with("auto"));
-    assert!(auto.pse.is_some() && auto.matrix_free && auto.compact_products);
-    assert!(!auto.compact_copy(700, 699));
+    let pse = params::<f64>(&with("pse"));
+    assert!(pse.pse.is_some() && pse.matrix_free && pse.compact_products);
+    assert!(!pse.compact_copy(700, 699));
 }
 
 #[test]

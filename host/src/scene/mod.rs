@@ -47,6 +47,9 @@
 pub mod auto;
 mod beads;
 mod bodies;
+pub mod box_cost;
+#[cfg(test)]
+mod box_cost_tests;
 #[cfg(test)]
 mod box_tests;
 mod contact;
@@ -71,6 +74,7 @@ mod wall;
 mod write;
 
 pub use beads::{Beads, BuildError, bonds, params, pins};
+pub use box_cost::pse_pays;
 pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE, SOFT_DT, SOFT_STIFFNESS};
 pub use error::{SceneError, line_col};
 pub use floor::{Floor, slab_fraction};

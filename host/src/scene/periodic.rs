@@ -48,15 +48,14 @@ pub enum BoxMethod {
 
 impl BoxMethod {
     /// The method a run uses: `"auto"` is `"pse"` where the scene needs mobility
-    /// products only (`products_only`, [`Scene::products_only`](super::Scene::products_only)),
-    /// `"ewald"` otherwise. Why not a crossover in `N`: the PSE product was measured
-    /// cheaper than the dense Ewald product at every size tried, from N = 10 (1.8 to
-    /// 3.4 times) to 400 (16 to 41 times), at tolerances 1e-3 to 1e-6
-    /// (`docs/PERIODIC.md`, PSE, crossover); what decides is whether the run needs the
-    /// assembled matrix. `"ewald"` and `"pse"` are themselves.
-    pub fn resolve(self, products_only: bool) -> BoxMethod {
+    /// products only and PSE is the cheaper path there (`pse_pays`: the measured cost
+    /// model of [`super::box_cost`], in the sphere count, the box and the tolerance),
+    /// `"ewald"` otherwise. A dilute box is Ewald's: a lone sphere in a box of 50 costs
+    /// PSE a grid of 80^3 points (0.15 s a product against 5e-5 s). `"ewald"` and
+    /// `"pse"` are themselves.
+    pub fn resolve(self, pse_pays: bool) -> BoxMethod {
         match self {
-            BoxMethod::Auto if products_only => BoxMethod::Pse,
+            BoxMethod::Auto if pse_pays => BoxMethod::Pse,
             BoxMethod::Auto => BoxMethod::Ewald,
             m => m,
         }
@@ -121,6 +120,26 @@ impl RawBox {
     pub(super) fn method_at(&self) -> Option<usize> {
         self.method.as_ref().map(|m| m.span().start)
     }
+
+    /// The method as written (`"auto"` when left out).
+    pub(super) fn method(&self) -> BoxMethod {
+        self.method
+            .as_ref()
+            .map_or(BoxMethod::Auto, |m| *m.get_ref())
+    }
+
+    /// Span of `method`, else of `tolerance`, else of `size`, when given.
+    pub(super) fn method_span(&self) -> Option<std::ops::Range<usize>> {
+        let method = self.method.as_ref().map(|m| m.span());
+        method
+            .or_else(|| self.tolerance_span())
+            .or_else(|| self.size_span())
+    }
+
+    /// Span of `tolerance`, when given.
+    pub(super) fn tolerance_span(&self) -> Option<std::ops::Range<usize>> {
+        self.tolerance.as_ref().map(|t| t.span())
+    }
 }
 
 /// Resolves `[box]`; `size` is the suspension generator's edge when the scene has one
@@ -182,7 +201,7 @@ pub(super) fn resolve(
             ),
         ));
     }
-    let method = r.method.as_ref().map_or(BoxMethod::Auto, |m| *m.get_ref());
+    let method = r.method();
     Ok(PeriodicBox {
         size,
         method,
@@ -264,32 +283,42 @@ pub fn pse_fits(size: [f64; 3], a_max: f64, tolerance: f64) -> bool {
         .is_ok_and(|cell| hydrorattle::mobility::pse::Pse::new(cell, a_max, tolerance).is_ok())
 }
 
+/// What in a scene of this model, integrator and noise needs the assembled mobility
+/// (so PSE cannot run it), or `None` where mobility products suffice: the overdamped
+/// or springs method (matrix-free), `level = "manual"` (the automatic level may pick
+/// another method), no rotation, the `"auto"` or `"krylov"` solver (Sweep and Newton
+/// read single blocks) and no Cholesky noise. Known before the body is generated, so
+/// that a scene is sized for the path it will run.
+pub fn needs_matrix(
+    model: &super::Model,
+    i: &super::Integrator,
+    brownian: Option<super::Thermal>,
+) -> Option<&'static str> {
+    use super::{Level, Method, Solver, Sqrt};
+    if !matches!(i.method, Method::Overdamped | Method::Springs) {
+        return Some("a method other than overdamped or springs");
+    }
+    if model.level != Level::Manual {
+        return Some("level = \"auto\" (it may pick another method)");
+    }
+    if model.rotation {
+        return Some("rotation");
+    }
+    if matches!(i.solver, Solver::Sweep | Solver::Newton) {
+        return Some("the sweep or newton solver");
+    }
+    let thermal = brownian.is_some_and(|b| b.temperature > 0.0);
+    if thermal && brownian.is_some_and(|b| b.sqrt == Sqrt::Cholesky) {
+        return Some("[brownian] sqrt = \"cholesky\"");
+    }
+    None
+}
+
 impl super::Scene {
     /// What in this scene needs the assembled mobility (so PSE cannot run it), or
-    /// `None` where mobility products suffice: the overdamped or springs method
-    /// (matrix-free), `level = "manual"` (the automatic level may pick another method),
-    /// no rotation, the `"auto"` or `"krylov"` solver (Sweep and Newton read single
-    /// blocks) and no Cholesky noise.
+    /// `None` where mobility products suffice ([`needs_matrix`]).
     pub fn needs_matrix(&self) -> Option<&'static str> {
-        use super::{Level, Method, Solver, Sqrt};
-        let i = &self.integrator;
-        if !matches!(i.method, Method::Overdamped | Method::Springs) {
-            return Some("a method other than overdamped or springs");
-        }
-        if self.model.level != Level::Manual {
-            return Some("level = \"auto\" (it may pick another method)");
-        }
-        if self.model.rotation {
-            return Some("rotation");
-        }
-        if matches!(i.solver, Solver::Sweep | Solver::Newton) {
-            return Some("the sweep or newton solver");
-        }
-        let thermal = self.brownian.is_some_and(|b| b.temperature > 0.0);
-        if thermal && self.brownian.is_some_and(|b| b.sqrt == Sqrt::Cholesky) {
-            return Some("[brownian] sqrt = \"cholesky\"");
-        }
-        None
+        needs_matrix(&self.model, &self.integrator, self.brownian)
     }
 
     /// Whether this scene needs mobility products only ([`needs_matrix`](Self::needs_matrix)).
@@ -301,24 +330,26 @@ impl super::Scene {
     /// `"auto"` becomes the method it picks, so the run's `scene.toml` re-runs the
     /// same path); a run on PSE is matrix-free (`matrix_free = true`, written back).
     pub fn with_box_resolved(mut self) -> super::Scene {
-        let products = self.products_only() && self.pse_fits();
+        let only = self.products_only();
+        let pays = only && self.pse_pays();
         if let Some(b) = self.periodic.as_mut() {
-            b.method = b.method.resolve(products);
-            if b.method == BoxMethod::Pse && products {
+            b.method = b.method.resolve(pays);
+            if b.method == BoxMethod::Pse && only {
                 self.integrator.matrix_free = true;
             }
         }
         self
     }
 
-    /// Whether PSE's parameters for this box, its largest radius and its tolerance fit
-    /// the kernel's bounds ([`pse_fits`]).
-    fn pse_fits(&self) -> bool {
+    /// Whether PSE runs this box, its largest radius and its tolerance, and costs less
+    /// than the Ewald sum for its spheres ([`super::box_cost::pse_pays`]).
+    fn pse_pays(&self) -> bool {
         let Some(b) = self.periodic else {
             return true;
         };
-        let a_max = self.radii().into_iter().fold(0.0, f64::max);
-        pse_fits(b.size, a_max, b.tolerance)
+        let radii = self.radii();
+        let a_max = radii.iter().fold(0.0, |m: f64, &a| m.max(a));
+        super::box_cost::pse_pays(b.size, radii.len(), a_max, b.tolerance)
     }
 
     /// Refuses a run of a box whose method is `"pse"` where the scene needs the

@@ -128,13 +128,22 @@ impl RawScene {
             // stays a number a scene file can hold.
             Some(e) => (*e.get_ref()).min(integrator.steps()),
         };
+        // A box PSE will sum (named, or "auto" where products suffice: the sizes where
+        // storage matters are PSE's) is sized without the stored mobility; its grid is
+        // checked once the box is known (`box_cost::check_pse`).
+        let products = super::periodic::needs_matrix(&model, &integrator, brownian).is_none();
+        let pse = match self.periodic.as_ref().map(|b| b.get_ref().method()) {
+            Some(super::BoxMethod::Pse) => true,
+            Some(super::BoxMethod::Auto) => products,
+            _ => false,
+        };
         let plans = plans(
             &model,
             &integrator,
             &flow,
             contact,
             brownian,
-            wall.is_some(),
+            (wall.is_some(), pse),
         );
         let every_span = self
             .output
@@ -156,6 +165,10 @@ impl RawScene {
         };
         if let Some(b) = &periodic {
             super::periodic::check_particles(b, &body.particles, &body.spans)?;
+        }
+        if let (Some(b), Some(raw)) = (&periodic, &self.periodic) {
+            let counts = (&body.particles[..], body.bonds.len());
+            super::box_cost::check_pse(b, raw, counts, &plans, limits.storage)?;
         }
         check_geometry(
             &body.particles,

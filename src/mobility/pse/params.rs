@@ -17,7 +17,10 @@ impl<T: Real> Pse<T> {
     }
 
     /// Parameters for a splitting parameter `xi` and a relative tolerance
-    /// `tol` in `[1e-12, 0.1]`. With `D = ln(1/tol)`:
+    /// `tol` in `[1e-12, 0.1]` (from [`min_tolerance`](super::min_tolerance) on in the
+    /// precision `T`), spheres of radius below
+    /// [`MAX_RADIUS_FRACTION`](super::MAX_RADIUS_FRACTION) of the smallest edge. With
+    /// `D = ln(1/tol)`:
     ///
     /// * `p^2 = D + 3/2 ln(p^2) + 2 ln(1 + (a_max xi p)^2 / 2)` (a fixed point): the
     ///   Ewald path's rule (the last term, the sphere factors' growth) plus the growth
@@ -46,8 +49,16 @@ impl<T: Real> Pse<T> {
             return Err(PeriodicError::BadParameter("largest radius").into());
         }
         let size = cell.size();
-        if !(a_max + a_max < size[0].min(size[1]).min(size[2])) {
+        let smallest = size[0].min(size[1]).min(size[2]);
+        if !(a_max + a_max < smallest) {
             return Err(PeriodicError::SphereTooLarge.into());
+        }
+        if !(a_max.to_f64() < super::MAX_RADIUS_FRACTION * smallest.to_f64()) {
+            return Err(PseError::LargeSphere);
+        }
+        let floor = super::min_tolerance::<T>();
+        if tol < floor {
+            return Err(PseError::Precision { floor });
         }
         // The rule in f64 whatever T.
         let (x, a, dig) = (xi.to_f64(), a_max.to_f64(), -libm::log(tol));

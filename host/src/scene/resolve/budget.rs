@@ -30,14 +30,14 @@ pub(super) fn check_output(
 }
 
 /// What sizes the scene's storage: its own method, or with `level = "auto"` each method
-/// the rules may pick.
+/// the rules may pick; in a box summed by PSE (`pse`) without the stored mobility.
 pub(super) fn plans(
     model: &Model,
     integrator: &Integrator,
     flow: &Flow,
     contact: Option<Contact>,
     brownian: Option<Thermal>,
-    wall: bool,
+    (wall, pse): (bool, bool),
 ) -> Vec<Plan> {
     let plan = |(method, rotation)| Plan {
         method,
@@ -49,7 +49,7 @@ pub(super) fn plans(
         wall,
         matrix_free: integrator.matrix_free,
         compact_products: integrator.compact_products,
-        pse: false,
+        pse,
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],
