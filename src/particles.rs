@@ -224,9 +224,20 @@ pub fn check_pairs<T: Real>(
     radius: &[T],
     allow_overlap: bool,
 ) -> Result<(), ParticleError> {
+    check_pairs_in(pos, radius, allow_overlap, None)
+}
+
+/// [`check_pairs`] in the periodic box `cell` when given: each pair through the
+/// minimum image (spheres that overlap through a face are refused as the step would).
+pub fn check_pairs_in<T: Real>(
+    pos: &[T::V3],
+    radius: &[T],
+    allow_overlap: bool,
+    cell: Option<&crate::cell::Periodic<T>>,
+) -> Result<(), ParticleError> {
     for i in 0..pos.len() {
         for j in i + 1..pos.len() {
-            let s = T::norm(pos[i] - pos[j]);
+            let s = T::norm(crate::cell::image(cell, pos[i] - pos[j]));
             let (ai, aj) = (radius[i], radius[j]);
             if s == T::ZERO {
                 return Err(ParticleError::Coincident { i, j });
