@@ -84,3 +84,16 @@ def test_ctrl_c_stops_run_scene_between_steps_and_the_run_resumes(tmp_path):
     hr.run_scene(ref_path, tmp_path / "ref")
     for name in ("trajectory.xyz", "observables.csv"):
         assert (out / name).read_bytes() == (tmp_path / "ref" / name).read_bytes(), name
+
+
+def test_a_huge_until_is_printed_short(tmp_path):
+    path = tmp_path / "short.toml"
+    path.write_text(SCENE.format(dt=DT, duration=1.0))
+    hr.run_scene(path, tmp_path / "out", checkpoint_every=0.5)
+    try:
+        hr.resume_run(tmp_path / "out", until=1e300)
+    except (RuntimeError, ValueError) as e:
+        message = str(e)
+    else:
+        raise AssertionError("resumed to 1e300")
+    assert "1e300" in message and len(message) < 400, message

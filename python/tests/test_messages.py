@@ -96,5 +96,6 @@ def test_a_refused_bond_names_its_index():
 
 def test_set_state_names_time():
     s = hr.System([[0.0, 0, 0]], 1.0, 2.0, dt=0.1)
-    with pytest.raises(TypeError, match="time"):
+    with pytest.raises(TypeError) as e:
         s.set_state(time="x")
+    assert str(e.value).startswith("time must be a real number"), str(e.value)
