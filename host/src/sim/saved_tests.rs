@@ -123,3 +123,15 @@ fn pins_survive_a_save_and_restore() {
     // The pinned sphere stayed where it was put; the other one settled onto it.
     assert_eq!(b.beads.pos[0], [0.0; 3].into());
 }
+
+#[test]
+fn spheres_in_contact_within_the_tolerance_load() {
+    // Touching to within the solver's tolerance, as a step with hard contacts leaves
+    // them: a state a step accepted loads; without contacts the overlap is refused.
+    let pos = [[0.0; 3], [2.0 - 1e-12, 0.0, 0.0]];
+    let contacts = engine(&pos, |p| p.contacts = Some(Contacts::new(4)));
+    assert!(reloaded(&contacts, |_| {}).is_ok());
+    let plain = engine(&pos, |_| {});
+    let err = reloaded(&plain, |_| {}).err().expect("an overlap loaded");
+    assert!(err.contains("overlap"), "{err}");
+}
