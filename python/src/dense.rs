@@ -50,12 +50,14 @@ fn band<T: Real>(packed: &[T::M3], blocks: usize, i0: usize, out: &mut [T]) {
 }
 
 /// The `(3 blocks) x (3 blocks)` dense matrix of the packed symmetric `packed`
-/// (`tri(blocks)` blocks), row-major, its [`BANDS`] bands of rows run through `par`.
-pub fn write_dense<T: Real>(packed: &[T::M3], blocks: usize, par: &dyn Parallel) -> Vec<T> {
+/// (`tri(blocks)` blocks) into `out` (`(3 blocks)^2` values: NumPy's new array, whose
+/// fresh pages the bands fault in parallel), row-major, its [`BANDS`] bands of rows run
+/// through `par`.
+pub fn write_dense<T: Real>(packed: &[T::M3], blocks: usize, par: &dyn Parallel, out: &mut [T]) {
     let m = 3 * blocks;
-    let mut out = vec![T::ZERO; m * m];
+    debug_assert_eq!(out.len(), m * m);
     if blocks == 0 {
-        return out;
+        return;
     }
     let rows = blocks.div_ceil(BANDS);
     let mut jobs: Vec<_> = out
@@ -68,5 +70,4 @@ pub fn write_dense<T: Real>(packed: &[T::M3], blocks: usize, par: &dyn Parallel)
         .map(|j| j as &mut (dyn FnMut() + Send))
         .collect();
     par.run(&mut refs);
-    out
 }

@@ -179,6 +179,23 @@ pub fn particle_error(py: Python<'_>, e: ParticleError) -> PyErr {
     )
 }
 
+/// A `ValueError` with `message` about particle `index`, of the kernel's `kind` for
+/// `like` (a refusal the package words itself, where the kernel's words would mislead).
+pub fn particle_message(
+    py: Python<'_>,
+    message: String,
+    index: usize,
+    like: ParticleError,
+) -> PyErr {
+    let kind = kind_of(py, KStep::Particle(like));
+    let index = index_of(py, None, Some(index));
+    with_attrs(
+        py,
+        PyValueError::new_err(message),
+        &[("index", index), ("kind", kind)],
+    )
+}
+
 /// The kernel's kind of `e` as a Python string.
 fn kind_of(py: Python<'_>, e: KStep) -> Py<PyAny> {
     e.kind()
@@ -189,17 +206,25 @@ fn kind_of(py: Python<'_>, e: KStep) -> Py<PyAny> {
 /// A kernel error met outside a step (the mobility alone, a system's construction) as
 /// a `ValueError` with the kernel's message and `kind` (and `index` for a particle).
 pub fn value_error(py: Python<'_>, e: KStep) -> PyErr {
-    if let KStep::Particle(p) = e {
-        return particle_error(py, p);
+    match e {
+        KStep::Particle(p) => return particle_error(py, p),
+        KStep::Bond(b) => return bond_error(py, b),
+        _ => {}
     }
     let kind = kind_of(py, e);
     with_attrs(py, PyValueError::new_err(e.to_string()), &[("kind", kind)])
 }
 
-/// A refused bond as a `ValueError` naming it.
+/// A refused bond as a `ValueError` naming it (`index`: the bond, or the particle of a
+/// refused tree).
 pub fn bond_error(py: Python<'_>, e: BondError) -> PyErr {
     let kind = kind_of(py, KStep::Bond(e));
-    with_attrs(py, PyValueError::new_err(e.to_string()), &[("kind", kind)])
+    let index = index_of(py, None, e.index());
+    with_attrs(
+        py,
+        PyValueError::new_err(e.to_string()),
+        &[("index", index), ("kind", kind)],
+    )
 }
 
 /// A scene error as `SceneError` with `file`, `line` and `column`.

@@ -3,12 +3,12 @@
 //! layouts); they are read here without a copy.
 
 use hydrorattle::particles::{check_one, check_pairs};
-use hydrorattle::{Particle, Real};
+use hydrorattle::{Particle, ParticleError, Periodic, Real};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::errors::particle_error;
+use crate::errors::{particle_error, particle_message};
 
 /// The `(N, 3)` rows of `a` as `[x, y, z]` (a `ValueError` for another shape).
 pub fn rows<'a>(a: &'a PyReadonlyArray2<'_, f64>, what: &str) -> PyResult<&'a [[f64; 3]]> {
@@ -103,4 +103,62 @@ pub fn is_f32(precision: &str) -> PyResult<bool> {
             "precision must be 'f64' or 'f32', not {precision:?}"
         ))),
     }
+}
+
+/// The periodic box of edges `edges` in precision `T`: finite, positive edges whose
+/// volume `T` holds (the Ewald and PSE parameters derive from it); a `ValueError`
+/// saying which otherwise.
+pub fn cell<T: Real>(edges: [f64; 3]) -> PyResult<Periodic<T>> {
+    let c = Periodic::new(edges.map(T::from_f64))
+        .map_err(|e| PyValueError::new_err(format!("box: {e}")))?;
+    if !c.volume().is_finite() {
+        return Err(PyValueError::new_err(format!(
+            "box: edges {edges:?} are too large: their volume overflows {} (the Ewald and PSE parameters derive from it)",
+            std::any::type_name::<T>()
+        )));
+    }
+    Ok(c)
+}
+
+/// Spheres in the box `edges`, checked as the CLI checks a scene's: every radius below
+/// half the smallest edge (a sphere would overlap its own image), and every centre
+/// within `1 / sqrt(eps)` edges of the origin in precision `T` (farther, its place in
+/// the box, all the minimum image sees, keeps less than half its digits, and spheres
+/// far apart look nested). A `ValueError` naming the particle (`index`) otherwise;
+/// NaN passes here, for the particle check to name it.
+pub fn in_box<T: Real>(
+    py: Python<'_>,
+    edges: [f64; 3],
+    pos: &[[f64; 3]],
+    radii: &[f64],
+) -> PyResult<()> {
+    let half = edges.iter().fold(f64::INFINITY, |m, &l| m.min(l)) / 2.0;
+    if let Some(k) = radii.iter().position(|&a| a >= half) {
+        return Err(particle_message(
+            py,
+            format!(
+                "particle {k} has radius {}, not below half the box's smallest edge ({half}): it would overlap its own image",
+                radii[k]
+            ),
+            k,
+            ParticleError::BadRadius { particle: k },
+        ));
+    }
+    let reach = 1.0 / T::EPSILON.to_f64().sqrt();
+    for (k, x) in pos.iter().enumerate() {
+        if let Some(d) = (0..3).find(|&d| x[d].abs() > reach * edges[d]) {
+            return Err(particle_message(
+                py,
+                format!(
+                    "particle {k} is at {:?}, more than {reach:.3e} box edges ({}) from the origin along axis {d}: in {} its place in the box would keep less than half its digits",
+                    x,
+                    edges[d],
+                    std::any::type_name::<T>()
+                ),
+                k,
+                ParticleError::NonFinite { particle: k },
+            ));
+        }
+    }
+    Ok(())
 }

@@ -12,6 +12,7 @@
 
 use pyo3::prelude::*;
 
+mod alloc;
 mod dense;
 mod errors;
 mod input;
@@ -31,6 +32,7 @@ fn _hydrorattle(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mobility::mobility, m)?)?;
     m.add_function(wrap_pyfunction!(mobility::mobility_dot, m)?)?;
     m.add_function(wrap_pyfunction!(runs::run_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(runs::resume_run, m)?)?;
     m.add_function(wrap_pyfunction!(runs::read_trajectory, m)?)?;
     m.add_function(wrap_pyfunction!(runs::load_scene_json, m)?)?;
     m.add_class::<system::Core>()?;

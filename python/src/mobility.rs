@@ -8,13 +8,14 @@ use std::sync::{Arc, Mutex, OnceLock};
 use hydrorattle::integrate::geometry;
 use hydrorattle::linalg::{sym_matvec, tri};
 use hydrorattle::parallel::{band_scratch, bands};
-use hydrorattle::{Hydro, Parallel, Params, Periodic, Real, Serial, Wall};
+use hydrorattle::{Hydro, Parallel, Params, Real, Serial, Wall};
 use hydrorattle_parallel::Threads;
 use numpy::ndarray::Array2;
-use numpy::{Element, IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{Element, IntoPyArray, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+use crate::alloc;
 use crate::dense::write_dense;
 use crate::errors::value_error;
 use crate::input::{column, is_f32, rows, spheres};
@@ -36,10 +37,24 @@ impl Geometry {
         p.rotation = rotation;
         p.wall = self.wall.map(|h| Wall::new(T::from_f64(h)));
         if let Some(c) = self.cell {
-            let cell = Periodic::new(c.map(T::from_f64));
-            p.periodic = Some(cell.map_err(|e| PyValueError::new_err(format!("box: {e}")))?);
+            p.periodic = Some(crate::input::cell::<T>(c)?);
         }
         Ok(p)
+    }
+
+    /// The spheres checked against the box, if any ([`crate::input::in_box`]).
+    fn spheres_fit(
+        &self,
+        py: Python<'_>,
+        f32: bool,
+        pos: &[[f64; 3]],
+        radii: &[f64],
+    ) -> PyResult<()> {
+        match (self.cell, f32) {
+            (Some(c), true) => crate::input::in_box::<f32>(py, c, pos, radii),
+            (Some(c), false) => crate::input::in_box::<f64>(py, c, pos, radii),
+            (None, _) => Ok(()),
+        }
     }
 }
 
@@ -61,20 +76,37 @@ fn dense<'py, T: Real + Element>(
     threads: usize,
 ) -> PyResult<Bound<'py, PyArray2<T>>> {
     let p = g.params::<T>(eta, level, rotation)?;
-    let (pos, r) = spheres::<T>(py, pos, radii, None)?;
     let n = pos.len();
+    let what = format!("mobility of {n} spheres");
     let blocks = if rotation { 2 * n } else { n };
-    let mut packed = vec![T::M3_ZERO; tri(blocks)];
+    let side = blocks.checked_mul(3);
+    let out_len = side.and_then(|m| m.checked_mul(m));
+    alloc::Need::new(&what)
+        .add::<T::M3>("packed blocks", alloc::packed(blocks))
+        .add::<T>("output", out_len)
+        .check()?;
+    let (pos, r) = spheres::<T>(py, pos, radii, None)?;
+    // Both arrays before any work. The output is NumPy's own zeros: fresh pages
+    // (faulted by the bands in parallel), NumPy's `MemoryError` where they are refused.
+    let m = 3 * blocks;
+    let dtype = numpy::dtype::<T>(py);
+    let array = py
+        .import("numpy")?
+        .call_method1("zeros", ((m, m), dtype))?
+        .cast_into::<PyArray2<T>>()?;
+    let mut packed = alloc::filled(&what, "packed blocks", tri(blocks), T::M3_ZERO)?;
     let filled = py.detach(|| match rotation {
         true => geometry::mobility_grand(&p, &pos, &r, &mut packed),
         false => geometry::mobility_tt(&p, &pos, &r, &mut packed),
     });
     filled.map_err(|e| value_error(py, e))?;
     let par = threads_for(blocks, threads)?;
-    let out = py.detach(|| write_dense::<T>(&packed, blocks, par_of(&par)));
-    Ok(Array2::from_shape_vec((3 * blocks, 3 * blocks), out)
-        .expect("3 rows and columns per block")
-        .into_pyarray(py))
+    {
+        let mut rw = array.readwrite();
+        let out = rw.as_slice_mut()?;
+        py.detach(|| write_dense::<T>(&packed, blocks, par_of(&par), out));
+    }
+    Ok(array)
 }
 
 /// Dense mobility matrix; see the Python docstring of `hydrorattle.mobility`.
@@ -98,6 +130,7 @@ pub fn mobility<'py>(
     let eta = crate::input::viscosity(viscosity)?;
     let level = crate::input::hydro(hydro)?;
     let g = geometry(wall, r#box);
+    g.spheres_fit(py, is_f32(precision)?, pos, radii)?;
     Ok(if is_f32(precision)? {
         dense::<f32>(py, pos, radii, eta, level, rotation, g, threads)?.into_any()
     } else {
@@ -180,8 +213,12 @@ fn product<'py, T: Real + Element>(
         || vec![T::V3_ZERO; n],
         |t| t.iter().map(|&x| T::v3_from(x)).collect(),
     ));
+    let what = format!("mobility_dot of {n} spheres with rotation");
+    alloc::Need::new(&what)
+        .add::<T::M3>("packed grand mobility", alloc::packed(2 * n))
+        .check()?;
     let mut y = vec![T::V3_ZERO; 2 * n];
-    let mut packed = vec![T::M3_ZERO; tri(2 * n)];
+    let mut packed = alloc::filled(&what, "packed grand mobility", tri(2 * n), T::M3_ZERO)?;
     py.detach(|| {
         geometry::mobility_grand(&p, &pos, &r, &mut packed)?;
         sym_matvec::<T>(&packed, 2 * n, &x, &mut y);
@@ -247,6 +284,7 @@ pub fn mobility_dot<'py>(
     let eta = crate::input::viscosity(viscosity)?;
     let level = crate::input::hydro(hydro)?;
     let g = geometry(wall, r#box);
+    g.spheres_fit(py, is_f32(precision)?, pos, radii)?;
     let asked = crate::pse::method(method, tolerance)?;
     let rotation = rotation || t.is_some();
     if let Some(size) = r#box.filter(|_| wall.is_none()) {
@@ -285,7 +323,6 @@ fn pse_product<'py, T: Real + Element>(
     let par = threads_for(n, threads)?;
     let mut u = vec![T::V3_ZERO; n];
     let par = par.as_deref();
-    py.detach(|| crate::pse::product::<T>(size, tolerance, eta, &pos, &r, &f, &mut u, par))
-        .map_err(|e| value_error(py, e))?;
+    crate::pse::product::<T>(py, size, tolerance, eta, &pos, &r, &f, &mut u, par)?;
     Ok(to_array::<T>(py, &u))
 }

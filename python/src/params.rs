@@ -1,7 +1,7 @@
 //! Kernel parameters from keyword arguments, with the kernel's names and defaults.
 
 use hydrorattle::{
-    Brownian, Contacts, Drift, Method, Named, NoiseSqrt, Params, Periodic, Real, SolverKind, Wall,
+    Brownian, Contacts, Drift, Method, Named, NoiseSqrt, Params, Real, SolverKind, Wall,
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -82,6 +82,20 @@ fn count<X: TryFrom<i128>>(k: &str, x: &Bound<'_, PyAny>) -> PyResult<X> {
     })
 }
 
+/// Largest contact capacity: a scene's `[contact] capacity` bound.
+const MAX_CAPACITY: usize = 1 << 32;
+
+/// A hard-contact capacity, from 1 to [`MAX_CAPACITY`] as in a scene.
+fn capacity(x: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let c: usize = count("contacts", x)?;
+    if !(1..=MAX_CAPACITY).contains(&c) {
+        return Err(PyValueError::new_err(format!(
+            "contacts (the capacity) must be a whole number from 1 to 2^32 (contacts at once), not {c}"
+        )));
+    }
+    Ok(c)
+}
+
 /// Kernel parameters in precision `T` from keyword arguments with the kernel's names
 /// and defaults ([`Params::new`]); the seed and thread count come back beside them.
 /// A value of the wrong type is a `TypeError`, a value out of range a `ValueError`,
@@ -132,17 +146,15 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
             "resolve_tensions" => p.resolve_tensions = flag(k, &x)?,
             "contacts" => {
                 p.contacts = (!x.is_none())
-                    .then(|| count::<usize>(k, &x))
+                    .then(|| capacity(&x))
                     .transpose()?
                     .map(Contacts::new);
             }
             "wall" => p.wall = (!x.is_none()).then(|| real(&x)).transpose()?.map(Wall::new),
             "box" => {
                 if !x.is_none() {
-                    let edges = v3(&x)?;
-                    let cell = Periodic::new(T::xyz(edges));
-                    p.periodic =
-                        Some(cell.map_err(|e| PyValueError::new_err(format!("box: {e}")))?);
+                    let edges = get::<[f64; 3]>(k, &x, "three real numbers")?;
+                    p.periodic = Some(crate::input::cell::<T>(edges)?);
                 }
             }
             "temperature" => temperature = (!x.is_none()).then(|| real(&x)).transpose()?,

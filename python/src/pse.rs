@@ -10,6 +10,9 @@ use hydrorattle_parallel::Threads;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+use crate::alloc;
+use crate::errors::value_error;
+
 /// The box method asked for (`"auto"`, `"ewald"`, `"pse"`) and the tolerance (PSE's
 /// relative error; default the scenes' [`DEFAULT_BOX_TOLERANCE`]).
 pub fn method(method: &str, tolerance: Option<f64>) -> PyResult<(BoxMethod, f64)> {
@@ -66,9 +69,11 @@ pub fn uses_pse(
 }
 
 /// `u = M f` in the box `size` by PSE to `tolerance` (viscosity `eta`), its pieces run
-/// by `par` (the same bits on any number of threads).
+/// by `par` (the same bits on any number of threads); the storage sized and reserved
+/// first ([`alloc`]), the product run with the GIL released.
 #[allow(clippy::too_many_arguments)]
 pub fn product<T: Real>(
+    py: Python<'_>,
     size: [f64; 3],
     tolerance: f64,
     eta: f64,
@@ -77,19 +82,29 @@ pub fn product<T: Real>(
     f: &[T::V3],
     u: &mut [T::V3],
     par: Option<&Threads>,
-) -> Result<(), StepError> {
-    let cell = Periodic::new(size.map(T::from_f64)).map_err(StepError::from)?;
+) -> PyResult<()> {
+    let fail = |e: StepError| value_error(py, e);
+    let cell = Periodic::new(size.map(T::from_f64)).map_err(|e| fail(e.into()))?;
     let a_max = radius.iter().fold(T::ZERO, |m, &a| m.max(a));
-    let pse = Pse::new(cell, a_max, tolerance)?;
+    let pse = Pse::new(cell, a_max, tolerance).map_err(|e| fail(e.into()))?;
     let need = pse.storage(pos.len());
-    let mut complex = vec![[T::ZERO; 2]; need.complex];
-    let mut index = vec![0usize; need.index];
-    let mut vectors = vec![T::V3_ZERO; need.vectors];
-    let store = PseStorage::new(&mut complex, &mut index, &mut vectors);
-    let par: &dyn Parallel = match par {
-        Some(t) => t,
-        None => &Serial,
-    };
-    let mut store = store.with_parallel(par);
-    Ok(pse.apply(Part::Both, T::from_f64(eta), pos, radius, f, u, &mut store)?)
+    let what = format!("mobility_dot of {} spheres by PSE", pos.len());
+    alloc::Need::new(&what)
+        .add::<[T; 2]>("grid", Some(need.complex))
+        .add::<usize>("cell list", Some(need.index))
+        .add::<T::V3>("vectors", Some(need.vectors))
+        .check()?;
+    let mut complex = alloc::filled(&what, "grid", need.complex, [T::ZERO; 2])?;
+    let mut index = alloc::filled(&what, "cell list", need.index, 0usize)?;
+    let mut vectors = alloc::filled(&what, "vectors", need.vectors, T::V3_ZERO)?;
+    py.detach(|| {
+        let store = PseStorage::new(&mut complex, &mut index, &mut vectors);
+        let par: &dyn Parallel = match par {
+            Some(t) => t,
+            None => &Serial,
+        };
+        let mut store = store.with_parallel(par);
+        pse.apply(Part::Both, T::from_f64(eta), pos, radius, f, u, &mut store)
+    })
+    .map_err(|e| fail(e.into()))
 }

@@ -8,17 +8,29 @@
 //! * a second `step` or a `set_state` while a `step(n)` runs raises `SystemBusyError`;
 //! * a read from inside the step itself (a force callable reading the system) raises
 //!   `SystemBusyError` too, naming what to read instead: the lock is not reentrant.
+//!
+//! The lock is fair to readers: a reader that finds it taken says so (`waiting`), and
+//! the stepping call gives way between two steps until the waiting readers have had
+//! it ([`Shared::give_way`]). A plain mutex lets the stepping thread, which unlocks
+//! and locks again within microseconds, win it step after step while a reader sleeps
+//! between tries: a read then waited for tens of steps.
 
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, MutexGuard, TryLockError};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use pyo3::prelude::*;
 
 use crate::errors::SystemBusyError;
 
-/// How long a waiting reader sleeps between tries (GIL released).
+/// How long a waiting reader sleeps between tries (GIL released), and a stepping
+/// call between its looks for waiting readers.
 const WAIT: Duration = Duration::from_micros(50);
+
+/// The longest a stepping call gives way to waiting readers between two steps (a
+/// reader that needs the GIL back from a busy Python thread may take Python's switch
+/// interval, 5 ms, to come).
+const GIVE_WAY: Duration = Duration::from_millis(20);
 
 /// This thread's number (0 is nobody's).
 fn me() -> u64 {
@@ -42,6 +54,8 @@ pub struct Shared<X> {
     owner: AtomicU64,
     /// A `step(n)` call is running.
     stepping: AtomicBool,
+    /// Readers waiting for the lock.
+    waiting: AtomicUsize,
 }
 
 /// The lock held for one step; the owner mark goes with it.
@@ -85,6 +99,7 @@ impl<X> Shared<X> {
             inner: Mutex::new(x),
             owner: AtomicU64::new(0),
             stepping: AtomicBool::new(false),
+            waiting: AtomicUsize::new(0),
         }
     }
 
@@ -97,14 +112,40 @@ impl<X> Shared<X> {
                  positions it is passed, not the system)",
             ));
         }
-        loop {
+        let mut marked = false;
+        let guard = loop {
             match self.inner.try_lock() {
-                Ok(g) => return Ok(g),
+                Ok(g) => break g,
                 // A panic cannot leave the engine half-stepped: a step commits last.
-                Err(TryLockError::Poisoned(p)) => return Ok(p.into_inner()),
-                Err(TryLockError::WouldBlock) => py.detach(|| std::thread::sleep(WAIT)),
+                Err(TryLockError::Poisoned(p)) => break p.into_inner(),
+                Err(TryLockError::WouldBlock) => {
+                    if !marked {
+                        self.waiting.fetch_add(1, Ordering::AcqRel);
+                        marked = true;
+                    }
+                    py.detach(|| std::thread::sleep(WAIT));
+                }
             }
+        };
+        if marked {
+            self.waiting.fetch_sub(1, Ordering::AcqRel);
         }
+        Ok(guard)
+    }
+
+    /// Between two steps of a `step(n)` call: waits (at most [`GIVE_WAY`]) while
+    /// readers wait for the lock, so that each gets it before the next step. Called
+    /// without the GIL (the readers need it to take their turn).
+    pub fn give_way(&self) {
+        let start = Instant::now();
+        while self.waiting.load(Ordering::Acquire) > 0 && start.elapsed() < GIVE_WAY {
+            std::thread::sleep(WAIT);
+        }
+    }
+
+    /// Whether a reader waits for the lock.
+    pub fn readers_waiting(&self) -> bool {
+        self.waiting.load(Ordering::Acquire) > 0
     }
 
     /// As [`Shared::read`], for a change of the state: `SystemBusyError` while a

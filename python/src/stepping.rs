@@ -6,6 +6,7 @@
 use std::time::{Duration, Instant};
 
 use hydrorattle::{Real, StepError};
+use hydrorattle_host::sim::retry::Retries;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -59,10 +60,15 @@ fn call_back(py: Python<'_>, every: Option<&Every>, done: usize) -> PyResult<()>
 fn free_steps(shared: &Shared<Inner>, n: usize, every: Option<&Every>) -> PyResult<Report> {
     let mut last = empty(0);
     let mut checked = Instant::now();
+    let mut start = None;
     for done in 1..=n {
+        shared.give_way();
         let r: Result<Report, StepError> = {
             let mut g = shared.step_lock();
-            each!(&mut *g, e, T => e.step().map(|r| Report::of::<T>(&r, done)))
+            each!(&mut *g, e, T => {
+                let from = *start.get_or_insert(e.retries);
+                e.step().map(|r| Report::of::<T>(&r, done, since(e.retries, from)))
+            })
         };
         last = r.map_err(|k| Python::attach(|py| completed(py, step_error(py, k), done - 1)))?;
         if every.is_some_and(|c| done.is_multiple_of(c.every)) {
@@ -85,9 +91,14 @@ fn held_steps(
     every: Option<&Every>,
 ) -> PyResult<Report> {
     let mut last = empty(0);
+    let mut start = None;
     for done in 1..=n {
+        if shared.readers_waiting() {
+            py.detach(|| shared.give_way());
+        }
         let mut g = shared.step_lock();
         let r = each!(&mut *g, e, T => {
+            let from = *start.get_or_insert(e.retries);
             let mut failed: Option<PyErr> = None;
             let mut extra = |pos: &[<T as Real>::V3], _: &[T], out: &mut [<T as Real>::V3]| {
                 if failed.is_some() {
@@ -103,7 +114,9 @@ fn held_steps(
             let r = e.step_with(&mut extra);
             match failed {
                 Some(err) => Err(err),
-                None => r.map(|r| Report::of::<T>(&r, done)).map_err(|k| step_error(py, k)),
+                None => r
+                    .map(|r| Report::of::<T>(&r, done, since(e.retries, from)))
+                    .map_err(|k| step_error(py, k)),
             }
         });
         drop(g);
@@ -137,6 +150,17 @@ pub fn empty(steps: usize) -> Report {
         contact_rounds: 0,
         noise_iterations: 0,
         steps,
+        retried_steps: 0,
+        retry_substeps: 0,
+    }
+}
+
+/// The retries counted from `from` to `now` (the engine's totals at a call's start and
+/// after its latest step).
+fn since(now: Retries, from: Retries) -> Retries {
+    Retries {
+        steps: now.steps - from.steps,
+        substeps: now.substeps - from.substeps,
     }
 }
 

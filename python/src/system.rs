@@ -3,6 +3,7 @@
 
 use hydrorattle::{Bond, Noise, Real, StepReport};
 use hydrorattle_host::scene::Scene;
+use hydrorattle_host::sim::retry::Retries;
 use hydrorattle_host::sim::{Beads, Engine, Saved, resolve_level};
 use hydrorattle_host::sizing::DEFAULT_LIMIT;
 use numpy::ndarray::{Array1, Array2};
@@ -14,7 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{bond_error, scene_error, value_error};
-use crate::input::{column, is_f32, rows, spheres};
+use crate::input::{column, in_box, is_f32, rows, spheres};
 use crate::params::params_from;
 use crate::shared::Shared;
 use crate::stepping::{Every, steps};
@@ -41,20 +42,33 @@ pub struct Report {
     pub noise_iterations: u32,
     /// Steps made by this call.
     pub steps: usize,
+    /// Steps of this call the kernel refused at full length and that were made as 2,
+    /// 4, ... shorter steps along a Brownian bridge instead (thermal runs only; the
+    /// CLI's `retried_steps`).
+    pub retried_steps: u64,
+    /// The shorter steps those retries took.
+    pub retry_substeps: u64,
 }
 
 #[pymethods]
 impl Report {
     fn __repr__(&self) -> String {
         format!(
-            "Report(steps={}, iterations={}, residual={:e}, max_tension={}, contacts={})",
-            self.steps, self.iterations, self.residual, self.max_tension, self.contacts
+            "Report(steps={}, iterations={}, residual={:e}, max_tension={}, contacts={}, retried_steps={})",
+            self.steps,
+            self.iterations,
+            self.residual,
+            self.max_tension,
+            self.contacts,
+            self.retried_steps
         )
     }
 }
 
 impl Report {
-    pub fn of<T: Real>(r: &StepReport<T>, steps: usize) -> Self {
+    /// The report of step `steps` of a call, `r` the kernel's, with the retries of the
+    /// call so far (`retried`: the engine's count now less at the call's start).
+    pub fn of<T: Real>(r: &StepReport<T>, steps: usize, retried: Retries) -> Self {
         Report {
             iterations: r.iterations,
             velocity_iterations: r.velocity_iterations,
@@ -65,6 +79,8 @@ impl Report {
             contact_rounds: r.contact_rounds,
             noise_iterations: r.noise_iterations,
             steps,
+            retried_steps: retried.steps,
+            retry_substeps: retried.substeps,
         }
     }
 }
@@ -132,6 +148,9 @@ fn engine_from<T: Real>(
     kw: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Engine<T>> {
     let (params, extras) = params_from::<T>(kw)?;
+    if let Some(c) = params.periodic {
+        in_box::<T>(py, c.size().map(|l| l.to_f64()), pos, radii)?;
+    }
     let (p, r) = spheres::<T>(py, pos, radii, Some(densities))?;
     let n = p.len();
     let index = |k: usize, i: i64| -> PyResult<usize> {
@@ -338,6 +357,14 @@ impl Core {
     #[getter]
     fn dt(&self, py: Python<'_>) -> PyResult<f64> {
         Ok(each!(&*self.shared.read(py)?, e, T => { let t: T = e.params.dt; t.to_f64() }))
+    }
+
+    /// The periodic box's edges `(Lx, Ly, Lz)`, or None.
+    #[getter]
+    fn cell(&self, py: Python<'_>) -> PyResult<Option<[f64; 3]>> {
+        Ok(each!(&*self.shared.read(py)?, e, T => {
+            e.params.periodic.map(|c| c.size().map(|l: T| l.to_f64()))
+        }))
     }
 
     /// "f64" or "f32".

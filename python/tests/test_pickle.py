@@ -2,8 +2,10 @@
 (issue 30 item 2), and the ASE round trip."""
 
 import copy
+import json
 import multiprocessing
 import pickle
+import struct
 
 import numpy as np
 import pytest
@@ -113,3 +115,120 @@ def test_ase_round_trip():
     assert np.allclose(u.densities, s.densities, rtol=1e-12)
     with pytest.raises(ValueError, match="radii"):
         hr.System.from_atoms(ase.Atoms("X2", positions=[[0, 0, 0], [3, 0, 0]]), dt=0.1)
+
+
+def saved(s):
+    return json.loads(s._core.save_json())
+
+
+def load(record):
+    return hr._restore_system(json.dumps(record))
+
+
+def test_a_damaged_record_is_refused_on_load_as_the_constructor_refuses_it():
+    s = build(("rattle", None), 4, 3, "f64")
+    s.step(2)
+    good = saved(s)
+    load(good)  # the record as saved loads
+
+    def damaged(change):
+        r = copy.deepcopy(good)
+        change(r)
+        return r
+
+    nan = struct.unpack("<Q", struct.pack("<d", float("nan")))[0]
+    zero = 0
+    cases = {
+        "NaN position": lambda r: r["pos"].__setitem__(0, nan),
+        "radius 0": lambda r: r["radius"].__setitem__(1, zero),
+        "dt 0": lambda r: r["params"].__setitem__("dt", zero),
+        "coincident spheres": lambda r: r["pos"].__setitem__(slice(3, 6), r["pos"][0:3]),
+        "short multipliers": lambda r: r.__setitem__("multipliers", r["multipliers"][:-1]),
+        "unknown key": lambda r: r.__setitem__("colour", "red"),
+        "unknown parameter": lambda r: r["params"].__setitem__("colour", "red"),
+    }
+    for name, change in cases.items():
+        # A pickle whose record was damaged in transit: refused as it loads.
+        data = pickle.dumps(Record(json.dumps(damaged(change))))
+        with pytest.raises(ValueError, match="saved system") as e:
+            pickle.loads(data)
+        assert name and e.value
+
+
+class Record:
+    """A pickle of a system's record as System.__reduce__ writes one."""
+
+    def __init__(self, text):
+        self.text = text
+
+    def __reduce__(self):
+        return (hr._restore_system, (self.text,))
+
+
+PINNED = """
+[[particle]]
+position = [0, 0, 0]
+radius = 1.0
+density = 2.0
+fixed = true
+
+[[particle]]
+position = [0, 0, 2.5]
+radius = 1.0
+density = 2.0
+
+[[particle]]
+position = [2.5, 0, 2.5]
+radius = 1.0
+density = 2.0
+
+[[bond]]
+between = [1, 2]
+
+[contact]
+model = "hard"
+
+[integrator]
+method = "overdamped"
+dt = 0.05
+duration = 1.0
+"""
+
+
+def test_a_pinned_sphere_stays_pinned_through_a_pickle():
+    s = hr.System.from_scene_text(PINNED)
+    s.step(3)
+    t = pickle.loads(pickle.dumps(s))
+    same(s, t)
+    s.step(10)
+    t.step(10)
+    same(s, t)
+    # The pin held the first sphere where it was put.
+    assert np.array_equal(t.positions[0], [0.0, 0.0, 0.0])
+
+
+def test_ase_round_trip_carries_the_box():
+    ase = pytest.importorskip("ase")
+    box = (9.0, 10.0, 11.0)
+    pos = np.array([[1.0, 1.0, 1.0], [4.0, 1.0, 1.0], [8.5, 9.0, 1.0]])
+    s = hr.System(pos, 1.0, 2.0, dt=0.1, box=box)
+    assert s.box == box
+    atoms = s.to_atoms()
+    assert tuple(atoms.pbc) == (True, True, True)
+    assert np.array_equal(atoms.cell[:], np.diag(box))
+    t = hr.System.from_atoms(atoms, dt=0.1)
+    assert t.box == box
+    s.step(3)
+    t.step(3)
+    assert s.state_bits() == t.state_bits()
+    # Free space stays free space; a box on some axes only, or a skewed cell, is refused.
+    free = hr.System(pos, 1.0, 2.0, dt=0.1)
+    assert free.box is None and not any(free.to_atoms().pbc)
+    assert hr.System.from_atoms(free.to_atoms(), dt=0.1).box is None
+    atoms.pbc = (True, True, False)
+    with pytest.raises(ValueError, match="some axes"):
+        hr.System.from_atoms(atoms, dt=0.1)
+    atoms.pbc = True
+    atoms.cell[0, 1] = 1.0
+    with pytest.raises(ValueError, match="diagonal"):
+        hr.System.from_atoms(atoms, dt=0.1)

@@ -73,10 +73,23 @@ pub fn check_pairs_in<T: Real>(
     allow_overlap: bool,
     store: &mut [usize],
 ) -> Result<(), ParticleError> {
+    check_pairs_periodic(pos, radius, allow_overlap, None, store)
+}
+
+/// [`check_pairs_in`] in the periodic box `cell` when given: each pair through the
+/// minimum image, so spheres that overlap through a face are refused as the step
+/// would refuse them.
+pub fn check_pairs_periodic<T: Real>(
+    pos: &[T::V3],
+    radius: &[T],
+    allow_overlap: bool,
+    cell: Option<&Periodic<T>>,
+    store: &mut [usize],
+) -> Result<(), ParticleError> {
     let n = pos.len().min(radius.len());
     let (pos, radius) = (&pos[..n], &radius[..n]);
     let verdict = |i: usize, j: usize| {
-        let s = T::norm(pos[i] - pos[j]);
+        let s = T::norm(crate::cell::image(cell, pos[i] - pos[j]));
         let (ai, aj) = (radius[i], radius[j]);
         if s == T::ZERO {
             Some(ParticleError::Coincident { i, j })
@@ -90,7 +103,7 @@ pub fn check_pairs_in<T: Real>(
     };
     // Both tests need `s <= |a_i| + |a_j|` (signed radii included).
     let cutoff = radius.iter().fold(T::ZERO, |m, &a| m.max(a.abs())) * T::TWO;
-    let found = first_pair(pos, None, cutoff, PairOrder::EarlierFirst, store, |i, j| {
+    let found = first_pair(pos, cell, cutoff, PairOrder::EarlierFirst, store, |i, j| {
         verdict(i, j).is_some()
     });
     match found.and_then(|(i, j)| verdict(i, j)) {

@@ -61,11 +61,17 @@ impl<T: Real> Beads<T> {
         Ok(beads)
     }
 
-    /// Nested spheres are refused; overlapping ones unless `allow_overlap`: the
-    /// kernel's `check_pairs` over its cell list (`O(N)` pairs, the same error).
-    pub fn check_pairs(&self, allow_overlap: bool) -> Result<(), ParticleError> {
+    /// Nested spheres are refused; overlapping ones unless `allow_overlap` (in the
+    /// periodic box `cell`, through the minimum image): the kernel's `check_pairs` over
+    /// its cell list (`O(N)` pairs, the same error).
+    pub fn check_pairs(
+        &self,
+        allow_overlap: bool,
+        cell: Option<&hydrorattle::cell::Periodic<T>>,
+    ) -> Result<(), ParticleError> {
         let mut store = vec![0; hydrorattle::cell_list::indices(self.len())];
-        hydrorattle::cell_list::check_pairs_in(&self.pos, &self.radius, allow_overlap, &mut store)
+        let (pos, radius) = (&self.pos, &self.radius);
+        hydrorattle::cell_list::check_pairs_periodic(pos, radius, allow_overlap, cell, &mut store)
     }
 
     /// Number of particles.

@@ -50,6 +50,12 @@ pub fn frame_bytes(n: usize) -> f64 {
 /// [`Layout`] nor its byte total overflows.
 const COUNT_MAX: usize = (usize::MAX >> 10).isqrt();
 
+/// Whether the storage of `n` particles and `constraints` constraints (bonds,
+/// contacts, wall rows) can be counted: both at most [`COUNT_MAX`].
+pub fn sizable(n: usize, constraints: usize) -> bool {
+    n <= COUNT_MAX && constraints <= COUNT_MAX
+}
+
 /// A run whose step storage would exceed the limit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TooLarge {
@@ -154,7 +160,7 @@ impl Plan {
         let c = b
             .saturating_add(contacts.unwrap_or(0))
             .saturating_add(walls);
-        (n <= COUNT_MAX && c <= COUNT_MAX).then(|| {
+        sizable(n, c).then(|| {
             let mut p = Params::<f64>::new(1.0);
             p.method = self.method.kernel();
             p.rotation = self.rotation;

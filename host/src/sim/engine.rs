@@ -68,7 +68,7 @@ impl<T: Real> Engine<T> {
         // The plan sizes thermal noise too (the factor or the Lanczos basis).
         let layout = Plan::of(scene).check(n, b, limit)?;
         let beads = Beads::<T>::new(&scene.particles, 1.0)?;
-        beads.check_pairs(scene.model.overlap == Overlap::Allow)?;
+        beads.check_pairs(scene.model.overlap == Overlap::Allow, p.periodic.as_ref())?;
         let bonds = bonds::<T>(&scene.bonds, n)?;
         let noise = Noise::new(scene.brownian.map_or(DEFAULT_SEED, |b| b.seed));
         let contact = scene.contact.and_then(|c| c.soft()).map(|k| SoftContact {
@@ -91,8 +91,38 @@ impl<T: Real> Engine<T> {
         contact: Option<SoftContact<T>>,
         limit: usize,
     ) -> Result<Self, BuildError> {
-        let layout = Layout::for_params(&params, beads.len(), bonds.len());
-        Self::with_layout(beads, bonds, params, noise, contact, layout, limit)
+        Self::from_rows(beads, bonds, Vec::new(), params, noise, contact, limit)
+    }
+
+    /// [`Engine::from_parts`] with pin rows (checked by the caller), sized for the
+    /// bonds and the pins together as [`Engine::new`] sizes a scene's.
+    pub(super) fn from_rows(
+        beads: Beads<T>,
+        bonds: Vec<Bond<T>>,
+        pins: Vec<Bond<T>>,
+        params: Params<T>,
+        noise: Noise,
+        contact: Option<SoftContact<T>>,
+        limit: usize,
+    ) -> Result<Self, BuildError> {
+        let (n, b) = (beads.len(), bonds.len() + pins.len());
+        // Counted as the scenes' plan counts them (saturating), before the kernel's
+        // layout arithmetic, which a contact capacity of 2^62 would overflow.
+        let capacity = params.contacts.map_or(0, |c| c.capacity);
+        let walls = if params.wall.is_some() { n } else { 0 };
+        if !crate::sizing::sizable(n, b.saturating_add(capacity).saturating_add(walls)) {
+            return Err(TooLarge {
+                particles: n,
+                bonds: b,
+                bytes: None,
+                limit,
+            }
+            .into());
+        }
+        let layout = Layout::for_params(&params, n, b);
+        let mut e = Self::with_layout(beads, bonds, params, noise, contact, layout, limit)?;
+        e.pins = pins;
+        Ok(e)
     }
 
     /// Storage for `layout`, within `limit` bytes.
@@ -166,11 +196,13 @@ impl<T: Real> Engine<T> {
     /// The checks the kernel's step makes of its inputs (parameters, particles, bonds,
     /// thermal noise, contacts, wall, box: [`hydrorattle::check_step`]) and of every
     /// pair (nested or coincident spheres; overlapping ones unless
-    /// [`Params::allow_overlap`]), without stepping. A front end asks it when it builds
+    /// [`Params::allow_overlap`]; in a periodic box through the minimum image), without
+    /// stepping. A front end asks it when it builds
     /// a system, so that what the first step would refuse (`dt = 0`, spheres
     /// overlapping at the start) is refused there, as a parameter error.
     pub fn check(&mut self) -> Result<(), StepError> {
-        self.beads.check_pairs(self.params.allow_overlap)?;
+        let cell = self.params.periodic.as_ref();
+        self.beads.check_pairs(self.params.allow_overlap, cell)?;
         let mut state = self.beads.state();
         state.noise = Some(&mut self.noise);
         let rows = match self.pins.is_empty() {

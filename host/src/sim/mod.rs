@@ -27,6 +27,8 @@ mod record;
 pub mod retry;
 mod run_loop;
 mod saved;
+#[cfg(test)]
+mod saved_tests;
 pub mod stop;
 mod tail;
 
@@ -405,9 +407,10 @@ pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Resul
     let at = checkpoint.time();
     let dt = scene.integrator.dt;
     // Compared in whole steps below (the checkpoint's time is a sum of steps, a few
-    // ulps off the multiple of dt that `until` names).
+    // ulps off the multiple of dt that `until` names). Times print as `{:?}`: 1e300
+    // as `1e300`, not as its 301 digits.
     if !(until.is_finite() && until > 0.0) {
-        bail!("--until {until} must be a time at or after the checkpoint's t = {at}");
+        bail!("--until {until:?} must be a time at or after the checkpoint's t = {at:?}");
     }
     if checkpoint.precision != scene.integrator.precision {
         bail!(
@@ -421,11 +424,11 @@ pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Resul
     // is `scene.toml`'s own, as this program writes it, with the new duration.
     let origin = scene_path.display().to_string();
     let scene = Scene::parse_limited(&scene.to_toml(), &origin, limits)
-        .with_context(|| format!("resuming to --until {until}"))?;
+        .with_context(|| format!("resuming to --until {until:?}"))?;
     let steps = scene.integrator.steps() as u64;
     if steps < checkpoint.step {
         bail!(
-            "--until {until} must be a time at or after the checkpoint's t = {at} (step {} of dt = {dt})",
+            "--until {until:?} must be a time at or after the checkpoint's t = {at:?} (step {} of dt = {dt:?})",
             checkpoint.step
         );
     }

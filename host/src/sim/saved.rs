@@ -18,8 +18,10 @@ use crate::sizing::DEFAULT_LIMIT;
 /// Format version of [`Saved`].
 const VERSION: u32 = 1;
 
-/// The parameters, floats as `f64` bits, names as the kernel's ([`Named`]).
+/// The parameters, floats as `f64` bits, names as the kernel's ([`Named`]). A key
+/// no system writes is a corrupt record (refused, not ignored).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SavedParams {
     dt: u64,
     viscosity: u64,
@@ -50,8 +52,10 @@ pub struct SavedParams {
     resolve_tensions: bool,
 }
 
-/// A system as plain data ([`Engine::save`], [`Engine::restore`]).
+/// A system as plain data ([`Engine::save`], [`Engine::restore`]); unknown keys are
+/// refused.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Saved {
     version: u32,
     /// The precision the system steps in.
@@ -63,6 +67,10 @@ pub struct Saved {
     density: Vec<u64>,
     time: u64,
     bonds: Vec<(usize, usize, u64)>,
+    /// The pin rows of fixed spheres ([`Engine::pins`]); absent in systems saved
+    /// before the key (none).
+    #[serde(default)]
+    pins: Vec<(usize, usize, u64)>,
     params: SavedParams,
     noise: [u64; 6],
     contact: Option<u64>,
@@ -189,6 +197,7 @@ impl<T: Real> Engine<T> {
             density: s(&beads.density),
             time: b(beads.time),
             bonds: self.bonds.iter().map(|x| (x.i, x.j, b(x.length))).collect(),
+            pins: self.pins.iter().map(|x| (x.i, x.j, b(x.length))).collect(),
             params: SavedParams::of(&self.params),
             noise: self.noise.save(),
             contact: self.contact.map(|c| b(c.stiffness)),
@@ -201,7 +210,9 @@ impl<T: Real> Engine<T> {
 
     /// The system [`Engine::save`] saved (its storage allocated again); an error for a
     /// record no system saves (another version, a name or generator state no system
-    /// has, arrays of the wrong lengths, refused particles or bonds).
+    /// has, arrays of the wrong lengths, multipliers for other than its bonds), and for
+    /// what a system's construction refuses ([`Engine::check`]: parameters, particles,
+    /// bonds, pairs), so that a damaged record fails here, not at its first step.
     pub fn restore(s: &Saved) -> Result<Self, String> {
         if s.version != VERSION {
             return Err(format!(
@@ -236,8 +247,33 @@ impl<T: Real> Engine<T> {
         let noise = Noise::restore(s.noise).ok_or("saved system: not a generator's state")?;
         let contact = s.contact.map(|k| SoftContact { stiffness: f(k) });
         let params = s.params.params::<T>()?;
-        let mut e = Engine::from_parts(beads, bonds, params, noise, contact, DEFAULT_LIMIT)
+        let pins: Vec<Bond<T>> = s
+            .pins
+            .iter()
+            .map(|&(i, j, l)| Bond { i, j, length: f(l) })
+            .collect();
+        if pins.iter().any(|p| !p.is_pin()) {
+            return Err("saved system: a pin row that pins nothing".into());
+        }
+        hydrorattle::bonds::validate(&pins, n).map_err(|e| format!("saved system: {e}"))?;
+        let mut e = Engine::from_rows(beads, bonds, pins, params, noise, contact, DEFAULT_LIMIT)
             .map_err(|e| e.to_string())?;
+        // None before a first step, else one per constraint row (bonds, then pins).
+        let rows = e.bonds.len() + e.pins.len();
+        if !(s.multipliers.is_empty() || s.multipliers.len() == rows) {
+            return Err(format!(
+                "saved system: {} multipliers for {rows} constraint rows",
+                s.multipliers.len()
+            ));
+        }
+        // A saved state is one a step accepted: with hard contacts, spheres touch to
+        // within the solver's tolerance, which the check of a new system's start would
+        // call an overlap. Nested and coincident spheres are refused all the same.
+        let allow = e.params.allow_overlap;
+        e.params.allow_overlap = allow || e.params.contacts.is_some();
+        let checked = e.check();
+        e.params.allow_overlap = allow;
+        checked.map_err(|k| format!("saved system: {k}"))?;
         e.retries = s.retries;
         e.lanczos = s.lanczos;
         e.multipliers = s.multipliers.iter().map(|&x| f(x)).collect();

@@ -57,6 +57,7 @@ __all__ = [
     "Run",
     "load_scene",
     "run_scene",
+    "resume_run",
     "read_run",
     "StepError",
     "InvalidStateError",
@@ -118,6 +119,16 @@ def _box(b: Any) -> Optional["tuple[float, float, float]"]:
     return (lx, ly, lz)
 
 
+#: Loads above this (2^64) go through :func:`mobility_dot` scaled to at most 1.
+_SCALE_ABOVE = 2.0**64
+
+
+def _all_finite(out: Any) -> bool:
+    """Whether every value of an array (or of a tuple of arrays) is finite."""
+    parts = out if isinstance(out, tuple) else (out,)
+    return all(bool(np.isfinite(x).all()) for x in parts)
+
+
 def _real(x: Any, what: str) -> float:
     """A real number (a bool or a complex number is a ``TypeError`` naming ``what``)."""
     if isinstance(x, (bool, np.bool_)) or np.iscomplexobj(x):
@@ -171,8 +182,10 @@ def mobility(
         ``System(..., wall=H)`` steps with. Rotation is supported.
     box : (Lx, Ly, Lz), optional
         A rectangular periodic box: the Ewald-summed RPY mobility (docs/PERIODIC.md),
-        as ``System(..., box=...)`` steps with. Every radius below half the smallest
-        edge; not with ``wall``, ``rotation`` or ``hydro="oseen"`` (``ValueError``).
+        as ``System(..., box=...)`` steps with; with ``rotation`` the box's ``tr`` and
+        ``rr`` blocks too. Every radius below half the smallest edge, every centre
+        within ``1/sqrt(eps)`` edges of the origin (``6.7e7`` in f64, ``2896`` in f32);
+        not with ``wall`` or ``hydro="oseen"`` (``ValueError``).
     threads : int
         Threads writing the dense output from 512 beads on (0: every core; the same
         values on any number). Above 32 MiB of output (N = 683 in f64) every new array
@@ -195,8 +208,12 @@ def mobility(
     ValueError
         Wrong shapes, NaN or infinite values, a radius <= 0, nested spheres, a centre
         below the wall; the message names the particle (``index`` attribute: the
-        particle or pair). A refused geometry (``box`` with ``wall``, ``rotation`` or
-        Oseen) with the kernel's message and ``kind``.
+        particle or pair). A refused geometry (``box`` with ``wall`` or Oseen) with
+        the kernel's message and ``kind``.
+    MemoryError
+        The arrays the call needs (the packed blocks and the output) exceed this
+        machine's memory and swap, or cannot be allocated; the message gives their
+        sizes. Checked before any work.
     """
     pos = _rows(positions, "positions")
     return _core.mobility(
@@ -251,16 +268,19 @@ def mobility_dot(
     any number of threads (and below 512 in free space those of the stored matrix times
     the forces). Above a wall, by the Ewald sum in a box and with rotation it runs on
     one thread.
+
+    Loads above ``2^64`` (where the product could overflow on the way: ``1e308`` in
+    a box, whose Ewald sum adds terms larger than the result, or past f32's range) are
+    taken scaled by a power of two to at most 1 and scaled back; velocities that overflow the precision themselves raise
+    ``OverflowError``. The arrays the call allocates (the packed grand mobility with
+    rotation, PSE's grid) are sized first: ``MemoryError`` with their sizes where they
+    exceed this machine's memory and swap or cannot be allocated.
     """
     pos = _rows(positions, "positions")
     n = len(pos)
     f = _rows(forces, "forces")
     t = None if torques is None else _rows(torques, "torques")
-    return _core.mobility_dot(
-        pos,
-        _column(radii, "radii", n),
-        f,
-        t,
+    args = (
         viscosity,
         hydro,
         rotation,
@@ -271,6 +291,25 @@ def mobility_dot(
         method,
         None if tolerance is None else _real(tolerance, "tolerance"),
     )
+    a = _column(radii, "radii", n)
+    # Loads so large that the product may overflow on the way (the Ewald sum's terms
+    # near f64's range; f32's range itself): the product is linear, so it is taken of
+    # the loads scaled by a power of two (exact) to at most 1, and scaled back.
+    largest = max(np.abs(f).max(initial=0.0), 0.0 if t is None else np.abs(t).max(initial=0.0))
+    if not largest > _SCALE_ABOVE:
+        return _core.mobility_dot(pos, a, f, t, *args)
+    k = int(np.frexp(largest)[1])
+    scaled = _core.mobility_dot(
+        pos, a, np.ldexp(f, -k), None if t is None else np.ldexp(t, -k), *args
+    )
+    with np.errstate(over="ignore"):
+        out = tuple(np.ldexp(x, k) for x in scaled) if isinstance(scaled, tuple) else np.ldexp(scaled, k)
+    if not _all_finite(out):
+        dtype = (out[0] if isinstance(out, tuple) else out).dtype
+        raise OverflowError(
+            f"the velocities of loads up to {largest:g} overflow {dtype}: scale the forces down"
+        )
+    return out
 
 
 class Frame(NamedTuple):
@@ -328,6 +367,12 @@ def _bond_pairs(bonds: Any) -> np.ndarray:
             raise ValueError(f"bonds{list(k)}: particle index {x[k]} is not an integer")
     if x.ndim != 2 or x.shape[1] != 2:
         raise ValueError(f"bonds must have shape (B, 2), not {x.shape}")
+    # Past int64 (a uint64 index of 2^64 - 1, a float of 1e30) the cast would wrap or
+    # saturate: name the index as given.
+    big = x > np.iinfo(np.int64).max
+    if big.any():
+        k = tuple(int(i) for i in np.argwhere(big)[0])
+        raise ValueError(f"bond {k[0]}: particle index {x[k]} out of range")
     return np.ascontiguousarray(x, dtype=np.int64)
 
 
@@ -357,7 +402,7 @@ class System:
     ``wall`` (None, or the height ``H`` of a no-slip plane wall ``z = H`` below every
     sphere: its mobility and its one-sided constraint; "overdamped" and "overdamped2"),
     ``box`` (None, or the edges ``(Lx, Ly, Lz)`` of a periodic box: the Ewald-summed
-    mobility and minimum-image bonds; not with ``wall`` or ``rotation``),
+    mobility, rotation too, and minimum-image bonds and overlaps; not with ``wall``),
     ``resolve_tensions`` (True in f32, False in f64: the inertial methods' tensions
     solved again from the step's displacements, two more constraint solves per step,
     needed in f32 where the position multipliers are rounding noise),
@@ -373,8 +418,10 @@ class System:
     type is a ``TypeError`` naming it (flags take ``True``/``False`` or 1/0), a value out
     of range a ``ValueError`` naming it (``dt=0``, ``seed=-1``), and the kernel's checks
     of parameters, particles and bonds (spheres overlapping at the start unless
-    ``allow_overlap``, coincident centres always, a sphere below the wall, a refused
-    combination) a ``ValueError`` with the kernel's message and ``kind``. Bond indices
+    ``allow_overlap``, in a box through its faces too, coincident centres always, a
+    sphere below the wall, a refused combination) a ``ValueError`` with the kernel's
+    message, ``kind`` and ``index``. Storage past the limit (8 GiB, as the CLI's
+    default ``--max-storage``) is a ``ValueError`` giving its size. Bond indices
     must be integers (``1.5`` is refused), arrays real (complex is a ``TypeError``).
 
     Constructors for the CLI's shapes: :meth:`from_scene` (a scene file, read by the
@@ -489,7 +536,10 @@ class System:
         lengths); one sphere inside another is refused by it."""
         conv = lambda a, w: None if a is None else _rows(a, w)  # noqa: E731
         self._core.set_state(
-            conv(positions, "positions"), conv(velocities, "velocities"), conv(spins, "spins"), time
+            conv(positions, "positions"),
+            conv(velocities, "velocities"),
+            conv(spins, "spins"),
+            None if time is None else _real(time, "time"),
         )
 
     def copy(self) -> "System":
@@ -503,14 +553,18 @@ class System:
         its centre with its velocity and mass (``4/3 pi a^3 density``), the radii and
         densities in the arrays ``radius`` and ``density``, the spins in ``spin``; the
         bonds ``(B, 2)``, their lengths and the time in ``info``; a periodic box as the
-        cell with ``pbc``. :meth:`from_atoms` reads it back."""
+        cell (its edges on the diagonal) with ``pbc`` on every axis, the positions
+        unwrapped as the system keeps them. :meth:`from_atoms` reads it back."""
         from ase import Atoms  # noqa: PLC0415 (optional dependency)
 
         a, rho = self.radii, self.densities
+        cell = self.box
         atoms = Atoms(
             symbols=["X"] * len(a),
             positions=self.positions,
             masses=4.0 / 3.0 * math.pi * a**3 * rho,
+            cell=None if cell is None else np.diag(cell),
+            pbc=cell is not None,
         )
         atoms.set_velocities(self.velocities)
         atoms.new_array("radius", a)
@@ -529,9 +583,24 @@ class System:
         ``radii`` or its ``radius`` array; densities from ``densities``, its ``density``
         array, or its masses over the spheres' volumes; bonds and lengths from
         ``params`` or its ``info`` (as :meth:`to_atoms` writes them); spins and time
-        from its ``spin`` array and ``info["time"]`` when present. ``params`` as the
+        from its ``spin`` array and ``info["time"]`` when present; a periodic box from
+        its cell when it is periodic on every axis (an orthorhombic cell: its diagonal
+        is the box; ``box=`` in ``params`` takes precedence). ``params`` as the
         constructor's (``dt`` required)."""
         n = len(atoms)
+        pbc = np.asarray(atoms.pbc, dtype=bool)
+        if pbc.any() and "box" not in params:
+            if not pbc.all():
+                raise ValueError(
+                    f"from_atoms: atoms periodic along some axes only (pbc = {tuple(pbc)}); "
+                    "a System's box is periodic along all three"
+                )
+            cell = np.asarray(atoms.cell[:], dtype=float)
+            if np.any(cell != np.diag(np.diag(cell))):
+                raise ValueError(
+                    "from_atoms: a System's box is rectangular: the cell must be diagonal"
+                )
+            params["box"] = tuple(float(x) for x in np.diag(cell))
         if radii is None:
             if "radius" not in atoms.arrays:
                 raise ValueError("from_atoms needs radii=, or a 'radius' array on the atoms")
@@ -603,6 +672,12 @@ class System:
         """"f64" or "f32"."""
         return self._core.precision
 
+    @property
+    def box(self) -> Optional["tuple[float, float, float]"]:
+        """The periodic box's edges ``(Lx, Ly, Lz)``, or None."""
+        cell = self._core.cell
+        return None if cell is None else tuple(cell)
+
     def __len__(self) -> int:
         return len(self._core.radii)
 
@@ -648,6 +723,13 @@ class System:
         held; its cost is the Python call plus two ``(N, 3)`` array conversions (a few
         microseconds at N = 25; see docs/PYTHON.md). An exception it raises aborts the step
         and propagates, leaving the state unchanged.
+
+        At temperature a step the kernel refuses (a rare large kick the constraint
+        solve cannot project) is retried as 2, 4, ... up to 16 shorter steps along a
+        Brownian bridge, as the CLI does (docs/BROWNIAN.md, "A refused step"): the
+        report's ``retried_steps`` counts the steps of this call made that way,
+        ``retry_substeps`` the shorter steps they took. Only a step whose deepest split
+        fails too raises.
 
         Raises a :class:`StepError` subclass (``kind``, ``stage``, ``index``,
         ``value``, ``completed``; ``kind`` and ``stage`` are the kernel's snake_case
@@ -704,10 +786,32 @@ def run_scene(
     """Runs the scene file ``path`` into the folder ``out`` exactly as
     ``host-demo run PATH --out OUT`` does: the same files, byte for byte apart from the
     wall times in ``summary.json`` (trajectory.xyz, trajectory.gsd, observables.csv,
-    scene.toml, summary.json, pictures). Returns the summary. The GIL is released
-    during the run. Raises :class:`SceneError` for a bad file and ``RuntimeError``
-    when the run stops early."""
+    scene.toml, summary.json; the pictures are the CLI's alone). Returns the summary.
+    The run goes on in a thread of its own with the GIL released. Raises
+    :class:`SceneError` for a bad file and ``RuntimeError`` when the run stops early.
+
+    Ctrl-C stops it between two steps as it stops ``host-demo run``: the run writes a
+    checkpoint at the step it reached and ``KeyboardInterrupt`` is raised, with
+    ``checkpoint`` (its path), ``step`` and ``time``; :func:`resume_run` (or
+    ``host-demo resume``) continues it to the same bytes as a run never stopped."""
     return json.loads(_core.run_scene(os.fspath(path), os.fspath(out), checkpoint_every))
+
+
+def resume_run(
+    out: PathLike, until: Optional[float] = None, checkpoint_every: Optional[float] = None
+) -> "dict[str, Any]":
+    """Continues the run in folder ``out`` from its checkpoint to simulated time
+    ``until`` (default: the end its ``scene.toml`` names), as ``host-demo resume OUT
+    --until T`` does: the files end as those of one run to ``until``. Returns the
+    summary; Ctrl-C as in :func:`run_scene`. A folder without a checkpoint raises
+    ``RuntimeError``."""
+    return json.loads(
+        _core.resume_run(
+            os.fspath(out),
+            None if until is None else _real(until, "until"),
+            checkpoint_every,
+        )
+    )
 
 
 @dataclass

@@ -42,6 +42,8 @@ class Report:
     contact_rounds: int
     noise_iterations: int
     steps: int
+    retried_steps: int
+    retry_substeps: int
 
 _F64 = npt.NDArray[np.float64]
 
@@ -75,6 +77,12 @@ def load_scene_json(path: Union[str, PathLike[str]]) -> str: ...
 def run_scene(
     path: Union[str, PathLike[str]],
     out: Union[str, PathLike[str]],
+    checkpoint_every: Optional[float] = ...,
+    max_storage: Optional[int] = ...,
+) -> str: ...
+def resume_run(
+    out: Union[str, PathLike[str]],
+    until: Optional[float] = ...,
     checkpoint_every: Optional[float] = ...,
     max_storage: Optional[int] = ...,
 ) -> str: ...
@@ -113,6 +121,7 @@ class Core:
     time: float
     dt: float
     precision: str
+    cell: Optional[tuple[float, float, float]]
     def set_state(
         self,
         positions: Optional[_F64] = ...,
