@@ -1,32 +1,61 @@
 //! SIGTERM and SIGINT stop a run cleanly: the first sets a flag that the run reads
 //! between steps (it checkpoints and exits with 128 + the signal's number: 143 for
-//! SIGTERM, as SLURM's time limit and `scancel` send it, 130 for Ctrl-C); a second of
-//! either ends the process at once, as without a handler.
+//! SIGTERM, as SLURM's time limit and `scancel` send it, 130 for Ctrl-C), and says so
+//! at once, since a step can take minutes. A second one of either ends the process at
+//! once, mid-step, with a message: nothing more is written, so every file stays as a
+//! kill would leave it, which a run is built to survive: the last complete checkpoint
+//! stays valid (it marks only bytes written before it was saved; the bytes after it,
+//! a frame cut off included, are cut away by the resume), and a run without one runs
+//! again from the start.
 
 use std::fmt;
-use std::sync::Arc;
-use std::sync::atomic::AtomicUsize;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use hydrorattle_host::sim::{Interrupted, Stop, stop::exit_status};
 use signal_hook::consts::{SIGINT, SIGTERM};
-use signal_hook::flag;
+use signal_hook::iterator::Signals;
 
 /// Installs the handlers; the [`Stop`] a run reads. Where a handler cannot be
-/// installed the signal keeps its default (the process ends), said once.
+/// installed the signals keep their default (the process ends), said once.
 pub fn install() -> Stop {
-    let signal: &'static Arc<AtomicUsize> = Box::leak(Box::new(Arc::new(AtomicUsize::new(0))));
-    for sig in [SIGTERM, SIGINT] {
-        // The second signal ends the process: registered first, it sees the flag the
-        // first one set.
-        let shutdown = Arc::new(std::sync::atomic::AtomicBool::new(false));
-        let installed = flag::register_conditional_shutdown(sig, 128 + sig, Arc::clone(&shutdown))
-            .and_then(|_| flag::register(sig, shutdown))
-            .and_then(|_| flag::register_usize(sig, Arc::clone(signal), sig as usize));
-        if let Err(e) = installed {
-            log::warn!("signal {sig}: no handler ({e}): it ends the process without a checkpoint");
-        }
+    let flag: &'static AtomicUsize = Box::leak(Box::new(AtomicUsize::new(0)));
+    // A thread of its own reads the signals: it can print, and it acts on a second
+    // signal while the run is inside a step.
+    let watched = Signals::new([SIGTERM, SIGINT]).and_then(|mut signals| {
+        std::thread::Builder::new()
+            .name("signals".into())
+            .spawn(move || {
+                for sig in signals.forever() {
+                    on_signal(flag, sig);
+                }
+            })
+    });
+    if let Err(e) = watched {
+        log::warn!("SIGTERM, SIGINT: no handler ({e}): they end the process without a checkpoint");
     }
-    Stop::on(signal)
+    Stop::on(flag)
+}
+
+/// The first signal asks for a stop after the step under way; the second ends the
+/// process now.
+fn on_signal(flag: &AtomicUsize, sig: i32) {
+    let first = flag
+        .compare_exchange(0, sig as usize, Ordering::SeqCst, Ordering::SeqCst)
+        .is_ok();
+    if first {
+        eprintln!(
+            "host-demo: signal {sig}: stopping after the step under way, with a checkpoint \
+             there (send it again to end at once, without one)"
+        );
+        return;
+    }
+    eprintln!(
+        "host-demo: signal {sig} again: ending at once, mid-step, writing nothing more: the \
+         last checkpoint written stays valid (resume from it, or rerun the sweep); a run \
+         without one runs again from the start"
+    );
+    // `_exit`: no destructor runs, so no file is renamed or removed half-way.
+    signal_hook::low_level::exit(i32::from(exit_status(sig as usize)));
 }
 
 /// A sweep that stopped on request (its points checkpointed).

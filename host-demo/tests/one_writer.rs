@@ -211,3 +211,120 @@ fn a_locked_point_is_skipped_and_said_or_waited_for_with_wait() {
     assert!(point.join("summary.json").is_file());
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// Flips one byte of `path`, a third of the way in.
+fn flip_a_byte(path: &Path) {
+    let mut bytes = std::fs::read(path).unwrap();
+    let k = bytes.len() / 3;
+    bytes[k] ^= 0x01;
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// A finished point whose data file was damaged in place (a byte flipped, or another
+/// point's file of the same size copied over it) is collected corrupt, and the next
+/// run recomputes it from the start: its files come out byte for byte as a clean
+/// run's, and `collect` then reports it done.
+#[test]
+fn a_damaged_finished_point_runs_again_from_the_start() {
+    let root = scratch("damaged");
+    let clean = root.join("clean");
+    let o = Command::new(BIN)
+        .arg("sweep")
+        .arg(small())
+        .arg("--out")
+        .arg(&clean)
+        .args(["--jobs", "1"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let id = first_point();
+    let clean_point = clean.join("points").join(&id);
+    // Another point whose GSD has the same size (the same steps and particles).
+    let size = |p: &Path| std::fs::metadata(p).unwrap().len();
+    let gsd = clean_point.join("trajectory.gsd");
+    let twin = std::fs::read_dir(clean.join("points"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p != &clean_point && size(&p.join("trajectory.gsd")) == size(&gsd))
+        .expect("two points with GSD files of one size");
+    let damages: [(&str, Box<dyn Fn(&Path)>); 4] = [
+        ("trajectory.gsd", Box::new(flip_a_byte)),
+        ("trajectory.xyz", Box::new(flip_a_byte)),
+        ("observables.csv", Box::new(flip_a_byte)),
+        (
+            "trajectory.gsd",
+            Box::new(|p: &Path| {
+                std::fs::copy(twin.join("trajectory.gsd"), p).unwrap();
+            }),
+        ),
+    ];
+    for (k, (name, damage)) in damages.iter().enumerate() {
+        let out = root.join(format!("try-{k}"));
+        let o = sweep(&out, &id).output().unwrap();
+        assert!(o.status.success(), "{}", text(&o));
+        let point = out.join("points").join(&id);
+        let file = point.join(name);
+        damage(&file);
+        assert!(
+            std::fs::read(&file).unwrap() != std::fs::read(clean_point.join(name)).unwrap(),
+            "try {k}: {name} not damaged"
+        );
+        let (_, said) = collect(&out);
+        let line = said.lines().find(|l| l.starts_with(&id)).unwrap();
+        assert!(line.contains(" corrupt "), "try {k}: {line}");
+        let o = sweep(&out, &id).output().unwrap();
+        let said = text(&o);
+        assert!(o.status.success(), "try {k}: {said}");
+        assert!(
+            said.contains(": ran, ") && said.contains("(1 from the start, 0 resumed"),
+            "try {k}: not run from the start: {said}"
+        );
+        for name in DATA {
+            let (x, y) = (
+                std::fs::read(clean_point.join(name)).unwrap(),
+                std::fs::read(point.join(name)).unwrap(),
+            );
+            assert!(x == y, "try {k}: {name} differs from a clean run's");
+        }
+        assert_eq!(summary(&clean_point), summary(&point), "try {k}");
+        let (_, said) = collect(&out);
+        assert!(!said.contains(&id), "try {k}: {id} not done: {said}");
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// `collect` while a job runs a point (a live process holds its lock): the point is
+/// `running`, not unfinished, and the `sbatch` line to run again leaves its task out.
+#[test]
+fn collect_reports_a_locked_point_running_not_to_be_resubmitted() {
+    let root = scratch("running");
+    let o = Command::new(BIN)
+        .arg("sweep")
+        .arg(small())
+        .arg("--out")
+        .arg(&root)
+        .args(["--emit", "slurm"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let id = first_point();
+    let held = FolderLock::take(&root.join("points").join(&id)).unwrap();
+    let (ok, said) = collect(&root);
+    assert!(!ok, "{said}");
+    let line = said.lines().find(|l| l.starts_with(&id)).unwrap();
+    assert!(line.contains(" running "), "{line}");
+    // The first point is task 0 of 8 (one per point): the others run again.
+    assert!(
+        said.contains("7 points to run again: sbatch --array=1-7 ")
+            && said.contains("1 points running now"),
+        "{said}"
+    );
+    let table = std::fs::read_to_string(root.join("collected.csv")).unwrap();
+    let row = table.lines().find(|l| l.starts_with(&id)).unwrap();
+    assert!(row.contains(",running,"), "{row}");
+    drop(held);
+    let (_, said) = collect(&root);
+    let line = said.lines().find(|l| l.starts_with(&id)).unwrap();
+    assert!(line.contains(" missing "), "{line}");
+    let _ = std::fs::remove_dir_all(&root);
+}

@@ -253,3 +253,84 @@ fn the_binary_exits_non_zero_on_a_bad_scene_before_writing() {
     );
     assert!(!out.exists(), "no output may be written for a bad scene");
 }
+
+/// The number after `before` in `text` (up to the next space).
+fn number_after(text: &str, before: &str) -> f64 {
+    let at = text
+        .find(before)
+        .unwrap_or_else(|| panic!("pile.toml does not say {before:?}"));
+    let rest = &text[at + before.len()..];
+    let word = rest.split_whitespace().next().unwrap_or_default();
+    word.parse()
+        .unwrap_or_else(|_| panic!("pile.toml: {before:?} then {word:?}"))
+}
+
+/// `pile.toml` run to its end is the pile its header describes: the spheres inside the
+/// fence and spilled over it, the pile's depth in layers, the spilled ones a monolayer
+/// on the wall.
+#[test]
+fn the_shipped_pile_is_what_its_header_says() {
+    let scene = manifest_dir().join("scenes/pile.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let header: String = text
+        .lines()
+        .take_while(|l| l.starts_with('#'))
+        .map(|l| format!("{} ", l.trim_start_matches('#').trim()))
+        .collect();
+    let inside_said = number_after(&header, "at rest");
+    let depth_said = number_after(&header, "in a pile");
+    let spilled_said = number_after(&header, "), and");
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("shipped-pile");
+    let _ = std::fs::remove_dir_all(&out);
+    let o = Command::new(env!("CARGO_BIN_EXE_host-demo"))
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let frames = hydrorattle_host::output::read_xyz_file(&out.join("trajectory.xyz")).unwrap();
+    let last = frames.last().unwrap();
+    // The fence: the spheres of radius 1.5, in a ring about the vertical axis.
+    let fence: Vec<usize> = (0..last.radii.len())
+        .filter(|&i| last.radii[i] > 1.2)
+        .collect();
+    assert_eq!(fence.len(), 15);
+    let ring = fence
+        .iter()
+        .map(|&i| last.positions[i][0].hypot(last.positions[i][1]))
+        .fold(0.0_f64, f64::max);
+    let (mut inside, mut spilled, mut top) = (0, 0, 0.0_f64);
+    for i in (0..last.radii.len()).filter(|i| !fence.contains(i)) {
+        let [x, y, z] = last.positions[i];
+        let r = last.radii[i];
+        if x.hypot(y) < ring {
+            inside += 1;
+            top = top.max(z + r);
+        } else {
+            spilled += 1;
+            // A monolayer: every spilled sphere on the wall (z = 0), none on another.
+            assert!(
+                (z - r).abs() < 1e-6,
+                "sphere {i} outside the fence at z = {z}"
+            );
+        }
+    }
+    let depth = top / 2.0;
+    eprintln!("inside {inside}, spilled {spilled}, pile {depth:.2} layers deep (top at {top:.2})");
+    assert_eq!(inside + spilled, 100);
+    assert!(
+        (inside as f64 - inside_said).abs() <= 3.0,
+        "{inside} inside, said {inside_said}"
+    );
+    assert!(
+        (spilled as f64 - spilled_said).abs() <= 3.0,
+        "{spilled} spilled, said {spilled_said}"
+    );
+    assert!(
+        (depth - depth_said).abs() <= 0.25,
+        "{depth} layers, said {depth_said}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

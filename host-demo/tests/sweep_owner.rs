@@ -336,6 +336,71 @@ fn nonsense_job_settings_are_refused_before_anything_is_written() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `--emit ENGINE --dry-run` prints the job file and writes nothing; the job name,
+/// the signal's lead and further sbatch options are set, and the time and memory forms
+/// SLURM accepts (`infinite`, `4GB`) are taken.
+#[test]
+fn emit_dry_run_previews_the_script_with_the_options_given() {
+    let dir = scratch("preview");
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/small.toml");
+    let out = dir.join("out");
+    let args = [
+        "sweep",
+        file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--emit",
+        "slurm",
+        "--time",
+        "infinite",
+        "--mem",
+        "4GB",
+        "--job-name",
+        "helices",
+        "--signal-lead",
+        "600",
+        "--sbatch-arg",
+        "--gres=gpu:1",
+        "--sbatch-arg=--mail-type=END,FAIL",
+        "--sbatch-arg",
+        "--exclusive",
+    ];
+    let o = host_demo(&[&args[..], &["--dry-run"]].concat());
+    assert!(o.status.success(), "{}", text(&o));
+    let printed = String::from_utf8(o.stdout.clone()).unwrap();
+    assert!(!out.exists(), "--dry-run wrote something");
+    assert!(
+        text(&o).contains("nothing written") && printed.starts_with("#!/bin/bash\n"),
+        "{}",
+        text(&o)
+    );
+    for line in [
+        "#SBATCH --job-name=helices\n",
+        "#SBATCH --time=infinite\n",
+        "#SBATCH --mem=4GB\n",
+        "#SBATCH --gres=gpu:1\n",
+        "#SBATCH --mail-type=END,FAIL\n",
+        "#SBATCH --exclusive\n",
+        "#SBATCH --signal=B:TERM@600\n",
+    ] {
+        assert!(printed.contains(line), "{line:?} not in {printed}");
+    }
+    // The preview is the script emitting writes.
+    ok(&args);
+    assert_eq!(
+        std::fs::read_to_string(out.join("slurm.sh")).unwrap(),
+        printed
+    );
+    // An option the script sets itself is refused, naming the flag that sets it.
+    let o = host_demo(&[&args[..], &["--sbatch-arg=--time=10", "--dry-run"]].concat());
+    assert!(
+        !o.status.success() && text(&o).contains("set by --time"),
+        "{}",
+        text(&o)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A sweep stopped by SIGTERM once two points have checkpoints: exit status 143, the
 /// running points checkpointed, `collect` names each point's array task and the
 /// `sbatch --array` line, and the rerun ends equal to a clean run.

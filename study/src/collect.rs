@@ -13,9 +13,10 @@
 //! run could not start: `error.txt`); `corrupt` (a summary, but the data files are not
 //! those it records: cut short or overwritten since, by size or digest); `foreign` (the
 //! folder's `scene.toml` is not the one `sweep.json` records for the point: another
-//! sweep's, or a run resumed by hand); `unfinished` (a checkpoint, no summary);
+//! sweep's, or a run resumed by hand); `running` (not done, and a live process holds
+//! the point's lock: a job is running it now); `unfinished` (a checkpoint, no summary);
 //! `missing`. `unfinished`, `missing`, `error` and `corrupt` points run again when the
-//! sweep does ([`Problem::reruns`]).
+//! sweep does ([`Problem::reruns`]); a `running` point is left to the process running it.
 //!
 //! A point is a Figure 1 case when its helix is one of the paper's three. Its claims
 //! are judged on its own observables; a claim comparing two cases ("settles faster
@@ -29,7 +30,9 @@ use anyhow::{Context, Result};
 use serde_json::Value as Json;
 
 use crate::claims::{CaseRun, SPECS, claims};
-use hydrorattle_host::output::{AtomicFile, CsvWriter, FileCheck, fnv1a64, format_f64, mismatch};
+use hydrorattle_host::output::{
+    AtomicFile, CsvWriter, FileCheck, FolderLock, fnv1a64, format_f64, mismatch,
+};
 use hydrorattle_host::scene::Scene;
 use hydrorattle_host::sim::{
     CHECKPOINT, COLUMNS, Front, OBSERVABLES_CSV, Observables, SCENE_TOML, SUMMARY_JSON,
@@ -70,7 +73,7 @@ pub struct Problem {
 
 impl Problem {
     /// Whether running the sweep again runs it (`stopped_early` ends the same way
-    /// again; a `foreign` folder is left alone).
+    /// again; a `foreign` folder is left alone; a `running` one is being run).
     pub fn reruns(&self) -> bool {
         matches!(self.status, "unfinished" | "missing" | "error" | "corrupt")
     }
@@ -140,6 +143,13 @@ fn read_point(dir: &Path, record: &Json, figure1: &[(&'static str, Scene)]) -> R
         (None, Some(_)) => "error",
         (None, None) if pdir.join(CHECKPOINT).is_file() => "unfinished",
         _ => "missing",
+    };
+    // A point whose run is under way: its files are in between, and it is not to be
+    // submitted again. A finished point is done even while a process looks at it.
+    let status = match status {
+        "done" | "foreign" => status,
+        _ if FolderLock::held(&pdir).unwrap_or(false) => "running",
+        s => s,
     };
     if foreign.is_some() {
         error = foreign;
@@ -324,6 +334,7 @@ pub fn collect(dir: &Path, chart: Option<(&str, &str)>) -> Result<Collected> {
             "error" | "corrupt" | "foreign" => {
                 r.error.clone().unwrap_or_default().trim().to_string()
             }
+            "running" => "a live process holds the point's lock: collect again when it ends".into(),
             _ => get("failure"),
         };
         row.extend([why.clone(), get("wall_time_s"), get("steps_per_second")]);

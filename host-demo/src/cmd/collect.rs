@@ -49,6 +49,10 @@ impl Collect {
             if let Some(line) = job.as_ref().and_then(|j| j.rerun(&rerun)) {
                 println!("{} points to run again: {line}", rerun.len());
             }
+            let running = c.problems.iter().filter(|p| p.status == "running").count();
+            if running > 0 {
+                println!("{running} points running now (not to be submitted again)");
+            }
             anyhow::bail!("{} of {} points are not done", c.problems.len(), c.points);
         }
         Ok(())

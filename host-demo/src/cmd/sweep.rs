@@ -47,8 +47,9 @@ pub struct SweepArgs {
     #[arg(long, conflicts_with_all = ["dry_run", "emit"])]
     wait: bool,
     /// Expand and check the sweep, list its points (id and state point, in sweep
-    /// order), run and write nothing.
-    #[arg(long, conflicts_with_all = ["shard", "point", "emit"])]
+    /// order), run and write nothing. With --emit: check every setting and print the
+    /// job file that would be written, writing nothing.
+    #[arg(long, conflicts_with_all = ["shard", "point"])]
     dry_run: bool,
     /// Write the point folders, the frozen scenes and an engine's job file instead of
     /// running: DIR/slurm.sh (slurm), DIR/parallel.sh (parallel) or DIR/workflow.toml
@@ -66,12 +67,23 @@ pub struct SweepArgs {
     #[arg(long)]
     partition: Option<String>,
     /// SLURM (and row): time limit per task: minutes, MM:SS, HH:MM:SS, D-HH,
-    /// D-HH:MM or D-HH:MM:SS.
+    /// D-HH:MM, D-HH:MM:SS, or infinite (SLURM only).
     #[arg(long)]
     time: Option<String>,
-    /// SLURM: memory per node (4G, 500M).
+    /// SLURM: memory per node (4G, 4GB, 500M).
     #[arg(long)]
     mem: Option<String>,
+    /// SLURM: the job's name (default hydrorattle-sweep).
+    #[arg(long, value_name = "NAME")]
+    job_name: Option<String>,
+    /// SLURM: SIGTERM this many seconds before the time limit, for the running steps to
+    /// end and checkpoint (default 60; give more when a step takes longer).
+    #[arg(long, value_name = "S")]
+    signal_lead: Option<u32>,
+    /// SLURM: another sbatch option, written as an #SBATCH line as given
+    /// (`--sbatch-arg=--gres=gpu:1`); repeat for more.
+    #[arg(long, value_name = "OPTION", allow_hyphen_values = true)]
+    sbatch_arg: Vec<String>,
     /// SLURM: account charged.
     #[arg(long)]
     account: Option<String>,
@@ -110,7 +122,12 @@ impl SweepArgs {
         let t = Instant::now();
         let report = match &self.file {
             None => hydrorattle_host::sweep::run_frozen(&self.out, &selection, opts)?,
-            Some(file) if self.dry_run => return list(file),
+            Some(file) if self.dry_run => {
+                return match self.emit {
+                    Some(engine) => self.preview(engine, &Sweep::from_path(file)?, file, verbose),
+                    None => list(file),
+                };
+            }
             Some(file) => match (&selection, self.emit) {
                 (Selection::Point(id), None) => {
                     hydrorattle_host::sweep::run_point_of_file(file, &self.out, id, opts)?
@@ -138,15 +155,9 @@ impl SweepArgs {
         Ok(())
     }
 
-    /// Writes the engine's job file.
-    fn emit(
-        &self,
-        engine: Engine,
-        sweep: &Sweep,
-        file: &std::path::Path,
-        verbose: u8,
-    ) -> Result<()> {
-        let opts = SlurmOptions {
+    /// The engine settings as given.
+    fn slurm(&self, verbose: u8) -> SlurmOptions {
+        SlurmOptions {
             tasks: self.tasks,
             throttle: self.throttle,
             partition: self.partition.clone(),
@@ -159,7 +170,41 @@ impl SweepArgs {
             program: self.program.clone(),
             checkpoint_every: self.checkpoint_every,
             verbose,
-        };
+            job_name: self.job_name.clone(),
+            signal_lead: self.signal_lead,
+            extra: self.sbatch_arg.clone(),
+        }
+    }
+
+    /// Prints the engine's job file, writing nothing.
+    fn preview(
+        &self,
+        engine: Engine,
+        sweep: &Sweep,
+        file: &std::path::Path,
+        verbose: u8,
+    ) -> Result<()> {
+        let opts = self.slurm(verbose);
+        let job = hydrorattle_host::sweep::emit::job_file(engine, sweep, file, &self.out, &opts)?;
+        print!("{}", job.text);
+        eprintln!(
+            "{} points; would write {} (and the point folders); nothing written\n{}",
+            sweep.points.len(),
+            job.path.display(),
+            job.command
+        );
+        Ok(())
+    }
+
+    /// Writes the engine's job file.
+    fn emit(
+        &self,
+        engine: Engine,
+        sweep: &Sweep,
+        file: &std::path::Path,
+        verbose: u8,
+    ) -> Result<()> {
+        let opts = self.slurm(verbose);
         let (path, command) = hydrorattle_host::sweep::emit(engine, sweep, file, &self.out, &opts)?;
         println!(
             "{} points; wrote {}\n{command}",

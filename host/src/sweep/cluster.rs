@@ -12,9 +12,32 @@ use serde::{Deserialize, Serialize};
 pub const DEFAULT_MAX_TASKS: usize = 1000;
 
 /// Seconds before the time limit at which SLURM sends the batch shell (`host-demo`
-/// itself, by `exec`) SIGTERM (`--signal=B:TERM@60`): time for the running steps to end
-/// and the points to checkpoint.
+/// itself, by `exec`) SIGTERM (`--signal=B:TERM@60`) unless asked otherwise: time for
+/// the running steps to end and the points to checkpoint.
 pub const SIGNAL_LEAD_S: u32 = 60;
+
+/// The most seconds `--signal` takes (SLURM's limit).
+const MAX_SIGNAL_LEAD_S: u32 = 65535;
+
+/// The job's name unless asked otherwise.
+pub const DEFAULT_JOB_NAME: &str = "hydrorattle-sweep";
+
+/// The `sbatch` options the script writes itself, long and short: given again as an
+/// extra option they would contradict it (the dedicated flag, named, sets them).
+const OWN_OPTIONS: [(&str, Option<char>, &str); 12] = [
+    ("job-name", Some('J'), "--job-name"),
+    ("array", Some('a'), "--tasks and --throttle"),
+    ("ntasks", Some('n'), "nothing: one process a task"),
+    ("cpus-per-task", Some('c'), "--cpus"),
+    ("time", Some('t'), "--time"),
+    ("partition", Some('p'), "--partition"),
+    ("mem", None, "--mem"),
+    ("account", Some('A'), "--account"),
+    ("qos", Some('q'), "--qos"),
+    ("constraint", Some('C'), "--constraint"),
+    ("signal", None, "--signal-lead"),
+    ("output", Some('o'), "nothing: the logs go to DIR/slurm"),
+];
 
 /// The array job's settings.
 #[derive(Debug, Clone, Default)]
@@ -25,10 +48,19 @@ pub struct SlurmOptions {
     pub throttle: Option<usize>,
     /// Partition.
     pub partition: Option<String>,
-    /// Time limit per task (`MM`, `MM:SS`, `HH:MM:SS`, `D-HH`, `D-HH:MM`, `D-HH:MM:SS`).
+    /// Time limit per task (`MM`, `MM:SS`, `HH:MM:SS`, `D-HH`, `D-HH:MM`, `D-HH:MM:SS`,
+    /// or `infinite`/`unlimited`).
     pub time: Option<String>,
-    /// Memory per node (`--mem`: a whole number with an optional unit K, M, G or T).
+    /// Memory per node (`--mem`: a whole number with an optional unit K, M, G or T and
+    /// an optional B, in either case).
     pub mem: Option<String>,
+    /// The job's name (default [`DEFAULT_JOB_NAME`]).
+    pub job_name: Option<String>,
+    /// Seconds before the time limit that SIGTERM comes (default [`SIGNAL_LEAD_S`]).
+    pub signal_lead: Option<u32>,
+    /// Further `sbatch` options, each written as an `#SBATCH` line as given
+    /// (`--gres=gpu:1`, `--mail-type=END`, `--exclusive`).
+    pub extra: Vec<String>,
     /// Account charged.
     pub account: Option<String>,
     /// Quality of service.
@@ -99,11 +131,17 @@ impl ArrayJob {
     }
 }
 
+/// Whether `t` is SLURM's time limit without limit (`infinite` or `unlimited`, in any
+/// case).
+pub fn infinite(t: &str) -> bool {
+    t.eq_ignore_ascii_case("infinite") || t.eq_ignore_ascii_case("unlimited")
+}
+
 /// A SLURM time limit: minutes, `M:S`, `H:M:S`, `D-H`, `D-H:M`, `D-H:M:S` (whole
-/// numbers), or `UNLIMITED`/`INFINITE`.
+/// numbers), or [`infinite`].
 fn time_ok(t: &str) -> bool {
     let num = |s: &str| !s.is_empty() && s.len() <= 9 && s.bytes().all(|b| b.is_ascii_digit());
-    if matches!(t, "UNLIMITED" | "INFINITE") {
+    if infinite(t) {
         return true;
     }
     let (days, rest) = match t.split_once('-') {
@@ -114,13 +152,37 @@ fn time_ok(t: &str) -> bool {
         return false;
     }
     let parts: Vec<&str> = rest.split(':').collect();
+    // With days: hours, then at most minutes and seconds.
     parts.len() <= 3 && parts.iter().all(|p| num(p))
 }
 
-/// A `--mem` size: a whole number and an optional unit K, M, G or T.
+/// A `--mem` size: a whole number, an optional unit K, M, G or T, then an optional B
+/// (either case).
 fn mem_ok(m: &str) -> bool {
+    let m = m
+        .strip_suffix(['B', 'b'])
+        .filter(|r| r.ends_with(|c: char| "KMGTkmgt".contains(c)))
+        .unwrap_or(m);
     let digits = m.trim_end_matches(['K', 'M', 'G', 'T', 'k', 'm', 'g', 't']);
     m.len() - digits.len() <= 1 && !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+}
+
+/// Why an extra `sbatch` option is refused, or None.
+fn extra_refused(x: &str) -> Option<String> {
+    if !x.starts_with('-') || x == "-" || x == "--" {
+        return Some("an sbatch option starts with - or -- (--gres=gpu:1)".into());
+    }
+    if x.chars().any(|c| c.is_control() || c == '#') {
+        return Some("one option on one line, without #".into());
+    }
+    let (long, short) = match x.strip_prefix("--") {
+        Some(rest) => (rest.split(['=', ' ']).next(), None),
+        None => (None, x[1..].chars().next()),
+    };
+    OWN_OPTIONS
+        .iter()
+        .find(|(l, s, _)| long == Some(*l) || (short.is_some() && short == *s))
+        .map(|(l, _, flag)| format!("the script sets --{l} itself (set by {flag})"))
 }
 
 impl SlurmOptions {
@@ -144,21 +206,32 @@ impl SlurmOptions {
             && !time_ok(t)
         {
             bail!(
-                "--time {t:?} is not a SLURM time limit: minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS"
+                "--time {t:?} is not a SLURM time limit: minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS or infinite"
             );
         }
         if let Some(m) = &self.mem
             && !mem_ok(m)
         {
             bail!(
-                "--mem {m:?} is not a size: a whole number with an optional unit K, M, G or T (4G, 500M)"
+                "--mem {m:?} is not a size: a whole number with an optional unit K, M, G or T and an optional B (4G, 4GB, 500M)"
             );
+        }
+        if let Some(s) = self.signal_lead
+            && !(1..=MAX_SIGNAL_LEAD_S).contains(&s)
+        {
+            bail!("--signal-lead {s}: seconds from 1 to {MAX_SIGNAL_LEAD_S}");
+        }
+        for x in &self.extra {
+            if let Some(why) = extra_refused(x) {
+                bail!("--sbatch-arg {x:?}: {why}");
+            }
         }
         for (flag, v) in [
             ("--partition", &self.partition),
             ("--account", &self.account),
             ("--qos", &self.qos),
             ("--constraint", &self.constraint),
+            ("--job-name", &self.job_name),
         ] {
             if let Some(v) = v
                 && (v.is_empty()
@@ -261,6 +334,49 @@ mod tests {
             },
             "--cpus 0",
         );
+        bad(
+            SlurmOptions {
+                signal_lead: Some(0),
+                ..ok.clone()
+            },
+            "--signal-lead 0",
+        );
+        bad(
+            SlurmOptions {
+                job_name: Some("my job".into()),
+                ..ok.clone()
+            },
+            "--job-name",
+        );
+        for (x, says) in [
+            ("gres=gpu:1", "starts with -"),
+            ("--mail-type=END\n#SBATCH --x", "one option on one line"),
+            ("--array=0-3", "set by --tasks"),
+            ("-J x", "set by --job-name"),
+            ("--time=10", "set by --time"),
+            ("--signal=USR1@30", "set by --signal-lead"),
+        ] {
+            bad(
+                SlurmOptions {
+                    extra: vec![x.into()],
+                    ..ok.clone()
+                },
+                says,
+            );
+        }
+        let extras = [
+            "--gres=gpu:1",
+            "--exclusive",
+            "--mail-type=END,FAIL",
+            "-x node3",
+        ];
+        let fine = SlurmOptions {
+            extra: extras.map(String::from).to_vec(),
+            signal_lead: Some(300),
+            job_name: Some("mine".into()),
+            ..ok.clone()
+        };
+        assert_eq!(fine.check(8).unwrap(), 8);
         for t in [
             "30",
             "30:00",
@@ -269,16 +385,21 @@ mod tests {
             "2-12:00",
             "1-00:00:00",
             "UNLIMITED",
+            "infinite",
+            "Infinite",
+            "unlimited",
         ] {
             assert!(time_ok(t), "{t}");
         }
         for t in ["", "1:2:3:4", "1h", "-1", "1-", "a-1"] {
             assert!(!time_ok(t), "{t}");
         }
-        for m in ["4G", "500", "500M", "1t"] {
+        for m in [
+            "4G", "500", "500M", "1t", "4GB", "4gb", "500Mb", "2TB", "16k",
+        ] {
             assert!(mem_ok(m), "{m}");
         }
-        for m in ["", "G", "4GB", "4.5G", "-4G"] {
+        for m in ["", "G", "GB", "4B", "4GBB", "4.5G", "-4G", "4 GB"] {
             assert!(!mem_ok(m), "{m}");
         }
     }

@@ -6,9 +6,9 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 
-use super::cluster::{ArrayJob, SIGNAL_LEAD_S, SLURM_JSON};
+use super::cluster::{ArrayJob, DEFAULT_JOB_NAME, SIGNAL_LEAD_S, SLURM_JSON, infinite};
 pub use super::cluster::{DEFAULT_MAX_TASKS, SlurmOptions};
 use super::{POINTS, STATEPOINT_JSON, Sweep, run::prepare_points};
 use crate::output::write_json;
@@ -62,19 +62,35 @@ fn absolute(p: &Path) -> Result<PathBuf> {
     std::path::absolute(p).with_context(|| format!("resolving {}", p.display()))
 }
 
-/// Writes the sweep's folder (`sweep.json`, the points' state points and scenes) and the
-/// engine's file in `dir`; returns the file and the command that starts it.
-pub fn emit(
+/// An engine's job file as [`emit`] writes it, and what else it writes beside it.
+#[derive(Debug, Clone)]
+pub struct JobFile {
+    /// Where it goes.
+    pub path: PathBuf,
+    /// Its text.
+    pub text: String,
+    /// The command that starts it.
+    pub command: String,
+    /// The array job's record ([`SLURM_JSON`]), for SLURM.
+    array: Option<ArrayJob>,
+    /// The ids list GNU parallel reads (`DIR/point_ids.txt`), for parallel.
+    ids: Option<(PathBuf, String)>,
+}
+
+/// The engine's job file for `sweep` (read from `file`) in `dir`, every setting
+/// checked: nothing is written (what `--emit ENGINE --dry-run` prints).
+pub fn job_file(
     engine: Engine,
     sweep: &Sweep,
     file: &Path,
     dir: &Path,
     slurm: &SlurmOptions,
-) -> Result<(PathBuf, String)> {
+) -> Result<JobFile> {
     let n = sweep.points.len();
-    // Every setting checked before anything is written.
     let tasks = slurm.check(n)?;
-    prepare_points(sweep, dir)?;
+    if engine == Engine::Row && slurm.time.as_deref().is_some_and(infinite) {
+        bail!("--time infinite: row's walltime is a finite time (HH:MM:SS or D-HH:MM:SS)");
+    }
     let exe = match &slurm.program {
         Some(p) => p.clone(),
         None => absolute(&std::env::current_exe().context("finding this program")?)?,
@@ -92,79 +108,44 @@ pub fn emit(
         sh(&exe.display().to_string()),
         sh(&dir.display().to_string())
     );
-    match engine {
+    let job = |path: PathBuf, text: String, command: String| JobFile {
+        path,
+        text,
+        command,
+        array: None,
+        ids: None,
+    };
+    Ok(match engine {
         Engine::Slurm => {
-            let throttle = slurm.throttle.map_or(String::new(), |m| format!("%{m}"));
-            let logs = dir.join("slurm");
-            std::fs::create_dir_all(&logs)?;
             let path = dir.join("slurm.sh");
-            let mut s = String::from("#!/bin/bash\n");
-            s += &format!(
-                "# {n} points of {} (frozen in {} when emitted) in {tasks} array tasks: task K runs\n\
-                 # shard K/{tasks} (the points whose index is K modulo {tasks}), skipping finished points\n\
-                 # and resuming unfinished ones. SIGTERM (the time limit, {SIGNAL_LEAD_S} s ahead, or scancel)\n\
-                 # checkpoints the running points; `host-demo collect {}` prints the sbatch line\n\
-                 # that reruns the tasks left unfinished.\n\
-                 # Submit: sbatch {}\n",
-                file.display(),
-                dir.display(),
-                dir.display(),
-                path.display()
-            );
-            s += "#SBATCH --job-name=hydrorattle-sweep\n";
-            s += &format!("#SBATCH --array=0-{}{throttle}\n", tasks - 1);
-            s += "#SBATCH --ntasks=1\n";
-            s += &format!("#SBATCH --cpus-per-task={}\n", slurm.cpus.max(1));
-            for (name, v) in [
-                ("time", &slurm.time),
-                ("partition", &slurm.partition),
-                ("mem", &slurm.mem),
-                ("account", &slurm.account),
-                ("qos", &slurm.qos),
-                ("constraint", &slurm.constraint),
-            ] {
-                if let Some(v) = v {
-                    s += &format!("#SBATCH --{name}={v}\n");
-                }
+            let text = slurm_script(slurm, tasks, n, &file, &dir, &path, &base);
+            let command = format!("sbatch {}", sh(&path.display().to_string()));
+            JobFile {
+                array: Some(ArrayJob {
+                    tasks,
+                    throttle: slurm.throttle,
+                    script: path.clone(),
+                }),
+                ..job(path, text, command)
             }
-            s += &format!("#SBATCH --signal=B:TERM@{SIGNAL_LEAD_S}\n");
-            s += &format!("#SBATCH --output={}/%A_%a.out\n", logs.display());
-            s += "set -euo pipefail\n";
-            // exec: host-demo is the batch shell, which the B: signal reaches.
-            s += &format!(
-                "exec {base} --shard \"$SLURM_ARRAY_TASK_ID/{tasks}\" --jobs \"${{SLURM_CPUS_PER_TASK:-1}}\"\n"
-            );
-            write_script(&path, &s)?;
-            let job = ArrayJob {
-                tasks,
-                throttle: slurm.throttle,
-                script: path.clone(),
-            };
-            write_json(&dir.join(SLURM_JSON), &job)?;
-            Ok((
-                path.clone(),
-                format!("sbatch {}", sh(&path.display().to_string())),
-            ))
         }
         Engine::Parallel => {
             let ids = dir.join("point_ids.txt");
             let list: String = sweep.points.iter().map(|p| format!("{}\n", p.id)).collect();
-            std::fs::write(&ids, list).with_context(|| format!("writing {}", ids.display()))?;
             let line = format!(
                 "parallel --jobs {} --joblog {} -q {base} --point {{}} --jobs 1 :::: {}",
                 slurm.cpus.max(1),
                 sh(&dir.join("parallel.log").display().to_string()),
                 sh(&ids.display().to_string())
             );
-            let path = dir.join("parallel.sh");
-            write_script(
-                &path,
-                &format!(
-                    "#!/bin/bash\n# {n} points of {}, one GNU parallel job each.\nset -euo pipefail\n{line}\n",
-                    file.display()
-                ),
-            )?;
-            Ok((path, line))
+            let text = format!(
+                "#!/bin/bash\n# {n} points of {}, one GNU parallel job each.\nset -euo pipefail\n{line}\n",
+                file.display()
+            );
+            JobFile {
+                ids: Some((ids, list)),
+                ..job(dir.join("parallel.sh"), text, line)
+            }
         }
         Engine::Row => {
             let command = format!("{base} --point {{directory}}");
@@ -183,14 +164,97 @@ pub fn emit(
             if let Some(t) = &slurm.time {
                 s += &format!("resources.walltime.per_directory = {:?}\n", t);
             }
-            let path = dir.join("workflow.toml");
-            std::fs::write(&path, s).with_context(|| format!("writing {}", path.display()))?;
-            Ok((
-                path,
-                format!("cd {} && row submit", sh(&dir.display().to_string())),
-            ))
+            let start = format!("cd {} && row submit", sh(&dir.display().to_string()));
+            job(dir.join("workflow.toml"), s, start)
+        }
+    })
+}
+
+/// `DIR/slurm.sh`: `tasks` array tasks over the `n` points of `file` in `dir`, each
+/// running `base` on its shard.
+fn slurm_script(
+    slurm: &SlurmOptions,
+    tasks: usize,
+    n: usize,
+    file: &Path,
+    dir: &Path,
+    path: &Path,
+    base: &str,
+) -> String {
+    let throttle = slurm.throttle.map_or(String::new(), |m| format!("%{m}"));
+    let lead = slurm.signal_lead.unwrap_or(SIGNAL_LEAD_S);
+    let mut s = String::from("#!/bin/bash\n");
+    s += &format!(
+        "# {n} points of {} (frozen in {} when emitted) in {tasks} array tasks: task K runs\n\
+         # shard K/{tasks} (the points whose index is K modulo {tasks}), skipping finished points\n\
+         # and resuming unfinished ones. SIGTERM (the time limit, {lead} s ahead, or scancel)\n\
+         # checkpoints the running points; `host-demo collect {}` prints the sbatch line\n\
+         # that reruns the tasks left unfinished.\n\
+         # Submit: sbatch {}\n",
+        file.display(),
+        dir.display(),
+        dir.display(),
+        path.display()
+    );
+    let name = slurm.job_name.as_deref().unwrap_or(DEFAULT_JOB_NAME);
+    s += &format!("#SBATCH --job-name={name}\n");
+    s += &format!("#SBATCH --array=0-{}{throttle}\n", tasks - 1);
+    s += "#SBATCH --ntasks=1\n";
+    s += &format!("#SBATCH --cpus-per-task={}\n", slurm.cpus.max(1));
+    for (name, v) in [
+        ("time", &slurm.time),
+        ("partition", &slurm.partition),
+        ("mem", &slurm.mem),
+        ("account", &slurm.account),
+        ("qos", &slurm.qos),
+        ("constraint", &slurm.constraint),
+    ] {
+        if let Some(v) = v {
+            s += &format!("#SBATCH --{name}={v}\n");
         }
     }
+    for extra in &slurm.extra {
+        s += &format!("#SBATCH {extra}\n");
+    }
+    s += &format!("#SBATCH --signal=B:TERM@{lead}\n");
+    s += &format!(
+        "#SBATCH --output={}/%A_%a.out\n",
+        dir.join("slurm").display()
+    );
+    s += "set -euo pipefail\n";
+    // exec: host-demo is the batch shell, which the B: signal reaches.
+    s += &format!(
+        "exec {base} --shard \"$SLURM_ARRAY_TASK_ID/{tasks}\" --jobs \"${{SLURM_CPUS_PER_TASK:-1}}\"\n"
+    );
+    s
+}
+
+/// Writes the sweep's folder (`sweep.json`, the points' state points and scenes) and the
+/// engine's file in `dir` ([`job_file`]); returns the file and the command that starts it.
+pub fn emit(
+    engine: Engine,
+    sweep: &Sweep,
+    file: &Path,
+    dir: &Path,
+    slurm: &SlurmOptions,
+) -> Result<(PathBuf, String)> {
+    // Every setting checked before anything is written.
+    let job = job_file(engine, sweep, file, dir, slurm)?;
+    prepare_points(sweep, dir)?;
+    let dir = absolute(dir)?;
+    if let Some((ids, list)) = &job.ids {
+        std::fs::write(ids, list).with_context(|| format!("writing {}", ids.display()))?;
+    }
+    match engine {
+        Engine::Row => std::fs::write(&job.path, &job.text)
+            .with_context(|| format!("writing {}", job.path.display()))?,
+        _ => write_script(&job.path, &job.text)?,
+    }
+    if let Some(array) = &job.array {
+        std::fs::create_dir_all(dir.join("slurm"))?;
+        write_json(&dir.join(SLURM_JSON), array)?;
+    }
+    Ok((job.path, job.command))
 }
 
 fn write_script(path: &Path, text: &str) -> Result<()> {

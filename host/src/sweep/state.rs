@@ -6,6 +6,11 @@
 //!   resumed by hand to another time): never touched.
 //! * *Finished*: the point's `scene.toml` and a `summary.json` whose data files are
 //!   those it records (size and digest).
+//! * *Damaged*: a `summary.json` whose data files are not those it records (a byte
+//!   changed, a file cut or copied over since the run finished), or one that cannot be
+//!   read: run from the start. A checkpoint marks how many bytes of each file it
+//!   continues, not what they hold, so resuming would keep the damaged bytes and vouch
+//!   for them in a new summary.
 //! * *Resumable*: the point's `scene.toml`, a readable `checkpoint.json` before the last
 //!   step or at it (one that records its step's solve, for the closing row), and each
 //!   data file (its `.tmp` or final name) holding at least the bytes the checkpoint
@@ -48,8 +53,10 @@ pub(super) fn state(pdir: &Path, scene_text: &str, scene: &Scene) -> State {
         }
         Err(_) => return State::New,
     }
-    if finished(pdir) {
-        return State::Finished;
+    match summary(pdir) {
+        Summary::Vouches => return State::Finished,
+        Summary::Damaged => return State::New,
+        Summary::None => {}
     }
     match Checkpoint::load(pdir) {
         Ok(c) if resumable(pdir, &c, scene) => State::Resumable(Box::new(c)),
@@ -57,20 +64,32 @@ pub(super) fn state(pdir: &Path, scene_text: &str, scene: &Scene) -> State {
     }
 }
 
-/// A summary whose data files are those it records.
-fn finished(pdir: &Path) -> bool {
-    let Ok(text) = std::fs::read_to_string(pdir.join(SUMMARY_JSON)) else {
-        return false;
+/// What a point's `summary.json` says of its data files.
+enum Summary {
+    /// They are those it records: the point is finished.
+    Vouches,
+    /// They are not (or the summary cannot be read): changed since the run finished.
+    Damaged,
+    /// No summary, or one without a files record (an older one vouches for nothing).
+    None,
+}
+
+fn summary(pdir: &Path) -> Summary {
+    let text = match std::fs::read(pdir.join(SUMMARY_JSON)) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Summary::None,
+        Err(_) => return Summary::Damaged,
     };
-    let Ok(summary) = serde_json::from_str::<serde_json::Value>(&text) else {
-        return false;
+    let Ok(summary) = serde_json::from_slice::<serde_json::Value>(&text) else {
+        return Summary::Damaged;
     };
-    let files = summary
-        .get("files")
-        .cloned()
-        .and_then(|f| serde_json::from_value::<BTreeMap<String, FileCheck>>(f).ok());
-    // A summary without a files record (an older one) vouches for nothing: run again.
-    files.is_some_and(|f| !f.is_empty() && mismatch(pdir, &f).is_none())
+    let Some(files) = summary.get("files") else {
+        return Summary::None;
+    };
+    match serde_json::from_value::<BTreeMap<String, FileCheck>>(files.clone()) {
+        Ok(f) if !f.is_empty() && mismatch(pdir, &f).is_none() => Summary::Vouches,
+        _ => Summary::Damaged,
+    }
 }
 
 /// A checkpoint of this scene before its last step, whose files hold what it marks.
