@@ -28,7 +28,7 @@ use crate::cell::Periodic;
 use crate::real::Real;
 
 mod pairs;
-pub use pairs::{PairOrder, check_pairs_in, first_pair};
+pub use pairs::{PairOrder, check_pairs_in, check_pairs_periodic, first_pair};
 
 /// Spheres from which the pair searches use a cell list; below, every pair is visited.
 /// Measured (`examples/pair_search.rs`: a step with contacts on, CPU time): the cell
