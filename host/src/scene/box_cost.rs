@@ -13,6 +13,10 @@
 //!   each (from the number density) and `P^3` the Gaussian support's points, all from
 //!   the kernel's own parameters (`Pse::new`).
 //!
+//! A step takes one product, or dozens with a constraint solve and Lanczos noise
+//! ([`Work`]); the Ewald path assembles its mobility once (twice with the midpoint) and
+//! serves them from it, PSE pays every one.
+//!
 //! A dilute box is where the grid dominates: a lone unit sphere in a box of 50 needs a
 //! grid of 72^3 points at tolerance 1e-6 for one pair's worth of Ewald work.
 
@@ -22,17 +26,73 @@ use hydrorattle::mobility::pse::Pse;
 /// Seconds per Ewald product, fixed part.
 pub const EWALD_FIXED: f64 = 0.000e0;
 /// Seconds per Ewald product per sphere.
-pub const EWALD_SPHERE: f64 = 4.418e-5;
+pub const EWALD_SPHERE: f64 = 3.484e-5;
 /// Seconds per Ewald product per pair (`N^2`, the self blocks included).
-pub const EWALD_PAIR: f64 = 2.536e-6;
+pub const EWALD_PAIR: f64 = 2.148e-6;
 /// Seconds per PSE product, fixed part.
-pub const PSE_FIXED: f64 = 1.760e-4;
+pub const PSE_FIXED: f64 = 7.286e-6;
 /// Seconds per PSE product per `M log2 M` of the grid (three FFTs each way).
-pub const PSE_GRID: f64 = 1.062e-8;
+pub const PSE_GRID: f64 = 1.199e-8;
 /// Seconds per PSE product per near-field pair (and per sphere).
-pub const PSE_NEAR: f64 = 2.049e-8;
+pub const PSE_NEAR: f64 = 2.132e-7;
 /// Seconds per PSE product per support point of a sphere (spread and interpolation).
-pub const PSE_SPREAD: f64 = 4.341e-8;
+pub const PSE_SPREAD: f64 = 1.296e-8;
+
+/// Mobility products a step takes beyond its first, for a constraint solve (the Krylov
+/// iterations), measured: the shipped 13-bead periodic chain on PSE
+/// (`host-demo/scenes/periodic_chain.toml` with `method = "pse"`, 10 steps:
+/// `mean_iterations` 21.6 in its `summary.json`).
+pub const PRODUCTS_SOLVE: f64 = 21.6;
+/// Products a step takes for Lanczos noise, measured on the same run (its
+/// `noise_iterations.mean`, 16.4).
+pub const PRODUCTS_NOISE: f64 = 16.4;
+/// Products of the midpoint's solve with bonds on PSE (`integrate::brownian`: "some
+/// 30 to 50 products"), and the Ewald path's second assembly there.
+pub const PRODUCTS_MIDPOINT: f64 = 40.0;
+
+/// What a step asks of the mobility: how many products, and how many assemblies the
+/// Ewald path makes for them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Work {
+    /// Constraints (bonds, pins, hard contacts): a Krylov solve a step.
+    pub constraints: bool,
+    /// Thermal noise (drawn by Lanczos from products on PSE).
+    pub thermal: bool,
+    /// The midpoint drift with constraints (a second solve).
+    pub midpoint: bool,
+    /// The Ewald path without the stored mobility (every product summed on the fly).
+    pub matrix_free: bool,
+}
+
+impl Work {
+    /// Products a step takes.
+    pub fn products(&self) -> f64 {
+        let mut k = 1.0;
+        k += if self.constraints {
+            PRODUCTS_SOLVE
+        } else {
+            0.0
+        };
+        k += if self.thermal { PRODUCTS_NOISE } else { 0.0 };
+        k += if self.midpoint {
+            PRODUCTS_MIDPOINT
+        } else {
+            0.0
+        };
+        k
+    }
+
+    /// The Ewald path's assemblies a step (the stored mobility then serves the
+    /// products at a few nanoseconds a pair, left out), or every product when
+    /// matrix-free.
+    pub fn assemblies(&self) -> f64 {
+        match (self.matrix_free, self.midpoint) {
+            (true, _) => self.products(),
+            (false, true) => 2.0,
+            (false, false) => 1.0,
+        }
+    }
+}
 
 /// The modelled time of one product by each path, seconds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,15 +127,24 @@ impl BoxCost {
         BoxCost { ewald, pse }
     }
 
-    /// Whether PSE runs here and costs less than the Ewald sum.
+    /// Whether PSE runs here and its product costs less than the Ewald sum's.
     pub fn pse_pays(&self) -> bool {
         self.pse.is_some_and(|p| p < self.ewald)
     }
+
+    /// The modelled time of a step asking `work` of each path, seconds: the Ewald
+    /// path's assemblies, PSE's products.
+    pub fn per_step(&self, work: Work) -> BoxCost {
+        BoxCost {
+            ewald: self.ewald * work.assemblies(),
+            pse: self.pse.map(|p| p * work.products()),
+        }
+    }
 }
 
-/// Whether `"auto"` should take PSE for `n` spheres up to radius `a_max` in the box
-/// `size` at `tolerance` ([`BoxCost::pse_pays`]): the rule of scenes and of the Python
-/// package's `mobility_dot`.
+/// Whether `"auto"` should take PSE for one product of `n` spheres up to radius `a_max`
+/// in the box `size` at `tolerance` ([`BoxCost::pse_pays`]): the rule of the Python
+/// package's `mobility_dot` (a scene's steps weigh their [`Work`] too).
 pub fn pse_pays(size: [f64; 3], n: usize, a_max: f64, tolerance: f64) -> bool {
     BoxCost::of(size, n, a_max, tolerance).pse_pays()
 }

@@ -349,7 +349,23 @@ impl super::Scene {
         };
         let radii = self.radii();
         let a_max = radii.iter().fold(0.0, |m: f64, &a| m.max(a));
-        super::box_cost::pse_pays(b.size, radii.len(), a_max, b.tolerance)
+        let cost = super::box_cost::BoxCost::of(b.size, radii.len(), a_max, b.tolerance);
+        let thermal = self.brownian.is_some_and(|t| t.temperature > 0.0);
+        let constraints = !self.bonds.is_empty()
+            || !self.pinned.is_empty()
+            || self
+                .contact
+                .is_some_and(|c| c.hard_capacity(radii.len()).is_some());
+        let midpoint = self
+            .brownian
+            .is_some_and(|t| t.drift == super::Drift::Midpoint);
+        let work = super::box_cost::Work {
+            constraints,
+            thermal,
+            midpoint: thermal && midpoint && constraints,
+            matrix_free: self.integrator.matrix_free,
+        };
+        cost.per_step(work).pse_pays()
     }
 
     /// Refuses a run of a box whose method is `"pse"` where the scene needs the
