@@ -135,3 +135,28 @@ fn spheres_in_contact_within_the_tolerance_load() {
     let err = reloaded(&plain, |_| {}).err().expect("an overlap loaded");
     assert!(err.contains("overlap"), "{err}");
 }
+
+#[test]
+fn a_huge_until_is_printed_short() {
+    // A run with a checkpoint, resumed to 1e300: refused, and the message says 1e300
+    // (Display would print its 301 digits).
+    let dir = std::env::temp_dir().join(format!("resume-until-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let text = "[[particle]]\nposition = [0, 0, 0]\nradius = 1.0\ndensity = 2.0\n\n\
+                [integrator]\nmethod = \"overdamped\"\ndt = 0.1\nduration = 1.0\n";
+    let scene = Scene::parse(text, "one.toml").unwrap();
+    let limits = crate::sizing::Limits::default();
+    let opts = super::RunOptions::files(limits, Some(0.5), false);
+    super::run(&scene, "one", Some(&dir), opts).unwrap();
+    let opts = super::RunOptions::files(limits, None, false);
+    let e = super::resume(&dir, 1e300, limits, opts)
+        .err()
+        .expect("resumed to 1e300");
+    let message = format!("{e:#}");
+    let _ = std::fs::remove_dir_all(&dir);
+    let digits = message.chars().fold((0, 0), |(run, most), c| {
+        let run = if c.is_ascii_digit() { run + 1 } else { 0 };
+        (run, most.max(run))
+    });
+    assert!(message.contains("1e300") && digits.1 < 30, "{message}");
+}
