@@ -87,7 +87,8 @@ fn a_damaged_record_is_refused_on_load() {
     let mut e = chain(&pos, vec![bond(0), bond(1)], |_| {});
     e.step().unwrap();
     assert!(reloaded(&e, |_| {}).is_ok());
-    let cases: [(&str, fn(&mut serde_json::Value)); 5] = [
+    type Edit = fn(&mut serde_json::Value);
+    let cases: [(&str, Edit); 5] = [
         ("radius 0", |v| v["radius"][1] = 0u64.into()),
         ("dt 0", |v| v["params"]["dt"] = 0u64.into()),
         ("coincident", |v| v["pos"][3] = v["pos"][0].clone()),
@@ -149,9 +150,9 @@ fn a_huge_until_is_printed_short() {
     let opts = super::RunOptions::files(limits, Some(0.5), false);
     super::run(&scene, "one", Some(&dir), opts).unwrap();
     let opts = super::RunOptions::files(limits, None, false);
-    let e = super::resume(&dir, 1e300, limits, opts)
-        .err()
-        .expect("resumed to 1e300");
+    let Err(e) = super::resume(&dir, 1e300, limits, opts) else {
+        panic!("resumed to 1e300");
+    };
     let message = format!("{e:#}");
     let _ = std::fs::remove_dir_all(&dir);
     let digits = message.chars().fold((0, 0), |(run, most), c| {
