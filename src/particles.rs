@@ -193,33 +193,6 @@ impl<T: Real, const N: usize> ParticleSet<T, N> {
     }
 }
 
-/// The pair checks of [`check_pairs`] in the periodic box `cell` when given: each
-/// pair through the minimum image (spheres that overlap through a face are refused as
-/// the step would refuse them). Fixed order (`i` ascending, then `j`).
-pub fn check_pairs_boxed<T: Real>(
-    pos: &[T::V3],
-    radius: &[T],
-    allow_overlap: bool,
-    cell: Option<&crate::cell::Periodic<T>>,
-) -> Result<(), ParticleError> {
-    for i in 0..pos.len() {
-        for j in i + 1..pos.len() {
-            let s = T::norm(crate::cell::image(cell, pos[i] - pos[j]));
-            let (ai, aj) = (radius[i], radius[j]);
-            if s == T::ZERO {
-                return Err(ParticleError::Coincident { i, j });
-            }
-            if s <= (ai - aj).abs() {
-                return Err(ParticleError::Nested { i, j });
-            }
-            if !allow_overlap && s < ai + aj {
-                return Err(ParticleError::Overlap { i, j });
-            }
-        }
-    }
-    Ok(())
-}
-
 /// Volume of a sphere of radius `a`.
 pub fn sphere_volume<T: Real>(a: T) -> T {
     T::from_f64(4.0 / 3.0) * T::PI * a * a * a
@@ -251,9 +224,20 @@ pub fn check_pairs<T: Real>(
     radius: &[T],
     allow_overlap: bool,
 ) -> Result<(), ParticleError> {
+    check_pairs_in(pos, radius, allow_overlap, None)
+}
+
+/// [`check_pairs`] in the periodic box `cell` when given: each pair through the
+/// minimum image (spheres that overlap through a face are refused as the step would).
+pub fn check_pairs_in<T: Real>(
+    pos: &[T::V3],
+    radius: &[T],
+    allow_overlap: bool,
+    cell: Option<&crate::cell::Periodic<T>>,
+) -> Result<(), ParticleError> {
     for i in 0..pos.len() {
         for j in i + 1..pos.len() {
-            let s = T::norm(pos[i] - pos[j]);
+            let s = T::norm(crate::cell::image(cell, pos[i] - pos[j]));
             let (ai, aj) = (radius[i], radius[j]);
             if s == T::ZERO {
                 return Err(ParticleError::Coincident { i, j });

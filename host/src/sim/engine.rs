@@ -9,7 +9,7 @@ use hydrorattle::{
 };
 use std::sync::Arc;
 
-use hydrorattle::particles::check_pairs_boxed;
+use hydrorattle::particles::check_pairs_in;
 use hydrorattle_heap::Buffers;
 use hydrorattle_parallel::Threads;
 
@@ -204,7 +204,7 @@ impl<T: Real> Engine<T> {
     pub fn check(&mut self) -> Result<(), StepError> {
         let b = &self.beads;
         let cell = self.params.periodic.as_ref();
-        check_pairs_boxed(&b.pos, &b.radius, self.params.allow_overlap, cell)?;
+        check_pairs_in(&b.pos, &b.radius, self.params.allow_overlap, cell)?;
         let mut state = self.beads.state();
         state.noise = Some(&mut self.noise);
         let rows = match self.pins.is_empty() {
