@@ -51,7 +51,8 @@ pub fn frame_bytes(n: usize) -> f64 {
 const COUNT_MAX: usize = (usize::MAX >> 10).isqrt();
 
 /// Whether the storage of `n` particles and `constraints` constraints (bonds,
-/// contacts, wall rows) can be counted: both at most [`COUNT_MAX`].
+/// contacts, wall rows) can be counted: both at most `(usize::MAX >> 10).isqrt()`,
+/// below which no count of the kernel's layout nor its byte total overflows.
 pub fn sizable(n: usize, constraints: usize) -> bool {
     n <= COUNT_MAX && constraints <= COUNT_MAX
 }

@@ -87,7 +87,8 @@ fn a_damaged_record_is_refused_on_load() {
     let mut e = chain(&pos, vec![bond(0), bond(1)], |_| {});
     e.step().unwrap();
     assert!(reloaded(&e, |_| {}).is_ok());
-    let cases: [(&str, fn(&mut serde_json::Value)); 5] = [
+    type Edit = fn(&mut serde_json::Value);
+    let cases: [(&str, Edit); 5] = [
         ("radius 0", |v| v["radius"][1] = 0u64.into()),
         ("dt 0", |v| v["params"]["dt"] = 0u64.into()),
         ("coincident", |v| v["pos"][3] = v["pos"][0].clone()),
@@ -134,4 +135,29 @@ fn spheres_in_contact_within_the_tolerance_load() {
     let plain = engine(&pos, |_| {});
     let err = reloaded(&plain, |_| {}).err().expect("an overlap loaded");
     assert!(err.contains("overlap"), "{err}");
+}
+
+#[test]
+fn a_huge_until_is_printed_short() {
+    // A run with a checkpoint, resumed to 1e300: refused, and the message says 1e300
+    // (Display would print its 301 digits).
+    let dir = std::env::temp_dir().join(format!("resume-until-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let text = "[[particle]]\nposition = [0, 0, 0]\nradius = 1.0\ndensity = 2.0\n\n\
+                [integrator]\nmethod = \"overdamped\"\ndt = 0.1\nduration = 1.0\n";
+    let scene = Scene::parse(text, "one.toml").unwrap();
+    let limits = crate::sizing::Limits::default();
+    let opts = super::RunOptions::files(limits, Some(0.5), false);
+    super::run(&scene, "one", Some(&dir), opts).unwrap();
+    let opts = super::RunOptions::files(limits, None, false);
+    let Err(e) = super::resume(&dir, 1e300, limits, opts) else {
+        panic!("resumed to 1e300");
+    };
+    let message = format!("{e:#}");
+    let _ = std::fs::remove_dir_all(&dir);
+    let digits = message.chars().fold((0, 0), |(run, most), c| {
+        let run = if c.is_ascii_digit() { run + 1 } else { 0 };
+        (run, most.max(run))
+    });
+    assert!(message.contains("1e300") && digits.1 < 30, "{message}");
 }

@@ -7,8 +7,9 @@ constraint solves. This package calls it with NumPy arrays:
 * :func:`mobility`, :func:`mobility_dot`: the mobility matrix and its product;
 * :class:`System`: particles and bonds stepped by the kernel (:meth:`System.step`,
   :meth:`System.run`);
-* :func:`load_scene`, :func:`run_scene`, :func:`read_run`: the scene files and runs of
-  the ``host-demo`` CLI, through the same library code (same files, same bits).
+* :func:`load_scene`, :func:`run_scene`, :func:`resume_run`, :func:`read_run`: the
+  scene files and runs of the ``host-demo`` CLI, through the same library code (same
+  files, same bits; Ctrl-C stops a run with a checkpoint, as the CLI's).
 
 Units are the caller's, consistent: with lengths in ``L``, viscosity in ``eta`` and
 forces in ``F``, velocities come out in ``F / (eta L)``, times in ``eta L^2 / F``. The
