@@ -4,8 +4,8 @@
 
 use super::{
     Projection, Start, StepReport, Sums, add_constraint_forces, add_flow, assemble_tt,
-    bond_vectors, max_tension, mobility_metric, mobility_product, project_overdamped, report, spin,
-    step_velocity,
+    bond_vectors, check_resolved, max_tension, mobility_metric, mobility_product,
+    project_overdamped, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch, SolveStats};
@@ -66,6 +66,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     }
     let mu = mu.into_ref();
     add_flow(p, s.pos, u);
+    check_resolved(s.pos, u, dt)?;
     // Unconstrained move r* = r + dt (U_inf + mu F), then the constraint move through
     // the full mobility: r' = r* + dt mu G^T lambda (bonds, and contacts if on).
     let free = |x: &mut [T::V3]| {
@@ -206,6 +207,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     projected_velocity(
         p, s.ewald, s.pos, s.radius, mu0, force, bonds, grad, disp, kappa, &mut sc, f0,
     )?;
+    check_resolved(s.pos, f0, dt)?;
     // Tension and spin at the start of the step: the velocity projection's multipliers
     // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
     let tension = max_tension(bonds, kappa);
