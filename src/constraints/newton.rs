@@ -69,11 +69,11 @@ pub fn newton<T: Real>(
     for it in 0..=solver.max_iterations {
         let (mut changed, mut pushes) = (false, true);
         // The residual at the iterate on the equations the last update solved (the
-        // active set it was built for), backtracked where that update made it worse.
+        // active set it was built for), backtracked where that update diverged.
         let (trial, damped) = match (applied, previous) {
             (true, Some(p)) => {
-                let limit = (p, solver.tolerance);
-                backtrack(&problem, bonds, (from, state), x, mult, rhs, limit, metric)
+                let limit = (p, solver.tolerance, it);
+                backtrack(&problem, bonds, (from, state), x, mult, rhs, limit, metric)?
             }
             _ => (None, false),
         };
@@ -200,21 +200,28 @@ pub fn newton<T: Real>(
     })
 }
 
-/// Halvings of a Newton update that made the residual worse ([`backtrack`]).
-const HALVINGS: u32 = 30;
+/// Halvings of a Newton update that made the residual grow ([`backtrack`]).
+const HALVINGS: u32 = 10;
 
-/// The backtracking line search on the residual (the largest normalised one, as the
-/// tolerance is stated): where the update `rhs` just applied to `x` and `mult` left
-/// the residual not below `previous` and above `tolerance` (or not finite: far outside the region where the
-/// linearisation holds, a jammed pile's Newton step overshoots by many sphere radii
-/// and the next one diverges), half of what was applied is taken back, up to
-/// [`HALVINGS`] times. A line search rather than a trust region: the step's direction
-/// is already the solver's (chord or Newton, dependent rows with a zero update), and
-/// only its length is in doubt; a converging iteration never meets the test and keeps
-/// its bits. The updates are linear in `rhs`, so halving retraces the same line.
+/// Growth of the residual in one update beyond which the update is taken to diverge.
+const DIVERGING: f64 = 10.0;
+
+/// The safeguard of a diverging update, a backtracking line search on the residual
+/// (the largest normalised one, as the tolerance is stated): where the update `rhs`
+/// just applied to `x` and `mult` left the residual above `tolerance` and more than
+/// [`DIVERGING`] times `previous`, or not finite (far outside the region where the
+/// linearisation holds: a jammed pile's step overshoots by many sphere radii and the
+/// next one diverges), half of what was applied is taken back until the residual is
+/// below `previous`, up to [`HALVINGS`] times. A line search rather than a trust
+/// region: the direction is already the solver's (chord or Newton, a zero update on
+/// dependent rows) and only its length is in doubt; the updates are linear in `rhs`,
+/// so the halvings retrace one line at one residual each. Only a diverging update is
+/// damped: the chord and the active set legitimately raise the residual for an
+/// iteration or two, and a converging solve never meets the test and keeps its bits.
 /// Returns the residual reached where it can stand for the iteration's (equalities
-/// only: the one-sided rows' is taken again after the active-set update) and whether
-/// any halving was done.
+/// only: the one-sided rows' is taken again after the active-set update), whether any
+/// halving was done, and an error where the halvings found no decrease (the step is
+/// too long for the linearisation: a shorter one can pass).
 #[allow(clippy::too_many_arguments)]
 fn backtrack<T: Real>(
     problem: &Problem<'_, T>,
@@ -223,17 +230,19 @@ fn backtrack<T: Real>(
     x: &mut [T::V3],
     mult: &mut [T],
     rhs: &mut [T],
-    (previous, tolerance): (T, T),
+    (previous, tolerance, it): (T, T, u32),
     metric: &Metric<'_, T>,
-) -> (Option<T>, bool) {
+) -> Result<(Option<T>, bool), StepError> {
     let one_sided = from < bonds.len();
     let measure = |x: &[T::V3], mult: &[T]| match one_sided {
         false => worst(problem, bonds, x),
         true => onesided::residual(problem, bonds, from, x, mult, state).0,
     };
     let mut r = measure(x, mult);
-    let mut halvings = 0;
-    while !(r < previous) && !(r <= tolerance) && halvings < HALVINGS {
+    if r <= tolerance || r <= previous * T::from_f64(DIVERGING) {
+        return Ok(((!one_sided).then_some(r), false));
+    }
+    for _ in 0..HALVINGS {
         for v in rhs.iter_mut() {
             *v *= -T::HALF;
         }
@@ -246,9 +255,11 @@ fn backtrack<T: Real>(
             *v = -*v;
         }
         r = measure(x, mult);
-        halvings += 1;
+        if r < previous {
+            return Ok(((!one_sided).then_some(r), true));
+        }
     }
-    ((!one_sided).then_some(r), halvings > 0)
+    Err(problem.no_convergence(it, r))
 }
 
 /// The inactive one-sided rows' equations (of the chord's lower triangle) replaced by
