@@ -212,7 +212,7 @@ const DIVERGING: f64 = 10.0;
 /// [`DIVERGING`] times `previous`, or not finite (far outside the region where the
 /// linearisation holds: a jammed pile's step overshoots by many sphere radii and the
 /// next one diverges), half of what was applied is taken back until the residual is
-/// below `previous`, up to [`HALVINGS`] times. A line search rather than a trust
+/// below `previous` or within `tolerance`, up to [`HALVINGS`] times. A line search rather than a trust
 /// region: the direction is already the solver's (chord or Newton, a zero update on
 /// dependent rows) and only its length is in doubt; the updates are linear in `rhs`,
 /// so the halvings retrace one line at one residual each. Only a diverging update is
@@ -255,7 +255,7 @@ fn backtrack<T: Real>(
             *v = -*v;
         }
         r = measure(x, mult);
-        if r < previous {
+        if r < previous || r <= tolerance {
             return Ok(((!one_sided).then_some(r), true));
         }
     }
