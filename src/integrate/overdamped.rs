@@ -207,7 +207,6 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     projected_velocity(
         p, s.ewald, s.pos, s.radius, mu0, force, bonds, grad, disp, kappa, &mut sc, f0,
     )?;
-    check_resolved(s.pos, f0, dt)?;
     // Tension and spin at the start of the step: the velocity projection's multipliers
     // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
     let tension = max_tension(bonds, kappa);

@@ -365,7 +365,9 @@ pub(super) fn project_positions<T: Real>(
 /// a state at rest. Velocities are taken from positions because that is what the step
 /// moves; refusing keeps every step that does move bit for bit as it was. A scene
 /// without motion (every `u_i` zero) is not refused, nor a sphere whose move is not
-/// finite (the acceptance names it).
+/// finite (the acceptance names it). First-order `Overdamped` only: `Overdamped2`'s
+/// predictor velocity is already projected (zero, to rounding, for pinned spheres), so
+/// it has no unconstrained move to judge.
 pub(super) fn check_resolved<T: Real>(pos: &[T::V3], u: &[T::V3], dt: T) -> Result<(), StepError> {
     let mut moving = false;
     for (&x, &v) in pos.iter().zip(u) {
