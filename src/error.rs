@@ -152,6 +152,65 @@ pub enum Stage {
     Contacts,
 }
 
+/// What a constraint row of a step holds, by the caller's numbering: the rows are the
+/// caller's bond list (bonds and pin rows, [`Bond::pin`](crate::Bond::pin)), then the
+/// step's one-sided rows (contacts and wall links).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Row {
+    /// Bond `k` of the caller's list.
+    Bond(usize),
+    /// The pin row of a sphere along an axis (0, 1, 2: x, y, z).
+    Pin {
+        /// The sphere.
+        particle: usize,
+        /// The axis.
+        axis: usize,
+    },
+    /// A hard-sphere contact between two spheres.
+    Contact {
+        /// First sphere.
+        i: usize,
+        /// Second sphere.
+        j: usize,
+    },
+    /// A sphere's link to the wall.
+    Wall {
+        /// The sphere.
+        particle: usize,
+    },
+}
+
+impl Row {
+    /// Row `k` of a step whose rows are `rows`, the one-sided ones (contacts, wall
+    /// links) from `one_sided` on.
+    pub fn of<T: crate::Real>(rows: &[crate::Bond<T>], k: usize, one_sided: usize) -> Self {
+        let b = &rows[k];
+        match () {
+            _ if b.is_pin() => Self::Pin {
+                particle: b.i,
+                axis: b.axis(),
+            },
+            _ if b.is_wall() => Self::Wall { particle: b.i },
+            _ if k >= one_sided => Self::Contact { i: b.i, j: b.j },
+            _ => Self::Bond(k),
+        }
+    }
+}
+
+impl fmt::Display for Row {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::Bond(k) => write!(f, "bond {k}"),
+            Self::Pin { particle, axis } => {
+                let name = ["x", "y", "z"].get(axis).copied().unwrap_or("?");
+                write!(f, "the pin of particle {particle} along {name}")
+            }
+            Self::Contact { i, j } => write!(f, "the contact of particles {i} and {j}"),
+            Self::Wall { particle } => write!(f, "the wall contact of particle {particle}"),
+        }
+    }
+}
+
 /// Most constraints a [`StepError::Infeasible`] lists.
 pub const INFEASIBLE_SHOWN: usize = 4;
 
@@ -189,6 +248,9 @@ pub enum StepError {
     Degenerate {
         /// The bond; past the bonds, contact `bond - bonds` of the step.
         bond: usize,
+        /// What that row holds (a bond, a pin, a contact or a wall link), named as
+        /// the message prints it.
+        row: Row,
     },
     /// The constraints cannot all hold at once: the geometry is infeasible (a sphere
     /// squeezed between two that cannot move apart: a bond shorter than the spheres
@@ -341,10 +403,10 @@ impl fmt::Display for StepError {
                 f,
                 "{stage:?} constraint solve did not converge in {iterations} iterations (residual {residual:e})"
             ),
-            Self::Degenerate { bond } => {
+            Self::Degenerate { row, .. } => {
                 write!(
                     f,
-                    "bond {bond} turned too far in one step (degenerate SHAKE update)"
+                    "{row} turned too far in one step (degenerate SHAKE update)"
                 )
             }
             Self::Infeasible {

@@ -191,8 +191,14 @@ fn head_on_stops_at_contact<T: Real>() {
         &before,
         &crossing,
         &r,
-        |e| matches!(e, StepError::Degenerate { bond: 0 }),
+        |e| matches!(e, StepError::Degenerate { bond: 0, .. }),
         "one sphere carried through the other",
+    );
+    // Named as what the row holds: a contact, not "bond 0" (there is no bond).
+    let e = r.unwrap_err().to_string();
+    assert!(
+        e.starts_with("the contact of particles 0 and 1 turned too far"),
+        "{e}"
     );
     // Without contacts the moderate step leaves them overlapping: refused.
     let mut ps2 = apart::<T>();
@@ -375,4 +381,45 @@ fn settling_helix_f64() {
 fn settling_helix_f32() {
     let d = settling_helix_never_overlaps::<f32>();
     assert_eq!(d, GOLDEN_F32, "contacts helix digest f32: {d:016x}");
+}
+
+/// A step's rows named by what they hold: the caller's bonds, then its pin rows, then
+/// the one-sided rows (contacts, wall links), as the solvers number them.
+#[test]
+fn rows_are_named_by_what_they_hold() {
+    use hydrorattle::{Bond, Row};
+    let mut rows = vec![Bond::<f64> {
+        i: 0,
+        j: 1,
+        length: 2.0,
+    }];
+    rows.extend(Bond::pins(2, 1.0));
+    rows.push(Bond {
+        i: 3,
+        j: 4,
+        length: 2.0,
+    });
+    rows.push(Bond::wall(5, 1.0));
+    let named: Vec<String> = (0..rows.len())
+        .map(|k| Row::of(&rows, k, 4).to_string())
+        .collect();
+    assert_eq!(
+        named,
+        [
+            "bond 0",
+            "the pin of particle 2 along x",
+            "the pin of particle 2 along y",
+            "the pin of particle 2 along z",
+            "the contact of particles 3 and 4",
+            "the wall contact of particle 5",
+        ]
+    );
+    let e = StepError::Degenerate {
+        bond: 4,
+        row: Row::of(&rows, 4, 4),
+    };
+    assert_eq!(
+        e.to_string(),
+        "the contact of particles 3 and 4 turned too far in one step (degenerate SHAKE update)"
+    );
 }

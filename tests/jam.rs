@@ -586,3 +586,59 @@ fn random_piles_hold_or_refuse() {
         }
     }
 }
+
+/// The 20-sphere pile at rest (every constraint holds), stepped at dt 10 and 100 with
+/// every solver: the step holds the constraints or refuses as a step too long
+/// (`Degenerate`, `NoConvergence`: what a shorter step avoids), never as an
+/// infeasible geometry, and a refusal keeps the state.
+#[test]
+fn a_pile_at_rest_is_never_infeasible_at_long_steps() {
+    let rest = pile_to_rest::<f64, 20>((0, 2, 5), 600, SolverKind::Newton);
+    let h = -2.0;
+    let spheres: Vec<Sphere> = rest
+        .iter()
+        .map(|&pos| Sphere {
+            pos,
+            radius: 1.0,
+            density: RHO,
+        })
+        .collect();
+    let none = |_: usize, _: usize| false;
+    for kind in SOLVERS {
+        for dt in [10.0, 100.0] {
+            let mut p = jam_params::<f64>(dt, Method::Overdamped, kind, h);
+            p.contacts = Some(Contacts::new(120));
+            p.solver.max_iterations = 2000;
+            // The rest state touches within the tolerance.
+            p.allow_overlap = true;
+            let mut ps = particles_overlapping::<20>(&spheres);
+            let bonds = BondSet::<f64, 1>::new();
+            let mut store = Buffers::<f64>::new(Layout::for_params(&p, 20, 0));
+            let before = snapshot(&ps);
+            match one_step(&mut ps, &bonds, &p, &mut store) {
+                Ok(_) => {
+                    let v = worst_violation(&ps, 20, h, &none);
+                    assert!(v <= slack(&p, h), "{kind:?} dt {dt}: violation {v}");
+                }
+                Err(e) => {
+                    assert!(
+                        matches!(
+                            e,
+                            StepError::Degenerate { .. } | StepError::NoConvergence { .. }
+                        ),
+                        "{kind:?} dt {dt}: {e}"
+                    );
+                    assert_eq!(snapshot(&ps), before, "{kind:?} dt {dt}: state kept");
+                }
+            }
+        }
+    }
+}
+
+fn particles_overlapping<const N: usize>(spheres: &[Sphere]) -> ParticleSet<f64, N> {
+    let list: Vec<_> = spheres
+        .iter()
+        .map(|s| hydrorattle::Particle::new(v3::<f64>(s.pos[0], s.pos[1], s.pos[2]), 1.0, RHO))
+        .collect();
+    ParticleSet::<f64, N>::from_slice(&list, true).unwrap()
+}

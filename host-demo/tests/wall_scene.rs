@@ -110,3 +110,31 @@ fn spheres_land_and_the_run_records_it() {
         assert_eq!(again.unwrap().wall, s.wall, "{what}");
     }
 }
+
+/// A sphere touching a wall far from the origin: in f32 the coordinates' spacing
+/// there (2 at 3e7) exceeds the radius, so its centre rounds onto the plane, and the
+/// parse refuses it at its position (the step's own test in the step's precision),
+/// where before the parse passed it and the run stopped at step 1. In f64 it runs.
+#[test]
+fn a_touching_sphere_far_from_the_origin_is_judged_in_the_run_precision() {
+    let text = |precision| {
+        format!(
+            "[wall]\nheight = -3e7\n\n\
+             [[particle]]\nposition = [0.0, 0.0, -29999999.0]\nradius = 1.0\n\n\
+             [contact]\nmodel = \"hard\"\n\n\
+             [integrator]\nmethod = \"overdamped\"\ndt = 0.1\nduration = 0.2\nprecision = \"{precision}\"\n"
+        )
+    };
+    let e = Scene::parse(&text("f32"), "far.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("far.toml:4:")
+            && e.contains("particle 0: sphere below or crossing the wall")
+            && e.contains("in f32"),
+        "{e}"
+    );
+    let s = Scene::parse(&text("f64"), "far.toml").unwrap();
+    let r = run(&s, "far", None, RunOptions::default()).unwrap();
+    assert_eq!(r.summary.failure, None);
+}

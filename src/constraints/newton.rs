@@ -64,10 +64,22 @@ pub fn newton<T: Real>(
     let mut deficient = 0;
     // The chord is kept to the end (one-sided rows dependent at the iterate only).
     let mut stay = false;
+    // `rhs` holds the update applied by the last iteration (none before the first).
+    let mut applied = false;
     for it in 0..=solver.max_iterations {
         let (mut changed, mut pushes) = (false, true);
+        // The residual at the iterate on the equations the last update solved (the
+        // active set it was built for), backtracked where that update diverged.
+        let (trial, damped) = match (applied, previous) {
+            (true, Some(p)) => {
+                let limit = (p, solver.tolerance, it);
+                backtrack(&problem, bonds, (from, state), x, mult, rhs, limit, metric)?
+            }
+            _ => (None, false),
+        };
+        applied = false;
         let residual = match one_sided {
-            false => worst(&problem, bonds, x),
+            false => trial.unwrap_or_else(|| worst(&problem, bonds, x)),
             true => {
                 changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
                 let (r, p) = onesided::residual(&problem, bonds, from, x, mult, state);
@@ -89,7 +101,9 @@ pub fn newton<T: Real>(
         }
         let fast = previous.is_some_and(|p| residual <= p * T::from_f64(0.1));
         // One-sided rows never leave the chord: their stall is judged on it.
+        // A damped step says nothing of the dependent rows (it stopped short).
         if deficient > 0
+            && !damped
             && (!chord || one_sided)
             && !changed
             && previous.is_some_and(|p| residual > p * T::HALF)
@@ -168,6 +182,7 @@ pub fn newton<T: Real>(
             *m += r;
         }
         metric.apply_each(bonds, rhs, x);
+        applied = true;
         if one_sided {
             // Released: exactly zero (the solve gives `-lambda_k` to rounding).
             for k in from..nb {
@@ -183,6 +198,68 @@ pub fn newton<T: Real>(
         iterations: solver.max_iterations,
         residual: f64::NAN,
     })
+}
+
+/// Halvings of a Newton update that made the residual grow ([`backtrack`]).
+const HALVINGS: u32 = 10;
+
+/// Growth of the residual in one update beyond which the update is taken to diverge.
+const DIVERGING: f64 = 10.0;
+
+/// The safeguard of a diverging update, a backtracking line search on the residual
+/// (the largest normalised one, as the tolerance is stated): where the update `rhs`
+/// just applied to `x` and `mult` left the residual above `tolerance` and more than
+/// [`DIVERGING`] times `previous`, or not finite (far outside the region where the
+/// linearisation holds: a jammed pile's step overshoots by many sphere radii and the
+/// next one diverges), half of what was applied is taken back until the residual is
+/// below `previous` or within `tolerance`, up to [`HALVINGS`] times. A line search rather than a trust
+/// region: the direction is already the solver's (chord or Newton, a zero update on
+/// dependent rows) and only its length is in doubt; the updates are linear in `rhs`,
+/// so the halvings retrace one line at one residual each. Only a diverging update is
+/// damped: the chord and the active set legitimately raise the residual for an
+/// iteration or two, and a converging solve never meets the test and keeps its bits.
+/// Returns the residual reached where it can stand for the iteration's (equalities
+/// only: the one-sided rows' is taken again after the active-set update), whether any
+/// halving was done, and an error where the halvings found no decrease (the step is
+/// too long for the linearisation: a shorter one can pass).
+#[allow(clippy::too_many_arguments)]
+fn backtrack<T: Real>(
+    problem: &Problem<'_, T>,
+    bonds: &[Bond<T>],
+    (from, state): (usize, &[usize]),
+    x: &mut [T::V3],
+    mult: &mut [T],
+    rhs: &mut [T],
+    (previous, tolerance, it): (T, T, u32),
+    metric: &Metric<'_, T>,
+) -> Result<(Option<T>, bool), StepError> {
+    let one_sided = from < bonds.len();
+    let measure = |x: &[T::V3], mult: &[T]| match one_sided {
+        false => worst(problem, bonds, x),
+        true => onesided::residual(problem, bonds, from, x, mult, state).0,
+    };
+    let mut r = measure(x, mult);
+    if r <= tolerance || r <= previous * T::from_f64(DIVERGING) {
+        return Ok(((!one_sided).then_some(r), false));
+    }
+    for _ in 0..HALVINGS {
+        for v in rhs.iter_mut() {
+            *v *= -T::HALF;
+        }
+        for (m, &v) in mult.iter_mut().zip(rhs.iter()) {
+            *m += v;
+        }
+        metric.apply_each(bonds, rhs, x);
+        // `rhs` is again what stands applied.
+        for v in rhs.iter_mut() {
+            *v = -*v;
+        }
+        r = measure(x, mult);
+        if r < previous || r <= tolerance {
+            return Ok(((!one_sided).then_some(r), true));
+        }
+    }
+    Err(problem.no_convergence(it, r))
 }
 
 /// The inactive one-sided rows' equations (of the chord's lower triangle) replaced by

@@ -24,7 +24,7 @@
 
 use super::{Metric, Problem, SolveStats, Solver, dependent, onesided};
 use crate::bonds::Bond;
-use crate::error::StepError;
+use crate::error::{Row, StepError};
 use crate::real::Real;
 
 /// The over-relaxation factor of the sweeps with one-sided rows (module docs): chosen
@@ -72,7 +72,10 @@ pub fn sweep<T: Real>(
             // A vanishing denominator means the bond turned ~90 degrees in one step.
             let floor = T::from_f64(1e-12) * T::norm(dir) * T::norm(w);
             if !(den.abs() > floor) {
-                return Err(StepError::Degenerate { bond: k });
+                return Err(StepError::Degenerate {
+                    bond: k,
+                    row: Row::of(bonds, k, from),
+                });
             }
             let mut delta = -value / den;
             if relax {

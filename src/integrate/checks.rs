@@ -112,14 +112,18 @@ pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result
 /// The first sphere whose centre is below `height + a_i (1 - 2 tol)`, less the
 /// rounding of the numbers compared (4 epsilons of `|z| + |height| + a_i`): far from
 /// the origin a sphere put or held at contact is off by an ulp of its coordinates,
-/// which can exceed `2 tol a_i`.
+/// which can exceed `2 tol a_i`. A centre that is not strictly above the plane in the
+/// step's precision (`z - height <= 0`: the coordinates' spacing there exceeds the
+/// radius, f32 far from the origin) is below it whatever that rounding: the wall's
+/// mobility has no value there (`mobility::wall`), and a scene checked with this test
+/// at parse time is not refused at its first step by that one.
 fn below_wall<T: Real>(pos: &[T::V3], radius: &[T], height: T, tol: T) -> Option<usize> {
     let reach = T::ONE - tol * T::TWO;
     let ulps = T::EPSILON * T::from_f64(4.0);
     pos.iter().zip(radius).position(|(&r, &a)| {
         let z = T::xyz(r)[2];
         let rounding = (z.abs() + height.abs() + a) * ulps;
-        !(z - height + rounding >= a * reach)
+        !(z - height > T::ZERO && z - height + rounding >= a * reach)
     })
 }
 

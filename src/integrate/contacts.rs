@@ -44,7 +44,7 @@ use crate::bonds::Bond;
 use crate::cell::{Periodic, image};
 use crate::cell_list::{self, CellList};
 use crate::constraints::{Scratch, SolveStats};
-use crate::error::{Stage, StepError};
+use crate::error::{Row, Stage, StepError};
 use crate::linalg::Mob;
 use crate::params::{Contacts, Params, Wall};
 use crate::real::Real;
@@ -161,7 +161,8 @@ pub(super) fn project_overdamped<'l, T: Real>(
         free(x);
         shift(x, wall, -T::ONE);
         // Contacts and wall links are inequalities inside the solve (`docs/CONTACTS.md`).
-        let stats = project_positions(p, active, &metric, x, lambda, scratch, nb, start)?;
+        let stats = project_positions(p, active, &metric, x, lambda, scratch, nb, start)
+            .map_err(|e| too_long(e, active, nb, start, wall, p))?;
         let Some(c) = one_sided else {
             return Ok(Projected {
                 stats,
@@ -185,7 +186,10 @@ pub(super) fn project_overdamped<'l, T: Real>(
             // wall: `grad = (0, 0, a)`, its relative vector `(0, 0, z)`).
             for (k, l) in links[nb..nb + nc].iter().enumerate() {
                 if !(T::dot(l.separation(x, cell.as_ref()), grad[nb + k]) > T::ZERO) {
-                    return Err(StepError::Degenerate { bond: nb + k });
+                    return Err(StepError::Degenerate {
+                        bond: nb + k,
+                        row: Row::of(links, nb + k, nb),
+                    });
                 }
             }
             shift(x, wall, T::ONE);
@@ -219,6 +223,58 @@ pub(super) fn project_overdamped<'l, T: Real>(
                 residual: deepest_overlap(x, radius, cell, wall.is_some()).to_f64(),
             });
         }
+    }
+}
+
+/// A dependent set that the solve found contradictory ([`StepError::Infeasible`]) is
+/// a claim about the linearisation at its iterate. Where every row already holds at
+/// the start of the step, the start is a point that meets them all: the geometry is
+/// feasible, and the step is too long for the linearisation (its rows turned too far):
+/// [`StepError::Degenerate`] on the dependent set's first row, which a shorter step
+/// can avoid. Other errors pass unchanged.
+fn too_long<T: Real>(
+    e: StepError,
+    rows: &[Bond<T>],
+    one_sided: usize,
+    start: &[T::V3],
+    wall: Option<Wall<T>>,
+    p: &Params<T>,
+) -> StepError {
+    let StepError::Infeasible { constraints, .. } = e else {
+        return e;
+    };
+    // The last step left its rows within the tolerance and its other pairs overlapping
+    // by at most that (measured as the solve measures them, which a sweep stops just
+    // inside): four tolerances here, far below any contradiction a start can hold.
+    let tol = p.solver.tolerance * T::from_f64(4.0);
+    let cell = super::cell(p);
+    let holds = rows.iter().enumerate().all(|(k, b)| {
+        // A pin row is measured from the start: it holds there.
+        if b.is_pin() {
+            return true;
+        }
+        let (gap, d) = match b.is_wall() {
+            true => {
+                let h = wall.map_or(T::ZERO, |w| w.height);
+                (T::xyz(start[b.i])[2] - h - b.length, b.length)
+            }
+            false => (
+                T::norm(b.separation(start, cell.as_ref())) - b.length,
+                b.length,
+            ),
+        };
+        let err = gap / d;
+        match k >= one_sided {
+            true => err >= -tol,
+            false => err.abs() <= tol,
+        }
+    });
+    match holds {
+        true => StepError::Degenerate {
+            bond: constraints[0],
+            row: Row::of(rows, constraints[0], one_sided),
+        },
+        false => e,
     }
 }
 

@@ -4,8 +4,8 @@
 
 use super::{
     Projection, Start, StepReport, Sums, add_constraint_forces, add_flow, assemble_tt,
-    bond_vectors, max_tension, mobility_metric, mobility_product, project_overdamped, report, spin,
-    step_velocity,
+    bond_vectors, check_resolved, max_tension, mobility_metric, mobility_product,
+    project_overdamped, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch, SolveStats};
@@ -66,6 +66,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     }
     let mu = mu.into_ref();
     add_flow(p, s.pos, u);
+    check_resolved(s.pos, u, dt)?;
     // Unconstrained move r* = r + dt (U_inf + mu F), then the constraint move through
     // the full mobility: r' = r* + dt mu G^T lambda (bonds, and contacts if on).
     let free = |x: &mut [T::V3]| {

@@ -42,7 +42,7 @@ pub struct Engine<T: Real> {
     pub noise: Noise,
     /// The soft contact force, when the scene asks for one.
     pub contact: Option<SoftContact<T>>,
-    /// Brownian steps refused and completed as split steps so far ([`retry`]).
+    /// Steps refused and completed as split steps so far ([`retry`]).
     pub retries: Retries,
     /// The thermal noise's Lanczos iterations so far ([`LanczosTally`]; empty without
     /// a temperature).
@@ -222,8 +222,9 @@ impl<T: Real> Engine<T> {
         self.step_with(&mut |_: &[T::V3], _: &[T], _: &mut [T::V3]| {})
     }
 
-    /// One step, `extra` adding forces after gravity and the soft contact; a Brownian
-    /// step the kernel refuses is retried split along a Brownian bridge ([`retry`]).
+    /// One step, `extra` adding forces after gravity and the soft contact; a step the
+    /// kernel refuses is retried split (along a Brownian bridge at temperature,
+    /// [`retry`]).
     /// A failed step leaves the state and the noise generator as they were.
     pub fn step_with(&mut self, extra: Extra<'_, T>) -> Result<StepReport<T>, StepError> {
         let contact = self.contact;

@@ -116,7 +116,7 @@ pub struct Summary {
     pub front: Front,
     /// Why the run stopped early, if it did.
     pub failure: Option<String>,
-    /// Brownian steps the kernel refused and the run completed as split steps.
+    /// Steps the kernel refused and the run completed as split steps.
     pub retries: retry::Retries,
     /// At temperature: the Lanczos iterations of the noise's square root per kernel
     /// step (absent for a run without noise).

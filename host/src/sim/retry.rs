@@ -1,15 +1,18 @@
-//! A Brownian step that the kernel refuses is retried before the run gives up.
+//! A step that the kernel refuses is retried before the run gives up.
 //!
 //! At temperature the unconstrained move carries a random kick of size `sqrt(dt)`; on
 //! rare steps it is so large, for the chain's local shape, that the projection along
 //! the start-of-step bond vectors has no solution near the start (the constraint
-//! solvers then fail, each in its own way; issue 19 in `docs/BROWNIAN.md`, "A refused
-//! step"). Such a step is retried as 2, then 4, ... up to `2^MAX_DEPTH` shorter
-//! steps whose noise refines the refused step's (a Brownian bridge, the kernel's
+//! solvers then fail, each in its own way; `docs/BROWNIAN.md`, "A refused step").
+//! Without noise the same happens where the step is long for the geometry: a jammed
+//! pile whose contacts turn far within one step (`docs/CONTACTS.md`). Such a step is
+//! retried as 2, then 4, ... up to `2^MAX_DEPTH` shorter steps; at temperature their
+//! noise refines the refused step's (a Brownian bridge, the kernel's
 //! [`Noise::split`]): the sub-steps' increments add up to the refused one, so the
 //! retry does not bias the run against large kicks. Only when the deepest split fails
 //! too does the run stop, with the state and the generator as they were before the
-//! step (and the last checkpoint kept).
+//! step (and the last checkpoint kept). A step the kernel accepts is never split, so a
+//! run that needs no retry keeps its bits.
 
 use hydrorattle::{ExternalForce, Noise, Params, Real, StepError, StepReport, Workspace};
 
@@ -37,8 +40,8 @@ pub struct Counters<'a> {
     pub lanczos: &'a mut LanczosTally,
 }
 
-/// One step of `p` from `beads`, drawing from `noise`; a thermal step the kernel
-/// refuses is retried split (see the module). On error the state and `noise` are as
+/// One step of `p` from `beads`, drawing from `noise`; a step the kernel refuses is
+/// retried split (see the module). On error the state and `noise` are as
 /// they were.
 pub fn step<T: Real, E: ExternalForce<T>>(
     beads: &mut Beads<T>,
@@ -61,7 +64,7 @@ pub fn step<T: Real, E: ExternalForce<T>>(
         Ok(r) => return Ok(r),
         Err(e) => e,
     };
-    if !thermal || !retryable(&refused) {
+    if !retryable(&refused) {
         return Err(refused);
     }
     let start = beads.clone();
@@ -76,7 +79,9 @@ pub fn step<T: Real, E: ExternalForce<T>>(
             let mut state = beads.state();
             state.noise = Some(&mut g);
             let outcome = hydrorattle::step_slices(state, bonds, &q, ws, ext);
-            lanczos.add(&outcome);
+            if thermal {
+                lanczos.add(&outcome);
+            }
             match outcome {
                 Ok(r) => {
                     // Work adds up; the state's figures are the last sub-step's.
