@@ -353,7 +353,9 @@ fn numeric_key<'v>(values: impl Iterator<Item = &'v Value>) -> String {
     fn put(out: &mut String, v: &Value) {
         match v {
             Value::Integer(i) => push_python_float(out, *i as f64),
-            Value::Float(x) => push_python_float(out, *x),
+            // `+ 0.0` turns -0.0 into 0.0: equal as numbers, and no parameter tells
+            // them apart.
+            Value::Float(x) => push_python_float(out, *x + 0.0),
             Value::Array(a) => {
                 out.push('[');
                 for x in a {

@@ -320,3 +320,14 @@ fn the_first_repeated_point_is_named_as_a_search_of_all_points_names_it() {
         }
     }
 }
+
+#[test]
+fn zero_and_negative_zero_are_one_value() {
+    // Every parameter treats -0.0 as 0.0 (the same trajectory), so a sweep that lists
+    // both lists one point twice.
+    let e = parse(&dimer_with("\"fluid.density\" = [0.0, -0.0]\n"))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(e.contains("given twice (it is point 0 already)"), "{e}");
+}
