@@ -316,7 +316,8 @@ pub fn needs_matrix(
 
 impl super::Scene {
     /// What in this scene needs the assembled mobility (so PSE cannot run it), or
-    /// `None` where mobility products suffice ([`needs_matrix`]).
+    /// `None` where mobility products suffice (the rule reads the model, the
+    /// integrator and the noise only, so the parser applies it before the body).
     pub fn needs_matrix(&self) -> Option<&'static str> {
         needs_matrix(&self.model, &self.integrator, self.brownian)
     }
