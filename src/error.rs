@@ -168,7 +168,7 @@ pub enum Row {
     },
     /// A hard-sphere contact between two spheres.
     Contact {
-        /// First sphere.
+        /// First sphere (the smaller index).
         i: usize,
         /// Second sphere.
         j: usize,
@@ -191,7 +191,10 @@ impl Row {
                 axis: b.axis(),
             },
             _ if b.is_wall() => Self::Wall { particle: b.i },
-            _ if k >= one_sided => Self::Contact { i: b.i, j: b.j },
+            _ if k >= one_sided => Self::Contact {
+                i: b.i.min(b.j),
+                j: b.i.max(b.j),
+            },
             _ => Self::Bond(k),
         }
     }

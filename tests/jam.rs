@@ -590,7 +590,9 @@ fn random_piles_hold_or_refuse() {
 /// The 20-sphere pile at rest (every constraint holds), stepped at dt 10 and 100 with
 /// every solver: the step holds the constraints or refuses as a step too long
 /// (`Degenerate`, `NoConvergence`: what a shorter step avoids), never as an
-/// infeasible geometry, and a refusal keeps the state.
+/// infeasible geometry, and a refusal keeps the state. (A guard: this small pile
+/// passed before too; the 136-sphere container of `host/tests/jam_retry.rs` is where
+/// the sweep reported an infeasible geometry from a feasible start.)
 #[test]
 fn a_pile_at_rest_is_never_infeasible_at_long_steps() {
     let rest = pile_to_rest::<f64, 20>((0, 2, 5), 600, SolverKind::Newton);

@@ -129,7 +129,7 @@ fn a_touching_sphere_far_from_the_origin_is_judged_in_the_run_precision() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.starts_with("far.toml:4:")
+        e.starts_with("far.toml:5:")
             && e.contains("particle 0: sphere below or crossing the wall")
             && e.contains("in f32"),
         "{e}"
