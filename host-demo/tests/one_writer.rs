@@ -247,24 +247,24 @@ fn a_damaged_finished_point_runs_again_from_the_start() {
         .map(|e| e.unwrap().path())
         .find(|p| p != &clean_point && size(&p.join("trajectory.gsd")) == size(&gsd))
         .expect("two points with GSD files of one size");
-    let damages: [(&str, Box<dyn Fn(&Path)>); 4] = [
-        ("trajectory.gsd", Box::new(flip_a_byte)),
-        ("trajectory.xyz", Box::new(flip_a_byte)),
-        ("observables.csv", Box::new(flip_a_byte)),
-        (
-            "trajectory.gsd",
-            Box::new(|p: &Path| {
-                std::fs::copy(twin.join("trajectory.gsd"), p).unwrap();
-            }),
-        ),
+    // The file damaged, and how: a byte flipped, or the twin's file copied over it.
+    let damages = [
+        ("trajectory.gsd", false),
+        ("trajectory.xyz", false),
+        ("observables.csv", false),
+        ("trajectory.gsd", true),
     ];
-    for (k, (name, damage)) in damages.iter().enumerate() {
+    for (k, &(name, copied)) in damages.iter().enumerate() {
         let out = root.join(format!("try-{k}"));
         let o = sweep(&out, &id).output().unwrap();
         assert!(o.status.success(), "{}", text(&o));
         let point = out.join("points").join(&id);
         let file = point.join(name);
-        damage(&file);
+        if copied {
+            std::fs::copy(twin.join(name), &file).unwrap();
+        } else {
+            flip_a_byte(&file);
+        }
         assert!(
             std::fs::read(&file).unwrap() != std::fs::read(clean_point.join(name)).unwrap(),
             "try {k}: {name} not damaged"
