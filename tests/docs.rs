@@ -370,7 +370,10 @@ fn every_benchmark_record_is_complete() {
             let f = csv_fields(line);
             let at = format!("{}:{}", file.display(), n + 2);
             let hex = f[commit].len() >= 7 && f[commit].chars().all(|c| c.is_ascii_hexdigit());
-            if f.len() != header.len() || !hex || f[command].is_empty() || f[value].is_empty() {
+            // A timing record may give its value in a `seconds` column instead.
+            let timed = column("seconds").is_some_and(|k| f.get(k).is_some_and(|s| !s.is_empty()));
+            let valued = f.get(value).is_some_and(|v| !v.is_empty()) || timed;
+            if f.len() != header.len() || !hex || f[command].is_empty() || !valued {
                 problems.push(format!("{at}: incomplete record {f:?}"));
             } else if !page.contains(&format!("| `{}` |", f[machine])) {
                 problems.push(format!(

@@ -155,19 +155,38 @@ fn run_text(name: &str, text: &str) -> (std::process::Output, PathBuf) {
     (o, out)
 }
 
-/// Issue 33, 5: a sphere touching a wall far from the origin (`z = h + r` rounds) and
-/// an f32 sphere just above the wall that rounds below it both run: touching is to
-/// the rounding of the coordinates, in the scene and in the kernel.
+/// A sphere touching a wall far from the origin (`z = h + r` rounds) and an f32 sphere
+/// just above the wall that rounds below it both run: touching is to the rounding of
+/// the coordinates, in the scene and in the kernel. The f32 sphere is pulled along the
+/// wall with steps long enough to move it by its coordinates' spacing (shorter ones
+/// are refused: its position would not change).
 #[test]
 fn spheres_touching_a_wall_to_the_rounding_run() {
     let scenes = [
-        ("far-wall", "-1e6", "-999999.9", "0.1", "f64"),
-        ("f32-wall", "1000.0", "1000.0010001", "0.001", "f32"),
+        (
+            "far-wall",
+            "-1e6",
+            "-999999.9",
+            "0.1",
+            "f64",
+            "",
+            ("0.01", "0.1"),
+        ),
+        (
+            "f32-wall",
+            "1000.0",
+            "1000.0010001",
+            "0.001",
+            "f32",
+            "[gravity]\nacceleration = [1.0, 0.0, 0.0]\n\n",
+            ("1000.0", "10000.0"),
+        ),
     ];
-    for (name, h, z, r, precision) in scenes {
+    for (name, h, z, r, precision, g, (dt, duration)) in scenes {
         let text = format!(
-            "[wall]\nheight = {h}\n\n[[particle]]\nposition = [0.0, 0.0, {z}]\nradius = {r}\n\n\
-             [integrator]\nmethod = \"overdamped\"\ndt = 0.01\nduration = 0.1\nprecision = \"{precision}\"\n"
+            "{g}[wall]\nheight = {h}\n\n\
+             [[particle]]\nposition = [0.0, 0.0, {z}]\nradius = {r}\n\n\
+             [integrator]\nmethod = \"overdamped\"\ndt = {dt}\nduration = {duration}\nprecision = \"{precision}\"\n"
         );
         let (o, out) = run_text(name, &text);
         assert!(

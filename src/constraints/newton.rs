@@ -203,13 +203,9 @@ pub fn newton<T: Real>(
 /// Halvings of a Newton update that made the residual grow ([`backtrack`]).
 const HALVINGS: u32 = 10;
 
-/// Growth of the residual in one update beyond which the update is taken to diverge.
-const DIVERGING: f64 = 10.0;
-
 /// The safeguard of a diverging update, a backtracking line search on the residual
 /// (the largest normalised one, as the tolerance is stated): where the update `rhs`
-/// just applied to `x` and `mult` left the residual above `tolerance` and more than
-/// [`DIVERGING`] times `previous`, or not finite (far outside the region where the
+/// just applied to `x` and `mult` left the residual not finite (far outside the region where the
 /// linearisation holds: a jammed pile's step overshoots by many sphere radii and the
 /// next one diverges), half of what was applied is taken back until the residual is
 /// below `previous` or within `tolerance`, up to [`HALVINGS`] times. A line search rather than a trust
@@ -239,7 +235,10 @@ fn backtrack<T: Real>(
         true => onesided::residual(problem, bonds, from, x, mult, state).0,
     };
     let mut r = measure(x, mult);
-    if r <= tolerance || r <= previous * T::from_f64(DIVERGING) {
+    // Only a residual that is no longer finite counts as divergence: the solve could
+    // never come back from it, so damping there changes no run that converged
+    // undamped (a finite growth, even a large one, is left to the iteration).
+    if r.is_finite() {
         return Ok(((!one_sided).then_some(r), false));
     }
     for _ in 0..HALVINGS {
