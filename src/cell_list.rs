@@ -259,10 +259,11 @@ pub(crate) fn largest<T: Real>(radius: &[T]) -> T {
 mod tests {
     use super::*;
 
-    /// A small generator (SplitMix64) for the configurations.
-    struct Mix(u64);
+    /// A small generator (SplitMix64) for the configurations (the pair checks' tests
+    /// use it too).
+    pub(super) struct Mix(pub(super) u64);
     impl Mix {
-        fn next(&mut self) -> f64 {
+        pub(super) fn next(&mut self) -> f64 {
             self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
             let mut z = self.0;
             z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);

@@ -118,17 +118,7 @@ mod tests {
     use crate::cell::PeriodicError;
     use glam::DVec3;
 
-    /// SplitMix64, uniform in `[0, 1)`.
-    struct Mix(u64);
-    impl Mix {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::cell_list::tests::Mix;
 
     /// The all-pairs loop in `order`, written out here.
     fn brute(
