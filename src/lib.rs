@@ -34,6 +34,8 @@ pub mod integrate;
 pub mod linalg;
 pub mod mobility;
 pub mod names;
+#[cfg(feature = "near")]
+pub mod near;
 pub mod noise;
 pub mod observables;
 pub mod parallel;

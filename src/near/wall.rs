@@ -1,0 +1,1 @@
+//! A sphere above a no-slip plane wall.
