@@ -18,10 +18,10 @@ pub const K_FAR: usize = 30;
 /// Gap `xi = s - 2` where the far-field series takes over from the tables.
 pub const XI_MAX: f64 = 2.0;
 /// Size-ratio nodes: `log10(lambda)` from `U_MIN` in steps of `U_STEP`.
-pub const N_L: usize = 21;
+pub const N_L: usize = 41;
 /// First node of `log10(lambda)`.
 pub const U_MIN: f64 = -1.0;
 /// Node spacing of `log10(lambda)`.
-pub const U_STEP: f64 = 0.1;
+pub const U_STEP: f64 = 0.05;
 /// Gap nodes, uniform in `t = sqrt(xi / XI_MAX)`.
 pub const N_T: usize = 33;
