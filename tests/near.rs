@@ -137,3 +137,66 @@ fn equal_spheres_side_by_side_at_2_1_fall_and_spin_as_published() {
         "the two spin in opposite senses"
     );
 }
+
+/// The pair's 12x12 RPY grand mobility, rows (U1, U2, W1, W2), columns (F1, F2, T1, T2).
+fn rpy(a1: f64, a2: f64, d: [f64; 3]) -> Mat {
+    let p = pair_blocks::<f64>(Hydro::Rpy, 1.0, a1, a2, f64::v3_from(d.map(|v| -v))).unwrap();
+    let mut m = vec![vec![0.0; 12]; 12];
+    let mut put = |bi: usize, bj: usize, b: &glam::DMat3, t: bool| {
+        for i in 0..3 {
+            for j in 0..3 {
+                m[3 * bi + i][3 * bj + j] = if t { entry::<f64>(b, j, i) } else { entry::<f64>(b, i, j) };
+            }
+        }
+    };
+    let id = glam::DMat3::IDENTITY;
+    put(0, 0, &(id * self_tt(1.0, a1)), false);
+    put(1, 1, &(id * self_tt(1.0, a2)), false);
+    put(2, 2, &(id * self_rr(1.0, a1)), false);
+    put(3, 3, &(id * self_rr(1.0, a2)), false);
+    put(0, 1, &p.tt, false);
+    put(1, 0, &p.tt, true);
+    put(2, 1, &p.rt_ij, false);
+    put(3, 0, &p.rt_ji, false);
+    put(1, 2, &p.rt_ij, true);
+    put(0, 3, &p.rt_ji, true);
+    put(2, 3, &p.rr, false);
+    put(3, 2, &p.rr, true);
+    m
+}
+
+/// Largest difference between the exact pair mobility and RPY's, each entry relative to
+/// the geometric mean of its row's and column's self mobilities.
+fn far_gap(a1: f64, a2: f64, d: [f64; 3]) -> f64 {
+    let exact = inverse(&resistance::<f64>(a1, a2, d));
+    let far = rpy(a1, a2, d);
+    let diag = |i: usize| far[i][i];
+    let mut worst = 0.0f64;
+    for i in 0..12 {
+        for j in 0..12 {
+            worst = worst.max((exact[i][j] - far[i][j]).abs() / (diag(i) * diag(j)).sqrt());
+        }
+    }
+    worst
+}
+
+#[test]
+fn the_far_field_agrees_with_rpy_to_the_order_rpy_is_exact() {
+    // RPY is exact through r^-3 (translation), r^-2 (coupling) and r^-3 (rotation): the
+    // difference must fall at least as r^-4, so doubling the distance divides it by >= 12.
+    for (a1, a2) in [(1.0, 1.0), (1.0, 2.0), (2.0, 1.0), (1.0, 4.0), (1.0, 10.0), (10.0, 1.0)] {
+        let dir = [0.36, -0.48, 0.8];
+        let mean = 0.5 * (a1 + a2);
+        let mut last = f64::NAN;
+        for k in [8.0, 16.0, 32.0] {
+            let r = k * mean;
+            let gap = far_gap(a1, a2, dir.map(|v| v * r));
+            println!("a1 {a1}, a2 {a2}, r = {k} (a1+a2)/2: gap {gap:.3e}, ratio {:.1}", last / gap);
+            if last.is_finite() {
+                assert!(last / gap > 12.0, "{a1} {a2} {k}: {last} -> {gap}");
+            }
+            last = gap;
+        }
+        assert!(last < 1e-4 * (a1.max(a2) / a1.min(a2)), "{last}");
+    }
+}
