@@ -6,6 +6,7 @@
 
 use hydrorattle::Hydro;
 use hydrorattle::mobility::{pair_blocks, self_rr, self_tt};
+use hydrorattle::near::wall::wall_scalars;
 use hydrorattle::near::{NearError, pair_resistance, scalars};
 use hydrorattle::real::Real;
 
@@ -145,7 +146,11 @@ fn rpy(a1: f64, a2: f64, d: [f64; 3]) -> Mat {
     let mut put = |bi: usize, bj: usize, b: &glam::DMat3, t: bool| {
         for i in 0..3 {
             for j in 0..3 {
-                m[3 * bi + i][3 * bj + j] = if t { entry::<f64>(b, j, i) } else { entry::<f64>(b, i, j) };
+                m[3 * bi + i][3 * bj + j] = if t {
+                    entry::<f64>(b, j, i)
+                } else {
+                    entry::<f64>(b, i, j)
+                };
             }
         }
     };
@@ -184,19 +189,204 @@ fn far_gap(a1: f64, a2: f64, d: [f64; 3]) -> f64 {
 fn the_far_field_agrees_with_rpy_to_the_order_rpy_is_exact() {
     // RPY is exact through r^-3 (translation), r^-2 (coupling) and r^-3 (rotation): the
     // difference must fall at least as r^-4, so doubling the distance divides it by >= 12.
-    for (a1, a2) in [(1.0, 1.0), (1.0, 2.0), (2.0, 1.0), (1.0, 4.0), (1.0, 10.0), (10.0, 1.0)] {
+    for (a1, a2) in [
+        (1.0, 1.0),
+        (1.0, 2.0),
+        (2.0, 1.0),
+        (1.0, 4.0),
+        (1.0, 10.0),
+        (10.0, 1.0),
+    ] {
         let dir = [0.36, -0.48, 0.8];
         let mean = 0.5 * (a1 + a2);
         let mut last = f64::NAN;
         for k in [8.0, 16.0, 32.0] {
             let r = k * mean;
             let gap = far_gap(a1, a2, dir.map(|v| v * r));
-            println!("a1 {a1}, a2 {a2}, r = {k} (a1+a2)/2: gap {gap:.3e}, ratio {:.1}", last / gap);
+            println!(
+                "a1 {a1}, a2 {a2}, r = {k} (a1+a2)/2: gap {gap:.3e}, ratio {:.1}",
+                last / gap
+            );
             if last.is_finite() {
                 assert!(last / gap > 12.0, "{a1} {a2} {k}: {last} -> {gap}");
             }
             last = gap;
         }
         assert!(last < 1e-4 * (a1.max(a2) / a1.min(a2)), "{last}");
+    }
+}
+
+/// Brenner's (1961) exact perpendicular drag factor for a sphere at `h / a` above a
+/// wall, as he writes it: `(4/3) sinh a sum n(n+1)/((2n-1)(2n+3)) [num / den - 1]`.
+fn brenner(h_over_a: f64) -> f64 {
+    let al = h_over_a.acosh();
+    let mut sum = 0.0;
+    for n in 1..100_000 {
+        let nf = n as f64;
+        let k = 2.0 * nf + 1.0;
+        let num = 2.0 * (k * al).sinh() + k * (2.0 * al).sinh();
+        let den = 4.0 * ((nf + 0.5) * al).sinh().powi(2) - k * k * al.sinh().powi(2);
+        if !num.is_finite() || !den.is_finite() {
+            break;
+        }
+        let term = nf * (nf + 1.0) / ((2.0 * nf - 1.0) * (2.0 * nf + 3.0)) * (num / den - 1.0);
+        sum += term;
+        if term.abs() < 1e-16 * sum {
+            break;
+        }
+    }
+    4.0 / 3.0 * al.sinh() * sum
+}
+
+#[test]
+fn a_sphere_approaching_the_wall_moves_as_brenner() {
+    for h in [1.001, 1.01, 1.02, 1.05, 1.1, 1.2, 1.5, 2.0, 3.0, 5.0, 10.0] {
+        let exact = brenner(h);
+        let w = wall_scalars::<f64>(1.0, h).unwrap();
+        let w32 = wall_scalars::<f32>(1.0, h as f32).unwrap();
+        let err = (w.xa / exact - 1.0).abs();
+        println!(
+            "h/a = {h}: X^A_w = {:.6}, Brenner {exact:.6}, error {err:.1e}",
+            w.xa
+        );
+        assert!(err < 5e-3, "{h}");
+        assert!((w32.xa as f64 / exact - 1.0).abs() < 5e-3, "{h} f32");
+    }
+    // Cox and Brenner's asymptote takes over below delta = 1e-3 without a visible step.
+    let below = hydrorattle::near::wall::perpendicular(0.999_999e-3);
+    let exact = brenner(1.0 + 0.999_999e-3);
+    println!("delta 1e-3: asymptote {below:.6}, series {exact:.6}");
+    assert!((below / exact - 1.0).abs() < 1e-4);
+}
+
+#[test]
+fn parallel_wall_functions_follow_goldman_cox_brenner_and_stay_positive_definite() {
+    // Goldman, Cox and Brenner (1967): near contact F/(6 pi eta a U) = (8/15) ln(1/d) +
+    // 0.9588, T/(8 pi eta a^2 U) = (1/10) ln(1/d) - 0.1895, T/(8 pi eta a^3 W) =
+    // (2/5) ln(1/d) + 0.3817.
+    for d in [1e-4, 1e-3, 1e-2] {
+        let w = wall_scalars::<f64>(1.0, 1.0 + d).unwrap();
+        let l = (1.0 / d).ln();
+        assert!((w.ya - (8.0 / 15.0 * l + 0.9588)).abs() < 1e-9);
+        assert!((w.yb - (0.1 * l - 0.1895)).abs() < 1e-9);
+        assert!((w.yc - (0.4 * l + 0.3817)).abs() < 1e-9);
+    }
+    // Far: the reflections' mobilities (Faxen's parallel translation; rotation 1 - 5/16
+    // (a/h)^3; a torque-free sphere turns at (3/32) (a/h)^4 U / a), here at h = 20 a.
+    let k: f64 = 1.0 / 20.0;
+    let w = wall_scalars::<f64>(1.0, 20.0).unwrap();
+    let det = w.ya * w.yc - 4.0 / 3.0 * w.yb * w.yb;
+    let mt = w.yc / det;
+    assert!(
+        (mt - (1.0 - 9.0 / 16.0 * k + k.powi(3) / 8.0
+            - 45.0 / 256.0 * k.powi(4)
+            - k.powi(5) / 16.0))
+            .abs()
+            < 1e-12
+    );
+    assert!((w.yb / w.yc - 3.0 / 32.0 * k.powi(4) / (1.0 - 9.0 / 16.0 * k)).abs() < 1e-6);
+    // Positive definite and decreasing all the way, across the joined interval.
+    let mut last = [f64::INFINITY; 3];
+    for i in 0..=400 {
+        let d = 10f64.powf(-4.0 + 6.0 * i as f64 / 400.0);
+        let w = wall_scalars::<f64>(1.0, 1.0 + d).unwrap();
+        assert!(
+            w.ya > 0.0 && w.yc > 0.0 && w.ya * w.yc > 4.0 / 3.0 * w.yb * w.yb,
+            "{d}"
+        );
+        assert!(w.ya < last[0] && w.yc < last[2], "{d}");
+        last = [w.ya, w.yb, w.yc];
+    }
+}
+
+/// Hurwitz zeta `sum_{n>=0} (n + q)^-3` (direct sum plus the Euler-Maclaurin tail).
+fn zeta3(q: f64) -> f64 {
+    let n = 2000;
+    let mut s: f64 = (0..n).map(|k| (k as f64 + q).powi(-3)).sum();
+    let x = n as f64 + q;
+    s += 0.5 / (x * x) + 0.5 / (x * x * x) + 0.25 / x.powi(4);
+    s
+}
+
+#[test]
+fn axial_rotation_matches_its_near_contact_and_far_forms() {
+    // Near contact (Jeffrey and Onishi 1984, as corrected by Townsend 2018), sizes 1:1 to
+    // 1:10: X^C_11 = l^3/(1+l)^3 zeta(3, l/(1+l)) - l^2/(4(1+l)) xi ln(1/xi),
+    // X^C_12 = -8/(1+l)^3 (l^3/(1+l)^3 zeta(3) - l^2/(4(1+l)) xi ln(1/xi)).
+    let xi: f64 = 1e-5;
+    for l in [1.0, 2.0, 4.0, 10.0, 0.5, 0.25, 0.1] {
+        let r = 0.5 * (1.0 + l) * (2.0 + xi);
+        let s = scalars::<f64>(1.0, l, r).unwrap();
+        let c = (l / (1.0 + l)).powi(3);
+        let lg = l * l / (4.0 * (1.0 + l)) * xi * (1.0 / xi).ln();
+        let x11 = c * zeta3(l / (1.0 + l)) - lg;
+        let x12 = -8.0 / (1.0 + l).powi(3) * (c * zeta3(1.0) - lg);
+        println!(
+            "l = {l}: X^C_11 {:.7} vs {x11:.7}, X^C_12 {:.7} vs {x12:.7}",
+            s.xc11, s.xc12
+        );
+        assert!((s.xc11 - x11).abs() < 1e-4 * x11 && (s.xc12 - x12).abs() < 1e-4 * x12.abs());
+    }
+    // A sphere against the wall: zeta(3) at contact; far away 1 + (a/h)^3 / 8.
+    let w = wall_scalars::<f64>(1.0, 1.0 + 1e-6).unwrap();
+    assert!((w.xc - zeta3(1.0)).abs() < 1e-4);
+    let w = wall_scalars::<f64>(1.0, 30.0).unwrap();
+    assert!((w.xc - (1.0 + 1.0 / (8.0 * 27000.0))).abs() < 1e-8);
+}
+
+#[test]
+fn the_functions_refuse_contact_bad_sizes_and_non_numbers() {
+    assert_eq!(
+        scalars::<f64>(1.0, 1.0, 2.0).unwrap_err(),
+        NearError::Contact
+    );
+    assert_eq!(
+        scalars::<f64>(1.0, 1.0, 1.0).unwrap_err(),
+        NearError::Contact
+    );
+    assert_eq!(
+        scalars::<f64>(1.0, 20.0, 30.0).unwrap_err(),
+        NearError::SizeRatio
+    );
+    assert_eq!(
+        scalars::<f64>(1.0, f64::NAN, 30.0).unwrap_err(),
+        NearError::NotPositive
+    );
+    assert_eq!(
+        scalars::<f32>(-1.0, 1.0, 3.0).unwrap_err(),
+        NearError::NotPositive
+    );
+    assert_eq!(
+        wall_scalars::<f64>(1.0, 1.0).unwrap_err(),
+        NearError::Contact
+    );
+    assert_eq!(
+        wall_scalars::<f64>(1.0, f64::INFINITY).unwrap_err(),
+        NearError::NotPositive
+    );
+    // At the edges of the size range both ways round.
+    assert!(scalars::<f64>(1.0, 10.0, 11.001).is_ok() && scalars::<f64>(10.0, 1.0, 11.001).is_ok());
+}
+
+#[test]
+fn f32_and_f64_agree() {
+    for (a1, a2, r) in [
+        (1.0, 1.0, 2.01),
+        (1.0, 3.0, 4.5),
+        (2.0, 0.5, 2.6),
+        (1.0, 10.0, 30.0),
+    ] {
+        let s = scalars::<f64>(a1, a2, r).unwrap();
+        let t = scalars::<f32>(a1 as f32, a2 as f32, r as f32).unwrap();
+        let pairs = [
+            (s.xa11, t.xa11),
+            (s.ya12, t.ya12),
+            (s.yb11, t.yb11),
+            (s.xc12, t.xc12),
+            (s.yc12, t.yc12),
+        ];
+        for (x, y) in pairs {
+            assert!((x - y as f64).abs() <= 1e-5 * x.abs().max(1e-2), "{x} {y}");
+        }
     }
 }

@@ -31,7 +31,7 @@ fn tail(y: f64) -> f64 {
 }
 
 /// `sum_{n >= n0} csch(n gamma + shift)^3`.
-fn csch3_sum(gamma: f64, shift: f64, n0: usize) -> f64 {
+pub(crate) fn csch3_sum(gamma: f64, shift: f64, n0: usize) -> f64 {
     let mut sum = 0.0;
     for n in n0..n0 + TERMS {
         sum += csch3(n as f64 * gamma + shift);
