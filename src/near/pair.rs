@@ -36,7 +36,7 @@ fn check(a1: f64, a2: f64, r: f64) -> Result<f64, NearError> {
         return Err(NearError::NotPositive);
     }
     let l = a2 / a1;
-    if !(LAMBDA_MIN * (1.0 - 1e-12) <= l && l <= LAMBDA_MAX * (1.0 + 1e-12)) {
+    if !(LAMBDA_MIN * (1.0 - 1e-12)..=LAMBDA_MAX * (1.0 + 1e-12)).contains(&l) {
         return Err(NearError::SizeRatio);
     }
     if !(r > a1 + a2) {

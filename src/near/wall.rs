@@ -13,8 +13,9 @@
 //!   Cox and Brenner 1967) for `delta >= DELTA_FAR`, joined in between by a cubic in
 //!   `ln(delta)` matching both values and slopes (no exact values there: see docs/NEAR.md).
 //!
-//! The blocks, with `n` the wall's unit normal into the fluid: `F = 6 pi eta a (X^A_w n n
-//! + Y^A_w (I - n n)) U + B^T W`, `T = B U + 8 pi eta a^3 (X^C_w n n + Y^C_w (I - n n)) W`,
+//! The blocks, with `n` the wall's unit normal into the fluid:
+//! `F = 6 pi eta a (X^A_w n n + Y^A_w (I - n n)) U + B^T W` and
+//! `T = B U + 8 pi eta a^3 (X^C_w n n + Y^C_w (I - n n)) W` with
 //! `B_ij = 8 pi eta a^2 Y^B_w eps_ijk n_k` (forces and torques on the fluid; `Y^B_w > 0`
 //! turns a torque-free sphere in the rolling sense).
 
