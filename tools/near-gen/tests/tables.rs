@@ -62,3 +62,34 @@ fn kernel_values_match_the_full_series_between_nodes() {
     }
     assert!(worst < 1e-4, "{worst}");
 }
+
+#[test]
+fn the_remainder_series_truncation_stays_within_the_documented_bounds() {
+    // The remainder's coefficients fall as k^-3, so its truncation error at K_SUM terms is
+    // estimated from the last terms: largest at contact (x = 1).
+    let mut fam = None;
+    let mut arrays = None;
+    for f in Func::ALL {
+        let family = spec(f).family;
+        if fam != Some(family) {
+            drop(arrays.take());
+            arrays = Some(Arrays::new(family, K_SUM));
+            fam = Some(family);
+        }
+        let c = poly(f, arrays.as_ref().unwrap(), K_SUM);
+        let (mut upto4, mut all) = (0.0f64, 0.0f64);
+        for i in 0..41 {
+            let l = 10f64.powf(-1.0 + 0.05 * i as f64);
+            let r = remainder_coeffs(f, &c, l);
+            let tail = remainder(&r, 0.0).1;
+            all = all.max(tail);
+            if (0.25..=4.0).contains(&l) {
+                upto4 = upto4.max(tail);
+            }
+        }
+        println!(
+            "{f:?}: truncation at contact <= {upto4:.1e} for 1/4 <= lambda <= 4, {all:.1e} for all"
+        );
+        assert!(upto4 < 2e-4 && all < 6e-4);
+    }
+}
