@@ -390,3 +390,170 @@ fn f32_and_f64_agree() {
         }
     }
 }
+
+/// 3x3 blocks of a 12x12 matrix in the caller's precision.
+fn blocks<T: Real>(m: &Mat) -> [[T::M3; 4]; 4] {
+    core::array::from_fn(|bi| {
+        core::array::from_fn(|bj| {
+            let col = |j: usize| {
+                let v = |i: usize| T::from_f64(m[3 * bi + i][3 * bj + j]);
+                T::v3(v(0), v(1), v(2))
+            };
+            T::m3_cols(col(0), col(1), col(2))
+        })
+    })
+}
+
+fn flat<T: Real>(b: &[[T::M3; 4]; 4]) -> Mat {
+    let mut m = vec![vec![0.0; 12]; 12];
+    for bi in 0..4 {
+        for bj in 0..4 {
+            for i in 0..3 {
+                for j in 0..3 {
+                    m[3 * bi + i][3 * bj + j] = entry::<T>(&b[bi][bj], i, j);
+                }
+            }
+        }
+    }
+    m
+}
+
+/// Smallest eigenvalue of a symmetric matrix scaled to unit diagonal `D^-1/2 A D^-1/2`
+/// (`D` the diagonal of `scale`), by cyclic Jacobi rotations.
+fn min_eig_scaled(a: &Mat, scale: &Mat) -> f64 {
+    let n = a.len();
+    let mut m: Mat = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| a[i][j] / (scale[i][i] * scale[j][j]).sqrt())
+                .collect()
+        })
+        .collect();
+    for _ in 0..60 {
+        for p in 0..n {
+            for q in p + 1..n {
+                if m[p][q].abs() < 1e-300 {
+                    continue;
+                }
+                let th = 0.5 * (2.0 * m[p][q]).atan2(m[q][q] - m[p][p]);
+                let (c, s) = (th.cos(), th.sin());
+                for k in 0..n {
+                    let (kp, kq) = (m[k][p], m[k][q]);
+                    m[k][p] = c * kp - s * kq;
+                    m[k][q] = s * kp + c * kq;
+                }
+                for k in 0..n {
+                    let (pk, qk) = (m[p][k], m[q][k]);
+                    m[p][k] = c * pk - s * qk;
+                    m[q][k] = s * pk + c * qk;
+                }
+            }
+        }
+    }
+    (0..n).map(|i| m[i][i]).fold(f64::INFINITY, f64::min)
+}
+
+fn sd_resistance_is_positive_definite<T: Real>(
+    a1: f64,
+    lambda: f64,
+    gap: f64,
+    dir: [f64; 3],
+) -> (f64, f64) {
+    let a2 = a1 * lambda;
+    let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
+    // A negative gap is an overlap, as a fraction of the smaller diameter (never nested).
+    let r = if gap >= 0.0 {
+        a1 + a2 + gap * 0.5 * (a1 + a2)
+    } else {
+        a1 + a2 + gap * 1.9 * a1.min(a2)
+    };
+    let d = dir.map(|v| v / n * r);
+    let far = rpy(a1, a2, d);
+    // The far field in the caller's precision, as a step would hold it.
+    let far_t = blocks::<T>(&far);
+    let far_inv = inverse(&flat::<T>(&far_t));
+    let near = hydrorattle::near::near_correction::<T>(
+        T::ONE,
+        T::from_f64(a1),
+        T::from_f64(a2),
+        T::v3_from(d),
+        &far_t,
+    );
+    let near = match near {
+        Ok(b) => flat::<T>(&b),
+        Err(e) => {
+            // Overlap (or a gap rounded to contact in f32): no correction, R = M_far^-1.
+            assert_eq!(e, NearError::Contact);
+            vec![vec![0.0; 12]; 12]
+        }
+    };
+    let sum: Mat = (0..12)
+        .map(|i| (0..12).map(|j| far_inv[i][j] + near[i][j]).collect())
+        .collect();
+    let sym: Mat = (0..12)
+        .map(|i| (0..12).map(|j| 0.5 * (sum[i][j] + sum[j][i])).collect())
+        .collect();
+    let nsym: Mat = (0..12)
+        .map(|i| (0..12).map(|j| 0.5 * (near[i][j] + near[j][i])).collect())
+        .collect();
+    (min_eig_scaled(&sym, &sym), min_eig_scaled(&nsym, &sym))
+}
+
+#[test]
+fn r_near_is_positive_semi_definite_on_a_grid() {
+    // The reason M_far^-1 + sum R_near stays positive definite for any number of spheres:
+    // every pair's R_near is itself positive semi-definite (the exact two-body resistance
+    // exceeds the far field's), so adding it to the positive definite M_far^-1 keeps it so.
+    let mut worst = (f64::INFINITY, 0.0, 0.0);
+    for ll in [-1.0, -0.6, -0.3, 0.0, 0.3, 0.6, 1.0] {
+        for lg in [-4.0, -3.0, -2.0, -1.5, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5] {
+            let (sd, near) = sd_resistance_is_positive_definite::<f64>(
+                1.0,
+                10f64.powf(ll),
+                10f64.powf(lg),
+                [0.3, 0.5, 0.8],
+            );
+            assert!(sd > 0.0);
+            if near < worst.0 {
+                worst = (near, 10f64.powf(ll), 10f64.powf(lg));
+            }
+        }
+    }
+    println!(
+        "smallest scaled eigenvalue of R_near: {:.2e} (lambda {:.2}, gap {:.1e})",
+        worst.0, worst.1, worst.2
+    );
+    assert!(worst.0 > -1e-6);
+}
+
+mod positive_definite {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        #[test]
+        fn m_far_inverse_plus_r_near_is_positive_definite_f64(
+            a1 in 0.3f64..3.0, ll in -1.0f64..1.0, lg in -4.0f64..1.3, over in 0.0f64..1.0,
+            x in -1.0f64..1.0, y in -1.0f64..1.0, z in 0.1f64..1.0, overlap in proptest::bool::weighted(0.1),
+        ) {
+            // Gaps from 1e-4 to 20 mean radii, and a tenth of the cases overlapping.
+            let gap = if overlap { -over } else { 10f64.powf(lg) };
+            let (sd, near) = sd_resistance_is_positive_definite::<f64>(a1, 10f64.powf(ll), gap, [x, y, z]);
+            prop_assert!(sd > 0.0, "M_far^-1 + R_near: smallest scaled eigenvalue {sd}");
+            prop_assert!(near > -1e-6, "R_near: smallest scaled eigenvalue {near}");
+        }
+
+        #[test]
+        fn m_far_inverse_plus_r_near_is_positive_definite_f32(
+            a1 in 0.3f64..3.0, ll in -1.0f64..1.0, lg in -3.0f64..1.3, over in 0.0f64..1.0,
+            x in -1.0f64..1.0, y in -1.0f64..1.0, z in 0.1f64..1.0, overlap in proptest::bool::weighted(0.1),
+        ) {
+            let gap = if overlap { -over } else { 10f64.powf(lg) };
+            let (sd, near) = sd_resistance_is_positive_definite::<f32>(a1, 10f64.powf(ll), gap, [x, y, z]);
+            prop_assert!(sd > 0.0, "M_far^-1 + R_near: smallest scaled eigenvalue {sd}");
+            prop_assert!(near > -1e-4, "R_near: smallest scaled eigenvalue {near}");
+        }
+    }
+}

@@ -91,7 +91,8 @@ pub struct PairResistance<T: Real> {
     pub r: [[T::M3; 4]; 4],
 }
 
-type M = [[f64; 3]; 3];
+/// A 3x3 block in `f64`, row-major.
+pub(crate) type M = [[f64; 3]; 3];
 
 /// `x d d + y (I - d d)`.
 fn xy(x: f64, y: f64, d: [f64; 3]) -> M {
@@ -139,17 +140,27 @@ fn half(eta: f64, a1: f64, a2: f64, d: [f64; 3], s: &Scalars<f64>) -> [M; 6] {
     ]
 }
 
-/// The exact two-sphere resistance of spheres of radii `a1` and `a2` in a fluid of
-/// viscosity `eta`, sphere 2 at `d` from sphere 1 (any length above `a1 + a2`).
-pub fn pair_resistance<T: Real>(
-    eta: T,
-    a1: T,
-    a2: T,
-    d: T::V3,
-) -> Result<PairResistance<T>, NearError> {
-    let [x, y, z] = T::xyz(d).map(T::to_f64);
+/// A 3x3 block of `f64` as the caller's matrix type.
+pub(crate) fn to_m3<T: Real>(m: M) -> T::M3 {
+    let col = |j: usize| {
+        T::v3(
+            T::from_f64(m[0][j]),
+            T::from_f64(m[1][j]),
+            T::from_f64(m[2][j]),
+        )
+    };
+    T::m3_cols(col(0), col(1), col(2))
+}
+
+/// [`pair_resistance`] in `f64` blocks.
+pub(crate) fn resistance_f64(
+    eta: f64,
+    a1: f64,
+    a2: f64,
+    d: [f64; 3],
+) -> Result<[[M; 4]; 4], NearError> {
+    let [x, y, z] = d;
     let r = libm::sqrt(x * x + y * y + z * z);
-    let (a1, a2, eta) = (a1.to_f64(), a2.to_f64(), eta.to_f64());
     if !(eta.is_finite() && eta > 0.0) {
         return Err(NearError::NotPositive);
     }
@@ -158,23 +169,26 @@ pub fn pair_resistance<T: Real>(
     let e = [x / r, y / r, z / r];
     let [a11, a12, b11, b12, c11, c12] = half(eta, a1, a2, e, &s1);
     let [a22, a21, b22, b21, c22, c21] = half(eta, a2, a1, e.map(|v| -v), &s2);
-    let t = |m: M| {
-        let col = |j: usize| {
-            T::v3(
-                T::from_f64(m[0][j]),
-                T::from_f64(m[1][j]),
-                T::from_f64(m[2][j]),
-            )
-        };
-        T::m3_cols(col(0), col(1), col(2))
-    };
-    let tr = |m: M| t(transpose(m));
+    let t = transpose;
+    Ok([
+        [a11, a12, t(b11), t(b21)],
+        [a21, a22, t(b12), t(b22)],
+        [b11, b12, c11, c12],
+        [b21, b22, c21, c22],
+    ])
+}
+
+/// The exact two-sphere resistance of spheres of radii `a1` and `a2` in a fluid of
+/// viscosity `eta`, sphere 2 at `d` from sphere 1 (any length above `a1 + a2`).
+pub fn pair_resistance<T: Real>(
+    eta: T,
+    a1: T,
+    a2: T,
+    d: T::V3,
+) -> Result<PairResistance<T>, NearError> {
+    let d = T::xyz(d).map(T::to_f64);
+    let b = resistance_f64(eta.to_f64(), a1.to_f64(), a2.to_f64(), d)?;
     Ok(PairResistance {
-        r: [
-            [t(a11), t(a12), tr(b11), tr(b21)],
-            [t(a21), t(a22), tr(b12), tr(b22)],
-            [t(b11), t(b12), t(c11), t(c12)],
-            [t(b21), t(b22), t(c21), t(c22)],
-        ],
+        r: b.map(|row| row.map(to_m3::<T>)),
     })
 }
