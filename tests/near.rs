@@ -3,6 +3,8 @@
 //! their line of centres, published exact values for other motions, the Rotne-Prager-
 //! Yamakawa far field, and the exact near-contact forms of the closed-form functions.
 #![cfg(feature = "near")]
+// Index loops over rows and columns read like the formulas.
+#![allow(clippy::needless_range_loop)]
 
 use hydrorattle::Hydro;
 use hydrorattle::mobility::{pair_blocks, self_rr, self_tt};
