@@ -1,5 +1,5 @@
 //! Far field: Jeffrey and Onishi's (1984) power series in `x = 2 / s`, to
-//! [`K_FAR`](super::tables::K_FAR) terms, from the generated coefficient polynomials.
+//! [`K_FAR`] terms, from the generated coefficient polynomials.
 
 use super::lubrication::Func;
 use super::tables::{FAR, K_FAR};
