@@ -34,7 +34,13 @@ fn tail(y: f64) -> f64 {
 pub(crate) fn csch3_sum(gamma: f64, shift: f64, n0: usize) -> f64 {
     let mut sum = 0.0;
     for n in n0..n0 + TERMS {
-        sum += csch3(n as f64 * gamma + shift);
+        let term = csch3(n as f64 * gamma + shift);
+        sum += term;
+        // Far apart the terms fall by exp(-3 gamma) each: once one is below the sum's
+        // last bit, so is the rest (the sum of all later ones is below twice it).
+        if gamma > 0.5 && term < 1e-17 * sum {
+            return sum;
+        }
     }
     sum + tail((n0 + TERMS) as f64 * gamma - 0.5 * gamma + shift) / gamma
 }
