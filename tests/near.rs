@@ -656,3 +656,21 @@ fn unequal_spheres_along_the_line_of_centres_match_the_exact_bispherical_solutio
     }
     assert!(worst < 1e-5, "{worst}");
 }
+
+#[test]
+fn equal_spheres_reach_jeffrey_and_onishis_contact_constants() {
+    // Jeffrey and Onishi (1984), equal spheres: X^A_11 = 1/(4 xi) + (9/40) ln(1/xi) +
+    // 0.9954 + ..., Y^A_11 = (1/6) ln(1/xi) + 0.9983 + ..., Y^C_11 = (1/5) ln(1/xi) +
+    // 0.7028 + ... (their tabulated constants; the g-functions at lambda = 1).
+    let r = 2.0 + 1e-7;
+    let xi = r - 2.0; // the gap the kernel sees (exact: Sterbenz)
+    let s = scalars::<f64>(1.0, 1.0, r).unwrap();
+    let l = (1.0 / xi).ln();
+    let a = s.xa11 - 0.25 / xi - 9.0 / 40.0 * l;
+    let y = s.ya11 - l / 6.0;
+    let c = s.yc11 - l / 5.0;
+    println!(
+        "contact constants: X^A_11 {a:.5} (0.9954), Y^A_11 {y:.5} (0.9983), Y^C_11 {c:.5} (0.7028)"
+    );
+    assert!((a - 0.9954).abs() < 2e-4 && (y - 0.9983).abs() < 2e-4 && (c - 0.7028).abs() < 2e-4);
+}
