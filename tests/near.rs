@@ -242,7 +242,9 @@ fn brenner(h_over_a: f64) -> f64 {
 
 #[test]
 fn a_sphere_approaching_the_wall_moves_as_brenner() {
-    for h in [1.001, 1.01, 1.02, 1.05, 1.1, 1.2, 1.5, 2.0, 3.0, 5.0, 10.0] {
+    for h in [
+        1.001, 1.01, 1.02, 1.05, 1.1, 1.2, 1.5, 2.0, 3.0, 5.0, 10.0, 900.0, 1100.0,
+    ] {
         let exact = brenner(h);
         let w = wall_scalars::<f64>(1.0, h).unwrap();
         let w32 = wall_scalars::<f32>(1.0, h as f32).unwrap();
@@ -673,4 +675,24 @@ fn equal_spheres_reach_jeffrey_and_onishis_contact_constants() {
         "contact constants: X^A_11 {a:.5} (0.9954), Y^A_11 {y:.5} (0.9983), Y^C_11 {c:.5} (0.7028)"
     );
     assert!((a - 0.9954).abs() < 2e-4 && (y - 0.9983).abs() < 2e-4 && (c - 0.7028).abs() < 2e-4);
+}
+
+#[test]
+fn far_and_huge_distances_give_finite_far_field_values() {
+    for r in [1e3, 1e8, 1e150, 1e300] {
+        let s = scalars::<f64>(1.0, 2.0, r).unwrap();
+        let v = [
+            s.xa11, s.xa12, s.ya11, s.ya12, s.yb11, s.yb12, s.xc11, s.xc12, s.yc11, s.yc12,
+        ];
+        assert!(v.iter().all(|x| x.is_finite()), "{r}: {v:?}");
+        assert!(
+            (s.xa11 - 1.0).abs() < 1e-4 && (s.xc11 - 1.0).abs() < 1e-4 && s.xa12.abs() < 1e-2,
+            "{r}: {v:?}"
+        );
+        let w = wall_scalars::<f64>(1.0, r).unwrap();
+        assert!(
+            [w.xa, w.ya, w.yb, w.xc, w.yc].iter().all(|x| x.is_finite()),
+            "{r}: {w:?}"
+        );
+    }
 }

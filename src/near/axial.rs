@@ -15,9 +15,10 @@
 /// Terms summed before the tail integral.
 pub const TERMS: usize = 48;
 
-fn csch3(y: f64) -> f64 {
-    let s = libm::sinh(y);
-    1.0 / (s * s * s)
+/// `(q / sinh(y))^3`, as a ratio first: no overflow for far pairs' large `q` and `y`.
+fn ratio3(q: f64, y: f64) -> f64 {
+    let t = q / libm::sinh(y);
+    t * t * t
 }
 
 /// `int_y^inf csch(t)^3 dt = (csch(y) coth(y) + ln(tanh(y / 2))) / 2`.
@@ -30,31 +31,35 @@ fn tail(y: f64) -> f64 {
     0.5 * (libm::cosh(y) / (s * s) + libm::log(libm::tanh(0.5 * y)))
 }
 
-/// `sum_{n >= n0} csch(n gamma + shift)^3`.
-pub(crate) fn csch3_sum(gamma: f64, shift: f64, n0: usize) -> f64 {
+/// `sum_{n >= n0} (q / sinh(n gamma + shift))^3`.
+pub(crate) fn csch3_sum(q: f64, gamma: f64, shift: f64, n0: usize) -> f64 {
     let mut sum = 0.0;
     for n in n0..n0 + TERMS {
-        let term = csch3(n as f64 * gamma + shift);
+        let term = ratio3(q, n as f64 * gamma + shift);
         sum += term;
         // Far apart the terms fall by exp(-3 gamma) each: once one is below the sum's
         // last bit, so is the rest (the sum of all later ones is below twice it).
-        if gamma > 0.5 && term < 1e-17 * sum {
+        if gamma > 0.5 && !(term > 1e-17 * sum) {
             return sum;
         }
     }
-    sum + tail((n0 + TERMS) as f64 * gamma - 0.5 * gamma + shift) / gamma
+    let t = tail((n0 + TERMS) as f64 * gamma - 0.5 * gamma + shift);
+    if t == 0.0 {
+        sum
+    } else {
+        sum + q * q * q * t / gamma
+    }
 }
 
 /// `(X^C_11, X^C_12)` for radii `a1`, `a2` at centre distance `r > a1 + a2`.
 pub fn xc(a1: f64, a2: f64, r: f64) -> (f64, f64) {
-    // c^2 = z1^2 - a1^2 in factored form: no cancellation near contact.
-    let c = libm::sqrt((r - a1 - a2) * (r + a1 + a2) * (r - a1 + a2) * (r + a1 - a2)) / (2.0 * r);
+    // c^2 = z1^2 - a1^2 in factored form: no cancellation near contact, no overflow far.
+    let (p, m) = ((a1 + a2) / r, (a1 - a2) / r);
+    let c = 0.5 * r * libm::sqrt((1.0 - p) * (1.0 + p) * (1.0 - m) * (1.0 + m));
     let alpha = libm::asinh(c / a1);
     let beta = libm::asinh(c / a2);
     let gamma = alpha + beta;
-    let sa = c / a1;
-    let x11 = sa * sa * sa * csch3_sum(gamma, alpha, 0);
-    let q = c / (a1 + a2);
-    let x12 = -8.0 * q * q * q * csch3_sum(gamma, 0.0, 1);
+    let x11 = csch3_sum(c / a1, gamma, alpha, 0);
+    let x12 = -8.0 * csch3_sum(c / (a1 + a2), gamma, 0.0, 1);
     (x11, x12)
 }

@@ -72,14 +72,19 @@ pub fn perpendicular(delta: f64) -> f64 {
     if delta < DELTA_BRENNER {
         return 1.0 / delta + 0.2 * libm::log(1.0 / delta) + 0.9713;
     }
+    if delta > 1e3 {
+        // Far away Brenner's terms overflow; the reflections' mobility 1 - 9/8 k + 1/2 k^3
+        // (Lorentz; Brenner's series to O(k^4), below 1e-12 here) is exact enough.
+        let k = 1.0 / (1.0 + delta);
+        return 1.0 / (1.0 - 9.0 / 8.0 * k + 0.5 * k * k * k);
+    }
     brenner(libm::acosh(1.0 + delta))
 }
 
 /// Rotation about the normal, `delta > 0`.
 pub fn axial(delta: f64) -> f64 {
     let alpha = libm::acosh(1.0 + delta);
-    let s = libm::sinh(alpha);
-    s * s * s * csch3_sum(alpha, alpha, 0)
+    csch3_sum(libm::sinh(alpha), alpha, alpha, 0)
 }
 
 /// Goldman, Cox and Brenner's near-contact forms `(Y^A, Y^B, Y^C)` and their slopes in
