@@ -27,10 +27,10 @@ mod table;
 pub(crate) use product::apply_drag;
 pub(crate) use table::tabulate;
 
+#[cfg(feature = "periodic")]
+use crate::geometry::sums::BoxSums;
 use crate::linalg::{Block, Mob, tri};
 use crate::mobility::Hydro;
-#[cfg(feature = "periodic")]
-use crate::mobility::sums::BoxSums;
 use crate::parallel::Parallel;
 use crate::real::Real;
 

@@ -13,13 +13,13 @@
 
 use crate::cell::Periodic;
 use crate::error::StepError;
+use crate::geometry::sums::BoxSums;
+#[cfg(feature = "pse")]
+use crate::geometry::sums::PseStep;
 use crate::linalg::{MobMut, with_blocks};
 use crate::mobility::periodic::{self, Ewald};
 #[cfg(feature = "pse")]
 use crate::mobility::pse::{Pse, PseSize, PseStorage};
-use crate::mobility::sums::BoxSums;
-#[cfg(feature = "pse")]
-use crate::mobility::sums::PseStep;
 use crate::noise::reduced;
 use crate::parallel::Parallel;
 use crate::params::Params;

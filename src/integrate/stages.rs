@@ -13,13 +13,13 @@ use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
 
-/// The step's periodic sums ([`super::periodic`], [`BoxSums`](crate::mobility::sums::BoxSums):
+/// The step's periodic sums ([`super::periodic`], [`BoxSums`](crate::geometry::sums::BoxSums):
 /// Ewald, or PSE with [`Params::pse`]): `Some` in a periodic box whose images interact
 /// (not with free draining), derived once by the step's checks and read by every
 /// product, assembly and matrix-free metric of the step. Without the `periodic`
 /// feature there are none (always `None`).
 #[cfg(feature = "periodic")]
-pub(super) type Sums<'a, T> = Option<crate::mobility::sums::BoxSums<'a, T>>;
+pub(super) type Sums<'a, T> = Option<crate::geometry::sums::BoxSums<'a, T>>;
 /// The step's Ewald parameters: none without the `periodic` feature.
 #[cfg(not(feature = "periodic"))]
 pub(super) type Sums<'a, T> = Option<&'a core::marker::PhantomData<T>>;
@@ -29,7 +29,7 @@ pub(super) type Sums<'a, T> = Option<&'a core::marker::PhantomData<T>>;
 #[cfg(feature = "periodic")]
 pub(super) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
     match held.as_ref()? {
-        super::periodic::Held::Ewald(e) => Some(crate::mobility::sums::BoxSums::Ewald(e)),
+        super::periodic::Held::Ewald(e) => Some(crate::geometry::sums::BoxSums::Ewald(e)),
         #[cfg(feature = "pse")]
         super::periodic::Held::Pse(_) => None,
     }

@@ -36,7 +36,7 @@ mod wave;
 pub use rot::{RotBlocks, add_spin, assemble_grand, pair_rot, self_rr};
 
 pub use crate::cell::{Periodic, PeriodicError};
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::linalg::{Block, tri};
 use crate::parallel::{
     Packed, Parallel, band_blocks, band_start, by_bands_and, by_bands_then_reduce,
