@@ -230,6 +230,34 @@ pub fn assemble<T: Real>(
     assemble_then(par, ew, eta, pos, radius, out, none, |_, _, _, _| {})
 }
 
+/// `u = mu_tt f`: [`assemble`] into `mu` (also into the compact copy `copy` of
+/// [`Params::compact_products`](crate::Params::compact_products) when given, in the same
+/// pass, [`assemble_then`]) and applied in the bands of [`crate::parallel`] through `par`
+/// (`bands`: their scratch).
+pub(crate) fn assemble_apply<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    (pos, radius): (&[T::V3], &[T]),
+    mu: crate::linalg::MobMut<'_, T>,
+    (f, u): (&[T::V3], &mut [T::V3]),
+    (par, bands): (&dyn Parallel, &mut [T::V3]),
+    copy: Option<&mut [T::M3]>,
+) -> Result<(), PeriodicError> {
+    use crate::noise::reduced;
+    crate::linalg::with_blocks!(mut mu, mu => {
+        match copy {
+            None => assemble(par, ew, eta, pos, radius, mu)?,
+            Some(copy) => {
+                let side = (copy, reduced::copy_start as fn(usize) -> usize);
+                let pack = reduced::pack_rows::<T, _>;
+                assemble_then(par, ew, eta, pos, radius, mu, side, pack)?
+            }
+        }
+        crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
+        Ok(())
+    })
+}
+
 /// [`assemble`], handing each row `i` of the mobility, just written and still in the
 /// core's cache, to `then(i, i + 1, row, side_rows)` with `side` from its row `i` on
 /// (empty where `side` is): a second use of the blocks without a second pass over
