@@ -312,3 +312,77 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::{sym_matvec, tri};
+    use glam::DVec3;
+
+    const N: usize = 7;
+
+    /// Spheres of unequal radii, some overlapping, all above a wall at -0.5.
+    fn spheres() -> ([DVec3; N], [f64; N], [DVec3; N]) {
+        let pos = core::array::from_fn(|k| {
+            let t = k as f64;
+            DVec3::new(
+                1.7 * libm::sin(1.3 * t),
+                1.9 * libm::cos(0.7 * t),
+                2.0 + 1.1 * t,
+            )
+        });
+        let radius = core::array::from_fn(|k| 0.6 + 0.1 * (k % 3) as f64);
+        let f = core::array::from_fn(|k| DVec3::new(libm::sin(k as f64), -0.4, 0.3 * k as f64));
+        (pos, radius, f)
+    }
+
+    /// The interface's matrix-free product has the bits of its own assembly applied
+    /// (the product of the stored blocks), and its metric blocks are the stored ones:
+    /// in free space and above a wall, the geometries whose products promise both.
+    #[test]
+    fn product_and_blocks_agree_with_the_assembly() -> Result<(), StepError> {
+        let (pos, radius, f) = spheres();
+        let geometries = [
+            Hydrodynamics::new(Hydro::Rpy, 0.9, None, None),
+            Hydrodynamics::new(Hydro::Oseen, 0.9, None, None),
+            #[cfg(feature = "wall")]
+            Hydrodynamics::new(Hydro::Rpy, 0.9, Some(-0.5), None),
+        ];
+        for h in geometries {
+            let mut mu = [glam::DMat3::ZERO; tri(N)];
+            h.assemble_tt(&pos, &radius, MobMut::Full(&mut mu))?;
+            let (mut stored, mut free) = ([DVec3::ZERO; N], [DVec3::ZERO; N]);
+            sym_matvec::<f64>(&mu, N, &f, &mut stored);
+            h.product(&parallel::Serial, &pos, &radius, &f, &mut free, &mut [])?;
+            let bits = |v: &DVec3| v.to_array().map(f64::to_bits);
+            assert!(
+                free.iter().zip(&stored).all(|(a, b)| bits(a) == bits(b)),
+                "{h:?}"
+            );
+            // Row `j` of the metric reads the block stored at `(i, j)`, `j < i`.
+            for i in 0..N {
+                for j in 0..i {
+                    assert_eq!(
+                        h.block_at(&pos, &radius, j, i),
+                        Some(mu[tri(i) + j]),
+                        "{h:?}"
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The one choice: the box's sums over the wall over free space, and the wall only
+    /// with its feature.
+    #[test]
+    fn the_geometry_is_chosen_in_one_place() {
+        let free = Hydrodynamics::new(Hydro::Rpy, 1.0, None, None);
+        assert!(matches!(free, Hydrodynamics::Free { .. }));
+        let wall = Hydrodynamics::<f64>::new(Hydro::Rpy, 1.0, Some(0.0), None);
+        assert_eq!(
+            matches!(wall, Hydrodynamics::Free { .. }),
+            !cfg!(feature = "wall")
+        );
+    }
+}
