@@ -300,6 +300,17 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         }
     }
 
+    /// Whether every block is symmetric (all but the wall's), so that a table of the
+    /// metric reads lower triangles only.
+    #[inline(always)]
+    pub fn symmetric(self) -> bool {
+        match self {
+            #[cfg(feature = "wall")]
+            Self::Wall { .. } => false,
+            _ => true,
+        }
+    }
+
     /// Whether the metric may read only the lower triangles of its blocks because they
     /// are known symmetric in bits without reading them (the Ewald box's). Free space's
     /// are too, but its entries read all nine, as they always have: the same bits.

@@ -109,7 +109,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
     }
     let n = pos.len();
     // Without a wall every block is symmetric: the table reads lower triangles only.
-    let sym = wall_height(p).is_none();
+    let sym = hydro(p, ew).symmetric();
     constraints::tabulate(mu, bonds, grad, scale, n, sym, disp);
     let disp = &disp[..n * bonds.len()];
     Metric::Dense { disp, n, grad }
