@@ -23,7 +23,7 @@
 //! for bit after the solve, so a pinned sphere never drifts.
 
 use crate::cell::Periodic;
-use crate::error::BondError;
+use crate::fault::BondError;
 use crate::real::Real;
 use heapless::Vec;
 

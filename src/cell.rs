@@ -8,7 +8,7 @@
 
 use core::fmt;
 
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::real::Real;
 
 /// A rejected periodic box, Ewald parameter or sphere.

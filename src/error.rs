@@ -5,134 +5,27 @@
 
 use core::fmt;
 
-use crate::workspace::Layout;
+// The low layers' errors are defined below them (`fault.rs`) and wrapped here.
+pub use crate::fault::{BondError, LinalgError, ParticleError};
 
-/// A particle set rejected an input.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ParticleError {
-    /// The set is full (capacity `N`).
-    Full,
-    /// A position, velocity, radius or density is NaN or infinite.
-    NonFinite {
-        /// Index of the particle.
-        particle: usize,
-    },
-    /// Radius is zero, negative or subnormal (below the precision's smallest normal
-    /// number, where `1 / (6 pi eta a)` loses its digits or overflows).
-    BadRadius {
-        /// Index of the particle.
-        particle: usize,
-    },
-    /// Density is negative.
-    BadDensity {
-        /// Index of the particle.
-        particle: usize,
-    },
-    /// One sphere lies inside the other (`|r_i - r_j| <= |a_i - a_j|`).
-    Nested {
-        /// First particle.
-        i: usize,
-        /// Second particle.
-        j: usize,
-    },
-    /// Two centres coincide (`r_i = r_j`): no overlap policy allows it (the pair has
-    /// no direction; with equal radii the spheres are one).
-    Coincident {
-        /// First particle.
-        i: usize,
-        /// Second particle.
-        j: usize,
-    },
-    /// Two spheres overlap (`|r_i - r_j| < a_i + a_j`) and the policy rejects it.
-    Overlap {
-        /// First particle.
-        i: usize,
-        /// Second particle.
-        j: usize,
-    },
-    /// An inertial method needs every particle to have positive mass.
-    Massless {
-        /// Index of the particle.
-        particle: usize,
-    },
-    /// The sphere crosses the wall or lies below it: its centre is below
-    /// `height + radius` ([`Wall`](crate::Wall)).
-    BelowWall {
-        /// Index of the particle.
-        particle: usize,
-    },
-}
-
-/// A bond set rejected an input.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum BondError {
-    /// The bond list is full (capacity `B`).
-    Full,
-    /// A bond joins a particle to itself.
-    SelfBond {
-        /// Index of the bond.
-        bond: usize,
-        /// The particle.
-        particle: usize,
-    },
-    /// A bond names a particle that does not exist.
-    OutOfRange {
-        /// Index of the bond.
-        bond: usize,
-        /// The index given.
-        particle: usize,
-    },
-    /// The same pair is bonded twice.
-    Duplicate {
-        /// Index of the later bond.
-        bond: usize,
-        /// Index of the earlier bond.
-        other: usize,
-    },
-    /// Length is negative, not finite, or so large that its square overflows; or zero
-    /// in a step of a method other than [`Method::Springs`](crate::Method::Springs)
-    /// (only a spring may have rest length zero); or, in a periodic box
-    /// ([`Params::periodic`](crate::Params::periodic)), not below half the box's
-    /// smallest edge (its minimum image would be ambiguous).
-    BadLength {
-        /// Index of the bond.
-        bond: usize,
-    },
-    /// The configuration is off the constraint by more than the tolerance.
-    Violated {
-        /// Index of the bond.
-        bond: usize,
-        /// Relative length error `| |r_ij| - d | / d`.
-        residual: f64,
-    },
-    /// A FENE spring at or past its maximum extension (at the start of a step, or in
-    /// the step's candidate: the step is refused; a shorter step may pass).
-    Overstretched {
-        /// Index of the bond.
-        bond: usize,
-        /// Length over the maximum extension (>= 1, or NaN).
-        ratio: f64,
-    },
-    /// A tree needs `parents.len() == particles` and each parent index below its child.
-    BadTree {
-        /// The child whose parent is invalid.
-        particle: usize,
-    },
-}
-
-/// A factorisation or solve failed.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum LinalgError {
-    /// The matrix is not (numerically) positive definite; the pivot at `row` was not positive.
-    NotPositiveDefinite {
-        /// Scalar row where the pivot failed.
-        row: usize,
-    },
-    /// The matrix is (numerically) singular at `row`.
-    Singular {
-        /// Scalar row where the pivot vanished.
-        row: usize,
-    },
+/// Element counts of the storage arrays one step uses (counted in `workspace/layout.rs`;
+/// declared here because [`StepError::Storage`] reports it): four numeric arrays, and the
+/// constraint list of a step with contacts or a wall (`links`, zero otherwise).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Layout {
+    /// 3x3 blocks (factors; the packed mobility above a wall and of the inertial
+    /// methods).
+    pub blocks: usize,
+    /// 3-vectors (forces, velocities, candidate state, bond vectors, solver vectors).
+    pub vectors: usize,
+    /// Scalars (multipliers, masses, solver matrices; the overdamped methods' packed
+    /// mobility in free space, six scalars a symmetric block).
+    pub scalars: usize,
+    /// Indices (LU pivots).
+    pub indices: usize,
+    /// Constraint links (bonds followed by contacts and wall links) of a step with
+    /// [`Params::contacts`](crate::Params::contacts) or [`Params::wall`](crate::Params::wall); zero otherwise.
+    pub links: usize,
 }
 
 /// Where in a step a linear-algebra failure happened.
@@ -318,78 +211,6 @@ pub enum StepError {
     Unsupported(&'static str),
 }
 
-impl fmt::Display for ParticleError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match *self {
-            Self::Full => write!(f, "particle set is full"),
-            Self::NonFinite { particle } => write!(f, "particle {particle}: non-finite value"),
-            Self::BadRadius { particle } => write!(
-                f,
-                "particle {particle}: radius must be > 0 and normal (not subnormal)"
-            ),
-            Self::BadDensity { particle } => write!(f, "particle {particle}: density must be >= 0"),
-            Self::Nested { i, j } => {
-                write!(f, "particles {i} and {j}: one sphere inside the other")
-            }
-            Self::Coincident { i, j } => write!(
-                f,
-                "particles {i} and {j}: coincident centres (refused even where overlaps are allowed)"
-            ),
-            Self::Overlap { i, j } => write!(f, "particles {i} and {j} overlap"),
-            Self::Massless { particle } => {
-                write!(f, "particle {particle}: inertial method needs mass > 0")
-            }
-            Self::BelowWall { particle } => write!(
-                f,
-                "particle {particle}: sphere below or crossing the wall (centre below height + radius)"
-            ),
-        }
-    }
-}
-
-impl fmt::Display for BondError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match *self {
-            Self::Full => write!(f, "bond list is full"),
-            Self::SelfBond { bond, particle } => {
-                write!(f, "bond {bond}: particle {particle} bonded to itself")
-            }
-            Self::OutOfRange { bond, particle } => {
-                write!(f, "bond {bond}: particle index {particle} out of range")
-            }
-            Self::Duplicate { bond, other } => write!(f, "bond {bond} duplicates bond {other}"),
-            Self::BadLength { bond } => write!(
-                f,
-                "bond {bond}: length must be finite and > 0 (0 only for springs; below half the smallest edge of a periodic box)"
-            ),
-            Self::Violated { bond, residual } => {
-                write!(f, "bond {bond}: configuration off by relative {residual:e}")
-            }
-            Self::Overstretched { bond, ratio } => write!(
-                f,
-                "bond {bond}: FENE spring at {ratio:.6} of its maximum extension (must stay below 1)"
-            ),
-            Self::BadTree { particle } => {
-                write!(
-                    f,
-                    "tree: particle {particle} needs a parent with a smaller index"
-                )
-            }
-        }
-    }
-}
-
-impl fmt::Display for LinalgError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match *self {
-            Self::NotPositiveDefinite { row } => {
-                write!(f, "matrix not positive definite (pivot at row {row})")
-            }
-            Self::Singular { row } => write!(f, "matrix singular (pivot at row {row})"),
-        }
-    }
-}
-
 impl fmt::Display for StepError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
@@ -465,9 +286,6 @@ impl fmt::Display for StepError {
     }
 }
 
-impl core::error::Error for ParticleError {}
-impl core::error::Error for BondError {}
-impl core::error::Error for LinalgError {}
 impl core::error::Error for StepError {}
 
 impl From<ParticleError> for StepError {

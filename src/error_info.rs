@@ -267,7 +267,7 @@ impl StepError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::workspace::Layout;
+    use crate::error::Layout;
 
     /// One of every variant (nested ones included).
     fn every() -> [StepError; 33] {

@@ -14,6 +14,41 @@
 //! * the SHAKE sweep, Newton solve and RATTLE velocity sweep: [`constraints`];
 //! * [`step`] and its stages: [`integrate`] (one file per integrator; the paper's
 //!   velocity-Verlet HydroRATTLE step is `src/integrate/rattle.rs`).
+//!
+//! ## Layers
+//!
+//! The modules stand in layers, each building only on the layers below it (and on
+//! modules of its own layer, without a circle); `host/tests/layers.rs` checks this
+//! against the same table, and prints the import graph with
+//! `cargo test --release -p hydrorattle-host --test layers -- --nocapture import_graph`.
+//! From the bottom:
+//!
+//! 1. **Foundation**: [`real`] (the precision, and the stored-block trait
+//!    [`linalg::Block`] its 3x3 matrix implements), the low layers' errors
+//!    ([`ParticleError`], [`BondError`], [`LinalgError`], re-exported from [`error`]),
+//!    and [`helix`] (the paper's chain, in `f64`). Builds on nothing in the crate.
+//! 2. **Linear algebra**: [`linalg`] (packed symmetric storage, the banded product
+//!    kernel, Cholesky, LU). Builds on the foundation.
+//! 3. **Free-space pairs and the periodic cell**: [`rpy`] (the self and pair blocks of
+//!    free space) and [`cell`] (a periodic box, minimum images). Build on linear algebra.
+//! 4. **Bonds, cell lists and bands**: [`bonds`], [`cell_list`] (pair searches over
+//!    cells) and [`parallel`] (the mobility's work in bands, the [`Parallel`] trait).
+//!    Build on the pairs and the cell.
+//! 5. **Noise**: [`noise`] (Cholesky, Lanczos and reduced square roots). Builds on the
+//!    bands.
+//! 6. **The geometries' mobility, particles**: [`mobility`] (free space, wall, periodic
+//!    box, PSE: assembly and products), [`particles`] and [`observables`]. Build on the
+//!    noise and the bands.
+//! 7. **The step's error**: [`error`] ([`StepError`], which wraps every error below and
+//!    reports a [`Layout`]). Builds on the geometries.
+//! 8. **The geometry a step sees**: [`geometry`] (the periodic sums held for a step).
+//!    Builds on the step's error and the geometries.
+//! 9. **Constraints**: [`constraints`] (SHAKE sweep, Newton, Krylov, the metric).
+//!    Builds on the geometry a step sees.
+//! 10. **Configuration**: [`params`], [`forces`], [`names`]. Build on the constraints'
+//!     and geometries' choices they name.
+//! 11. **Workspace**: [`workspace`] (what a step needs, sized from its parameters).
+//! 12. **Integrators**: [`integrate`] ([`step`] and its stages). Build on everything.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -28,7 +63,9 @@ pub mod cell_list;
 pub mod constraints;
 pub mod error;
 mod error_info;
+mod fault;
 pub mod forces;
+pub mod geometry;
 pub mod helix;
 pub mod integrate;
 pub mod linalg;
@@ -42,6 +79,7 @@ pub mod parallel;
 pub mod params;
 pub mod particles;
 pub mod real;
+pub mod rpy;
 pub mod workspace;
 
 pub use bonds::{Bond, BondSet};

@@ -1,6 +1,6 @@
 //! Fixed-capacity set of rigid spheres: the dynamic state and the per-particle data.
 
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::noise::Noise;
 use crate::real::Real;
 

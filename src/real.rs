@@ -8,6 +8,23 @@
 use core::fmt::{Debug, Display};
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
+/// A stored block of a packed mobility: [`Real::M3`] itself (nine scalars) or the
+/// symmetric [`Sym`](crate::linalg::Sym) (six), in `linalg/block.rs`. Declared here,
+/// below `linalg`, because [`Real::M3`] is one.
+pub trait Block<T: Real>: Copy + Send + Sync + core::fmt::Debug + 'static {
+    /// Scalars a block takes in memory (9 general, 6 symmetric).
+    const SCALARS: usize;
+    /// The block to store for `m` (for [`Sym`](crate::linalg::Sym), its lower triangle: `m` must be
+    /// symmetric in bits, as every free-space translational block is).
+    fn store(m: T::M3) -> Self;
+    /// The full block.
+    fn full(self) -> T::M3;
+    /// `b x`, with the bits of glam's `M3 * V3` on [`Block::full`].
+    fn mul(self, x: T::V3) -> T::V3;
+    /// `b^T x`, with the bits of [`Real::m3_tmul`] on [`Block::full`].
+    fn tmul(self, x: T::V3) -> T::V3;
+}
+
 /// A floating-point precision the kernel runs in.
 pub trait Real:
     Copy
@@ -56,7 +73,7 @@ pub trait Real:
         + Mul<Self, Output = Self::M3>
         + AddAssign
         + SubAssign
-        + crate::linalg::Block<Self>;
+        + Block<Self>;
 
     /// 0.
     const ZERO: Self;
@@ -345,7 +362,7 @@ macro_rules! impl_real {
         }
 
         /// The general block: glam's product, the kernel's transposed product.
-        impl crate::linalg::Block<$t> for $m {
+        impl Block<$t> for $m {
             const SCALARS: usize = 9;
             #[inline(always)]
             fn store(m: $m) -> Self {

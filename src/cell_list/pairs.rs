@@ -4,7 +4,7 @@
 
 use super::CellList;
 use crate::cell::Periodic;
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::real::Real;
 
 /// The order in which the pairs `(i, j)`, `i < j`, are met: which failing pair is the
@@ -184,7 +184,7 @@ mod tests {
             }
             let mut store = [0; 3 * 257 + 1];
             for allow in [false, true] {
-                let want = crate::particles::check_pairs(pos, radius, allow);
+                let want = check_pairs_in(pos, radius, allow, &mut []);
                 assert_eq!(check_pairs_in(pos, radius, allow, &mut store), want);
             }
         }

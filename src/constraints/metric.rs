@@ -27,10 +27,8 @@ mod table;
 pub(crate) use product::apply_drag;
 pub(crate) use table::tabulate;
 
+use crate::geometry::Hydrodynamics;
 use crate::linalg::{Block, Mob, tri};
-use crate::mobility::Hydro;
-#[cfg(feature = "periodic")]
-use crate::mobility::sums::BoxSums;
 use crate::parallel::Parallel;
 use crate::real::Real;
 
@@ -69,10 +67,11 @@ pub enum Metric<'a, T: Real> {
     /// The positions must have passed a product at these positions ([`tt_product`](crate::mobility::tt_product)),
     /// which refuses nested spheres.
     Free {
-        /// Hydrodynamic level.
-        level: Hydro,
-        /// Viscosity.
-        eta: T,
+        /// The geometry: free space, the wall, or the box with the step's periodic sums
+        /// (derived once per step, not per block: `integrate/periodic.rs`); PSE has
+        /// products only (its `D_l(p)` entries are zero: the step refuses the solvers
+        /// that read them).
+        hydro: Hydrodynamics<'a, T>,
         /// Bead centres.
         pos: &'a [T::V3],
         /// Bead radii.
@@ -81,14 +80,6 @@ pub enum Metric<'a, T: Real> {
         grad: &'a [T::V3],
         /// Overall factor (`dt` for positions).
         scale: T,
-        /// The wall's height when there is one ([`wall`](crate::mobility::wall)).
-        wall: Option<T>,
-        /// The step's periodic sums when it runs in a box whose images interact
-        /// (derived once per step, not per block: `integrate/periodic.rs`): Ewald, or
-        /// PSE, which has products only (its `D_l(p)` entries are zero: the step
-        /// refuses the solvers that read them).
-        #[cfg(feature = "periodic")]
-        ewald: Option<BoxSums<'a, T>>,
         /// How its free-space products run ([`crate::parallel::free_product`], the bits
         /// of the stored product on any number of threads).
         par: &'a dyn Parallel,

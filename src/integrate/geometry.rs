@@ -7,10 +7,9 @@
 //! no step would use.
 
 use super::checks::check_box;
-use super::stages::{HeldSums, Sums, assemble_tt, free_product, held_ewald, wall_height};
+use super::stages::{HeldSums, Sums, assemble_tt, free_product, held_ewald, hydro};
 use crate::error::StepError;
 use crate::linalg::tri;
-use crate::mobility;
 use crate::parallel::{Parallel, band_scratch};
 use crate::params::Params;
 use crate::real::Real;
@@ -46,7 +45,7 @@ pub fn mobility_tt<T: Real>(
 }
 
 /// The grand mobility (`2n x 2n` blocks, translations then rotations, packed as
-/// [`mobility::assemble_grand`] stores it: [`tri`]`(2n)` blocks of `out`): free space,
+/// [`crate::mobility::assemble_grand`] stores it: [`tri`]`(2n)` blocks of `out`): free space,
 /// above the wall or in the box.
 pub fn mobility_grand<T: Real>(
     p: &Params<T>,
@@ -74,24 +73,8 @@ pub(super) fn grand<T: Real>(
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), StepError> {
-    let (level, eta, out) = (p.hydro, p.viscosity, &mut out[..tri(2 * pos.len())]);
-    #[cfg(feature = "periodic")]
-    if let Some(e) = ew {
-        let Some(e) = e.ewald() else {
-            return Err(StepError::Unsupported(
-                "PSE with rotation (its rt and rr products are not built: Ewald sums them)",
-            ));
-        };
-        return Ok(mobility::periodic::assemble_grand(
-            e, eta, pos, radius, out,
-        )?);
-    }
-    let _ = ew; // Read above only with the `periodic` feature.
-    match wall_height(p) {
-        Some(h) => mobility::wall::assemble_grand(level, eta, h, pos, radius, out)?,
-        None => mobility::assemble_grand(level, eta, pos, radius, out)?,
-    }
-    Ok(())
+    let out = &mut out[..tri(2 * pos.len())];
+    hydro(p, ew).assemble_grand(pos, radius, out)
 }
 
 /// `u = mu_tt f` without storing `mu_tt`, as a matrix-free step computes it. In free

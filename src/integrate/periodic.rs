@@ -13,14 +13,13 @@
 
 use crate::cell::Periodic;
 use crate::error::StepError;
-use crate::linalg::{MobMut, with_blocks};
+use crate::geometry::sums::BoxSums;
+#[cfg(feature = "pse")]
+use crate::geometry::sums::PseStep;
+use crate::linalg::MobMut;
 use crate::mobility::periodic::{self, Ewald};
 #[cfg(feature = "pse")]
 use crate::mobility::pse::{Pse, PseSize, PseStorage};
-use crate::mobility::sums::BoxSums;
-#[cfg(feature = "pse")]
-use crate::mobility::sums::PseStep;
-use crate::noise::reduced;
 use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
@@ -77,25 +76,21 @@ pub(super) fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>
 pub(super) fn assemble_apply<T: Real>(
     p: &Params<T>,
     ew: &Ewald<T>,
-    (pos, radius): (&[T::V3], &[T]),
+    spheres: (&[T::V3], &[T]),
     mu: MobMut<'_, T>,
-    (f, u): (&[T::V3], &mut [T::V3]),
-    (par, bands): (&dyn Parallel, &mut [T::V3]),
+    fu: (&[T::V3], &mut [T::V3]),
+    work: (&dyn Parallel, &mut [T::V3]),
     copy: Option<&mut [T::M3]>,
 ) -> Result<(), StepError> {
-    let eta = p.viscosity;
-    with_blocks!(mut mu, mu => {
-        match copy {
-            None => periodic::assemble(par, ew, eta, pos, radius, mu)?,
-            Some(copy) => {
-                let side = (copy, reduced::copy_start as fn(usize) -> usize);
-                let pack = reduced::pack_rows::<T, _>;
-                periodic::assemble_then(par, ew, eta, pos, radius, mu, side, pack)?
-            }
-        }
-        crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
-        Ok(())
-    })
+    Ok(periodic::assemble_apply(
+        ew,
+        p.viscosity,
+        spheres,
+        mu,
+        fu,
+        work,
+        copy,
+    )?)
 }
 
 /// The caller's PSE arrays as the step's storage, after checking them against the

@@ -12,7 +12,7 @@
 
 use super::Start;
 use crate::error::StepError;
-use crate::mobility::sums::BoxProduct;
+use crate::geometry::sums::BoxProduct;
 use crate::noise::Noise;
 use crate::params::{Drift, Params};
 use crate::real::Real;

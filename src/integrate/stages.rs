@@ -6,30 +6,29 @@ use super::StepReport;
 use crate::bonds::Bond;
 use crate::cell::Periodic;
 use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind};
-use crate::error::{ParticleError, StepError};
-use crate::linalg::{Mob, MobMut, with_blocks};
-use crate::mobility::{self, Hydro};
+use crate::error::StepError;
+use crate::geometry::Hydrodynamics;
+use crate::linalg::{Mob, MobMut};
+use crate::mobility::Hydro;
 use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
 
-/// The step's periodic sums ([`super::periodic`], [`BoxSums`](crate::mobility::sums::BoxSums):
-/// Ewald, or PSE with [`Params::pse`]): `Some` in a periodic box whose images interact
-/// (not with free draining), derived once by the step's checks and read by every
-/// product, assembly and matrix-free metric of the step. Without the `periodic`
-/// feature there are none (always `None`).
-#[cfg(feature = "periodic")]
-pub(super) type Sums<'a, T> = Option<crate::mobility::sums::BoxSums<'a, T>>;
-/// The step's Ewald parameters: none without the `periodic` feature.
-#[cfg(not(feature = "periodic"))]
-pub(super) type Sums<'a, T> = Option<&'a core::marker::PhantomData<T>>;
+pub(super) use crate::geometry::{PSE_ASSEMBLED, Sums};
+
+/// The step's geometry ([`Hydrodynamics`]) from its parameters and its periodic sums
+/// `ew` ([`Sums`]): the one place a stage turns the parameters into it.
+#[inline(always)]
+pub(super) fn hydro<'a, T: Real>(p: &Params<T>, ew: Sums<'a, T>) -> Hydrodynamics<'a, T> {
+    Hydrodynamics::new(p.hydro, p.viscosity, wall_height(p), ew)
+}
 
 /// The Ewald sums of what [`super::checks::check_box`] holds, as [`Sums`] (it never
 /// holds PSE's).
 #[cfg(feature = "periodic")]
 pub(super) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
     match held.as_ref()? {
-        super::periodic::Held::Ewald(e) => Some(crate::mobility::sums::BoxSums::Ewald(e)),
+        super::periodic::Held::Ewald(e) => Some(crate::geometry::sums::BoxSums::Ewald(e)),
         #[cfg(feature = "pse")]
         super::periodic::Held::Pse(_) => None,
     }
@@ -47,11 +46,6 @@ pub(super) type HeldSums<T> = Option<super::periodic::Held<T>>;
 /// What the step's checks hold for [`Sums`] to borrow: nothing without the feature.
 #[cfg(not(feature = "periodic"))]
 pub(super) type HeldSums<T> = Option<core::marker::PhantomData<T>>;
-
-/// Why PSE ([`Params::pse`]) cannot serve a stage that needs the assembled mobility.
-pub(super) const PSE_ASSEMBLED: &str = "PSE (Params::pse) where the step needs the assembled mobility \
-     (without matrix_free, Cholesky noise, the Sweep or Newton solver, RattleStable): \
-     PSE gives products only";
 
 /// `u = mu_tt(pos) f`: assembled into `mu` and applied in one pass, in bands through
 /// `par` (`bands` holds their partial sums, [`crate::parallel`]), or matrix-free (then
@@ -71,32 +65,7 @@ pub(super) fn mobility_product<T: Real>(
     if p.matrix_free {
         return free_product(p, ew, pos, radius, f, u, (par, bands));
     }
-    #[cfg(feature = "periodic")]
-    if let Some(e) = ew {
-        // In a box: assembled and applied in bands (`integrate/periodic.rs`).
-        let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-        return super::periodic::assemble_apply(
-            p,
-            e,
-            (pos, radius),
-            mu,
-            (f, u),
-            (par, bands),
-            None,
-        );
-    }
-    if let Some(h) = wall_height(p) {
-        // Above a wall: assembled, then applied (`mobility::wall`).
-        let (level, eta, mu) = (p.hydro, p.viscosity, mu.general());
-        mobility::wall::assemble(par, level, eta, h, pos, radius, mu)?;
-        crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
-        return Ok(());
-    }
-    let (level, eta) = (p.hydro, p.viscosity);
-    with_blocks!(mut mu, a => {
-        crate::parallel::assemble_apply(par, level, eta, pos, radius, a, f, u, bands)
-    })
-    .map_err(StepError::from)
+    hydro(p, ew).assemble_apply(par, pos, radius, mu, f, u, bands)
 }
 
 /// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`: matrix-free when asked;
@@ -120,19 +89,14 @@ pub(super) fn mobility_metric<'a, T: Real>(
 ) -> Metric<'a, T> {
     if p.matrix_free {
         return Metric::Free {
-            level: p.hydro,
-            eta: p.viscosity,
+            hydro: hydro(p, ew),
             pos,
             radius,
             grad,
             scale,
-            wall: wall_height(p),
-            #[cfg(feature = "periodic")]
-            ewald: ew,
             par,
         };
     }
-    let _ = ew; // Read above only with the `periodic` feature.
     if p.solver.kind.resolve(bonds.len()) == SolverKind::Krylov {
         return Metric::Mobility {
             mu,
@@ -145,7 +109,7 @@ pub(super) fn mobility_metric<'a, T: Real>(
     }
     let n = pos.len();
     // Without a wall every block is symmetric: the table reads lower triangles only.
-    let sym = wall_height(p).is_none();
+    let sym = hydro(p, ew).symmetric();
     constraints::tabulate(mu, bonds, grad, scale, n, sym, disp);
     let disp = &disp[..n * bonds.len()];
     Metric::Dense { disp, n, grad }
@@ -164,17 +128,7 @@ pub(super) fn free_product<T: Real>(
     u: &mut [T::V3],
     (par, bands): (&dyn Parallel, &mut [T::V3]),
 ) -> Result<(), StepError> {
-    #[cfg(feature = "periodic")]
-    if let Some(e) = ew {
-        return e.product(p.viscosity, pos, radius, f, u, (par, bands));
-    }
-    let _ = ew; // Read above only with the `periodic` feature.
-    let (level, eta) = (p.hydro, p.viscosity);
-    match wall_height(p) {
-        Some(h) => mobility::wall::free_product(par, level, eta, h, pos, radius, f, u, bands)?,
-        None => crate::parallel::free_product::<T>(par, level, eta, pos, radius, f, u, bands)?,
-    }
-    Ok(())
+    hydro(p, ew).product(par, pos, radius, f, u, bands)
 }
 
 /// The wall's height when the step has one and the kernel its `wall` feature (without
@@ -213,25 +167,7 @@ pub(super) fn assemble_tt<T: Real>(
     radius: &[T],
     mu: MobMut<'_, T>,
 ) -> Result<(), StepError> {
-    #[cfg(feature = "periodic")]
-    if let Some(e) = ew {
-        // PSE has no blocks; the checks refuse it wherever the step assembles.
-        let e = e.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-        let (serial, eta) = (&crate::parallel::Serial, p.viscosity);
-        use mobility::periodic::assemble;
-        return Ok(with_blocks!(mut mu, mu => assemble(serial, e, eta, pos, radius, mu))?);
-    }
-    let _ = ew; // Read above only with the `periodic` feature.
-    if let Some(h) = wall_height(p) {
-        let (level, eta, serial) = (p.hydro, p.viscosity, &crate::parallel::Serial);
-        let mu = mu.general();
-        return Ok(mobility::wall::assemble(
-            serial, level, eta, h, pos, radius, mu,
-        )?);
-    }
-    let (level, eta) = (p.hydro, p.viscosity);
-    with_blocks!(mut mu, a => mobility::assemble_tt(level, eta, pos, radius, a))
-        .map_err(StepError::from)
+    hydro(p, ew).assemble_tt(pos, radius, mu)
 }
 
 /// `g_l = r_i - r_j` for every bond (its minimum image in a periodic box `cell`);
@@ -293,31 +229,10 @@ pub(super) fn spin<T: Real>(
     out: &mut [T::V3],
 ) -> Result<(), StepError> {
     out.fill(p.vorticity);
-    #[cfg(feature = "periodic")]
-    if let (true, Some(e)) = (p.rotation, ew.and_then(|s| s.ewald())) {
-        let eta = p.viscosity;
-        return Ok(mobility::periodic::add_spin(e, eta, pos, radius, f, out)?);
-    }
-    let _ = ew; // Read above only with the `periodic` feature.
-    if let (true, Some(h)) = (p.rotation, wall_height(p)) {
-        let (level, eta) = (p.hydro, p.viscosity);
-        return Ok(mobility::wall::add_spin(
-            level, eta, h, pos, radius, f, out,
-        )?);
-    }
-    if !p.rotation || p.hydro == Hydro::FreeDraining {
+    if !p.rotation {
         return Ok(());
     }
-    for i in 0..pos.len() {
-        for j in 0..i {
-            let b =
-                mobility::pair_blocks(p.hydro, p.viscosity, radius[i], radius[j], pos[i] - pos[j])
-                    .ok_or(StepError::Particle(ParticleError::Nested { i: j, j: i }))?;
-            out[i] += b.rt_ij * f[j];
-            out[j] += b.rt_ji * f[i];
-        }
-    }
-    Ok(())
+    hydro(p, ew).add_spin(pos, radius, f, out)
 }
 
 /// Projects `x` onto the bonds along `metric`; the multipliers start from zero and end

@@ -4,7 +4,7 @@
 //! columns `k - w ..= k` (entries left of column 0 are unused zeros), so the storage is
 //! `n (w + 1)` scalars and the factorisation costs `n w^2` flops.
 
-use crate::error::LinalgError;
+use crate::fault::LinalgError;
 use crate::real::Real;
 
 /// Index of entry `(k, l)`, `k - w <= l <= k`, in band storage of half-bandwidth `w`.

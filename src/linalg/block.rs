@@ -17,26 +17,13 @@
 //! entry and in the same order, on the entries the full block would hold: for a block
 //! that is symmetric in bits both give the full block's bits.
 
+// Declared beside `Real`, whose general block (`M3`) implements it.
+pub use crate::real::Block;
 use crate::real::Real;
 
 /// A symmetric 3x3 block by its lower triangle in glam's column-major order:
 /// `[m00, m10, m20, m11, m21, m22]` (`m_rc`, row `r`, column `c`).
 pub type Sym<T> = [T; 6];
-
-/// A stored block of a packed mobility.
-pub trait Block<T: Real>: Copy + Send + Sync + core::fmt::Debug + 'static {
-    /// Scalars a block takes in memory (9 general, 6 symmetric).
-    const SCALARS: usize;
-    /// The block to store for `m` (for [`Sym`], its lower triangle: `m` must be
-    /// symmetric in bits, as every free-space translational block is).
-    fn store(m: T::M3) -> Self;
-    /// The full block.
-    fn full(self) -> T::M3;
-    /// `b x`, with the bits of glam's `M3 * V3` on [`Block::full`].
-    fn mul(self, x: T::V3) -> T::V3;
-    /// `b^T x`, with the bits of [`Real::m3_tmul`] on [`Block::full`].
-    fn tmul(self, x: T::V3) -> T::V3;
-}
 
 impl<T: Real> Block<T> for Sym<T> {
     const SCALARS: usize = 6;
@@ -200,7 +187,7 @@ pub(crate) mod tests {
     }
 
     /// [`lcg`]'s values with zeros, huge and tiny values mixed in.
-    fn values(seed: u64) -> impl FnMut() -> f64 {
+    pub(crate) fn values(seed: u64) -> impl FnMut() -> f64 {
         let mut next = lcg(seed);
         move || {
             let (v, s) = next();
@@ -239,39 +226,5 @@ pub(crate) mod tests {
             assert_eq!(bits(s.tmul(x)), bits(<f32 as Real>::m3_tmul(m, x)));
             assert_eq!(Block::<f32>::full(s), m);
         }
-    }
-
-    /// What makes the symmetric storage exact: every free-space translational block
-    /// (far, overlapping, Oseen, free draining; unequal radii; both precisions) equals
-    /// its transpose bit for bit, so its lower triangle gives back the block.
-    #[test]
-    fn free_space_blocks_are_symmetric_in_bits() {
-        use crate::mobility::{Hydro, pair_tt, self_tt};
-        fn check<T: Real>(v: &mut impl FnMut() -> f64) {
-            let bits = |m: T::M3| T::m3_entries(&m).map(|e| e.to_f64().to_bits());
-            for _ in 0..20_000 {
-                let (ai, aj) = (T::from_f64(0.3 + v().abs()), T::from_f64(0.3 + v().abs()));
-                // Separations from inside the overlap branch to far apart.
-                let s = 4.0 * (v() + 0.5);
-                let r = T::v3_from([s * v(), s * v(), s * v()]);
-                for level in [Hydro::Rpy, Hydro::Oseen, Hydro::FreeDraining] {
-                    let Some(m) = pair_tt(level, T::ONE, ai, aj, r) else {
-                        continue;
-                    };
-                    assert_eq!(bits(m), bits(T::transpose(m)), "{level:?}");
-                    assert_eq!(bits(<Sym<T> as Block<T>>::store(m).full()), bits(m));
-                }
-                let d = T::m3_diag(self_tt(T::from_f64(0.7), ai));
-                assert_eq!(bits(d), bits(T::transpose(d)));
-            }
-        }
-        // Values in [-0.5, 0.5) without the huge and tiny ones (radii, positions).
-        let mut w = values(5);
-        let mut v = move || match w() {
-            x if x.abs() > 0.5 || (x != 0.0 && x.abs() < 1e-200) => 0.25,
-            x => x,
-        };
-        check::<f64>(&mut v);
-        check::<f32>(&mut v);
     }
 }

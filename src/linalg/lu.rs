@@ -12,7 +12,7 @@
 //! right-hand side (one that the others imply) holds as well. `floor = 0` keeps the
 //! strict behaviour (every pivot must be positive).
 
-use crate::error::LinalgError;
+use crate::fault::LinalgError;
 use crate::real::Real;
 
 /// In-place LU factorisation with partial pivoting of the `n x n` row-major `a`.

@@ -20,13 +20,14 @@
 pub mod band;
 pub(crate) mod block;
 mod lu;
+pub(crate) mod packed;
 
 pub(crate) use block::with_blocks;
 pub use block::{Block, Mob, MobMut, Sym};
 
 pub use lu::{cholesky_dense, cholesky_dense_solve, lu, lu_ranked, lu_solve};
 
-use crate::error::LinalgError;
+use crate::fault::LinalgError;
 use crate::real::Real;
 
 /// Offset of packed row `i`: `i (i + 1) / 2`; `tri(n)` is the size of an `n x n` matrix.
@@ -67,7 +68,7 @@ pub fn sym3_mul<T: Real>(b: T::M3, x: T::V3) -> T::V3 {
 /// pass on one thread at any size; [`crate::parallel::product`] is the same arithmetic
 /// cut into bands (the same bits below [`crate::parallel::BANDED_MIN`] rows).
 pub fn sym_matvec<T: Real>(a: &[impl Block<T>], n: usize, x: &[T::V3], y: &mut [T::V3]) {
-    crate::parallel::band::<T, _>(a, 0, x, &mut y[..n], &mut []);
+    packed::band::<T, _>(a, 0, x, &mut y[..n], &mut []);
 }
 
 /// Lower Cholesky factor of a symmetric 3x3 block; `row0` names the block's first row

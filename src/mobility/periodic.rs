@@ -36,7 +36,7 @@ mod wave;
 pub use rot::{RotBlocks, add_spin, assemble_grand, pair_rot, self_rr};
 
 pub use crate::cell::{Periodic, PeriodicError};
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::linalg::{Block, tri};
 use crate::parallel::{
     Packed, Parallel, band_blocks, band_start, by_bands_and, by_bands_then_reduce,
@@ -228,6 +228,34 @@ pub fn assemble<T: Real>(
 ) -> Result<(), PeriodicError> {
     let none = (&mut [][..], tri as fn(usize) -> usize);
     assemble_then(par, ew, eta, pos, radius, out, none, |_, _, _, _| {})
+}
+
+/// `u = mu_tt f`: [`assemble`] into `mu` (also into the compact copy `copy` of
+/// [`Params::compact_products`](crate::Params::compact_products) when given, in the same
+/// pass, [`assemble_then`]) and applied in the bands of [`crate::parallel`] through `par`
+/// (`bands`: their scratch).
+pub(crate) fn assemble_apply<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    (pos, radius): (&[T::V3], &[T]),
+    mu: crate::linalg::MobMut<'_, T>,
+    (f, u): (&[T::V3], &mut [T::V3]),
+    (par, bands): (&dyn Parallel, &mut [T::V3]),
+    copy: Option<&mut [T::M3]>,
+) -> Result<(), PeriodicError> {
+    use crate::noise::reduced;
+    crate::linalg::with_blocks!(mut mu, mu => {
+        match copy {
+            None => assemble(par, ew, eta, pos, radius, mu)?,
+            Some(copy) => {
+                let side = (copy, reduced::copy_start as fn(usize) -> usize);
+                let pack = reduced::pack_rows::<T, _>;
+                assemble_then(par, ew, eta, pos, radius, mu, side, pack)?
+            }
+        }
+        crate::parallel::product::<T>(par, mu, pos.len(), f, u, bands);
+        Ok(())
+    })
 }
 
 /// [`assemble`], handing each row `i` of the mobility, just written and still in the

@@ -31,7 +31,7 @@ use core::fmt;
 pub use fft::{Cx, good_size};
 pub use spread::MAX_SUPPORT;
 
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::mobility::periodic::real::Split;
 use crate::mobility::periodic::{Periodic, PeriodicError};
 use crate::noise::lanczos::LanczosError;

@@ -35,7 +35,7 @@
 mod rotation;
 pub use rotation::{add_spin, assemble_grand, image_rot, self_wall_rot};
 
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::linalg::tri;
 use crate::mobility::{Hydro, pair_tt, self_tt};
 use crate::parallel::{Parallel, band_start, bands, by_bands};

@@ -4,10 +4,10 @@
 //! product of the stored blocks). The first nested pair in band order is the error.
 
 use super::{Pairs, Parallel, band_start, bands, blocked, by_bands, lanes, reduce};
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::linalg::{Block, tri};
-use crate::mobility::{Hydro, pair_tt, self_tt};
 use crate::real::Real;
+use crate::rpy::{Hydro, pair_tt, self_tt};
 
 /// [`band`](super::band) while assembling: each block is evaluated, stored into `rows`
 /// (the packed rows from `b0` on) and applied at once, in the same order, so the

@@ -17,10 +17,10 @@
 //! group in order.
 
 use super::{Packed, Pairs, Parallel, band_start, bands, by_bands_and, reduce};
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::linalg::{Block, tri};
-use crate::mobility::{Hydro, pair_norm2, pair_tt_from};
 use crate::real::Real;
+use crate::rpy::{Hydro, pair_norm2, pair_tt_from};
 
 /// Block rows walked together: 8 measured best at N = 1024 and 2048 (4: 4.7, 8: 4.0,
 /// 12: 4.3, 16: 5.3 ns per block at N = 1024).

@@ -10,9 +10,9 @@
 
 use super::blocked::runs_k;
 use super::{Pairs, Parallel, band_start, by_bands_then_reduce};
-use crate::error::ParticleError;
-use crate::mobility::{Hydro, self_tt};
+use crate::fault::ParticleError;
 use crate::real::Real;
+use crate::rpy::{Hydro, self_tt};
 
 /// Columns evaluated into the stack buffer at a time (whole runs of square roots).
 const SPAN: usize = 64;

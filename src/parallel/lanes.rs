@@ -19,10 +19,10 @@
 //! pair by pair by [`pair_tt`]; nested spheres are the same first error.
 
 use super::Pairs;
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::linalg::{Block, tri};
-use crate::mobility::{Hydro, pair_tt, self_tt};
 use crate::real::Real;
+use crate::rpy::{Hydro, pair_tt, self_tt};
 
 /// Beads the lanes take at most (the arrays live on the stack, and are zeroed once per
 /// assembly: 32 covers the paper's chain at half the bytes of `RUNS_MIN`).

@@ -3,6 +3,7 @@
 //! time and a host sizes `Buffers` at run time from the same numbers.
 
 use crate::constraints::{SolverKind, scratch_size};
+use crate::error::Layout;
 use crate::linalg::tri;
 use crate::noise::lanczos;
 use crate::parallel::band_scratch;
@@ -34,25 +35,6 @@ const fn symmetric_mobilities(method: Method) -> usize {
         Method::Overdamped2 => 2,
         Method::Rattle | Method::RattleStable => 0,
     }
-}
-
-/// Element counts of the storage arrays one step uses: four numeric arrays, and the
-/// constraint list of a step with contacts or a wall (`links`, zero otherwise).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Layout {
-    /// 3x3 blocks (factors; the packed mobility above a wall and of the inertial
-    /// methods).
-    pub blocks: usize,
-    /// 3-vectors (forces, velocities, candidate state, bond vectors, solver vectors).
-    pub vectors: usize,
-    /// Scalars (multipliers, masses, solver matrices; the overdamped methods' packed
-    /// mobility in free space, six scalars a symmetric block).
-    pub scalars: usize,
-    /// Indices (LU pivots).
-    pub indices: usize,
-    /// Constraint links (bonds followed by contacts and wall links) of a step with
-    /// [`Params::contacts`] or [`Params::wall`]; zero otherwise.
-    pub links: usize,
 }
 
 /// Block rows of the mobility: `2n` when rotation is resolved (only the stable inertial

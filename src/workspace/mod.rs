@@ -20,7 +20,7 @@
 mod layout;
 mod views;
 
-pub use layout::Layout;
+pub use crate::error::Layout;
 pub(crate) use layout::{block_rows, symmetric};
 pub(crate) use views::{Links, Views};
 

@@ -8,9 +8,6 @@
 use super::{Metric, sym_block, sym_diff_mul};
 use crate::bonds::Bond;
 use crate::linalg::{self, tri, with_blocks};
-#[cfg(feature = "periodic")]
-use crate::mobility::periodic;
-use crate::mobility::{tt_block_at, wall};
 use crate::real::Real;
 
 impl<T: Real> Metric<'_, T> {
@@ -65,39 +62,24 @@ impl<T: Real> Metric<'_, T> {
                 })
             }
             Metric::Free {
-                level,
-                eta,
+                hydro,
                 pos,
                 radius,
                 grad,
                 scale,
-                wall,
-                #[cfg(feature = "periodic")]
-                ewald,
                 ..
             } => {
-                #[cfg(feature = "periodic")]
-                if let Some(sums) = ewald {
-                    return match sums.ewald() {
-                        Some(ew) => periodic_at(ew, eta, pos, radius, b, grad[l] * scale, p),
-                        None => T::V3_ZERO,
-                    };
+                if !hydro.has_blocks() {
+                    return T::V3_ZERO;
                 }
-                // Nested pairs were refused by the product at these positions. The block
-                // (q, p), as `sym_block` reads it.
-                let block = |q| match wall {
-                    Some(h) if cfg!(feature = "wall") => {
-                        wall::tt_block_at(level, eta, h, pos, radius, q, p).ok()
-                    }
-                    _ => tt_block_at(level, eta, pos, radius, p, q),
-                };
-                let block = |q| block(q).unwrap_or(T::M3_ZERO);
+                // Nested pairs were refused by the product at these positions.
+                let block = |q| hydro.block_at(pos, radius, p, q).unwrap_or(T::M3_ZERO);
                 let mu_pj = if b.one_sphere() {
                     T::M3_ZERO
                 } else {
                     block(b.j)
                 };
-                sym_diff_mul::<T>(block(b.i), mu_pj, grad[l] * scale, false)
+                sym_diff_mul::<T>(block(b.i), mu_pj, grad[l] * scale, hydro.lower_only())
             }
             Metric::Drag {
                 mu, sq, dt, grad, ..
@@ -219,26 +201,4 @@ impl<T: Real> Metric<'_, T> {
             }
         }
     }
-}
-
-/// [`Metric::Free`]'s `D_l(p)` in a periodic box: `(mu_pi - mu_pj) g` from the Ewald
-/// blocks (exactly symmetric, so read in either orientation) with the step's
-/// parameters (the product at these positions refused nested spheres).
-#[cfg(feature = "periodic")]
-fn periodic_at<T: Real>(
-    ew: &periodic::Ewald<T>,
-    eta: T,
-    pos: &[T::V3],
-    radius: &[T],
-    b: Bond<T>,
-    g: T::V3,
-    p: usize,
-) -> T::V3 {
-    let block = |q| periodic::tt_block_at(ew, eta, pos, radius, p, q).unwrap_or(T::M3_ZERO);
-    let mu_pj = if b.one_sphere() {
-        T::M3_ZERO
-    } else {
-        block(b.j)
-    };
-    sym_diff_mul::<T>(block(b.i), mu_pj, g, true)
 }

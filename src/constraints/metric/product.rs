@@ -8,7 +8,6 @@
 use super::Metric;
 use crate::bonds::Bond;
 use crate::linalg::{self, with_blocks};
-use crate::mobility::wall;
 use crate::real::Real;
 
 /// `y <- S^-1 dt K^-1 S y` with `K = dt I + S mu S` factorised in `fac`.
@@ -66,39 +65,17 @@ impl<T: Real> Metric<'_, T> {
                 }
             }
             Metric::Free {
-                level,
-                eta,
+                hydro,
                 pos,
                 radius,
                 grad,
                 scale,
-                wall,
-                #[cfg(feature = "periodic")]
-                ewald,
                 par,
             } => {
                 let (f, bands) = tmp.split_at_mut(n);
                 spread(bonds, grad, c, scale, f);
                 // Nested pairs were refused by the product at these positions.
-                #[cfg(feature = "periodic")]
-                if let Some(sums) = ewald {
-                    if sums
-                        .product(eta, pos, radius, f, out, (par, bands))
-                        .is_err()
-                    {
-                        out.fill(T::V3_ZERO);
-                    }
-                    return;
-                }
-                let done = match wall {
-                    Some(h) if cfg!(feature = "wall") => {
-                        wall::free_product(par, level, eta, h, pos, radius, f, out, bands)
-                    }
-                    _ => crate::parallel::free_product::<T>(
-                        par, level, eta, pos, radius, f, out, bands,
-                    ),
-                };
-                if done.is_err() {
+                if hydro.product(par, pos, radius, f, out, bands).is_err() {
                     out.fill(T::V3_ZERO);
                 }
             }

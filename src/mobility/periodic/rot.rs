@@ -16,7 +16,7 @@
 use super::real::for_each_image;
 use super::wave::{add_kk, for_each_mode, for_each_phase, projected};
 use super::{Ewald, PeriodicError, check};
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::linalg::tri;
 use crate::mobility::{Hydro, pair_blocks, self_rr as free_self_rr};
 use crate::real::Real;

@@ -11,7 +11,7 @@
 //! other row, so the operator is exactly symmetric.
 
 use super::{Pse, PseError};
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::mobility::periodic::PeriodicError;
 use crate::mobility::periodic::real::real_sum;
 use crate::real::Real;

@@ -8,7 +8,7 @@
 //! z x p`, then rotated to the axes ([`image_rot`]).
 
 use super::{Lifted, lift, self_block};
-use crate::error::ParticleError;
+use crate::fault::ParticleError;
 use crate::linalg::tri;
 use crate::mobility::{Hydro, PairBlocks, pair_blocks, self_rr, self_tt};
 use crate::real::Real;
