@@ -29,8 +29,10 @@
 //!    and [`helix`] (the paper's chain, in `f64`). Builds on nothing in the crate.
 //! 2. **Linear algebra**: [`linalg`] (packed symmetric storage, the banded product
 //!    kernel, Cholesky, LU). Builds on the foundation.
-//! 3. **Free-space pairs and the periodic cell**: [`rpy`] (the self and pair blocks of
-//!    free space) and [`cell`] (a periodic box, minimum images). Build on linear algebra.
+//! 3. **Free-space pairs, the periodic cell, the near field's pair functions**: [`rpy`]
+//!    (the self and pair blocks of free space), [`cell`] (a periodic box, minimum
+//!    images) and `near` (feature `near`: the two-sphere and sphere-wall resistance
+//!    functions). Build on linear algebra.
 //! 4. **Bonds, cell lists and bands**: [`bonds`], [`cell_list`] (pair searches over
 //!    cells) and [`parallel`] (the mobility's work in bands, the [`Parallel`] trait).
 //!    Build on the pairs and the cell.

@@ -205,7 +205,10 @@ fn the_host_library_names_no_cli_terminal_or_plotting_crate() {
 const KERNEL_LAYERS: &[(&str, &[&str])] = &[
     ("foundation", &["real", "fault", "helix"]),
     ("linear algebra", &["linalg"]),
-    ("free-space pairs and the periodic cell", &["rpy", "cell"]),
+    (
+        "free-space pairs, the periodic cell, the near field's pair functions",
+        &["rpy", "cell", "near"],
+    ),
     (
         "bonds, cell lists and bands",
         &["bonds", "cell_list", "parallel"],
