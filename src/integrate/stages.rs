@@ -365,9 +365,11 @@ pub(super) fn project_positions<T: Real>(
 /// a state at rest. Velocities are taken from positions because that is what the step
 /// moves; refusing keeps every step that does move bit for bit as it was. A scene
 /// without motion (every `u_i` zero) is not refused, nor a sphere whose move is not
-/// finite (the acceptance names it). First-order `Overdamped` only: `Overdamped2`'s
-/// predictor velocity is already projected (zero, to rounding, for pinned spheres), so
-/// it has no unconstrained move to judge.
+/// finite (the acceptance names it). The overdamped schemes (both orders) and the
+/// deterministic spring step judge their unconstrained velocity at the start; the
+/// inertial schemes are not judged (from rest their first move is `a dt^2 / 2`, below
+/// the spacing at steps that are legitimate), nor the Brownian ones (the thermal move
+/// goes as `sqrt(dt)`).
 pub(super) fn check_resolved<T: Real>(pos: &[T::V3], u: &[T::V3], dt: T) -> Result<(), StepError> {
     let mut moving = false;
     for (&x, &v) in pos.iter().zip(u) {
