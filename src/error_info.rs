@@ -21,6 +21,7 @@ impl ParticleError {
             Self::Overlap { .. } => "overlap",
             Self::Massless { .. } => "massless",
             Self::BelowWall { .. } => "below_wall",
+            Self::Unresolved { .. } => "unresolved",
         }
     }
 
@@ -32,7 +33,8 @@ impl ParticleError {
             | Self::BadRadius { particle }
             | Self::BadDensity { particle }
             | Self::Massless { particle }
-            | Self::BelowWall { particle } => Some(particle),
+            | Self::BelowWall { particle }
+            | Self::Unresolved { particle } => Some(particle),
             Self::Nested { i, .. } | Self::Coincident { i, .. } | Self::Overlap { i, .. } => {
                 Some(i)
             }
@@ -135,6 +137,7 @@ impl StepError {
                 ParticleError::Overlap { .. } => "particle_overlap",
                 ParticleError::Massless { .. } => "particle_massless",
                 ParticleError::BelowWall { .. } => "particle_below_wall",
+                ParticleError::Unresolved { .. } => "particle_unresolved",
             },
             Self::Bond(e) => match e {
                 BondError::Full => "bond_full",
@@ -270,7 +273,7 @@ mod tests {
     use crate::error::Layout;
 
     /// One of every variant (nested ones included).
-    fn every() -> [StepError; 33] {
+    fn every() -> [StepError; 34] {
         let p = |e| StepError::Particle(e);
         let b = |e| StepError::Bond(e);
         let (i, j, bond) = (3, 5, 7);
@@ -290,6 +293,7 @@ mod tests {
             p(ParticleError::Overlap { i, j }),
             p(ParticleError::Massless { particle: i }),
             p(ParticleError::BelowWall { particle: i }),
+            p(ParticleError::Unresolved { particle: i }),
             b(BondError::Full),
             b(BondError::SelfBond { bond, particle: i }),
             b(BondError::OutOfRange { bond, particle: j }),

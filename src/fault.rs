@@ -59,6 +59,14 @@ pub enum ParticleError {
         /// Index of the particle.
         particle: usize,
     },
+    /// In a periodic box, a coordinate so far from the origin that its spacing in the
+    /// precision (`eps |x|`) reaches half the sphere's radius: the minimum image of a
+    /// separation is lost in the rounding, so no pair geometry can be computed (a
+    /// position given there, or a step that would carry a sphere there).
+    Unresolved {
+        /// Index of the particle.
+        particle: usize,
+    },
 }
 
 /// A bond set rejected an input.
@@ -157,6 +165,10 @@ impl fmt::Display for ParticleError {
             Self::BelowWall { particle } => write!(
                 f,
                 "particle {particle}: sphere below or crossing the wall (centre below height + radius)"
+            ),
+            Self::Unresolved { particle } => write!(
+                f,
+                "particle {particle}: a coordinate too far from the origin for the periodic box (its spacing in the precision reaches half the radius; the minimum image is lost in the rounding)"
             ),
         }
     }

@@ -25,16 +25,24 @@ fn stokes() -> f64 {
     4.0 / 3.0 * PI * RHO / (6.0 * PI)
 }
 
+/// The schemes whose step moves the positions by the unconstrained velocity times `dt`
+/// (overdamped, both orders, and springs): each is judged on that move.
+const JUDGED: [Method; 3] = [Method::Overdamped, Method::Overdamped2, Method::Springs];
+
 /// Two spheres far apart near `(x0, 0, 5)` (a loose pair: the pair's coupling is below
-/// 1e-3 of the speed), one step of `dt`.
-fn one_step<T: Real>(dt: f64, x0: f64) -> (Result<(), StepError>, Vec<u64>, Vec<u64>, f64) {
+/// 1e-3 of the speed), one step of `dt` by `method`.
+fn one_step<T: Real>(
+    method: Method,
+    dt: f64,
+    x0: f64,
+) -> (Result<(), StepError>, Vec<u64>, Vec<u64>, f64) {
     let s = |x: f64| Sphere {
         pos: [x, 0.0, 5.0],
         radius: 1.0,
         density: RHO,
     };
     let mut ps = particles::<T, 2>(&[s(x0), s(x0 + 2000.0)]);
-    let mut p = params::<T>(dt, Method::Overdamped, SolverKind::Newton);
+    let mut p = params::<T>(dt, method, SolverKind::Newton);
     p.gravity = v3::<T>(0.0, 0.0, -1.0);
     let mut store = Buffers::<T>::new(Layout::for_params(&p, 2, 0));
     let bonds = hydrorattle::BondSet::<T, 1>::new();
@@ -44,25 +52,25 @@ fn one_step<T: Real>(dt: f64, x0: f64) -> (Result<(), StepError>, Vec<u64>, Vec<
     (r, before, snapshot(&ps), speed)
 }
 
-fn tiny_steps_are_refused<T: Real>() {
+fn tiny_steps_are_refused<T: Real>(method: Method) {
     // Coordinates about 1 (spacing eps): the move `dt U` must reach about eps.
     for dt in [1e-20, 1e-30, f64::from_bits(1), pick::<T>(1e-9, 1e-18)] {
         let dt = T::from_f64(dt).to_f64();
         if dt == 0.0 {
             continue; // Rounds to zero in f32: the zero-step check's case.
         }
-        let (r, before, after, _) = one_step::<T>(dt, 1.0);
+        let (r, before, after, _) = one_step::<T>(method, dt, 1.0);
         assert!(
             matches!(r, Err(StepError::BadParameter(name)) if name.starts_with("dt")),
-            "dt {dt:e}: {r:?}"
+            "{method:?} dt {dt:e}: {r:?}"
         );
-        assert_eq!(before, after, "dt {dt:e}: state kept");
+        assert_eq!(before, after, "{method:?} dt {dt:e}: state kept");
     }
     // Far from the origin the spacing is larger: a step that resolves the move at 1
     // does not at 1e6 (f64: 1e-13 moves by 2e-14, the spacing at 1e6 is 1.2e-10).
     let far = pick::<T>(1e6, 1e6);
     let dt = pick::<T>(1e-4, 1e-13);
-    let (r, _, _, speed) = one_step::<T>(dt, 1.0);
+    let (r, _, _, speed) = one_step::<T>(method, dt, 1.0);
     assert!(r.is_ok(), "dt {dt:e} near the origin: {r:?}");
     let rel = (speed - stokes()).abs() / stokes();
     // Resolved: the speed within the rounding of the move (a spacing over `dt U`)
@@ -74,7 +82,7 @@ fn tiny_steps_are_refused<T: Real>() {
         "dt {dt:e}: speed {speed}, Stokes {}",
         stokes()
     );
-    let (r, _, _, _) = one_step::<T>(dt, far);
+    let (r, _, _, _) = one_step::<T>(method, dt, far);
     assert!(
         matches!(r, Err(StepError::BadParameter(_))),
         "dt {dt:e} at {far:e}: {r:?}"
@@ -83,12 +91,16 @@ fn tiny_steps_are_refused<T: Real>() {
 
 #[test]
 fn tiny_steps_are_refused_f64() {
-    tiny_steps_are_refused::<f64>();
+    for method in JUDGED {
+        tiny_steps_are_refused::<f64>(method);
+    }
 }
 
 #[test]
 fn tiny_steps_are_refused_f32() {
-    tiny_steps_are_refused::<f32>();
+    for method in JUDGED {
+        tiny_steps_are_refused::<f32>(method);
+    }
 }
 
 /// A sphere of radius 1 touching a wall at `height` as written in f64 (centre at

@@ -2,7 +2,8 @@
 //! The Python layer hands C-contiguous float64 arrays (converting other dtypes and
 //! layouts); they are read here without a copy.
 
-use hydrorattle::particles::{check_one, check_pairs};
+use hydrorattle::cell_list::{check_pairs_in, indices};
+use hydrorattle::particles::check_one;
 use hydrorattle::{Particle, ParticleError, Periodic, Real};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -42,7 +43,8 @@ pub fn column<'a>(a: &'a PyReadonlyArray1<'_, f64>, what: &str, n: usize) -> PyR
 
 /// Positions and radii in precision `T`, each particle checked by the kernel (finite,
 /// radius > 0, density >= 0) and every pair (no sphere inside another; overlaps are
-/// allowed): a `ValueError` naming the particle otherwise.
+/// allowed): a `ValueError` naming the particle otherwise. The pairs through the
+/// kernel's cell list (`O(N)` for spheres spread in space), with the all-pairs answer.
 pub fn spheres<T: Real>(
     py: Python<'_>,
     pos: &[[f64; 3]],
@@ -50,7 +52,8 @@ pub fn spheres<T: Real>(
     densities: Option<&[f64]>,
 ) -> PyResult<(Vec<T::V3>, Vec<T>)> {
     let (p, r) = each_sphere::<T>(py, pos, radii, densities)?;
-    check_pairs(&p, &r, true).map_err(|e| particle_error(py, e))?;
+    let mut cells = vec![0; indices(p.len())];
+    check_pairs_in(&p, &r, true, &mut cells).map_err(|e| particle_error(py, e))?;
     Ok((p, r))
 }
 

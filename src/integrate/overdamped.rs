@@ -130,6 +130,8 @@ fn compact_product<T: Real>(
 /// such that every bond's length rate vanishes. `mu` and `force` must hold the mobility
 /// and external forces at `pos`; the result is left in `u`. Inlined at both calls, so
 /// that the solver choice folds where the parameters are constant ([`constraints::solve`]).
+/// With `judge`, the unconstrained velocity `U_inf + mu F` is first checked to resolve
+/// a step ([`check_resolved`]), as the first-order scheme checks it.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn projected_velocity<T: Real>(
@@ -145,10 +147,14 @@ fn projected_velocity<T: Real>(
     kappa: &mut [T],
     scratch: &mut Scratch<'_, T>,
     u: &mut [T::V3],
+    judge: bool,
 ) -> Result<SolveStats<T>, StepError> {
     let n = pos.len();
     with_blocks!(mu, a => linalg::sym_matvec::<T>(a, n, force, u));
     add_flow(p, pos, u);
+    if judge {
+        check_resolved(pos, u, p.dt)?;
+    }
     bond_vectors(bonds, pos, super::cell(p), grad);
     kappa.fill(T::ZERO);
     let problem = Problem::Velocities {
@@ -205,7 +211,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     let mu0 = mu0.into_ref();
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     projected_velocity(
-        p, s.ewald, s.pos, s.radius, mu0, force, bonds, grad, disp, kappa, &mut sc, f0,
+        p, s.ewald, s.pos, s.radius, mu0, force, bonds, grad, disp, kappa, &mut sc, f0, true,
     )?;
     // Tension and spin at the start of the step: the velocity projection's multipliers
     // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
@@ -232,7 +238,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     let mu1 = mu1.into_ref();
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
     projected_velocity(
-        p, s.ewald, x_p, s.radius, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1,
+        p, s.ewald, x_p, s.radius, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1, false,
     )?;
     // Projection as in the first-order scheme: r' = r* + dt mu(r) G(r)^T lambda.
     let trapezoid = |x: &mut [T::V3]| {

@@ -4,7 +4,7 @@
 //! displacement `dx` of covariance `2 kT dt mu` (`brownian.rs`, without constraints).
 
 use super::brownian::{Krylov, kick};
-use super::{Start, StepReport, add_flow, mobility_product, spin, step_velocity};
+use super::{Start, StepReport, add_flow, check_resolved, mobility_product, spin, step_velocity};
 use crate::bonds::{Bond, max_residual_in};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
@@ -58,6 +58,9 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
     let mut noise_iterations = 0;
     match thermal {
         None => {
+            // The velocities are `u` itself, but positions that round back would
+            // freeze the trajectory: judged as the overdamped step judges it.
+            check_resolved(s.pos, u, dt)?;
             for i in 0..n {
                 new_pos[i] = s.pos[i] + u[i] * dt;
                 new_vel[i] = u[i];

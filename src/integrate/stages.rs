@@ -271,7 +271,7 @@ pub(super) fn project_positions<T: Real>(
 }
 
 /// Refuses a step too short for the positions' precision: where no sphere's
-/// unconstrained move `dt |u_i|` reaches the spacing of its coordinates (`eps` times
+/// unconstrained move `dt |u_i|` (its largest component) reaches the spacing of its coordinates (`eps` times
 /// its largest coordinate, within a factor 2 of the ulp), the new positions round to
 /// the old ones and the velocities `(x' - x) / dt` come out zero, or (a move of a few
 /// spacings) wrong by the rounding of the difference (dt 1e-16 on a pile about the
@@ -280,21 +280,29 @@ pub(super) fn project_positions<T: Real>(
 /// a state at rest. Velocities are taken from positions because that is what the step
 /// moves; refusing keeps every step that does move bit for bit as it was. A scene
 /// without motion (every `u_i` zero) is not refused, nor a sphere whose move is not
-/// finite (the acceptance names it). First-order `Overdamped` only: `Overdamped2`'s
-/// predictor velocity is already projected (zero, to rounding, for pinned spheres), so
-/// it has no unconstrained move to judge.
+/// finite (the acceptance names it). The overdamped schemes (both orders) and the
+/// deterministic spring step judge their unconstrained velocity at the start; the
+/// inertial schemes are not judged (from rest their first move is `a dt^2 / 2`, below
+/// the spacing at steps that are legitimate), nor the Brownian ones (the thermal move
+/// goes as `sqrt(dt)`).
 pub(super) fn check_resolved<T: Real>(pos: &[T::V3], u: &[T::V3], dt: T) -> Result<(), StepError> {
     let mut moving = false;
+    // The largest component, not the norm: the norm's square overflows for speeds
+    // above the square root of the largest number (gravity of 1e160), which would read
+    // as no move at all.
+    let largest = |v: T::V3| {
+        let [a, b, c] = T::xyz(v);
+        a.abs().max(b.abs()).max(c.abs())
+    };
     for (&x, &v) in pos.iter().zip(u) {
-        let moved = T::norm(v) * dt;
+        let moved = largest(v) * dt;
         if !(moved > T::ZERO) || !moved.is_finite() {
             // A move that underflows to zero is still a move below the spacing.
-            moving |= T::norm(v) > T::ZERO;
+            moving |= largest(v) > T::ZERO;
             continue;
         }
         moving = true;
-        let [a, b, c] = T::xyz(x);
-        if moved >= T::EPSILON * a.abs().max(b.abs()).max(c.abs()) {
+        if moved >= T::EPSILON * largest(x) {
             return Ok(());
         }
     }

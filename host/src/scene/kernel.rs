@@ -161,7 +161,8 @@ pub(super) fn check(scene: &Scene, keys: &KeySpans, body: &BodySpans) -> Result<
             ParticleError::NonFinite { particle }
             | ParticleError::BadRadius { particle }
             | ParticleError::BadDensity { particle }
-            | ParticleError::BelowWall { particle },
+            | ParticleError::BelowWall { particle }
+            | ParticleError::Unresolved { particle },
         ) => body.position(particle),
         // A helix's bonds are its generator's: the maximum extension is the key at fault.
         StepError::Bond(BondError::Overstretched { .. }) if matches!(body, BodySpans::Helix(_)) => {

@@ -726,7 +726,7 @@ class System:
         and propagates, leaving the state unchanged.
 
         At temperature a step the kernel refuses (a rare large kick the constraint
-        solve cannot project) is retried as 2, 4, ... up to 16 shorter steps along a
+        solve cannot project) is retried as 2, 4, ... up to 128 shorter steps along a
         Brownian bridge, as the CLI does (docs/BROWNIAN.md, "A refused step"): the
         report's ``retried_steps`` counts the steps of this call made that way,
         ``retry_substeps`` the shorter steps they took. Only a step whose deepest split

@@ -41,6 +41,11 @@ pub(in crate::integrate) fn accept<T: Real>(
     {
         return Err(ParticleError::BelowWall { particle }.into());
     }
+    if p.periodic.is_some()
+        && let Some(particle) = super::periodic_box::unresolved(pos, radius)
+    {
+        return Err(ParticleError::Unresolved { particle }.into());
+    }
     let n = pos.len();
     // Without the `cells` feature (firmware) this is the all-pairs check alone.
     let list = if cfg!(feature = "cells") && n >= crate::cell_list::CELLS_MIN {

@@ -30,6 +30,9 @@ pub(super) fn check_periodic<T: Real>(
         return Ok(None);
     };
     let summed = box_geometry(p, state.radius)?;
+    if let Some(particle) = unresolved(state.pos, state.radius) {
+        return Err(ParticleError::Unresolved { particle }.into());
+    }
     let [x, y, z] = c.size();
     let half = x.min(y).min(z) * T::HALF;
     if let Some(bond) = bonds.iter().position(|b| !(b.length < half)) {
@@ -45,6 +48,20 @@ pub(super) fn check_periodic<T: Real>(
         (Some(c), None) => ewald_sums(c, state.radius),
         (Some(c), Some(tol)) => pse_sums(p, c, state, bonds.len(), tol),
     }
+}
+
+/// The first sphere with a coordinate whose spacing in the precision (`eps |x|`, within
+/// a factor 2 of its ulp) reaches half its radius: there the minimum image
+/// `x - round(x / L) L` keeps nothing of where the sphere is in its box, and every pair
+/// geometry (the mobility's blocks, the overlap checks) would be rounding. Positions are
+/// not wrapped into the box, so this bounds how far they may be carried, not where they
+/// are given; a scene this far out is refused by name instead of by the nonsense its
+/// first pair block would report (nested spheres).
+pub(in crate::integrate) fn unresolved<T: Real>(pos: &[T::V3], radius: &[T]) -> Option<usize> {
+    pos.iter().zip(radius).position(|(&r, &a)| {
+        let [x, y, z] = T::xyz(r);
+        !(T::EPSILON * x.abs().max(y.abs()).max(z.abs()) < a * T::HALF)
+    })
 }
 
 /// The box's part of [`check_periodic`] that needs no bonds (the mobility alone,
