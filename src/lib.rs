@@ -42,6 +42,8 @@ pub mod parallel;
 pub mod params;
 pub mod particles;
 pub mod real;
+#[cfg(feature = "near")]
+pub mod stokesian;
 pub mod workspace;
 
 pub use bonds::{Bond, BondSet};
