@@ -86,7 +86,7 @@ pub enum SdError {
 /// The storage [`mobility`] needs for `n` spheres: `(packed blocks, dense scalars)`,
 /// `tri(2n)` 3x3 blocks and `(6n)^2` entries of `T` (the output).
 pub fn storage(n: usize) -> (usize, usize) {
-    (tri(2 * n), 36 * n * n)
+    (tri(2 * n), 36usize.saturating_mul(n).saturating_mul(n))
 }
 
 /// The Stokesian dynamics grand mobility of the spheres at `pos` with radii `radius`, in
