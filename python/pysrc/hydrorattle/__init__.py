@@ -200,11 +200,12 @@ def mobility(
         exact sphere-wall resistance of every sphere within 4 radii of the wall
         (docs/NEAR.md). Exact for two spheres (Stimson and Jeffery) and for one sphere
         at the wall (Brenner). Gaps below 1e-3 radii, overlaps included, get the
-        correction of that gap. Dense (``O(N^3)``: about 1 s at N = 100... see
-        docs/NEAR.md), RPY only, a pair closer than the cutoff with size ratio
-        within 0.1 to 10; not with ``box`` (``ValueError``: the periodic near field is
-        not built). Without ``rotation`` the translational block of the full
-        inverse (the mobility of torque-free spheres); ``threads`` is not used.
+        correction of that gap. Dense, ``O(N^3)``: 0.3 s at N = 100 and 3 s at
+        N = 200 on one core (docs/NEAR.md). RPY only; a pair inside the cutoff
+        needs a size ratio within 0.1 to 10. Not with ``box`` (``ValueError``: the
+        periodic near field is not built). Without ``rotation`` the translational
+        block of the full inverse (the mobility of torque-free spheres).
+        ``threads`` is not used.
 
     Returns
     -------
