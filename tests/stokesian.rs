@@ -294,3 +294,17 @@ fn bad_storage_and_parameters_are_errors() {
         "size ratio 11 near: {r:?}"
     );
 }
+
+#[test]
+fn the_series_side_by_side_give_the_same_bits() {
+    use hydrorattle::near::Func;
+    use hydrorattle::near::series::{far, far_all};
+    for l in [0.1, 0.37, 1.0, 2.5, 10.0] {
+        for x in [1e-6, 0.01, 0.2, 0.45, 0.5] {
+            let all = far_all(l, x);
+            for (k, f) in Func::ALL.into_iter().enumerate() {
+                assert_eq!(all[k].to_bits(), far(f, l, x).to_bits(), "{f:?} {l} {x}");
+            }
+        }
+    }
+}
