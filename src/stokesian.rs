@@ -91,7 +91,8 @@ pub fn storage(n: usize) -> (usize, usize) {
 
 /// The Stokesian dynamics grand mobility of the spheres at `pos` with radii `radius`, in
 /// a fluid of viscosity `eta`, above the wall at height `wall` if given; into `out`
-/// (`(6n)^2`, row-major), with `packed` as scratch ([`storage`]).
+/// (`(6n)^2`, row-major), with `packed` as scratch ([`storage`]). On an error `out` and
+/// `packed` hold no meaningful values (they are the caller's buffers, not state).
 pub fn mobility<T: Real>(
     eta: T,
     wall: Option<T>,
