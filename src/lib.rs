@@ -43,8 +43,10 @@
 //!    noise and the bands.
 //! 7. **The step's error**: [`error`] ([`StepError`], which wraps every error below and
 //!    reports a [`Layout`]). Builds on the geometries.
-//! 8. **The geometry a step sees**: [`geometry`] (the periodic sums held for a step).
-//!    Builds on the step's error and the geometries.
+//! 8. **The geometry a step sees**: [`geometry`] (the periodic sums held for a step), and
+//!    `stokesian` (feature `near`: the dense Stokesian dynamics mobility, far field plus
+//!    the near field's pair and wall corrections). Build on the step's error and the
+//!    geometries.
 //! 9. **Constraints**: [`constraints`] (SHAKE sweep, Newton, Krylov, the metric).
 //!    Builds on the geometry a step sees.
 //! 10. **Configuration**: [`params`], [`forces`], [`names`]. Build on the constraints'
@@ -82,6 +84,8 @@ pub mod params;
 pub mod particles;
 pub mod real;
 pub mod rpy;
+#[cfg(feature = "near")]
+pub mod stokesian;
 pub mod workspace;
 
 pub use bonds::{Bond, BondSet};

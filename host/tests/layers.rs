@@ -219,7 +219,10 @@ const KERNEL_LAYERS: &[(&str, &[&str])] = &[
         &["mobility", "particles", "observables"],
     ),
     ("the step's error", &["error", "error_info"]),
-    ("the geometry a step sees", &["geometry"]),
+    (
+        "the geometry a step sees, the dense Stokesian dynamics mobility",
+        &["geometry", "stokesian"],
+    ),
     ("constraints", &["constraints"]),
     ("configuration", &["params", "forces", "names"]),
     ("workspace", &["workspace"]),

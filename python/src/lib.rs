@@ -17,6 +17,7 @@ mod dense;
 mod errors;
 mod input;
 mod mobility;
+mod near;
 mod params;
 mod pse;
 mod runs;

@@ -111,7 +111,7 @@ fn dense<'py, T: Real + Element>(
 
 /// Dense mobility matrix; see the Python docstring of `hydrorattle.mobility`.
 #[pyfunction]
-#[pyo3(signature = (positions, radii, viscosity=1.0, hydro="rpy", rotation=false, precision="f64", wall=None, r#box=None, threads=0))]
+#[pyo3(signature = (positions, radii, viscosity=1.0, hydro="rpy", rotation=false, precision="f64", wall=None, r#box=None, threads=0, near_field=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn mobility<'py>(
     py: Python<'py>,
@@ -124,17 +124,51 @@ pub fn mobility<'py>(
     wall: Option<f64>,
     r#box: Option<[f64; 3]>,
     threads: usize,
+    near_field: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let pos = rows(&positions, "positions")?;
     let radii = column(&radii, "radii", pos.len())?;
     let eta = crate::input::viscosity(viscosity)?;
     let level = crate::input::hydro(hydro)?;
+    if near_field {
+        return near_field_mobility(py, pos, radii, eta, level, rotation, precision, wall, r#box);
+    }
     let g = geometry(wall, r#box);
     g.spheres_fit(py, is_f32(precision)?, pos, radii)?;
     Ok(if is_f32(precision)? {
         dense::<f32>(py, pos, radii, eta, level, rotation, g, threads)?.into_any()
     } else {
         dense::<f64>(py, pos, radii, eta, level, rotation, g, threads)?.into_any()
+    })
+}
+
+/// `mobility(..., near_field=True)`: RPY only, free space or the wall.
+#[allow(clippy::too_many_arguments)]
+fn near_field_mobility<'py>(
+    py: Python<'py>,
+    pos: &[[f64; 3]],
+    radii: &[f64],
+    eta: f64,
+    level: Hydro,
+    rotation: bool,
+    precision: &str,
+    wall: Option<f64>,
+    cell: Option<[f64; 3]>,
+) -> PyResult<Bound<'py, PyAny>> {
+    if cell.is_some() {
+        return Err(PyValueError::new_err(
+            "near_field=True is not available with box= (the periodic near field is not built)",
+        ));
+    }
+    if level != Hydro::Rpy {
+        return Err(PyValueError::new_err(
+            "near_field=True adds the near field to RPY: use hydro=\"rpy\"",
+        ));
+    }
+    Ok(if is_f32(precision)? {
+        crate::near::dense::<f32>(py, pos, radii, eta, rotation, wall)?.into_any()
+    } else {
+        crate::near::dense::<f64>(py, pos, radii, eta, rotation, wall)?.into_any()
     })
 }
 

@@ -1,7 +1,7 @@
 //! The ten scalar resistance functions of a pair and its 12x12 resistance matrix.
 
 use super::lubrication::Func;
-use super::{LAMBDA_MAX, LAMBDA_MIN, NearError, axial, value};
+use super::{LAMBDA_MAX, LAMBDA_MIN, NearError, axial, series, tables, value};
 use crate::real::Real;
 
 /// Jeffrey and Onishi's (1984) ten scalar resistance functions of sphere 1 (radius `a1`)
@@ -48,7 +48,9 @@ fn check(a1: f64, a2: f64, r: f64) -> Result<f64, NearError> {
 fn scalars_f64(a1: f64, a2: f64, r: f64) -> Result<Scalars<f64>, NearError> {
     let l = check(a1, a2, r)?;
     let s = 2.0 * r / (a1 + a2);
-    let v = |f: Func| value(f, l, s);
+    // Far pairs: the eight series side by side ([`series::far_all`], the same bits).
+    let all = (s - 2.0 >= tables::XI_MAX).then(|| series::far_all(l, 2.0 / s));
+    let v = |f: Func| all.map_or_else(|| value(f, l, s), |a| a[f as usize]);
     let (xc11, xc12) = axial::xc(a1, a2, r);
     Ok(Scalars {
         xa11: v(Func::X11A),

@@ -32,3 +32,39 @@ pub fn far(f: Func, l: f64, x: f64) -> f64 {
     }
     f.prefactor(l) * sum
 }
+
+/// [`far`] of all eight functions at once (in [`Func::ALL`] order), bit for bit: at each
+/// power the four functions of its parity advance side by side, so their Horner chains
+/// overlap instead of waiting on each other's latency (about 3x faster).
+pub fn far_all(l: f64, x: f64) -> [f64; 8] {
+    let odd = Func::ALL.map(Func::odd);
+    let group = |want: bool| {
+        let mut g = [0usize; 4];
+        let mut n = 0;
+        for (i, &o) in odd.iter().enumerate() {
+            if o == want && n < 4 {
+                g[n] = i;
+                n += 1;
+            }
+        }
+        g
+    };
+    let (even, odd_g) = (group(false), group(true));
+    let w = x / (1.0 + l);
+    let mut sum = [0.0; 8];
+    let mut wk = 1.0;
+    for k in 0..=K_FAR {
+        let g = if k % 2 == 1 { odd_g } else { even };
+        let mut p = [0.0; 4];
+        for j in (row(k)..row(k) + k + 2).rev() {
+            for (p, &f) in p.iter_mut().zip(&g) {
+                *p = *p * l + FAR[f][j];
+            }
+        }
+        for (p, &f) in p.iter().zip(&g) {
+            sum[f] += p * wk;
+        }
+        wk *= w;
+    }
+    core::array::from_fn(|f| Func::ALL[f].prefactor(l) * sum[f])
+}

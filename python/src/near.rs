@@ -1,0 +1,71 @@
+//! `mobility(..., near_field=True)`: the dense Stokesian dynamics mobility, the inverse
+//! of `M_far^-1 + R_near` ([`hydrorattle::stokesian`]), in free space or above a wall.
+
+use hydrorattle::Real;
+use hydrorattle::stokesian::{NearField, SdError, mobility, storage};
+use numpy::ndarray::Array2;
+use numpy::{Element, IntoPyArray, PyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::alloc;
+use crate::errors::particle_error;
+use crate::input::spheres;
+
+/// The dense SD mobility in `T`: `(6N, 6N)` with rotation, else its `(3N, 3N)`
+/// translational block (the mobility of torque-free spheres).
+pub fn dense<'py, T: Real + Element>(
+    py: Python<'py>,
+    pos: &[[f64; 3]],
+    radii: &[f64],
+    eta: f64,
+    rotation: bool,
+    wall: Option<f64>,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let n = pos.len();
+    let what = format!("near-field mobility of {n} spheres");
+    let (nb, nd) = storage(n);
+    alloc::Need::new(&what)
+        .add::<T::M3>("packed blocks", Some(nb))
+        .add::<T>("resistance", Some(nd))
+        .check()?;
+    let (p, r) = spheres::<T>(py, pos, radii, None)?;
+    let mut packed = alloc::filled(&what, "packed blocks", nb, T::M3_ZERO)?;
+    let mut out = alloc::filled(&what, "resistance", nd, T::ZERO)?;
+    let (eta, wall) = (T::from_f64(eta), wall.map(T::from_f64));
+    let near = NearField::default();
+    py.detach(|| mobility(eta, wall, &p, &r, near, &mut packed, &mut out))
+        .map_err(|e| sd_error(py, e))?;
+    drop(packed);
+    let m = 6 * n;
+    let side = if rotation { m } else { 3 * n };
+    if !rotation {
+        for i in 0..side {
+            out.copy_within(i * m..i * m + side, i * side);
+        }
+        out.truncate(side * side);
+    }
+    Ok(Array2::from_shape_vec((side, side), out)
+        .expect("side * side values")
+        .into_pyarray(py))
+}
+
+/// The kernel's refusal as a `ValueError`.
+fn sd_error(py: Python<'_>, e: SdError) -> PyErr {
+    match e {
+        SdError::Particle(p) => particle_error(py, p),
+        SdError::Near { i, j, why } if i == j => PyValueError::new_err(format!(
+            "particle {i}: no near-field wall resistance ({why:?})"
+        )),
+        SdError::Near { i, j, why } => PyValueError::new_err(format!(
+            "particles {i} and {j}: no near-field pair resistance ({why:?}; the size \
+             ratio of a pair closer than the cutoff must be within 0.1 to 10)"
+        )),
+        SdError::NotPositiveDefinite(l) => PyValueError::new_err(format!(
+            "the near-field resistance is not positive definite in this precision ({l})"
+        )),
+        SdError::Params | SdError::Storage => {
+            PyValueError::new_err(format!("near-field mobility refused: {e:?}"))
+        }
+    }
+}

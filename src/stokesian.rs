@@ -1,0 +1,334 @@
+//! The dense Stokesian dynamics mobility of `N` spheres in free space or above the wall:
+//! `M_SD = R^-1`, `R = M_far^-1 + sum R_near`, translation and rotation (`6N x 6N`).
+//!
+//! * `M_far`: the kernel's RPY grand mobility ([`crate::mobility::assemble_grand`], or
+//!   [`crate::mobility::wall::assemble_grand`] above the wall).
+//! * Pairs whose surface gap is below [`NearField::cutoff`] mean radii: the pair's
+//!   [`crate::near::near_correction`], `R_2B,exact - (pair RPY 12x12 mobility in free
+//!   space)^-1` (above the wall too: the wall enters the pair only through `M_far`).
+//! * Spheres whose gap to the wall is below [`NearField::wall_cutoff`] radii: the exact
+//!   sphere-wall resistance ([`crate::near::wall::wall_scalars`]) minus the inverse of the
+//!   sphere's own 6x6 wall mobility block (RPY self term with its wall reflections,
+//!   [`crate::mobility::wall::self_wall`] and [`crate::mobility::wall::self_wall_rot`]).
+//! * A pair or a sphere closer than [`NearField::min_gap`] (overlaps included, which RPY
+//!   allows) gets the correction of the minimum gap, along the same line of centres
+//!   (clamped): a surface roughness. Its far part is evaluated at the clamped gap too, so
+//!   the correction is still a two-body `R_exact - R_far`.
+//!
+//! Positive definite: `M_far` is, and each pair's correction is semi-definite (checked in
+//! `docs/NEAR.md`), so `R` is; its Cholesky factor failing is reported, not hidden.
+//! With no pair or sphere inside its cutoff the result is `M_far` itself, bit for bit.
+//!
+//! Storage is the caller's ([`storage`]); the output is row-major `6N x 6N`, rows and
+//! columns `(U_0 .. U_{N-1}, W_0 .. W_{N-1})`, three each, as the grand mobility is laid
+//! out. Cost: two dense Cholesky inversions, about `(6N)^3 4/3` flops, and `O(N^2)`
+//! distance tests.
+
+use crate::error::LinalgError;
+use crate::error::ParticleError;
+use crate::linalg::{cholesky_dense, tri};
+use crate::mobility::wall::{self_wall, self_wall_rot};
+use crate::mobility::{Hydro, pair_blocks, self_rr, self_tt};
+use crate::near::wall::wall_scalars;
+use crate::near::{NearError, near_correction};
+use crate::real::Real;
+
+/// The near field's parameters, in units of the spheres' radii.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NearField<T> {
+    /// Pairs whose surface gap is below `cutoff` mean radii (`xi = s - 2 < cutoff`,
+    /// `s = 2 r / (a1 + a2)`) are corrected. Default 4 (`s < 6`, where RPY is within
+    /// 0.2 % of the exact pair: the correction's jump there).
+    pub cutoff: T,
+    /// Spheres whose surface is nearer the wall than `wall_cutoff` radii (`h / a - 1`)
+    /// are corrected. Default 4 (`h < 5 a`, where the far field's perpendicular
+    /// mobility is within 0.2 % of the exact).
+    pub wall_cutoff: T,
+    /// The smallest gap the near field sees (surface roughness), for pairs in mean radii,
+    /// for the wall in radii; closer pairs and spheres, overlaps included, get the
+    /// correction of this gap. Default `1e-3`.
+    pub min_gap: T,
+}
+
+impl<T: Real> Default for NearField<T> {
+    fn default() -> Self {
+        Self {
+            cutoff: T::from_f64(4.0),
+            wall_cutoff: T::from_f64(4.0),
+            min_gap: T::from_f64(1e-3),
+        }
+    }
+}
+
+/// Why the Stokesian dynamics mobility was not formed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SdError {
+    /// The far field refused the spheres (nested spheres, a centre below the wall).
+    Particle(ParticleError),
+    /// A pair's near field has no value (a size ratio outside `0.1..=10`, a radius that
+    /// is not positive), or a sphere's wall functions.
+    Near {
+        /// First sphere.
+        i: usize,
+        /// Second sphere (`i` for the wall).
+        j: usize,
+        /// The near-field module's reason.
+        why: NearError,
+    },
+    /// `M_far` or `R` is not positive definite in this precision.
+    NotPositiveDefinite(LinalgError),
+    /// A parameter is not finite, a cutoff is negative or `min_gap` is not positive.
+    Params,
+    /// The storage is shorter than [`storage`] asks.
+    Storage,
+}
+
+/// The storage [`mobility`] needs for `n` spheres: `(packed blocks, dense scalars)`,
+/// `tri(2n)` 3x3 blocks and `(6n)^2` entries of `T` (the output).
+pub fn storage(n: usize) -> (usize, usize) {
+    (tri(2 * n), 36usize.saturating_mul(n).saturating_mul(n))
+}
+
+/// The Stokesian dynamics grand mobility of the spheres at `pos` with radii `radius`, in
+/// a fluid of viscosity `eta`, above the wall at height `wall` if given; into `out`
+/// (`(6n)^2`, row-major), with `packed` as scratch ([`storage`]). On an error `out` and
+/// `packed` hold no meaningful values (they are the caller's buffers, not state).
+pub fn mobility<T: Real>(
+    eta: T,
+    wall: Option<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    near: NearField<T>,
+    packed: &mut [T::M3],
+    out: &mut [T],
+) -> Result<(), SdError> {
+    let n = pos.len().min(radius.len());
+    let (nb, nd) = storage(n);
+    let (Some(packed), Some(out)) = (packed.get_mut(..nb), out.get_mut(..nd)) else {
+        return Err(SdError::Storage);
+    };
+    let ok = |v: T| v.is_finite() && v >= T::ZERO;
+    if !(ok(near.cutoff) && ok(near.wall_cutoff) && ok(near.min_gap) && near.min_gap > T::ZERO) {
+        return Err(SdError::Params);
+    }
+    let (pos, radius) = (&pos[..n], &radius[..n]);
+    match wall {
+        None => crate::mobility::assemble_grand(Hydro::Rpy, eta, pos, radius, packed),
+        Some(h) => crate::mobility::wall::assemble_grand(Hydro::Rpy, eta, h, pos, radius, packed),
+    }
+    .map_err(SdError::Particle)?;
+    let m = 6 * n;
+    for bi in 0..2 * n {
+        for bj in 0..=bi {
+            let b = packed[tri(bi) + bj];
+            for r in 0..3 {
+                for c in 0..3 {
+                    let v = T::m3_get(b, r, c);
+                    out[(3 * bi + r) * m + 3 * bj + c] = v;
+                    out[(3 * bj + c) * m + 3 * bi + r] = v;
+                }
+            }
+        }
+    }
+    let pairs = close_pairs(pos, radius, near.cutoff);
+    let walls = wall.map_or(0, |h| close_walls(h, pos, radius, near.wall_cutoff));
+    if pairs == 0 && walls == 0 {
+        return Ok(());
+    }
+    spd_inverse(out, m)?;
+    add_pairs(eta, pos, radius, near, out)?;
+    if let Some(h) = wall {
+        add_walls(eta, h, pos, radius, near, out)?;
+    }
+    spd_inverse(out, m)
+}
+
+/// The scaled surface gap `xi = 2 r / (a1 + a2) - 2` of spheres `i` and `j`, and `r`.
+fn gap<T: Real>(pos: &[T::V3], radius: &[T], i: usize, j: usize) -> (T, T::V3) {
+    let r = pos[j] - pos[i];
+    let s = T::norm2(r).sqrt() * T::TWO / (radius[i] + radius[j]);
+    (s - T::TWO, r)
+}
+
+/// How many pairs are inside the cutoff.
+fn close_pairs<T: Real>(pos: &[T::V3], radius: &[T], cutoff: T) -> usize {
+    let n = pos.len();
+    (0..n)
+        .map(|i| {
+            (i + 1..n)
+                .filter(|&j| gap(pos, radius, i, j).0 < cutoff)
+                .count()
+        })
+        .sum()
+}
+
+/// How many spheres are inside the wall's cutoff.
+fn close_walls<T: Real>(height: T, pos: &[T::V3], radius: &[T], cutoff: T) -> usize {
+    (0..pos.len())
+        .filter(|&i| (T::xyz(pos[i])[2] - height) / radius[i] - T::ONE < cutoff)
+        .count()
+}
+
+/// Adds `m` (rows `rows`, columns `cols`, 3 each) into the dense `out`.
+fn add_block<T: Real>(out: &mut [T], m: usize, (bi, bj): (usize, usize), b: T::M3) {
+    for r in 0..3 {
+        for c in 0..3 {
+            out[(3 * bi + r) * m + 3 * bj + c] += T::m3_get(b, r, c);
+        }
+    }
+}
+
+/// Adds every close pair's `R_near` to the resistance in `out`.
+fn add_pairs<T: Real>(
+    eta: T,
+    pos: &[T::V3],
+    radius: &[T],
+    near: NearField<T>,
+    out: &mut [T],
+) -> Result<(), SdError> {
+    let n = pos.len();
+    let m = 6 * n;
+    for i in 0..n {
+        for j in i + 1..n {
+            let (xi, r) = gap(pos, radius, i, j);
+            if !(xi < near.cutoff) {
+                continue;
+            }
+            let (a1, a2) = (radius[i], radius[j]);
+            let len = T::norm2(r).sqrt();
+            if !(len > T::ZERO) {
+                // Coincident centres: no line of centres; RPY alone (positive definite).
+                continue;
+            }
+            let d = r * (T::ONE / len);
+            let xi = if xi < near.min_gap { near.min_gap } else { xi };
+            let dist = (a1 + a2) * T::HALF * (T::TWO + xi);
+            let far = pair_far(eta, a1, a2, d * dist);
+            let why = |why| SdError::Near { i, j, why };
+            let c = near_correction(eta, a1, a2, d * dist, &far).map_err(why)?;
+            let idx = [i, j, n + i, n + j];
+            for (bi, row) in c.iter().enumerate() {
+                for (bj, &b) in row.iter().enumerate() {
+                    add_block::<T>(out, m, (idx[bi], idx[bj]), b);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The free-space RPY 12x12 mobility of a pair, sphere 2 at `r` from sphere 1, as
+/// [`near_correction`] takes it (rows `(U1, U2, W1, W2)`, columns `(F1, F2, T1, T2)`).
+pub fn pair_far<T: Real>(eta: T, a1: T, a2: T, r: T::V3) -> [[T::M3; 4]; 4] {
+    let z = T::M3_ZERO;
+    let mut f = [[z; 4]; 4];
+    f[0][0] = T::m3_diag(self_tt(eta, a1));
+    f[1][1] = T::m3_diag(self_tt(eta, a2));
+    f[2][2] = T::m3_diag(self_rr(eta, a1));
+    f[3][3] = T::m3_diag(self_rr(eta, a2));
+    // Apart (s > 2 after clamping), so the blocks exist; zero coupling otherwise.
+    if let Some(p) = pair_blocks(Hydro::Rpy, eta, a1, a2, -r) {
+        f[0][1] = p.tt;
+        f[1][0] = T::transpose(p.tt);
+        f[2][1] = p.rt_ij;
+        f[1][2] = T::transpose(p.rt_ij);
+        f[3][0] = p.rt_ji;
+        f[0][3] = T::transpose(p.rt_ji);
+        f[2][3] = p.rr;
+        f[3][2] = T::transpose(p.rr);
+    }
+    f
+}
+
+/// Adds each close sphere's wall correction to the resistance in `out`.
+fn add_walls<T: Real>(
+    eta: T,
+    height: T,
+    pos: &[T::V3],
+    radius: &[T],
+    near: NearField<T>,
+    out: &mut [T],
+) -> Result<(), SdError> {
+    let n = pos.len();
+    let m = 6 * n;
+    for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
+        let delta = (T::xyz(p)[2] - height) / a - T::ONE;
+        if !(delta < near.wall_cutoff) {
+            continue;
+        }
+        let delta = if delta < near.min_gap {
+            near.min_gap
+        } else {
+            delta
+        };
+        let h = a * (T::ONE + delta);
+        let w = wall_scalars(a, h).map_err(|why| SdError::Near { i, j: i, why })?;
+        let pi = T::PI * eta;
+        let (ta, ra) = (T::from_f64(6.0) * pi * a, T::from_f64(8.0) * pi * a * a * a);
+        let b = T::from_f64(8.0) * pi * a * a * w.yb;
+        // The far 6x6 self mobility decouples into z-translation, z-rotation and the two
+        // (U_x, W_y), (U_y, W_x) pairs, whose 2x2 inverses are closed forms.
+        let (par, perp) = self_wall(eta, a, h);
+        let (rpar, rperp, c) = self_wall_rot(eta, a, h);
+        let det = par * rpar - c * c;
+        let (t, r) = (i, n + i);
+        let mut put = |bi: usize, k: usize, bj: usize, l: usize, v: T| {
+            out[(3 * bi + k) * m + 3 * bj + l] += v;
+        };
+        put(t, 2, t, 2, ta * w.xa - T::ONE / perp);
+        put(r, 2, r, 2, ra * w.xc - T::ONE / rperp);
+        for k in 0..2 {
+            put(t, k, t, k, ta * w.ya - rpar / det);
+            put(r, k, r, k, ra * w.yc - par / det);
+        }
+        // (U_x, W_y): exact -b, far -c / det; (U_y, W_x): +b and +c / det.
+        let cross = b - c / det;
+        for (k, l, sign) in [(0, 1, -T::ONE), (1, 0, T::ONE)] {
+            put(t, k, r, l, sign * cross);
+            put(r, l, t, k, sign * cross);
+        }
+    }
+    Ok(())
+}
+
+/// Inverts the symmetric positive definite `m x m` row-major `a` in place: Cholesky
+/// `A = U^T U` ([`cholesky_dense`], upper triangle `U`, diagonal `1 / U_kk`), `V = U^-1`
+/// row by row from the bottom, then `A^-1 = V V^T`. About `2/3 m^3` flops.
+fn spd_inverse<T: Real>(a: &mut [T], m: usize) -> Result<(), SdError> {
+    cholesky_dense(a, m, T::ZERO).map_err(SdError::NotPositiveDefinite)?;
+    for j in (0..m).rev() {
+        // Row j of V: V_jk = -V_jj sum_{j < l <= k} U_jl V_lk, taking l from the right so
+        // that each U_jl is read before the sums overwrite it.
+        let (head, tail) = a.split_at_mut((j + 1) * m);
+        let row = &mut head[j * m..];
+        for l in (j + 1..m).rev() {
+            let u = row[l];
+            let vl = &tail[(l - j - 1) * m..(l - j) * m];
+            row[l] = u * vl[l];
+            for k in l + 1..m {
+                row[k] += u * vl[k];
+            }
+        }
+        let vjj = row[j];
+        for v in &mut row[j + 1..] {
+            *v = -*v * vjj;
+        }
+    }
+    // (V V^T)_ik = sum_{l >= k} V_il V_kl for k >= i: row i from the left, each entry
+    // needing only row i's entries to its right and the rows below (not yet touched).
+    for i in 0..m {
+        let (head, tail) = a.split_at_mut((i + 1) * m);
+        let row = &mut head[i * m..];
+        row[i] = row[i..].iter().fold(T::ZERO, |s, &v| s + v * v);
+        for k in i + 1..m {
+            let vk = &tail[(k - i - 1) * m..(k - i) * m];
+            row[k] = (k..m).fold(T::ZERO, |s, l| s + row[l] * vk[l]);
+        }
+    }
+    for i in 0..m {
+        for k in 0..i {
+            a[i * m + k] = a[k * m + i];
+        }
+    }
+    Ok(())
+}
