@@ -32,6 +32,11 @@ impl Recorder {
     pub fn new(manifest_dir: &str, name: &str, command: String) -> Recorder {
         let root = git(manifest_dir, &["rev-parse", "--show-toplevel"])
             .map_or_else(|| PathBuf::from(manifest_dir), PathBuf::from);
+        // A debug build's times are not the release build's the command names.
+        let command = match cfg!(debug_assertions) {
+            true => format!("{command} (debug build)"),
+            false => command,
+        };
         Recorder {
             file: root.join("bench/results").join(format!("{name}.csv")),
             command,
