@@ -2,7 +2,7 @@
 # A sweep on a real SLURM: installs slurm-wlm, munge and GNU parallel from Debian,
 # starts munged, slurmctld and slurmd on this machine (one node, 2 CPUs, a generated
 # slurm.conf, completion records in a jobcomp/filetxt file), submits the array job that
-# `host-demo sweep --emit slurm` writes for host-demo/sweeps/small.toml (8 points),
+# `host-demo sweep --emit slurm` writes for host/sweeps/small.toml (8 points),
 # waits for it, and checks that `collect` finds every point and that the point folders
 # equal a local `sweep` run byte for byte (summary.json apart from its execution fields:
 # wall_time_s, steps_per_second, machine, resumed_from). Then a task stopped by SIGTERM
@@ -18,7 +18,7 @@ set -euo pipefail
 
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 bin=$(realpath "${1:-target/release/host-demo}")
-sweep=host-demo/sweeps/small.toml
+sweep=host/sweeps/small.toml
 t_start=$SECONDS
 say() { printf '\n==> [slurm] %s\n' "$*"; }
 loud() { printf '\n!!!!!!!!!! %s !!!!!!!!!!\n' "$*"; }
@@ -211,7 +211,7 @@ cmp "$local_dir/sweep.json" "$engine_dir/sweep.json"
 # point and exits 143; `collect` names the task and prints the `sbatch --array` line,
 # which is run as printed; the points then equal a clean local run.
 long="$work/long.toml"
-cp host-demo/scenes/figure1a.toml "$work/long-base.toml"
+cp host/scenes/figure1a.toml "$work/long-base.toml"
 cat >"$long" <<EOT
 [sweep]
 base = "long-base.toml"

@@ -4,7 +4,11 @@
 //! told to): independent multiply-adds on data that stays in L1, which the compiler
 //! vectorises. Prints GFLOP/s for f64 and f32.
 //!
-//! `cargo run --release --example peak`
+//! `cargo run --release --example peak` (with `HYDRORATTLE_BENCH_MACHINE` set, it appends
+//! its rows to `bench/results/helix25.csv`)
+
+#[path = "shared/record.rs"]
+mod record;
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -44,4 +48,20 @@ fn main() {
     println!(
         "peak multiply-add rate, one core: f64 {f64_rate:.2} GFLOP/s, f32 {f32_rate:.2} GFLOP/s"
     );
+    let build = if cfg!(target_feature = "avx2") {
+        "fast (AVX2)"
+    } else {
+        "default (SSE2)"
+    };
+    let mut rows = record::Recorder::new(
+        env!("CARGO_MANIFEST_DIR"),
+        "helix25",
+        "cargo run --release --example peak".into(),
+    );
+    let table = "practical peak multiply-add rate, one core, no FMA";
+    for (precision, rate) in [("f64", f64_rate), ("f32", f32_rate)] {
+        rows.row(table, build, precision, &format!("{rate:.2} GFLOP/s"));
+    }
+    rows.finish()
+        .expect("appending to bench/results/helix25.csv");
 }

@@ -4,7 +4,11 @@
 //!
 //! `cargo run --release --example product -- N [REPS]`: the helix of `scale`, the best of
 //! `REPS` (default 20) single-thread passes, and a digest of `y` (the same on every
-//! build that keeps the arithmetic).
+//! build that keeps the arithmetic). With `HYDRORATTLE_BENCH_MACHINE` set, appends its
+//! rows to `bench/results/large-n.csv`.
+#[path = "shared/record.rs"]
+mod record;
+
 use hydrorattle::linalg::tri;
 use hydrorattle::mobility::Hydro;
 use hydrorattle::noise::reduced;
@@ -47,6 +51,12 @@ fn main() {
     let mut y = vec![glam::DVec3::ZERO; n];
     let mut z = vec![glam::DVec3::ZERO; band_scratch(n).max(1)];
     let blocks = tri(n) as f64;
+    let mut rows = record::Recorder::new(
+        env!("CARGO_MANIFEST_DIR"),
+        "large-n",
+        format!("cargo run --release --example product -- {n} {reps}"),
+    );
+    let table = format!("banded product per packed 3x3 block, one thread, best of {reps}");
     // The best of `reps` runs of `f`, printed with the digest of `y` it leaves.
     let mut report = |name: &str, f: &mut dyn FnMut(&mut Vec<glam::DVec3>)| {
         let mut best = f64::MAX;
@@ -58,6 +68,13 @@ fn main() {
         let (ms, ns) = (best * 1e3, best * 1e9 / blocks);
         let h = digest(&y);
         println!("{name} N={n}: {ms:.3} ms, {ns:.2} ns/block, digest {h:016x}");
+        let case = format!("{name}, N = {n}");
+        rows.row(
+            &table,
+            &case,
+            "ns a block",
+            &format!("{ns:.2} ns ({ms:.3} ms)"),
+        );
     };
     report("product", &mut |y| {
         product::<f64>(&par, &mu, n, &x, y, &mut z)
@@ -74,4 +91,6 @@ fn main() {
         let (level, eta) = (Hydro::Rpy, 1.0);
         assemble_apply::<f64>(&par, level, eta, &pos, &rad, &mut mu, &x, y, &mut z).unwrap()
     });
+    rows.finish()
+        .expect("appending to bench/results/large-n.csv");
 }

@@ -9,7 +9,7 @@ fn main() {
         Some(d) => format!("{} ({d})", env!("CARGO_PKG_VERSION")),
         None => format!("{} (no git)", env!("CARGO_PKG_VERSION")),
     };
-    println!("cargo:rustc-env=HOST_DEMO_VERSION={version}");
+    println!("cargo:rustc-env=HYDRORATTLE_HOST_VERSION={version}");
     // Rebuilt when the checked-out commit or the index changes (the paths asked of git,
     // so that a linked worktree works too).
     let head_ref = git(&["rev-parse", "--symbolic-full-name", "HEAD"]);

@@ -4,7 +4,7 @@
 
 use hydrorattle::helix::{HeadEnd, Helix, HelixError};
 
-/// Figure 1 (c) of the paper, as `host-demo/scenes/figure1c.toml` and the firmware
+/// Figure 1 (c) of the paper, as `host/scenes/figure1c.toml` and the firmware
 /// build it.
 const FIGURE1C: Helix = Helix {
     tails: 24,

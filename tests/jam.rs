@@ -339,7 +339,7 @@ fn column(side: usize, layers: usize, h: f64, rng: &mut Rng) -> Vec<Sphere> {
 }
 
 /// A ring of `fence` spheres of radius 1.5 on the wall at `h`, 0.002 apart (bonded by
-/// the caller: the fence of `host-demo/scenes/pile.toml`).
+/// the caller: the fence of `host/scenes/pile.toml`).
 fn ring(fence: usize, h: f64) -> Vec<Sphere> {
     let r = 1.501 / (PI / fence as f64).sin();
     (0..fence)

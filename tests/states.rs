@@ -4,7 +4,7 @@
 use hydrorattle::Real;
 use hydrorattle::bonds::Bond;
 use hydrorattle::observables::{
-    Rotation, Shape, State, StateThresholds, is_rotating, state_name, state_of,
+    FrameState, Rotation, Shape, StateThresholds, is_rotating, state_name, state_of,
 };
 
 /// Bonds joining consecutive beads at their current distances.
@@ -26,7 +26,7 @@ fn down<T: Real>() -> T::V3 {
     v::<T>(0.0, 0.0, -1.0)
 }
 
-fn named<T: Real>(pos: &[T::V3], vel: &[T::V3]) -> State {
+fn named<T: Real>(pos: &[T::V3], vel: &[T::V3]) -> FrameState {
     let mass = vec![T::ONE; pos.len()];
     let bonds = chain::<T>(pos);
     let cos = T::from_f64(0.9);
@@ -49,12 +49,12 @@ fn shapes<T: Real>() {
     let still = |n: usize| vec![T::V3_ZERO; n];
     // Straight down: stretched.
     let line: Vec<T::V3> = (0..25).map(|k| v::<T>(0.0, 0.0, -2.0 * k as f64)).collect();
-    assert_eq!(named::<T>(&line, &still(25)), State::Stretched);
+    assert_eq!(named::<T>(&line, &still(25)), FrameState::Stretched);
     // Straight at 45 degrees, still: none of the states.
     let tilted: Vec<T::V3> = (0..25)
         .map(|k| v::<T>(1.5 * k as f64, 0.0, -1.5 * k as f64))
         .collect();
-    assert_eq!(named::<T>(&tilted, &still(25)), State::Other);
+    assert_eq!(named::<T>(&tilted, &still(25)), FrameState::Other);
     // A column of 12 vertical bonds above a knot: 12 more beads on a small circle.
     let mut column: Vec<T::V3> = (0..13)
         .map(|k| v::<T>(0.0, 0.0, 24.0 - 2.0 * k as f64))
@@ -63,27 +63,27 @@ fn shapes<T: Real>() {
         let a = std::f64::consts::TAU * k as f64 / 12.0;
         v::<T>(3.8 * (a.cos() - 1.0), 3.8 * a.sin(), 0.0)
     }));
-    assert_eq!(named::<T>(&column, &still(25)), State::ColumnOverKnot);
+    assert_eq!(named::<T>(&column, &still(25)), FrameState::ColumnOverKnot);
     // The same column over a straight horizontal tail (not compact): not a column.
     let mut flag: Vec<T::V3> = column[..13].to_vec();
     flag.extend((1..=12).map(|k| v::<T>(2.0 * k as f64, 0.0, 0.0)));
-    assert_eq!(named::<T>(&flag, &still(25)), State::Other);
+    assert_eq!(named::<T>(&flag, &still(25)), FrameState::Other);
     // A horizontal ring, still: folded; spinning about the vertical: rotating.
     let r = ring::<T>();
-    assert_eq!(named::<T>(&r, &still(25)), State::Folded);
+    assert_eq!(named::<T>(&r, &still(25)), FrameState::Folded);
     let w = T::from_f64(0.05);
     let spin: Vec<T::V3> = r
         .iter()
         .map(|&p| T::cross(v::<T>(0.0, 0.0, 1.0), p) * w)
         .collect();
-    assert_eq!(named::<T>(&r, &spin), State::Rotating);
+    assert_eq!(named::<T>(&r, &spin), FrameState::Rotating);
     // Spinning about a horizontal axis is not a rotation about the vertical: the
     // horizontal motion is all along x, which a turn about z cannot explain.
     let flip: Vec<T::V3> = r
         .iter()
         .map(|&p| T::cross(v::<T>(0.0, 1.0, 0.0), p) * w)
         .collect();
-    assert_eq!(named::<T>(&r, &flip), State::Folded);
+    assert_eq!(named::<T>(&r, &flip), FrameState::Folded);
     // A ring rolling over itself: each bead turns about the core tangent through a
     // tube of radius 1 around the circle of radius 4.
     let (mut pos, mut vel) = (Vec::new(), Vec::new());
@@ -101,7 +101,7 @@ fn shapes<T: Real>() {
         let t = T::v3_from(tangent);
         vel.push(T::cross(t, T::v3_from(rho)) * T::from_f64(0.3) + down::<T>());
     }
-    assert_eq!(named::<T>(&pos, &vel), State::RollingRing);
+    assert_eq!(named::<T>(&pos, &vel), FrameState::RollingRing);
 }
 
 /// A shape with every number at a neutral value: open, tilted, still.
@@ -131,26 +131,26 @@ fn boundaries<T: Real>() {
         state_of(&s, &th)
     };
     let x = T::from_f64;
-    assert_eq!(at(&|_| ()), State::Other);
+    assert_eq!(at(&|_| ()), FrameState::Other);
     // Stretched: both at their thresholds; either just below is not.
     let stretched = |s: &mut Shape<T>| {
         s.verticality = x(0.95);
         s.extension = x(0.85);
     };
-    assert_eq!(at(&stretched), State::Stretched);
+    assert_eq!(at(&stretched), FrameState::Stretched);
     assert_eq!(
         at(&|s| {
             stretched(s);
             s.verticality = x(0.94);
         }),
-        State::Other
+        FrameState::Other
     );
     assert_eq!(
         at(&|s| {
             stretched(s);
             s.extension = x(0.84);
         }),
-        State::Other
+        FrameState::Other
     );
     // Column: 6 bonds is a column, 5 is not; the knot (8 bonds of length 2 outside a
     // run of 8 of 16) may spread 0.5 x 16 = 8 across, not more; a run over every bond
@@ -161,11 +161,11 @@ fn boundaries<T: Real>() {
             s.horizontal = x(wide);
         }
     };
-    assert_eq!(at(&column(8, 8.0)), State::ColumnOverKnot);
-    assert_eq!(at(&column(8, 8.5)), State::Other);
-    assert_eq!(at(&column(6, 1.0)), State::ColumnOverKnot);
-    assert_eq!(at(&column(5, 1.0)), State::Other);
-    assert_eq!(at(&column(16, 0.0)), State::Other);
+    assert_eq!(at(&column(8, 8.0)), FrameState::ColumnOverKnot);
+    assert_eq!(at(&column(8, 8.5)), FrameState::Other);
+    assert_eq!(at(&column(6, 1.0)), FrameState::ColumnOverKnot);
+    assert_eq!(at(&column(5, 1.0)), FrameState::Other);
+    assert_eq!(at(&column(16, 0.0)), FrameState::Other);
     // Rolling ring: compact (extension 0.35), coherence 0.5, rate 0.01 (either sign).
     let rolling = |e: f64, c: f64, r: f64| {
         move |s: &mut Shape<T>| {
@@ -176,10 +176,10 @@ fn boundaries<T: Real>() {
             };
         }
     };
-    assert_eq!(at(&rolling(0.35, 0.5, -0.01)), State::RollingRing);
-    assert_eq!(at(&rolling(0.36, 0.5, 0.01)), State::Other);
-    assert_eq!(at(&rolling(0.35, 0.49, 0.01)), State::Folded);
-    assert_eq!(at(&rolling(0.35, 0.9, 0.009)), State::Folded);
+    assert_eq!(at(&rolling(0.35, 0.5, -0.01)), FrameState::RollingRing);
+    assert_eq!(at(&rolling(0.36, 0.5, 0.01)), FrameState::Other);
+    assert_eq!(at(&rolling(0.35, 0.49, 0.01)), FrameState::Folded);
+    assert_eq!(at(&rolling(0.35, 0.9, 0.009)), FrameState::Folded);
     // Rotating: coherence 0.5 and rate 0.002 (either sign), open or compact.
     let spinning = |c: f64, r: f64| {
         move |s: &mut Shape<T>| {
@@ -189,9 +189,9 @@ fn boundaries<T: Real>() {
             };
         }
     };
-    assert_eq!(at(&spinning(0.5, -0.002)), State::Rotating);
-    assert_eq!(at(&spinning(0.49, 0.1)), State::Other);
-    assert_eq!(at(&spinning(0.9, 0.0019)), State::Other);
+    assert_eq!(at(&spinning(0.5, -0.002)), FrameState::Rotating);
+    assert_eq!(at(&spinning(0.49, 0.1)), FrameState::Other);
+    assert_eq!(at(&spinning(0.9, 0.0019)), FrameState::Other);
     assert!(is_rotating(
         &Rotation {
             rate: x(0.002),
@@ -206,23 +206,23 @@ fn boundaries<T: Real>() {
             stretched(s);
             spinning(0.9, 0.1)(s);
         }),
-        State::Stretched
+        FrameState::Stretched
     );
     assert_eq!(
         at(&|s| {
             rolling(0.1, 0.9, 0.1)(s);
             spinning(0.9, 0.1)(s);
         }),
-        State::RollingRing
+        FrameState::RollingRing
     );
     assert_eq!(
         at(&|s| {
             rolling(0.1, 0.0, 0.0)(s);
             spinning(0.9, 0.1)(s);
         }),
-        State::Rotating
+        FrameState::Rotating
     );
-    assert_eq!(at(&rolling(0.1, 0.0, 0.0)), State::Folded);
+    assert_eq!(at(&rolling(0.1, 0.0, 0.0)), FrameState::Folded);
 }
 
 macro_rules! state_tests {
@@ -245,7 +245,7 @@ state_tests!(f32_states, f32);
 
 #[test]
 fn names_are_fixed_and_read_back() {
-    let names: Vec<&str> = State::ALL.iter().map(|&s| state_name(s)).collect();
+    let names: Vec<&str> = FrameState::ALL.iter().map(|&s| state_name(s)).collect();
     assert_eq!(
         names,
         [
@@ -257,9 +257,9 @@ fn names_are_fixed_and_read_back() {
             "other"
         ]
     );
-    for (k, s) in State::ALL.into_iter().enumerate() {
-        assert_eq!(State::from_name(s.name()), Some(s));
+    for (k, s) in FrameState::ALL.into_iter().enumerate() {
+        assert_eq!(FrameState::from_name(s.name()), Some(s));
         assert_eq!(s.index(), k);
     }
-    assert_eq!(State::from_name("twisting"), None);
+    assert_eq!(FrameState::from_name("twisting"), None);
 }

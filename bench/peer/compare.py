@@ -25,7 +25,9 @@ checked to write a byte-identical trajectory and timed against the same peer run
    operations a step, counted by stage from the code for the 25-bead helix at its 3.3
    chord iterations a step: docs/BENCHMARKS.md) over the best run-loop time.
 
-Needs numpy and pygrpy (`pip install numpy pygrpy`). Prints a table and the ratio.
+Needs numpy and pygrpy (`pip install numpy pygrpy`). Prints a table and the ratio;
+with HYDRORATTLE_BENCH_MACHINE set, appends them to bench/results/helix25.csv
+(bench/record.py).
 """
 
 import argparse
@@ -42,6 +44,9 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from overdamped_numpy import OverdampedChain, read_xyz_frames  # noqa: E402
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent))
+import record  # noqa: E402
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
@@ -114,6 +119,8 @@ def main():
                     help="floating-point operations a step of the scene (default: the "
                          "25-bead helix's count, docs/BENCHMARKS.md)")
     args = ap.parse_args()
+    rows = record.Recorder("helix25", " ".join(["python3", "bench/peer/compare.py", *sys.argv[1:]]))
+    table = "against the NumPy + pygrpy peer, alternated"
     demos = args.demo or [str(ROOT / "target/release/host-demo")]
     text = pathlib.Path(args.scene).read_text()
     cfg = tomllib.loads(text)
@@ -171,6 +178,9 @@ def main():
         print(f"  host-demo run (process wall, with start-up) {wall_best[k] * 1e6:9.2f} us/step")
         print(f"  ratio peer / host-demo: {peer_best / demo_best[k]:.1f}x (run loop), "
               f"{peer_best / wall_best[k]:.1f}x (process wall)")
+        rows.row(table, demo, "run loop", f"{demo_best[k] * 1e6:.2f} us")
+        rows.row(table, demo, "peer", f"{peer_best * 1e6:.1f} us")
+        rows.row(table, demo, "ratio", f"{peer_best / demo_best[k]:.1f}x")
         rate = args.flops / demo_best[k] / 1e9
         if peaks[k] is None:
             print(f"  {rate:.2f} GFLOP/s at {args.flops:.0f} flops a step (no examples/peak "
@@ -180,6 +190,8 @@ def main():
                   f"{100 * rate / peak_best[k]:.1f} % of this build's f64 peak, "
                   f"{peak_best[k]:.2f} GFLOP/s (examples/peak, best of {args.rounds}, "
                   "same minutes)")
+            rows.row(table, demo, "fraction of the f64 peak", f"{100 * rate / peak_best[k]:.1f} %")
+    rows.finish()
 
 
 if __name__ == "__main__":

@@ -122,7 +122,7 @@ fn a_full_disk_names_the_file_and_leaves_no_tmp_and_no_folder_of_its_own() {
     let out = scratch("full");
     std::fs::create_dir_all(&out).unwrap();
     std::os::unix::fs::symlink("/dev/full", out.join("trajectory.xyz.tmp")).unwrap();
-    let scene = manifest().join("scenes/dimer.toml");
+    let scene = manifest().join("../host/scenes/dimer.toml");
     let (o, _) = run(&scene, &out, &[]);
     let err = assert_names_file(&o, &out, "trajectory.xyz");
     assert!(err.to_lowercase().contains("space"), "{err}");
@@ -151,7 +151,7 @@ fn a_read_only_folder_names_the_file_and_leaves_nothing() {
         eprintln!("cannot make a read-only folder here: skipped");
         return;
     }
-    let scene = manifest().join("scenes/dimer.toml");
+    let scene = manifest().join("../host/scenes/dimer.toml");
     let (o, took) = run(&scene, &out, &[]);
     lock(false);
     // The resolved scene is the first file a run writes (so that a killed run resumes).
@@ -166,7 +166,7 @@ fn an_output_path_that_is_a_file_is_refused_by_name() {
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("not-a-folder");
     std::fs::write(&out, b"x").unwrap();
-    let (o, _) = run(&manifest().join("scenes/dimer.toml"), &out, &[]);
+    let (o, _) = run(&manifest().join("../host/scenes/dimer.toml"), &out, &[]);
     let err = assert_refused(&o, &out, None);
     assert!(!err.contains("panicked"));
     assert_eq!(std::fs::read(&out).unwrap(), b"x");

@@ -5,7 +5,7 @@
 use hydrorattle_host::scene::{Drift, Precision, Scene, Sqrt, Thermal};
 use hydrorattle_host::sim::{RunOptions, run};
 
-const SHIPPED: &str = include_str!("../scenes/brownian_chain.toml");
+const SHIPPED: &str = include_str!("../../host/scenes/brownian_chain.toml");
 
 /// The shipped Brownian scene with its `[brownian]` table replaced by `table` (none
 /// when empty) and the given precision.
@@ -224,7 +224,7 @@ fn sqrt_key() {
 /// = 2 (b = 10) within 3 block standard errors (its 1e5 steps give about 4 %).
 #[test]
 fn fene_dumbbell_scene() {
-    let text = include_str!("../scenes/fene_dumbbell.toml");
+    let text = include_str!("../../host/scenes/fene_dumbbell.toml");
     let s = Scene::parse(text, "fene_dumbbell.toml").unwrap();
     assert_eq!(s.integrator.fene, Some(10f64.sqrt()));
     assert_eq!(s.bonds[0].length, 0.0);

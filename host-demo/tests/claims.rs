@@ -1,7 +1,7 @@
 //! The claims' verdicts on made-up series whose verdicts are known, and the same
 //! verdicts from two runs of the Figure 1 cases.
 
-use hydrorattle::observables::State;
+use hydrorattle::observables::FrameState;
 use hydrorattle_host::scene::Scene;
 use hydrorattle_host::sim::{Front, Label, Observables, RunOptions, run};
 use hydrorattle_study::claims::{CaseRun, Claim, Verdict, claims};
@@ -10,7 +10,7 @@ use hydrorattle_study::figure1::claims_of;
 /// 41 frames at t = 0, 10, ..., 400: state `state(t)`, spin `(rate, coherence)` from
 /// `spin(t)`, centre of mass falling at `speed(t)`.
 fn series(
-    state: impl Fn(f64) -> State,
+    state: impl Fn(f64) -> FrameState,
     spin: impl Fn(f64) -> (f64, f64),
     speed: impl Fn(f64) -> f64,
 ) -> Vec<Observables> {
@@ -77,9 +77,9 @@ fn lasting_states_hold_pass_or_fail() {
     let a = series(
         |t| {
             if t >= 100.0 {
-                State::Stretched
+                FrameState::Stretched
             } else {
-                State::Other
+                FrameState::Other
             }
         },
         still,
@@ -87,7 +87,7 @@ fn lasting_states_hold_pass_or_fail() {
     );
     // (b) twisting from t = 50 to 150 only: transient, window [50, 160) as [50, 160].
     let b = series(
-        |_| State::Folded,
+        |_| FrameState::Folded,
         |t| {
             if (50.0..=150.0).contains(&t) {
                 (0.1, 0.8)
@@ -101,9 +101,9 @@ fn lasting_states_hold_pass_or_fail() {
     let c = series(
         |t| {
             if t == 200.0 || t == 210.0 {
-                State::Stretched
+                FrameState::Stretched
             } else {
-                State::Folded
+                FrameState::Folded
             }
         },
         still,
@@ -125,9 +125,9 @@ fn lasting_states_hold_pass_or_fail() {
         series(
             move |t| {
                 if t >= 300.0 && t < 300.0 + gap {
-                    State::Other
+                    FrameState::Other
                 } else {
-                    State::Stretched
+                    FrameState::Stretched
                 }
             },
             still,
@@ -152,10 +152,10 @@ fn early_twisting_must_start_in_the_first_quarter() {
             }
         }
     };
-    let a = series(|_| State::Other, twist_between(10.0, 30.0), one);
-    let b = series(|_| State::Other, twist_between(200.0, 300.0), one);
+    let a = series(|_| FrameState::Other, twist_between(10.0, 30.0), one);
+    let b = series(|_| FrameState::Other, twist_between(200.0, 300.0), one);
     // Coherent but too slow to count.
-    let c = series(|_| State::Other, |_| (0.001, 0.9), one);
+    let c = series(|_| FrameState::Other, |_| (0.001, 0.9), one);
     let cs = judge(&a, &b, &c, &front(0.0, 0));
     assert_eq!(
         verdict(&cs, "a_group_rotation"),
@@ -173,7 +173,7 @@ fn early_twisting_must_start_in_the_first_quarter() {
 #[test]
 fn faster_settling_over_every_quarter_or_some() {
     let still = |_| (0.0, 0.0);
-    let other = |_| State::Other;
+    let other = |_| FrameState::Other;
     let a = series(other, still, |_| 1.0);
     // (b) fast in the second quarter only.
     let b = series(other, still, |t| {
@@ -201,7 +201,7 @@ fn faster_settling_over_every_quarter_or_some() {
 
 #[test]
 fn a_front_runs_from_the_head_when_most_bonds_turn_in_index_order() {
-    let s = series(|_| State::Stretched, |_| (0.0, 0.0), |_| 1.0);
+    let s = series(|_| FrameState::Stretched, |_| (0.0, 0.0), |_| 1.0);
     let cs = judge(&s, &s, &s, &front(0.9, 24));
     assert_eq!(
         verdict(&cs, "c_front_from_head"),

@@ -79,7 +79,7 @@ fn ten_million_tails_are_refused_at_once_at_their_line() {
 
 #[test]
 fn the_limit_can_be_raised_or_lowered() {
-    let scene = manifest().join("scenes/figure1a.toml");
+    let scene = manifest().join("../host/scenes/figure1a.toml");
     let out = scratch("limit");
     // The 25-bead chain needs tens of kB: 1 kB is too little.
     let o = cli_run(&[

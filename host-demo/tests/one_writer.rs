@@ -26,7 +26,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn small() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/small.toml")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../host/sweeps/small.toml")
 }
 
 fn text(o: &Output) -> String {
@@ -151,7 +151,7 @@ fn collect_reports_a_cut_trajectory_corrupt_not_done() {
 fn a_run_into_a_folder_another_process_writes_is_refused_before_it_writes() {
     let out = scratch("run-locked");
     let held = FolderLock::take(&out).unwrap();
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/dimer.toml");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../host/scenes/dimer.toml");
     let run = || {
         let mut c = Command::new(BIN);
         c.arg("run")

@@ -81,7 +81,9 @@ fn periodic_scenes_run_and_give_the_box_in_both_formats() {
         ("periodic_chain", "ewald"),
         ("periodic_suspension", "ewald"),
     ] {
-        let path = manifest().join("scenes").join(format!("{name}.toml"));
+        let path = manifest()
+            .join("../host/scenes")
+            .join(format!("{name}.toml"));
         let scene = Scene::from_path(&path).unwrap();
         let cell = scene.periodic.unwrap().size;
         let out = scratch(name);
@@ -154,7 +156,7 @@ fn periodic_scenes_run_and_give_the_box_in_both_formats() {
 #[test]
 fn a_run_without_a_box_writes_no_box() {
     let out = scratch("dimer");
-    let r = demo_run(&manifest().join("scenes/dimer.toml"), &out);
+    let r = demo_run(&manifest().join("../host/scenes/dimer.toml"), &out);
     assert!(r.status.success());
     let xyz = std::fs::read_to_string(out.join("trajectory.xyz")).unwrap();
     assert!(!xyz.contains("Lattice") && xyz.contains("pbc=\"F F F\""));
@@ -173,7 +175,7 @@ fn a_run_without_a_box_writes_no_box() {
 fn pse_runs_and_matches_ewald_or_stops_at_its_line() {
     let dir = scratch("pse");
     std::fs::create_dir_all(&dir).unwrap();
-    let chain = manifest().join("scenes/periodic_chain.toml");
+    let chain = manifest().join("../host/scenes/periodic_chain.toml");
     let text = std::fs::read_to_string(&chain).unwrap();
     let text = text.replace("method = \"ewald\"", "method = \"pse\"");
     let path = dir.join("pse.toml");

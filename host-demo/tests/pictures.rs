@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use hydrorattle::observables::State;
+use hydrorattle::observables::FrameState;
 use hydrorattle_host::scene::Scene;
 use hydrorattle_study::pictures::{ANIMATION_FRAMES, ANIMATION_SIZE};
 use hydrorattle_study::render::{Animation, Snapshot, chain_colors, draw_timeline, write_gif};
@@ -118,7 +118,7 @@ fn a_bad_at_list_is_refused_before_anything_runs() {
 #[test]
 fn run_draws_the_initial_and_final_configuration() {
     let out = scratch("run");
-    let scene = manifest().join("scenes").join("tree.toml");
+    let scene = manifest().join("../host/scenes").join("tree.toml");
     let o = cli(&[
         "run",
         scene.to_str().unwrap(),
@@ -150,7 +150,7 @@ fn drawing_is_deterministic() {
         })
         .collect();
     let colors = chain_colors(frames[0].positions.len());
-    let names = State::ALL.map(State::name);
+    let names = FrameState::ALL.map(FrameState::name);
     let rows: Vec<(f64, &str)> = (0..12u32)
         .map(|k| (f64::from(k), names[k as usize % names.len()]))
         .chain([(12.0, "unknown state")])

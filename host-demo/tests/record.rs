@@ -50,7 +50,7 @@ const TRAJECTORY_FILES: [&str; 3] = ["trajectory.xyz", "trajectory.gsd", "observ
 
 #[test]
 fn the_summary_records_what_a_rerun_needs() {
-    let scene = manifest().join("scenes/dimer.toml");
+    let scene = manifest().join("../host/scenes/dimer.toml");
     let out = scratch("summary");
     run(&scene, &out, &[]);
     let s = json(&out.join("summary.json"));
@@ -83,7 +83,7 @@ fn the_last_row_of_the_observables_is_the_summary_s_final_observables() {
     let dir = scratch("last-row");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("odd.toml");
-    let text = std::fs::read_to_string(manifest().join("scenes/dimer.toml")).unwrap();
+    let text = std::fs::read_to_string(manifest().join("../host/scenes/dimer.toml")).unwrap();
     assert!(text.contains("every = 10"));
     let text = text.replace("every = 10", "every = 7");
     std::fs::write(&scene, text).unwrap();
@@ -197,7 +197,7 @@ fn a_killed_run_resumes_from_the_files_it_left() {
     // checkpoint: resume cuts them back and continues, to the bytes of one run.
     let dir = scratch("killed");
     std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string(manifest().join("scenes/ring.toml")).unwrap();
+    let text = std::fs::read_to_string(manifest().join("../host/scenes/ring.toml")).unwrap();
     let scene = |name: &str, duration: &str| {
         let path = dir.join(name);
         // A fixed `every`: the default depends on the duration.
@@ -232,7 +232,7 @@ fn a_run_killed_after_a_checkpoint_on_its_last_step_resumes_to_one_run() {
     // from there as one longer run.
     let dir = scratch("last-step");
     std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string(manifest().join("scenes/dimer.toml")).unwrap();
+    let text = std::fs::read_to_string(manifest().join("../host/scenes/dimer.toml")).unwrap();
     let scene = |name: &str, duration: &str| {
         let path = dir.join(name);
         std::fs::write(
@@ -293,7 +293,7 @@ fn a_run_killed_after_a_checkpoint_on_its_last_step_resumes_to_one_run() {
 fn a_run_of_an_older_version_is_refused_with_the_columns_named() {
     let old = scratch("older");
     run(
-        &manifest().join("scenes/dimer.toml"),
+        &manifest().join("../host/scenes/dimer.toml"),
         &old,
         &["--checkpoint-every", "10"],
     );

@@ -20,7 +20,7 @@ fn scratch(name: &str) -> PathBuf {
 
 #[test]
 fn every_shipped_scene_runs_and_writes_whole_files() {
-    for entry in std::fs::read_dir(manifest().join("scenes")).unwrap() {
+    for entry in std::fs::read_dir(manifest().join("../host/scenes")).unwrap() {
         let path = entry.unwrap().path();
         let scene = Scene::from_path(&path).unwrap();
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();

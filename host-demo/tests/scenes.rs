@@ -44,7 +44,7 @@ fn winding_number(points: &[[f64; 3]], centre: [f64; 3]) -> f64 {
 
 #[test]
 fn every_shipped_scene_parses() {
-    let files = toml_files(&manifest_dir().join("scenes"));
+    let files = toml_files(&manifest_dir().join("../host/scenes"));
     let names: Vec<_> = files
         .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
@@ -80,7 +80,7 @@ fn every_shipped_scene_parses() {
 
 #[test]
 fn small_scenes_have_the_described_shapes() {
-    let dir = manifest_dir().join("scenes");
+    let dir = manifest_dir().join("../host/scenes");
     let dimer = Scene::from_path(&dir.join("dimer.toml")).unwrap();
     assert_eq!((dimer.particles.len(), dimer.bonds.len()), (2, 1));
     assert!((dimer.bonds[0].length - 3.15).abs() < 1e-12);
@@ -124,7 +124,7 @@ fn figure1_scenes_are_the_papers_cases() {
     }
     // The embedded copies are the files on disk.
     for (_, name, text) in FIGURE1_SCENES {
-        let on_disk = std::fs::read_to_string(manifest_dir().join(name)).unwrap();
+        let on_disk = std::fs::read_to_string(manifest_dir().join("../host").join(name)).unwrap();
         assert_eq!(on_disk, text);
     }
 }
@@ -270,7 +270,7 @@ fn number_after(text: &str, before: &str) -> f64 {
 /// on the wall.
 #[test]
 fn the_shipped_pile_is_what_its_header_says() {
-    let scene = manifest_dir().join("scenes/pile.toml");
+    let scene = manifest_dir().join("../host/scenes/pile.toml");
     let text = std::fs::read_to_string(&scene).unwrap();
     let header: String = text
         .lines()

@@ -19,11 +19,11 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn scenes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../host/scenes")
 }
 
 fn sweeps() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../host/sweeps")
 }
 
 /// A sweep file in `dir` on the Figure 1 (a) scene with `body` after `[sweep]`.

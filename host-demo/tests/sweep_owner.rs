@@ -21,7 +21,7 @@ fn scratch(name: &str) -> PathBuf {
 
 fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
+        .join("../host/scenes")
         .join(name)
 }
 
@@ -251,7 +251,7 @@ fn points_run_with_the_values_emitted_whatever_the_base_becomes() {
 #[test]
 fn nonsense_job_settings_are_refused_before_anything_is_written() {
     let dir = scratch("nonsense");
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/small.toml");
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../host/sweeps/small.toml");
     let out = dir.join("out");
     for (args, says) in [
         (&["--tasks", "0"][..], "--tasks 0"),
@@ -342,7 +342,7 @@ fn nonsense_job_settings_are_refused_before_anything_is_written() {
 #[test]
 fn emit_dry_run_previews_the_script_with_the_options_given() {
     let dir = scratch("preview");
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/small.toml");
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../host/sweeps/small.toml");
     let out = dir.join("out");
     let args = [
         "sweep",
@@ -544,7 +544,7 @@ fn circular_bases_misspellings_and_equal_numbers_are_said_at_their_line() {
         "[sweep]\nbase = \"small.toml\"\n\"integrator.dt\" = [0.1]\n".into(),
     );
     std::fs::copy(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/small.toml"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../host/sweeps/small.toml"),
         dir.join("small.toml"),
     )
     .unwrap();

@@ -43,7 +43,7 @@ use hydrorattle_host::sweep::{Sweep, frozen};
 
 /// A sweep of `n` x `n` points over the Figure 1 (a) scene.
 fn grid(n: usize) -> String {
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../host-demo/scenes/figure1a.toml");
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/figure1a.toml");
     format!(
         "[sweep]\nbase = {:?}\n\"helix.dhat\" = {{ linspace = [1.05, 2.0, {n}] }}\n\"helix.head_ratio\" = {{ linspace = [1.0, 2.5, {n}] }}\n",
         base.display().to_string()

@@ -5,7 +5,11 @@ use serde::Serialize;
 
 /// The code version: the crate version and `git describe` of the build's checkout
 /// (`no git` when built outside one).
-pub const CODE_VERSION: &str = env!("HOST_DEMO_VERSION");
+pub const CODE_VERSION: &str = env!("HYDRORATTLE_HOST_VERSION");
+
+/// The library that writes the records and trajectories, and its crate version: the
+/// application a trajectory file names (GSD's `application` field).
+pub const APPLICATION: &str = concat!("hydrorattle-host ", env!("CARGO_PKG_VERSION"));
 
 /// The machine a run ran on.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]

@@ -7,10 +7,10 @@
 //! (0.55) and the densest random packing of frictionless polydisperse spheres (0.66).
 //!
 //! CI: 30 spheres on a 3 x 3 floor (`cargo test --release -p hydrorattle-host --test
-//! packing`). The full scene `host-demo/scenes/packing.toml` (160 spheres on 5 x 5)
+//! packing`). The full scene `host/scenes/packing.toml` (160 spheres on 5 x 5)
 //! is `#[ignore]`d: `cargo test --release -p hydrorattle-host --test packing --
 //! --ignored --nocapture` (the same run as `cargo run --release -p host-demo -- run
-//! host-demo/scenes/packing.toml --out out/packing`).
+//! host/scenes/packing.toml --out out/packing`).
 
 use std::f64::consts::PI;
 
@@ -146,10 +146,7 @@ duration = 100.0
 #[test]
 #[ignore]
 fn packing_scene_rests_on_its_pinned_floor() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../host-demo/scenes/packing.toml"
-    );
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/packing.toml");
     // `PACKING_SCENE` names the file where the binary runs from another tree.
     let path = std::env::var("PACKING_SCENE").unwrap_or(path.to_string());
     let scene = Scene::from_path(std::path::Path::new(&path)).expect("the scene");

@@ -22,7 +22,7 @@ import hydrorattle as hr
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HOST_DEMO = pathlib.Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "target" / "release" / "host-demo"
-SCENE = (ROOT / "host-demo" / "scenes" / "figure1c.toml").read_text()
+SCENE = (ROOT / "host" / "scenes" / "figure1c.toml").read_text()
 STEPS = 1000
 
 

@@ -263,7 +263,7 @@ def test_bad_system_input_is_refused():
 def test_helix_keys_build_the_scene_files_chain():
     import pathlib
 
-    scene = pathlib.Path(__file__).resolve().parents[2] / "host-demo" / "scenes" / "figure1c.toml"
+    scene = pathlib.Path(__file__).resolve().parents[2] / "host" / "scenes" / "figure1c.toml"
     a = hr.System.from_scene(scene)
     b = hr.System.helix(
         tails=24, head_ratio=2.0, dhat=1.05, radius=2.0, pitch=7.0, density=4.5,

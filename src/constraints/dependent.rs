@@ -20,7 +20,7 @@ use crate::real::Real;
 /// its row's diagonal (1.5e-8 in f64, 3.5e-4 in f32) is taken for a dependent row. An
 /// exactly dependent row's pivot is the difference of sums of rounded terms of the
 /// diagonal's size, a few hundred `eps` at a few hundred rows (measured: the pile of
-/// `host-demo/scenes/pile.toml` went below `-64 rows eps` at 280 rows); a row that
+/// `host/scenes/pile.toml` went below `-64 rows eps` at 280 rows); a row that
 /// independent has a condition number of `1 / eps` against the others, and its
 /// multiplier would carry no digit the step can use.
 pub(crate) fn rank_floor<T: Real>() -> T {

@@ -13,7 +13,7 @@ pub use motion::{
     FrontOrder, Rotation, VerticalFront, bond_is_vertical, com_settling_speed, extents,
     poloidal_circulation, spin_about_vertical, vertical_run,
 };
-pub use state::{Shape, State, StateThresholds, is_rotating, state_name, state_of};
+pub use state::{FrameState, Shape, StateThresholds, is_rotating, state_name, state_of};
 
 use crate::bonds::Bond;
 use crate::real::Real;

@@ -10,9 +10,10 @@ use super::{extension, verticality};
 use crate::bonds::Bond;
 use crate::real::Real;
 
-/// What a chain is doing in one frame.
+/// What a chain is doing in one frame: a name read from the frame, not the particles'
+/// state a step advances ([`crate::State`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum State {
+pub enum FrameState {
     /// Hangs straight along the vertical ("stretched like a chopstick"): verticality
     /// and extension both high.
     Stretched,
@@ -30,42 +31,42 @@ pub enum State {
     Other,
 }
 
-impl State {
+impl FrameState {
     /// Every state, in the fixed order of the classifier (and of any legend).
-    pub const ALL: [State; 6] = [
-        State::Stretched,
-        State::ColumnOverKnot,
-        State::RollingRing,
-        State::Rotating,
-        State::Folded,
-        State::Other,
+    pub const ALL: [FrameState; 6] = [
+        FrameState::Stretched,
+        FrameState::ColumnOverKnot,
+        FrameState::RollingRing,
+        FrameState::Rotating,
+        FrameState::Folded,
+        FrameState::Other,
     ];
 
     /// Lower-case name, as written to files.
     pub fn name(self) -> &'static str {
         match self {
-            State::Stretched => "stretched",
-            State::ColumnOverKnot => "column_over_knot",
-            State::RollingRing => "rolling_ring",
-            State::Rotating => "rotating",
-            State::Folded => "folded",
-            State::Other => "other",
+            FrameState::Stretched => "stretched",
+            FrameState::ColumnOverKnot => "column_over_knot",
+            FrameState::RollingRing => "rolling_ring",
+            FrameState::Rotating => "rotating",
+            FrameState::Folded => "folded",
+            FrameState::Other => "other",
         }
     }
 
-    /// The state of a name written by [`State::name`].
-    pub fn from_name(name: &str) -> Option<State> {
-        State::ALL.into_iter().find(|s| s.name() == name)
+    /// The state of a name written by [`FrameState::name`].
+    pub fn from_name(name: &str) -> Option<FrameState> {
+        FrameState::ALL.into_iter().find(|s| s.name() == name)
     }
 
-    /// Position in [`State::ALL`].
+    /// Position in [`FrameState::ALL`].
     pub fn index(self) -> usize {
         self as usize
     }
 }
 
-/// [`State::name`], as a free function (for plotting code that maps states to names).
-pub fn state_name(s: State) -> &'static str {
+/// [`FrameState::name`], as a free function (for plotting code that maps states to names).
+pub fn state_name(s: FrameState) -> &'static str {
     s.name()
 }
 
@@ -175,31 +176,31 @@ fn turning<T: Real>(r: &Rotation<T>, coherence: T, rate: T) -> bool {
 /// `true` when a rotation about the vertical is coherent and fast enough to count as
 /// turning ([`StateThresholds::spin_coherence`], [`StateThresholds::spin_rate`]),
 /// whatever the shape: the "twisting" of a chain that also stretches or folds (the
-/// state [`State::Rotating`] is this motion when no shape state applies first).
+/// state [`FrameState::Rotating`] is this motion when no shape state applies first).
 pub fn is_rotating<T: Real>(spin: &Rotation<T>, th: &StateThresholds<T>) -> bool {
     turning(spin, th.spin_coherence, th.spin_rate)
 }
 
-/// Names a frame: the first of [`State::ALL`] whose definition fits (see
-/// [`StateThresholds`]); [`State::Other`] when none does.
-pub fn state_of<T: Real>(s: &Shape<T>, th: &StateThresholds<T>) -> State {
+/// Names a frame: the first of [`FrameState::ALL`] whose definition fits (see
+/// [`StateThresholds`]); [`FrameState::Other`] when none does.
+pub fn state_of<T: Real>(s: &Shape<T>, th: &StateThresholds<T>) -> FrameState {
     let compact = s.extension <= th.compact_extension;
     if s.verticality >= th.stretched_verticality && s.extension >= th.stretched_extension {
-        return State::Stretched;
+        return FrameState::Stretched;
     }
     if s.vertical_run >= th.column_bonds && s.vertical_run < s.bonds && s.bonds > 0 {
         let rest = T::from_f64((s.bonds - s.vertical_run) as f64) / T::from_f64(s.bonds as f64);
         if s.horizontal <= th.knot_spread * rest * s.contour {
-            return State::ColumnOverKnot;
+            return FrameState::ColumnOverKnot;
         }
     }
     if compact && turning(&s.poloidal, th.rolling_coherence, th.rolling_rate) {
-        State::RollingRing
+        FrameState::RollingRing
     } else if is_rotating(&s.spin, th) {
-        State::Rotating
+        FrameState::Rotating
     } else if compact {
-        State::Folded
+        FrameState::Folded
     } else {
-        State::Other
+        FrameState::Other
     }
 }

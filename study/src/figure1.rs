@@ -12,7 +12,7 @@ use serde::Serialize;
 use crate::claims::{CaseRun, Claim, claims};
 use crate::pictures::{self, ANIMATION_FRAMES, check_times, figure1_pictures};
 use crate::timeline::{Segment, segments};
-use hydrorattle::observables::State;
+use hydrorattle::observables::FrameState;
 use hydrorattle_host::output::write_json;
 use hydrorattle_host::scene::Scene;
 use hydrorattle_host::sim::{Front, KeepFrames, RunOptions, RunResult, run};
@@ -232,7 +232,7 @@ pub fn figure1_wall(
     let (pictures, drawing) = figure1_pictures(out, &case_runs, at)?;
     log::info!("figure 1 pictures drawn in {drawing:.3} s");
     let summary = Figure1Summary {
-        states: State::ALL.iter().map(|s| s.name()).collect(),
+        states: FrameState::ALL.iter().map(|s| s.name()).collect(),
         wall_height: wall,
         cases,
         claims: claims_of(&scenes, &runs),

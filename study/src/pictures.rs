@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Result, anyhow};
-use hydrorattle::observables::State;
+use hydrorattle::observables::FrameState;
 use plotters::style::RGBColor;
 use rayon::prelude::*;
 
@@ -152,7 +152,7 @@ pub fn figure1_pictures(
             last: c.result.last.clone(),
         })
         .collect();
-    let names = State::ALL.map(State::name);
+    let names = FrameState::ALL.map(FrameState::name);
     let states: Vec<Vec<(f64, &str)>> = cases
         .iter()
         .map(|c| crate::timeline::states(&c.result.series))

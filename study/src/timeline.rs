@@ -5,7 +5,7 @@
 //! first frame (the last one to the last frame's time), so the segments of a run tile
 //! its time without gaps: a strip of `(t_start, t_end, state)` bars draws it.
 
-use hydrorattle::observables::State;
+use hydrorattle::observables::FrameState;
 use serde::Serialize;
 
 use hydrorattle_host::sim::Observables;
@@ -13,9 +13,9 @@ use hydrorattle_host::sim::Observables;
 /// A stretch of frames in one state.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Segment {
-    /// The state ([`State::name`] in files).
+    /// The state ([`FrameState::name`] in files).
     #[serde(serialize_with = "state_by_name")]
-    pub state: State,
+    pub state: FrameState,
     /// Time of the segment's first frame.
     pub t_start: f64,
     /// Time of the next segment's first frame (the last frame's for the last segment).
@@ -24,7 +24,7 @@ pub struct Segment {
     pub frames: usize,
 }
 
-fn state_by_name<S: serde::Serializer>(s: &State, ser: S) -> Result<S::Ok, S::Error> {
+fn state_by_name<S: serde::Serializer>(s: &FrameState, ser: S) -> Result<S::Ok, S::Error> {
     ser.serialize_str(s.name())
 }
 
@@ -69,7 +69,7 @@ mod tests {
     use super::*;
     use hydrorattle_host::sim::Label;
 
-    fn frame(time: f64, s: State) -> Observables {
+    fn frame(time: f64, s: FrameState) -> Observables {
         Observables {
             time,
             state: Label(s),
@@ -80,22 +80,22 @@ mod tests {
     #[test]
     fn segments_tile_the_run() {
         let series = [
-            frame(0.0, State::Other),
-            frame(2.0, State::Rotating),
-            frame(4.0, State::Rotating),
-            frame(6.0, State::Stretched),
+            frame(0.0, FrameState::Other),
+            frame(2.0, FrameState::Rotating),
+            frame(4.0, FrameState::Rotating),
+            frame(6.0, FrameState::Stretched),
         ];
         let s = segments(&series);
-        let got: Vec<(State, f64, f64, usize)> = s
+        let got: Vec<(FrameState, f64, f64, usize)> = s
             .iter()
             .map(|g| (g.state, g.t_start, g.t_end, g.frames))
             .collect();
         assert_eq!(
             got,
             [
-                (State::Other, 0.0, 2.0, 1),
-                (State::Rotating, 2.0, 6.0, 2),
-                (State::Stretched, 6.0, 6.0, 1),
+                (FrameState::Other, 0.0, 2.0, 1),
+                (FrameState::Rotating, 2.0, 6.0, 2),
+                (FrameState::Stretched, 6.0, 6.0, 1),
             ]
         );
         assert!(segments(&[]).is_empty());

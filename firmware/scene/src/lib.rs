@@ -2,7 +2,7 @@
 //! once and used by the Cortex-M firmware, the host check and the C interface, so that
 //! "host and target give the same bits" compares like with like.
 //!
-//! The chain follows `host-demo/scenes/figure1c.toml`: a head of radius 2 (bead 0) and
+//! The chain follows `host/scenes/figure1c.toml`: a head of radius 2 (bead 0) and
 //! 24 tails of radius 1, density 4.5, bonds of length `1.05 (a_i + a_j)`, the tails on
 //! a right-handed helix of radius 2 and pitch 7 about the vertical axis, the head on the
 //! axis below the first tail. The geometry is computed in `f64` with `libm` (the same

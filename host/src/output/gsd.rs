@@ -268,7 +268,7 @@ impl<W: Write + Seek> GsdWriter<W> {
         }
         header.extend_from_slice(&SCHEMA_VERSION.to_le_bytes());
         header.extend_from_slice(&FILE_VERSION.to_le_bytes());
-        for text in ["hydrorattle host-demo", "hoomd"] {
+        for text in [crate::provenance::APPLICATION, "hoomd"] {
             let start = header.len();
             header.extend_from_slice(text.as_bytes());
             header.resize(start + 64, 0);

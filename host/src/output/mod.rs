@@ -79,8 +79,10 @@ mod tests {
     use std::path::PathBuf;
 
     fn scratch(name: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("host-demo-output-{}-{name}", std::process::id()));
+        let dir = std::env::temp_dir().join(format!(
+            "hydrorattle-host-output-{}-{name}",
+            std::process::id()
+        ));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir

@@ -40,7 +40,7 @@ pub const PSE_SPREAD: f64 = 1.296e-8;
 
 /// Mobility products a step takes beyond its first, for a constraint solve (the Krylov
 /// iterations), measured: the shipped 13-bead periodic chain on PSE
-/// (`host-demo/scenes/periodic_chain.toml` with `method = "pse"`, 10 steps:
+/// (`host/scenes/periodic_chain.toml` with `method = "pse"`, 10 steps:
 /// `mean_iterations` 21.6 in its `summary.json`).
 pub const PRODUCTS_SOLVE: f64 = 21.6;
 /// Products a step takes for Lanczos noise, measured on the same run (its

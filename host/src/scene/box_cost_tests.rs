@@ -179,10 +179,7 @@ fn pse_refuses_what_it_cannot_meet() {
 #[test]
 fn auto_takes_ewald_for_the_shipped_chains() {
     let scene = |name: &str| {
-        let path = format!(
-            "{}/../host-demo/scenes/{name}.toml",
-            env!("CARGO_MANIFEST_DIR")
-        );
+        let path = format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"));
         std::fs::read_to_string(path).unwrap()
     };
     let chain = scene("periodic_chain").replace("method = \"ewald\"", "method = \"auto\"");

@@ -130,23 +130,23 @@ pub const MAX_ITERATIONS: usize = 10_000;
 pub const TARGET_FRAMES: usize = 200;
 
 /// The scene files of the paper's Figure 1, embedded so that the demo runs from any
-/// directory: `(case, file name, text)`. The files live with the CLI's other scenes
-/// (`host-demo/scenes/`), where users find and copy them.
+/// directory: `(case, file name, text)`. The files live with the library's other
+/// shipped scenes (`host/scenes/`), where users find and copy them.
 pub const FIGURE1_SCENES: [(&str, &str, &str); 3] = [
     (
         "a",
         "scenes/figure1a.toml",
-        include_str!("../../../host-demo/scenes/figure1a.toml"),
+        include_str!("../../scenes/figure1a.toml"),
     ),
     (
         "b",
         "scenes/figure1b.toml",
-        include_str!("../../../host-demo/scenes/figure1b.toml"),
+        include_str!("../../scenes/figure1b.toml"),
     ),
     (
         "c",
         "scenes/figure1c.toml",
-        include_str!("../../../host-demo/scenes/figure1c.toml"),
+        include_str!("../../scenes/figure1c.toml"),
     ),
 ];
 

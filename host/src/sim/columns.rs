@@ -41,8 +41,9 @@ impl std::fmt::Display for ColumnsMismatch {
         }
         write!(
             f,
-            ": the run was written by another version of host-demo; resume it with that \
-             version, or run its scene.toml again"
+            ": the run was written by another version of hydrorattle-host (this is {}); resume \
+             it with that version, or run its scene.toml again",
+            crate::provenance::CODE_VERSION
         )
     }
 }

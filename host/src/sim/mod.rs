@@ -110,7 +110,7 @@ pub struct Summary {
     /// time unit.
     pub twist_rate: f64,
     /// Late state: the named state of most frames in the last quarter of the run's time
-    /// (`observables::State` names), or "failed".
+    /// (`observables::FrameState` names), or "failed".
     pub outcome: String,
     /// The order in which the bonds first turned near-vertical (the stretching front).
     pub front: Front,
@@ -436,7 +436,7 @@ pub fn resume(dir: &Path, until: f64, limits: Limits, opts: RunOptions) -> Resul
     // checkpoint records, which an older checkpoint lacks.
     if steps == checkpoint.step && checkpoint.last_step.is_none() {
         bail!(
-            "{}: this checkpoint (of an older host-demo) does not record its step's solve, which a run ending at t = {at} writes: resume to a later time, or run scene.toml again",
+            "{}: this checkpoint (of an older hydrorattle-host) does not record its step's solve, which a run ending at t = {at} writes: resume to a later time, or run scene.toml again",
             dir.join(CHECKPOINT).display()
         );
     }

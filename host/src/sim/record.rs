@@ -6,7 +6,7 @@ use std::io::Seek;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use hydrorattle::observables::{self, Shape, State, StateThresholds, state_of};
+use hydrorattle::observables::{self, FrameState, Shape, StateThresholds, state_of};
 use hydrorattle::{Bond, Real};
 use serde::{Deserialize, Serialize};
 
@@ -56,13 +56,13 @@ pub const TRAJECTORY_GSD: &str = "trajectory.gsd";
 /// Observables, one row per frame.
 pub const OBSERVABLES_CSV: &str = "observables.csv";
 
-/// A frame's named state ([`State`]), written by its name; `other` by default.
+/// A frame's named state ([`FrameState`]), written by its name; `other` by default.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Label(pub State);
+pub struct Label(pub FrameState);
 
 impl Default for Label {
     fn default() -> Self {
-        Label(State::Other)
+        Label(FrameState::Other)
     }
 }
 
@@ -75,7 +75,7 @@ impl Serialize for Label {
 impl<'de> Deserialize<'de> for Label {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let name = String::deserialize(d)?;
-        State::from_name(&name)
+        FrameState::from_name(&name)
             .map(Label)
             .ok_or_else(|| serde::de::Error::custom(format!("unknown state {name:?}")))
     }
@@ -299,7 +299,7 @@ impl Observables {
             wall_height: w[0],
             wall_gap: w[1],
             wall_contacts: w[2].map(|n| n as u32),
-            state: Label(State::from_name(state)?),
+            state: Label(FrameState::from_name(state)?),
         })
     }
 }

@@ -4,7 +4,7 @@
 //! (running means and co-moments, updated in frame order, so a resumed run that replays
 //! the same rows gets the same bits).
 
-use hydrorattle::observables::State;
+use hydrorattle::observables::FrameState;
 
 use super::record::Observables;
 
@@ -19,8 +19,8 @@ pub(super) struct TailSlope {
     stt: f64,
     /// Sum of (t - mean_t)(w - mean_w).
     stw: f64,
-    /// Frames in each state of [`State::ALL`].
-    states: [u64; State::ALL.len()],
+    /// Frames in each state of [`FrameState::ALL`].
+    states: [u64; FrameState::ALL.len()],
 }
 
 impl TailSlope {
@@ -34,7 +34,7 @@ impl TailSlope {
             mean_w: 0.0,
             stt: 0.0,
             stw: 0.0,
-            states: [0; State::ALL.len()],
+            states: [0; FrameState::ALL.len()],
         }
     }
 
@@ -52,11 +52,11 @@ impl TailSlope {
         self.stw += dt * (o.twist - self.mean_w);
     }
 
-    /// The state of most frames in the window (the first in [`State::ALL`] on a tie);
+    /// The state of most frames in the window (the first in [`FrameState::ALL`] on a tie);
     /// None without frames.
-    pub(super) fn late_state(&self) -> Option<State> {
-        let mut best: Option<(State, u64)> = None;
-        for s in State::ALL {
+    pub(super) fn late_state(&self) -> Option<FrameState> {
+        let mut best: Option<(FrameState, u64)> = None;
+        for s in FrameState::ALL {
             let n = self.states[s.index()];
             if n > 0 && best.is_none_or(|b| n > b.1) {
                 best = Some((s, n));
@@ -103,14 +103,14 @@ mod tests {
         assert_eq!(s.late_state(), None);
         // Stretched early (outside the window), rotating in 3 late frames, folded in 2.
         let states = [
-            (1.0, State::Stretched),
-            (2.0, State::Stretched),
-            (3.0, State::Stretched),
-            (7.6, State::Folded),
-            (8.0, State::Rotating),
-            (8.5, State::Folded),
-            (9.0, State::Rotating),
-            (10.0, State::Rotating),
+            (1.0, FrameState::Stretched),
+            (2.0, FrameState::Stretched),
+            (3.0, FrameState::Stretched),
+            (7.6, FrameState::Folded),
+            (8.0, FrameState::Rotating),
+            (8.5, FrameState::Folded),
+            (9.0, FrameState::Rotating),
+            (10.0, FrameState::Rotating),
         ];
         for (time, st) in states {
             s.add(&Observables {
@@ -119,6 +119,6 @@ mod tests {
                 ..Observables::default()
             });
         }
-        assert_eq!(s.late_state(), Some(State::Rotating));
+        assert_eq!(s.late_state(), Some(FrameState::Rotating));
     }
 }

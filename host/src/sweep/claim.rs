@@ -40,7 +40,7 @@ impl fmt::Display for AnotherSweep {
             self.theirs
                 .1
                 .as_deref()
-                .unwrap_or("none: an older host-demo wrote it"),
+                .unwrap_or("none: an older hydrorattle-host wrote it"),
             self.ours.0,
             self.ours.1
         )?;
@@ -52,7 +52,7 @@ impl fmt::Display for AnotherSweep {
         }
         write!(
             f,
-            "A folder holds one sweep: nothing was written. Give this one its own --out; to go on with the one in {d} as it was emitted, run `host-demo sweep --frozen --out {d}`"
+            "A folder holds one sweep: nothing was written. Give this one its own --out; to go on with the one in {d} as it was emitted, run its frozen points (`sweep --frozen --out {d}`)"
         )
     }
 }
@@ -74,7 +74,7 @@ pub fn claim(sweep: &Sweep, dir: &Path) -> Result<()> {
                 .iter()
                 .zip(&sweep.points)
                 .all(|(a, b)| a.id == b.id);
-        // A record of an older host-demo (format 1, no digest) with the same points is
+        // A record of an older hydrorattle-host (format 1, no digest) with the same points is
         // adopted: each point's scene.toml is still checked before it is touched.
         if !(r.digest.is_none() && same_ids) {
             return Err(AnotherSweep {

@@ -59,8 +59,7 @@ pub type Refused = (String, String);
 pub fn load(dir: &Path, selection: &Selection) -> Result<(SweepRecord, Vec<Point>, Vec<Refused>)> {
     let Some(record) = SweepRecord::read(dir)? else {
         bail!(
-            "{}: no sweep.json: nothing was emitted or run into this folder (run `host-demo sweep FILE --out {}` first)",
-            dir.display(),
+            "{}: no sweep.json: nothing was emitted or run into this folder (emit or run a sweep file into it first)",
             dir.display()
         );
     };
@@ -103,7 +102,7 @@ pub fn load(dir: &Path, selection: &Selection) -> Result<(SweepRecord, Vec<Point
 fn thaw(dir: &Path, record: &SweepRecord, r: &super::record::PointRecord) -> Result<Point> {
     let Some(want) = &r.scene_toml_fnv1a64 else {
         bail!(
-            "sweep.json records no scene digest (format 1, from an older host-demo): run the sweep file into a new folder"
+            "sweep.json records no scene digest (format 1, from an older hydrorattle-host): run the sweep file into a new folder"
         );
     };
     let path = frozen_path(dir, &r.id);

@@ -13,8 +13,13 @@ use super::{SWEEP_JSON, Sweep};
 use crate::output::fnv1a64;
 use crate::scene::Scene;
 
-/// The record's format.
-pub const FORMAT: &str = "host-demo sweep 2";
+/// The record's format: the library that writes it and the format's version.
+pub const FORMAT: &str = "hydrorattle-host sweep 2";
+
+/// The names earlier versions wrote for the formats still read: the same record under
+/// the CLI's name ("host-demo sweep 2"), and format 1 (no digests), which a claim adopts
+/// and a frozen run refuses with why.
+pub const FORMERLY: [&str; 2] = ["host-demo sweep 2", "host-demo sweep 1"];
 
 /// What `sweep.json` holds.
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -10,7 +10,7 @@ use crate::scene::Scene;
 
 /// The dimer scene with a `[sweep]` table added.
 fn dimer_with(sweep: &str) -> String {
-    let dimer = include_str!("../../../host-demo/scenes/dimer.toml");
+    let dimer = include_str!("../../scenes/dimer.toml");
     format!("{dimer}\n[sweep]\n{sweep}")
 }
 
@@ -40,11 +40,7 @@ fn lists_combine_as_a_product_in_file_order_the_last_fastest() {
     ];
     assert_eq!(got, want);
     // The rest of the scene is the base's.
-    let base = Scene::parse(
-        include_str!("../../../host-demo/scenes/dimer.toml"),
-        "dimer",
-    )
-    .unwrap();
+    let base = Scene::parse(include_str!("../../scenes/dimer.toml"), "dimer").unwrap();
     let mut p = s.points[4].scene.clone();
     (p.integrator.dt, p.particles[1].radius) = (base.integrator.dt, base.particles[1].radius);
     p.output = base.output;
@@ -60,7 +56,7 @@ fn lists_combine_as_a_product_in_file_order_the_last_fastest() {
 fn zip_groups_vary_together_and_replicas_count_seeds() {
     let text = format!(
         "{}\n[brownian]\ntemperature = 0.5\nseed = 40\n\n[sweep]\nreplicas = 3\n\"model.hydrodynamics\" = [\"rpy\", \"free-draining\"]\n\n[[sweep.zip]]\n\"integrator.dt\" = [0.01, 0.02]\n\"integrator.duration\" = [1.0, 2.0]\n",
-        include_str!("../../../host-demo/scenes/dimer.toml")
+        include_str!("../../scenes/dimer.toml")
     );
     let s = parse(&text).unwrap();
     assert_eq!(s.points.len(), 2 * 2 * 3);
@@ -95,9 +91,7 @@ fn error(text: &str) -> (usize, String) {
 
 #[test]
 fn errors_name_the_line_of_the_value_at_fault() {
-    let base_lines = include_str!("../../../host-demo/scenes/dimer.toml")
-        .lines()
-        .count();
+    let base_lines = include_str!("../../scenes/dimer.toml").lines().count();
     // The [sweep] header is two lines after the base; its first key the next.
     let first = base_lines + 3;
     let (line, msg) = error(&dimer_with("\"integrator.dt\" = [0.01, 30.0]\n"));
@@ -134,7 +128,7 @@ fn errors_name_the_line_of_the_value_at_fault() {
         + 1;
     assert_eq!(line, radius_line, "{msg}");
     // No [sweep] at all.
-    let e = parse(include_str!("../../../host-demo/scenes/dimer.toml")).unwrap_err();
+    let e = parse(include_str!("../../scenes/dimer.toml")).unwrap_err();
     assert!(e.to_string().contains("no [sweep] table"), "{e}");
 }
 
@@ -163,22 +157,10 @@ fn each_point_is_the_scene_its_text_would_give() {
     // The base's parsed document with each point's values set, resolved, against the
     // scene of the text written from the base's table with the values set.
     let scenes = [
-        (
-            "dimer",
-            include_str!("../../../host-demo/scenes/dimer.toml"),
-        ),
-        (
-            "figure1a",
-            include_str!("../../../host-demo/scenes/figure1a.toml"),
-        ),
-        (
-            "chain",
-            include_str!("../../../host-demo/scenes/periodic_chain.toml"),
-        ),
-        (
-            "brownian",
-            include_str!("../../../host-demo/scenes/brownian_chain.toml"),
-        ),
+        ("dimer", include_str!("../../scenes/dimer.toml")),
+        ("figure1a", include_str!("../../scenes/figure1a.toml")),
+        ("chain", include_str!("../../scenes/periodic_chain.toml")),
+        ("brownian", include_str!("../../scenes/brownian_chain.toml")),
     ];
     let sweeps = [
         (
@@ -223,7 +205,7 @@ fn one_point_found_alone_is_the_point_of_the_whole_sweep() {
     let file = dir.join("s.toml");
     let text = format!(
         "{}\n[brownian]\ntemperature = 0.5\n\n[sweep]\nreplicas = 2\n\"integrator.dt\" = [0.01, 0.02, 0.04]\n\"particle.1.radius\" = [1, 0.5]\n",
-        include_str!("../../../host-demo/scenes/dimer.toml")
+        include_str!("../../scenes/dimer.toml")
     );
     std::fs::write(&file, text).unwrap();
     let all = Sweep::from_path(&file).unwrap();

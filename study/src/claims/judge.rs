@@ -1,7 +1,7 @@
 //! The verdict of each kind of claim (the definitions are in the parent module's
 //! documentation), with the numbers it rests on.
 
-use hydrorattle::observables::State;
+use hydrorattle::observables::FrameState;
 use serde_json::{Value, json};
 
 use super::{
@@ -26,16 +26,16 @@ fn share(r: &CaseRun<'_>, d: Doing, t0: f64, t1: f64) -> f64 {
     if n > 0 { yes as f64 / n as f64 } else { 0.0 }
 }
 
-/// The named state of most frames in `[t0, t1]` (first in `State::ALL` on a tie).
-fn most(r: &CaseRun<'_>, t0: f64, t1: f64) -> Option<State> {
-    let mut counts = [0usize; State::ALL.len()];
+/// The named state of most frames in `[t0, t1]` (first in `FrameState::ALL` on a tie).
+fn most(r: &CaseRun<'_>, t0: f64, t1: f64) -> Option<FrameState> {
+    let mut counts = [0usize; FrameState::ALL.len()];
     for o in r.series.iter().filter(|o| o.time >= t0 && o.time <= t1) {
         counts[o.state.0.index()] += 1;
     }
-    State::ALL
+    FrameState::ALL
         .into_iter()
         .filter(|k| counts[k.index()] > 0)
-        .fold(None, |b: Option<State>, k| match b {
+        .fold(None, |b: Option<FrameState>, k| match b {
             Some(b) if counts[b.index()] >= counts[k.index()] => Some(b),
             _ => Some(k),
         })
@@ -123,7 +123,7 @@ pub(super) fn lasting(r: &CaseRun<'_>, d: Doing) -> Judged {
         "state": d.name(),
         "late_window": [late, t1],
         "late_share": late_share,
-        "late_state": most(r, late, t1).map(State::name),
+        "late_state": most(r, late, t1).map(FrameState::name),
         "final_state": last.state.0.name(),
         "overall_share": share(r, d, t0, t1),
         "final_extension": last.extension,
@@ -154,7 +154,7 @@ pub(super) fn early(r: &CaseRun<'_>, d: Doing) -> Judged {
         "state": d.name(),
         "initial_stage": [t0, initial],
         "initial_share": share(r, d, t0, initial),
-        "initial_state": most(r, t0, initial).map(State::name),
+        "initial_state": most(r, t0, initial).map(FrameState::name),
         "longest_run_frames": longest_any,
         "min_frames": MIN_FRAMES,
         "initial_mean_spin_rate": mean(r, t0, initial, |o| o.spin_rate),
@@ -282,10 +282,10 @@ pub(super) fn starts_like(r: &CaseRun<'_>, other: &CaseRun<'_>) -> Judged {
     let verdict = if same { Verdict::Holds } else { Verdict::Fails };
     let evidence = json!({
         "initial_stage": mine.2,
-        "initial_state": mine.0.map(State::name),
+        "initial_state": mine.0.map(FrameState::name),
         "initial_state_share": mine.1,
         "other": other.case,
-        "other_initial_state": theirs.0.map(State::name),
+        "other_initial_state": theirs.0.map(FrameState::name),
         "other_initial_state_share": theirs.1,
     });
     (verdict, same.then_some(mine.2), evidence)

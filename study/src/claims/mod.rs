@@ -36,7 +36,7 @@ mod sensitivity;
 
 pub use sensitivity::claim_tables;
 
-use hydrorattle::observables::{Rotation, State, StateThresholds, is_rotating};
+use hydrorattle::observables::{FrameState, Rotation, StateThresholds, is_rotating};
 use serde::Serialize;
 use serde_json::Value;
 
@@ -81,7 +81,7 @@ impl Verdict {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Doing {
     /// In this named state.
-    In(State),
+    In(FrameState),
     /// Turning coherently about the vertical, whatever its shape.
     Twisting,
 }
@@ -150,7 +150,7 @@ pub const SPECS: [Spec; 9] = [
         id: "a_stretched",
         case: "a",
         words: "eventually stretched like a chopstick in the vertical direction",
-        kind: Kind::Lasting(Doing::In(State::Stretched)),
+        kind: Kind::Lasting(Doing::In(FrameState::Stretched)),
     },
     Spec {
         id: "b_starts_like_a",
@@ -186,7 +186,7 @@ pub const SPECS: [Spec; 9] = [
         id: "c_stretched",
         case: "c",
         words: "later, the chain primarily underwent full stretching",
-        kind: Kind::Lasting(Doing::In(State::Stretched)),
+        kind: Kind::Lasting(Doing::In(FrameState::Stretched)),
     },
     Spec {
         id: "c_front_from_head",
