@@ -13,6 +13,8 @@ use crate::error::ParticleError;
 use crate::linalg::tri;
 use crate::real::Real;
 
+#[cfg(feature = "fast-free")]
+pub mod free_fast;
 #[cfg(feature = "periodic")]
 pub mod periodic;
 #[cfg(feature = "pse")]
