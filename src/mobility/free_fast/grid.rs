@@ -14,11 +14,11 @@ use crate::real::Real;
 /// Kernel components: `xx, yy, zz, xy, xz, yz`, by pairs of axes.
 const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
 
+/// The padded grid, the FFT scratch and the twiddles per axis.
+type Parts<'c, T> = (&'c mut [Cx<T>], &'c mut [Cx<T>], [&'c [Cx<T>]; 3]);
+
 /// Twiddles of the padded grid at the end of `cx`; returns the grid, scratch and them.
-fn split<'c, T: Real>(
-    ff: &FreeFast<T>,
-    cx: &'c mut [Cx<T>],
-) -> (&'c mut [Cx<T>], &'c mut [Cx<T>], [&'c [Cx<T>]; 3]) {
+fn split<'c, T: Real>(ff: &FreeFast<T>, cx: &'c mut [Cx<T>]) -> Parts<'c, T> {
     let [px, py, pz] = ff.grid.m;
     let (grid, rest) = cx.split_at_mut(3 * px * py * pz);
     let (scratch, rest) = rest.split_at_mut(ff.grid.scratch_len());
