@@ -17,6 +17,8 @@ use crate::fault::ParticleError;
 use crate::linalg::tri;
 use crate::real::Real;
 
+#[cfg(feature = "fast-free")]
+pub mod free_fast;
 #[cfg(feature = "periodic")]
 pub mod periodic;
 #[cfg(feature = "pse")]

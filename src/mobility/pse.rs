@@ -17,7 +17,7 @@
 //! `unsafe`: the caller owns the grid, the cell list and the rows ([`Pse::storage`],
 //! [`PseStorage`]).
 
-mod fft;
+pub(crate) mod fft;
 mod jobs;
 mod near;
 mod noise;

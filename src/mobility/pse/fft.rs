@@ -24,14 +24,14 @@ const MAX_STAGES: usize = 24;
 
 /// The radix stages of a length, largest first: 4s, then a 2, then 3s and 5s.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Factors {
+pub(crate) struct Factors {
     radix: [u8; MAX_STAGES],
     count: usize,
 }
 
 impl Factors {
     /// `None` unless `n >= 1` is `2^a 3^b 5^c`.
-    pub(super) fn new(mut n: usize) -> Option<Self> {
+    pub(crate) fn new(mut n: usize) -> Option<Self> {
         let mut f = Self {
             radix: [0; MAX_STAGES],
             count: 0,
@@ -63,7 +63,7 @@ pub fn good_size(n: usize) -> usize {
 
 /// `tw[t] = exp(-2 pi i t / n)`, `t < n`, each from `libm` in f64 (no recurrence, so
 /// no drift).
-pub(super) fn twiddles<T: Real>(n: usize, tw: &mut [Cx<T>]) {
+pub(crate) fn twiddles<T: Real>(n: usize, tw: &mut [Cx<T>]) {
     for (t, w) in tw[..n].iter_mut().enumerate() {
         let a = -2.0 * core::f64::consts::PI * (t as f64) / (n as f64);
         *w = [T::from_f64(libm::cos(a)), T::from_f64(libm::sin(a))];
@@ -210,15 +210,15 @@ fn transform<T: Real>(
 /// A 3D grid's shape for the transform: points per axis, their radix stages, and the
 /// number of interleaved components per point.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Grid3 {
-    pub(super) m: [usize; 3],
-    pub(super) factors: [Factors; 3],
-    pub(super) comps: usize,
+pub(crate) struct Grid3 {
+    pub(crate) m: [usize; 3],
+    pub(crate) factors: [Factors; 3],
+    pub(crate) comps: usize,
 }
 
 impl Grid3 {
     /// Scratch values [`fft3`] needs: two buffers of [`CHUNK`] lines of the longest axis.
-    pub(super) fn scratch_len(&self) -> usize {
+    pub(crate) fn scratch_len(&self) -> usize {
         2 * CHUNK * self.m[0].max(self.m[1]).max(self.m[2])
     }
 }
@@ -229,7 +229,7 @@ impl Grid3 {
 /// each line's arithmetic its own (so slabs of planes transformed apart along `x` and
 /// `y` give the same bits). `tw[d]`
 /// holds [`twiddles`] for `M_d`; `scratch` at least [`Grid3::scratch_len`].
-pub(super) fn fft3<T: Real>(
+pub(crate) fn fft3<T: Real>(
     g: &Grid3,
     grid: &mut [Cx<T>],
     scratch: &mut [Cx<T>],

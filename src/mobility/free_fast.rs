@@ -1,0 +1,430 @@
+//! A fast free-space RPY product `u = M F` (translation), `O(N log N)`: the
+//! positively split product of the periodic box ([`crate::mobility::pse`]) carried to
+//! open space.
+//!
+//! The Stokeslet is split by a Gaussian of variance `s^2 = 4 sigma^2`:
+//!
+//! * far part: `(1 + a_i^2 lap / 6)(1 + a_j^2 lap / 6)` of the Stokeslet smoothed by the
+//!   Gaussian, summed on a grid over the cloud's bounding box: each sphere spread with
+//!   the Gaussian of variance `sigma^2` and its sphere factor, the grid convolved
+//!   aperiodically (zero-padded to twice its size, the kernel's own FFT) with the
+//!   Stokeslet smoothed by the remaining variance `2 sigma^2`, sampled in real space
+//!   (smooth, so sampling it is spectrally accurate: no truncated Green's function is
+//!   needed), and interpolated back with the same weights;
+//! * near part: the exact RPY block (overlapping pairs included) minus the far block,
+//!   for the pairs closer than the cutoff (a cell list), and the self blocks; beyond the
+//!   cutoff the two agree to the tolerance.
+//!
+//! One tolerance sets `sigma`'s grid spacing, the window and the cutoff
+//! ([`FreeFast::new`], `docs/FREE.md`); [`FreeFast::estimate`] reports the error the
+//! chosen parameters give. The caller owns the storage ([`FreeFast::storage`],
+//! [`FreeStorage`]); the kernel's transform is computed on the first product and kept
+//! there. Serial, in a fixed order: the same inputs give the same bits.
+
+mod grid;
+mod radial;
+
+use core::fmt;
+
+use crate::cell_list::CellList;
+use crate::mobility::pse::fft::{self, Cx, good_size};
+use crate::mobility::{Hydro, pair_tt, self_tt};
+use crate::real::Real;
+
+/// The tolerances [`FreeFast::new`] accepts (from [`min_tolerance`] on in the precision).
+pub const MIN_TOLERANCE: f64 = 1e-10;
+/// See [`MIN_TOLERANCE`].
+pub const MAX_TOLERANCE: f64 = 0.1;
+/// Machine epsilons below which no tolerance is accepted (the transforms' rounding, as
+/// in PSE): `f32` takes tolerances from about 1.9e-6 on.
+pub const EPSILONS: f64 = 16.0;
+/// The largest padded grid edge, in points.
+pub const MAX_GRID: usize = 2048;
+/// The largest window per axis, in grid points.
+pub const MAX_SUPPORT: usize = 40;
+
+/// The smallest tolerance accepted in precision `T`.
+pub fn min_tolerance<T: Real>() -> f64 {
+    MIN_TOLERANCE.max(EPSILONS * T::EPSILON.to_f64())
+}
+
+/// A rejected parameter, configuration or storage.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FreeError {
+    /// A parameter (named) is not finite, not positive or out of range.
+    BadParameter(&'static str),
+    /// The tolerance is below what the precision can reach (the floor given).
+    Precision {
+        /// The smallest tolerance this precision accepts.
+        floor: f64,
+    },
+    /// The cloud needs a grid edge above [`MAX_GRID`] or a window above
+    /// [`MAX_SUPPORT`].
+    GridTooLarge,
+    /// Positions, radii, forces and output differ in length.
+    Length,
+    /// A position or force is not finite.
+    NonFinite {
+        /// The sphere.
+        particle: usize,
+    },
+    /// A radius outside `(0, a_max]`.
+    Radius {
+        /// The sphere.
+        particle: usize,
+    },
+    /// The cloud's bounding box exceeds the extent the parameters were sized for.
+    Extent,
+    /// One sphere lies inside another.
+    Nested {
+        /// The spheres.
+        i: usize,
+        /// See `i`.
+        j: usize,
+    },
+    /// Caller storage too small: complex values, reals, indices.
+    Storage {
+        /// Needed.
+        need: [usize; 3],
+        /// Given.
+        have: [usize; 3],
+    },
+}
+
+impl fmt::Display for FreeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BadParameter(p) => write!(f, "fast free-space product: bad {p}"),
+            Self::Precision { floor } => write!(
+                f,
+                "the tolerance is below what this precision can reach ({floor:e})"
+            ),
+            Self::GridTooLarge => write!(f, "the tolerance and cloud need too large a grid"),
+            Self::Length => write!(f, "positions, radii, forces and output differ in length"),
+            Self::NonFinite { particle } => write!(f, "particle {particle}: non-finite value"),
+            Self::Radius { particle } => write!(f, "particle {particle}: radius out of range"),
+            Self::Extent => write!(f, "the cloud is larger than the extent it was sized for"),
+            Self::Nested { i, j } => write!(f, "sphere {i} lies inside sphere {j}"),
+            Self::Storage { need, have } => {
+                write!(f, "storage too small: need {need:?} values, have {have:?}")
+            }
+        }
+    }
+}
+
+/// Storage sizes of [`FreeFast::apply`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FreeSize {
+    /// Complex values: the padded grid (3 per point), FFT scratch and twiddles.
+    pub complex: usize,
+    /// Reals: the kernel's transform (6 per padded point).
+    pub reals: usize,
+    /// Indices: the cell list.
+    pub index: usize,
+}
+
+/// Caller-owned storage of [`FreeFast::apply`], at least [`FreeFast::storage`]. It keeps
+/// the kernel's transform between products with the same parameters.
+pub struct FreeStorage<'a, T: Real> {
+    complex: &'a mut [Cx<T>],
+    reals: &'a mut [T],
+    index: &'a mut [usize],
+    /// The parameters whose kernel `reals` holds.
+    ready: Option<[u64; 5]>,
+}
+
+impl<'a, T: Real> FreeStorage<'a, T> {
+    /// Storage over the caller's arrays (sizes checked by [`FreeFast::apply`]).
+    pub fn new(complex: &'a mut [Cx<T>], reals: &'a mut [T], index: &'a mut [usize]) -> Self {
+        Self {
+            complex,
+            reals,
+            index,
+            ready: None,
+        }
+    }
+}
+
+/// The parameters of the fast free-space product for a largest radius, a tolerance
+/// and the largest cloud (bounding box edges and number of spheres).
+#[derive(Clone, Copy, Debug)]
+pub struct FreeFast<T: Real> {
+    a_max: T,
+    tol: f64,
+    extent: [f64; 3],
+    /// The spreading Gaussian's standard deviation; grid spacing; window half-width.
+    sigma: f64,
+    h: f64,
+    reach: f64,
+    /// Window points per axis.
+    support: usize,
+    /// Grid points per axis (the cloud's) and the padded transform's.
+    m: [usize; 3],
+    grid: fft::Grid3,
+    r_cut: f64,
+    estimate: f64,
+}
+
+impl<T: Real> FreeFast<T> {
+    /// Parameters for spheres of radius up to `a_max`, a relative tolerance `tol` in
+    /// [`min_tolerance`]`..=`[`MAX_TOLERANCE`], and clouds of `n` spheres whose bounding
+    /// box has edges at most `extent`. With `D = ln(12/tol)`:
+    ///
+    /// * `sigma = max(a_max / 2, 0.38 (V / n)^{1/3})` (`V` the box's volume): the near
+    ///   pairs and the grid points cost alike at `0.38`;
+    /// * grid spacing `h = pi sigma sqrt(3 / (2 D))`: the worst aliasing term of the
+    ///   double grid sum, `exp(-3 pi^2 sigma^2 / (2 h^2))`, is `exp(-D)`;
+    /// * window half-width `sigma sqrt(2 D + 4)`;
+    /// * cutoff `r_c = max(2 sigma sqrt(2 (D + 2)), 2 a_max)`: the near part left out,
+    ///   `~ erfc(r_c / (2 sqrt(2) sigma))`, below the tolerance, and every overlapping
+    ///   pair inside.
+    pub fn new(a_max: T, tol: f64, extent: [T; 3], n: usize) -> Result<Self, FreeError> {
+        let e = extent.map(|e| e.to_f64());
+        let a = a_max.to_f64();
+        let vol = e.iter().map(|e| e + 2.0 * a).product::<f64>();
+        let sigma = (0.5 * a).max(0.38 * libm::cbrt(vol / n.max(1) as f64));
+        Self::with_sigma(a_max, tol, extent, T::from_f64(sigma))
+    }
+
+    /// [`FreeFast::new`]'s parameters for a given spreading width `sigma` (at least
+    /// `a_max / 2`: narrower, the sphere factors' growth `(a k)^4` spoils the rule).
+    pub fn with_sigma(a_max: T, tol: f64, extent: [T; 3], sigma: T) -> Result<Self, FreeError> {
+        if !(MIN_TOLERANCE..=MAX_TOLERANCE).contains(&tol) {
+            return Err(FreeError::BadParameter("tolerance"));
+        }
+        let floor = min_tolerance::<T>();
+        if tol < floor {
+            return Err(FreeError::Precision { floor });
+        }
+        let a = a_max.to_f64();
+        if !(a > 0.0 && a.is_finite()) {
+            return Err(FreeError::BadParameter("largest radius"));
+        }
+        let extent = extent.map(|e| e.to_f64());
+        if !extent.iter().all(|e| *e >= 0.0 && e.is_finite()) {
+            return Err(FreeError::BadParameter("extent"));
+        }
+        // The truncations' polynomial prefactors: measured errors reach 6 times
+        // `exp(-D)` at 1e-3 (a lone sphere), so the rule runs 12 times below the tolerance.
+        let dig = -libm::log(tol) + libm::log(12.0);
+        let sigma = sigma.to_f64();
+        if !(sigma >= 0.5 * a && sigma.is_finite()) {
+            return Err(FreeError::BadParameter("sigma"));
+        }
+        let h = PI * sigma * libm::sqrt(1.5 / dig);
+        let reach = sigma * libm::sqrt(2.0 * dig + 4.0);
+        let support = libm::floor(2.0 * reach / h) as usize + 2;
+        if support > MAX_SUPPORT {
+            return Err(FreeError::GridTooLarge);
+        }
+        let (mut m, mut mp) = ([0; 3], [0; 3]);
+        let mut factors = [fft::Factors::new(1).ok_or(FreeError::GridTooLarge)?; 3];
+        for d in 0..3 {
+            let need = libm::ceil(extent[d] / h) + support as f64 + 2.0;
+            if !(2.0 * need <= MAX_GRID as f64) {
+                return Err(FreeError::GridTooLarge);
+            }
+            m[d] = need as usize;
+            mp[d] = good_size(2 * m[d]);
+            factors[d] = fft::Factors::new(mp[d]).ok_or(FreeError::GridTooLarge)?;
+        }
+        let r_cut = (2.0 * sigma * libm::sqrt(2.0 * (dig + 2.0))).max(2.0 * a);
+        let alias = libm::exp(-1.5 * PI * PI * sigma * sigma / (h * h));
+        let window = libm::exp(-0.5 * reach * reach / (sigma * sigma)) * (2.0 * dig + 4.0);
+        let near = libm::erfc(r_cut / (2.0 * SQRT_2 * sigma));
+        Ok(Self {
+            a_max,
+            tol,
+            extent,
+            sigma,
+            h,
+            reach,
+            support,
+            m,
+            grid: fft::Grid3 {
+                m: mp,
+                factors,
+                comps: 3,
+            },
+            r_cut,
+            estimate: alias + window + near,
+        })
+    }
+
+    /// Storage [`FreeFast::apply`] needs for `n` spheres.
+    pub fn storage(&self, n: usize) -> FreeSize {
+        let [px, py, pz] = self.grid.m;
+        FreeSize {
+            complex: 3 * px * py * pz + self.grid.scratch_len() + px + py + pz,
+            reals: 6 * px * py * pz,
+            index: 3 * n + 1,
+        }
+    }
+
+    /// The tolerance the parameters were derived for.
+    pub fn tolerance(&self) -> f64 {
+        self.tol
+    }
+    /// The relative error the chosen parameters give (the sum of the aliasing, window
+    /// and cutoff terms, after rounding): at most about the tolerance.
+    pub fn estimate(&self) -> f64 {
+        self.estimate
+    }
+    /// The real-space cutoff.
+    pub fn r_cut(&self) -> f64 {
+        self.r_cut
+    }
+    /// Padded grid points per axis.
+    pub fn grid(&self) -> [usize; 3] {
+        self.grid.m
+    }
+    /// Window points per axis.
+    pub fn support(&self) -> usize {
+        self.support
+    }
+
+    /// `out = M F`: the free-space RPY mobility (viscosity `eta`) of the spheres at
+    /// `pos` with radii `radius` in `(0, a_max]` applied to `force`, to the tolerance.
+    /// The near part row by row, then the far part added, each in a fixed order. On
+    /// error `out` is unspecified and the storage's kernel is kept.
+    pub fn apply(
+        &self,
+        eta: T,
+        pos: &[T::V3],
+        radius: &[T],
+        force: &[T::V3],
+        out: &mut [T::V3],
+        store: &mut FreeStorage<'_, T>,
+    ) -> Result<(), FreeError> {
+        let lo = self.check(eta, pos, radius, force, out, store)?;
+        self.near(eta, pos, radius, force, out, store.index)?;
+        let key = [
+            self.grid.m[0] as u64,
+            self.grid.m[1] as u64,
+            self.grid.m[2] as u64,
+            self.h.to_bits(),
+            self.sigma.to_bits(),
+        ];
+        if store.ready != Some(key) {
+            store.ready = None;
+            grid::kernel(self, store.complex, store.reals);
+            store.ready = Some(key);
+        }
+        let spheres = (pos, radius);
+        grid::far(
+            self,
+            eta,
+            lo,
+            spheres,
+            force,
+            (store.complex, store.reals),
+            out,
+        );
+        Ok(())
+    }
+
+    /// Lengths, storage, viscosity, values, radii and extent; the bounding box's
+    /// lower corner.
+    fn check(
+        &self,
+        eta: T,
+        pos: &[T::V3],
+        radius: &[T],
+        force: &[T::V3],
+        out: &[T::V3],
+        store: &FreeStorage<'_, T>,
+    ) -> Result<[f64; 3], FreeError> {
+        let n = pos.len();
+        if radius.len() != n || force.len() != n || out.len() != n {
+            return Err(FreeError::Length);
+        }
+        let size = self.storage(n);
+        let need = [size.complex, size.reals, size.index];
+        let have = [store.complex.len(), store.reals.len(), store.index.len()];
+        if need.iter().zip(&have).any(|(n, h)| h < n) {
+            return Err(FreeError::Storage { need, have });
+        }
+        if !(eta > T::ZERO && eta.is_finite()) {
+            return Err(FreeError::BadParameter("viscosity"));
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
+            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) {
+                return Err(FreeError::NonFinite { particle: i });
+            }
+            if !(a > T::ZERO && a <= self.a_max) {
+                return Err(FreeError::Radius { particle: i });
+            }
+            let p = T::v3_to_f64(p);
+            for d in 0..3 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        if (0..3).any(|d| hi[d] - lo[d] > self.extent[d]) {
+            return Err(FreeError::Extent);
+        }
+        Ok(lo)
+    }
+
+    /// `out = M^near F`: self blocks, and RPY minus far for pairs within the cutoff.
+    fn near(
+        &self,
+        eta: T,
+        pos: &[T::V3],
+        radius: &[T],
+        force: &[T::V3],
+        out: &mut [T::V3],
+        index: &mut [usize],
+    ) -> Result<(), FreeError> {
+        let b = 1.0 / (2.0 * SQRT_2 * self.sigma);
+        let beta = 2.0 * self.sigma * self.sigma;
+        let cut2 = self.r_cut * self.r_cut;
+        let inv_eta = 1.0 / eta.to_f64();
+        let cut = T::from_f64(self.r_cut);
+        let list = CellList::build::<T>(pos, None, cut, index).map(|(l, _)| l);
+        for i in 0..pos.len() {
+            let ai = radius[i];
+            let alpha_i = ai.to_f64() * ai.to_f64() / 6.0;
+            let (c_self, _) = radial::far(b, beta, (alpha_i, alpha_i), 0.0);
+            let own = self_tt(eta, ai) - T::from_f64(c_self * inv_eta);
+            let mut acc = force[i] * own;
+            let mut err = None;
+            let mut pair = |j: usize| {
+                if j == i || err.is_some() {
+                    return;
+                }
+                let r = pos[i] - pos[j];
+                let u = T::norm2(r).to_f64();
+                if u >= cut2 {
+                    return;
+                }
+                let Some(rpy) = pair_tt(Hydro::Rpy, eta, ai, radius[j], r) else {
+                    err = Some(FreeError::Nested {
+                        i: j.min(i),
+                        j: j.max(i),
+                    });
+                    return;
+                };
+                let aj = radius[j].to_f64();
+                let (ci, crr) = radial::far(b, beta, (alpha_i, aj * aj / 6.0), u);
+                let f = force[j];
+                let far =
+                    f * T::from_f64(ci * inv_eta) + r * (T::dot(r, f) * T::from_f64(crr * inv_eta));
+                acc += rpy * f - far;
+            };
+            match &list {
+                Some(l) => l.near::<T>(pos[i], &mut pair),
+                None => (0..pos.len()).for_each(&mut pair),
+            }
+            if let Some(e) = err {
+                return Err(e);
+            }
+            out[i] = acc;
+        }
+        Ok(())
+    }
+}
+
+const PI: f64 = core::f64::consts::PI;
+const SQRT_2: f64 = core::f64::consts::SQRT_2;
