@@ -7,7 +7,7 @@
 //! tolerance after any step, the pins' spheres never move, and the pile comes to rest
 //! (no sphere moving by 1e-9 in three consecutive steps).
 //!
-//! `cargo test --release -p hydrorattle-host --test jam_retry`
+//! `cargo test --release -p hydrorattle-host --test host jam_retry::`
 
 use std::f64::consts::PI;
 

@@ -1,5 +1,5 @@
 //! Fuzzing the scene parser with a fixed seed: mutated copies of every shipped scene,
-//! every bad scene and the seeds of `tests/data/fuzz` (which cover every table: the
+//! every bad scene (`host-demo/tests/data/bad`) and the seeds of `host/tests/data/fuzz` (which cover every table: the
 //! wall, Brownian noise by Cholesky and by Lanczos, FENE, rest length 0, matrix-free,
 //! rotation, hard contacts, f32, a periodic box by the Ewald sum and by PSE, a
 //! suspension; each must be among the accepted cases) (lines deleted, duplicated, swapped or cut; numbers replaced by
@@ -16,10 +16,7 @@ use std::path::PathBuf;
 use hydrorattle_host::scene::{BoxMethod, Level, Precision, Scene, Sqrt};
 use hydrorattle_host::sizing::Limits;
 
-#[path = "../../tests/common/fuzz.rs"]
-mod fuzz;
-
-use fuzz::{Rng, report, settings};
+use crate::fuzz::{Rng, report, settings};
 
 /// Picks one of `xs`.
 trait Pick {
@@ -139,7 +136,11 @@ fn mutate(rng: &mut Rng, text: &str) -> Vec<u8> {
 fn corpus() -> Vec<String> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let mut texts = Vec::new();
-    for dir in ["scenes", "tests/data/bad", "tests/data/fuzz"] {
+    for dir in [
+        "../host-demo/scenes",
+        "../host-demo/tests/data/bad",
+        "tests/data/fuzz",
+    ] {
         let mut files: Vec<PathBuf> = std::fs::read_dir(root.join(dir))
             .unwrap()
             .map(|e| e.unwrap().path())

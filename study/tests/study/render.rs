@@ -85,7 +85,7 @@ fn figure1_layout() {
 
 #[test]
 fn single_configurations() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../host-demo/scenes");
     for name in ["dimer", "ring", "tree", "figure1c"] {
         let scene = Scene::from_path(&dir.join(format!("{name}.toml"))).unwrap();
         let path = out_dir().join(format!("{name}.png"));

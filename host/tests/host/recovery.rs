@@ -23,7 +23,7 @@ use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 const EXECUTION: [&str; 4] = ["wall_time_s", "steps_per_second", "machine", "resumed_from"];
 
 fn sweep(dir: &Path) -> Sweep {
-    let dimer = include_str!("../../host-demo/scenes/dimer.toml");
+    let dimer = include_str!("../../../host-demo/scenes/dimer.toml");
     let text =
         format!("{dimer}\n[sweep]\n\"integrator.duration\" = [0.6]\n\"output.every\" = [7]\n");
     Sweep::parse(&text, "recovery.toml", dir).unwrap()

@@ -8,7 +8,7 @@
 //!
 //! CI: 30 spheres on a 3 x 3 floor (`cargo test --release -p hydrorattle-host --test
 //! packing`). The full scene `host-demo/scenes/packing.toml` (160 spheres on 5 x 5)
-//! is `#[ignore]`d: `cargo test --release -p hydrorattle-host --test packing --
+//! is `#[ignore]`d: `cargo test --release -p hydrorattle-host --test host packing:: --
 //! --ignored --nocapture` (the same run as `cargo run --release -p host-demo -- run
 //! host-demo/scenes/packing.toml --out out/packing`).
 

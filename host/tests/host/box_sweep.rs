@@ -7,7 +7,7 @@ use std::path::Path;
 use hydrorattle_host::scene::BoxMethod;
 use hydrorattle_host::sweep::Sweep;
 
-const CHAIN: &str = include_str!("../../host-demo/scenes/periodic_chain.toml");
+const CHAIN: &str = include_str!("../../../host-demo/scenes/periodic_chain.toml");
 
 #[test]
 fn the_box_size_is_a_sweep_key() {
