@@ -6,10 +6,10 @@
 use hydrorattle::glam::DVec3;
 use hydrorattle::parallel::{self, BANDED_MIN, Parallel, Serial, band_scratch, bands};
 use hydrorattle::{
-    Bond, Brownian, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Params, Real, State, linalg,
+    Bond, Brownian, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, Params, Real, linalg,
     mobility, step_slices,
 };
-use hydrorattle_heap::Buffers;
+use hydrorattle_heap::{Buffers, Spheres};
 use hydrorattle_parallel::Threads;
 
 /// `n` beads of radius 1 on a helix (radius 3, rise 2.5 per bead), bonds of length 3.
@@ -108,7 +108,7 @@ fn steps<T: Real>(n: usize, par: &dyn Parallel) -> Vec<u64> {
 /// products at the start, a banded assembly and product at the midpoint).
 fn steps_at<T: Real>(n: usize, par: &dyn Parallel, kt: Option<f64>) -> Vec<u64> {
     let (p, radius) = helix(n);
-    let mut pos: Vec<T::V3> = p.iter().map(|&x| T::v3_from(x)).collect();
+    let pos: Vec<T::V3> = p.iter().map(|&x| T::v3_from(x)).collect();
     let radius: Vec<T> = radius.iter().map(|&a| T::from_f64(a)).collect();
     let bonds: Vec<Bond<T>> = (1..n)
         .map(|i| Bond {
@@ -121,26 +121,16 @@ fn steps_at<T: Real>(n: usize, par: &dyn Parallel, kt: Option<f64>) -> Vec<u64> 
     assert_eq!(params.method, Method::Overdamped);
     params.brownian = kt.map(|t| Brownian::new(T::from_f64(t)));
     params.noise_sqrt = NoiseSqrt::Lanczos;
-    let mut noise = Noise::new(3);
     let mut store = Buffers::<T>::new(Layout::for_params(&params, n, n - 1));
     let mut ws = store.workspace().with_parallel(par);
-    let (mut vel, mut omega) = (vec![T::V3_ZERO; n], vec![T::V3_ZERO; n]);
-    let density = vec![T::from_f64(4.5); n];
-    let mut time = T::ZERO;
+    let mut s = Spheres::at_rest(pos, radius, vec![T::from_f64(4.5); n]);
+    s.noise = kt.map(|_| Noise::new(3));
     for _ in 0..3 {
-        let state = State {
-            pos: &mut pos,
-            vel: &mut vel,
-            omega: &mut omega,
-            radius: &radius,
-            density: &density,
-            time: &mut time,
-            noise: kt.map(|_| &mut noise),
-        };
-        let r = step_slices(state, &bonds, &params, &mut ws, &mut NoForce).unwrap();
+        let r = step_slices(s.state(), &bonds, &params, &mut ws, &mut NoForce).unwrap();
         assert_eq!(r.noise_iterations > 0, kt.is_some());
     }
-    pos.iter()
+    s.pos
+        .iter()
         .flat_map(|&v| T::xyz(v).map(|c| c.to_f64().to_bits()))
         .collect()
 }

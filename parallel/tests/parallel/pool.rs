@@ -12,7 +12,7 @@ use hydrorattle_parallel::Threads;
 use hydrorattle_parallel::pool::SPIN;
 
 /// Rounds of the loops below (few under Miri, which checks the pool's `unsafe` and
-/// atomics: `cargo +nightly miri test -p hydrorattle-parallel --test pool`, with
+/// atomics: `cargo +nightly miri test -p hydrorattle-parallel --test parallel pool::`, with
 /// `MIRIFLAGS=-Zmiri-disable-isolation` for the clock).
 const ROUNDS: usize = if cfg!(miri) { 4 } else { 300 };
 

@@ -6,10 +6,9 @@
 
 use hydrorattle::parallel::{Parallel, Serial, bands};
 use hydrorattle::{
-    Contacts, Hydro, Layout, NoForce, Params, Real, State, StepError, StepReport, cell_list,
-    step_slices,
+    Contacts, Hydro, Layout, NoForce, Params, Real, StepError, StepReport, cell_list, step_slices,
 };
-use hydrorattle_heap::Buffers;
+use hydrorattle_heap::{Buffers, Spheres};
 use hydrorattle_parallel::Threads;
 
 const N: usize = 600;
@@ -45,8 +44,7 @@ fn run<T: Real>(
     let mut p = Params::<T>::new(T::from_f64(0.5));
     p.hydro = Hydro::FreeDraining;
     p.contacts = contacts.then(|| Contacts::new(2 * N));
-    let mut pos: Vec<T::V3> = start.iter().map(|&x| T::v3_from(x)).collect();
-    let (mut vel, mut omega) = (vec![T::V3_ZERO; N], vec![T::V3_ZERO; N]);
+    let pos: Vec<T::V3> = start.iter().map(|&x| T::v3_from(x)).collect();
     let radius = vec![T::ONE; N];
     // With contacts, heavier spheres in every third layer: they catch up with the ones
     // below. Without, all alike: they move together and keep their distances.
@@ -59,24 +57,14 @@ fn run<T: Real>(
             })
         })
         .collect();
-    let mut time = T::ZERO;
+    let mut s = Spheres::at_rest(pos, radius, density);
     let mut store = Buffers::<T>::new(Layout::for_params(&p, N, 0));
     let mut ws = store.workspace().with_parallel(par);
     let reports = (0..steps)
-        .map(|_| {
-            let state = State {
-                pos: &mut pos,
-                vel: &mut vel,
-                omega: &mut omega,
-                radius: &radius,
-                density: &density,
-                time: &mut time,
-                noise: None,
-            };
-            step_slices(state, &[], &p, &mut ws, &mut NoForce)
-        })
+        .map(|_| step_slices(s.state(), &[], &p, &mut ws, &mut NoForce))
         .collect();
-    let bits = pos
+    let bits = s
+        .pos
         .iter()
         .flat_map(|&v| T::xyz(v).map(|c| c.to_f64().to_bits()))
         .collect();

@@ -14,10 +14,10 @@ use hydrorattle::glam::DVec3;
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{self, Parallel, Serial, band_scratch, bands};
 use hydrorattle::{
-    Bond, Brownian, Drift, Hydro, Layout, NoForce, Noise, Params, Periodic, Real, State,
-    StepReport, Wall, step_slices,
+    Bond, Brownian, Drift, Hydro, Layout, NoForce, Noise, Params, Periodic, Real, StepReport, Wall,
+    step_slices,
 };
-use hydrorattle_heap::Buffers;
+use hydrorattle_heap::{Buffers, Spheres};
 use hydrorattle_parallel::Threads;
 
 /// `n` beads of radius 1 on a helix (radius 3, rise 2.5 per bead), bonds of length 3.
@@ -124,26 +124,16 @@ fn chain_steps(
             length: (start[i] - start[i - 1]).length(),
         })
         .collect();
-    let (radius, density) = (vec![1.0; n], vec![4.5; n]);
     let mut store = Buffers::<f64>::new(Layout::for_params(p, n, n - 1));
     let mut ws = store.workspace().with_parallel(par);
-    let mut pos = start.to_vec();
-    let (mut vel, mut omega, mut time) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n], 0.0);
+    let mut s = Spheres::at_rest(start.to_vec(), vec![1.0; n], vec![4.5; n]);
     // Thermal runs draw from the same seed.
-    let mut noise = Noise::new(11);
+    s.noise = p.brownian.map(|_| Noise::new(11));
     let mut last = None;
     for _ in 0..steps {
-        let state = State {
-            pos: &mut pos,
-            vel: &mut vel,
-            omega: &mut omega,
-            radius: &radius,
-            density: &density,
-            time: &mut time,
-            noise: p.brownian.map(|_| &mut noise),
-        };
-        last = Some(step_slices(state, &bonds, p, &mut ws, &mut NoForce).unwrap());
+        last = Some(step_slices(s.state(), &bonds, p, &mut ws, &mut NoForce).unwrap());
     }
+    let pos = s.pos;
     // The tolerance, measured from the positions: every bond's relative length error.
     let edge = p.periodic.map(|c| DVec3::from(c.size()));
     let image = |d: DVec3| edge.map_or(d, |l| d - l * (d / l).round());

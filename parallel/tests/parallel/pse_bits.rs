@@ -9,14 +9,7 @@ use hydrorattle::parallel::{Parallel, Serial};
 use hydrorattle::{Periodic, PeriodicError};
 use hydrorattle_parallel::Threads;
 
-/// SplitMix64 in `[0, 1)`.
-fn unit(state: &mut u64) -> f64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-}
+use crate::fuzz::Rng;
 
 /// `M F` for every part, as bits, with `par`.
 fn product(pse: &Pse<f64>, pos: &[DVec3], f: &[DVec3], par: &dyn Parallel) -> Vec<u64> {
@@ -41,12 +34,12 @@ fn same_bits_on_any_thread_count() -> Result<(), PeriodicError> {
     // From fewer spheres and planes than pieces (empty pieces) to a few thousand.
     for (n, phi, tol) in [(3usize, 0.01, 1e-3), (300, 0.1, 1e-4), (3000, 0.1, 1e-5)] {
         let l = (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / phi).cbrt();
-        let mut s = n as u64;
+        let mut s = Rng(n as u64);
         let pos: Vec<DVec3> = (0..n)
-            .map(|_| f64::v3(unit(&mut s) * l, unit(&mut s) * l, unit(&mut s) * l))
+            .map(|_| f64::v3(s.unit() * l, s.unit() * l, s.unit() * l))
             .collect();
         let f: Vec<DVec3> = (0..n)
-            .map(|_| f64::v3(unit(&mut s) - 0.5, unit(&mut s) - 0.5, unit(&mut s) - 0.5))
+            .map(|_| f64::v3(s.unit() - 0.5, s.unit() - 0.5, s.unit() - 0.5))
             .collect();
         let pse = Pse::new(Periodic::new([l; 3])?, 1.0, tol).unwrap();
         let one = product(&pse, &pos, &f, &Serial);

@@ -13,23 +13,16 @@ use hydrorattle::parallel::{Parallel, Serial, band_scratch};
 use hydrorattle::{ParticleError, Periodic, PeriodicError, linalg};
 use hydrorattle_parallel::Threads;
 
-/// SplitMix64 in `[0, 1)`.
-fn unit(state: &mut u64) -> f64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-}
+use crate::fuzz::Rng;
 
 /// `n` spheres of radii 0.8 to 1.2 at volume fraction about 0.05, forces, and the Ewald
 /// sums of their box at a tolerance of 1e-6 (cheaper than the default's near-epsilon
 /// one; the arithmetic's order, which the bits test, is the same).
 fn spheres(n: usize) -> (Ewald<f64>, Vec<DVec3>, Vec<f64>, Vec<DVec3>) {
     let l = (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.05).cbrt();
-    let mut s = n as u64;
+    let mut s = Rng(n as u64);
     let mut v = |scale: f64, shift: f64| {
-        let (a, b, c) = (unit(&mut s), unit(&mut s), unit(&mut s));
+        let (a, b, c) = (s.unit(), s.unit(), s.unit());
         DVec3::new(a, b, c) * scale - DVec3::splat(shift)
     };
     let pos: Vec<DVec3> = (0..n).map(|_| v(l, 0.0)).collect();
