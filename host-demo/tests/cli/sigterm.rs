@@ -4,19 +4,10 @@
 //! checkpoint stays valid and `resume` from it ends with the bytes of one run; a run
 //! ended so before its first checkpoint is refused by `resume`, by name.
 
+use crate::common::{BIN, SAME, text};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
-
-const BIN: &str = env!("CARGO_BIN_EXE_host-demo");
-
-/// The files a resumed run writes to the bytes of one run.
-const SAME: [&str; 4] = [
-    "trajectory.xyz",
-    "trajectory.gsd",
-    "observables.csv",
-    "scene.toml",
-];
 
 /// Beads in the chain: enough for a step of about a second (the dense solve of the
 /// bonds through the RPY mobility).
@@ -25,21 +16,6 @@ const BEADS: usize = 1600;
 const DT: f64 = 0.01;
 /// Steps of the run.
 const STEPS: usize = 3;
-
-fn scratch(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("sigterm-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
 
 /// A chain of [`BEADS`] beads in a zig-zag, bonded, settling overdamped: a slow step.
 fn scene(dir: &Path) -> PathBuf {
@@ -126,7 +102,7 @@ fn checkpoint_step(dir: &Path) -> u64 {
 
 #[test]
 fn a_second_sigterm_ends_a_long_step_at_once_and_nothing_is_lost() {
-    let dir = scratch("twice");
+    let dir = empty_dir!("twice");
     let scene = scene(&dir);
     let (one, cut, early) = (dir.join("one"), dir.join("cut"), dir.join("early"));
     let o = run(&scene, &one).wait_with_output().unwrap();

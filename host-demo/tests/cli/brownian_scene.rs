@@ -2,10 +2,11 @@
 //! its seed (same seed same bits in f32 and f64; another seed another run; `kT = 0` the
 //! deterministic run).
 
+use crate::common::ok;
 use hydrorattle_host::scene::{Drift, Precision, Scene, Sqrt, Thermal};
 use hydrorattle_host::sim::{RunOptions, run};
 
-const SHIPPED: &str = include_str!("../scenes/brownian_chain.toml");
+const SHIPPED: &str = include_str!("../../scenes/brownian_chain.toml");
 
 /// The shipped Brownian scene with its `[brownian]` table replaced by `table` (none
 /// when empty) and the given precision.
@@ -78,7 +79,7 @@ fn the_seed_fixes_the_run() {
 /// the summary and runs to the end. Without the retry the run stopped at step 2557.
 #[test]
 fn a_refused_step_is_retried_split_and_counted() {
-    let text = include_str!("data/star_kt1.toml");
+    let text = include_str!("../data/star_kt1.toml");
     for solver in ["newton", "sweep", "krylov"] {
         let text = text.replace(
             "duration = 270.0",
@@ -104,7 +105,7 @@ fn a_brownian_run_resumes_to_the_bytes_of_one_run() {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("brownian-restart");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let text = include_str!("data/star_kt1.toml");
+    let text = include_str!("../data/star_kt1.toml");
     // To step 2700 (past the retried step 2557) in one run and in two.
     let long = dir.join("long.toml");
     std::fs::write(
@@ -224,7 +225,7 @@ fn sqrt_key() {
 /// = 2 (b = 10) within 3 block standard errors (its 1e5 steps give about 4 %).
 #[test]
 fn fene_dumbbell_scene() {
-    let text = include_str!("../scenes/fene_dumbbell.toml");
+    let text = include_str!("../../scenes/fene_dumbbell.toml");
     let s = Scene::parse(text, "fene_dumbbell.toml").unwrap();
     assert_eq!(s.integrator.fene, Some(10f64.sqrt()));
     assert_eq!(s.bonds[0].length, 0.0);
@@ -300,19 +301,6 @@ fn rattle_stable_scene_at_temperature() {
     same_files(&one, &two, &["trajectory.xyz", "observables.csv"]);
 }
 
-/// Runs `host-demo`, which must succeed.
-fn cli(args: &[&str]) {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_host-demo"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
 /// Runs `long` in one go into `dir/one`, and `short` into `dir/two` with checkpoints
 /// every `every`, then resumes `dir/two` until `until`; returns the two folders.
 fn run_and_resume(
@@ -324,10 +312,10 @@ fn run_and_resume(
 ) -> (std::path::PathBuf, std::path::PathBuf) {
     let (one, two) = (dir.join("one"), dir.join("two"));
     let (one_s, two_s) = (one.to_str().unwrap(), two.to_str().unwrap());
-    cli(&["run", long.to_str().unwrap(), "--out", one_s]);
+    ok(&["run", long.to_str().unwrap(), "--out", one_s]);
     let short = short.to_str().unwrap();
-    cli(&["run", short, "--out", two_s, "--checkpoint-every", every]);
-    cli(&["resume", two_s, "--until", until]);
+    ok(&["run", short, "--out", two_s, "--checkpoint-every", every]);
+    ok(&["resume", two_s, "--until", until]);
     (one, two)
 }
 

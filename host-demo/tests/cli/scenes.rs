@@ -1,13 +1,10 @@
 //! Scene files: every shipped scene parses; the helix generator is exact; every bad
 //! file under `tests/data/bad/` is refused with the line its `# expect-line:` names.
 
+use crate::common::{BIN, manifest};
 use hydrorattle_host::scene::{FIGURE1_SCENES, HeadEnd, Helix, Scene};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn manifest_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn toml_files(dir: &Path) -> Vec<PathBuf> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
@@ -44,7 +41,7 @@ fn winding_number(points: &[[f64; 3]], centre: [f64; 3]) -> f64 {
 
 #[test]
 fn every_shipped_scene_parses() {
-    let files = toml_files(&manifest_dir().join("scenes"));
+    let files = toml_files(&manifest().join("scenes"));
     let names: Vec<_> = files
         .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
@@ -80,7 +77,7 @@ fn every_shipped_scene_parses() {
 
 #[test]
 fn small_scenes_have_the_described_shapes() {
-    let dir = manifest_dir().join("scenes");
+    let dir = manifest().join("scenes");
     let dimer = Scene::from_path(&dir.join("dimer.toml")).unwrap();
     assert_eq!((dimer.particles.len(), dimer.bonds.len()), (2, 1));
     assert!((dimer.bonds[0].length - 3.15).abs() < 1e-12);
@@ -124,7 +121,7 @@ fn figure1_scenes_are_the_papers_cases() {
     }
     // The embedded copies are the files on disk.
     for (_, name, text) in FIGURE1_SCENES {
-        let on_disk = std::fs::read_to_string(manifest_dir().join(name)).unwrap();
+        let on_disk = std::fs::read_to_string(manifest().join(name)).unwrap();
         assert_eq!(on_disk, text);
     }
 }
@@ -198,7 +195,7 @@ fn expectation(path: &Path) -> Expectation {
 
 #[test]
 fn bad_scenes_report_file_line_and_reason() {
-    let files = toml_files(&manifest_dir().join("tests/data/bad"));
+    let files = toml_files(&manifest().join("tests/data/bad"));
     assert!(files.len() >= 20);
     let mut failures = Vec::new();
     for path in files {
@@ -235,10 +232,10 @@ fn unreadable_file_is_an_error_without_a_line() {
 
 #[test]
 fn the_binary_exits_non_zero_on_a_bad_scene_before_writing() {
-    let bad = manifest_dir().join("tests/data/bad/negative_radius.toml");
+    let bad = manifest().join("tests/data/bad/negative_radius.toml");
     let out = std::env::temp_dir().join(format!("host-demo-bad-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let result = Command::new(env!("CARGO_BIN_EXE_host-demo"))
+    let result = Command::new(BIN)
         .arg("run")
         .arg(&bad)
         .arg("--out")
@@ -270,7 +267,7 @@ fn number_after(text: &str, before: &str) -> f64 {
 /// on the wall.
 #[test]
 fn the_shipped_pile_is_what_its_header_says() {
-    let scene = manifest_dir().join("scenes/pile.toml");
+    let scene = manifest().join("scenes/pile.toml");
     let text = std::fs::read_to_string(&scene).unwrap();
     let header: String = text
         .lines()
@@ -282,7 +279,7 @@ fn the_shipped_pile_is_what_its_header_says() {
     let spilled_said = number_after(&header, "), and");
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("shipped-pile");
     let _ = std::fs::remove_dir_all(&out);
-    let o = Command::new(env!("CARGO_BIN_EXE_host-demo"))
+    let o = Command::new(BIN)
         .arg("run")
         .arg(&scene)
         .arg("--out")

@@ -2,7 +2,7 @@
 //! its bonds held, and a scene too large for the storage limit is refused at once, at
 //! its line, before anything is written.
 
-use std::path::PathBuf;
+use crate::common::{BIN, manifest};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -10,28 +10,14 @@ use hydrorattle_host::output::read_xyz_file;
 use hydrorattle_host::scene::Scene;
 use hydrorattle_host::sim::{BuildError, RunOptions, run};
 
-fn manifest() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("host-demo-large-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
 fn cli_run(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_host-demo"))
-        .arg("run")
-        .args(args)
-        .output()
-        .unwrap()
+    Command::new(BIN).arg("run").args(args).output().unwrap()
 }
 
 #[test]
 fn a_4096_bead_helix_steps_with_its_bonds_held() {
     let scene = manifest().join("tests/data/helix4096.toml");
-    let out = scratch("helix4096");
+    let out = scratch!("helix4096");
     let o = cli_run(&[scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let summary: serde_json::Value =
@@ -65,7 +51,7 @@ fn a_4096_bead_helix_steps_with_its_bonds_held() {
 #[test]
 fn ten_million_tails_are_refused_at_once_at_their_line() {
     let scene = manifest().join("tests/data/bad/helix_too_large.toml");
-    let out = scratch("too-large");
+    let out = scratch!("too-large");
     let start = Instant::now();
     let o = cli_run(&[scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     let took = start.elapsed();
@@ -80,7 +66,7 @@ fn ten_million_tails_are_refused_at_once_at_their_line() {
 #[test]
 fn the_limit_can_be_raised_or_lowered() {
     let scene = manifest().join("scenes/figure1a.toml");
-    let out = scratch("limit");
+    let out = scratch!("limit");
     // The 25-bead chain needs tens of kB: 1 kB is too little.
     let o = cli_run(&[
         scene.to_str().unwrap(),
@@ -124,7 +110,7 @@ fn a_matrix_free_brownian_chain_runs_with_the_same_bits_on_any_threads() {
     let text = std::fs::read_to_string(manifest().join("tests/data/brownian_chain4096.toml"))
         .unwrap()
         .replace("tails = 4095", "tails = 255");
-    let dir = scratch("bd256");
+    let dir = scratch!("bd256");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("bd256.toml");
     std::fs::write(&scene, text).unwrap();

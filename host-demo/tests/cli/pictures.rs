@@ -3,30 +3,13 @@
 //! `--at` list is refused before anything runs, `run` draws its initial and final
 //! configuration, and drawing is deterministic.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use crate::common::{cli, manifest};
+use std::path::Path;
 
 use hydrorattle::observables::State;
 use hydrorattle_host::scene::Scene;
 use hydrorattle_study::pictures::{ANIMATION_FRAMES, ANIMATION_SIZE};
 use hydrorattle_study::render::{Animation, Snapshot, chain_colors, draw_timeline, write_gif};
-
-fn manifest() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("pictures-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
-fn cli(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_host-demo"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 /// Width and height from a PNG's IHDR chunk, after checking the signature.
 fn png_size(path: &Path) -> (u32, u32) {
@@ -55,7 +38,7 @@ fn gif_frames(path: &Path) -> ((u16, u16), usize) {
 
 #[test]
 fn figure1_quick_writes_every_picture() {
-    let out = scratch("figure1");
+    let out = scratch!("figure1");
     let o = cli(&[
         "figure1",
         "--quick",
@@ -99,7 +82,7 @@ fn figure1_quick_writes_every_picture() {
 #[test]
 fn a_bad_at_list_is_refused_before_anything_runs() {
     for bad in ["-1", "nan", "inf", "400.5", "1,2,x", "", "1,,2"] {
-        let out = scratch("bad-at");
+        let out = scratch!("bad-at");
         let o = cli(&[
             "figure1",
             "--quick",
@@ -117,7 +100,7 @@ fn a_bad_at_list_is_refused_before_anything_runs() {
 
 #[test]
 fn run_draws_the_initial_and_final_configuration() {
-    let out = scratch("run");
+    let out = scratch!("run");
     let scene = manifest().join("scenes").join("tree.toml");
     let o = cli(&[
         "run",
@@ -134,7 +117,7 @@ fn run_draws_the_initial_and_final_configuration() {
 
 #[test]
 fn drawing_is_deterministic() {
-    let dir = scratch("deterministic");
+    let dir = scratch!("deterministic");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = &Scene::figure1().unwrap()[2].1;
     let frames: Vec<Snapshot> = (0..12)
@@ -187,7 +170,7 @@ const WALL_SCENE: &str = "[wall]\nheight = -2.5\n\n\
 /// without (the geometry is `render::panel`'s unit test).
 #[test]
 fn a_wall_scene_s_pictures_draw_the_wall() {
-    let out = scratch("wall");
+    let out = scratch!("wall");
     std::fs::create_dir_all(&out).unwrap();
     let path = out.join("landing.toml");
     std::fs::write(&path, WALL_SCENE).unwrap();
@@ -227,7 +210,7 @@ fn a_wall_scene_s_pictures_draw_the_wall() {
 /// than its coordinates' spacing (about 2 there): a shorter one is refused.
 #[test]
 fn a_sphere_far_from_the_origin_is_skipped_not_drawn_forever() {
-    let dir = scratch("far-sphere");
+    let dir = scratch!("far-sphere");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("far.toml");
     let text = "[[particle]]\nposition = [1e16, 1e16, 1e16]\nradius = 1.0\n\n\

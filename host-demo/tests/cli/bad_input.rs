@@ -3,24 +3,15 @@
 //! second (limits are checked before any work). Faults while writing (a full disk, a
 //! read-only folder) name the file and leave no `*.tmp` behind.
 
+use crate::common::{BIN, manifest};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-fn manifest() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("bad-input-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
 /// Runs `host-demo run SCENE --out OUT`; the output and the wall time.
 fn run(scene: &Path, out: &Path, extra: &[&str]) -> (Output, Duration) {
     let t = Instant::now();
-    let o = Command::new(env!("CARGO_BIN_EXE_host-demo"))
+    let o = Command::new(BIN)
         .arg("run")
         .arg(scene)
         .arg("--out")
@@ -85,7 +76,7 @@ fn every_bad_scene_is_refused_at_its_line_within_a_second_and_writes_nothing() {
     files.sort();
     assert!(files.len() >= 40, "{} bad scenes", files.len());
     for (k, path) in files.iter().enumerate() {
-        let out = scratch(&format!("scene-{k}"));
+        let out = scratch!(&format!("scene-{k}"));
         let (o, took) = run(path, &out, &[]);
         assert_refused(&o, path, Some(expect_line(path)));
         assert!(
@@ -99,7 +90,7 @@ fn every_bad_scene_is_refused_at_its_line_within_a_second_and_writes_nothing() {
 
 #[test]
 fn invalid_utf8_is_refused_at_its_line() {
-    let dir = scratch("utf8");
+    let dir = scratch!("utf8");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("latin1.toml");
     let text = b"[helix]\ntails = 3\n\n# caf\xe9 au lait\n[integrator]\nmethod = \"overdamped\"\ndt = 0.01\nduration = 1.0\n";
@@ -119,7 +110,7 @@ fn a_full_disk_names_the_file_and_leaves_no_tmp_and_no_folder_of_its_own() {
     }
     // The trajectory's temporary name points at /dev/full: every write fails with
     // "no space left on device", as on a full disk.
-    let out = scratch("full");
+    let out = scratch!("full");
     std::fs::create_dir_all(&out).unwrap();
     std::os::unix::fs::symlink("/dev/full", out.join("trajectory.xyz.tmp")).unwrap();
     let scene = manifest().join("scenes/dimer.toml");
@@ -132,7 +123,7 @@ fn a_full_disk_names_the_file_and_leaves_no_tmp_and_no_folder_of_its_own() {
 
 #[test]
 fn a_read_only_folder_names_the_file_and_leaves_nothing() {
-    let out = scratch("read-only");
+    let out = scratch!("read-only");
     std::fs::create_dir_all(&out).unwrap();
     let lock = |on: bool| {
         // chmod stops a normal user; root needs the immutable flag as well.
@@ -162,7 +153,7 @@ fn a_read_only_folder_names_the_file_and_leaves_nothing() {
 
 #[test]
 fn an_output_path_that_is_a_file_is_refused_by_name() {
-    let dir = scratch("file-out");
+    let dir = scratch!("file-out");
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("not-a-folder");
     std::fs::write(&out, b"x").unwrap();

@@ -2,21 +2,13 @@
 //! give byte-identical point folders; a killed shard rerun completes only what is
 //! missing; the phase map as a sweep reproduces `phase`'s outcomes.
 
+use crate::common::{BIN, cli, text};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
 use hydrorattle_host::scene::{Helix, Scene};
 use hydrorattle_host::sweep::Sweep;
-
-const BIN: &str = env!("CARGO_BIN_EXE_host-demo");
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("host-demo-sweep-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
@@ -40,26 +32,11 @@ fn sweep_file_on(dir: &Path, name: &str, base: &str, body: &str) -> PathBuf {
     path
 }
 
-fn host_demo(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("host-demo runs")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
 /// The error of a bad sweep file: at `name:line:`, and no folder written.
 fn refused(dir: &Path, name: &str, body: &str, line: usize, says: &str) {
     let file = sweep_file(dir, name, body);
     let out = dir.join(format!("{name}.out"));
-    let o = host_demo(&[
+    let o = cli(&[
         "sweep",
         file.to_str().unwrap(),
         "--out",
@@ -78,7 +55,7 @@ fn refused(dir: &Path, name: &str, body: &str, line: usize, says: &str) {
 
 #[test]
 fn bad_sweep_files_are_refused_at_their_line_before_anything_runs() {
-    let dir = scratch("bad");
+    let dir = empty_dir!("bad");
     // Line 1 is [sweep], line 2 the base.
     refused(
         &dir,
@@ -190,11 +167,11 @@ fn collected(dir: &Path) -> Vec<String> {
 
 #[test]
 fn two_shards_in_parallel_give_what_one_process_gives() {
-    let dir = scratch("shards");
+    let dir = empty_dir!("shards");
     let file = sweeps().join("small.toml");
     let file = file.to_str().unwrap();
     let (one, two) = (dir.join("one"), dir.join("two"));
-    let o = host_demo(&["sweep", file, "--out", one.to_str().unwrap()]);
+    let o = cli(&["sweep", file, "--out", one.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
     let shard = |k: &str| {
         Command::new(BIN)
@@ -214,7 +191,7 @@ fn two_shards_in_parallel_give_what_one_process_gives() {
     let (mut a, mut b) = (shard("0/2"), shard("1/2"));
     assert!(a.wait().unwrap().success() && b.wait().unwrap().success());
     for d in [&one, &two] {
-        let o = host_demo(&["collect", d.to_str().unwrap()]);
+        let o = cli(&["collect", d.to_str().unwrap()]);
         assert!(o.status.success(), "{}", text(&o));
     }
     let files = same_points(&one, &two);
@@ -255,7 +232,7 @@ fn a_killed_brownian_shard_resumes_to_the_same_bits() {
 /// finished and another is midway, then rerun: only the missing points run, at least
 /// one resumes from its checkpoint, and every file equals the whole run's.
 fn killed_and_rerun(name: &str, base: &str, body: &str, every: &str) {
-    let dir = scratch(name);
+    let dir = empty_dir!(name);
     let file = sweep_file_on(&dir, "kill.toml", base, body);
     let file = file.to_str().unwrap();
     let (whole, killed) = (dir.join("whole"), dir.join("killed"));
@@ -357,18 +334,18 @@ fn the_phase_sweep_is_the_phase_grid() {
 
 #[test]
 fn sweep_and_collect_reproduce_the_phase_outcomes() {
-    let dir = scratch("phase");
+    let dir = empty_dir!("phase");
     hydrorattle_study::phase::phase(&dir.join("phase"), 6, None).unwrap();
     let file = sweeps().join("phase.toml");
     let out = dir.join("sweep");
-    let o = host_demo(&[
+    let o = cli(&[
         "sweep",
         file.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", text(&o));
-    let o = host_demo(&["collect", out.to_str().unwrap()]);
+    let o = cli(&["collect", out.to_str().unwrap()]);
     let phase = std::fs::read_to_string(dir.join("phase/phase.csv")).unwrap();
     let want: BTreeMap<(String, String), String> = phase
         .lines()
@@ -406,7 +383,7 @@ fn sweep_and_collect_reproduce_the_phase_outcomes() {
 fn a_point_with_level_auto_is_finished_once_run() {
     // Its scene.toml is written with the auto choice applied, as the run records it, so
     // the second invocation finds it finished.
-    let dir = scratch("auto");
+    let dir = empty_dir!("auto");
     let path = dir.join("auto.toml");
     let base = scenes().join("dimer.toml");
     let file = format!(
@@ -416,7 +393,7 @@ fn a_point_with_level_auto_is_finished_once_run() {
     std::fs::write(&path, file).unwrap();
     let out = dir.join("out");
     let run = || {
-        host_demo(&[
+        cli(&[
             "sweep",
             path.to_str().unwrap(),
             "--out",

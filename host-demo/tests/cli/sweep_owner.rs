@@ -5,42 +5,16 @@
 //! anything is written; SIGTERM checkpoints a sweep, which then ends equal to a clean
 //! run; bad sweep files are said at their line.
 
+use crate::common::{BIN, cli, ok, text};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-const BIN: &str = env!("CARGO_BIN_EXE_host-demo");
-
-fn scratch(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("sweep-owner-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenes")
         .join(name)
-}
-
-fn host_demo(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = host_demo(args);
-    assert!(o.status.success(), "{args:?}: {}", text(&o));
-    text(&o)
 }
 
 /// A sweep file `name` in `dir` over `base` with `body` after `[sweep]`.
@@ -101,7 +75,7 @@ fn same_points(a: &Path, b: &Path) -> usize {
 
 #[test]
 fn a_second_sweep_into_one_folder_is_refused_and_the_first_stays_byte_for_byte() {
-    let dir = scratch("two");
+    let dir = empty_dir!("two");
     let body = "\"integrator.duration\" = [2.0]\n\"integrator.dt\" = [0.1, 0.05]\n";
     let chain = sweep_file(&dir, "chain.toml", &scene("figure1a.toml"), body);
     // The same parameters over a dimer: the same ids, other scenes.
@@ -112,7 +86,7 @@ fn a_second_sweep_into_one_folder_is_refused_and_the_first_stays_byte_for_byte()
     let before = files(&out);
     for other in [&dimer, &chain] {
         // The second: refused; the first again (a rerun of the same sweep): finished.
-        let o = host_demo(&["sweep", other.to_str().unwrap(), "--out", out_s]);
+        let o = cli(&["sweep", other.to_str().unwrap(), "--out", out_s]);
         if other == &dimer {
             assert_eq!(o.status.code(), Some(1), "{}", text(&o));
             let said = text(&o);
@@ -124,13 +98,11 @@ fn a_second_sweep_into_one_folder_is_refused_and_the_first_stays_byte_for_byte()
             );
             // --emit and --point are refused alike.
             for extra in [&["--emit", "slurm"][..], &["--shard", "0/2"][..]] {
-                let o = host_demo(
-                    &[
-                        &["sweep", other.to_str().unwrap(), "--out", out_s][..],
-                        extra,
-                    ]
-                    .concat(),
-                );
+                let o = cli(&[
+                    &["sweep", other.to_str().unwrap(), "--out", out_s][..],
+                    extra,
+                ]
+                .concat());
                 assert!(
                     !o.status.success() && text(&o).contains("holds another sweep"),
                     "{extra:?}: {}",
@@ -166,7 +138,7 @@ fn a_second_sweep_into_one_folder_is_refused_and_the_first_stays_byte_for_byte()
 
 #[test]
 fn points_run_with_the_values_emitted_whatever_the_base_becomes() {
-    let dir = scratch("frozen");
+    let dir = empty_dir!("frozen");
     let base = dir.join("base.toml");
     std::fs::copy(scene("figure1a.toml"), &base).unwrap();
     let body = "\"integrator.duration\" = [2.0]\n\"helix.dhat\" = [1.05, 1.5]\n\"integrator.dt\" = [0.1, 0.05]\n";
@@ -193,7 +165,7 @@ fn points_run_with_the_values_emitted_whatever_the_base_becomes() {
     assert!(edited.contains("viscosity = 3.0"));
     std::fs::write(&base, edited).unwrap();
     // The sweep file now gives other scenes: refused in the emitted folder.
-    let o = host_demo(&[
+    let o = cli(&[
         "sweep",
         file.to_str().unwrap(),
         "--out",
@@ -233,7 +205,7 @@ fn points_run_with_the_values_emitted_whatever_the_base_becomes() {
         .unwrap()
         .replace("viscosity = 1.0", "viscosity = 2.0");
     std::fs::write(&frozen, f).unwrap();
-    let o = host_demo(&["sweep", "--frozen", "--out", out.to_str().unwrap()]);
+    let o = cli(&["sweep", "--frozen", "--out", out.to_str().unwrap()]);
     let said = text(&o);
     assert_eq!(o.status.code(), Some(1), "{said}");
     assert!(
@@ -250,7 +222,7 @@ fn points_run_with_the_values_emitted_whatever_the_base_becomes() {
 
 #[test]
 fn nonsense_job_settings_are_refused_before_anything_is_written() {
-    let dir = scratch("nonsense");
+    let dir = empty_dir!("nonsense");
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/small.toml");
     let out = dir.join("out");
     for (args, says) in [
@@ -261,20 +233,18 @@ fn nonsense_job_settings_are_refused_before_anything_is_written() {
         (&["--qos", "a b"][..], "--qos"),
         (&["--throttle", "0"][..], "--throttle 0"),
     ] {
-        let o = host_demo(
+        let o = cli(&[
             &[
-                &[
-                    "sweep",
-                    file.to_str().unwrap(),
-                    "--out",
-                    out.to_str().unwrap(),
-                    "--emit",
-                    "slurm",
-                ][..],
-                args,
-            ]
-            .concat(),
-        );
+                "sweep",
+                file.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--emit",
+                "slurm",
+            ][..],
+            args,
+        ]
+        .concat());
         assert!(
             !o.status.success() && text(&o).contains(says),
             "{args:?}: {}",
@@ -341,7 +311,7 @@ fn nonsense_job_settings_are_refused_before_anything_is_written() {
 /// SLURM accepts (`infinite`, `4GB`) are taken.
 #[test]
 fn emit_dry_run_previews_the_script_with_the_options_given() {
-    let dir = scratch("preview");
+    let dir = empty_dir!("preview");
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/small.toml");
     let out = dir.join("out");
     let args = [
@@ -365,7 +335,7 @@ fn emit_dry_run_previews_the_script_with_the_options_given() {
         "--sbatch-arg",
         "--exclusive",
     ];
-    let o = host_demo(&[&args[..], &["--dry-run"]].concat());
+    let o = cli(&[&args[..], &["--dry-run"]].concat());
     assert!(o.status.success(), "{}", text(&o));
     let printed = String::from_utf8(o.stdout.clone()).unwrap();
     assert!(!out.exists(), "--dry-run wrote something");
@@ -392,7 +362,7 @@ fn emit_dry_run_previews_the_script_with_the_options_given() {
         printed
     );
     // An option the script sets itself is refused, naming the flag that sets it.
-    let o = host_demo(&[&args[..], &["--sbatch-arg=--time=10", "--dry-run"]].concat());
+    let o = cli(&[&args[..], &["--sbatch-arg=--time=10", "--dry-run"]].concat());
     assert!(
         !o.status.success() && text(&o).contains("set by --time"),
         "{}",
@@ -406,7 +376,7 @@ fn emit_dry_run_previews_the_script_with_the_options_given() {
 /// `sbatch --array` line, and the rerun ends equal to a clean run.
 #[test]
 fn sigterm_checkpoints_a_sweep_that_then_ends_as_a_clean_run() {
-    let dir = scratch("sigterm");
+    let dir = empty_dir!("sigterm");
     let body = "\"integrator.duration\" = [300.0]\n\"helix.dhat\" = [1.05, 1.2, 1.35]\n";
     let file = sweep_file(&dir, "long.toml", &scene("figure1a.toml"), body);
     let (clean, out) = (dir.join("clean"), dir.join("out"));
@@ -472,7 +442,7 @@ fn sigterm_checkpoints_a_sweep_that_then_ends_as_a_clean_run() {
                 && said.contains("not started (run again to go on)"),
             "{said}"
         );
-        let c = host_demo(&["collect", out.to_str().unwrap()]);
+        let c = cli(&["collect", out.to_str().unwrap()]);
         let listed = text(&c);
         assert!(!c.status.success());
         assert!(
@@ -496,7 +466,7 @@ fn sigterm_checkpoints_a_sweep_that_then_ends_as_a_clean_run() {
 /// A bad sweep file, said at `FILE:LINE:` with `says`, nothing written.
 fn refused_at(file: &Path, line: usize, says: &str) {
     let out = file.with_extension("out");
-    let o = host_demo(&[
+    let o = cli(&[
         "sweep",
         file.to_str().unwrap(),
         "--out",
@@ -514,7 +484,7 @@ fn refused_at(file: &Path, line: usize, says: &str) {
 
 #[test]
 fn circular_bases_misspellings_and_equal_numbers_are_said_at_their_line() {
-    let dir = scratch("messages");
+    let dir = empty_dir!("messages");
     let dimer = scene("dimer.toml");
     let w = |name: &str, text: String| {
         let p = dir.join(name);

@@ -1,22 +1,12 @@
 //! End-to-end runs: every shipped scene runs, the files of a run are whole and
 //! consistent, and a bad scene stops the CLI with file and line before any output.
 
+use crate::common::{cli, manifest};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use hydrorattle_host::output::read_xyz_file;
 use hydrorattle_host::scene::Scene;
 use hydrorattle_host::sim::{COLUMNS, RunOptions, run};
-
-fn manifest() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("host-demo-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
 
 #[test]
 fn every_shipped_scene_runs_and_writes_whole_files() {
@@ -24,7 +14,7 @@ fn every_shipped_scene_runs_and_writes_whole_files() {
         let path = entry.unwrap().path();
         let scene = Scene::from_path(&path).unwrap();
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let out = scratch(&name);
+        let out = scratch!(&name);
         let opts = RunOptions {
             progress: false,
             max_steps: Some(300),
@@ -69,13 +59,6 @@ fn every_shipped_scene_runs_and_writes_whole_files() {
     }
 }
 
-fn cli(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_host-demo"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
 #[test]
 fn a_bad_scene_stops_the_cli_with_file_and_line_before_any_output() {
     let bad = manifest().join("tests/data/bad");
@@ -85,7 +68,7 @@ fn a_bad_scene_stops_the_cli_with_file_and_line_before_any_output() {
         if path.extension().is_none_or(|e| e != "toml") {
             continue;
         }
-        let out = scratch(&format!("bad-{checked}"));
+        let out = scratch!(&format!("bad-{checked}"));
         let o = cli(&[
             "run",
             path.to_str().unwrap(),
@@ -108,7 +91,7 @@ fn a_bad_scene_stops_the_cli_with_file_and_line_before_any_output() {
 
 #[test]
 fn figure1_quick_writes_its_picture_and_table() {
-    let out = scratch("figure1");
+    let out = scratch!("figure1");
     let o = cli(&["figure1", "--quick", "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.join("figure1.png").metadata().unwrap().len() > 10_000);
@@ -141,7 +124,7 @@ fn figure1_quick_writes_its_picture_and_table() {
 /// Writes `text` as `name.toml` in a fresh scratch folder and runs it: the output, the
 /// output folder.
 fn run_text(name: &str, text: &str) -> (std::process::Output, PathBuf) {
-    let dir = scratch(name);
+    let dir = scratch!(name);
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join(format!("{name}.toml"));
     std::fs::write(&scene, text).unwrap();

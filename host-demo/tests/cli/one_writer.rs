@@ -4,12 +4,12 @@
 //! A point held by another process is skipped and said, or waited for with `--wait`;
 //! a plain `run` into a folder another process writes is refused before it writes.
 
+use crate::common::{BIN, text};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 
 use hydrorattle_host::output::FolderLock;
 
-const BIN: &str = env!("CARGO_BIN_EXE_host-demo");
 const DATA: [&str; 5] = [
     "observables.csv",
     "trajectory.xyz",
@@ -18,23 +18,8 @@ const DATA: [&str; 5] = [
     "signac_statepoint.json",
 ];
 
-fn scratch(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("one-writer-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
 fn small() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/small.toml")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 fn sweep(out: &Path, id: &str) -> Command {
@@ -78,7 +63,7 @@ fn collect(dir: &Path) -> (bool, String) {
 
 #[test]
 fn two_processes_on_one_point_end_as_one_clean_run_twenty_times_over() {
-    let root = scratch("twice");
+    let root = empty_dir!("twice");
     let id = first_point();
     let clean = root.join("clean");
     let o = sweep(&clean, &id).output().unwrap();
@@ -128,7 +113,7 @@ fn two_processes_on_one_point_end_as_one_clean_run_twenty_times_over() {
 
 #[test]
 fn collect_reports_a_cut_trajectory_corrupt_not_done() {
-    let root = scratch("cut");
+    let root = empty_dir!("cut");
     let id = first_point();
     let o = sweep(&root, &id).output().unwrap();
     assert!(o.status.success(), "{}", text(&o));
@@ -149,7 +134,7 @@ fn collect_reports_a_cut_trajectory_corrupt_not_done() {
 
 #[test]
 fn a_run_into_a_folder_another_process_writes_is_refused_before_it_writes() {
-    let out = scratch("run-locked");
+    let out = empty_dir!("run-locked");
     let held = FolderLock::take(&out).unwrap();
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/dimer.toml");
     let run = || {
@@ -177,7 +162,7 @@ fn a_run_into_a_folder_another_process_writes_is_refused_before_it_writes() {
 
 #[test]
 fn a_locked_point_is_skipped_and_said_or_waited_for_with_wait() {
-    let root = scratch("held");
+    let root = empty_dir!("held");
     let id = first_point();
     let point = root.join("points").join(&id);
     std::fs::create_dir_all(&point).unwrap();
@@ -226,7 +211,7 @@ fn flip_a_byte(path: &Path) {
 /// run's, and `collect` then reports it done.
 #[test]
 fn a_damaged_finished_point_runs_again_from_the_start() {
-    let root = scratch("damaged");
+    let root = empty_dir!("damaged");
     let clean = root.join("clean");
     let o = Command::new(BIN)
         .arg("sweep")
@@ -297,7 +282,7 @@ fn a_damaged_finished_point_runs_again_from_the_start() {
 /// `running`, not unfinished, and the `sbatch` line to run again leaves its task out.
 #[test]
 fn collect_reports_a_locked_point_running_not_to_be_resubmitted() {
-    let root = scratch("running");
+    let root = empty_dir!("running");
     let o = Command::new(BIN)
         .arg("sweep")
         .arg(small())

@@ -2,30 +2,9 @@
 //! re-runs to the same bytes, `observables.csv` ends where the summary ends, and a run
 //! to `T` resumed to `2 T` writes the same bytes as one run to `2 T`.
 
-use std::path::{Path, PathBuf};
+use crate::common::{BIN, manifest, ok};
+use std::path::Path;
 use std::process::Command;
-
-fn manifest() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("record-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
-fn cli(args: &[&str]) {
-    let o = Command::new(env!("CARGO_BIN_EXE_host-demo"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
 
 fn run(scene: &Path, out: &Path, extra: &[&str]) {
     let mut args = vec![
@@ -35,7 +14,7 @@ fn run(scene: &Path, out: &Path, extra: &[&str]) {
         out.to_str().unwrap(),
     ];
     args.extend_from_slice(extra);
-    cli(&args);
+    ok(&args);
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -51,7 +30,7 @@ const TRAJECTORY_FILES: [&str; 3] = ["trajectory.xyz", "trajectory.gsd", "observ
 #[test]
 fn the_summary_records_what_a_rerun_needs() {
     let scene = manifest().join("scenes/dimer.toml");
-    let out = scratch("summary");
+    let out = scratch!("summary");
     run(&scene, &out, &[]);
     let s = json(&out.join("summary.json"));
     for key in [
@@ -80,7 +59,7 @@ fn the_summary_records_what_a_rerun_needs() {
 #[test]
 fn the_last_row_of_the_observables_is_the_summary_s_final_observables() {
     // A step count that is not a multiple of `every`: the last frame is off schedule.
-    let dir = scratch("last-row");
+    let dir = scratch!("last-row");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("odd.toml");
     let text = std::fs::read_to_string(manifest().join("scenes/dimer.toml")).unwrap();
@@ -124,9 +103,9 @@ fn the_resolved_scene_reruns_to_the_same_bytes() {
         ("helix", "scenes/figure1c.toml"),
         ("explicit", "scenes/tree.toml"),
     ] {
-        let first = scratch(&format!("first-{name}"));
+        let first = scratch!(&format!("first-{name}"));
         run(&manifest().join(scene), &first, &[]);
-        let again = scratch(&format!("again-{name}"));
+        let again = scratch!(&format!("again-{name}"));
         run(&first.join("scene.toml"), &again, &[]);
         for f in TRAJECTORY_FILES.iter().chain(&["scene.toml"]) {
             assert!(bytes(&first, f) == bytes(&again, f), "{name}: {f} differs");
@@ -137,7 +116,7 @@ fn the_resolved_scene_reruns_to_the_same_bytes() {
 #[test]
 fn a_run_resumed_from_its_checkpoint_writes_the_same_bytes_as_one_run() {
     // An inertial scene with initial velocities, ending off the frame schedule at T.
-    let dir = scratch("restart");
+    let dir = scratch!("restart");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("spin.toml");
     std::fs::write(
@@ -161,7 +140,7 @@ fn a_run_resumed_from_its_checkpoint_writes_the_same_bytes_as_one_run() {
     run(&scene, &two, &["--checkpoint-every", "4"]);
     let c = json(&two.join("checkpoint.json"));
     assert_eq!(c["step"], 400);
-    cli(&["resume", two.to_str().unwrap(), "--until", "8"]);
+    ok(&["resume", two.to_str().unwrap(), "--until", "8"]);
     for f in TRAJECTORY_FILES {
         assert!(bytes(&one, f) == bytes(&two, f), "{f} differs after resume");
     }
@@ -195,7 +174,7 @@ fn as_if_killed(dir: &Path) {
 fn a_killed_run_resumes_from_the_files_it_left() {
     // A killed run leaves its files under their temporary names, with frames past the
     // checkpoint: resume cuts them back and continues, to the bytes of one run.
-    let dir = scratch("killed");
+    let dir = scratch!("killed");
     std::fs::create_dir_all(&dir).unwrap();
     let text = std::fs::read_to_string(manifest().join("scenes/ring.toml")).unwrap();
     let scene = |name: &str, duration: &str| {
@@ -215,7 +194,7 @@ fn a_killed_run_resumes_from_the_files_it_left() {
         &["--checkpoint-every", "2"],
     );
     as_if_killed(&killed);
-    cli(&["resume", killed.to_str().unwrap(), "--until", "4"]);
+    ok(&["resume", killed.to_str().unwrap(), "--until", "4"]);
     for f in TRAJECTORY_FILES {
         assert!(bytes(&one, f) == bytes(&killed, f), "{f} differs");
         assert!(!killed.join(format!("{f}.tmp")).exists());
@@ -230,7 +209,7 @@ fn a_run_killed_after_a_checkpoint_on_its_last_step_resumes_to_one_run() {
     // finished by `resume --until` its own end, with the closing row of the
     // uninterrupted run (that step's iterations and tension, not zeros), and goes on
     // from there as one longer run.
-    let dir = scratch("last-step");
+    let dir = scratch!("last-step");
     std::fs::create_dir_all(&dir).unwrap();
     let text = std::fs::read_to_string(manifest().join("scenes/dimer.toml")).unwrap();
     let scene = |name: &str, duration: &str| {
@@ -254,7 +233,7 @@ fn a_run_killed_after_a_checkpoint_on_its_last_step_resumes_to_one_run() {
     assert_eq!(json(&killed.join("checkpoint.json"))["step"], 95);
     std::fs::remove_file(killed.join("summary.json")).unwrap();
     as_if_killed(&killed);
-    cli(&["resume", killed.to_str().unwrap(), "--until", "0.95"]);
+    ok(&["resume", killed.to_str().unwrap(), "--until", "0.95"]);
     let rows = String::from_utf8(bytes(&killed, "observables.csv")).unwrap();
     let last: Vec<&str> = rows.lines().last().unwrap().split(',').collect();
     assert!(
@@ -263,7 +242,7 @@ fn a_run_killed_after_a_checkpoint_on_its_last_step_resumes_to_one_run() {
     );
     for (done, until) in [(&one, "0.95"), (&longer, "1.33")] {
         if until != "0.95" {
-            cli(&["resume", killed.to_str().unwrap(), "--until", until]);
+            ok(&["resume", killed.to_str().unwrap(), "--until", until]);
         }
         for f in TRAJECTORY_FILES {
             assert!(
@@ -291,7 +270,7 @@ fn a_run_killed_after_a_checkpoint_on_its_last_step_resumes_to_one_run() {
 /// file is touched (no migration).
 #[test]
 fn a_run_of_an_older_version_is_refused_with_the_columns_named() {
-    let old = scratch("older");
+    let old = scratch!("older");
     run(
         &manifest().join("scenes/dimer.toml"),
         &old,
@@ -332,7 +311,7 @@ fn a_run_of_an_older_version_is_refused_with_the_columns_named() {
     assert!(m.unknown.is_empty());
     assert_eq!(m.found.len(), 21);
     // The command line says the same, and nothing changed.
-    let o = Command::new(env!("CARGO_BIN_EXE_host-demo"))
+    let o = Command::new(BIN)
         .args(["resume", old.to_str().unwrap(), "--until", "40"])
         .output()
         .unwrap();

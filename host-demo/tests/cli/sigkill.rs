@@ -4,39 +4,13 @@
 //! (trajectories, observables and `scene.toml`; `summary.json` differs by its wall time,
 //! machine and `resumed_from`). `resume` reads the scene under the limits `run` applies.
 
+use crate::common::{BIN, SAME, ok};
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const BIN: &str = env!("CARGO_BIN_EXE_host-demo");
-
-/// The files a resumed run writes to the bytes of one run.
-const SAME: [&str; 4] = [
-    "trajectory.xyz",
-    "trajectory.gsd",
-    "observables.csv",
-    "scene.toml",
-];
-
-fn scratch(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("sigkill-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn ok(args: &[&str]) {
-    let o = Command::new(BIN).args(args).output().unwrap();
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
-#[path = "../../tests/common/fuzz.rs"]
-mod fuzz;
+use crate::fuzz;
 
 /// The fuzzers' deterministic generator: the test draws the same scenes and kill times
 /// on every machine.
@@ -193,7 +167,7 @@ fn kill_and_resume(dir: &Path, spec: &Spec, draw: &mut Draw, k: usize, at: u64) 
 
 #[test]
 fn a_run_killed_with_sigkill_resumes_to_the_bytes_of_one_run() {
-    let dir = scratch("chain");
+    let dir = empty_dir!("chain");
     let spec = Spec {
         method: "rattle-stable",
         n: 6,
@@ -239,7 +213,7 @@ fn killed_runs_of_random_scenes_resume_to_the_bytes_of_one_run() {
         let k = if steps.is_multiple_of(k) { k + 2 } else { k };
         let at = (draw.int(1, 5) * k as u64).min((steps / k * k) as u64);
         eprintln!("case {case}: {spec:?}, checkpoints every {k} steps, killed after {at}");
-        let dir = scratch(&format!("random-{case}"));
+        let dir = empty_dir!(&format!("random-{case}"));
         if kill_and_resume(&dir, &spec, &mut draw, k, at) == Kill::Midway {
             midway += 1;
         }
@@ -303,7 +277,7 @@ fn refused(args: &[&str]) -> String {
 /// and says so at `scene.toml`, before any file is touched.
 #[test]
 fn resume_applies_the_output_limits_of_run() {
-    let dir = scratch("limits");
+    let dir = empty_dir!("limits");
     let out = small_run(&dir, 3, 400, &["--checkpoint-every", "2"]);
     let out_s = out.to_str().unwrap();
     let before = std::fs::read(out.join("observables.csv")).unwrap();
@@ -343,7 +317,7 @@ fn resume_applies_the_output_limits_of_run() {
 /// so, naming the checkpoint.
 #[test]
 fn a_run_without_a_checkpoint_is_refused_by_name() {
-    let dir = scratch("none");
+    let dir = empty_dir!("none");
     let out = small_run(&dir, 2, 100, &[]);
     let e = hydrorattle_host::sim::resume(&out, 2.0, Default::default(), Default::default())
         .unwrap_err();

@@ -6,24 +6,15 @@
 //! a solver that needs the assembled mobility stop the run at its file and line before
 //! any output.
 
-use std::path::{Path, PathBuf};
+use crate::common::{BIN, manifest};
+use std::path::Path;
 use std::process::Command;
 
 use hydrorattle_host::output::read_xyz_file;
 use hydrorattle_host::scene::Scene;
 
-fn manifest() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("host-demo-periodic-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
 fn demo_run(scene: &Path, out: &Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_host-demo"))
+    Command::new(BIN)
         .arg("run")
         .arg(scene)
         .arg("--out")
@@ -84,7 +75,7 @@ fn periodic_scenes_run_and_give_the_box_in_both_formats() {
         let path = manifest().join("scenes").join(format!("{name}.toml"));
         let scene = Scene::from_path(&path).unwrap();
         let cell = scene.periodic.unwrap().size;
-        let out = scratch(name);
+        let out = scratch!(name);
         let r = demo_run(&path, &out);
         assert!(
             r.status.success(),
@@ -153,7 +144,7 @@ fn periodic_scenes_run_and_give_the_box_in_both_formats() {
 
 #[test]
 fn a_run_without_a_box_writes_no_box() {
-    let out = scratch("dimer");
+    let out = scratch!("dimer");
     let r = demo_run(&manifest().join("scenes/dimer.toml"), &out);
     assert!(r.status.success());
     let xyz = std::fs::read_to_string(out.join("trajectory.xyz")).unwrap();
@@ -171,7 +162,7 @@ fn a_run_without_a_box_writes_no_box() {
 /// before any output.
 #[test]
 fn pse_runs_and_matches_ewald_or_stops_at_its_line() {
-    let dir = scratch("pse");
+    let dir = scratch!("pse");
     std::fs::create_dir_all(&dir).unwrap();
     let chain = manifest().join("scenes/periodic_chain.toml");
     let text = std::fs::read_to_string(&chain).unwrap();
