@@ -7,7 +7,7 @@
 
 use std::collections::TryReserveError;
 
-use hydrorattle::{Bond, Layout, Real, Workspace};
+use hydrorattle::{Bond, Layout, Noise, Real, State, Workspace};
 
 /// Heap storage holding a [`Layout`]: built element by element on the heap, so no
 /// size ever passes through the stack.
@@ -73,5 +73,55 @@ impl<T: Real> Buffers<T> {
             &mut self.indices,
         )
         .with_links(&mut self.links)
+    }
+}
+
+/// A particle state on the heap: the arrays a [`State`] borrows, owned, for hosts,
+/// tests and examples that size their systems at run time.
+#[derive(Clone, Debug)]
+pub struct Spheres<T: Real> {
+    /// Centres.
+    pub pos: Vec<T::V3>,
+    /// Translational velocities.
+    pub vel: Vec<T::V3>,
+    /// Angular velocities.
+    pub omega: Vec<T::V3>,
+    /// Radii.
+    pub radius: Vec<T>,
+    /// Material densities.
+    pub density: Vec<T>,
+    /// Simulated time.
+    pub time: T,
+    /// The thermal noise's generator, when the steps draw noise.
+    pub noise: Option<Noise>,
+}
+
+impl<T: Real> Spheres<T> {
+    /// Spheres at `pos` with radii `radius` and densities `density`, at rest at time
+    /// zero, without a noise generator.
+    pub fn at_rest(pos: Vec<T::V3>, radius: Vec<T>, density: Vec<T>) -> Self {
+        let n = pos.len();
+        Self {
+            pos,
+            vel: vec![T::V3_ZERO; n],
+            omega: vec![T::V3_ZERO; n],
+            radius,
+            density,
+            time: T::ZERO,
+            noise: None,
+        }
+    }
+
+    /// The state a step takes, every array borrowed.
+    pub fn state(&mut self) -> State<'_, T> {
+        State {
+            pos: &mut self.pos,
+            vel: &mut self.vel,
+            omega: &mut self.omega,
+            radius: &self.radius,
+            density: &self.density,
+            time: &mut self.time,
+            noise: self.noise.as_mut(),
+        }
     }
 }

@@ -16,7 +16,7 @@
 //! ```
 //!
 //! The bands and the order of every sum depend on the bead count alone, so a run gives
-//! the same bits on any number of threads (tested in `tests/bits.rs`).
+//! the same bits on any number of threads (tested in `tests/parallel/bits.rs`).
 //!
 //! **The pool** ([`pool`]) is this crate's own, shaped for the kernel's many short
 //! rounds: the thread that steps is one of the pool's threads (`Threads::new(t)` spawns

@@ -8,7 +8,7 @@
 //! Rust arithmetic in the same order, only with wider registers (and VEX encodings)
 //! available. Rust never contracts `a * b + c` into a fused multiply-add (nor does this
 //! module enable `fma`), and AVX2's `f64`/`f32` lanes round as SSE2's do, so every
-//! output has the portable build's bits (`tests/block.rs` compares them).
+//! output has the portable build's bits (`tests/parallel/block.rs` compares them).
 //!
 //! **The `unsafe`.** Calling a `target_feature` function from code compiled without the
 //! feature is `unsafe`: the caller must know the CPU has it. Each call here is made

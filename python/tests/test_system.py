@@ -18,7 +18,7 @@ RHO = 4.5  # a lone unit sphere settles at speed 1 under |g| = 1, eta = 1
 
 def dimer_rate(a1, a2, d, drho_g=RHO, eta=1.0):
     """Turning rate C of a settling rigid dimer (far-field RPY), derived in
-    tests/dynamics.rs: d theta / dt = -C sin theta, so
+    tests/kernel/dynamics.rs: d theta / dt = -C sin theta, so
     tan(theta / 2) = tan(theta0 / 2) exp(-C t)."""
     weight = lambda a: 4.0 / 3.0 * math.pi * a**3 * drho_g  # noqa: E731
     mu = lambda a: 1.0 / (6.0 * math.pi * eta * a)  # noqa: E731
@@ -348,7 +348,7 @@ def test_overdamped2_has_no_tensions():
 
 def test_lanczos_noise_is_reported_and_keeps_the_bonds():
     """The Krylov square root is chosen by name, reports its iterations (the kernel's
-    tests/lanczos.rs checks its covariance), and the step still holds every bond."""
+    tests/kernel/lanczos.rs checks its covariance), and the step still holds every bond."""
     pos, bonds = chain(8)
     kw = dict(bonds=bonds, dt=0.01, method="overdamped", temperature=1.0, seed=3)
     lan = hr.System(pos, 1.0, RHO, noise_sqrt="lanczos", **kw)
@@ -367,7 +367,7 @@ def test_rattle_stable_at_temperature_equipartition_of_the_scheme():
     """A lone unit sphere of mass 1 with zeta = 6 pi eta a = 1 under RattleStable at
     kT = 1 and dt = m / zeta (h = 1): the kernel's discretised Langevin step samples
     velocities of variance kT / (m + zeta dt / 2) = 2/3 per component exactly (the
-    kernel's tests/inertial_thermal.rs derives it and checks the dt -> 0 limit kT / m).
+    kernel's tests/kernel/inertial_thermal.rs derives it and checks the dt -> 0 limit kT / m).
     20000 steps, blocks of 400 (the velocity decorrelates in a few steps)."""
     rho = 3.0 / (4.0 * math.pi)
     s = hr.System([[0.0, 0.0, 0.0]], 1.0, rho, dt=1.0, method="rattle-stable",

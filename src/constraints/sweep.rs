@@ -51,7 +51,7 @@ pub fn sweep<T: Real>(
     // good where a relaxed sweep ends with a larger residual than the first sweep met
     // (`limit`, the violation of the move the solve started from): the safeguard
     // against overshoot on nonlinear or inconsistent rows (the squeezed sphere of
-    // `tests/jam.rs`, where the relaxed sweeps stretched the bond by 68 %).
+    // `tests/kernel/jam.rs`, where the relaxed sweeps stretched the bond by 68 %).
     let mut relaxing = from < bonds.len();
     let mut limit = T::ZERO;
     for it in 0..=solver.max_iterations {

@@ -154,7 +154,7 @@ mod tests {
 
     /// Spheres in the box: 64, so that the test's storage fits a test thread's stack
     /// (the kernel and its tests allocate nothing). One band; the copy's products at
-    /// 512 spheres in sixteen bands are `tests/box_copy.rs`.
+    /// 512 spheres in sixteen bands are `tests/kernel/box_copy.rs`.
     const N: usize = 64;
 
     /// The box's assembly pass with the compact copy written beside it

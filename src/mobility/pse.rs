@@ -56,7 +56,7 @@ pub const MAX_TOLERANCE: f64 = 0.1;
 /// below it): from a third of the edge on, the rule's parameters miss the tolerance
 /// against the Ewald sum (measured error over tolerance, one to three spheres: at most
 /// 0.26 at 0.3 of the edge, 0.90 at 0.35, 1.19 at 0.38, 2.2 at 0.42, 4.5 at 0.48;
-/// `tests/pse.rs`). The Ewald path takes any sphere below half the edge.
+/// `tests/kernel/pse.rs`). The Ewald path takes any sphere below half the edge.
 pub const MAX_RADIUS_FRACTION: f64 = 1.0 / 3.0;
 
 /// Machine epsilons of the precision below which no tolerance is accepted: the FFTs'

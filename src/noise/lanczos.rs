@@ -28,7 +28,7 @@ use core::fmt;
 pub struct Lanczos<T> {
     /// Relative error of the noise at which the iteration stops, estimated from the
     /// change between successive iterations and the rate it falls at (the geometric
-    /// tail of the remaining error; `tests/lanczos_chain.rs` checks the actual error
+    /// tail of the remaining error; `tests/kernel/lanczos_chain.rs` checks the actual error
     /// against roots from a dense eigen-decomposition, below this tolerance). Default
     /// `1e-3` (f64 and f32): the covariance of the noise is then right to about
     /// `1e-3`, below the statistical error of any run's averages, at about half the

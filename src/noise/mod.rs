@@ -46,7 +46,7 @@ const UNIT: f64 = 1.0 / (1u64 << 53) as f64;
 impl Noise {
     /// A generator seeded from `seed`: the xoshiro256++ state is four outputs of
     /// SplitMix64 started at `seed`, as `rand_xoshiro` seeds `seed_from_u64` (the
-    /// same stream bit for bit: `tests/bridge.rs` compares them).
+    /// same stream bit for bit: `tests/kernel/bridge.rs` compares them).
     pub const fn new(seed: u64) -> Self {
         let mut sm = seed;
         let mut rng = [0u64; 4];

@@ -11,7 +11,7 @@
 //! does four `f32` operations where it does two `f64`, and the `f64` walk was compute
 //! bound at 3.4 ns a block; this one takes 1.3 at N = 1024). Lanczos then computes
 //! `M~^(1/2) z` with `M~` the rounded mobility; each product is right to about `1e-6`
-//! relative (`f32` sums, `tests/lanczos_chain.rs` measures it), far below the
+//! relative (`f32` sums, `tests/kernel/lanczos_chain.rs` measures it), far below the
 //! tolerance. Bits: the same on any number of threads (the bands of
 //! [`parallel::product`], each summing its rows and transposed blocks in `f64`, added
 //! in band order), and on any target (`Vec4` is IEEE `f32` lane by lane,

@@ -1,0 +1,52 @@
+//! The PSE product (`mobility::pse`) on a thread pool gives the bits of one thread: its
+//! pieces (near-field rows, slabs of grid planes, interpolation rows) depend on the
+//! sizes alone, and each value's arithmetic is the same in whichever piece it falls.
+
+use hydrorattle::Real;
+use hydrorattle::glam::DVec3;
+use hydrorattle::mobility::pse::{Part, Pse, PseStorage};
+use hydrorattle::parallel::{Parallel, Serial};
+use hydrorattle::{Periodic, PeriodicError};
+use hydrorattle_parallel::Threads;
+
+use crate::fuzz::Rng;
+
+/// `M F` for every part, as bits, with `par`.
+fn product(pse: &Pse<f64>, pos: &[DVec3], f: &[DVec3], par: &dyn Parallel) -> Vec<u64> {
+    let n = pos.len();
+    let size = pse.storage(n);
+    let (mut cx, mut ix) = (vec![[0.0; 2]; size.complex], vec![0usize; size.index]);
+    let mut v = vec![DVec3::ZERO; size.vectors];
+    let mut store = PseStorage::new(&mut cx, &mut ix, &mut v).with_parallel(par);
+    let rad = vec![1.0; n];
+    let mut bits = vec![];
+    for part in [Part::Both, Part::Near, Part::Wave] {
+        let mut out = vec![DVec3::ZERO; n];
+        pse.apply(part, 1.0, pos, &rad, f, &mut out, &mut store)
+            .unwrap();
+        bits.extend(out.iter().flat_map(|u| u.to_array().map(f64::to_bits)));
+    }
+    bits
+}
+
+#[test]
+fn same_bits_on_any_thread_count() -> Result<(), PeriodicError> {
+    // From fewer spheres and planes than pieces (empty pieces) to a few thousand.
+    for (n, phi, tol) in [(3usize, 0.01, 1e-3), (300, 0.1, 1e-4), (3000, 0.1, 1e-5)] {
+        let l = (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / phi).cbrt();
+        let mut s = Rng(n as u64);
+        let pos: Vec<DVec3> = (0..n)
+            .map(|_| f64::v3(s.unit() * l, s.unit() * l, s.unit() * l))
+            .collect();
+        let f: Vec<DVec3> = (0..n)
+            .map(|_| f64::v3(s.unit() - 0.5, s.unit() - 0.5, s.unit() - 0.5))
+            .collect();
+        let pse = Pse::new(Periodic::new([l; 3])?, 1.0, tol).unwrap();
+        let one = product(&pse, &pos, &f, &Serial);
+        for t in [1, 2, 3, 4] {
+            let pool = Threads::new(t).unwrap();
+            assert!(product(&pse, &pos, &f, &pool) == one, "n {n}, {t} threads");
+        }
+    }
+    Ok(())
+}

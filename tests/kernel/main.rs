@@ -1,0 +1,64 @@
+//! The kernel's integration tests, one binary: each file of this folder is a module.
+//! A single binary links the kernel once instead of once a file, which is most of the
+//! build's time. Run one file's tests with its module path as the filter:
+//! `cargo test --release --test kernel jam::`.
+//!
+//! A new test file `tests/kernel/NAME.rs` is added by one line below, `mod NAME;`
+//! (with `#[cfg(feature = "...")]` in front if it needs a feature), and
+//! `use crate::common;` inside it for the shared helpers.
+
+#[macro_use]
+mod common;
+
+mod alloc;
+mod auto_boundary;
+#[cfg(feature = "periodic")]
+mod box_copy;
+mod bridge;
+mod brownian;
+mod budget;
+#[cfg(feature = "contacts")]
+mod contacts;
+mod determinism;
+mod docs;
+mod dynamics;
+mod fuzz_step;
+mod helix;
+mod inertial_thermal;
+#[cfg(feature = "contacts")]
+mod jam;
+mod krylov;
+mod lanczos;
+mod lanczos_chain;
+mod matrix_free;
+mod midpoint_storage;
+mod mobility;
+mod observables;
+#[cfg(all(feature = "contacts", feature = "periodic", feature = "wall"))]
+mod pair_search;
+#[cfg(feature = "periodic")]
+mod periodic;
+mod periodic_brownian;
+mod periodic_digest;
+#[cfg(all(feature = "periodic", feature = "contacts"))]
+mod periodic_step;
+mod pins;
+#[cfg(feature = "pse")]
+mod pse;
+#[cfg(feature = "pse")]
+mod pse_brownian;
+#[cfg(feature = "pse")]
+mod pse_limits;
+mod pse_step;
+mod reference;
+mod resolution;
+mod robustness;
+mod springs_thermal;
+mod stability;
+mod states;
+mod tensions;
+mod transactional;
+mod wall;
+mod wall_barometric;
+mod wall_contacts;
+mod weak_order;
