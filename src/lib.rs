@@ -18,9 +18,9 @@
 //! ## Layers
 //!
 //! The modules stand in layers, each building only on the layers below it (and on
-//! modules of its own layer, without a circle); `host/tests/layers.rs` checks this
+//! modules of its own layer, without a circle); `host/tests/host/layers.rs` checks this
 //! against the same table, and prints the import graph with
-//! `cargo test --release -p hydrorattle-host --test layers -- --nocapture import_graph`.
+//! `cargo test --release -p hydrorattle-host --test host import_graph -- --nocapture`.
 //! From the bottom:
 //!
 //! 1. **Foundation**: [`real`] (the precision, and the stored-block trait

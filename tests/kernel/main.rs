@@ -14,6 +14,8 @@ mod alloc;
 mod auto_boundary;
 #[cfg(feature = "periodic")]
 mod box_copy;
+#[cfg(feature = "periodic")]
+mod box_resolution;
 mod bridge;
 mod brownian;
 mod budget;
@@ -22,6 +24,8 @@ mod contacts;
 mod determinism;
 mod docs;
 mod dynamics;
+#[cfg(feature = "fast-free")]
+mod free_fast;
 mod fuzz_step;
 mod helix;
 mod inertial_thermal;
@@ -33,6 +37,8 @@ mod lanczos_chain;
 mod matrix_free;
 mod midpoint_storage;
 mod mobility;
+#[cfg(feature = "near")]
+mod near;
 mod observables;
 #[cfg(all(feature = "contacts", feature = "periodic", feature = "wall"))]
 mod pair_search;
@@ -56,6 +62,8 @@ mod robustness;
 mod springs_thermal;
 mod stability;
 mod states;
+#[cfg(feature = "near")]
+mod stokesian;
 mod tensions;
 mod transactional;
 mod wall;

@@ -26,6 +26,7 @@ mod fuzz;
 mod bad_input;
 mod brownian_scene;
 mod large;
+mod library_names;
 mod one_writer;
 mod periodic_scene;
 mod pictures;

@@ -136,11 +136,7 @@ fn mutate(rng: &mut Rng, text: &str) -> Vec<u8> {
 fn corpus() -> Vec<String> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let mut texts = Vec::new();
-    for dir in [
-        "scenes",
-        "../host-demo/tests/data/bad",
-        "tests/data/fuzz",
-    ] {
+    for dir in ["scenes", "../host-demo/tests/data/bad", "tests/data/fuzz"] {
         let mut files: Vec<PathBuf> = std::fs::read_dir(root.join(dir))
             .unwrap()
             .map(|e| e.unwrap().path())

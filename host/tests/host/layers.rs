@@ -264,7 +264,7 @@ fn the_kernel_imports_only_its_own_layer_or_below() {
 }
 
 /// Prints the kernel's import graph, a module a line with the modules it names:
-/// `cargo test --release -p hydrorattle-host --test layers -- --nocapture import_graph`.
+/// `cargo test --release -p hydrorattle-host --test host import_graph -- --nocapture`.
 #[test]
 fn the_kernel_import_graph() {
     let g = graph(&root().join("src"));

@@ -3,30 +3,11 @@
 //! names are still resumed and collected.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+use crate::common::ok;
 
 use hydrorattle_host::provenance::APPLICATION;
 use hydrorattle_host::sweep::record::{FORMAT, FORMERLY};
-
-const BIN: &str = env!("CARGO_BIN_EXE_host-demo");
-
-fn scratch(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("library-names-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn ok(args: &[&str]) -> String {
-    let o: Output = Command::new(BIN).args(args).output().unwrap();
-    let said = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert!(o.status.success(), "{args:?}: {said}");
-    said
-}
 
 /// A two-point sweep of the shipped dimer, short, in `dir`.
 fn dimer_sweep(dir: &Path) -> PathBuf {
@@ -51,7 +32,7 @@ fn records_and_trajectories_name_the_library() {
         APPLICATION,
         format!("hydrorattle-host {}", env!("CARGO_PKG_VERSION"))
     );
-    let dir = scratch("new");
+    let dir = empty_dir!("new");
     let out = dir.join("out");
     ok(&[
         "sweep",
@@ -80,7 +61,7 @@ fn records_and_trajectories_name_the_library() {
 #[test]
 fn a_sweep_recorded_under_a_former_name_resumes_and_collects() {
     for former in FORMERLY.iter().filter(|f| f.ends_with(" 2")) {
-        let dir = scratch("former");
+        let dir = empty_dir!("former");
         let (file, out) = (dimer_sweep(&dir), dir.join("out"));
         let (file_s, out_s) = (file.to_str().unwrap(), out.to_str().unwrap());
         ok(&["sweep", file_s, "--out", out_s, "--emit", "parallel"]);

@@ -5,9 +5,7 @@
 //! (`ParticleError::Unresolved`), the state kept, instead of as a pair of nested
 //! spheres; a far but resolved position still steps.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use hydrorattle::{
     Layout, Method, NoForce, ParticleError, Periodic, Real, SolverKind, StepError, step,
 };
