@@ -12,7 +12,7 @@
 //!   with each square root of the mobility at N = 64 ... 1024, Lanczos iterations
 //!   printed (the `NoiseSqrt::Auto` crossover);
 //! * `brownian/{Deterministic,Lanczos}/N`: the Brownian Overdamped step (kT = 1,
-//!   midpoint, Lanczos) and the deterministic one at N = 256 ... 2048 (issue 19's
+//!   midpoint, Lanczos) and the deterministic one at N = 256 ... 2048 (their
 //!   ratio at 1024 and cost exponent), iteration counts printed;
 //! * `products/{stored_f64,compact_f32,recompute}/N`: one product `mu_tt x` by each
 //!   path at N = 1024, 4096, 8192, one thread, bytes streamed as the throughput;
@@ -218,7 +218,7 @@ fn all_steps<T: Real>(c: &mut Criterion, prec: &str) {
 }
 
 /// `step_slices` on runtime-sized state (no compile-time capacity), f64: the scaling
-/// targets of issue 8. `group/label/N`. Prints the constraint iterations per step
+/// targets. `group/label/N`. Prints the constraint iterations per step
 /// (operator products for Krylov) next to the times: counts, not only seconds.
 fn scaling_bench(
     c: &mut Criterion,
@@ -300,7 +300,7 @@ fn scaling(c: &mut Criterion) {
             },
         );
     }
-    // Issue 19, item 9: the Brownian Overdamped step (kT = 1, midpoint, Lanczos) against
+    // The Brownian Overdamped step (kT = 1, midpoint, Lanczos) against
     // the deterministic one on the same chain, N = 256 ... 2048, in one run: the ratio
     // at N = 1024 (target <= 3) and the thermal step's cost exponent (target <= 2.2).
     // The two are taken in turn at each N, so that a change in the load of a shared

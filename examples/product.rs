@@ -1,6 +1,6 @@
 //! Nanoseconds per packed block of the stored product `y = mu_tt x` and of the fused
 //! assembly + product, and of the noise's products on the reduced copy (written on the
-//! way, and read back), at the bead counts given (issue 20, item 4; issue 19, item 9).
+//! way, and read back), at the bead counts given.
 //!
 //! `cargo run --release --example product -- N [REPS]`: the helix of `scale`, the best of
 //! `REPS` (default 20) single-thread passes, and a digest of `y` (the same on every

@@ -1,4 +1,4 @@
-//! A periodic suspension sedimenting with hard contacts on the PSE path (issue 27):
+//! A periodic suspension sedimenting with hard contacts on the PSE path:
 //! unit spheres of density 4.5 in a fluid of density 0 and viscosity 1 under `|g| = 1`
 //! (free Stokes speed `U0 = 2/9 (4.5) = 1`), placed at random without overlap at volume
 //! fraction `phi` in a cubic box, stepped by `Overdamped` (matrix-free, Krylov, hard

@@ -1,6 +1,6 @@
 """Times the kernel's f64 overdamped step through `host-demo run` against the NumPy +
 pygrpy peer (overdamped_numpy.py) in one run, after checking that both give the same
-trajectory (issue 20, item 2).
+trajectory.
 
     python3 bench/peer/compare.py [--demo target/release/host-demo] [--scene S] [--rounds 3]
     python3 bench/peer/compare.py --demo target/release/host-demo --demo target-v3/release/host-demo

@@ -1,4 +1,4 @@
-"""The NumPy + pygrpy peer of the kernel's overdamped HydroSHAKE step (issue 20, item 2).
+"""The NumPy + pygrpy peer of the kernel's overdamped HydroSHAKE step.
 
 The same step as `hydrorattle`'s `Method::Overdamped` (src/integrate/overdamped.rs), written
 the way a Python user would: pygrpy's vectorised RPY translational mobility

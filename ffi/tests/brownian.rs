@@ -1,4 +1,4 @@
-//! Thermal noise through the C interface (issue 19, item 7): the temperature, the drift
+//! Thermal noise through the C interface: the temperature, the drift
 //! and a generator (seed, save by copy, restore by copy). A run through the interface
 //! is the kernel's run bit for bit; a refused step leaves the generator as it was; a
 //! restored generator continues the same run.

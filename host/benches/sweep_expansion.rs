@@ -1,4 +1,4 @@
-//! Sweep expansion (issue 29 item 6): 10^5 points of the Figure 1 (a) chain resolved
+//! Sweep expansion: 10^5 points of the Figure 1 (a) chain resolved
 //! (every scene resolved and validated, duplicates checked, ids computed), held
 //! (`Sweep::parse`) or let go as checked (`Sweep::check_path`, `--dry-run`); and what
 //! finding one point costs: from an emitted folder (`--frozen --point ID`: `sweep.json`

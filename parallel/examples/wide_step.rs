@@ -1,5 +1,5 @@
 //! A small step run plainly and inside a function compiled with AVX2 enabled (runtime
-//! selection of a whole step, issue 31): the time per step both ways and whether the
+//! selection of a whole step): the time per step both ways and whether the
 //! positions keep their bits.
 //!
 //! `cargo run --release -p hydrorattle-parallel --example wide_step -- [N] [STEPS] [ROUNDS]`

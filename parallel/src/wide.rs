@@ -1,4 +1,4 @@
-//! Runtime choice of wider vector instructions for the product paths (issue 31): on an
+//! Runtime choice of wider vector instructions for the product paths: on an
 //! x86-64 CPU with AVX2, each band of a product runs in a copy of the kernel's band
 //! loop compiled with AVX2 enabled; elsewhere, the portable kernel function.
 //!

@@ -1,5 +1,5 @@
 """mobility_dot against a numba-parallel RPY product (the stand-in for what users write
-themselves), and the dense mobility's cost per entry (issue 30 item 7).
+themselves), and the dense mobility's cost per entry.
 
 Usage: python python/bench/mobility_dot.py [N ...]   (needs numba; default 1000 4096 16384)
 

@@ -1,4 +1,4 @@
-"""mobility_dot in a periodic box by PSE (issue 27): time against N.
+"""mobility_dot in a periodic box by PSE: time against N.
 
 Usage: python python/bench/pse_dot.py N THREADS [METHOD [TOLERANCE]]
 (METHOD "auto" by default: PSE at the scenes' tolerance 1e-6; "ewald" for the exact sum)

@@ -1,4 +1,4 @@
-"""System steps on every core (issue 31 item 4): from 512 beads the kernel cuts the
+"""System steps on every core: from 512 beads the kernel cuts the
 mobility's work into 16 bands, which ``threads`` (0: every core, the default) runs on a
 thread pool; the bits do not depend on the thread count."""
 

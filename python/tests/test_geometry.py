@@ -1,4 +1,4 @@
-"""`mobility` and `mobility_dot` above a wall and in a periodic box (issue 30 item 1)
+"""`mobility` and `mobility_dot` above a wall and in a periodic box
 against closed forms nobody here computed with the package: Hasimoto's lone sphere in
 a cubic box, Faxen's and Brenner's lone sphere above a wall; the product against the
 matrix; refused combinations; the same bits on any number of threads."""

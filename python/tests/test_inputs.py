@@ -1,4 +1,4 @@
-"""Inputs that never pass silently (issue 30 item 5): each works as meant or raises a
+"""Inputs that never pass silently: each works as meant or raises a
 ValueError / TypeError naming the parameter; what the first step would refuse is
 refused when the system is built; the kernel's kinds and messages reach Python."""
 

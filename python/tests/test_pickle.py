@@ -1,5 +1,5 @@
-"""Systems that pickle, deep-copy and travel between processes with the same bits
-(issue 30 item 2), and the ASE round trip."""
+"""Systems that pickle, deep-copy and travel between processes with the same bits,
+and the ASE round trip."""
 
 import copy
 import json

@@ -426,7 +426,7 @@ def dimer_closed_form(d, rho, a_top=1.0, a_bottom=2.0):
 @pytest.mark.parametrize("dt", [0.01, 0.001])
 def test_settling_dimer_tension_in_both_precisions(precision, method, dt):
     """Radii 1 (above) and 2 (below), 4 apart, density 4.5: every method's tension
-    against the closed form (14.7596, the issue's figure) in f32 and f64 (issue 30 item 4: f32 rattle read
+    against the closed form (14.7596, the issue's figure) in f32 and f64 (f32 rattle read
     16.6, and -0 at dt = 0.001, before the inertial tensions were solved from the
     displacements). Springs: the spring law against the closed form at the stretched
     length, once the stretch has relaxed."""

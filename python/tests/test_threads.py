@@ -1,4 +1,4 @@
-"""Watching a running system (issue 30 item 3): a callback every k steps, and reads
+"""Watching a running system: a callback every k steps, and reads
 from other threads while it steps (a consistent snapshot, never PyO3's borrow error)."""
 
 import threading

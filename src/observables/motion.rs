@@ -1,4 +1,4 @@
-//! Observables that name what a settling chain does over time (issue 10): rotation
+//! Observables that name what a settling chain does over time: rotation
 //! about the vertical, poloidal circulation of a ring rolling over itself, vertical
 //! runs of bonds and the order in which bonds turn vertical, extents and the
 //! centre-of-mass settling speed.

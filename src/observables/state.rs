@@ -1,4 +1,4 @@
-//! Named states of a settling chain, read from one frame (issue 10): the vocabulary of
+//! Named states of a settling chain, read from one frame: the vocabulary of
 //! the outcome timeline. A frame's numbers ([`Shape`]) come from the motion and shape
 //! observables; [`state_of`] names them with the thresholds of [`StateThresholds`].
 //!

@@ -119,7 +119,7 @@ impl<'a, T: Real> Workspace<'a, T> {
     /// The position multipliers of the last constrained step with `bonds` bonds (force
     /// per unit length along each bond). The inertial methods solve them again from
     /// the step's displacements, which f32 resolves where it cannot resolve the
-    /// positions' change (issue 30 item 4). After `Springs` or a failed step they are
+    /// positions' change. After `Springs` or a failed step they are
     /// stale or partial; after `Overdamped2` they hold only the final projection's
     /// small correction.
     pub fn multipliers(&self, bonds: usize) -> &[T] {

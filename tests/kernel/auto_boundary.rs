@@ -4,7 +4,7 @@
 //! be past the boundary. The storage (`Layout::for_params`) and every stage of the step
 //! must take the same side of it: a stage that resolved `Auto` from the rows it held in
 //! one round once read a dense table the storage had not carved (a panic in the
-//! default solver, issue 33).
+//! default solver).
 //!
 //! Every method, with and without a wall, contacts, matrix-free products, rotation and
 //! thermal noise (both square roots), at 31 to 34 rows, f64 and f32: the step never

@@ -1,4 +1,4 @@
-//! A refused Brownian step and its retry (issue 19, item 5).
+//! A refused Brownian step and its retry.
 //!
 //! * The reproduction of the issue: a free-draining 3-arm star at kT = 1 (seed 45)
 //!   whose step 2557 (the first refused) has no solution near the start: its noise kick leaves the

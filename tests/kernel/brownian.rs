@@ -1,4 +1,4 @@
-//! Brownian dynamics (issue 12): thermal noise in the overdamped step, checked against
+//! Brownian dynamics: thermal noise in the overdamped step, checked against
 //! exact equilibrium and transport results that do not come from the kernel.
 //!
 //! Units: `kT = 1`. Every statistical check states its tolerance and also asserts its

@@ -1,4 +1,4 @@
-//! Storage budgets (issue 8): the paper's chain (N = 25, B = 24) in f32, particles +
+//! Storage budgets: the paper's chain (N = 25, B = 24) in f32, particles +
 //! bonds + workspace, measured with `size_of` and the method's [`Layout`]. The table
 //! for f32 and f64 prints with `--nocapture` and is copied into docs/STORAGE.md.
 //!
@@ -68,7 +68,7 @@ fn paper_chain_fits_the_budgets() {
         "| Overdamped matrix-free | false | {} | {mf64} | - |",
         free(mf.bytes::<f32>())
     );
-    // Thermal noise (issue 12): the Cholesky factor and the midpoint's vectors on top.
+    // Thermal noise: the Cholesky factor and the midpoint's vectors on top.
     let th = Layout::new(Method::Overdamped, false, N, B).thermal(Method::Overdamped, N, B);
     let th64 = core::mem::size_of::<ParticleSet<f64, N>>()
         + core::mem::size_of::<BondSet<f64, B>>()
@@ -77,7 +77,7 @@ fn paper_chain_fits_the_budgets() {
         "| Overdamped thermal | false | {} | {th64} | - |",
         free(th.bytes::<f32>())
     );
-    // Hard contacts (issue 10): 3 per bead counted as extra constraints, Newton solver
+    // Hard contacts: 3 per bead counted as extra constraints, Newton solver
     // (the Figure 1 scenes' settings).
     for (method, capacity) in [(Method::Overdamped, 75), (Method::Overdamped2, 75)] {
         let mut p = hydrorattle::Params::<f32>::new(0.1);

@@ -1,4 +1,4 @@
-//! Physics validation of the integrators (issue 3): the settling dimer against its
+//! Physics validation of the integrators: the settling dimer against its
 //! closed form, constraints on chains, rings and trees, flows, rotation, and the
 //! sweep-versus-Newton iteration counts on the paper's helix.
 //!

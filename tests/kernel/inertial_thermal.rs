@@ -1,4 +1,4 @@
-//! `RattleStable` at temperature (issue 19, item 3): Langevin dynamics with the
+//! `RattleStable` at temperature: Langevin dynamics with the
 //! implicit hydrodynamic drag, checked against exact results.
 //!
 //! Units: a unit sphere of mass `m = 1` (density `3 / 4 pi`) in a fluid of viscosity

@@ -1,4 +1,4 @@
-//! The Lanczos square root of the mobility (issue 19, item 1), checked against what
+//! The Lanczos square root of the mobility, checked against what
 //! does not come from it:
 //! * the block Cholesky factor `L` (`L L^T = M`): `y = M^(1/2) z` exactly when `L^-1 y`
 //!   preserves inner products (`L^-1 M^(1/2)` is orthogonal) and `z_j . y_k` is

@@ -1,4 +1,4 @@
-//! The Lanczos noise against exact answers (issue 19, item 8), f64:
+//! The Lanczos noise against exact answers, f64:
 //! * its truncation error: `M^(1/2) z` and `M^(-1/2) z` from Lanczos against the roots
 //!   from a dense eigen-decomposition of `M` done here (cyclic Jacobi on the `3N x 3N`
 //!   matrix, nothing from the kernel but the assembled mobility), below the stated

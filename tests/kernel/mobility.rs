@@ -660,7 +660,7 @@ fn symmetry<T: Real>(tol: &Tol) {
     assert!(w <= tol.exact, "assembled mobility asymmetric by {w:e}");
 }
 
-/// "Symmetric by construction" (issue 2): every entry equals its mirror bit for bit.
+/// "Symmetric by construction": every entry equals its mirror bit for bit.
 fn exact_symmetry<T: Real>(_tol: &Tol) {
     let w = worst_asymmetry::<T>();
     assert!(

@@ -79,7 +79,7 @@ fn centre_of_mass_and_settling_speed() {
     assert!((settling_speed::<f64>(&vel, 0, DVec3::new(0.0, 0.0, -9.0)) - 1.5).abs() < 1e-15);
 }
 
-// --- Issue 10: motion and shape over time ------------------------------------------
+// --- Motion and shape over time ----------------------------------------------------
 
 use hydrorattle::observables::{
     VerticalFront, com_settling_speed, extents, poloidal_circulation, spin_about_vertical,

@@ -1,4 +1,4 @@
-//! Brownian motion in a periodic box (issue 27, "Done when": Brownian), `kT = 1`, f64,
+//! Brownian motion in a periodic box, `kT = 1`, f64,
 //! against values that do not come from the kernel:
 //!
 //! * a lone sphere's diffusion coefficient in cubic boxes `L/a = 5, 10, 20` against

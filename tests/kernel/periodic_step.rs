@@ -1,4 +1,4 @@
-//! Steps in a periodic box (issue 27 items 1 and 3: every method, solver and noise
+//! Steps in a periodic box (every method, solver and noise
 //! with the Ewald-summed mobility; bonds, springs and contacts through the minimum
 //! image), each checked against a value that does not come from the code under test:
 //!

@@ -1,5 +1,4 @@
-//! Brownian steps on the PSE path (`Params::pse`, issue 27 items 2 and "Done when":
-//! Brownian): the step's noise is PSE's own (`Pse::noise_in`: the real part by Lanczos
+//! Brownian steps on the PSE path (`Params::pse`): the step's noise is PSE's own (`Pse::noise_in`: the real part by Lanczos
 //! on the near field, the wave part from white noise on the grid; the Fixman midpoint's
 //! `M^-1 L w` by conjugate gradients with PSE products). Checked against values not
 //! from the PSE code:

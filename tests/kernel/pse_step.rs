@@ -1,4 +1,4 @@
-//! Steps on the PSE path (`Params::pse`, issue 27 item 2 in steps): the matrix-free
+//! Steps on the PSE path (`Params::pse`): the matrix-free
 //! product and the Krylov metric's product (bonds, contacts) read `Pse::apply`; the
 //! Brownian noise is PSE's own (`Pse::noise_in`, tested in `tests/kernel/pse_brownian.rs`).
 //! Each PSE step is checked against the same step on the exact Ewald path (itself

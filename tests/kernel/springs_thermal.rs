@@ -1,4 +1,4 @@
-//! The bead-spring model at temperature (issue 19, item 2): a Hookean dumbbell's
+//! The bead-spring model at temperature: a Hookean dumbbell's
 //! equilibrium against its exact distribution.
 //!
 //! Two spheres joined by a spring `U = H (Q - d)^2 / 2` in free space: whatever the

@@ -1,4 +1,4 @@
-//! The named states (issue 10) on synthetic shapes and hand-set numbers whose states are
+//! The named states on synthetic shapes and hand-set numbers whose states are
 //! known, with the boundary of every threshold; each test in f32 and f64.
 
 use hydrorattle::Real;

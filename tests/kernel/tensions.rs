@@ -1,4 +1,4 @@
-//! Bond tensions of every method in both precisions (issue 30 item 4): the vertical
+//! Bond tensions of every method in both precisions: the vertical
 //! settling dimer against its closed form, and a chain's f32 tensions against f64.
 //!
 //! Before the fix the inertial methods' f32 tensions were the position multipliers,

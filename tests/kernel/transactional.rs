@@ -257,7 +257,7 @@ fn bad_inputs<T: Real>() {
     step(&mut ps, &bonds, &p, &mut ws, &mut NoForce).expect("massless bead, overdamped");
 }
 
-/// Issue 11: a tolerance below what the precision can reach is refused at once (not
+/// A tolerance below what the precision can reach is refused at once (not
 /// iterated to a huge cap), a non-finite or non-advancing time is refused, and the
 /// tolerance bounds the relative length error as documented, compressed bonds included.
 fn tolerance_and_time<T: Real>() {

@@ -1,4 +1,4 @@
-//! The mobility above a no-slip plane wall (issue 21, items 1 and 4's mobility side),
+//! The mobility above a no-slip plane wall,
 //! checked against results that do not come from the kernel:
 //!
 //! * a lone sphere against the method of reflections: Faxén's series parallel to the

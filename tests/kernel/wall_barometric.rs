@@ -1,4 +1,4 @@
-//! Brownian motion above the wall (issue 21, item 4): a lone sphere under gravity,
+//! Brownian motion above the wall: a lone sphere under gravity,
 //! held above the wall by the wall's one-sided constraint, reaches the barometric
 //! distribution of its height, `P(h) ~ exp(-m_b g h / kT)` above its contact height,
 //! with the midpoint scheme; without the correction it does not.

@@ -1,5 +1,4 @@
-//! The equilibrium bias of the constrained Brownian step vanishes with dt (issue 19,
-//! item 8): `<cos^2>` between consecutive bonds of a freely jointed 8-bead chain
+//! The equilibrium bias of the constrained Brownian step vanishes with dt: `<cos^2>` between consecutive bonds of a freely jointed 8-bead chain
 //! (Overdamped, `Drift::Midpoint`: the stiff-bond equilibrium, exact value 1/3) at
 //! three time steps, free draining and RPY, from 256 independent chains each (one
 //! sample per chain: its mean over 380 time units after 20, bond length 3, bead

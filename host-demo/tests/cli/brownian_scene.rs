@@ -1,4 +1,4 @@
-//! `[brownian]` scene keys (issue 12): parsed with their defaults, and a run is fixed by
+//! `[brownian]` scene keys: parsed with their defaults, and a run is fixed by
 //! its seed (same seed same bits in f32 and f64; another seed another run; `kT = 0` the
 //! deterministic run).
 
@@ -99,7 +99,7 @@ fn a_refused_step_is_retried_split_and_counted() {
 
 /// A Brownian run (the star at kT = 1, with its retried step before the checkpoint)
 /// resumed from its checkpoint writes the same bytes as one run: the generator's state
-/// is saved and restored (issue 19, item 6).
+/// is saved and restored.
 #[test]
 fn a_brownian_run_resumes_to_the_bytes_of_one_run() {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("brownian-restart");
@@ -263,7 +263,7 @@ fn fene_dumbbell_scene() {
     assert!((mean - 2.0).abs() < 3.0 * se, "{mean} +- {se}");
 }
 
-/// A `rattle-stable` scene at temperature (issue 19, item 3): a bonded trimer of
+/// A `rattle-stable` scene at temperature: a bonded trimer of
 /// heavy spheres runs, the same seed gives the same bits, and a run resumed from its
 /// checkpoint writes the bytes of one run (velocities and generator restored).
 #[test]

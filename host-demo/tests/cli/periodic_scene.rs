@@ -1,4 +1,4 @@
-//! Periodic boxes through the CLI (issue 27, items 3 and 4): the shipped periodic
+//! Periodic boxes through the CLI: the shipped periodic
 //! scenes run and write both trajectory formats with the box, the GSD file's wrapped
 //! positions plus image flags give back the extended XYZ's unwrapped ones, the bonds
 //! measured straight from the unwrapped positions keep their lengths; a box on the PSE

@@ -181,7 +181,7 @@ fn spheres_touching_a_wall_to_the_rounding_run() {
     }
 }
 
-/// Issue 33, 4: two spheres under vorticity 100 at dt 0.1 turn 10 rad a step: the
+/// Two spheres under vorticity 100 at dt 0.1 turn 10 rad a step: the
 /// explicit flow term grows their radius tenfold a step until f32's squares overflow
 /// (NaN observables). A rotation no step follows is refused at its line, in either
 /// precision, before any folder exists; at dt 0.01 (1 rad a step) it runs.

@@ -1,4 +1,4 @@
-//! A run killed with a real SIGKILL resumes from what it left (issue 33, item 2): the
+//! A run killed with a real SIGKILL resumes from what it left: the
 //! child `host-demo run --checkpoint-every` is killed once a checkpoint is on disk, and
 //! `host-demo resume DIR --until T` then writes the same bytes as one run to `T`
 //! (trajectories, observables and `scene.toml`; `summary.json` differs by its wall time,

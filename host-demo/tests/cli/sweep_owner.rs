@@ -1,4 +1,4 @@
-//! A sweep folder belongs to one sweep (issue 29 items 1, 2, 5, 6): a second sweep into
+//! A sweep folder belongs to one sweep: a second sweep into
 //! it is refused and the first one's files stay byte for byte; the points run from the
 //! copy frozen when the job was emitted, whatever happens to the base scene after, and a
 //! frozen scene changed since is refused; nonsense job settings are refused before

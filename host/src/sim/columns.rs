@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use super::record::COLUMNS;
 
 /// An `observables.csv` whose columns are not the ones this program writes (a run of
-/// another version: the wall's three columns came with issue 21), which a resumed run
+/// another version: the wall's three columns came later), which a resumed run
 /// cannot continue. [`check_columns`] returns it inside its `anyhow::Error`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ColumnsMismatch {

@@ -1,4 +1,4 @@
-//! Sweeps vary the periodic box (issue 27, item 4): `"box.size"` as a sweep key
+//! Sweeps vary the periodic box: `"box.size"` as a sweep key
 //! reaches each point's `[box]`, and a size the box refuses is an error at the sweep
 //! value's line. (An integration test, so the sweep module stays as it is.)
 

@@ -1,4 +1,4 @@
-//! No import circles between the host library's modules (issue 28): each top-level
+//! No import circles between the host library's modules: each top-level
 //! module (one concern: `scene`, `sim`, `output`, `sweep`, ...) may use others only in
 //! one direction. Read from the source, as anyone can check with an import grep:
 //! `grep -rhoE 'crate::[a-z_]+' host/src/<module>`. The study crate is checked the same

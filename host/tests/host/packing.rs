@@ -1,4 +1,4 @@
-//! A random close packing compressed under gravity in a periodic box (issue 32): a
+//! A random close packing compressed under gravity in a periodic box: a
 //! polydisperse suspension settles onto a pinned floor (`[floor]`, the kernel's pin
 //! rows) and jams. Checked: no overlap beyond the tolerance at any step, the run comes
 //! to rest, the floor has not moved, at rest the pins carry the buoyant weight of every

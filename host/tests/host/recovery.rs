@@ -1,4 +1,4 @@
-//! Recovery from every partial state of a point (issue 29 item 4): a point finished,
+//! Recovery from every partial state of a point: a point finished,
 //! or stopped as SIGTERM stops it after a random step (its checkpoint there, its files
 //! under their temporary names), loses a random subset of its files; run again, it
 //! ends with the bytes of a clean run, whether it is found finished, resumed or

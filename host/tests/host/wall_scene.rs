@@ -1,4 +1,4 @@
-//! `[wall]` in scene files (issue 21, item 3): parsed, written back in `scene.toml` to
+//! `[wall]` in scene files: parsed, written back in `scene.toml` to
 //! the same scene, and run: a sphere and a dimer land, the run records when (the
 //! landing time: the end of the first step after which a sphere is held on the wall)
 //! and the observables gain the height above the wall and the contacts with it. Bad

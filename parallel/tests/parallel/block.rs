@@ -1,4 +1,4 @@
-//! Block products (several vectors in one pass over the mobility, issue 31): each of the
+//! Block products (several vectors in one pass over the mobility): each of the
 //! `K` outputs holds the bits the single-vector product gives it, for the stored `f64`
 //! blocks, the compact `f32` copy and the recompute path, with one band and with
 //! sixteen, on one thread and on a pool.

@@ -1,4 +1,4 @@
-//! The wall's mobility (issue 21) in bands on a thread pool: the bits of one thread for
+//! The wall's mobility in bands on a thread pool: the bits of one thread for
 //! the assembly, the banded product and whole overdamped steps above the wall.
 
 use hydrorattle::glam::DVec3;

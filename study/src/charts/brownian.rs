@@ -1,4 +1,4 @@
-//! Brownian dynamics (issue 12): the charts that show the noise is right and what it
+//! Brownian dynamics: the charts that show the noise is right and what it
 //! does to the paper's chain.
 //!
 //! * `brownian_trimer`: a freely jointed trimer's bond-angle density, with and without

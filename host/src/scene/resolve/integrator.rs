@@ -89,7 +89,7 @@ fn resolve_fene(r: &RawIntegrator) -> Result<Option<f64>, Issue> {
 /// velocity `Omega x r` enters every method explicitly, so a step grows a radius about
 /// the axis by `sqrt(1 + (|Omega| dt)^2)` (first order; Heun's is no better there): past
 /// one radian a step no longer follows the rotation at all, and the run spirals out
-/// until its precision overflows (issue 33: vorticity 100 at dt 0.1 grew the radius
+/// until its precision overflows (vorticity 100 at dt 0.1 grew the radius
 /// tenfold a step). Refused at the `vorticity` line instead.
 pub const MAX_TURN_PER_STEP: f64 = 1.0;
 
