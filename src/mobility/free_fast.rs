@@ -27,6 +27,7 @@ mod radial;
 use core::fmt;
 
 use crate::cell_list::CellList;
+use crate::fault::ParticleError;
 use crate::mobility::pse::fft::{self, Cx, good_size};
 use crate::mobility::{Hydro, pair_tt, self_tt};
 use crate::real::Real;
@@ -63,11 +64,10 @@ pub enum FreeError {
     GridTooLarge,
     /// Positions, radii, forces and output differ in length.
     Length,
-    /// A position or force is not finite.
-    NonFinite {
-        /// The sphere.
-        particle: usize,
-    },
+    /// A sphere the product cannot take: a position or force not finite
+    /// ([`ParticleError::NonFinite`]), or one sphere inside another
+    /// ([`ParticleError::Nested`]).
+    Particle(ParticleError),
     /// A radius outside `(0, a_max]`.
     Radius {
         /// The sphere.
@@ -75,13 +75,6 @@ pub enum FreeError {
     },
     /// The cloud's bounding box exceeds the extent the parameters were sized for.
     Extent,
-    /// One sphere lies inside another.
-    Nested {
-        /// The spheres.
-        i: usize,
-        /// See `i`.
-        j: usize,
-    },
     /// Caller storage too small: complex values, reals, indices.
     Storage {
         /// Needed.
@@ -101,10 +94,9 @@ impl fmt::Display for FreeError {
             ),
             Self::GridTooLarge => write!(f, "the tolerance and cloud need too large a grid"),
             Self::Length => write!(f, "positions, radii, forces and output differ in length"),
-            Self::NonFinite { particle } => write!(f, "particle {particle}: non-finite value"),
+            Self::Particle(e) => write!(f, "{e}"),
             Self::Radius { particle } => write!(f, "particle {particle}: radius out of range"),
             Self::Extent => write!(f, "the cloud is larger than the extent it was sized for"),
-            Self::Nested { i, j } => write!(f, "sphere {i} lies inside sphere {j}"),
             Self::Storage { need, have } => {
                 write!(f, "storage too small: need {need:?} values, have {have:?}")
             }
@@ -350,7 +342,9 @@ impl<T: Real> FreeFast<T> {
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
             if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) {
-                return Err(FreeError::NonFinite { particle: i });
+                return Err(FreeError::Particle(ParticleError::NonFinite {
+                    particle: i,
+                }));
             }
             if !(a > T::ZERO && a <= self.a_max) {
                 return Err(FreeError::Radius { particle: i });
@@ -400,10 +394,10 @@ impl<T: Real> FreeFast<T> {
                     return;
                 }
                 let Some(rpy) = pair_tt(Hydro::Rpy, eta, ai, radius[j], r) else {
-                    err = Some(FreeError::Nested {
+                    err = Some(FreeError::Particle(ParticleError::Nested {
                         i: j.min(i),
                         j: j.max(i),
-                    });
+                    }));
                     return;
                 };
                 let aj = radius[j].to_f64();

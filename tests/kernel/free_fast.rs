@@ -4,9 +4,9 @@
 //! same bits on reruns.
 #![cfg(feature = "fast-free")]
 
-use hydrorattle::Real;
 use hydrorattle::mobility::free_fast::{FreeError, FreeFast, FreeStorage};
 use hydrorattle::mobility::{Hydro, tt_product};
+use hydrorattle::{ParticleError, Real};
 
 /// SplitMix64 in `[0, 1)`.
 struct Rng(u64);
@@ -192,7 +192,7 @@ fn bad_input_is_a_typed_error() {
     bad[3][1] = f64::NAN;
     assert_eq!(
         fast(&ff, &bad, &rad, &f).unwrap_err(),
-        FreeError::NonFinite { particle: 3 }
+        FreeError::Particle(ParticleError::NonFinite { particle: 3 })
     );
     let mut far = pos.clone();
     far[2][0] += 100.0;
@@ -203,7 +203,7 @@ fn bad_input_is_a_typed_error() {
     r[7] = r[4] * 0.5;
     assert!(matches!(
         fast(&ff, &nested, &r, &f),
-        Err(FreeError::Nested { .. })
+        Err(FreeError::Particle(ParticleError::Nested { .. }))
     ));
     assert!(matches!(
         FreeFast::<f64>::new(1.0, 1e-13, [1.0; 3], 10),
