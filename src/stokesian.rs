@@ -26,7 +26,7 @@
 
 use crate::error::LinalgError;
 use crate::error::ParticleError;
-use crate::linalg::{cholesky_dense, tri};
+use crate::linalg::{spd_inverse, tri};
 use crate::mobility::wall::{self_wall, self_wall_rot};
 use crate::mobility::{Hydro, pair_blocks, self_rr, self_tt};
 use crate::near::wall::wall_scalars;
@@ -135,12 +135,12 @@ pub fn mobility<T: Real>(
     if pairs == 0 && walls == 0 {
         return Ok(());
     }
-    spd_inverse(out, m)?;
+    spd_inverse(out, m).map_err(SdError::NotPositiveDefinite)?;
     add_pairs(eta, pos, radius, near, out)?;
     if let Some(h) = wall {
         add_walls(eta, h, pos, radius, near, out)?;
     }
-    spd_inverse(out, m)
+    spd_inverse(out, m).map_err(SdError::NotPositiveDefinite)
 }
 
 /// The scaled surface gap `xi = 2 r / (a1 + a2) - 2` of spheres `i` and `j`, and `r`.
@@ -286,48 +286,6 @@ fn add_walls<T: Real>(
         for (k, l, sign) in [(0, 1, -T::ONE), (1, 0, T::ONE)] {
             put(t, k, r, l, sign * cross);
             put(r, l, t, k, sign * cross);
-        }
-    }
-    Ok(())
-}
-
-/// Inverts the symmetric positive definite `m x m` row-major `a` in place: Cholesky
-/// `A = U^T U` ([`cholesky_dense`], upper triangle `U`, diagonal `1 / U_kk`), `V = U^-1`
-/// row by row from the bottom, then `A^-1 = V V^T`. About `2/3 m^3` flops.
-fn spd_inverse<T: Real>(a: &mut [T], m: usize) -> Result<(), SdError> {
-    cholesky_dense(a, m, T::ZERO).map_err(SdError::NotPositiveDefinite)?;
-    for j in (0..m).rev() {
-        // Row j of V: V_jk = -V_jj sum_{j < l <= k} U_jl V_lk, taking l from the right so
-        // that each U_jl is read before the sums overwrite it.
-        let (head, tail) = a.split_at_mut((j + 1) * m);
-        let row = &mut head[j * m..];
-        for l in (j + 1..m).rev() {
-            let u = row[l];
-            let vl = &tail[(l - j - 1) * m..(l - j) * m];
-            row[l] = u * vl[l];
-            for k in l + 1..m {
-                row[k] += u * vl[k];
-            }
-        }
-        let vjj = row[j];
-        for v in &mut row[j + 1..] {
-            *v = -*v * vjj;
-        }
-    }
-    // (V V^T)_ik = sum_{l >= k} V_il V_kl for k >= i: row i from the left, each entry
-    // needing only row i's entries to its right and the rows below (not yet touched).
-    for i in 0..m {
-        let (head, tail) = a.split_at_mut((i + 1) * m);
-        let row = &mut head[i * m..];
-        row[i] = row[i..].iter().fold(T::ZERO, |s, &v| s + v * v);
-        for k in i + 1..m {
-            let vk = &tail[(k - i - 1) * m..(k - i) * m];
-            row[k] = (k..m).fold(T::ZERO, |s, l| s + row[l] * vk[l]);
-        }
-    }
-    for i in 0..m {
-        for k in 0..i {
-            a[i * m + k] = a[k * m + i];
         }
     }
     Ok(())

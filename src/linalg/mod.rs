@@ -25,7 +25,7 @@ pub(crate) mod packed;
 pub(crate) use block::with_blocks;
 pub use block::{Block, Mob, MobMut, Sym};
 
-pub use lu::{cholesky_dense, cholesky_dense_solve, lu, lu_ranked, lu_solve};
+pub use lu::{cholesky_dense, cholesky_dense_solve, lu, lu_ranked, lu_solve, spd_inverse};
 
 use crate::fault::LinalgError;
 use crate::real::Real;

@@ -10,6 +10,7 @@
 
 use super::NearError;
 use super::pair::{M, resistance_f64, to_m3};
+use crate::linalg::spd_inverse;
 use crate::real::Real;
 
 /// 12x12 in `f64`, rows and columns `(U1, U2, W1, W2)`.
@@ -27,43 +28,6 @@ fn flatten(b: &[[M; 4]; 4]) -> Big {
         }
     }
     m
-}
-
-/// Inverse by Gauss-Jordan elimination with partial pivoting; `None` when singular.
-fn inverse(m: &Big) -> Option<Big> {
-    let mut a = *m;
-    let mut inv = [[0.0; 12]; 12];
-    for (i, row) in inv.iter_mut().enumerate() {
-        row[i] = 1.0;
-    }
-    for c in 0..12 {
-        let mut p = c;
-        for r in c + 1..12 {
-            if a[r][c].abs() > a[p][c].abs() {
-                p = r;
-            }
-        }
-        if !(a[p][c].abs() > 0.0) {
-            return None;
-        }
-        a.swap(c, p);
-        inv.swap(c, p);
-        let d = 1.0 / a[c][c];
-        for j in 0..12 {
-            a[c][j] *= d;
-            inv[c][j] *= d;
-        }
-        for r in 0..12 {
-            let f = a[r][c];
-            if r != c && f != 0.0 {
-                for j in 0..12 {
-                    a[r][j] -= f * a[c][j];
-                    inv[r][j] -= f * inv[c][j];
-                }
-            }
-        }
-    }
-    Some(inv)
 }
 
 /// `R_near` of spheres of radii `a1`, `a2`, sphere 2 at `d` from sphere 1, given the
@@ -88,7 +52,9 @@ pub fn near_correction<T: Real>(
             core::array::from_fn(|i| core::array::from_fn(|j| e[j * 3 + i].to_f64()))
         })
     });
-    let far_r = inverse(&flatten(&far)).ok_or(NearError::Singular)?;
+    // The pair's RPY grand mobility is symmetric positive definite (also overlapping).
+    let mut far_r = flatten(&far);
+    spd_inverse(far_r.as_flattened_mut(), 12).map_err(|_| NearError::Singular)?;
     let mut out = [[[[0.0; 3]; 3]; 4]; 4];
     for (bi, row) in out.iter_mut().enumerate() {
         for (bj, blk) in row.iter_mut().enumerate() {
