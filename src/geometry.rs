@@ -26,6 +26,7 @@ use core::marker::PhantomData;
 use crate::error::{ParticleError, StepError};
 use crate::linalg::{MobMut, with_blocks};
 use crate::mobility::{self, Hydro};
+use crate::noise::reduced;
 use crate::parallel::{self, Parallel};
 use crate::real::Real;
 
@@ -135,7 +136,11 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
     }
 
     /// `u = mu_tt(pos) f` assembled into `mu` and applied, in bands through `par`
-    /// (`bands` holds their partial sums, [`crate::parallel`]).
+    /// (`bands` holds their partial sums, [`crate::parallel`]). With `copy`, each row of
+    /// the compact copy of `mu` ([`Params::compact_products`](crate::Params::compact_products),
+    /// `noise::reduced`) is written in the same pass, while the row's blocks are in
+    /// cache; the product reads the full blocks either way, with the same bits. Only
+    /// symmetric blocks have a copy: above a wall it is refused.
     #[allow(clippy::too_many_arguments)]
     pub fn assemble_apply(
         self,
@@ -143,17 +148,28 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         pos: &[T::V3],
         radius: &[T],
         mu: MobMut<'_, T>,
-        f: &[T::V3],
-        u: &mut [T::V3],
+        (f, u): (&[T::V3], &mut [T::V3]),
         bands: &mut [T::V3],
+        copy: Option<&mut [T::M3]>,
     ) -> Result<(), StepError> {
         match self {
-            Self::Free { level, eta } => with_blocks!(mut mu, a => {
-                parallel::assemble_apply(par, level, eta, pos, radius, a, f, u, bands)
+            Self::Free { level, eta } => with_blocks!(mut mu, a => match copy {
+                None => parallel::assemble_apply(par, level, eta, pos, radius, a, f, u, bands),
+                Some(copy) => {
+                    let side = (copy, reduced::copy_start as fn(usize) -> usize);
+                    let pairs = (level, eta, pos, radius);
+                    let pack = reduced::pack_rows::<T, _>;
+                    parallel::assemble_apply_then(par, pairs, a, f, u, bands, side, pack)
+                }
             })
             .map_err(StepError::from),
             #[cfg(feature = "wall")]
             Self::Wall { level, eta, height } => {
+                if copy.is_some() {
+                    return Err(StepError::Unsupported(
+                        "the compact copy above a wall (its blocks are not symmetric)",
+                    ));
+                }
                 // Assembled, then applied.
                 let mu = mu.general();
                 mobility::wall::assemble(par, level, eta, height, pos, radius, mu)?;
@@ -164,7 +180,7 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
             Self::Periodic { eta, sums, .. } => {
                 let e = sums.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
                 let work = (par, bands);
-                mobility::periodic::assemble_apply(e, eta, (pos, radius), mu, (f, u), work, None)
+                mobility::periodic::assemble_apply(e, eta, (pos, radius), mu, (f, u), work, copy)
                     .map_err(StepError::from)
             }
             #[cfg(not(feature = "periodic"))]

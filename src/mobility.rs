@@ -43,21 +43,8 @@ pub fn tt_product<T: Real>(
     x: &[T::V3],
     y: &mut [T::V3],
 ) -> Result<(), ParticleError> {
-    let n = pos.len();
-    for i in 0..n {
-        y[i] = T::m3_diag(self_tt(eta, radius[i])) * x[i];
-    }
-    for i in 0..n {
-        let mut acc = T::V3_ZERO;
-        for j in 0..i {
-            let b = pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
-                .ok_or(ParticleError::Nested { i: j, j: i })?;
-            acc += b * x[j];
-            y[j] += T::m3_tmul(b, x[i]);
-        }
-        y[i] += acc;
-    }
-    Ok(())
+    let src = crate::parallel::Pairs::new(level, eta, pos, radius);
+    crate::parallel::serial_product(&src, &x[..pos.len()], y)
 }
 
 /// Block `(p, q)` of `mu_tt` as [`assemble_tt`] stores it (the pair evaluated from the
@@ -71,11 +58,8 @@ pub fn tt_block_at<T: Real>(
     p: usize,
     q: usize,
 ) -> Option<T::M3> {
-    let (i, j) = if p >= q { (p, q) } else { (q, p) };
-    if i == j {
-        return Some(T::m3_diag(self_tt(eta, radius[i])));
-    }
-    pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
+    let src = crate::parallel::Pairs::new(level, eta, pos, radius);
+    crate::parallel::block_at(&src, false, p, q).ok()
 }
 
 /// Assembles the `n x n` translational mobility `mu_tt`, packed lower triangle

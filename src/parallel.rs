@@ -29,14 +29,15 @@ mod blocked;
 mod free;
 mod jobs;
 mod lanes;
+mod source;
 
 pub use assembly::{assemble, assemble_apply};
 pub(crate) use blocked::assemble_apply_then;
-pub(crate) use free::band_blocks;
 pub use free::{free_band, free_product, free_products};
 #[cfg(feature = "pse")]
 pub(crate) use jobs::{Jobs, run_all};
 pub(crate) use jobs::{Packed, by_bands, by_bands_and, by_bands_k, by_rows, map_bands, reduce};
+pub(crate) use source::{Blocks, assemble_blocks, block_at, product_blocks, serial_product};
 
 // The band kernel is the dense product's (`sym_matvec` is its one-band case), so it
 // lives in `linalg`.
@@ -121,16 +122,28 @@ pub const fn band_scratch(n: usize) -> usize {
     s
 }
 
-/// The pairs a fused band evaluates its blocks from.
+/// The pairs a fused band evaluates its blocks from: free space's blocks
+/// ([`Blocks`]).
 #[derive(Clone, Copy)]
-struct Pairs<'a, T: Real> {
+pub(crate) struct Pairs<'a, T: Real> {
     level: Hydro,
     eta: T,
     pos: &'a [T::V3],
     radius: &'a [T],
 }
 
-impl<T: Real> Pairs<'_, T> {
+impl<'a, T: Real> Pairs<'a, T> {
+    /// Free space's blocks at `level` and viscosity `eta`.
+    #[inline(always)]
+    pub(crate) fn new(level: Hydro, eta: T, pos: &'a [T::V3], radius: &'a [T]) -> Self {
+        Self {
+            level,
+            eta,
+            pos,
+            radius,
+        }
+    }
+
     /// The diagonal blocks of rows `b0..b0 + y.len()` into `rows` (the packed rows from
     /// `b0` on), `y` started from their products, `z` zeroed: a fused band's first step.
     #[inline(always)]

@@ -4,7 +4,7 @@
 
 use super::{
     Projection, Start, StepReport, Sums, add_constraint_forces, add_flow, assemble_tt,
-    bond_vectors, check_resolved, max_tension, mobility_metric, mobility_product,
+    bond_vectors, check_resolved, hydro, max_tension, mobility_metric, mobility_product,
     project_overdamped, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
@@ -12,8 +12,7 @@ use crate::constraints::{self, Problem, Scratch, SolveStats};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
 use crate::linalg::{self, Mob, MobMut, with_blocks};
-use crate::noise::reduced;
-use crate::parallel::{self, Parallel};
+use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
 use crate::workspace::Views;
@@ -108,22 +107,7 @@ fn compact_product<T: Real>(
     (par, bands): (&dyn Parallel, &mut [T::V3]),
     copy: &mut [T::M3],
 ) -> Result<(), StepError> {
-    #[cfg(feature = "periodic")]
-    if let Some(e) = ew {
-        let e = e
-            .ewald()
-            .ok_or(StepError::Unsupported(super::stages::PSE_ASSEMBLED))?;
-        let work = (par, bands);
-        return super::periodic::assemble_apply(p, e, (pos, radius), mu, (f, u), work, Some(copy));
-    }
-    let _ = ew; // Read above only with the `periodic` feature.
-    let pairs = (p.hydro, p.viscosity, pos, radius);
-    let side = (copy, reduced::copy_start as fn(usize) -> usize);
-    with_blocks!(mut mu, a => {
-        let pack = reduced::pack_rows::<T, _>;
-        parallel::assemble_apply_then(par, pairs, a, f, u, bands, side, pack)
-    })
-    .map_err(StepError::from)
+    hydro(p, ew).assemble_apply(par, pos, radius, mu, (f, u), bands, Some(copy))
 }
 
 /// Projected overdamped velocity at `pos`: `U = U_inf + mu (F + G^T kappa)` with `kappa`

@@ -16,16 +16,13 @@ use crate::error::StepError;
 use crate::geometry::sums::BoxSums;
 #[cfg(feature = "pse")]
 use crate::geometry::sums::PseStep;
-use crate::linalg::MobMut;
-use crate::mobility::periodic::{self, Ewald};
+use crate::mobility::periodic::Ewald;
 #[cfg(feature = "pse")]
 use crate::mobility::pse::{Pse, PseSize, PseStorage};
-use crate::parallel::Parallel;
-use crate::params::Params;
 use crate::real::Real;
 
 /// What a step in a box holds for its products ([`super::stages::Sums`] borrows it):
-/// the Ewald parameters, or PSE's ([`Params::pse`]).
+/// the Ewald parameters, or PSE's ([`Params::pse`](crate::Params::pse)).
 #[derive(Debug)]
 pub(super) enum Held<T: Real> {
     /// The exact Ewald sums.
@@ -48,11 +45,14 @@ pub(super) fn pse<T: Real>(cell: Periodic<T>, radius: &[T], tol: f64) -> Result<
 
 /// The PSE storage a step of these spheres needs with `p`
 /// ([`Workspace::with_pse`](crate::Workspace::with_pse)): `Some` where the step sums
-/// its box by PSE ([`Params::pse`], a box whose images interact), from the same
+/// its box by PSE ([`Params::pse`](crate::Params::pse), a box whose images interact), from the same
 /// parameters the step derives; `None` where it needs none. A host sizes its arrays
 /// with it before the first step (the radii do not change during a run).
 #[cfg(feature = "pse")]
-pub fn pse_storage<T: Real>(p: &Params<T>, radius: &[T]) -> Result<Option<PseSize>, StepError> {
+pub fn pse_storage<T: Real>(
+    p: &crate::Params<T>,
+    radius: &[T],
+) -> Result<Option<PseSize>, StepError> {
     match (super::stages::ewald_cell(p), p.pse) {
         (Some(c), Some(tol)) => Ok(Some(pse(c, radius, tol)?.storage(radius.len()))),
         _ => Ok(None),
@@ -63,34 +63,6 @@ pub fn pse_storage<T: Real>(p: &Params<T>, radius: &[T]) -> Result<Option<PseSiz
 /// largest, so the sums accept each one).
 pub(super) fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>, StepError> {
     Ok(Ewald::new(cell, a_max(radius))?)
-}
-
-/// `u = mu_tt f` in the box: `mu_tt` assembled into the packed lower triangle `mu`
-/// ([`periodic::assemble`]: the blocks of [`periodic::assemble_tt`]), then applied,
-/// both in bands through `par` (`bands`: the product's partial sums). With `copy`
-/// each row of `mu` is also packed into the compact `f32` copy
-/// ([`Params::compact_products`], `noise::reduced`) as soon as it is written, while
-/// its blocks are in cache (the Ewald sums cost far more than the packing, so no pass
-/// of its own). The product reads the `f64` blocks either way: the unconstrained move
-/// keeps its bits.
-pub(super) fn assemble_apply<T: Real>(
-    p: &Params<T>,
-    ew: &Ewald<T>,
-    spheres: (&[T::V3], &[T]),
-    mu: MobMut<'_, T>,
-    fu: (&[T::V3], &mut [T::V3]),
-    work: (&dyn Parallel, &mut [T::V3]),
-    copy: Option<&mut [T::M3]>,
-) -> Result<(), StepError> {
-    Ok(periodic::assemble_apply(
-        ew,
-        p.viscosity,
-        spheres,
-        mu,
-        fu,
-        work,
-        copy,
-    )?)
 }
 
 /// The caller's PSE arrays as the step's storage, after checking them against the
@@ -142,10 +114,11 @@ pub(super) fn sums<T: Real>(held: Option<&Held<T>>) -> super::stages::Sums<'_, T
 
 #[cfg(test)]
 mod tests {
-    use super::{assemble_apply, ewald};
+    use super::ewald;
     use crate::cell::Periodic;
     use crate::error::StepError;
     use crate::linalg::{MobMut, Sym, tri};
+    use crate::mobility::periodic;
     use crate::noise::reduced;
     use crate::parallel::{self, Serial, band_scratch};
     use crate::params::Params;
@@ -187,10 +160,26 @@ mod tests {
         let mut copy = [f64::M3_ZERO; reduced::slots(N)];
         let mu = MobMut::Sym(&mut plain);
         let work = (&Serial as &dyn parallel::Parallel, &mut bands[..]);
-        assemble_apply(&p, &ew, spheres, mu, (&f, &mut u_plain), work, None)?;
+        periodic::assemble_apply(
+            &ew,
+            p.viscosity,
+            spheres,
+            mu,
+            (&f, &mut u_plain),
+            work,
+            None,
+        )?;
         let mu = MobMut::Sym(&mut packed);
         let (work, side) = ((&Serial as _, &mut bands[..]), Some(&mut copy[..]));
-        assemble_apply(&p, &ew, spheres, mu, (&f, &mut u_packed), work, side)?;
+        periodic::assemble_apply(
+            &ew,
+            p.viscosity,
+            spheres,
+            mu,
+            (&f, &mut u_packed),
+            work,
+            side,
+        )?;
         let same = |a: &[DVec3], b: &[DVec3]| {
             a.iter()
                 .zip(b)

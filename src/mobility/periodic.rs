@@ -39,7 +39,7 @@ pub use crate::cell::{Periodic, PeriodicError};
 use crate::fault::ParticleError;
 use crate::linalg::{Block, tri};
 use crate::parallel::{
-    Packed, Parallel, band_blocks, band_start, by_bands_and, by_bands_then_reduce,
+    Blocks, Packed, Parallel, assemble_blocks, block_at, product_blocks, serial_product,
 };
 use crate::real::Real;
 
@@ -280,47 +280,14 @@ where
     F: Fn(usize, usize, &[B], &mut [T::M3]) + Sync,
 {
     check(ew, pos, radius)?;
-    let n = pos.len();
-    let out = &mut out[..tri(n)];
-    let side_start = side.1;
-    let bands = (out, tri as fn(usize) -> usize);
-    let job = |t, rows_t: &mut [B], st: &mut [T::M3], _: &mut [T::V3], _: &mut [T::V3]| {
-        let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-        let first = side_start(b0);
-        rows(ew, eta, pos, radius, b0..b1, rows_t, |i, row| {
-            let rest = st.get_mut(side_start(i) - first..).unwrap_or_default();
-            then(i, i + 1, row, rest);
-        })
+    let src = Sums {
+        ew,
+        eta,
+        pos,
+        radius,
+        whole: true,
     };
-    by_bands_and::<T, _, _, _, _>(par, n, bands, side, &mut [], &mut [], job)
-}
-
-/// Packed rows `range` of the periodic `mu_tt` into `out` (which starts at row
-/// `range.start`): each row's self block, then its pairs in column order; each row
-/// handed to `row_done(i, blocks)` once written.
-fn rows<T: Real, B: Block<T>>(
-    ew: &Ewald<T>,
-    eta: T,
-    pos: &[T::V3],
-    radius: &[T],
-    range: core::ops::Range<usize>,
-    out: &mut [B],
-    mut row_done: impl FnMut(usize, &[B]),
-) -> Result<(), PeriodicError> {
-    let base = tri(range.start);
-    for i in range {
-        let row = tri(i) - base;
-        out[row + i] = B::store(self_tt(ew, eta, radius[i]));
-        for j in 0..i {
-            out[row + j] = B::store(
-                pair_tt(ew, eta, radius[i], radius[j], pos[i] - pos[j]).ok_or(
-                    PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
-                )?,
-            );
-        }
-        row_done(i, &out[row..=row + i]);
-    }
-    Ok(())
+    assemble_blocks(par, pos.len(), &src, out, side, then)
 }
 
 /// `y = mu_tt x` without storing `mu_tt`: the real-space blocks pair by pair (each
@@ -338,9 +305,15 @@ pub fn tt_product<T: Real>(
     y: &mut [T::V3],
 ) -> Result<(), PeriodicError> {
     check(ew, pos, radius)?;
-    let (diag, block) = real_blocks(ew, eta, pos, radius);
-    let n = pos.len();
-    band_blocks::<T, _>(0, diag, block, &x[..n], &mut y[..n], &mut [])?;
+    let whole = false;
+    let src = Sums {
+        ew,
+        eta,
+        pos,
+        radius,
+        whole,
+    };
+    serial_product(&src, &x[..pos.len()], y)?;
     wave::wave_product(ew, eta, pos, radius, x, y);
     Ok(())
 }
@@ -364,39 +337,64 @@ pub fn free_product<T: Real>(
     z: &mut [T::V3],
 ) -> Result<(), PeriodicError> {
     check(ew, pos, radius)?;
-    let (diag, block) = real_blocks(ew, eta, pos, radius);
-    let n = pos.len();
-    by_bands_then_reduce::<T, _, 1>(par, n, [&mut *y], z, |t, [yt], [zt]| {
-        band_blocks::<T, _>(band_start(n, t), diag, block, &x[..n], yt, zt)
-    })?;
+    let whole = false;
+    let src = Sums {
+        ew,
+        eta,
+        pos,
+        radius,
+        whole,
+    };
+    product_blocks(par, &src, &x[..pos.len()], y, z)?;
     wave::wave_product(ew, eta, pos, radius, x, y);
     Ok(())
 }
 
-/// The real-space self block of sphere `i` and pair block `(i, j)`, `j < i` (nested
-/// spheres the error of [`assemble_tt`]), as the matrix-free products read them.
-#[allow(clippy::type_complexity)]
-fn real_blocks<'a, T: Real>(
+/// The box's blocks as the band loops of [`crate::parallel`] read them: whole (real
+/// and wave space, as [`assemble_tt`] stores them), or the real-space half alone (the
+/// matrix-free products add the wave-space half through structure factors). Nested
+/// spheres the error of [`assemble_tt`].
+#[derive(Clone, Copy)]
+struct Sums<'a, T: Real> {
     ew: &'a Ewald<T>,
     eta: T,
     pos: &'a [T::V3],
     radius: &'a [T],
-) -> (
-    impl Fn(usize) -> T::M3 + Copy + Sync + 'a,
-    impl Fn(usize, usize) -> Result<T::M3, PeriodicError> + Copy + Sync + 'a,
-) {
-    // a < L/2: no image of a sphere lies inside it, so the self sum is never `None`.
-    let diag = move |i: usize| {
-        let a = radius[i];
-        real::real_sum(&ew.split, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO)
-    };
-    let block = move |i: usize, j: usize| {
-        let r0 = ew.cell.minimum_image(pos[i] - pos[j]);
-        real::real_sum(&ew.split, eta, radius[i], radius[j], r0, false).ok_or(
-            PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
-        )
-    };
-    (diag, block)
+    whole: bool,
+}
+
+impl<T: Real> Blocks<T> for Sums<'_, T> {
+    type Site = ();
+    type Error = PeriodicError;
+    #[inline(always)]
+    fn site(&self, _: usize) -> Result<(), PeriodicError> {
+        Ok(())
+    }
+    #[inline(always)]
+    fn diag(&self, i: usize, _: ()) -> T::M3 {
+        let a = self.radius[i];
+        match self.whole {
+            true => self_tt(self.ew, self.eta, a),
+            // a < L/2: no image of a sphere lies inside it, so the self sum is never `None`.
+            false => real::real_sum(&self.ew.split, self.eta, a, a, T::V3_ZERO, true)
+                .unwrap_or(T::M3_ZERO),
+        }
+    }
+    #[inline(always)]
+    fn pair(&self, i: usize, _: (), j: usize, _: ()) -> Result<T::M3, PeriodicError> {
+        let (ew, eta, pos, radius) = (self.ew, self.eta, self.pos, self.radius);
+        let block = match self.whole {
+            true => pair_tt(ew, eta, radius[i], radius[j], pos[i] - pos[j]),
+            false => {
+                let r0 = ew.cell.minimum_image(pos[i] - pos[j]);
+                real::real_sum(&ew.split, eta, radius[i], radius[j], r0, false)
+            }
+        };
+        block.ok_or(PeriodicError::Particle(ParticleError::Nested {
+            i: j,
+            j: i,
+        }))
+    }
 }
 
 /// Block `(p, q)` of the matrix [`assemble_tt`] stores (the pair evaluated from the
@@ -410,11 +408,20 @@ pub fn tt_block_at<T: Real>(
     p: usize,
     q: usize,
 ) -> Option<T::M3> {
-    let (hi, lo) = (p.max(q), p.min(q));
-    match hi == lo {
-        true => Some(self_tt(ew, eta, radius[hi])),
-        false => pair_tt(ew, eta, radius[hi], radius[lo], pos[hi] - pos[lo]),
-    }
+    let whole = true;
+    block_at(
+        &Sums {
+            ew,
+            eta,
+            pos,
+            radius,
+            whole,
+        },
+        false,
+        p,
+        q,
+    )
+    .ok()
 }
 
 #[cfg(test)]

@@ -38,7 +38,9 @@ pub use rotation::{add_spin, assemble_grand, image_rot, self_wall_rot};
 use crate::fault::ParticleError;
 use crate::linalg::tri;
 use crate::mobility::{Hydro, pair_tt, self_tt};
-use crate::parallel::{Parallel, band_start, bands, by_bands};
+use crate::parallel::{
+    Blocks, Parallel, assemble_blocks, block_at, product_blocks, serial_product,
+};
 use crate::real::Real;
 
 /// `(mu_par, mu_perp)`: Swan & Brady's self mobility of a sphere of radius `a` whose
@@ -166,6 +168,41 @@ fn pair<T: Real>(
     Some((free + image) * (si.b * sj.b))
 }
 
+/// `mu_tt` above the wall at `height`, block by block, as the band loops of
+/// [`crate::parallel`] read it: a sphere's site is its lift (an error below the wall).
+#[derive(Clone, Copy)]
+struct Wall<'a, T: Real> {
+    level: Hydro,
+    eta: T,
+    height: T,
+    pos: &'a [T::V3],
+    radius: &'a [T],
+}
+
+impl<T: Real> Blocks<T> for Wall<'_, T> {
+    type Site = Lifted<T>;
+    type Error = ParticleError;
+    #[inline(always)]
+    fn site(&self, i: usize) -> Result<Lifted<T>, ParticleError> {
+        lift(self.height, self.radius[i], self.pos[i], i)
+    }
+    #[inline(always)]
+    fn diag(&self, i: usize, si: Lifted<T>) -> T::M3 {
+        self_block(self.eta, self.radius[i], si)
+    }
+    #[inline(always)]
+    fn pair(
+        &self,
+        i: usize,
+        si: Lifted<T>,
+        j: usize,
+        sj: Lifted<T>,
+    ) -> Result<T::M3, ParticleError> {
+        let (ai, aj) = (self.radius[i], self.radius[j]);
+        pair(self.level, self.eta, ai, aj, si, sj).ok_or(ParticleError::Nested { i: j, j: i })
+    }
+}
+
 /// Block `(p, q)` of `mu_tt` above the wall at `height`, in that orientation (the
 /// stored block `(max, min)`, transposed when `p < q`).
 pub fn tt_block_at<T: Real>(
@@ -177,40 +214,14 @@ pub fn tt_block_at<T: Real>(
     p: usize,
     q: usize,
 ) -> Result<T::M3, ParticleError> {
-    let (i, j) = if p >= q { (p, q) } else { (q, p) };
-    let si = lift(height, radius[i], pos[i], i)?;
-    if i == j {
-        return Ok(self_block(eta, radius[i], si));
-    }
-    let sj = lift(height, radius[j], pos[j], j)?;
-    let b = pair(level, eta, radius[i], radius[j], si, sj)
-        .ok_or(ParticleError::Nested { i: j, j: i })?;
-    Ok(if p >= q { b } else { T::transpose(b) })
-}
-
-/// Packed rows `range` of `mu_tt` with the wall into `out` (starting at row
-/// `range.start`).
-fn rows<T: Real>(
-    level: Hydro,
-    eta: T,
-    height: T,
-    pos: &[T::V3],
-    radius: &[T],
-    range: core::ops::Range<usize>,
-    out: &mut [T::M3],
-) -> Result<(), ParticleError> {
-    let base = tri(range.start);
-    for i in range {
-        let si = lift(height, radius[i], pos[i], i)?;
-        let (pairs, diag) = out[tri(i) - base..=tri(i) - base + i].split_at_mut(i);
-        for (j, o) in pairs.iter_mut().enumerate() {
-            let sj = lift(height, radius[j], pos[j], j)?;
-            *o = pair(level, eta, radius[i], radius[j], si, sj)
-                .ok_or(ParticleError::Nested { i: j, j: i })?;
-        }
-        diag[0] = self_block(eta, radius[i], si);
-    }
-    Ok(())
+    let src = Wall {
+        level,
+        eta,
+        height,
+        pos,
+        radius,
+    };
+    block_at(&src, true, p, q)
 }
 
 /// Assembles `mu_tt` above the wall at `height` (packed lower triangle, [`tri`]`(n)`
@@ -225,15 +236,15 @@ pub fn assemble<T: Real>(
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), ParticleError> {
-    let n = pos.len();
-    let out = &mut out[..tri(n)];
-    if bands(n) == 1 {
-        return rows(level, eta, height, pos, radius, 0..n, out);
-    }
-    by_bands::<T, _, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
-        let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-        rows(level, eta, height, pos, radius, b0..b1, rows_t)
-    })
+    let src = Wall {
+        level,
+        eta,
+        height,
+        pos,
+        radius,
+    };
+    let none = (&mut [][..], tri as fn(usize) -> usize);
+    assemble_blocks(par, pos.len(), &src, out, none, |_, _, _, _| {})
 }
 
 /// `y = mu_tt x` above the wall without storing `mu_tt`, in the bands of
@@ -255,33 +266,21 @@ pub fn free_product<T: Real>(
     y: &mut [T::V3],
     z: &mut [T::V3],
 ) -> Result<(), ParticleError> {
-    for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
-        lift(height, a, p, i)?;
-    }
-    // Every sphere is above the wall: the lifts below cannot fail.
-    let at = |i: usize| {
-        lift(height, radius[i], pos[i], i).unwrap_or(Lifted {
-            p: pos[i],
-            h: radius[i],
-            b: T::ONE,
-        })
+    let src = Wall {
+        level,
+        eta,
+        height,
+        pos,
+        radius,
     };
-    let n = pos.len();
-    crate::parallel::by_bands_then_reduce::<T, _, 1>(par, n, [y], z, |t, [yt], [zt]| {
-        let diag = |i: usize| self_block(eta, radius[i], at(i));
-        let block = |i: usize, j: usize| {
-            pair(level, eta, radius[i], radius[j], at(i), at(j))
-                .ok_or(ParticleError::Nested { i: j, j: i })
-        };
-        let x = &x[..n];
-        crate::parallel::band_blocks::<T, _>(band_start(n, t), diag, block, x, yt, zt)
-    })
+    product_blocks(par, &src, &x[..pos.len()], y, z)
 }
 
 /// `y = mu_tt x` above the wall without storing `mu_tt`, in the order of [`assemble`]
 /// followed by [`sym_matvec`](crate::linalg::sym_matvec) (the same bits below
 /// [`BANDED_MIN`](crate::parallel::BANDED_MIN) rows, as in free space); one thread
-/// ([`free_product`] runs in bands).
+/// ([`free_product`] runs in bands). A sphere below the wall (in particle order), then
+/// nested spheres in row order.
 pub fn tt_product<T: Real>(
     level: Hydro,
     eta: T,
@@ -291,22 +290,12 @@ pub fn tt_product<T: Real>(
     x: &[T::V3],
     y: &mut [T::V3],
 ) -> Result<(), ParticleError> {
-    let n = pos.len();
-    for i in 0..n {
-        let si = lift(height, radius[i], pos[i], i)?;
-        y[i] = self_block(eta, radius[i], si) * x[i];
-    }
-    for i in 0..n {
-        let si = lift(height, radius[i], pos[i], i)?;
-        let mut acc = T::V3_ZERO;
-        for j in 0..i {
-            let sj = lift(height, radius[j], pos[j], j)?;
-            let b = pair(level, eta, radius[i], radius[j], si, sj)
-                .ok_or(ParticleError::Nested { i: j, j: i })?;
-            acc += b * x[j];
-            y[j] += T::m3_tmul(b, x[i]);
-        }
-        y[i] += acc;
-    }
-    Ok(())
+    let src = Wall {
+        level,
+        eta,
+        height,
+        pos,
+        radius,
+    };
+    serial_product(&src, &x[..pos.len()], y)
 }

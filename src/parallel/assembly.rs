@@ -3,11 +3,13 @@
 //! walks the rows in [`band`](super::band)'s order, so its product has the bits of a
 //! product of the stored blocks). The first nested pair in band order is the error.
 
-use super::{Pairs, Parallel, band_start, bands, blocked, by_bands, lanes, reduce};
+use super::{
+    Pairs, Parallel, assemble_blocks, band_start, bands, blocked, by_bands, lanes, reduce,
+};
 use crate::fault::ParticleError;
 use crate::linalg::{Block, tri};
 use crate::real::Real;
-use crate::rpy::{Hydro, pair_tt, self_tt};
+use crate::rpy::{Hydro, pair_tt};
 
 /// [`band`](super::band) while assembling: each block is evaluated, stored into `rows`
 /// (the packed rows from `b0` on) and applied at once, in the same order, so the
@@ -86,38 +88,9 @@ pub fn assemble<T: Real>(
     radius: &[T],
     out: &mut [impl Block<T>],
 ) -> Result<(), ParticleError> {
-    let n = pos.len();
-    let out = &mut out[..tri(n)];
-    if bands(n) == 1 {
-        return rows::<T, _>(level, eta, pos, radius, 0..n, out);
-    }
-    by_bands::<T, _, _, _>(par, n, out, tri, &mut [], &mut [], |t, rows_t, _, _| {
-        let (b0, b1) = (band_start(n, t), band_start(n, t + 1));
-        rows::<T, _>(level, eta, pos, radius, b0..b1, rows_t)
-    })
-}
-
-/// Packed rows `range` of `mu_tt` into `out` (which starts at row `range.start`).
-fn rows<T: Real, B: Block<T>>(
-    level: Hydro,
-    eta: T,
-    pos: &[T::V3],
-    radius: &[T],
-    range: core::ops::Range<usize>,
-    out: &mut [B],
-) -> Result<(), ParticleError> {
-    let base = tri(range.start);
-    for i in range {
-        let (pairs, diag) = out[tri(i) - base..=tri(i) - base + i].split_at_mut(i);
-        for (j, o) in pairs.iter_mut().enumerate() {
-            *o = B::store(
-                pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
-                    .ok_or(ParticleError::Nested { i: j, j: i })?,
-            );
-        }
-        diag[0] = B::store(T::m3_diag(self_tt(eta, radius[i])));
-    }
-    Ok(())
+    let src = Pairs::new(level, eta, pos, radius);
+    let none = (&mut [][..], tri as fn(usize) -> usize);
+    assemble_blocks(par, pos.len(), &src, out, none, |_, _, _, _| {})
 }
 
 /// [`assemble`] and [`product`](super::product) `y = mu_tt x` in one pass over the pairs
