@@ -17,8 +17,11 @@
 //! place the choice is made; adding a geometry adds a variant, its arms here and its
 //! own module under `mobility/`.
 
+mod place;
 #[cfg(feature = "periodic")]
 pub mod sums;
+
+pub use place::Place;
 
 #[cfg(not(feature = "periodic"))]
 use core::marker::PhantomData;

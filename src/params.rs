@@ -345,6 +345,18 @@ impl<T: Real> Params<T> {
         self.flow_velocity + T::cross(self.vorticity, r)
     }
 
+    /// The geometry these parameters name ([`Place`](crate::geometry::Place)): the one
+    /// reading of [`Params::wall`] and [`Params::periodic`] that the checks, the
+    /// workspace's sizes, the noise and the pair geometry ask.
+    #[inline(always)]
+    pub const fn place(&self) -> crate::geometry::Place<T> {
+        let wall = match self.wall {
+            Some(w) => Some(w.height),
+            None => None,
+        };
+        crate::geometry::Place::new(wall, self.periodic)
+    }
+
     /// `true` when a thermal step of `n` beads draws its noise by Lanczos: as
     /// [`NoiseSqrt::lanczos`] picks, and always with [`Params::matrix_free`] (there is no
     /// stored mobility to factorise; [`NoiseSqrt::Cholesky`] with `matrix_free` is

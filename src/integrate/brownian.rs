@@ -369,7 +369,7 @@ fn midpoint<T: Real>(
     // mobility without a wall does not depend on the positions: mu(x~) is mu, and is
     // not assembled again.
     let mid = &*mid;
-    let same = p.hydro == Hydro::FreeDraining && p.wall.is_none() && !p.matrix_free;
+    let same = p.hydro == Hydro::FreeDraining && p.place().wall().is_none() && !p.matrix_free;
     let mu_mid: Mob<'_, T> = if same {
         with_blocks!(mu, a => parallel::product::<T>(par, a, n, xi, dx, bands));
         mu

@@ -82,10 +82,10 @@ pub(super) fn check_thermal<T: Real>(
 /// Overdamped2); and no sphere below its contact height `height + a_i` (beyond the
 /// contacts' tolerance: the last step's wall contacts end within it).
 pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result<(), StepError> {
-    let Some(w) = p.wall else {
+    let Some(height) = p.place().wall() else {
         return Ok(());
     };
-    if !w.height.is_finite() {
+    if !height.is_finite() {
         return Err(StepError::BadParameter("wall.height (finite)"));
     }
     if !cfg!(feature = "wall") {
@@ -103,7 +103,7 @@ pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result
             "a wall with a method other than Overdamped or Overdamped2",
         ));
     }
-    match below_wall(state.pos, state.radius, w.height, p.solver.tolerance) {
+    match below_wall(state.pos, state.radius, height, p.solver.tolerance) {
         Some(particle) => Err(ParticleError::BelowWall { particle }.into()),
         None => Ok(()),
     }

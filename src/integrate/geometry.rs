@@ -21,7 +21,7 @@ fn check<T: Real>(p: &Params<T>, radius: &[T]) -> Result<HeldSums<T>, StepError>
     if !(p.viscosity > T::ZERO && p.viscosity.is_finite()) {
         return Err(StepError::BadParameter("viscosity"));
     }
-    if p.wall.is_some_and(|w| !w.height.is_finite()) {
+    if p.place().wall().is_some_and(|h| !h.is_finite()) {
         return Err(StepError::BadParameter("wall.height (finite)"));
     }
     check_box(p, radius)

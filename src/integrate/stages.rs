@@ -9,7 +9,6 @@ use crate::constraints::{self, Metric, Problem, Scratch, SolveStats, SolverKind}
 use crate::error::StepError;
 use crate::geometry::Hydrodynamics;
 use crate::linalg::{Mob, MobMut};
-use crate::mobility::Hydro;
 use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
@@ -135,27 +134,21 @@ pub(super) fn free_product<T: Real>(
 /// it the wall's code compiles away; `check_wall` refuses the wall then).
 #[inline(always)]
 pub(super) fn wall_height<T: Real>(p: &Params<T>) -> Option<T> {
-    match p.wall {
-        Some(w) if cfg!(feature = "wall") => Some(w.height),
-        _ => None,
-    }
+    p.place().step_wall()
 }
 
 /// The periodic box when the step has one and the kernel its `periodic` feature
 /// (without it the box's code compiles away; `check_periodic` refuses the box then).
 #[inline(always)]
 pub(super) fn cell<T: Real>(p: &Params<T>) -> Option<Periodic<T>> {
-    match p.periodic {
-        Some(c) if cfg!(feature = "periodic") => Some(c),
-        _ => None,
-    }
+    p.place().step_cell()
 }
 
 /// The box when its images interact through the mobility: not with free draining,
 /// whose mobility has self blocks only (the same in a box as outside it).
 #[inline(always)]
 pub(super) fn ewald_cell<T: Real>(p: &Params<T>) -> Option<Periodic<T>> {
-    cell(p).filter(|_| p.hydro != Hydro::FreeDraining)
+    p.place().summed_cell(p.hydro)
 }
 
 /// `mu_tt(pos)` into the packed lower triangle `mu`: free space, above the wall, or in

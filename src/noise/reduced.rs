@@ -65,14 +65,12 @@ pub const fn usable<T: Real>(n: usize) -> bool {
 /// keeps no storage for it).
 #[inline(always)]
 pub(crate) const fn for_noise<T: Real>(p: &crate::Params<T>, n: usize) -> bool {
-    let ewald = p.periodic.is_some() && !matches!(p.hydro, crate::Hydro::FreeDraining);
     usable::<T>(n)
         && matches!(p.method, crate::Method::Overdamped | crate::Method::Springs)
         && matches!(p.brownian, Some(b) if matches!(b.drift, crate::Drift::Midpoint))
         && p.lanczos_noise(n)
         && !p.matrix_free
-        && p.wall.is_none()
-        && !ewald
+        && p.place().free_blocks(p.hydro)
 }
 
 /// Groups of row `i` (blocks `0 ..= i`).

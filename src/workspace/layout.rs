@@ -20,7 +20,7 @@ pub(crate) const SYM: usize = 6;
 /// (whose factors and rotational blocks are not symmetric) the stored mobility keeps
 /// nine-scalar blocks in the block array.
 pub(crate) const fn symmetric<T: Real>(p: &Params<T>) -> bool {
-    p.wall.is_none()
+    p.place().symmetric()
         && matches!(
             p.method,
             Method::Overdamped | Method::Overdamped2 | Method::Springs
@@ -142,7 +142,7 @@ impl Layout {
     pub const fn for_params<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Self {
         let c = p.constraints(n, bonds);
         let mut l = Self::with_solver(p.method, p.rotation, p.solver_kind(n, bonds), n, c);
-        if p.contacts.is_some() || p.wall.is_some() {
+        if p.contacts.is_some() || p.place().wall().is_some() {
             l.links = c;
         }
         let l = if p.brownian.is_some() {

@@ -36,12 +36,12 @@ pub(in crate::integrate) fn accept<T: Real>(
             return Err(StepError::NonFinite { particle: i });
         }
     }
-    if let Some(w) = p.wall
-        && let Some(particle) = below_wall(pos, radius, w.height, p.solver.tolerance)
+    if let Some(height) = p.place().wall()
+        && let Some(particle) = below_wall(pos, radius, height, p.solver.tolerance)
     {
         return Err(ParticleError::BelowWall { particle }.into());
     }
-    if p.periodic.is_some()
+    if p.place().cell().is_some()
         && let Some(particle) = super::periodic_box::unresolved(pos, radius)
     {
         return Err(ParticleError::Unresolved { particle }.into());

@@ -26,7 +26,7 @@ pub(super) fn check_periodic<T: Real>(
     state: &State<'_, T>,
     bonds: &[Bond<T>],
 ) -> Result<HeldSums<T>, StepError> {
-    let Some(c) = p.periodic else {
+    let Some(c) = p.place().cell() else {
         return Ok(None);
     };
     let summed = box_geometry(p, state.radius)?;
@@ -81,7 +81,7 @@ pub(in crate::integrate) fn check_box<T: Real>(
 /// smallest edge. The box when its images interact (not with free draining, which has
 /// no pair blocks).
 fn box_geometry<T: Real>(p: &Params<T>, radius: &[T]) -> Result<Option<Periodic<T>>, StepError> {
-    let Some(c) = p.periodic else {
+    let Some(c) = p.place().cell() else {
         return Ok(None);
     };
     if !cfg!(feature = "periodic") {
@@ -89,7 +89,7 @@ fn box_geometry<T: Real>(p: &Params<T>, radius: &[T]) -> Result<Option<Periodic<
             "a periodic box: the kernel was built without its `periodic` feature",
         ));
     }
-    if p.wall.is_some() {
+    if p.place().wall().is_some() {
         return Err(StepError::Unsupported("a periodic box with a wall"));
     }
     if p.hydro == Hydro::Oseen {
