@@ -280,13 +280,7 @@ where
     F: Fn(usize, usize, &[B], &mut [T::M3]) + Sync,
 {
     check(ew, pos, radius)?;
-    let src = Sums {
-        ew,
-        eta,
-        pos,
-        radius,
-        whole: true,
-    };
+    let src = Sums::new(ew, eta, (pos, radius), true);
     assemble_blocks(par, pos.len(), &src, out, side, then)
 }
 
@@ -305,14 +299,7 @@ pub fn tt_product<T: Real>(
     y: &mut [T::V3],
 ) -> Result<(), PeriodicError> {
     check(ew, pos, radius)?;
-    let whole = false;
-    let src = Sums {
-        ew,
-        eta,
-        pos,
-        radius,
-        whole,
-    };
+    let src = Sums::new(ew, eta, (pos, radius), false);
     serial_product(&src, &x[..pos.len()], y)?;
     wave::wave_product(ew, eta, pos, radius, x, y);
     Ok(())
@@ -337,14 +324,7 @@ pub fn free_product<T: Real>(
     z: &mut [T::V3],
 ) -> Result<(), PeriodicError> {
     check(ew, pos, radius)?;
-    let whole = false;
-    let src = Sums {
-        ew,
-        eta,
-        pos,
-        radius,
-        whole,
-    };
+    let src = Sums::new(ew, eta, (pos, radius), false);
     product_blocks(par, &src, &x[..pos.len()], y, z)?;
     wave::wave_product(ew, eta, pos, radius, x, y);
     Ok(())
@@ -361,6 +341,19 @@ struct Sums<'a, T: Real> {
     pos: &'a [T::V3],
     radius: &'a [T],
     whole: bool,
+}
+
+impl<'a, T: Real> Sums<'a, T> {
+    #[inline(always)]
+    fn new(ew: &'a Ewald<T>, eta: T, (pos, radius): (&'a [T::V3], &'a [T]), whole: bool) -> Self {
+        Self {
+            ew,
+            eta,
+            pos,
+            radius,
+            whole,
+        }
+    }
 }
 
 impl<T: Real> Blocks<T> for Sums<'_, T> {
@@ -408,20 +401,8 @@ pub fn tt_block_at<T: Real>(
     p: usize,
     q: usize,
 ) -> Option<T::M3> {
-    let whole = true;
-    block_at(
-        &Sums {
-            ew,
-            eta,
-            pos,
-            radius,
-            whole,
-        },
-        false,
-        p,
-        q,
-    )
-    .ok()
+    let src = Sums::new(ew, eta, (pos, radius), true);
+    block_at(&src, false, p, q).ok()
 }
 
 #[cfg(test)]

@@ -179,6 +179,19 @@ struct Wall<'a, T: Real> {
     radius: &'a [T],
 }
 
+impl<'a, T: Real> Wall<'a, T> {
+    #[inline(always)]
+    fn new(level: Hydro, eta: T, height: T, pos: &'a [T::V3], radius: &'a [T]) -> Self {
+        Self {
+            level,
+            eta,
+            height,
+            pos,
+            radius,
+        }
+    }
+}
+
 impl<T: Real> Blocks<T> for Wall<'_, T> {
     type Site = Lifted<T>;
     type Error = ParticleError;
@@ -214,13 +227,7 @@ pub fn tt_block_at<T: Real>(
     p: usize,
     q: usize,
 ) -> Result<T::M3, ParticleError> {
-    let src = Wall {
-        level,
-        eta,
-        height,
-        pos,
-        radius,
-    };
+    let src = Wall::new(level, eta, height, pos, radius);
     block_at(&src, true, p, q)
 }
 
@@ -236,13 +243,7 @@ pub fn assemble<T: Real>(
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), ParticleError> {
-    let src = Wall {
-        level,
-        eta,
-        height,
-        pos,
-        radius,
-    };
+    let src = Wall::new(level, eta, height, pos, radius);
     let none = (&mut [][..], tri as fn(usize) -> usize);
     assemble_blocks(par, pos.len(), &src, out, none, |_, _, _, _| {})
 }
@@ -266,13 +267,7 @@ pub fn free_product<T: Real>(
     y: &mut [T::V3],
     z: &mut [T::V3],
 ) -> Result<(), ParticleError> {
-    let src = Wall {
-        level,
-        eta,
-        height,
-        pos,
-        radius,
-    };
+    let src = Wall::new(level, eta, height, pos, radius);
     product_blocks(par, &src, &x[..pos.len()], y, z)
 }
 
@@ -290,12 +285,6 @@ pub fn tt_product<T: Real>(
     x: &[T::V3],
     y: &mut [T::V3],
 ) -> Result<(), ParticleError> {
-    let src = Wall {
-        level,
-        eta,
-        height,
-        pos,
-        radius,
-    };
+    let src = Wall::new(level, eta, height, pos, radius);
     serial_product(&src, &x[..pos.len()], y)
 }
