@@ -26,7 +26,7 @@ pub use place::Place;
 #[cfg(not(feature = "periodic"))]
 use core::marker::PhantomData;
 
-use crate::error::{ParticleError, StepError};
+use crate::error::StepError;
 use crate::linalg::{MobMut, with_blocks};
 use crate::mobility::{self, Hydro};
 use crate::noise::reduced;
@@ -277,15 +277,8 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         if level == Hydro::FreeDraining {
             return Ok(());
         }
-        for i in 0..pos.len() {
-            for j in 0..i {
-                let b = mobility::pair_blocks(level, eta, radius[i], radius[j], pos[i] - pos[j])
-                    .ok_or(StepError::Particle(ParticleError::Nested { i: j, j: i }))?;
-                out[i] += b.rt_ij * f[j];
-                out[j] += b.rt_ji * f[i];
-            }
-        }
-        Ok(())
+        let src = parallel::Pairs::new(level, eta, pos, radius);
+        Ok(mobility::add_spin_of(&src, pos.len(), f, out)?)
     }
 
     /// The block of `mu_tt` a row-`p` entry of the matrix-free metric reads against

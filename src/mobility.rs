@@ -14,11 +14,11 @@
 //! (wall, periodic box, PSE) build on both.
 
 use crate::fault::ParticleError;
-use crate::linalg::tri;
 use crate::real::Real;
 
 #[cfg(feature = "fast-free")]
 pub mod free_fast;
+mod grand;
 #[cfg(feature = "periodic")]
 pub mod periodic;
 #[cfg(feature = "pse")]
@@ -27,6 +27,7 @@ pub mod wall;
 
 // The pair formulas sit below the band machinery (`parallel`), which evaluates them.
 pub use crate::rpy::{Hydro, PairBlocks, pair_blocks, pair_tt, self_rr, self_tt};
+pub(crate) use grand::{Grand, add_spin_of, assemble_grand_of};
 
 /// `y = mu_tt x` without storing `mu_tt`: each pair block is evaluated where it is
 /// used, in the orientation and summation order of [`assemble_tt`] followed by
@@ -63,7 +64,7 @@ pub fn tt_block_at<T: Real>(
 }
 
 /// Assembles the `n x n` translational mobility `mu_tt`, packed lower triangle
-/// ([`tri`]`(n)` blocks into `out`; symmetric by construction: each pair is evaluated once).
+/// ([`tri`](crate::linalg::tri)`(n)` blocks into `out`; symmetric by construction: each pair is evaluated once).
 pub fn assemble_tt<T: Real>(
     level: Hydro,
     eta: T,
@@ -83,22 +84,6 @@ pub fn assemble_grand<T: Real>(
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), ParticleError> {
-    let n = pos.len();
-    for i in 0..n {
-        let a = radius[i];
-        let (ti, ri) = (tri(i), tri(n + i));
-        out[ti + i] = T::m3_diag(self_tt(eta, a));
-        out[ri + n + i] = T::m3_diag(self_rr(eta, a));
-        out[ri + i] = T::M3_ZERO;
-        for j in 0..i {
-            let b = pair_blocks(level, eta, a, radius[j], pos[i] - pos[j])
-                .ok_or(ParticleError::Nested { i: j, j: i })?;
-            let rj = tri(n + j);
-            out[ti + j] = b.tt;
-            out[ri + n + j] = b.rr;
-            out[ri + j] = b.rt_ij;
-            out[rj + i] = b.rt_ji;
-        }
-    }
-    Ok(())
+    let src = crate::parallel::Pairs::new(level, eta, pos, radius);
+    grand::assemble_grand_of(&src, pos.len(), out)
 }

@@ -126,10 +126,10 @@ pub const fn band_scratch(n: usize) -> usize {
 /// ([`Blocks`]).
 #[derive(Clone, Copy)]
 pub(crate) struct Pairs<'a, T: Real> {
-    level: Hydro,
-    eta: T,
-    pos: &'a [T::V3],
-    radius: &'a [T],
+    pub(crate) level: Hydro,
+    pub(crate) eta: T,
+    pub(crate) pos: &'a [T::V3],
+    pub(crate) radius: &'a [T],
 }
 
 impl<'a, T: Real> Pairs<'a, T> {

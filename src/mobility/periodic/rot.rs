@@ -15,10 +15,11 @@
 
 use super::real::for_each_image;
 use super::wave::{add_kk, for_each_mode, for_each_phase, projected};
-use super::{Ewald, PeriodicError, check};
+use super::{Ewald, PeriodicError, Sums, check};
 use crate::fault::ParticleError;
-use crate::linalg::tri;
-use crate::mobility::{Hydro, pair_blocks, self_rr as free_self_rr};
+use crate::mobility::{
+    Grand, Hydro, PairBlocks, add_spin_of, assemble_grand_of, pair_blocks, self_rr as free_self_rr,
+};
 use crate::real::Real;
 
 /// Terms of the power series below `xi r = 1` (as for the translational kernel).
@@ -161,26 +162,8 @@ pub fn assemble_grand<T: Real>(
     out: &mut [T::M3],
 ) -> Result<(), PeriodicError> {
     check(ew, pos, radius)?;
-    let n = pos.len();
-    for i in 0..n {
-        let a = radius[i];
-        let (ti, ri) = (tri(i), tri(n + i));
-        out[ti + i] = super::self_tt(ew, eta, a);
-        out[ri + n + i] = self_rr(ew, eta, a);
-        out[ri + i] = T::M3_ZERO;
-        for j in 0..i {
-            let nested = PeriodicError::Particle(ParticleError::Nested { i: j, j: i });
-            let r = pos[i] - pos[j];
-            let tt = super::pair_tt(ew, eta, a, radius[j], r).ok_or(nested)?;
-            let (rt_ij, rt_ji, rr) = pair_rot(ew, eta, a, radius[j], r).ok_or(nested)?;
-            let rj = tri(n + j);
-            out[ti + j] = tt;
-            out[ri + n + j] = rr;
-            out[ri + j] = rt_ij;
-            out[rj + i] = rt_ji;
-        }
-    }
-    Ok(())
+    let src = Sums::new(ew, eta, (pos, radius), true);
+    assemble_grand_of(&src, pos.len(), out)
 }
 
 /// `out_i += sum_j rt_ij f_j` (the spin of torque-free spheres from the forces): the
@@ -196,16 +179,8 @@ pub fn add_spin<T: Real>(
     out: &mut [T::V3],
 ) -> Result<(), PeriodicError> {
     check(ew, pos, radius)?;
-    for i in 0..pos.len() {
-        for j in 0..i {
-            let r0 = ew.cell.minimum_image(pos[i] - pos[j]);
-            let (rt_ij, rt_ji, _) = real_rot(ew, eta, radius[i], radius[j], r0, false).ok_or(
-                PeriodicError::Particle(ParticleError::Nested { i: j, j: i }),
-            )?;
-            out[i] += rt_ij * f[j];
-            out[j] += rt_ji * f[i];
-        }
-    }
+    // The real-space blocks pair by pair; the wave-space part below.
+    add_spin_of(&Sums::new(ew, eta, (pos, radius), false), pos.len(), f, out)?;
     let w = T::ONE / (eta * ew.volume);
     for_each_mode(ew, |n| {
         let (k, _, _, base) = super::wave::mode(ew, n);
@@ -222,6 +197,53 @@ pub fn add_spin<T: Real>(
         }
     });
     Ok(())
+}
+
+/// The box's rotation blocks: whole (real and wave space, as [`assemble_grand`]
+/// stores them), or the real-space half alone for the spins, whose wave-space half
+/// [`add_spin`] sums through structure factors. The `rt` self block vanishes.
+impl<T: Real> Grand<T> for Sums<'_, T> {
+    #[inline(always)]
+    fn self_rr(&self, i: usize, _: ()) -> T::M3 {
+        self_rr(self.ew, self.eta, self.radius[i])
+    }
+    #[inline(always)]
+    fn self_rt(&self, _: usize, _: ()) -> Option<T::M3> {
+        None
+    }
+    #[inline(always)]
+    fn pair_grand(&self, i: usize, _: (), j: usize, _: ()) -> Result<PairBlocks<T>, PeriodicError> {
+        let (ew, eta, pos, radius) = (self.ew, self.eta, self.pos, self.radius);
+        let nested = PeriodicError::Particle(ParticleError::Nested { i: j, j: i });
+        let r = pos[i] - pos[j];
+        let tt = super::pair_tt(ew, eta, radius[i], radius[j], r).ok_or(nested)?;
+        let (rt_ij, rt_ji, rr) = pair_rot(ew, eta, radius[i], radius[j], r).ok_or(nested)?;
+        Ok(PairBlocks {
+            tt,
+            rt_ij,
+            rt_ji,
+            rr,
+        })
+    }
+    #[inline(always)]
+    fn pair_spin(&self, i: usize, _: (), j: usize, _: ()) -> Result<(T::M3, T::M3), PeriodicError> {
+        let (ew, eta, pos, radius) = (self.ew, self.eta, self.pos, self.radius);
+        let r = pos[i] - pos[j];
+        let nested = PeriodicError::Particle(ParticleError::Nested { i: j, j: i });
+        let (rt_ij, rt_ji, _) = match self.whole {
+            true => pair_rot(ew, eta, radius[i], radius[j], r),
+            false => real_rot(
+                ew,
+                eta,
+                radius[i],
+                radius[j],
+                ew.cell.minimum_image(r),
+                false,
+            ),
+        }
+        .ok_or(nested)?;
+        Ok((rt_ij, rt_ji))
+    }
 }
 
 #[cfg(test)]

@@ -7,10 +7,11 @@
 //! `(p, q, z)`, `p` the wall-parallel direction of `R` (any, when `R` is normal), `q =
 //! z x p`, then rotated to the axes ([`image_rot`]).
 
-use super::{Lifted, lift, self_block};
+use super::{Lifted, Wall};
 use crate::fault::ParticleError;
-use crate::linalg::tri;
-use crate::mobility::{Hydro, PairBlocks, pair_blocks, self_rr, self_tt};
+use crate::mobility::{
+    Grand, Hydro, PairBlocks, add_spin_of, assemble_grand_of, pair_blocks, self_rr, self_tt,
+};
 use crate::real::Real;
 
 /// The image's rotation blocks `(rt_ij, rr_ij)` for the source radius `aj`, `r = r_i -
@@ -118,25 +119,8 @@ pub fn assemble_grand<T: Real>(
     radius: &[T],
     out: &mut [T::M3],
 ) -> Result<(), ParticleError> {
-    let n = pos.len();
-    for i in 0..n {
-        let a = radius[i];
-        let si = lift(height, a, pos[i], i)?;
-        let (ti, ri) = (tri(i), tri(n + i));
-        out[ti + i] = self_block(eta, a, si);
-        (out[ri + n + i], out[ri + i]) = self_rot(eta, a, si);
-        for j in 0..i {
-            let sj = lift(height, radius[j], pos[j], j)?;
-            let b = pair_grand(level, eta, a, radius[j], si, sj)
-                .ok_or(ParticleError::Nested { i: j, j: i })?;
-            let rj = tri(n + j);
-            out[ti + j] = b.tt;
-            out[ri + n + j] = b.rr;
-            out[ri + j] = b.rt_ij;
-            out[rj + i] = b.rt_ji;
-        }
-    }
-    Ok(())
+    let src = Wall::new(level, eta, height, pos, radius);
+    assemble_grand_of(&src, pos.len(), out)
 }
 
 /// `out_i += sum_j rt_ij f_j` above the wall (self terms included): the spins of
@@ -150,16 +134,29 @@ pub fn add_spin<T: Real>(
     f: &[T::V3],
     out: &mut [T::V3],
 ) -> Result<(), ParticleError> {
-    for i in 0..pos.len() {
-        let si = lift(height, radius[i], pos[i], i)?;
-        out[i] += self_rot(eta, radius[i], si).1 * f[i];
-        for j in 0..i {
-            let sj = lift(height, radius[j], pos[j], j)?;
-            let b = pair_grand(level, eta, radius[i], radius[j], si, sj)
-                .ok_or(ParticleError::Nested { i: j, j: i })?;
-            out[i] += b.rt_ij * f[j];
-            out[j] += b.rt_ji * f[i];
-        }
+    let src = Wall::new(level, eta, height, pos, radius);
+    add_spin_of(&src, pos.len(), f, out)
+}
+
+/// The wall's rotation blocks: its self blocks damped as its translational ones.
+impl<T: Real> Grand<T> for Wall<'_, T> {
+    #[inline(always)]
+    fn self_rr(&self, i: usize, si: Lifted<T>) -> T::M3 {
+        self_rot(self.eta, self.radius[i], si).0
     }
-    Ok(())
+    #[inline(always)]
+    fn self_rt(&self, i: usize, si: Lifted<T>) -> Option<T::M3> {
+        Some(self_rot(self.eta, self.radius[i], si).1)
+    }
+    #[inline(always)]
+    fn pair_grand(
+        &self,
+        i: usize,
+        si: Lifted<T>,
+        j: usize,
+        sj: Lifted<T>,
+    ) -> Result<PairBlocks<T>, ParticleError> {
+        let (ai, aj) = (self.radius[i], self.radius[j]);
+        pair_grand(self.level, self.eta, ai, aj, si, sj).ok_or(ParticleError::Nested { i: j, j: i })
+    }
 }
