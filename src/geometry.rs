@@ -23,7 +23,6 @@ pub mod sums;
 
 pub use place::Place;
 
-#[cfg(not(feature = "periodic"))]
 use core::marker::PhantomData;
 
 use crate::error::StepError;
@@ -81,8 +80,8 @@ pub enum Hydrodynamics<'a, T: Real> {
         /// The step's sums.
         sums: sums::BoxSums<'a, T>,
     },
-    /// Never built: holds the lifetime without the `periodic` feature.
-    #[cfg(not(feature = "periodic"))]
+    /// Never built: holds the lifetime where no variant borrows (without the
+    /// `periodic` feature), so that the variants need no twin without it.
     #[doc(hidden)]
     Never(core::convert::Infallible, PhantomData<&'a T>),
 }
@@ -133,7 +132,6 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
                 use mobility::periodic::assemble;
                 Ok(with_blocks!(mut mu, mu => assemble(serial, e, eta, pos, radius, mu))?)
             }
-            #[cfg(not(feature = "periodic"))]
             Self::Never(never, _) => match never {},
         }
     }
@@ -186,7 +184,6 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
                 mobility::periodic::assemble_apply(e, eta, (pos, radius), mu, (f, u), work, copy)
                     .map_err(StepError::from)
             }
-            #[cfg(not(feature = "periodic"))]
             Self::Never(never, _) => match never {},
         }
     }
@@ -214,7 +211,6 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
             )?),
             #[cfg(feature = "periodic")]
             Self::Periodic { eta, sums, .. } => sums.product(eta, pos, radius, f, u, (par, bands)),
-            #[cfg(not(feature = "periodic"))]
             Self::Never(never, _) => match never {},
         }
     }
@@ -242,7 +238,6 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
                 };
                 mobility::periodic::assemble_grand(e, eta, pos, radius, out)?
             }
-            #[cfg(not(feature = "periodic"))]
             Self::Never(never, _) => match never {},
         }
         Ok(())
@@ -271,7 +266,6 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
                 // PSE has no rt blocks (the checks refuse it with rotation).
                 None => (level, eta),
             },
-            #[cfg(not(feature = "periodic"))]
             Self::Never(never, _) => match never {},
         };
         if level == Hydro::FreeDraining {
@@ -297,7 +291,6 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
             Self::Periodic { eta, sums, .. } => {
                 mobility::periodic::tt_block_at(sums.ewald()?, eta, pos, radius, p, q)
             }
-            #[cfg(not(feature = "periodic"))]
             Self::Never(never, _) => match never {},
         }
     }

@@ -354,7 +354,7 @@ impl<T: Real> Params<T> {
             Some(w) => Some(w.height),
             None => None,
         };
-        crate::geometry::Place::new(wall, self.periodic)
+        crate::geometry::Place::new(wall, self.periodic, self.pse.is_some())
     }
 
     /// `true` when a thermal step of `n` beads draws its noise by Lanczos: as
@@ -408,8 +408,7 @@ impl<T: Real> Params<T> {
             && matches!(self.method, Method::Overdamped)
             && (self.brownian.is_none() || crate::noise::reduced::for_noise(self, n))
             && !self.matrix_free
-            && self.wall.is_none()
-            && !(self.periodic.is_some() && self.pse.is_some())
+            && self.place().stores_symmetric()
             && core::mem::size_of::<T>() == 8
             && n >= crate::noise::reduced::REDUCED_MIN
             && matches!(self.solver_kind(n, bonds), SolverKind::Krylov)

@@ -29,16 +29,19 @@ pub enum Place<T: Real> {
         cell: Periodic<T>,
         /// A wall asked for beside the box.
         wall: Option<T>,
+        /// Summed by PSE ([`Params::pse`](crate::Params::pse): products only, nothing
+        /// stored), not by Ewald.
+        pse: bool,
     },
 }
 
 impl<T: Real> Place<T> {
-    /// The place of a wall at `wall` and a box `cell` (either may be absent): the box
-    /// first, as every check takes it.
+    /// The place of a wall at `wall` and a box `cell` summed by PSE where `pse` (either
+    /// may be absent): the box first, as every check takes it.
     #[inline(always)]
-    pub const fn new(wall: Option<T>, cell: Option<Periodic<T>>) -> Self {
+    pub const fn new(wall: Option<T>, cell: Option<Periodic<T>>, pse: bool) -> Self {
         match (cell, wall) {
-            (Some(cell), wall) => Self::Box { cell, wall },
+            (Some(cell), wall) => Self::Box { cell, wall, pse },
             (None, Some(height)) => Self::Wall { height },
             (None, None) => Self::Free,
         }
@@ -101,11 +104,53 @@ impl<T: Real> Place<T> {
         self.wall().is_none()
     }
 
+    /// Whether a step stores a mobility of symmetric blocks to copy: not above a wall,
+    /// nor in a box summed by PSE, which stores nothing.
+    #[inline(always)]
+    pub const fn stores_symmetric(self) -> bool {
+        self.symmetric() && !matches!(self, Self::Box { pse: true, .. })
+    }
+
     /// Whether the stored mobility at `level` is free space's (no wall, no box whose
     /// images interact): what a compact copy and the reduced noise read.
     #[inline(always)]
     pub const fn free_blocks(self, level: Hydro) -> bool {
         let summed = self.cell().is_some() && !matches!(level, Hydro::FreeDraining);
         self.symmetric() && !summed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every answer is the reading of the parameters it replaces, for every combination
+    /// of a wall, a box, PSE and the level (a box with a wall included, which the checks
+    /// refuse but the workspace's sizes still see).
+    #[test]
+    fn answers_are_the_parameters_read_by_hand() -> Result<(), crate::cell::PeriodicError> {
+        let cell = Periodic::new([10.0, 11.0, 12.0])?;
+        for wall in [None, Some(-0.5)] {
+            for periodic in [None, Some(cell)] {
+                for pse in [false, true] {
+                    let place = Place::<f64>::new(wall, periodic, pse);
+                    assert_eq!(place.wall(), wall);
+                    assert_eq!(place.cell(), periodic);
+                    assert_eq!(place.symmetric(), wall.is_none());
+                    let stored = wall.is_none() && !(periodic.is_some() && pse);
+                    assert_eq!(place.stores_symmetric(), stored);
+                    for level in [Hydro::Rpy, Hydro::Oseen, Hydro::FreeDraining] {
+                        let summed = periodic.is_some() && level != Hydro::FreeDraining;
+                        assert_eq!(place.free_blocks(level), wall.is_none() && !summed);
+                        let step = periodic.filter(|_| cfg!(feature = "periodic"));
+                        let step = step.filter(|_| level != Hydro::FreeDraining);
+                        assert_eq!(place.summed_cell(level), step);
+                    }
+                    let step = wall.filter(|_| cfg!(feature = "wall"));
+                    assert_eq!(place.step_wall(), step);
+                }
+            }
+        }
+        Ok(())
     }
 }
