@@ -14,8 +14,19 @@
 //! every host (each step compiled four times). Firmware drops what it does not use by
 //! the kernel's features (`wall`, `periodic`, `pse`: a variant and its code compile
 //! away with its feature), as before. The `match` over the variants below is the one
-//! place the choice is made; adding a geometry adds a variant, its arms here and its
-//! own module under `mobility/`.
+//! place the choice is made.
+//!
+//! **What a geometry gives.** Its blocks, not its loops: a source of blocks for the
+//! band loops written once in `parallel/source.rs` (`Blocks`: what a row needs of a
+//! sphere, the self block, the pair block; the assembly in bands, the matrix-free
+//! banded and serial products and the block at `(p, q)` read them) and, with
+//! rotation, for the grand mobility and the spins of `mobility/grand.rs` (`Grand`).
+//! What its parameters name is asked through [`Place`] ([`Params::place`](crate::Params::place)):
+//! the checks, the workspace's sizes, the noise and the minimum images never read
+//! the parameters' geometry fields by hand. Adding a geometry (a slit between two
+//! walls, say) is its module under `mobility/` with those two implementations, a
+//! variant and its arms here, a variant of [`Place`] (and the parameter that names
+//! it), its own input checks, and its tests.
 
 mod place;
 #[cfg(feature = "periodic")]
