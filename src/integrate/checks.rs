@@ -4,17 +4,19 @@
 //!
 //! This file holds the input checks that read the parameters and the spheres one by
 //! one; the periodic box's checks, which also derive the step's Ewald or PSE sums, are
-//! in `checks/periodic_box.rs`, and the acceptance of a candidate (a pair search, in
+//! in `checks/periodic_box.rs`, the wall's in `checks/wall.rs`, and the acceptance of a candidate (a pair search, in
 //! bands through the host's threads) in `checks/acceptance.rs`. The seam is what each
 //! costs and what it hands on: `O(N + B)` checks that return nothing, the box's sums
 //! that every product of the step reads, and the `O(N^2)` (or cell-list) pair search.
 
 mod acceptance;
 mod periodic_box;
+mod wall;
 
 pub(super) use acceptance::accept;
 pub(super) use periodic_box::check_box;
 use periodic_box::check_periodic;
+use wall::{below_wall, check_wall};
 
 use crate::bonds::Bond;
 use crate::constraints::Solver;
@@ -74,57 +76,6 @@ pub(super) fn check_thermal<T: Real>(
         ));
     }
     Ok(Some(b))
-}
-
-/// Checks the wall: a finite height; the kernel built with its `wall` feature (the
-/// wall's mobility, `mobility::wall`) and its `contacts` feature (the wall is held as
-/// a one-sided constraint); a method whose position projection holds it (Overdamped,
-/// Overdamped2); and no sphere below its contact height `height + a_i` (beyond the
-/// contacts' tolerance: the last step's wall contacts end within it).
-pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result<(), StepError> {
-    let Some(height) = p.place().wall() else {
-        return Ok(());
-    };
-    if !height.is_finite() {
-        return Err(StepError::BadParameter("wall.height (finite)"));
-    }
-    if !cfg!(feature = "wall") {
-        return Err(StepError::Unsupported(
-            "a wall: the kernel was built without its `wall` feature",
-        ));
-    }
-    if !cfg!(feature = "contacts") {
-        return Err(StepError::Unsupported(
-            "a wall: the kernel was built without its `contacts` feature",
-        ));
-    }
-    if !matches!(p.method, Method::Overdamped | Method::Overdamped2) {
-        return Err(StepError::Unsupported(
-            "a wall with a method other than Overdamped or Overdamped2",
-        ));
-    }
-    match below_wall(state.pos, state.radius, height, p.solver.tolerance) {
-        Some(particle) => Err(ParticleError::BelowWall { particle }.into()),
-        None => Ok(()),
-    }
-}
-
-/// The first sphere whose centre is below `height + a_i (1 - 2 tol)`, less the
-/// rounding of the numbers compared (4 epsilons of `|z| + |height| + a_i`): far from
-/// the origin a sphere put or held at contact is off by an ulp of its coordinates,
-/// which can exceed `2 tol a_i`. A centre that is not strictly above the plane in the
-/// step's precision (`z - height <= 0`: the coordinates' spacing there exceeds the
-/// radius, f32 far from the origin) is below it whatever that rounding: the wall's
-/// mobility has no value there (`mobility::wall`), and a scene checked with this test
-/// at parse time is not refused at its first step by that one.
-fn below_wall<T: Real>(pos: &[T::V3], radius: &[T], height: T, tol: T) -> Option<usize> {
-    let reach = T::ONE - tol * T::TWO;
-    let ulps = T::EPSILON * T::from_f64(4.0);
-    pos.iter().zip(radius).position(|(&r, &a)| {
-        let z = T::xyz(r)[2];
-        let rounding = (z.abs() + height.abs() + a) * ulps;
-        !(z - height > T::ZERO && z - height + rounding >= a * reach)
-    })
 }
 
 /// Stage 1 of a step: every check of its inputs, in order; the thermal settings when
