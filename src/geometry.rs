@@ -148,11 +148,7 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
     }
 
     /// `u = mu_tt(pos) f` assembled into `mu` and applied, in bands through `par`
-    /// (`bands` holds their partial sums, [`crate::parallel`]). With `copy`, each row of
-    /// the compact copy of `mu` ([`Params::compact_products`](crate::Params::compact_products),
-    /// `noise::reduced`) is written in the same pass, while the row's blocks are in
-    /// cache; the product reads the full blocks either way, with the same bits. Only
-    /// symmetric blocks have a copy: above a wall it is refused.
+    /// (`bands` holds their partial sums, [`crate::parallel`]).
     #[allow(clippy::too_many_arguments)]
     pub fn assemble_apply(
         self,
@@ -160,28 +156,17 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         pos: &[T::V3],
         radius: &[T],
         mu: MobMut<'_, T>,
-        (f, u): (&[T::V3], &mut [T::V3]),
+        f: &[T::V3],
+        u: &mut [T::V3],
         bands: &mut [T::V3],
-        copy: Option<&mut [T::M3]>,
     ) -> Result<(), StepError> {
         match self {
-            Self::Free { level, eta } => with_blocks!(mut mu, a => match copy {
-                None => parallel::assemble_apply(par, level, eta, pos, radius, a, f, u, bands),
-                Some(copy) => {
-                    let side = (copy, reduced::copy_start as fn(usize) -> usize);
-                    let pairs = (level, eta, pos, radius);
-                    let pack = reduced::pack_rows::<T, _>;
-                    parallel::assemble_apply_then(par, pairs, a, f, u, bands, side, pack)
-                }
+            Self::Free { level, eta } => with_blocks!(mut mu, a => {
+                parallel::assemble_apply(par, level, eta, pos, radius, a, f, u, bands)
             })
             .map_err(StepError::from),
             #[cfg(feature = "wall")]
             Self::Wall { level, eta, height } => {
-                if copy.is_some() {
-                    return Err(StepError::Unsupported(
-                        "the compact copy above a wall (its blocks are not symmetric)",
-                    ));
-                }
                 // Assembled, then applied.
                 let mu = mu.general();
                 mobility::wall::assemble(par, level, eta, height, pos, radius, mu)?;
@@ -192,6 +177,45 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
             Self::Periodic { eta, sums, .. } => {
                 let e = sums.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
                 let work = (par, bands);
+                mobility::periodic::assemble_apply(e, eta, (pos, radius), mu, (f, u), work, None)
+                    .map_err(StepError::from)
+            }
+            Self::Never(never, _) => match never {},
+        }
+    }
+
+    /// [`Hydrodynamics::assemble_apply`] that also writes each row of the compact copy
+    /// `copy` of `mu` ([`Params::compact_products`](crate::Params::compact_products),
+    /// `noise::reduced`) in the same pass, while the row's blocks are in cache; the
+    /// product reads the full blocks, with the same bits. Apart, so that a kernel whose
+    /// steps keep no copy (an `f32` firmware) links none of it. Only symmetric blocks
+    /// have a copy: above a wall it is refused.
+    #[allow(clippy::too_many_arguments)]
+    pub fn assemble_apply_copy(
+        self,
+        par: &dyn Parallel,
+        pos: &[T::V3],
+        radius: &[T],
+        mu: MobMut<'_, T>,
+        (f, u): (&[T::V3], &mut [T::V3]),
+        bands: &mut [T::V3],
+        copy: &mut [T::M3],
+    ) -> Result<(), StepError> {
+        match self {
+            Self::Free { level, eta } => with_blocks!(mut mu, a => {
+                let side = (copy, reduced::copy_start as fn(usize) -> usize);
+                let (pairs, pack) = ((level, eta, pos, radius), reduced::pack_rows::<T, _>);
+                parallel::assemble_apply_then(par, pairs, a, f, u, bands, side, pack)
+            })
+            .map_err(StepError::from),
+            #[cfg(feature = "wall")]
+            Self::Wall { .. } => Err(StepError::Unsupported(
+                "the compact copy above a wall (its blocks are not symmetric)",
+            )),
+            #[cfg(feature = "periodic")]
+            Self::Periodic { eta, sums, .. } => {
+                let e = sums.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
+                let (work, copy) = ((par, bands), Some(copy));
                 mobility::periodic::assemble_apply(e, eta, (pos, radius), mu, (f, u), work, copy)
                     .map_err(StepError::from)
             }

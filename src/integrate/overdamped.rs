@@ -107,7 +107,7 @@ fn compact_product<T: Real>(
     (par, bands): (&dyn Parallel, &mut [T::V3]),
     copy: &mut [T::M3],
 ) -> Result<(), StepError> {
-    hydro(p, ew).assemble_apply(par, pos, radius, mu, (f, u), bands, Some(copy))
+    hydro(p, ew).assemble_apply_copy(par, pos, radius, mu, (f, u), bands, copy)
 }
 
 /// Projected overdamped velocity at `pos`: `U = U_inf + mu (F + G^T kappa)` with `kappa`

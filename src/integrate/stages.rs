@@ -64,7 +64,7 @@ pub(super) fn mobility_product<T: Real>(
     if p.matrix_free {
         return free_product(p, ew, pos, radius, f, u, (par, bands));
     }
-    hydro(p, ew).assemble_apply(par, pos, radius, mu, (f, u), bands, None)
+    hydro(p, ew).assemble_apply(par, pos, radius, mu, f, u, bands)
 }
 
 /// The hydrodynamic constraint metric `D_l = scale mu G^T e_l`: matrix-free when asked;
