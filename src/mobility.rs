@@ -59,8 +59,11 @@ pub fn tt_block_at<T: Real>(
     p: usize,
     q: usize,
 ) -> Option<T::M3> {
-    let src = crate::parallel::Pairs::new(level, eta, pos, radius);
-    crate::parallel::block_at(&src, false, p, q).ok()
+    let (i, j) = if p >= q { (p, q) } else { (q, p) };
+    if i == j {
+        return Some(T::m3_diag(self_tt(eta, radius[i])));
+    }
+    pair_tt(level, eta, radius[i], radius[j], pos[i] - pos[j])
 }
 
 /// Assembles the `n x n` translational mobility `mu_tt`, packed lower triangle
