@@ -53,6 +53,12 @@ pub type Sums<'a, T> = Option<sums::BoxSums<'a, T>>;
 #[cfg(not(feature = "periodic"))]
 pub type Sums<'a, T> = Option<&'a PhantomData<T>>;
 
+/// Whether a geometry this kernel was built with has pair blocks that are not
+/// symmetric (the wall's: block `(j, i)` is the transpose of `(i, j)`), so that the
+/// readers of a stored nine-scalar mobility must transpose the other triangle. Without
+/// one, every such branch folds away.
+pub const GENERAL_BLOCKS: bool = cfg!(feature = "wall");
+
 /// Why PSE ([`Params::pse`](crate::Params::pse)) cannot serve a stage that needs the
 /// assembled mobility.
 pub(crate) const PSE_ASSEMBLED: &str = "PSE (Params::pse) where the step needs the assembled mobility \

@@ -27,7 +27,7 @@ mod table;
 pub(crate) use product::apply_drag;
 pub(crate) use table::tabulate;
 
-use crate::geometry::Hydrodynamics;
+use crate::geometry::{GENERAL_BLOCKS, Hydrodynamics};
 use crate::linalg::{Block, Mob, tri};
 use crate::parallel::Parallel;
 use crate::real::Real;
@@ -121,10 +121,10 @@ pub enum Metric<'a, T: Real> {
 #[inline(always)]
 fn sym_block<T: Real, B: Block<T>>(mu: &[B], p: usize, q: usize) -> T::M3 {
     if q <= p {
-        // Symmetric blocks (and every block without the `wall` feature): no transpose
-        // needed.
+        // Symmetric blocks (and every block where no geometry has general ones): no
+        // transpose needed.
         let b = mu[tri(p) + q].full();
-        if cfg!(feature = "wall") && B::SCALARS == 9 {
+        if GENERAL_BLOCKS && B::SCALARS == 9 {
             T::transpose(b)
         } else {
             b
@@ -144,7 +144,7 @@ fn sym_block<T: Real, B: Block<T>>(mu: &[B], p: usize, q: usize) -> T::M3 {
 fn sym_diff_mul<T: Real>(a: T::M3, c: T::M3, g: T::V3, sym: bool) -> T::V3 {
     let d = |r, col| T::m3_get(a, r, col) - T::m3_get(c, r, col);
     let [x, y, z] = T::xyz(g);
-    if !cfg!(feature = "wall") || sym {
+    if !GENERAL_BLOCKS || sym {
         // Symmetric blocks only: the lower triangles suffice (12 loads and 6
         // subtractions instead of 18 and 9), the same bits (M4 firmware's hot loop).
         let (d00, d10, d20) = (d(0, 0), d(1, 0), d(2, 0));

@@ -29,7 +29,7 @@ pub(crate) fn tabulate<T: Real>(
     // One body per case, so that the block reads branch on nothing at run time.
     match mu {
         Mob::Sym(mu) => table::<T, _, true>(mu, bonds, grad, scale, n, disp),
-        Mob::Full(mu) if sym || !cfg!(feature = "wall") => {
+        Mob::Full(mu) if sym || !crate::geometry::GENERAL_BLOCKS => {
             table::<T, _, true>(mu, bonds, grad, scale, n, disp)
         }
         Mob::Full(mu) => table::<T, _, false>(mu, bonds, grad, scale, n, disp),
@@ -50,7 +50,7 @@ fn table<T: Real, B: Block<T>, const SYM: bool>(
     let disp = &mut disp[..n * nb];
     let sym = SYM;
     let tr = |m: T::M3| {
-        if cfg!(feature = "wall") && !sym {
+        if crate::geometry::GENERAL_BLOCKS && !sym {
             T::transpose(m)
         } else {
             m
