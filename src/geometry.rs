@@ -122,6 +122,14 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         Self::Free { level, eta }
     }
 
+    /// The geometry of a step at `place` ([`Params::place`](crate::Params::place)) with
+    /// its sums: what the stages build, so that a new geometry reaches them through
+    /// [`Place`] alone.
+    #[inline(always)]
+    pub fn at(place: Place<T>, level: Hydro, eta: T, sums: Sums<'a, T>) -> Self {
+        Self::new(level, eta, place.step_wall(), sums)
+    }
+
     /// `mu_tt(pos)` into the packed lower triangle `mu`, on the calling thread.
     pub fn assemble_tt(
         self,

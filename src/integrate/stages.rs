@@ -19,7 +19,7 @@ pub(super) use crate::geometry::{PSE_ASSEMBLED, Sums};
 /// `ew` ([`Sums`]): the one place a stage turns the parameters into it.
 #[inline(always)]
 pub(super) fn hydro<'a, T: Real>(p: &Params<T>, ew: Sums<'a, T>) -> Hydrodynamics<'a, T> {
-    Hydrodynamics::new(p.hydro, p.viscosity, wall_height(p), ew)
+    Hydrodynamics::at(p.place(), p.hydro, p.viscosity, ew)
 }
 
 /// The Ewald sums of what [`super::checks::check_box`] holds, as [`Sums`] (it never
