@@ -13,9 +13,12 @@ From a script:
     rows.row("measurement", "case", "quantity", "12.5 us")
     rows.finish()
 
-From a shell script, one row:
+From a shell script, one row, or many as tab-separated lines of MEASUREMENT, CASE,
+QUANTITY and VALUE on the standard input (`-`); `--exact` leaves the load empty, for
+counts no load changes (instructions under QEMU's -icount, bytes):
 
     python3 bench/record.py NAME COMMAND MEASUREMENT CASE QUANTITY VALUE
+    python3 bench/record.py --exact NAME COMMAND - <rows.tsv
 """
 
 import csv
@@ -43,11 +46,11 @@ def load():
 class Recorder:
     """The rows of one run, appended to `bench/results/{name}.csv` by `finish`."""
 
-    def __init__(self, name, command):
+    def __init__(self, name, command, exact=False):
         self.file = ROOT / "bench" / "results" / f"{name}.csv"
         self.command = command
         self.machine = os.environ.get(MACHINE) or None
-        self.load_at_start = load()
+        self.load_at_start = None if exact else load()
         self.rows = []
 
     def row(self, measurement, case, quantity, value):
@@ -83,10 +86,19 @@ class Recorder:
 
 
 def main(argv):
-    if len(argv) != 7:
+    exact = argv[1:2] == ["--exact"]
+    args = argv[2:] if exact else argv[1:]
+    if len(args) == 3 and args[2] == "-":
+        cells = [line.rstrip("\n").split("\t") for line in sys.stdin if line.strip()]
+    elif len(args) == 6:
+        cells = [args[2:6]]
+    else:
         sys.exit(__doc__)
-    rows = Recorder(argv[1], argv[2])
-    rows.row(*argv[3:7])
+    if any(len(c) != 4 for c in cells):
+        sys.exit("each row needs 4 tab-separated fields: MEASUREMENT CASE QUANTITY VALUE")
+    rows = Recorder(args[0], args[1], exact)
+    for c in cells:
+        rows.row(*c)
     rows.finish()
 
 

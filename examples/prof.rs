@@ -2,7 +2,10 @@
 //!
 //! `cargo run --profile profiling --example prof -- o|o2|r|s|sp [sweep]` (release
 //! code with line tables for the profiler), with `STEPS=n` to set the number of steps
-//! (default 20000). Prints microseconds per step and mean constraint iterations.
+//! (default 20000). Prints microseconds per step and mean constraint iterations; with
+//! `HYDRORATTLE_BENCH_MACHINE` set, appends them to `bench/results/helix25.csv`.
+#[path = "shared/record.rs"]
+mod record;
 
 use glam::DVec3;
 use hydrorattle::*;
@@ -29,7 +32,8 @@ fn main() {
         "s" => Method::RattleStable,
         _ => Method::Springs,
     };
-    if std::env::args().nth(2).as_deref() == Some("sweep") {
+    let sweep = std::env::args().nth(2).as_deref() == Some("sweep");
+    if sweep {
         p.solver.kind = SolverKind::Sweep;
     }
     let mut ws_store = hydrorattle_heap::Buffers::<f64>::new(hydrorattle::Layout::all(32, 32));
@@ -45,9 +49,26 @@ fn main() {
             .unwrap()
             .iterations;
     }
-    println!(
-        "{method}: {:.2} us/step its {:.2}",
+    let (us, mean) = (
         t0.elapsed().as_secs_f64() * 1e6 / steps as f64,
-        its as f64 / steps as f64
+        its as f64 / steps as f64,
     );
+    println!("{method}: {us:.2} us/step its {mean:.2}");
+    let solver = if sweep { " sweep" } else { "" };
+    let mut rows = record::Recorder::new(
+        env!("CARGO_MANIFEST_DIR"),
+        "helix25",
+        format!("STEPS={steps} cargo run --profile profiling --example prof -- {method}{solver}"),
+    );
+    let table = format!("one method's step, 25-bead chain, f64, mean of {steps} steps");
+    let case = format!("{:?}{solver}", p.method);
+    rows.row(&table, &case, "us a step", &format!("{us:.2} us"));
+    rows.row(
+        &table,
+        &case,
+        "constraint iterations",
+        &format!("{mean:.2}"),
+    );
+    rows.finish()
+        .expect("appending to bench/results/helix25.csv");
 }

@@ -13,7 +13,9 @@
 //! ```
 //!
 //! Times are the best of a few repetitions on whatever machine runs it (the development
-//! machine is shared): read ratios, and the counts printed with them.
+//! machine is shared): read ratios, and the counts printed with them. With
+//! `HYDRORATTLE_BENCH_MACHINE` set, appends each printed line's numbers to
+//! `bench/results/large-n.csv`.
 
 use std::time::Instant;
 
@@ -80,6 +82,13 @@ use cpu::cpu;
 mod best;
 use best::best;
 
+#[path = "shared/record.rs"]
+mod record;
+use record::Recorder;
+
+/// The table of the product's rows.
+const PRODUCT: &str = "PSE product in a periodic box, volume fraction 0.1, f64, one thread";
+
 /// Heap storage for one `Pse` and `n` spheres, and the product into `out`.
 struct Store(Vec<[f64; 2]>, Vec<usize>, Vec<V>);
 impl Store {
@@ -143,7 +152,25 @@ fn describe(pse: &Pse<f64>, n: usize) -> String {
     )
 }
 
-fn scaling(tol: f64) {
+/// The rows of one PSE timing (`time_pse`'s) of case `case`.
+fn pse_rows(rows: &mut Recorder, case: &str, (t, near, wave): (f64, f64, f64), pse: &Pse<f64>) {
+    let g = pse.grid();
+    rows.row(PRODUCT, case, "product", &format!("{t:.4} s"));
+    rows.row(
+        PRODUCT,
+        case,
+        "near / wave",
+        &format!("{near:.4} / {wave:.4} s"),
+    );
+    rows.row(
+        PRODUCT,
+        case,
+        "grid",
+        &format!("{}x{}x{}", g[0], g[1], g[2]),
+    );
+}
+
+fn scaling(rows: &mut Recorder, tol: f64) {
     let ns = [1_000usize, 10_000, 100_000];
     let mut times = vec![];
     for &n in &ns {
@@ -154,12 +181,18 @@ fn scaling(tol: f64) {
             t / n as f64 * 1e6,
             describe(&pse, n)
         );
+        pse_rows(
+            rows,
+            &format!("N = {n}, tolerance {tol:e}"),
+            (t, near, wave),
+            &pse,
+        );
         times.push(t);
     }
     exponents(&ns, &times);
 }
 
-fn tols() {
+fn tols(rows: &mut Recorder) {
     let n = 10_000;
     for tol in [1e-3, 1e-4, 1e-5, 1e-6] {
         let (t, near, wave, pse) = time_pse(n, tol, 0.5, 3);
@@ -167,10 +200,16 @@ fn tols() {
             "tol {tol:e}: {t:.4} s (near {near:.4}, wave {wave:.4}); {}",
             describe(&pse, n)
         );
+        pse_rows(
+            rows,
+            &format!("N = {n}, tolerance {tol:e}"),
+            (t, near, wave),
+            &pse,
+        );
     }
 }
 
-fn xi_scan() {
+fn xi_scan(rows: &mut Recorder) {
     let n = 10_000;
     for tol in [1e-3, 1e-4, 1e-6] {
         for xi_a in [0.3, 0.4, 0.5, 0.6, 0.8] {
@@ -179,11 +218,13 @@ fn xi_scan() {
                 "tol {tol:e} xi a {xi_a}: {t:.4} s (near {near:.4}, wave {wave:.4}); {}",
                 describe(&pse, n)
             );
+            let case = format!("N = {n}, tolerance {tol:e}, xi a = {xi_a}");
+            pse_rows(rows, &case, (t, near, wave), &pse);
         }
     }
 }
 
-fn crossover() {
+fn crossover(rows: &mut Recorder) {
     for n in [10usize, 20, 50, 100, 400] {
         let (l, pos, rad, force) = suspension(n, 0.1, 7);
         let cell = Periodic::new([l; 3]).unwrap();
@@ -208,12 +249,18 @@ fn crossover() {
                 te / tp,
                 (num / den).sqrt()
             );
+            let table = "PSE against the dense Ewald product, volume fraction 0.1, f64, one thread";
+            let case = format!("N = {n}, tolerance {tol:e}");
+            rows.row(table, &case, "Ewald", &format!("{te:.4} s"));
+            rows.row(table, &case, "PSE", &format!("{tp:.4} s"));
+            let error = format!("{:.2e}", (num / den).sqrt());
+            rows.row(table, &case, "PSE relative error", &error);
         }
     }
 }
 
 /// The Brownian displacement (`Pse::noise`, Lanczos tolerance 1e-3) against N.
-fn noise() {
+fn noise(rows: &mut Recorder) {
     let ns = [1_000usize, 10_000, 100_000];
     let mut times = vec![];
     for &n in &ns {
@@ -234,6 +281,10 @@ fn noise() {
                 .unwrap();
         });
         println!("N {n:>6}: noise {t:.3} s, {iterations} Lanczos iterations");
+        let table =
+            "PSE Brownian displacement, volume fraction 0.1, tolerance 1e-4, f64, one thread";
+        let value = format!("{t:.3} s ({iterations} iterations)");
+        rows.row(table, &format!("N = {n}"), "Lanczos 1e-3", &value);
         times.push(t);
     }
     exponents(&ns, &times);
@@ -245,7 +296,7 @@ fn noise() {
 /// tolerance 1e-3, the default drift: without bonds the step takes PSE's uncorrected
 /// draw), against N (default 1e3, 1e4, 1e5): this thread's CPU time per step (best of
 /// 2, one step each) and the noise's Lanczos iterations (the near field's).
-fn steps(ns: &[usize]) {
+fn steps(rows: &mut Recorder, ns: &[usize]) {
     use hydrorattle::integrate::{pse_storage, step_slices};
     use hydrorattle::{Brownian, Drift, Layout, Method, NoForce, Params, State};
     for drift in [Drift::Midpoint] {
@@ -300,6 +351,11 @@ fn steps(ns: &[usize]) {
                 "{drift:?} N {n:>6}: step {t:.3} s, noise iterations {}",
                 r.noise_iterations
             );
+            let table = "Brownian step on PSE, Overdamped, matrix-free, volume fraction 0.1, f64, one thread";
+            let case = format!("N = {n}, {drift:?} drift");
+            rows.row(table, &case, "CPU time a step", &format!("{t:.3} s"));
+            let noise = r.noise_iterations.to_string();
+            rows.row(table, &case, "noise iterations", &noise);
             times.push(t);
         }
         if ns.len() > 1 {
@@ -309,22 +365,35 @@ fn steps(ns: &[usize]) {
 }
 
 fn main() {
-    let arg = std::env::args().nth(1).unwrap_or_default();
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut recorder = Recorder::new(
+        env!("CARGO_MANIFEST_DIR"),
+        "large-n",
+        format!(
+            "cargo run --release --example pse_scaling -- {}",
+            args.join(" ")
+        ),
+    );
+    let rows = &mut recorder;
+    let arg = args.first().cloned().unwrap_or_default();
     match arg.as_str() {
-        "tols" => tols(),
-        "xi" => xi_scan(),
-        "crossover" => crossover(),
-        "noise" => noise(),
+        "tols" => tols(rows),
+        "xi" => xi_scan(rows),
+        "crossover" => crossover(rows),
+        "noise" => noise(rows),
         "step" => {
             let ns: Vec<usize> = std::env::args()
                 .skip(2)
                 .map(|s| s.parse().unwrap())
                 .collect();
-            steps(if ns.is_empty() {
-                &[1_000, 10_000, 100_000]
-            } else {
-                &ns
-            })
+            steps(
+                rows,
+                if ns.is_empty() {
+                    &[1_000, 10_000, 100_000]
+                } else {
+                    &ns
+                },
+            )
         }
         "one" => {
             let n: usize = std::env::args()
@@ -335,7 +404,16 @@ fn main() {
                 "N {n}: {t:.4} s (near {near:.4}, wave {wave:.4}); {}",
                 describe(&pse, n)
             );
+            pse_rows(
+                rows,
+                &format!("N = {n}, tolerance 1e-4"),
+                (t, near, wave),
+                &pse,
+            );
         }
-        _ => scaling(1e-4),
+        _ => scaling(rows, 1e-4),
     }
+    recorder
+        .finish()
+        .expect("appending to bench/results/large-n.csv");
 }

@@ -16,7 +16,11 @@
 //! mobility, `docs/PERIODIC.md`). `COMPACT=1` sets `Params::compact_products` (the
 //! Krylov constraint products from the compact `f32` copy, where the kernel takes it:
 //! Overdamped, N >= 700, free space or a box). Each line ends with a digest of the final positions'
-//! bits (the same on every build that keeps the arithmetic).
+//! bits (the same on every build that keeps the arithmetic). With
+//! `HYDRORATTLE_BENCH_MACHINE` set, appends each line's numbers to
+//! `bench/results/large-n.csv`.
+#[path = "shared/record.rs"]
+mod record;
 
 use hydrorattle::*;
 use hydrorattle_heap::Buffers;
@@ -75,6 +79,39 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(5);
+    // The command with the variables that changed the run, so that a row reruns.
+    let vars = [
+        "STEPS",
+        "MF",
+        "DT",
+        "KT",
+        "UNCORRECTED",
+        "LTOL",
+        "CHAIN",
+        "BOX",
+        "COMPACT",
+    ];
+    let set: Vec<String> = vars
+        .iter()
+        .filter_map(|v| std::env::var(v).ok().map(|x| format!("{v}={x} ")))
+        .collect();
+    let mut rows = record::Recorder::new(
+        env!("CARGO_MANIFEST_DIR"),
+        "large-n",
+        format!(
+            "{}cargo run --release --example scale -- {}",
+            set.concat(),
+            args[1..].join(" ")
+        ),
+    );
+    let table = format!(
+        "{method:?} step, solver {kind:?}, {}, f64, mean of {steps} steps",
+        if std::env::var("CHAIN").is_ok() {
+            "kernel bench's chain"
+        } else {
+            "helix"
+        },
+    );
     for n in args[3..].iter().map(|s| s.parse::<usize>().unwrap()) {
         let (mut pos, radius) = match std::env::var("CHAIN").is_ok() {
             true => chain(n),
@@ -151,5 +188,22 @@ fn main() {
             mid as f64 / steps as f64,
             layout.bytes::<f64>() as f64 / 1e6
         );
+        let case = format!("N = {n}");
+        let mean = |x: u32| format!("{:.1}", f64::from(x) / steps as f64);
+        for (quantity, value) in [
+            ("time a step", format!("{us:.2} us")),
+            ("constraint iterations", mean(its)),
+            ("Lanczos iterations", mean(lanczos)),
+            ("midpoint iterations", mean(mid)),
+            (
+                "storage",
+                format!("{:.1} MB", layout.bytes::<f64>() as f64 / 1e6),
+            ),
+            ("positions digest", format!("{digest:016x}")),
+        ] {
+            rows.row(&table, &case, quantity, &value);
+        }
     }
+    rows.finish()
+        .expect("appending to bench/results/large-n.csv");
 }

@@ -11,7 +11,8 @@
 #           again; a deliberately small stack must end in the HardFault report; the
 #           C example built with arm-none-eabi-gcc against the thumbv7em staticlib and
 #           run under QEMU, its digest compared with the host C run and the firmware.
-# Prints a table of flash, RAM and instructions per step. Without the thumbv7em
+# Prints a table of flash, RAM and instructions per step (with HYDRORATTLE_BENCH_MACHINE
+# set, also appended to bench/results/m4.csv by bench/record.py). Without the thumbv7em
 # target (or the Debian packages) it says so and runs the host part only.
 set -euo pipefail
 
@@ -170,6 +171,21 @@ fi
 say "summary (f32, N = 25, ${#bins[@]}+1 firmware binaries; bytes)"
 printf '%-16s %8s %8s %8s %8s %10s %8s %14s\n' binary flash bss stack ram_need min_ram \
     digest instr/step
+# The rows of bench/results/m4.csv, one cell a line: measurement, case, quantity, value.
+table="firmware per binary, f32 N = 25, 200 steps"
+case_of() {
+    case $1 in
+    overdamped) echo Overdamped ;;
+    overdamped2) echo Overdamped2 ;;
+    rattle) echo Rattle ;;
+    stable) echo RattleStable ;;
+    springs) echo Springs ;;
+    brownian) echo "Overdamped, kT = 0.5 (brownian)" ;;
+    stable_rotation) echo "RattleStable, rotation" ;;
+    *) echo "$1" ;;
+    esac
+}
+: >"$out/m4-rows.tsv"
 for bin in "${bins[@]}" stable_rotation; do
     dir=fw
     [ "$bin" = stable_rotation ] && dir=fw-big
@@ -180,7 +196,16 @@ for bin in "${bins[@]}" stable_rotation; do
     printf '%-16s %8s %8s %8s %8s %9sK %8s %14s\n' "$bin" "$flash" "$(field bss)" \
         "$(field stack_peak)" "$(field ram_needed)" "$(cat "$out/$bin-min-kib")" \
         "$(digest "$out/$bin.txt" | cut -c1-8)" "$(field instructions_per_step)"
+    c=$(case_of "$bin")
+    printf '%s\t%s\t%s\t%s\n' "$table" "$c" flash "$flash" "$table" "$c" .bss "$(field bss)" \
+        "$table" "$c" "peak stack" "$(field stack_peak)" "$table" "$c" "RAM needed" \
+        "$(field ram_needed)" "$table" "$c" "min RAM" "$(cat "$out/$bin-min-kib")K" \
+        "$table" "$c" "instructions / step" "$(field instructions_per_step)" \
+        "$table" "$c" digest "$(digest "$out/$bin.txt")" >>"$out/m4-rows.tsv"
 done
+if command -v python3 >/dev/null 2>&1; then
+    python3 "$root/bench/record.py" --exact m4 "bash firmware/ci.sh" - <"$out/m4-rows.tsv"
+fi
 echo "host == Cortex-M4 bits for every binary; C example (host and QEMU) == firmware:" \
     "$(digest "$out/c-host.txt") (Brownian: $(digest "$out/brownian.txt"))"
 say "firmware/ci.sh passed"

@@ -7,7 +7,8 @@
 
 use std::collections::TryReserveError;
 
-use hydrorattle::{Bond, Layout, Noise, Real, State, Workspace};
+use hydrorattle::particles::sphere_volume;
+use hydrorattle::{Bond, Layout, Noise, ParticleError, Real, State, Workspace};
 
 /// Heap storage holding a [`Layout`]: built element by element on the heap, so no
 /// size ever passes through the stack.
@@ -77,7 +78,8 @@ impl<T: Real> Buffers<T> {
 }
 
 /// A particle state on the heap: the arrays a [`State`] borrows, owned, for hosts,
-/// tests and examples that size their systems at run time.
+/// tests and examples that size their systems at run time (the host library's
+/// `Beads`, whose engine keeps the generator itself and leaves `noise` empty).
 #[derive(Clone, Debug)]
 pub struct Spheres<T: Real> {
     /// Centres.
@@ -110,6 +112,34 @@ impl<T: Real> Spheres<T> {
             time: T::ZERO,
             noise: None,
         }
+    }
+
+    /// Number of spheres.
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+
+    /// `true` when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+
+    /// Mass of sphere `i`.
+    pub fn mass(&self, i: usize) -> T {
+        sphere_volume(self.radius[i]) * self.density[i]
+    }
+
+    /// Nested spheres are refused; overlapping ones unless `allow_overlap` (in the
+    /// periodic box `cell`, through the minimum image): the kernel's `check_pairs` over
+    /// its cell list (`O(N)` pairs, the same error).
+    pub fn check_pairs(
+        &self,
+        allow_overlap: bool,
+        cell: Option<&hydrorattle::cell::Periodic<T>>,
+    ) -> Result<(), ParticleError> {
+        let mut store = vec![0; hydrorattle::cell_list::indices(self.len())];
+        let (pos, radius) = (&self.pos, &self.radius);
+        hydrorattle::cell_list::check_pairs_periodic(pos, radius, allow_overlap, cell, &mut store)
     }
 
     /// The state a step takes, every array borrowed.

@@ -6,7 +6,10 @@
 //! (default 20000 steps in windows of 100). Prints the best window and the 10th
 //! percentile and median, in microseconds a step, the CPU time a step of the whole run
 //! (`/proc/self/stat`'s user + system ticks), and an FNV-1a digest of the final
-//! positions' bits, so that builds can be compared.
+//! positions' bits, so that builds can be compared. With `HYDRORATTLE_BENCH_MACHINE`
+//! set, appends them to `bench/results/helix25.csv`.
+#[path = "../../examples/shared/record.rs"]
+mod record;
 
 use hydrorattle_host::scene::Scene;
 use hydrorattle_host::sim::Engine;
@@ -42,13 +45,39 @@ fn main() {
             h = (h ^ x.to_bits()).wrapping_mul(0x100_0000_01b3);
         }
     }
+    let done = per.len() * window;
+    let (best, p10, median) = (at(0.0), at(0.1), at(0.5));
     println!(
-        "{} steps: best {:.3} us, p10 {:.3} us, median {:.3} us a step; CPU {cpu:.2} us a step; positions {h:016x}",
-        per.len() * window,
-        at(0.0),
-        at(0.1),
-        at(0.5),
+        "{done} steps: best {best:.3} us, p10 {p10:.3} us, median {median:.3} us a step; CPU {cpu:.2} us a step; positions {h:016x}",
     );
+    let mut rows = record::Recorder::new(
+        env!("CARGO_MANIFEST_DIR"),
+        "helix25",
+        format!(
+            "cargo run --release -p hydrorattle-host --example step_windows -- {}",
+            args[1..].join(" ")
+        ),
+    );
+    let table = format!("best {window}-step window, {done} steps, one thread");
+    // The builds of docs/BENCHMARKS.md: the default x86-64 target, and x86-64-v3.
+    let case = if cfg!(target_feature = "avx2") {
+        "x86-64-v3 (AVX2)"
+    } else if cfg!(target_arch = "x86_64") {
+        "default (SSE2)"
+    } else {
+        std::env::consts::ARCH
+    };
+    for (quantity, value) in [
+        ("best window", format!("{best:.3} us")),
+        ("p10 window", format!("{p10:.3} us")),
+        ("median window", format!("{median:.3} us")),
+        ("CPU a step", format!("{cpu:.2} us")),
+        ("positions digest", format!("{h:016x}")),
+    ] {
+        rows.row(&table, case, quantity, &value);
+    }
+    rows.finish()
+        .expect("appending to bench/results/helix25.csv");
 }
 
 /// This process's user + system time in clock ticks (100 a second on Linux).

@@ -6,16 +6,17 @@
 use std::time::{Duration, Instant};
 
 use hydrorattle::{Real, StepError};
+use hydrorattle_host::each_engine;
+use hydrorattle_host::sim::AnyEngine;
 use hydrorattle_host::sim::retry::Retries;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::each;
 use crate::errors::{step_error, with_attrs};
 use crate::input::rows;
 use crate::shared::Shared;
-use crate::system::{Inner, Report, rows_f64};
+use crate::system::{Report, rows_f64};
 
 /// How often a long `step(n)` looks for Ctrl-C.
 const SIGNAL_EVERY: Duration = Duration::from_millis(20);
@@ -32,7 +33,7 @@ pub struct Every {
 /// the last good step, `completed` on the exception).
 pub fn steps(
     py: Python<'_>,
-    shared: &Shared<Inner>,
+    shared: &Shared<AnyEngine>,
     n: usize,
     force: Option<&Bound<'_, PyAny>>,
     every: Option<Every>,
@@ -57,7 +58,7 @@ fn call_back(py: Python<'_>, every: Option<&Every>, done: usize) -> PyResult<()>
 }
 
 /// The steps with the GIL released (taken back for the callback, a failure and Ctrl-C).
-fn free_steps(shared: &Shared<Inner>, n: usize, every: Option<&Every>) -> PyResult<Report> {
+fn free_steps(shared: &Shared<AnyEngine>, n: usize, every: Option<&Every>) -> PyResult<Report> {
     let mut last = empty(0);
     let mut checked = Instant::now();
     let mut start = None;
@@ -65,7 +66,7 @@ fn free_steps(shared: &Shared<Inner>, n: usize, every: Option<&Every>) -> PyResu
         shared.give_way();
         let r: Result<Report, StepError> = {
             let mut g = shared.step_lock();
-            each!(&mut *g, e, T => {
+            each_engine!(&mut *g, e, T => {
                 let from = *start.get_or_insert(e.retries);
                 e.step().map(|r| Report::of::<T>(&r, done, since(e.retries, from)))
             })
@@ -85,7 +86,7 @@ fn free_steps(shared: &Shared<Inner>, n: usize, every: Option<&Every>) -> PyResu
 /// The steps with a force callable: the GIL held throughout.
 fn held_steps(
     py: Python<'_>,
-    shared: &Shared<Inner>,
+    shared: &Shared<AnyEngine>,
     n: usize,
     f: &Bound<'_, PyAny>,
     every: Option<&Every>,
@@ -97,7 +98,7 @@ fn held_steps(
             py.detach(|| shared.give_way());
         }
         let mut g = shared.step_lock();
-        let r = each!(&mut *g, e, T => {
+        let r = each_engine!(&mut *g, e, T => {
             let from = *start.get_or_insert(e.retries);
             let mut failed: Option<PyErr> = None;
             let mut extra = |pos: &[<T as Real>::V3], _: &[T], out: &mut [<T as Real>::V3]| {

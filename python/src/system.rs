@@ -1,10 +1,11 @@
-//! A system stepped by the kernel: the host library's [`Engine`] in f64 or f32, with
-//! NumPy getters (copies) and `step(n)` run with the GIL released.
+//! A system stepped by the kernel: the host library's [`Engine`] in f64 or f32
+//! ([`AnyEngine`]), with NumPy getters (copies) and `step(n)` run with the GIL released.
 
 use hydrorattle::{Bond, Noise, Real, StepReport};
-use hydrorattle_host::scene::Scene;
+use hydrorattle_host::each_engine;
+use hydrorattle_host::scene::{Precision, Scene};
 use hydrorattle_host::sim::retry::Retries;
-use hydrorattle_host::sim::{Beads, Engine, Saved, resolve_level};
+use hydrorattle_host::sim::{AnyEngine, Beads, Engine, Saved, resolve_level};
 use hydrorattle_host::sizing::DEFAULT_LIMIT;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{
@@ -85,38 +86,15 @@ impl Report {
     }
 }
 
-/// The engine in its precision.
-pub enum Inner {
-    F64(Engine<f64>),
-    F32(Engine<f32>),
-}
-
-/// Runs `$body` with `$e` bound to the engine, `$t` to its precision.
-#[macro_export]
-macro_rules! each {
-    ($inner:expr, $e:ident, $t:ident => $body:expr) => {
-        match $inner {
-            $crate::system::Inner::F64($e) => {
-                type $t = f64;
-                $body
-            }
-            $crate::system::Inner::F32($e) => {
-                type $t = f32;
-                $body
-            }
-        }
-    };
-}
-
 /// The Rust side of `hydrorattle.System`: the engine shared between Python threads
 /// ([`Shared`]: reads from other threads while it steps wait for the end of the step).
 #[pyclass(module = "hydrorattle", frozen)]
 pub struct Core {
-    shared: Shared<Inner>,
+    shared: Shared<AnyEngine>,
 }
 
 impl Core {
-    fn of(inner: Inner) -> Core {
+    fn of(inner: AnyEngine) -> Core {
         Core {
             shared: Shared::new(inner),
         }
@@ -176,14 +154,8 @@ fn engine_from<T: Real>(
         });
     }
     hydrorattle::bonds::validate(&links, n).map_err(|e| bond_error(py, e))?;
-    let beads = Beads {
-        pos: p,
-        vel: vec![T::V3_ZERO; n],
-        omega: vec![T::V3_ZERO; n],
-        radius: r,
-        density: densities.iter().map(|&d| T::from_f64(d)).collect(),
-        time: T::ZERO,
-    };
+    let density = densities.iter().map(|&d| T::from_f64(d)).collect();
+    let beads = Beads::at_rest(p, r, density);
     let noise = Noise::new(extras.seed);
     let engine = Engine::from_parts(beads, links, params, noise, None, DEFAULT_LIMIT)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -199,19 +171,11 @@ fn ready<T: Real>(py: Python<'_>, mut e: Engine<T>, threads: usize) -> PyResult<
 }
 
 /// The engine of a scene (its level resolved), in the scene's precision.
-fn engine_of_scene(py: Python<'_>, scene: &Scene) -> PyResult<Inner> {
+fn engine_of_scene(py: Python<'_>, scene: &Scene) -> PyResult<AnyEngine> {
     let (scene, _) = resolve_level(scene, "scene");
-    let fail = |e: hydrorattle_host::sim::BuildError| PyValueError::new_err(e.to_string());
-    Ok(match scene.integrator.precision {
-        hydrorattle_host::scene::Precision::F64 => {
-            let e = Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?;
-            Inner::F64(ready(py, e, 0)?)
-        }
-        hydrorattle_host::scene::Precision::F32 => {
-            let e = Engine::new(&scene, DEFAULT_LIMIT).map_err(fail)?;
-            Inner::F32(ready(py, e, 0)?)
-        }
-    })
+    let engine =
+        AnyEngine::new(&scene, DEFAULT_LIMIT).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(each_engine!(engine, e, _T => ready(py, e, 0)?.into()))
 }
 
 #[pymethods]
@@ -246,11 +210,11 @@ impl Core {
             None => None,
         };
         let inner = if is_f32(precision)? {
-            Inner::F32(engine_from(
+            AnyEngine::F32(engine_from(
                 py, pos, radii, densities, pairs, lengths, params,
             )?)
         } else {
-            Inner::F64(engine_from(
+            AnyEngine::F64(engine_from(
                 py, pos, radii, densities, pairs, lengths, params,
             )?)
         };
@@ -292,37 +256,37 @@ impl Core {
     /// Positions `(N, 3)`, a float64 copy.
     #[getter]
     fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => rows_f64::<T>(py, &e.beads.pos)))
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => rows_f64::<T>(py, &e.beads.pos)))
     }
 
     /// Velocities `(N, 3)`, a float64 copy.
     #[getter]
     fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => rows_f64::<T>(py, &e.beads.vel)))
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => rows_f64::<T>(py, &e.beads.vel)))
     }
 
     /// Angular velocities `(N, 3)`, a float64 copy.
     #[getter]
     fn spins<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => rows_f64::<T>(py, &e.beads.omega)))
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => rows_f64::<T>(py, &e.beads.omega)))
     }
 
     /// Radii `(N,)`, a float64 copy.
     #[getter]
     fn radii<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => values_f64::<T>(py, &e.beads.radius)))
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => values_f64::<T>(py, &e.beads.radius)))
     }
 
     /// Densities `(N,)`, a float64 copy.
     #[getter]
     fn densities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => values_f64::<T>(py, &e.beads.density)))
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => values_f64::<T>(py, &e.beads.density)))
     }
 
     /// Bonds `(B, 2)`, an int64 copy.
     #[getter]
     fn bonds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => {
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => {
             let _: Option<T> = None;
             let flat: Vec<i64> = e.bonds.iter().flat_map(|b| [b.i as i64, b.j as i64]).collect();
             Array2::from_shape_vec((e.bonds.len(), 2), flat).expect("2 per row").into_pyarray(py)
@@ -332,7 +296,7 @@ impl Core {
     /// Bond lengths `(B,)`, a float64 copy.
     #[getter]
     fn lengths<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => {
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => {
             let l: Vec<T> = e.bonds.iter().map(|b| b.length).collect();
             values_f64::<T>(py, &l)
         }))
@@ -344,25 +308,27 @@ impl Core {
     /// and for `overdamped2`, whose last projection's multipliers are only a correction.
     #[getter]
     fn tensions<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => e.tensions().map(|t| values_f64::<T>(py, &t))))
+        Ok(
+            each_engine!(&*self.shared.read(py)?, e, T => e.tensions().map(|t| values_f64::<T>(py, &t))),
+        )
     }
 
     /// Simulated time.
     #[getter]
     fn time(&self, py: Python<'_>) -> PyResult<f64> {
-        Ok(each!(&*self.shared.read(py)?, e, T => { let t: T = e.beads.time; t.to_f64() }))
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => { let t: T = e.beads.time; t.to_f64() }))
     }
 
     /// Time step.
     #[getter]
     fn dt(&self, py: Python<'_>) -> PyResult<f64> {
-        Ok(each!(&*self.shared.read(py)?, e, T => { let t: T = e.params.dt; t.to_f64() }))
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => { let t: T = e.params.dt; t.to_f64() }))
     }
 
     /// The periodic box's edges `(Lx, Ly, Lz)`, or None.
     #[getter]
     fn cell(&self, py: Python<'_>) -> PyResult<Option<[f64; 3]>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => {
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => {
             e.params.periodic.map(|c| c.size().map(|l: T| l.to_f64()))
         }))
     }
@@ -370,9 +336,9 @@ impl Core {
     /// "f64" or "f32".
     #[getter]
     fn precision(&self, py: Python<'_>) -> PyResult<&'static str> {
-        Ok(match &*self.shared.read(py)? {
-            Inner::F64(_) => "f64",
-            Inner::F32(_) => "f32",
+        Ok(match self.shared.read(py)?.precision() {
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
         })
     }
 
@@ -388,7 +354,7 @@ impl Core {
         time: Option<f64>,
     ) -> PyResult<()> {
         let mut guard = self.shared.write(py)?;
-        let n = each!(&*guard, e, T => { let _: Option<T> = None; e.beads.len() });
+        let n = each_engine!(&*guard, e, T => { let _: Option<T> = None; e.beads.len() });
         let mut new: [Option<&[[f64; 3]]>; 3] = [None; 3];
         let given = [
             ("positions", &positions),
@@ -417,7 +383,7 @@ impl Core {
                 "time must be finite, not {t}"
             )));
         }
-        each!(&mut *guard, e, T => {
+        each_engine!(&mut *guard, e, T => {
             let b = &mut e.beads;
             for (v, dst) in new.iter().zip([&mut b.pos, &mut b.vel, &mut b.omega]) {
                 if let Some(v) = v {
@@ -436,40 +402,29 @@ impl Core {
     /// The whole system as JSON text (state, bonds, parameters, noise generator,
     /// counters, the last tensions; every float's bits): what pickling carries.
     fn save_json(&self, py: Python<'_>) -> PyResult<String> {
-        use hydrorattle_host::scene::Precision;
-        let saved = match &*self.shared.read(py)? {
-            Inner::F64(e) => e.save(Precision::F64),
-            Inner::F32(e) => e.save(Precision::F32),
-        };
+        let saved = self.shared.read(py)?.save();
         serde_json::to_string(&saved).map_err(|e| PyValueError::new_err(e.to_string()))
     }
 
     /// The system [`Core::save_json`] wrote.
     #[staticmethod]
     fn restore_json(text: &str) -> PyResult<Core> {
-        use hydrorattle_host::scene::Precision;
         let saved: Saved = serde_json::from_str(text)
             .map_err(|e| PyValueError::new_err(format!("saved system: {e}")))?;
-        let fail = PyValueError::new_err;
-        let inner = match saved.precision {
-            Precision::F64 => Inner::F64(Engine::restore(&saved).map_err(fail)?),
-            Precision::F32 => Inner::F32(Engine::restore(&saved).map_err(fail)?),
-        };
-        Ok(Core::of(inner))
+        Ok(Core::of(
+            AnyEngine::restore(&saved).map_err(PyValueError::new_err)?,
+        ))
     }
 
     /// An independent copy of the system (state, storage, noise generator).
     fn copy(&self, py: Python<'_>) -> PyResult<Core> {
-        Ok(Core::of(match &*self.shared.read(py)? {
-            Inner::F64(e) => Inner::F64(e.clone()),
-            Inner::F32(e) => Inner::F32(e.clone()),
-        }))
+        Ok(Core::of(self.shared.read(py)?.clone()))
     }
 
     /// The state's bits (positions, velocities, spins, time, then the noise
     /// generator's next draw on a copy), for exact comparisons.
     fn state_bits(&self, py: Python<'_>) -> PyResult<Vec<u64>> {
-        Ok(each!(&*self.shared.read(py)?, e, T => {
+        Ok(each_engine!(&*self.shared.read(py)?, e, T => {
             let mut out = Vec::new();
             for v in [&e.beads.pos, &e.beads.vel, &e.beads.omega] {
                 for &x in v.iter() {

@@ -31,6 +31,7 @@ pub struct Variant {
     /// Short name (`main`, `first-order`, ...).
     pub name: &'static str,
     /// Integrator.
+    #[serde(serialize_with = "hydrorattle_host::scene::names::serialize")]
     pub method: Method,
     /// Time step.
     pub dt: f64,

@@ -34,12 +34,14 @@ pub const FREE_DRAINING_MAX: f64 = 0.01;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Choice {
     /// Hydrodynamic model.
+    #[serde(serialize_with = "super::names::serialize")]
     pub hydrodynamics: Hydrodynamics,
     /// Whether inertia is resolved.
     pub inertia: bool,
     /// Whether rotation is resolved.
     pub rotation: bool,
     /// Integrator.
+    #[serde(serialize_with = "super::names::serialize")]
     pub method: Method,
     /// Largest particle Stokes number `m U / (6 pi eta a^2)`.
     pub stokes_number: f64,

@@ -5,102 +5,50 @@
 
 use std::fmt;
 
-use hydrorattle::particles::sphere_volume;
-use hydrorattle::{Bond, BondError, Params, ParticleError, Real, Solver, State};
+use hydrorattle::{Bond, BondError, Params, ParticleError, Real, Solver};
 
 use super::sizing::TooLarge;
 use crate::scene::{self, Scene};
 
-/// Particle state in vectors of any length (all of the same length).
-#[derive(Clone, Debug)]
-pub struct Beads<T: Real> {
-    /// Centres.
-    pub pos: Vec<T::V3>,
-    /// Translational velocities.
-    pub vel: Vec<T::V3>,
-    /// Angular velocities.
-    pub omega: Vec<T::V3>,
-    /// Radii.
-    pub radius: Vec<T>,
-    /// Material densities.
-    pub density: Vec<T>,
-    /// Simulated time.
-    pub time: T,
-}
+/// Particle state in vectors of any length (all of the same length): the heap
+/// crate's [`Spheres`](hydrorattle_heap::Spheres). Its `noise` stays `None`: an
+/// engine keeps its generator itself ([`Engine::noise`](crate::sim::Engine::noise)).
+pub type Beads<T> = hydrorattle_heap::Spheres<T>;
 
-impl<T: Real> Beads<T> {
-    /// The particles with their initial velocities, densities scaled by `density_scale`, each checked on its
-    /// own in precision `T` (finite, radius > 0, density >= 0; pairs are
-    /// [`check_pairs`](Self::check_pairs)' job).
-    pub fn new(particles: &[scene::Particle], density_scale: f64) -> Result<Self, ParticleError> {
-        let n = particles.len();
-        let mut beads = Beads {
-            pos: Vec::with_capacity(n),
-            vel: vec![T::V3_ZERO; n],
-            omega: vec![T::V3_ZERO; n],
-            radius: Vec::with_capacity(n),
-            density: Vec::with_capacity(n),
-            time: T::ZERO,
-        };
-        for (k, q) in particles.iter().enumerate() {
-            let (r, d) = (
-                T::from_f64(q.radius),
-                T::from_f64(q.density * density_scale),
-            );
-            let pos = T::v3_from(q.position);
-            let mut kp = hydrorattle::Particle::new(pos, r, d);
-            kp.velocity = T::v3_from(q.velocity);
-            // Values valid in f64 may not be in f32 (an overflow, a radius that rounds to 0).
-            hydrorattle::particles::check_one(k, &kp)?;
-            beads.vel[k] = kp.velocity;
-            beads.omega[k] = T::v3_from(q.angular_velocity);
-            beads.pos.push(pos);
-            beads.radius.push(r);
-            beads.density.push(d);
-        }
-        Ok(beads)
+/// The particles with their initial velocities, densities scaled by `density_scale`,
+/// each checked on its own in precision `T` (finite, radius > 0, density >= 0; pairs
+/// are [`Beads::check_pairs`]' job).
+pub fn beads<T: Real>(
+    particles: &[scene::Particle],
+    density_scale: f64,
+) -> Result<Beads<T>, ParticleError> {
+    let n = particles.len();
+    let mut beads = Beads {
+        pos: Vec::with_capacity(n),
+        vel: vec![T::V3_ZERO; n],
+        omega: vec![T::V3_ZERO; n],
+        radius: Vec::with_capacity(n),
+        density: Vec::with_capacity(n),
+        time: T::ZERO,
+        noise: None,
+    };
+    for (k, q) in particles.iter().enumerate() {
+        let (r, d) = (
+            T::from_f64(q.radius),
+            T::from_f64(q.density * density_scale),
+        );
+        let pos = T::v3_from(q.position);
+        let mut kp = hydrorattle::Particle::new(pos, r, d);
+        kp.velocity = T::v3_from(q.velocity);
+        // Values valid in f64 may not be in f32 (an overflow, a radius that rounds to 0).
+        hydrorattle::particles::check_one(k, &kp)?;
+        beads.vel[k] = kp.velocity;
+        beads.omega[k] = T::v3_from(q.angular_velocity);
+        beads.pos.push(pos);
+        beads.radius.push(r);
+        beads.density.push(d);
     }
-
-    /// Nested spheres are refused; overlapping ones unless `allow_overlap` (in the
-    /// periodic box `cell`, through the minimum image): the kernel's `check_pairs` over
-    /// its cell list (`O(N)` pairs, the same error).
-    pub fn check_pairs(
-        &self,
-        allow_overlap: bool,
-        cell: Option<&hydrorattle::cell::Periodic<T>>,
-    ) -> Result<(), ParticleError> {
-        let mut store = vec![0; hydrorattle::cell_list::indices(self.len())];
-        let (pos, radius) = (&self.pos, &self.radius);
-        hydrorattle::cell_list::check_pairs_periodic(pos, radius, allow_overlap, cell, &mut store)
-    }
-
-    /// Number of particles.
-    pub fn len(&self) -> usize {
-        self.pos.len()
-    }
-
-    /// `true` when there are none.
-    pub fn is_empty(&self) -> bool {
-        self.pos.is_empty()
-    }
-
-    /// The kernel's view of this state, for `step_slices`.
-    pub fn state(&mut self) -> State<'_, T> {
-        State {
-            pos: &mut self.pos,
-            vel: &mut self.vel,
-            omega: &mut self.omega,
-            radius: &self.radius,
-            density: &self.density,
-            time: &mut self.time,
-            noise: None,
-        }
-    }
-
-    /// Mass of particle `i`.
-    pub fn mass(&self, i: usize) -> T {
-        sphere_volume(self.radius[i]) * self.density[i]
-    }
+    Ok(beads)
 }
 
 /// A scene's bonds in precision `T`, validated against `n` particles (range,
@@ -185,15 +133,15 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     p.gravity = T::v3_from(scene.gravity);
     p.flow_velocity = T::v3_from(scene.flow.velocity);
     p.vorticity = T::v3_from(scene.flow.vorticity);
-    p.hydro = scene.model.hydrodynamics.kernel();
-    p.method = i.method.kernel();
+    p.hydro = scene.model.hydrodynamics;
+    p.method = i.method;
     p.rotation = scene.model.rotation;
     p.matrix_free = i.matrix_free;
     p.compact_products = i.compact_products;
     // f32 cannot reach 1e-10: floor the tolerance at a few hundred ulps.
     let floor = 256.0 * T::EPSILON.to_f64();
     p.solver = Solver {
-        kind: i.solver.kind(),
+        kind: i.solver,
         tolerance: T::from_f64(i.tolerance.max(floor)),
         max_iterations: u32::try_from(i.max_iterations).unwrap_or(u32::MAX),
     };
@@ -211,10 +159,10 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
         .map(hydrorattle::Contacts::new);
     p.brownian = scene.brownian.map(|b| hydrorattle::Brownian {
         temperature: T::from_f64(b.temperature),
-        drift: b.drift.kernel(),
+        drift: b.drift,
     });
     if let Some(b) = scene.brownian {
-        p.noise_sqrt = b.sqrt.kernel();
+        p.noise_sqrt = b.sqrt;
     }
     p.wall = scene
         .wall
@@ -239,6 +187,14 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
 mod tests {
     use super::*;
 
+    /// The host's particle state is the heap crate's: one definition of the arrays.
+    #[test]
+    fn beads_are_the_heap_spheres() {
+        use std::any::TypeId;
+        let spheres = TypeId::of::<hydrorattle_heap::Spheres<f32>>();
+        assert_eq!(TypeId::of::<Beads<f32>>(), spheres);
+    }
+
     fn sphere(radius: f64) -> scene::Particle {
         scene::Particle {
             radius,
@@ -250,10 +206,10 @@ mod tests {
     #[test]
     fn values_valid_in_f64_are_checked_again_in_f32() {
         let ps = [sphere(1.0), sphere(1e-50)];
-        assert!(Beads::<f64>::new(&ps, 1.0).is_ok());
-        let e = Beads::<f32>::new(&ps, 1.0).unwrap_err();
+        assert!(beads::<f64>(&ps, 1.0).is_ok());
+        let e = beads::<f32>(&ps, 1.0).unwrap_err();
         assert_eq!(e, ParticleError::BadRadius { particle: 1 });
-        let e = Beads::<f32>::new(&[sphere(1e300)], 1.0).unwrap_err();
+        let e = beads::<f32>(&[sphere(1e300)], 1.0).unwrap_err();
         assert_eq!(e, ParticleError::NonFinite { particle: 0 });
     }
 

@@ -8,7 +8,7 @@ use std::ops::Range;
 
 use hydrorattle::{BondError, Noise, ParticleError, Real, StepError};
 
-use super::beads::{Beads, bonds};
+use super::beads::{beads, bonds};
 use super::error::{Issue, issue};
 use super::raw::RawScene;
 use super::resolve::BodySpans;
@@ -188,7 +188,7 @@ pub(super) fn check(scene: &Scene, keys: &KeySpans, body: &BodySpans) -> Result<
 /// extensions at the start.
 fn first_step<T: Real>(scene: &Scene) -> Result<(), StepError> {
     let p = super::beads::params::<T>(scene);
-    let mut beads = Beads::<T>::new(&scene.particles, 1.0)?;
+    let mut beads = beads::<T>(&scene.particles, 1.0)?;
     let mut bonds = bonds::<T>(&scene.bonds, beads.len())?;
     let springs = bonds.len();
     bonds.extend(super::beads::pins::<T>(scene));

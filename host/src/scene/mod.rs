@@ -60,7 +60,7 @@ mod floor_tests;
 mod helix;
 mod kernel;
 mod model;
-mod names;
+pub mod names;
 mod periodic;
 mod precision;
 mod raw;
@@ -73,7 +73,7 @@ mod thermal;
 mod wall;
 mod write;
 
-pub use beads::{Beads, BuildError, bonds, params, pins};
+pub use beads::{Beads, BuildError, beads, bonds, params, pins};
 pub use box_cost::pse_pays;
 pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE, SOFT_DT, SOFT_STIFFNESS};
 pub use error::{SceneError, line_col};

@@ -2,8 +2,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::names::{Kernel, by_kernel_name};
-
 /// The fluid around the particles.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Fluid {
@@ -49,37 +47,8 @@ pub struct Bond {
     pub length: f64,
 }
 
-/// Hydrodynamic interaction model (named by the kernel's [`hydrorattle::Hydro`] names).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Hydrodynamics {
-    /// Rotne-Prager-Yamakawa grand mobility (with its overlap regularisation).
-    #[default]
-    Rpy,
-    /// Oseen tensor (not positive definite when beads come close).
-    Oseen,
-    /// Self terms only: no hydrodynamic interaction between beads.
-    FreeDraining,
-}
-
-impl Hydrodynamics {
-    /// The kernel's model.
-    pub fn kernel(self) -> hydrorattle::Hydro {
-        match self {
-            Self::Rpy => hydrorattle::Hydro::Rpy,
-            Self::Oseen => hydrorattle::Hydro::Oseen,
-            Self::FreeDraining => hydrorattle::Hydro::FreeDraining,
-        }
-    }
-}
-
-impl Kernel for Hydrodynamics {
-    type K = hydrorattle::Hydro;
-    const ALL: &'static [Self] = &[Self::Rpy, Self::Oseen, Self::FreeDraining];
-    fn kernel(self) -> hydrorattle::Hydro {
-        Hydrodynamics::kernel(self)
-    }
-}
-by_kernel_name!(Hydrodynamics);
+/// Hydrodynamic interaction model: the kernel's [`hydrorattle::Hydro`], by its names.
+pub use hydrorattle::Hydro as Hydrodynamics;
 
 /// Whether the driver may pick the model level itself.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -110,6 +79,7 @@ pub enum Overlap {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
 pub struct Model {
     /// Hydrodynamic interactions.
+    #[serde(serialize_with = "super::names::serialize")]
     pub hydrodynamics: Hydrodynamics,
     /// Whether particle inertia is resolved.
     pub inertia: bool,
@@ -121,95 +91,12 @@ pub struct Model {
     pub overlap: Overlap,
 }
 
-/// Time integration method (`docs/MODEL.md#integrators`), named by the kernel's
-/// [`hydrorattle::Method`] names.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// First-order overdamped step with constraint projection (HydroSHAKE).
-    Overdamped,
-    /// Second-order (predictor-corrector) overdamped step.
-    Overdamped2,
-    /// The paper's inertial HydroRATTLE, explicit drag.
-    Rattle,
-    /// Inertial RATTLE with a drag treatment stable at any `dt`.
-    RattleStable,
-    /// Hookean springs instead of constraints.
-    Springs,
-}
+/// Time integration method (`docs/MODEL.md#integrators`): the kernel's
+/// [`hydrorattle::Method`], by its names.
+pub use hydrorattle::Method;
 
-impl Kernel for Method {
-    type K = hydrorattle::Method;
-    const ALL: &'static [Self] = &Method::ALL;
-    fn kernel(self) -> hydrorattle::Method {
-        Method::kernel(self)
-    }
-}
-by_kernel_name!(Method);
-
-impl Method {
-    /// Every method, in declaration order.
-    pub const ALL: [Method; 5] = [
-        Method::Overdamped,
-        Method::Overdamped2,
-        Method::Rattle,
-        Method::RattleStable,
-        Method::Springs,
-    ];
-
-    /// Whether the method carries particle momenta (and so needs positive masses).
-    pub fn is_inertial(self) -> bool {
-        matches!(self, Method::Rattle | Method::RattleStable)
-    }
-
-    /// The kernel's method.
-    pub fn kernel(self) -> hydrorattle::Method {
-        match self {
-            Method::Overdamped => hydrorattle::Method::Overdamped,
-            Method::Overdamped2 => hydrorattle::Method::Overdamped2,
-            Method::Rattle => hydrorattle::Method::Rattle,
-            Method::RattleStable => hydrorattle::Method::RattleStable,
-            Method::Springs => hydrorattle::Method::Springs,
-        }
-    }
-}
-
-/// Constraint solver (named by the kernel's [`hydrorattle::SolverKind`] names).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Solver {
-    /// The kernel's choice: Newton up to [`hydrorattle::DENSE_BONDS_MAX`] bonds, Krylov
-    /// above (the same bits as Newton for the small scenes).
-    #[default]
-    Auto,
-    /// Cyclic SHAKE sweeps, one constraint at a time.
-    Sweep,
-    /// Newton iteration on the whole (dense) constraint Jacobian: `O(B^2)` storage,
-    /// `O(B^3)` per iteration.
-    Newton,
-    /// Chord Newton with preconditioned conjugate gradients: `O(B)` storage, one
-    /// mobility product per iteration (thousands of beads).
-    Krylov,
-}
-
-impl Kernel for Solver {
-    type K = hydrorattle::SolverKind;
-    const ALL: &'static [Self] = &[Self::Auto, Self::Sweep, Self::Newton, Self::Krylov];
-    fn kernel(self) -> hydrorattle::SolverKind {
-        self.kind()
-    }
-}
-by_kernel_name!(Solver);
-
-impl Solver {
-    /// The kernel's solver kind.
-    pub fn kind(self) -> hydrorattle::SolverKind {
-        match self {
-            Solver::Auto => hydrorattle::SolverKind::Auto,
-            Solver::Sweep => hydrorattle::SolverKind::Sweep,
-            Solver::Newton => hydrorattle::SolverKind::Newton,
-            Solver::Krylov => hydrorattle::SolverKind::Krylov,
-        }
-    }
-}
+/// Constraint solver: the kernel's [`hydrorattle::SolverKind`], by its names.
+pub use hydrorattle::SolverKind as Solver;
 
 /// Floating-point precision of the kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -226,12 +113,14 @@ pub enum Precision {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Integrator {
     /// Method.
+    #[serde(serialize_with = "super::names::serialize")]
     pub method: Method,
     /// Time step (> 0).
     pub dt: f64,
     /// Simulated time (> 0, at least one step).
     pub duration: f64,
     /// Constraint solver.
+    #[serde(serialize_with = "super::names::serialize")]
     pub solver: Solver,
     /// Constraint tolerance (> 0).
     pub tolerance: f64,

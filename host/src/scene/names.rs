@@ -1,10 +1,12 @@
-//! The scene files' names of the kernel's choices come from the kernel's tables
-//! ([`hydrorattle::names`]): each scene enum is read and written through its kernel
-//! value's name, so the files, Python and the firmware spell a choice one way.
+//! Scene files name the kernel's choices by the kernel's tables
+//! ([`hydrorattle::names`]): the scene holds the kernel's enums themselves
+//! ([`hydrorattle::Method`], [`hydrorattle::Hydro`], [`hydrorattle::SolverKind`],
+//! [`hydrorattle::Drift`], [`hydrorattle::NoiseSqrt`]), so a choice has one definition
+//! and one spelling in files, Python and the firmware.
 //!
-//! The scene enums stay (they carry the scene's documentation and defaults); only
-//! their spellings moved. An unknown name is refused with serde's own
-//! `unknown variant` message listing the kernel's names, as the derived code did.
+//! The kernel links no serde; this module reads and writes any [`Named`] choice for
+//! serde. An unknown name is refused with serde's own `unknown variant` message listing
+//! the kernel's names.
 
 use std::fmt;
 use std::marker::PhantomData;
@@ -12,91 +14,120 @@ use std::marker::PhantomData;
 use hydrorattle::Named;
 use serde::de::{self, Visitor};
 
-/// A scene enum that stands for a kernel choice `K`, one variant each.
-pub(crate) trait Kernel: Copy + 'static {
-    /// The kernel's choice.
-    type K: Named + PartialEq;
-    /// Every variant.
-    const ALL: &'static [Self];
-    /// The kernel's value.
-    fn kernel(self) -> Self::K;
-}
+/// A kernel choice read from its name (`Deserialize` for the scene's raw tables).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Name<K>(pub K);
 
-/// Reads a scene enum from its kernel name.
-pub(crate) fn deserialize<'de, D, H>(d: D) -> Result<H, D::Error>
-where
-    D: de::Deserializer<'de>,
-    H: Kernel,
-{
-    struct Name<H>(PhantomData<H>);
-    impl<H: Kernel> Visitor<'_> for Name<H> {
-        type Value = H;
-        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-            write!(f, "a {} name", H::K::WHAT)
+impl<'de, K: Named> serde::Deserialize<'de> for Name<K> {
+    fn deserialize<D: de::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Of<K>(PhantomData<K>);
+        impl<K: Named> Visitor<'_> for Of<K> {
+            type Value = Name<K>;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                write!(f, "a {} name", K::WHAT)
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Name<K>, E> {
+                K::from_name(v)
+                    .map(Name)
+                    .map_err(|_| E::unknown_variant(v, K::NAMES))
+            }
         }
-        fn visit_str<E: de::Error>(self, v: &str) -> Result<H, E> {
-            let k = H::K::from_name(v).map_err(|_| E::unknown_variant(v, H::K::NAMES))?;
-            // Every kernel value has its scene variant (a test checks it).
-            H::ALL
-                .iter()
-                .copied()
-                .find(|h| h.kernel() == k)
-                .ok_or_else(|| E::unknown_variant(v, H::K::NAMES))
-        }
+        d.deserialize_str(Of(PhantomData))
     }
-    d.deserialize_str(Name(PhantomData))
 }
 
-/// `Serialize` and `Deserialize` of a [`Kernel`] scene enum by the kernel's names.
-macro_rules! by_kernel_name {
-    ($ty:ty) => {
-        impl serde::Serialize for $ty {
-            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-                s.serialize_str(hydrorattle::Named::name(
-                    $crate::scene::names::Kernel::kernel(*self),
-                ))
-            }
-        }
-        impl<'de> serde::Deserialize<'de> for $ty {
-            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-                $crate::scene::names::deserialize(d)
-            }
-        }
-    };
+/// Writes a kernel choice as its name: `#[serde(serialize_with =
+/// "hydrorattle_host::scene::names::serialize")]` on a field of a kernel enum.
+pub fn serialize<K: Named, S: serde::Serializer>(k: &K, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(k.name())
 }
-pub(crate) use by_kernel_name;
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::{Drift, Hydrodynamics, Method, Solver, Sqrt};
 
-    /// Each scene enum and its kernel choice are one to one, and read back what they write.
-    fn one_to_one<H>()
-    where
-        H: Kernel + PartialEq + fmt::Debug + serde::Serialize + for<'de> serde::Deserialize<'de>,
-    {
-        assert_eq!(H::ALL.len(), H::K::ALL.len());
-        for &k in H::K::ALL {
-            assert_eq!(H::ALL.iter().filter(|h| h.kernel() == k).count(), 1);
+    #[derive(serde::Serialize)]
+    struct Out<K: Named>(#[serde(serialize_with = "serialize")] K);
+
+    /// Each kernel choice reads back what it writes, and refuses an unknown name with
+    /// the list of the kernel's names.
+    fn round_trip<K: Named + PartialEq + fmt::Debug>() {
+        for &k in K::ALL {
+            let json = serde_json::to_string(&Out(k)).unwrap();
+            assert_eq!(json, format!("\"{}\"", k.name()));
+            assert_eq!(serde_json::from_str::<Name<K>>(&json).unwrap(), Name(k));
         }
-        for &h in H::ALL {
-            let json = serde_json::to_string(&h).unwrap();
-            assert_eq!(json, format!("\"{}\"", h.kernel().name()));
-            assert_eq!(serde_json::from_str::<H>(&json).unwrap(), h);
-        }
-        let e = serde_json::from_str::<H>("\"nope\"")
+        let e = serde_json::from_str::<Name<K>>("\"nope\"")
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("unknown variant `nope`, expected "), "{e}");
+        for n in K::NAMES {
+            assert!(e.contains(&format!("`{n}`")), "{e} lacks {n}");
+        }
+    }
+
+    /// The scene holds the kernel's enums themselves, not copies converted by hand.
+    #[test]
+    fn scene_choices_are_the_kernels_enums() {
+        use std::any::TypeId;
+        assert_eq!(TypeId::of::<Method>(), TypeId::of::<hydrorattle::Method>());
+        assert_eq!(
+            TypeId::of::<Hydrodynamics>(),
+            TypeId::of::<hydrorattle::Hydro>()
+        );
+        assert_eq!(
+            TypeId::of::<Solver>(),
+            TypeId::of::<hydrorattle::SolverKind>()
+        );
+        assert_eq!(TypeId::of::<Drift>(), TypeId::of::<hydrorattle::Drift>());
+        assert_eq!(TypeId::of::<Sqrt>(), TypeId::of::<hydrorattle::NoiseSqrt>());
+    }
+
+    /// A scene file's unknown name is refused with every accepted name, in the
+    /// kernel's order and spelling.
+    #[test]
+    fn unknown_names_list_the_accepted_ones() {
+        let od = "[integrator]\nmethod = \"overdamped\"\ndt = 0.01\nduration = 1\n";
+        let kt = "[brownian]\ntemperature = 1\n";
+        let cases = [
+            (
+                "[integrator]\nmethod = \"verlet\"\ndt = 0.01\nduration = 1\n".to_string(),
+                "unknown variant `verlet`, expected one of `overdamped`, `overdamped2`, \
+                 `rattle`, `rattle-stable`, `springs`",
+            ),
+            (
+                format!("{od}solver = \"lu\"\n"),
+                "unknown variant `lu`, expected one of `auto`, `sweep`, `newton`, `krylov`",
+            ),
+            (
+                format!("{od}[model]\nhydrodynamics = \"stokes\"\n"),
+                "unknown variant `stokes`, expected one of `rpy`, `oseen`, `free-draining`",
+            ),
+            (
+                format!("{od}{kt}drift = \"ito\"\n"),
+                "unknown variant `ito`, expected `midpoint` or `uncorrected`",
+            ),
+            (
+                format!("{od}{kt}sqrt = \"qr\"\n"),
+                "unknown variant `qr`, expected one of `auto`, `cholesky`, `lanczos`",
+            ),
+        ];
+        for (tail, message) in cases {
+            let text = format!("[[particle]]\nposition = [0, 0, 0]\nradius = 1\n\n{tail}");
+            let e = crate::scene::Scene::parse(&text, "s.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(message), "{e}");
+        }
     }
 
     #[test]
     fn scene_names_are_the_kernels() {
-        one_to_one::<Method>();
-        one_to_one::<Hydrodynamics>();
-        one_to_one::<Solver>();
-        one_to_one::<Drift>();
-        one_to_one::<Sqrt>();
+        round_trip::<Method>();
+        round_trip::<Hydrodynamics>();
+        round_trip::<Solver>();
+        round_trip::<Drift>();
+        round_trip::<Sqrt>();
     }
 }

@@ -5,6 +5,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::error::{Issue, issue};
+use super::names::Name;
 use super::{HeadEnd, Hydrodynamics, Level, Method, Overlap, Precision, Solver};
 
 pub(super) type S<T> = Option<Spanned<T>>;
@@ -86,7 +87,7 @@ pub(super) struct RawHelix {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawModel {
-    pub(super) hydrodynamics: Option<Hydrodynamics>,
+    pub(super) hydrodynamics: Option<Name<Hydrodynamics>>,
     pub(super) inertia: Option<bool>,
     pub(super) rotation: Option<bool>,
     pub(super) level: Option<Level>,
@@ -96,10 +97,10 @@ pub(super) struct RawModel {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawIntegrator {
-    pub(super) method: Method,
+    pub(super) method: Name<Method>,
     pub(super) dt: Spanned<f64>,
     pub(super) duration: Spanned<f64>,
-    pub(super) solver: Option<Solver>,
+    pub(super) solver: Option<Name<Solver>>,
     pub(super) tolerance: S<f64>,
     pub(super) max_iterations: S<usize>,
     pub(super) precision: Option<Precision>,

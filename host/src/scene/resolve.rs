@@ -56,7 +56,7 @@ impl RawScene {
         let model = match &self.model {
             None => Model::default(),
             Some(m) => Model {
-                hydrodynamics: m.hydrodynamics.unwrap_or_default(),
+                hydrodynamics: m.hydrodynamics.map_or_else(Default::default, |h| h.0),
                 inertia: m.inertia.unwrap_or(false),
                 rotation: m.rotation.unwrap_or(false),
                 level: m.level.unwrap_or_default(),
@@ -192,7 +192,7 @@ impl RawScene {
                 .fold(f64::INFINITY, |m, p| m.min(p.radius));
             raw.check_precision(thermal, &integrator, fluid.viscosity, min_radius)?;
         }
-        if integrator.method.is_inertial()
+        if matches!(integrator.method, Method::Rattle | Method::RattleStable)
             && let Some(k) = body.particles.iter().position(|p| p.density <= 0.0)
         {
             return Err(issue(

@@ -163,9 +163,9 @@ impl Plan {
             .saturating_add(walls);
         sizable(n, c).then(|| {
             let mut p = Params::<f64>::new(1.0);
-            p.method = self.method.kernel();
+            p.method = self.method;
             p.rotation = self.rotation;
-            p.solver.kind = self.solver.kind();
+            p.solver.kind = self.solver;
             p.contacts = contacts.map(Contacts::new);
             p.wall = self.wall.then_some(hydrorattle::Wall::new(0.0));
             p.matrix_free = self.matrix_free || self.pse;
@@ -178,9 +178,9 @@ impl Plan {
             if let Some(t) = self.brownian {
                 p.brownian = Some(hydrorattle::Brownian {
                     temperature: t.temperature,
-                    drift: t.drift.kernel(),
+                    drift: t.drift,
                 });
-                p.noise_sqrt = t.sqrt.kernel();
+                p.noise_sqrt = t.sqrt;
             }
             Layout::for_params(&p, n, b)
         })
@@ -235,7 +235,7 @@ mod tests {
 
     #[test]
     fn every_method_fits_4096_beads_in_f64_under_the_default_limit() {
-        for method in Method::ALL {
+        for &method in Method::ALL {
             let p = plan(method, true, Precision::F64);
             assert!(p.check(4096, 4095, DEFAULT_LIMIT).is_ok(), "{method:?}");
         }

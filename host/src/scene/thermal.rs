@@ -5,71 +5,15 @@ use toml::Spanned;
 
 use super::error::{Issue, issue};
 use super::model::{Integrator, Level, Method, Model, Precision};
-use super::names::{Kernel, by_kernel_name};
+use super::names::Name;
 use super::raw::{Bound, S, number};
 
-/// Drift scheme of a Brownian run (the kernel's [`hydrorattle::Drift`], by its names).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Drift {
-    /// Fixman-type midpoint: the stiff-bond (flexible chain) equilibrium.
-    #[default]
-    Midpoint,
-    /// Noise then projection, no correction (rigid-constraint bias).
-    Uncorrected,
-}
+/// Drift scheme of a Brownian run: the kernel's [`hydrorattle::Drift`], by its names.
+pub use hydrorattle::Drift;
 
-impl Drift {
-    /// The kernel's drift.
-    pub fn kernel(self) -> hydrorattle::Drift {
-        match self {
-            Drift::Midpoint => hydrorattle::Drift::Midpoint,
-            Drift::Uncorrected => hydrorattle::Drift::Uncorrected,
-        }
-    }
-}
-
-/// Square root of the mobility for the noise (the kernel's [`hydrorattle::NoiseSqrt`]):
-/// `sqrt = "auto" | "cholesky" | "lanczos"` (the kernel's names).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Sqrt {
-    /// Cholesky up to the kernel's crossover ([`hydrorattle::LANCZOS_CROSSOVER`]
-    /// beads), Lanczos above.
-    #[default]
-    Auto,
-    /// The block Cholesky factor (exact, `O(N^3)`).
-    Cholesky,
-    /// The Lanczos square root from mobility products (`O(m N^2)`).
-    Lanczos,
-}
-
-impl Sqrt {
-    /// The kernel's choice.
-    pub fn kernel(self) -> hydrorattle::NoiseSqrt {
-        match self {
-            Sqrt::Auto => hydrorattle::NoiseSqrt::Auto,
-            Sqrt::Cholesky => hydrorattle::NoiseSqrt::Cholesky,
-            Sqrt::Lanczos => hydrorattle::NoiseSqrt::Lanczos,
-        }
-    }
-}
-
-impl Kernel for Drift {
-    type K = hydrorattle::Drift;
-    const ALL: &'static [Self] = &[Self::Midpoint, Self::Uncorrected];
-    fn kernel(self) -> hydrorattle::Drift {
-        Drift::kernel(self)
-    }
-}
-by_kernel_name!(Drift);
-
-impl Kernel for Sqrt {
-    type K = hydrorattle::NoiseSqrt;
-    const ALL: &'static [Self] = &[Self::Auto, Self::Cholesky, Self::Lanczos];
-    fn kernel(self) -> hydrorattle::NoiseSqrt {
-        Sqrt::kernel(self)
-    }
-}
-by_kernel_name!(Sqrt);
+/// Square root of the mobility for the noise, `sqrt = "auto" | "cholesky" | "lanczos"`:
+/// the kernel's [`hydrorattle::NoiseSqrt`], by its names.
+pub use hydrorattle::NoiseSqrt as Sqrt;
 
 /// Thermal noise settings (`[brownian]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -79,8 +23,10 @@ pub struct Thermal {
     /// Generator seed: the same seed gives the same run, bit for bit.
     pub seed: u64,
     /// Drift scheme.
+    #[serde(serialize_with = "super::names::serialize")]
     pub drift: Drift,
     /// Square root of the mobility.
+    #[serde(serialize_with = "super::names::serialize")]
     pub sqrt: Sqrt,
 }
 
@@ -92,8 +38,8 @@ pub const DEFAULT_SEED: u64 = 1;
 pub(super) struct RawBrownian {
     temperature: S<f64>,
     seed: Option<Spanned<i64>>,
-    drift: Option<Drift>,
-    sqrt: Option<Spanned<Sqrt>>,
+    drift: Option<Name<Drift>>,
+    sqrt: Option<Spanned<Name<Sqrt>>>,
 }
 
 impl RawBrownian {
@@ -137,11 +83,11 @@ impl RawBrownian {
         Ok(Thermal {
             temperature,
             seed,
-            drift: self.drift.unwrap_or_default(),
+            drift: self.drift.map_or_else(Drift::default, |d| d.0),
             sqrt: self
                 .sqrt
                 .as_ref()
-                .map_or_else(Sqrt::default, |s| *s.get_ref()),
+                .map_or_else(Sqrt::default, |s| s.get_ref().0),
         })
     }
 

@@ -43,7 +43,7 @@ impl Scene {
         t.insert(
             "model".into(),
             table([
-                ("hydrodynamics", value(m.hydrodynamics)),
+                ("hydrodynamics", value(m.hydrodynamics.name())),
                 ("inertia", value(m.inertia)),
                 ("rotation", value(m.rotation)),
                 ("level", value(Level::Manual)),
@@ -54,10 +54,10 @@ impl Scene {
         t.insert(
             "integrator".into(),
             table([
-                ("method", value(i.method)),
+                ("method", value(i.method.name())),
                 ("dt", value(i.dt)),
                 ("duration", value(i.duration)),
-                ("solver", value(i.solver)),
+                ("solver", value(i.solver.name())),
                 ("tolerance", value(i.tolerance)),
                 ("max_iterations", value(i.max_iterations as i64)),
                 ("precision", value(i.precision)),
@@ -93,11 +93,11 @@ impl Scene {
             let mut bt = table([
                 ("temperature", value(b.temperature)),
                 ("seed", value(b.seed as i64)),
-                ("drift", value(b.drift)),
+                ("drift", value(b.drift.name())),
             ]);
             // Written only when chosen: scenes written before the key stay the same.
             if let (Value::Table(m), false) = (&mut bt, b.sqrt == super::Sqrt::Auto) {
-                m.insert("sqrt".into(), value(b.sqrt));
+                m.insert("sqrt".into(), value(b.sqrt.name()));
             }
             t.insert("brownian".into(), bt);
         }

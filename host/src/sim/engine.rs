@@ -67,7 +67,7 @@ impl<T: Real> Engine<T> {
         let (n, b) = (scene.particles.len(), scene.bonds.len() + pins.len());
         // The plan sizes thermal noise too (the factor or the Lanczos basis).
         let layout = Plan::of(scene).check(n, b, limit)?;
-        let beads = Beads::<T>::new(&scene.particles, 1.0)?;
+        let beads = crate::scene::beads::<T>(&scene.particles, 1.0)?;
         beads.check_pairs(scene.model.overlap == Overlap::Allow, p.periodic.as_ref())?;
         let bonds = bonds::<T>(&scene.bonds, n)?;
         let noise = Noise::new(scene.brownian.map_or(DEFAULT_SEED, |b| b.seed));

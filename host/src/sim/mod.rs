@@ -18,6 +18,7 @@
 //! built). The run itself is a short list of stages (`run_loop.rs`); the CLI's `run`
 //! and the Python package call it through [`run_scene_file`].
 
+mod any;
 mod checkpoint;
 mod columns;
 mod engine;
@@ -32,7 +33,8 @@ mod saved_tests;
 pub mod stop;
 mod tail;
 
-pub use crate::scene::{Beads, BuildError, bonds, params};
+pub use crate::scene::{Beads, BuildError, beads, bonds, params};
+pub use any::AnyEngine;
 pub use checkpoint::{CHECKPOINT, Checkpoint, NoCheckpoint, StepSolve};
 pub use columns::{ColumnsMismatch, check_columns};
 pub use engine::{Engine, Extra};
@@ -301,10 +303,11 @@ pub fn run_from(
         checkpoint: start.checkpoint.as_ref(),
         locked: start.locked,
     };
-    let result = match scene.integrator.precision {
-        Precision::F64 => run_loop::run_t::<f64>(&scene, name, out, opts, origin),
-        Precision::F32 => run_loop::run_t::<f32>(&scene, name, out, opts, origin),
-    };
+    let result = AnyEngine::new(&scene, opts.max_storage)
+        .map_err(anyhow::Error::from)
+        .and_then(|engine| {
+            crate::each_engine!(engine, e, _T => run_loop::run_t(e, &scene, name, out, opts, origin))
+        });
     // A folder another process locked is that process's, even one created since; a
     // run stopped on request keeps its files for the rerun.
     let theirs = |e: &anyhow::Error| {
@@ -486,7 +489,7 @@ mod tests {
     #[test]
     fn the_storage_checked_is_the_storage_the_kernel_asks_for() {
         let mut scene = Scene::figure1().unwrap().remove(0).1;
-        for method in Method::ALL {
+        for &method in Method::ALL {
             for solver in [Solver::Auto, Solver::Sweep, Solver::Newton, Solver::Krylov] {
                 for rotation in [false, true] {
                     scene.integrator.method = method;

@@ -42,16 +42,17 @@ pub(super) struct Origin<'a> {
     pub locked: bool,
 }
 
-/// Runs `scene` (its level already applied) from the start or from `origin`'s
-/// checkpoint, writing the run's files into `out` when given.
+/// Runs `scene` (its level already applied) on `engine` (built from it) from the
+/// start or from `origin`'s checkpoint, writing the run's files into `out` when given.
 pub(super) fn run_t<T: Real>(
+    engine: Engine<T>,
     scene: &Scene,
     name: &str,
     out: Option<&Path>,
     opts: RunOptions,
     origin: Origin,
 ) -> Result<RunResult> {
-    let mut engine = Engine::<T>::new(scene, opts.max_storage)?.with_threads(opts.threads)?;
+    let mut engine = engine.with_threads(opts.threads)?;
     if let Some(c) = origin.checkpoint {
         c.restore(&mut engine.beads)?;
         // A Brownian run continues its generator and its retry count.

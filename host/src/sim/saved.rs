@@ -237,6 +237,7 @@ impl<T: Real> Engine<T> {
             radius: s.radius.iter().map(|&x| f(x)).collect(),
             density: s.density.iter().map(|&x| f(x)).collect(),
             time: f(s.time),
+            noise: None,
         };
         let bonds: Vec<Bond<T>> = s
             .bonds

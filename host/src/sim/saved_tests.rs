@@ -9,14 +9,8 @@ use crate::sizing::DEFAULT_LIMIT;
 
 fn beads(pos: &[[f64; 3]]) -> Beads<f64> {
     let n = pos.len();
-    Beads {
-        pos: pos.iter().map(|&p| p.into()).collect(),
-        vel: vec![[0.0; 3].into(); n],
-        omega: vec![[0.0; 3].into(); n],
-        radius: vec![1.0; n],
-        density: vec![2.0; n],
-        time: 0.0,
-    }
+    let pos = pos.iter().map(|&p| p.into()).collect();
+    Beads::at_rest(pos, vec![1.0; n], vec![2.0; n])
 }
 
 fn engine(pos: &[[f64; 3]], edit: impl FnOnce(&mut hydrorattle::Params<f64>)) -> Engine<f64> {

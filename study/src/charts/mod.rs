@@ -28,7 +28,7 @@ use hydrorattle_heap::Buffers;
 use crate::render::{LineChart, Series, line_chart};
 use hydrorattle_host::output::{AtomicFile, CsvWriter};
 use hydrorattle_host::scene::Scene;
-use hydrorattle_host::sim::{Beads, bonds, params};
+use hydrorattle_host::sim::{Beads, beads, bonds, params};
 
 /// How a chart run is set up: the kernel parameters and the density scale (Stokes number).
 #[derive(Clone, Copy)]
@@ -49,7 +49,7 @@ struct Outcome {
 
 /// The scene's beads (densities scaled by `st`) and bonds.
 fn build<T: Real>(scene: &Scene, st: f64) -> Result<(Beads<T>, Vec<Bond<T>>), StepError> {
-    let beads = Beads::new(&scene.particles, st)?;
+    let beads = beads(&scene.particles, st)?;
     let bonds = bonds(&scene.bonds, beads.len())?;
     Ok((beads, bonds))
 }

@@ -39,10 +39,10 @@ pub(super) fn resolve_integrator(r: &RawIntegrator) -> Result<Integrator, Issue>
         Some(m) => *m.get_ref(),
     };
     Ok(Integrator {
-        method: r.method,
+        method: r.method.0,
         dt,
         duration,
-        solver: r.solver.unwrap_or_default(),
+        solver: r.solver.map_or_else(Default::default, |s| s.0),
         tolerance: number(&r.tolerance, 1e-10, "tolerance", Bound::Positive)?,
         max_iterations,
         precision: r.precision.unwrap_or_default(),
@@ -58,7 +58,7 @@ fn resolve_fene(r: &RawIntegrator) -> Result<Option<f64>, Issue> {
     let Some(q0) = &r.fene else {
         return Ok(None);
     };
-    if r.method != Method::Springs {
+    if r.method.0 != Method::Springs {
         return Err(issue(
             q0.span(),
             "fene (the FENE springs' maximum extension) needs method = \"springs\"",
