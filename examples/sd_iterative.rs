@@ -145,7 +145,9 @@ fn main() {
             };
             let case = format!("N = {n}, cutoff {cutoff}");
             let mut store = Store::new(far, &pos, &rad, near);
-            let setup = best(3, || drop(store.solver(far, &pos, &rad, near)));
+            let setup = best(3, || {
+                std::hint::black_box(store.solver(far, &pos, &rad, near).pairs());
+            });
             let mut solver = store.solver(far, &pos, &rad, near);
             let np = solver.pairs();
             // The near field's work per iteration: a block-diagonal far field (Stokes'

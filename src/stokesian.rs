@@ -6,7 +6,8 @@
 //!   [`crate::mobility::wall::assemble_grand`] above the wall, the Ewald sums'
 //!   `crate::mobility::periodic::assemble_grand` in the box).
 //! * Pairs whose surface gap is below [`NearField::cutoff`] mean radii (in the box, at
-//!   their minimum image: the cutoff is far below half an edge): the pair's
+//!   their minimum image, and only while it is shorter than half the smallest edge, so
+//!   that a pair has one image at most): the pair's
 //!   [`crate::near::near_correction`], `R_2B,exact - (pair RPY 12x12 mobility in free
 //!   space)^-1` (above the wall too: the wall enters the pair only through `M_far`).
 //! * Spheres whose gap to the wall is below [`NearField::wall_cutoff`] radii: the exact
@@ -139,6 +140,25 @@ impl<T: Real> Far<'_, T> {
         }
     }
 
+    /// Whether a pair at separation `r` (a minimum image) is the only image within its
+    /// length: in the box, `|r|` below half the smallest edge. Farther pairs get no
+    /// near field (two images would be equally close at half an edge, and a correction
+    /// that picked one would break the box's translation invariance).
+    fn unique(self, r: T::V3) -> bool {
+        match self {
+            #[cfg(feature = "periodic")]
+            Self::Box(e) => {
+                let [x, y, z] = e.cell().size();
+                let h = x.min(y).min(z) * T::HALF;
+                T::norm2(r) < h * h
+            }
+            _ => {
+                let _ = r;
+                true
+            }
+        }
+    }
+
     /// The RPY grand mobility of the spheres, packed as `assemble_grand` stores it.
     pub fn assemble_grand(
         self,
@@ -251,7 +271,11 @@ impl<T: Real> NearField<T> {
 fn gap<T: Real>(far: Far<'_, T>, pos: &[T::V3], radius: &[T], i: usize, j: usize) -> (T, T::V3) {
     let r = far.separation(pos[i], pos[j]);
     let s = T::norm2(r).sqrt() * T::TWO / (radius[i] + radius[j]);
-    (s - T::TWO, r)
+    match far.unique(r) {
+        true => (s - T::TWO, r),
+        // Beyond every (finite) cutoff.
+        false => (T::ONE / T::MIN_POSITIVE, r),
+    }
 }
 
 /// How many pairs are inside the cutoff.

@@ -17,7 +17,7 @@
 //! on the close pairs only.
 //!
 //! **Preconditioner.** Block Jacobi over pairs: `B_p = I + L_p^T M_pp L_p`, with `M_pp`
-//! the pair's own free-space RPY 12x12 mobility, factored once. An isolated pair is
+//! the pair's own free-space RPY 12x12 mobility, inverted once. An isolated pair is
 //! solved exactly, so the lubrication's `1/gap` stiffness leaves the iteration; what
 //! remains is the coupling of pairs through shared spheres and the far field.
 //!
@@ -33,13 +33,18 @@
 
 use super::{Far, NearField, SdError, pair_correction, pair_far};
 use crate::cell_list::{self, CellList};
-use crate::linalg::{cholesky_dense, cholesky_dense_solve};
+use crate::linalg::{cholesky_dense, spd_inverse};
 use crate::real::Real;
 
 /// Entries of one pair's 12x12 matrix.
 const B: usize = 144;
 /// Unknowns per pair.
 const K: usize = 12;
+
+/// The far field's product `u = M_far f` over the `2n` vectors (forces then torques in,
+/// velocities then spins out).
+pub type FarProduct<'f, T> =
+    dyn FnMut(&[<T as Real>::V3], &mut [<T as Real>::V3]) -> Result<(), SdError> + 'f;
 
 /// What [`Solver::product`] needs for `n` spheres and `pairs` close pairs:
 /// `(pairs, pair reals, sphere vectors, cell-list indices)`.
@@ -52,7 +57,7 @@ pub fn sizes(n: usize, pairs: usize) -> (usize, usize, usize, usize) {
 pub struct Storage<'a, T: Real> {
     /// The close pairs `(i, j)`, `j < i`.
     pub pairs: &'a mut [[usize; 2]],
-    /// Per pair: `L_p`, the preconditioner's factor, and the five Krylov vectors.
+    /// Per pair: `L_p`, the preconditioner's block, and the five Krylov vectors.
     pub reals: &'a mut [T],
     /// `6n` vectors: the far field's input, output and the right-hand side.
     pub field: &'a mut [T::V3],
@@ -228,7 +233,7 @@ impl<'a, T: Real> Solver<'a, T> {
     /// iterations.
     pub fn product(
         &mut self,
-        far: &mut dyn FnMut(&[T::V3], &mut [T::V3]) -> Result<(), SdError>,
+        far: &mut FarProduct<'_, T>,
         f: &[T::V3],
         u: &mut [T::V3],
         tol: T,
@@ -325,17 +330,28 @@ fn axpy<T: Real>(a: T, x: &[T], y: &mut [T]) {
     }
 }
 
+/// Pair `p`'s `L_p` and preconditioner `B_p^-1` as fixed-size blocks (always there:
+/// the storage holds `2 B` reals a pair).
+#[inline(always)]
+fn blocks<T: Real>(fac: &[T], p: usize) -> Option<(&[T; B], &[T; B])> {
+    let (l, rest) = fac.get(p * 2 * B..)?.split_first_chunk::<B>()?;
+    Some((l, rest.first_chunk::<B>()?))
+}
+
 /// `x = L v` over the sphere vectors (`2n`).
 fn scatter<T: Real>((n, pairs, fac): Ctx<'_, T>, v: &[T], x: &mut [T::V3]) {
     x.fill(T::V3_ZERO);
-    for ((&pair, l), v) in pairs
-        .iter()
-        .zip(fac.chunks_exact(2 * B))
-        .zip(v.chunks_exact(K))
-    {
+    for (p, (&pair, v)) in pairs.iter().zip(v.chunks_exact(K)).enumerate() {
+        let Some((l, _)) = blocks(fac, p) else {
+            continue;
+        };
         let mut w = [T::ZERO; K];
         for k in 0..K {
-            w[k] = (0..=k).fold(T::ZERO, |s, m| s + l[k * K + m] * v[m]);
+            let mut s = T::ZERO;
+            for m in 0..=k {
+                s += l[k * K + m] * v[m];
+            }
+            w[k] = s;
         }
         for b in 0..4 {
             x[slot(n, pair, b)] += T::v3(w[3 * b], w[3 * b + 1], w[3 * b + 2]);
@@ -345,30 +361,37 @@ fn scatter<T: Real>((n, pairs, fac): Ctx<'_, T>, v: &[T], x: &mut [T::V3]) {
 
 /// `g = L^T u`, pair by pair.
 fn gather<T: Real>((n, pairs, fac): Ctx<'_, T>, u: &[T::V3], g: &mut [T]) {
-    for ((&pair, l), g) in pairs
-        .iter()
-        .zip(fac.chunks_exact(2 * B))
-        .zip(g.chunks_exact_mut(K))
-    {
+    for (p, (&pair, g)) in pairs.iter().zip(g.chunks_exact_mut(K)).enumerate() {
+        let Some((l, _)) = blocks(fac, p) else {
+            continue;
+        };
         let mut loc = [T::ZERO; K];
         for b in 0..4 {
             loc[3 * b..3 * b + 3].copy_from_slice(&T::xyz(u[slot(n, pair, b)]));
         }
-        for m in 0..K {
-            g[m] = (m..K).fold(T::ZERO, |s, k| s + l[k * K + m] * loc[k]);
+        let mut out = [T::ZERO; K];
+        for k in 0..K {
+            for m in 0..=k {
+                out[m] += l[k * K + m] * loc[k];
+            }
         }
+        g.copy_from_slice(&out);
     }
 }
 
-/// `s = B^-1 r`, pair by pair.
+/// `s = B^-1 r`, pair by pair (the stored inverse).
 fn precond<T: Real>((_, _, fac): Ctx<'_, T>, r: &[T], s: &mut [T]) {
-    for ((b, r), s) in fac
-        .chunks_exact(2 * B)
-        .zip(r.chunks_exact(K))
-        .zip(s.chunks_exact_mut(K))
-    {
-        s.copy_from_slice(r);
-        cholesky_dense_solve(&b[B..], K, s);
+    for (p, (r, s)) in r.chunks_exact(K).zip(s.chunks_exact_mut(K)).enumerate() {
+        let Some((_, b)) = blocks(fac, p) else {
+            continue;
+        };
+        for k in 0..K {
+            let mut t = T::ZERO;
+            for m in 0..K {
+                t += b[k * K + m] * r[m];
+            }
+            s[k] = t;
+        }
     }
 }
 
@@ -385,7 +408,7 @@ fn factor_semidefinite<T: Real>(l: &mut [T]) -> Result<(), SdError> {
     Ok(())
 }
 
-/// The preconditioner's factor `chol(I + L^T M_pp L)` of one pair into `b`.
+/// The preconditioner's block `(I + L^T M_pp L)^-1` of one pair into `b`.
 #[allow(clippy::too_many_arguments)]
 fn precondition<T: Real>(
     eta: T,
@@ -421,7 +444,6 @@ fn precondition<T: Real>(
             b[k * K + c] = v + if k == c { T::ONE } else { T::ZERO };
         }
     }
-    // Symmetric in exact arithmetic; its lower half is what the factor reads.
-    cholesky_dense(b, K, T::ZERO).map_err(SdError::NotPositiveDefinite)?;
-    Ok(())
+    // Symmetric in exact arithmetic; its inverse, by the kernel's Cholesky.
+    spd_inverse(b, K).map_err(SdError::NotPositiveDefinite)
 }

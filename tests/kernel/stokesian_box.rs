@@ -57,6 +57,17 @@ fn a_close_pair_in_a_large_box_is_free_space_plus_hasimoto() {
         let d = u(&boxed, k, [1.0, 1.0]) - u(&free, k, [1.0, 1.0]);
         println!("axis {k}: together {:.6e} against {:.6e}", d, -2.0 * shift);
         assert!((d / (-2.0 * shift) - 1.0).abs() < 0.1, "axis {k}: {d}");
+        if k == 0 {
+            // Along the line of centres no spin couples in, and to first order
+            // `dM_SD = M_SD M^-1 dM M^-1 M_SD` gives exactly `-2 shift (U_SD / U_RPY)^2`,
+            // `U_RPY` the closed form of two RPY spheres moving together, `U_SD` free
+            // space's (checked against Stimson and Jeffery in `stokesian.rs`).
+            let r = 2.1;
+            let rpy = mu0 + (1.0 - 2.0 / (3.0 * r * r)) / (4.0 * std::f64::consts::PI * r);
+            let want = -2.0 * shift * (u(&free, 0, [1.0, 1.0]) / rpy).powi(2);
+            println!("axis 0: together {d:.6e} against first order {want:.6e}");
+            assert!((d / want - 1.0).abs() < 0.01, "{d} against {want}");
+        }
         // Apart (equal and opposite): the uniform shift cancels; what is left is of
         // order (a/L)^3 and (r/L)^2 a/L, far below the shift.
         let d = u(&boxed, k, [1.0, -1.0]) - u(&free, k, [1.0, -1.0]);
