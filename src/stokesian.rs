@@ -28,14 +28,15 @@
 //! out. Cost: two dense Cholesky inversions, about `(6N)^3 4/3` flops, and `O(N^2)`
 //! distance tests.
 
+mod far;
 pub mod iterative;
+
+pub use far::Far;
 
 use crate::cell::PeriodicError;
 use crate::error::LinalgError;
 use crate::error::ParticleError;
 use crate::linalg::{spd_inverse, tri};
-#[cfg(feature = "periodic")]
-use crate::mobility::periodic::Ewald;
 use crate::mobility::wall::{self_wall, self_wall_rot};
 use crate::mobility::{Hydro, pair_blocks, self_rr, self_tt};
 use crate::near::wall::wall_scalars;
@@ -103,85 +104,6 @@ pub enum SdError {
         /// The relative residual reached (`f64` whatever the precision).
         residual: f64,
     },
-}
-
-/// The far field the near field corrects: free space, the wall at a height, or the
-/// periodic box with its Ewald sums (feature `periodic`).
-#[derive(Clone, Copy, Debug)]
-pub enum Far<'a, T: Real> {
-    /// Free space.
-    Free,
-    /// Above the no-slip wall at this height.
-    Wall(T),
-    /// In the periodic box of these sums; pairs meet at their minimum image.
-    #[cfg(feature = "periodic")]
-    Box(&'a Ewald<T>),
-    /// Never built: holds the lifetime without the `periodic` feature.
-    #[cfg(not(feature = "periodic"))]
-    #[doc(hidden)]
-    Never(core::convert::Infallible, core::marker::PhantomData<&'a T>),
-}
-
-impl<T: Real> Far<'_, T> {
-    /// The wall's height, where there is one.
-    pub fn wall(self) -> Option<T> {
-        match self {
-            Self::Wall(h) => Some(h),
-            _ => None,
-        }
-    }
-
-    /// The separation `r_j - r_i` the pair's near field sees: the minimum image in the box.
-    pub fn separation(self, pi: T::V3, pj: T::V3) -> T::V3 {
-        match self {
-            #[cfg(feature = "periodic")]
-            Self::Box(e) => e.cell().minimum_image(pj - pi),
-            _ => pj - pi,
-        }
-    }
-
-    /// Whether a pair at separation `r` (a minimum image) is the only image within its
-    /// length: in the box, `|r|` below half the smallest edge. Farther pairs get no
-    /// near field (two images would be equally close at half an edge, and a correction
-    /// that picked one would break the box's translation invariance).
-    fn unique(self, r: T::V3) -> bool {
-        match self {
-            #[cfg(feature = "periodic")]
-            Self::Box(e) => {
-                let [x, y, z] = e.cell().size();
-                let h = x.min(y).min(z) * T::HALF;
-                T::norm2(r) < h * h
-            }
-            _ => {
-                let _ = r;
-                true
-            }
-        }
-    }
-
-    /// The RPY grand mobility of the spheres, packed as `assemble_grand` stores it.
-    pub fn assemble_grand(
-        self,
-        eta: T,
-        pos: &[T::V3],
-        radius: &[T],
-        packed: &mut [T::M3],
-    ) -> Result<(), SdError> {
-        match self {
-            Self::Free => crate::mobility::assemble_grand(Hydro::Rpy, eta, pos, radius, packed),
-            Self::Wall(h) => {
-                crate::mobility::wall::assemble_grand(Hydro::Rpy, eta, h, pos, radius, packed)
-            }
-            #[cfg(feature = "periodic")]
-            Self::Box(e) => {
-                return crate::mobility::periodic::assemble_grand(e, eta, pos, radius, packed)
-                    .map_err(SdError::Periodic);
-            }
-            #[cfg(not(feature = "periodic"))]
-            Self::Never(never, _) => match never {},
-        }
-        .map_err(SdError::Particle)
-    }
 }
 
 /// The storage [`mobility`] needs for `n` spheres: `(packed blocks, dense scalars)`,
