@@ -45,8 +45,9 @@
 //!    reports a [`Layout`]). Builds on the geometries.
 //! 8. **The geometry a step sees**: [`geometry`] (the periodic sums held for a step), and
 //!    `stokesian` (feature `near`: the dense Stokesian dynamics mobility, far field plus
-//!    the near field's pair and wall corrections). Build on the step's error and the
-//!    geometries.
+//!    the near field's pair and wall corrections, in free space, above the wall or in
+//!    the box, and `stokesian::iterative`, its product for many spheres by conjugate
+//!    gradients over the close pairs). Build on the step's error and the geometries.
 //! 9. **Constraints**: [`constraints`] (SHAKE sweep, Newton, Krylov, the metric).
 //!    Builds on the geometry a step sees.
 //! 10. **Configuration**: [`params`], [`forces`], [`names`]. Build on the constraints'

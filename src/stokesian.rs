@@ -1,9 +1,13 @@
-//! The dense Stokesian dynamics mobility of `N` spheres in free space or above the wall:
-//! `M_SD = R^-1`, `R = M_far^-1 + sum R_near`, translation and rotation (`6N x 6N`).
+//! The dense Stokesian dynamics mobility of `N` spheres in free space, above the wall or
+//! in a periodic box ([`Far`]): `M_SD = R^-1`, `R = M_far^-1 + sum R_near`, translation
+//! and rotation (`6N x 6N`). The iterative product for large `N` is [`iterative`].
 //!
-//! * `M_far`: the kernel's RPY grand mobility ([`crate::mobility::assemble_grand`], or
-//!   [`crate::mobility::wall::assemble_grand`] above the wall).
-//! * Pairs whose surface gap is below [`NearField::cutoff`] mean radii: the pair's
+//! * `M_far`: the kernel's RPY grand mobility ([`crate::mobility::assemble_grand`],
+//!   [`crate::mobility::wall::assemble_grand`] above the wall, the Ewald sums'
+//!   `crate::mobility::periodic::assemble_grand` in the box).
+//! * Pairs whose surface gap is below [`NearField::cutoff`] mean radii (in the box, at
+//!   their minimum image, and only while it is shorter than half the smallest edge, so
+//!   that a pair has one image at most): the pair's
 //!   [`crate::near::near_correction`], `R_2B,exact - (pair RPY 12x12 mobility in free
 //!   space)^-1` (above the wall too: the wall enters the pair only through `M_far`).
 //! * Spheres whose gap to the wall is below [`NearField::wall_cutoff`] radii: the exact
@@ -24,6 +28,12 @@
 //! out. Cost: two dense Cholesky inversions, about `(6N)^3 4/3` flops, and `O(N^2)`
 //! distance tests.
 
+mod far;
+pub mod iterative;
+
+pub use far::Far;
+
+use crate::cell::PeriodicError;
 use crate::error::LinalgError;
 use crate::error::ParticleError;
 use crate::linalg::{spd_inverse, tri};
@@ -65,6 +75,9 @@ impl<T: Real> Default for NearField<T> {
 pub enum SdError {
     /// The far field refused the spheres (nested spheres, a centre below the wall).
     Particle(ParticleError),
+    /// The box's sums refused the spheres (a radius above the sums' largest, a sphere
+    /// inside another's image).
+    Periodic(PeriodicError),
     /// A pair's near field has no value (a size ratio outside `0.1..=10`, a radius that
     /// is not positive), or a sphere's wall functions.
     Near {
@@ -77,10 +90,20 @@ pub enum SdError {
     },
     /// `M_far` or `R` is not positive definite in this precision.
     NotPositiveDefinite(LinalgError),
-    /// A parameter is not finite, a cutoff is negative or `min_gap` is not positive.
+    /// A parameter is not finite, a cutoff is negative or `min_gap` is not positive (or,
+    /// for [`iterative`], a tolerance that is not positive, or the wall, which that path
+    /// does not model).
     Params,
     /// The storage is shorter than [`storage`] asks.
     Storage,
+    /// The iterative product did not reach its tolerance within its iterations
+    /// ([`iterative`]): the relative residual it stopped at.
+    NotConverged {
+        /// Iterations done.
+        iterations: u32,
+        /// The relative residual reached (`f64` whatever the precision).
+        residual: f64,
+    },
 }
 
 /// The storage [`mobility`] needs for `n` spheres: `(packed blocks, dense scalars)`,
@@ -93,9 +116,24 @@ pub fn storage(n: usize) -> (usize, usize) {
 /// a fluid of viscosity `eta`, above the wall at height `wall` if given; into `out`
 /// (`(6n)^2`, row-major), with `packed` as scratch ([`storage`]). On an error `out` and
 /// `packed` hold no meaningful values (they are the caller's buffers, not state).
+/// [`mobility_in`] with `Far::Wall` or `Far::Free`.
 pub fn mobility<T: Real>(
     eta: T,
     wall: Option<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    near: NearField<T>,
+    packed: &mut [T::M3],
+    out: &mut [T],
+) -> Result<(), SdError> {
+    let far = wall.map_or(Far::Free, Far::Wall);
+    mobility_in(eta, far, pos, radius, near, packed, out)
+}
+
+/// The Stokesian dynamics grand mobility in the geometry `far` (as [`mobility`]).
+pub fn mobility_in<T: Real>(
+    eta: T,
+    far: Far<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     near: NearField<T>,
@@ -107,16 +145,10 @@ pub fn mobility<T: Real>(
     let (Some(packed), Some(out)) = (packed.get_mut(..nb), out.get_mut(..nd)) else {
         return Err(SdError::Storage);
     };
-    let ok = |v: T| v.is_finite() && v >= T::ZERO;
-    if !(ok(near.cutoff) && ok(near.wall_cutoff) && ok(near.min_gap) && near.min_gap > T::ZERO) {
-        return Err(SdError::Params);
-    }
+    near.check()?;
     let (pos, radius) = (&pos[..n], &radius[..n]);
-    match wall {
-        None => crate::mobility::assemble_grand(Hydro::Rpy, eta, pos, radius, packed),
-        Some(h) => crate::mobility::wall::assemble_grand(Hydro::Rpy, eta, h, pos, radius, packed),
-    }
-    .map_err(SdError::Particle)?;
+    let wall = far.wall();
+    far.assemble_grand(eta, pos, radius, packed)?;
     let m = 6 * n;
     for bi in 0..2 * n {
         for bj in 0..=bi {
@@ -130,33 +162,51 @@ pub fn mobility<T: Real>(
             }
         }
     }
-    let pairs = close_pairs(pos, radius, near.cutoff);
+    let pairs = close_pairs(far, pos, radius, near.cutoff);
     let walls = wall.map_or(0, |h| close_walls(h, pos, radius, near.wall_cutoff));
     if pairs == 0 && walls == 0 {
         return Ok(());
     }
     spd_inverse(out, m).map_err(SdError::NotPositiveDefinite)?;
-    add_pairs(eta, pos, radius, near, out)?;
+    add_pairs(eta, far, pos, radius, near, out)?;
     if let Some(h) = wall {
         add_walls(eta, h, pos, radius, near, out)?;
     }
     spd_inverse(out, m).map_err(SdError::NotPositiveDefinite)
 }
 
-/// The scaled surface gap `xi = 2 r / (a1 + a2) - 2` of spheres `i` and `j`, and `r`.
-fn gap<T: Real>(pos: &[T::V3], radius: &[T], i: usize, j: usize) -> (T, T::V3) {
-    let r = pos[j] - pos[i];
+impl<T: Real> NearField<T> {
+    /// `Err(SdError::Params)` unless the cutoffs are finite and not negative and
+    /// `min_gap` finite and positive.
+    pub fn check(&self) -> Result<(), SdError> {
+        let ok = |v: T| v.is_finite() && v >= T::ZERO;
+        match ok(self.cutoff) && ok(self.wall_cutoff) && ok(self.min_gap) && self.min_gap > T::ZERO
+        {
+            true => Ok(()),
+            false => Err(SdError::Params),
+        }
+    }
+}
+
+/// The scaled surface gap `xi = 2 r / (a1 + a2) - 2` of spheres `i` and `j`, and `r`
+/// (from `i` to `j`, the minimum image in the box).
+fn gap<T: Real>(far: Far<'_, T>, pos: &[T::V3], radius: &[T], i: usize, j: usize) -> (T, T::V3) {
+    let r = far.separation(pos[i], pos[j]);
     let s = T::norm2(r).sqrt() * T::TWO / (radius[i] + radius[j]);
-    (s - T::TWO, r)
+    match far.unique(r) {
+        true => (s - T::TWO, r),
+        // Beyond every (finite) cutoff.
+        false => (T::ONE / T::MIN_POSITIVE, r),
+    }
 }
 
 /// How many pairs are inside the cutoff.
-fn close_pairs<T: Real>(pos: &[T::V3], radius: &[T], cutoff: T) -> usize {
+fn close_pairs<T: Real>(far: Far<'_, T>, pos: &[T::V3], radius: &[T], cutoff: T) -> usize {
     let n = pos.len();
     (0..n)
         .map(|i| {
             (i + 1..n)
-                .filter(|&j| gap(pos, radius, i, j).0 < cutoff)
+                .filter(|&j| gap(far, pos, radius, i, j).0 < cutoff)
                 .count()
         })
         .sum()
@@ -181,6 +231,7 @@ fn add_block<T: Real>(out: &mut [T], m: usize, (bi, bj): (usize, usize), b: T::M
 /// Adds every close pair's `R_near` to the resistance in `out`.
 fn add_pairs<T: Real>(
     eta: T,
+    far: Far<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     near: NearField<T>,
@@ -190,22 +241,9 @@ fn add_pairs<T: Real>(
     let m = 6 * n;
     for i in 0..n {
         for j in i + 1..n {
-            let (xi, r) = gap(pos, radius, i, j);
-            if !(xi < near.cutoff) {
+            let Some(c) = pair_correction(eta, far, pos, radius, near, (i, j))? else {
                 continue;
-            }
-            let (a1, a2) = (radius[i], radius[j]);
-            let len = T::norm2(r).sqrt();
-            if !(len > T::ZERO) {
-                // Coincident centres: no line of centres; RPY alone (positive definite).
-                continue;
-            }
-            let d = r * (T::ONE / len);
-            let xi = if xi < near.min_gap { near.min_gap } else { xi };
-            let dist = (a1 + a2) * T::HALF * (T::TWO + xi);
-            let far = pair_far(eta, a1, a2, d * dist);
-            let why = |why| SdError::Near { i, j, why };
-            let c = near_correction(eta, a1, a2, d * dist, &far).map_err(why)?;
+            };
             let idx = [i, j, n + i, n + j];
             for (bi, row) in c.iter().enumerate() {
                 for (bj, &b) in row.iter().enumerate() {
@@ -215,6 +253,37 @@ fn add_pairs<T: Real>(
         }
     }
     Ok(())
+}
+
+/// The near-field correction `R_near` of the pair `(i, j)` (rows and columns
+/// `(1, 2, rotation 1, rotation 2)`), `None` beyond the cutoff or at coincident centres.
+#[allow(clippy::type_complexity)]
+pub fn pair_correction<T: Real>(
+    eta: T,
+    far: Far<'_, T>,
+    pos: &[T::V3],
+    radius: &[T],
+    near: NearField<T>,
+    (i, j): (usize, usize),
+) -> Result<Option<[[T::M3; 4]; 4]>, SdError> {
+    let (xi, r) = gap(far, pos, radius, i, j);
+    if !(xi < near.cutoff) {
+        return Ok(None);
+    }
+    let (a1, a2) = (radius[i], radius[j]);
+    let len = T::norm2(r).sqrt();
+    if !(len > T::ZERO) {
+        // Coincident centres: no line of centres; RPY alone (positive definite).
+        return Ok(None);
+    }
+    let d = r * (T::ONE / len);
+    let xi = if xi < near.min_gap { near.min_gap } else { xi };
+    let dist = (a1 + a2) * T::HALF * (T::TWO + xi);
+    let pf = pair_far(eta, a1, a2, d * dist);
+    let why = |why| SdError::Near { i, j, why };
+    near_correction(eta, a1, a2, d * dist, &pf)
+        .map(Some)
+        .map_err(why)
 }
 
 /// The free-space RPY 12x12 mobility of a pair, sphere 2 at `r` from sphere 1, as

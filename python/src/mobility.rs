@@ -142,7 +142,7 @@ pub fn mobility<'py>(
     })
 }
 
-/// `mobility(..., near_field=True)`: RPY only, free space or the wall.
+/// `mobility(..., near_field=True)`: RPY only, in free space, above the wall or in the box.
 #[allow(clippy::too_many_arguments)]
 fn near_field_mobility<'py>(
     py: Python<'py>,
@@ -155,9 +155,9 @@ fn near_field_mobility<'py>(
     wall: Option<f64>,
     cell: Option<[f64; 3]>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if cell.is_some() {
+    if cell.is_some() && wall.is_some() {
         return Err(PyValueError::new_err(
-            "near_field=True is not available with box= (the periodic near field is not built)",
+            "near_field=True takes a wall or a box, not both",
         ));
     }
     if level != Hydro::Rpy {
@@ -166,9 +166,9 @@ fn near_field_mobility<'py>(
         ));
     }
     Ok(if is_f32(precision)? {
-        crate::near::dense::<f32>(py, pos, radii, eta, rotation, wall)?.into_any()
+        crate::near::dense::<f32>(py, pos, radii, eta, rotation, wall, cell)?.into_any()
     } else {
-        crate::near::dense::<f64>(py, pos, radii, eta, rotation, wall)?.into_any()
+        crate::near::dense::<f64>(py, pos, radii, eta, rotation, wall, cell)?.into_any()
     })
 }
 

@@ -1,8 +1,10 @@
 //! `mobility(..., near_field=True)`: the dense Stokesian dynamics mobility, the inverse
-//! of `M_far^-1 + R_near` ([`hydrorattle::stokesian`]), in free space or above a wall.
+//! of `M_far^-1 + R_near` ([`hydrorattle::stokesian`]), in free space, above a wall or
+//! in a periodic box (Ewald sums by the kernel's rule, pairs at their minimum image).
 
 use hydrorattle::Real;
-use hydrorattle::stokesian::{NearField, SdError, mobility, storage};
+use hydrorattle::mobility::periodic::Ewald;
+use hydrorattle::stokesian::{Far, NearField, SdError, mobility_in, storage};
 use numpy::ndarray::Array2;
 use numpy::{Element, IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
@@ -21,6 +23,7 @@ pub fn dense<'py, T: Real + Element>(
     eta: f64,
     rotation: bool,
     wall: Option<f64>,
+    cell: Option<[f64; 3]>,
 ) -> PyResult<Bound<'py, PyArray2<T>>> {
     let n = pos.len();
     let what = format!("near-field mobility of {n} spheres");
@@ -29,12 +32,30 @@ pub fn dense<'py, T: Real + Element>(
         .add::<T::M3>("packed blocks", Some(nb))
         .add::<T>("resistance", Some(nd))
         .check()?;
+    if let Some(c) = cell {
+        crate::input::in_box::<T>(py, c, pos, radii)?;
+    }
     let (p, r) = spheres::<T>(py, pos, radii, None)?;
+    let ewald = match cell {
+        Some(c) => {
+            let a_max = r.iter().fold(T::ZERO, |m, &a| m.max(a));
+            Some(
+                Ewald::new(crate::input::cell::<T>(c)?, a_max)
+                    .map_err(|e| PyValueError::new_err(format!("box: {e}")))?,
+            )
+        }
+        None => None,
+    };
     let mut packed = alloc::filled(&what, "packed blocks", nb, T::M3_ZERO)?;
     let mut out = alloc::filled(&what, "resistance", nd, T::ZERO)?;
-    let (eta, wall) = (T::from_f64(eta), wall.map(T::from_f64));
+    let eta = T::from_f64(eta);
+    let far = match (&ewald, wall) {
+        (Some(e), _) => Far::Box(e),
+        (None, Some(h)) => Far::Wall(T::from_f64(h)),
+        (None, None) => Far::Free,
+    };
     let near = NearField::default();
-    py.detach(|| mobility(eta, wall, &p, &r, near, &mut packed, &mut out))
+    py.detach(|| mobility_in(eta, far, &p, &r, near, &mut packed, &mut out))
         .map_err(|e| sd_error(py, e))?;
     drop(packed);
     let m = 6 * n;
@@ -64,7 +85,8 @@ fn sd_error(py: Python<'_>, e: SdError) -> PyErr {
         SdError::NotPositiveDefinite(l) => PyValueError::new_err(format!(
             "the near-field resistance is not positive definite in this precision ({l})"
         )),
-        SdError::Params | SdError::Storage => {
+        SdError::Periodic(p) => PyValueError::new_err(format!("box: {p}")),
+        SdError::Params | SdError::Storage | SdError::NotConverged { .. } => {
             PyValueError::new_err(format!("near-field mobility refused: {e:?}"))
         }
     }

@@ -81,9 +81,34 @@ def test_positive_definite_with_overlaps(precision):
         assert np.linalg.eigvalsh((m + m.T) / 2).min() > 0
 
 
-def test_box_and_other_levels_are_refused():
-    with pytest.raises(ValueError, match="periodic near field is not built"):
-        hr.mobility([[1, 1, 1], [3, 1, 1]], 1.0, box=(10, 10, 10), near_field=True)
+def test_in_a_large_box_a_close_pair_is_free_space_plus_hasimoto():
+    # Each translation block shifts by -2.837297 a / L U0 (Hasimoto); together the
+    # pair's velocity by twice that, apart (opposite forces) by O((a/L)^3) only.
+    pos = [[50, 50, 50], [52.1, 50, 50]]
+    free = hr.mobility(pos, 1.0, near_field=True)
+    boxed = hr.mobility(pos, 1.0, box=(100, 100, 100), near_field=True)
+    shift = 2.837297 / 100 * U0
+    for k in range(3):
+        together = (boxed[k, k] + boxed[k, 3 + k]) - (free[k, k] + free[k, 3 + k])
+        apart = (boxed[k, k] - boxed[k, 3 + k]) - (free[k, k] - free[k, 3 + k])
+        assert abs(together / (-2 * shift) - 1) < 0.1, together
+        assert abs(apart) < 1e-3 * shift, apart
+
+
+def test_in_the_box_a_pair_across_a_face_is_the_pair_inside():
+    across = np.array([[11.0, 3, 4], [1.05, 3, 4.2], [5, 7, 2]])
+    inside = across + [6.0, 1, 2]
+    inside[:, 0] %= 12
+    a = [1.0, 1.0, 1.5]
+    x = hr.mobility(across, a, rotation=True, box=(12, 12, 12), near_field=True)
+    y = hr.mobility(inside, a, rotation=True, box=(12, 12, 12), near_field=True)
+    np.testing.assert_allclose(x, y, rtol=0, atol=1e-9 * np.abs(x).max())
+    assert np.linalg.eigvalsh((x + x.T) / 2).min() > 0
+
+
+def test_box_with_wall_and_other_levels_are_refused():
+    with pytest.raises(ValueError, match="a wall or a box"):
+        hr.mobility([[1, 1, 1], [3, 1, 1]], 1.0, wall=0.0, box=(10, 10, 10), near_field=True)
     with pytest.raises(ValueError, match="rpy"):
         hr.mobility([[1, 1, 1], [3, 1, 1]], 1.0, hydro="oseen", near_field=True)
     with pytest.raises(ValueError, match="size ratio"):

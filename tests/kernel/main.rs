@@ -64,6 +64,10 @@ mod stability;
 mod states;
 #[cfg(feature = "near")]
 mod stokesian;
+#[cfg(all(feature = "near", feature = "periodic"))]
+mod stokesian_box;
+#[cfg(feature = "near")]
+mod stokesian_iter;
 mod tensions;
 mod transactional;
 mod wall;

@@ -155,7 +155,7 @@ fn beyond_the_cutoffs_it_is_rpy_bit_for_bit() {
 
 /// Smallest pivot of the test's own Cholesky of `m`, relative to its diagonal: positive
 /// for a positive definite matrix. Also checks symmetry.
-fn smallest_pivot(m: &[f64], n: usize) -> f64 {
+pub fn smallest_pivot(m: &[f64], n: usize) -> f64 {
     let mut a = m.to_vec();
     let mut worst = f64::INFINITY;
     for i in 0..n {

@@ -202,8 +202,10 @@ def mobility(
         at the wall (Brenner). Gaps below 1e-3 radii, overlaps included, get the
         correction of that gap. Dense, ``O(N^3)``: 0.3 s at N = 100 and 3 s at
         N = 200 on one core (docs/NEAR.md). RPY only; a pair inside the cutoff
-        needs a size ratio within 0.1 to 10. Not with ``box`` (``ValueError``: the
-        periodic near field is not built). Without ``rotation`` the translational
+        needs a size ratio within 0.1 to 10. With ``box`` the far field is the
+        Ewald-summed RPY and pairs meet at their minimum image (shorter than half
+        the smallest edge); ``wall`` and ``box`` together are a ``ValueError``.
+        Without ``rotation`` the translational
         block of the full inverse (the mobility of torque-free spheres).
         ``threads`` is not used.
 

@@ -1,0 +1,146 @@
+//! The pairs' blocks of the iterative product: `L` and `L^T` over the sphere vectors,
+//! the block-Jacobi preconditioner, and their set-up.
+
+use super::super::{Far, NearField, SdError, pair_far};
+use super::{B, K};
+use crate::linalg::{cholesky_dense, spd_inverse};
+use crate::real::Real;
+
+/// The `V3` slot (in the grand layout) of entry `b` (0..4) of pair `(i, j)`.
+#[inline(always)]
+fn slot(n: usize, [i, j]: [usize; 2], b: usize) -> usize {
+    [i, j, n + i, n + j][b]
+}
+
+/// `(n, pairs, factors)`.
+pub(super) type Ctx<'c, T> = (usize, &'c [[usize; 2]], &'c [T]);
+
+/// `a . b`, in order.
+pub(super) fn dot<T: Real>(a: &[T], b: &[T]) -> T {
+    a.iter().zip(b).fold(T::ZERO, |s, (&a, &b)| s + a * b)
+}
+
+/// `y += a x`.
+pub(super) fn axpy<T: Real>(a: T, x: &[T], y: &mut [T]) {
+    for (y, &x) in y.iter_mut().zip(x) {
+        *y += a * x;
+    }
+}
+
+/// Pair `p`'s `L_p` and preconditioner `B_p^-1` as fixed-size blocks (always there:
+/// the storage holds `2 B` reals a pair).
+#[inline(always)]
+fn blocks<T: Real>(fac: &[T], p: usize) -> Option<(&[T; B], &[T; B])> {
+    let (l, rest) = fac.get(p * 2 * B..)?.split_first_chunk::<B>()?;
+    Some((l, rest.first_chunk::<B>()?))
+}
+
+/// `x = L v` over the sphere vectors (`2n`).
+pub(super) fn scatter<T: Real>((n, pairs, fac): Ctx<'_, T>, v: &[T], x: &mut [T::V3]) {
+    x.fill(T::V3_ZERO);
+    for (p, (&pair, v)) in pairs.iter().zip(v.chunks_exact(K)).enumerate() {
+        let Some((l, _)) = blocks(fac, p) else {
+            continue;
+        };
+        let mut w = [T::ZERO; K];
+        for k in 0..K {
+            let mut s = T::ZERO;
+            for m in 0..=k {
+                s += l[k * K + m] * v[m];
+            }
+            w[k] = s;
+        }
+        for b in 0..4 {
+            x[slot(n, pair, b)] += T::v3(w[3 * b], w[3 * b + 1], w[3 * b + 2]);
+        }
+    }
+}
+
+/// `g = L^T u`, pair by pair.
+pub(super) fn gather<T: Real>((n, pairs, fac): Ctx<'_, T>, u: &[T::V3], g: &mut [T]) {
+    for (p, (&pair, g)) in pairs.iter().zip(g.chunks_exact_mut(K)).enumerate() {
+        let Some((l, _)) = blocks(fac, p) else {
+            continue;
+        };
+        let mut loc = [T::ZERO; K];
+        for b in 0..4 {
+            loc[3 * b..3 * b + 3].copy_from_slice(&T::xyz(u[slot(n, pair, b)]));
+        }
+        let mut out = [T::ZERO; K];
+        for k in 0..K {
+            for m in 0..=k {
+                out[m] += l[k * K + m] * loc[k];
+            }
+        }
+        g.copy_from_slice(&out);
+    }
+}
+
+/// `s = B^-1 r`, pair by pair (the stored inverse).
+pub(super) fn precond<T: Real>((_, _, fac): Ctx<'_, T>, r: &[T], s: &mut [T]) {
+    for (p, (r, s)) in r.chunks_exact(K).zip(s.chunks_exact_mut(K)).enumerate() {
+        let Some((_, b)) = blocks(fac, p) else {
+            continue;
+        };
+        for k in 0..K {
+            let mut t = T::ZERO;
+            for m in 0..K {
+                t += b[k * K + m] * r[m];
+            }
+            s[k] = t;
+        }
+    }
+}
+
+/// `l` (a semi-definite 12x12, row-major) into its lower Cholesky factor, strict upper
+/// part zero; a dependent row's column is zero.
+pub(super) fn factor_semidefinite<T: Real>(l: &mut [T]) -> Result<(), SdError> {
+    let floor = T::EPSILON * T::from_f64(64.0);
+    cholesky_dense(l, K, floor).map_err(SdError::NotPositiveDefinite)?;
+    for k in 0..K {
+        let d = l[k * K + k];
+        l[k * K + k] = if d == T::ZERO { T::ZERO } else { T::ONE / d };
+        l[k * K + k + 1..(k + 1) * K].fill(T::ZERO);
+    }
+    Ok(())
+}
+
+/// The preconditioner's block `(I + L^T M_pp L)^-1` of one pair into `b`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn precondition<T: Real>(
+    eta: T,
+    far: Far<'_, T>,
+    pos: &[T::V3],
+    radius: &[T],
+    near: NearField<T>,
+    [i, j]: [usize; 2],
+    l: &[T],
+    b: &mut [T],
+) -> Result<(), SdError> {
+    let (a1, a2) = (radius[i], radius[j]);
+    let r = far.separation(pos[i], pos[j]);
+    let len = T::norm2(r).sqrt();
+    // At the clamped gap, as the correction is (apart, so RPY's pair is positive definite).
+    let (mean, floor) = ((a1 + a2) * T::HALF, near.min_gap + T::TWO);
+    let d = match len > T::ZERO {
+        true => r * ((len.max(mean * floor)) / len),
+        false => T::v3(mean * floor, T::ZERO, T::ZERO),
+    };
+    let m = pair_far(eta, a1, a2, d);
+    let mp = |k: usize, c: usize| T::m3_get(m[k / 3][c / 3], k % 3, c % 3);
+    // t = M_pp L, then b = I + L^T t.
+    let mut t = [T::ZERO; B];
+    for k in 0..K {
+        for c in 0..K {
+            t[k * K + c] = (c..K).fold(T::ZERO, |s, q| s + mp(k, q) * l[q * K + c]);
+        }
+    }
+    for k in 0..K {
+        for c in 0..K {
+            let v = (k..K).fold(T::ZERO, |s, q| s + l[q * K + k] * t[q * K + c]);
+            b[k * K + c] = v + if k == c { T::ONE } else { T::ZERO };
+        }
+    }
+    // Symmetric in exact arithmetic; its inverse, by the kernel's Cholesky.
+    spd_inverse(b, K).map_err(SdError::NotPositiveDefinite)
+}
