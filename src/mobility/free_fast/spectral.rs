@@ -240,59 +240,35 @@ impl Plan {
         }
     }
 
-    /// Transforms along `y` the lines `(c, k, z)`, `z < planes`, of `spec` (`comps`
-    /// values per point): point `j` read as `load(j)` (`Some((j', sign))`: the value at
-    /// `j'` times `sign`; `None`: zero), points `j < keep` written back.
+    /// Transforms along `y` the lines `(c, k, z)`, `z < planes`, of `spec` (3 values a
+    /// point): point `j` read as `load(c, j)` (`Some((j', sign))`: the value at `j'`
+    /// times `sign`; `None`: zero), points `j < keep` written back.
     fn y_pass<T: Real>(
         &self,
         parts: &mut Parts<'_, T>,
-        (comps, planes, inverse): (usize, usize, bool),
+        (planes, inverse): (usize, bool),
         load: impl Fn(usize, usize) -> Option<(usize, T)>,
         keep: usize,
     ) {
         let (hx, py) = (self.hx(), self.p[1]);
-        let per_plane = comps * hx;
-        let total = per_plane * planes;
-        let ty = parts.tw[2];
-        let mut first = 0;
-        while first < total {
-            // Batches within one plane: its lines are contiguous at each `y`.
-            let plane = first / per_plane;
-            let batch = CHUNK.min(per_plane * (plane + 1) - first);
-            let start = |l: usize| {
-                let q = first + l - plane * per_plane;
-                q + comps * hx * py * plane
-            };
-            for j in 0..py {
-                for l in 0..batch {
-                    let lc = (first + l) % comps;
-                    parts.a[j * batch + l] = match load(lc, j) {
-                        Some((jj, s)) => {
-                            let v = parts.spec[start(l) + per_plane * jj];
-                            [v[0] * s, v[1] * s]
-                        }
-                        None => [T::ZERO; 2],
-                    };
-                }
-            }
-            let n = py * batch;
-            let in_b = transform(
-                &mut parts.a[..n],
-                &mut parts.b[..n],
-                py,
-                batch,
-                &self.factors[1],
-                ty,
-                inverse,
-            );
-            let out: &[Cx<T>] = if in_b { &*parts.b } else { &*parts.a };
-            for j in 0..keep {
-                for l in 0..batch {
-                    parts.spec[start(l) + per_plane * j] = out[j * batch + l];
-                }
-            }
-            first += batch;
-        }
+        // Line `l = c + 3 (k + hx z)`: point `j` at `3 (k + hx (j + py z)) + c`.
+        let at = |l: usize, j: usize| (l % (3 * hx)) + 3 * hx * (j + py * (l / (3 * hx)));
+        let axis = (py, &self.factors[1], parts.tw[2], inverse);
+        let scratch = (&mut *parts.a, &mut *parts.b);
+        lines(
+            scratch,
+            axis,
+            3 * hx * planes,
+            &mut *parts.spec,
+            |spec, l, j| {
+                load(l % 3, j).map_or([T::ZERO; 2], |(jj, s)| {
+                    let v = spec[at(l, jj)];
+                    [v[0] * s, v[1] * s]
+                })
+            },
+            keep,
+            |spec, l, j, v| spec[at(l, j)] = v,
+        );
     }
 }
 
@@ -307,12 +283,12 @@ pub(super) fn convolve<T: Real>(plan: &Plan, cx: &mut [Cx<T>], kernel: &[T], clo
     });
     plan.y_pass(
         &mut parts,
-        (3, mz, false),
+        (mz, false),
         |_, j| (j < my).then_some((j, T::ONE)),
         py,
     );
     z_convolve(plan, &mut parts, kernel);
-    plan.y_pass(&mut parts, (3, mz, true), |_, j| Some((j, T::ONE)), my);
+    plan.y_pass(&mut parts, (mz, true), |_, j| Some((j, T::ONE)), my);
     plan.x_inverse(&mut parts, |q, v| cloud[q] = v);
 }
 
@@ -432,45 +408,61 @@ pub(super) fn kernel<T: Real>(
             (diag + crr * d[k] * d[l]) * weight * sx
         });
         let load_y = |c: usize, j: usize| mirror(j, py, my, odd(half, c, 1));
-        plan.y_pass(&mut parts, (3, mz, false), load_y, oy);
+        plan.y_pass(&mut parts, (mz, false), load_y, oy);
         // Along `z`, the lines `(c, k, ky)` of the octant, into `kernel`.
-        let tz = parts.tw[3];
-        let total = 3 * hx * oy;
-        let mut first = 0;
-        while first < total {
-            let batch = CHUNK.min(total - first);
-            for j in 0..pz {
-                for l in 0..batch {
-                    let (c, q) = ((first + l) % 3, (first + l) / 3);
-                    let (k, ky) = (q % hx, q / hx);
-                    parts.a[j * batch + l] = match mirror(j, pz, mz, odd(half, c, 2)) {
-                        Some((jj, s)) => {
-                            let v = parts.spec[3 * (k + hx * (ky + py * jj)) + c];
-                            [v[0] * s, v[1] * s]
-                        }
-                        None => [T::ZERO; 2],
-                    };
-                }
+        let at = |l: usize| (l % 3, (l / 3) % hx, l / (3 * hx));
+        let axis = (pz, &plan.factors[2], parts.tw[3], false);
+        let scratch = (&mut *parts.a, &mut *parts.b);
+        let data = (&*parts.spec, &mut *kernel);
+        lines(
+            scratch,
+            axis,
+            3 * hx * oy,
+            data,
+            |(spec, _), l, j| {
+                let (c, k, ky) = at(l);
+                mirror(j, pz, mz, odd(half, c, 2)).map_or([T::ZERO; 2], |(jj, s)| {
+                    let v = spec[3 * (k + hx * (ky + py * jj)) + c];
+                    [v[0] * s, v[1] * s]
+                })
+            },
+            oz,
+            |(_, kernel), l, kz, v| {
+                let (c, k, ky) = at(l);
+                kernel[6 * (k + hx * (ky + oy * kz)) + 3 * half + c] = v[0];
+            },
+        );
+    }
+}
+
+/// Transforms `total` lines of length `n` (the axis' radix stages and twiddles, and the
+/// direction), [`CHUNK`] at a time through the scratch: point `j` of line `l` read as
+/// `load(data, l, j)`, and points `j < keep` handed to `store(data, l, j, value)`.
+fn lines<T: Real, D>(
+    (a, b): (&mut [Cx<T>], &mut [Cx<T>]),
+    (n, f, tw, inverse): (usize, &Factors, &[Cx<T>], bool),
+    total: usize,
+    mut data: D,
+    load: impl Fn(&D, usize, usize) -> Cx<T>,
+    keep: usize,
+    mut store: impl FnMut(&mut D, usize, usize, Cx<T>),
+) {
+    let mut first = 0;
+    while first < total {
+        let batch = CHUNK.min(total - first);
+        for j in 0..n {
+            for l in 0..batch {
+                a[j * batch + l] = load(&data, first + l, j);
             }
-            let n = pz * batch;
-            let in_b = transform(
-                &mut parts.a[..n],
-                &mut parts.b[..n],
-                pz,
-                batch,
-                &plan.factors[2],
-                tz,
-                false,
-            );
-            let out: &[Cx<T>] = if in_b { &*parts.b } else { &*parts.a };
-            for kz in 0..oz {
-                for l in 0..batch {
-                    let (c, q) = ((first + l) % 3, (first + l) / 3);
-                    let (k, ky) = (q % hx, q / hx);
-                    kernel[6 * (k + hx * (ky + oy * kz)) + 3 * half + c] = out[kz * batch + l][0];
-                }
-            }
-            first += batch;
         }
+        let len = n * batch;
+        let in_b = transform(&mut a[..len], &mut b[..len], n, batch, f, tw, inverse);
+        let out: &[Cx<T>] = if in_b { &*b } else { &*a };
+        for j in 0..keep {
+            for l in 0..batch {
+                store(&mut data, first + l, j, out[j * batch + l]);
+            }
+        }
+        first += batch;
     }
 }
