@@ -191,6 +191,11 @@ impl<'s> CellList<'s> {
         }
     }
 
+    /// The spheres cell by cell: an order in which neighbours are near in memory.
+    pub(crate) fn order(&self) -> &[usize] {
+        self.order
+    }
+
     /// Calls `f(j)` for every sphere `j` in the cells around `p` (its own included),
     /// each once, in the list's order.
     #[inline]

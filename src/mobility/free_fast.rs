@@ -23,12 +23,13 @@
 
 mod grid;
 mod radial;
+mod spectral;
 
 use core::fmt;
 
 use crate::cell_list::CellList;
 use crate::fault::ParticleError;
-use crate::mobility::pse::fft::{self, Cx, good_size};
+use crate::mobility::pse::fft::Cx;
 use crate::mobility::{Hydro, pair_tt, self_tt};
 use crate::real::Real;
 
@@ -122,7 +123,7 @@ pub struct FreeStorage<'a, T: Real> {
     reals: &'a mut [T],
     index: &'a mut [usize],
     /// The parameters whose kernel `reals` holds.
-    ready: Option<[u64; 5]>,
+    ready: Option<[u64; 8]>,
 }
 
 impl<'a, T: Real> FreeStorage<'a, T> {
@@ -150,9 +151,8 @@ pub struct FreeFast<T: Real> {
     reach: f64,
     /// Window points per axis.
     support: usize,
-    /// Grid points per axis (the cloud's) and the padded transform's.
-    m: [usize; 3],
-    grid: fft::Grid3,
+    /// The cloud's grid points per axis and the padded transform's.
+    plan: spectral::Plan,
     r_cut: f64,
     estimate: f64,
 }
@@ -162,8 +162,9 @@ impl<T: Real> FreeFast<T> {
     /// [`min_tolerance`]`..=`[`MAX_TOLERANCE`], and clouds of `n` spheres whose bounding
     /// box has edges at most `extent`. With `D = ln(12/tol)`:
     ///
-    /// * `sigma = max(a_max / 2, 0.38 (V / n)^{1/3})` (`V` the box's volume): the near
-    ///   pairs and the grid points cost alike at `0.38`;
+    /// * `sigma = max(0.75 a_max, 0.31 (V / n)^{1/3})` (`V` the box's volume): the near
+    ///   pairs and the grid points cost alike at `0.31`; the floor keeps the sphere
+    ///   factor's growth on the grid (`(a k)^4`) below the tolerance down to 1e-8;
     /// * grid spacing `h = pi sigma sqrt(3 / (2 D))`: the worst aliasing term of the
     ///   double grid sum, `exp(-3 pi^2 sigma^2 / (2 h^2))`, is `exp(-D)`;
     /// * window half-width `sigma sqrt(2 D + 4)`;
@@ -174,7 +175,7 @@ impl<T: Real> FreeFast<T> {
         let e = extent.map(|e| e.to_f64());
         let a = a_max.to_f64();
         let vol = e.iter().map(|e| e + 2.0 * a).product::<f64>();
-        let sigma = (0.5 * a).max(0.38 * libm::cbrt(vol / n.max(1) as f64));
+        let sigma = (0.75 * a).max(0.31 * libm::cbrt(vol / n.max(1) as f64));
         Self::with_sigma(a_max, tol, extent, T::from_f64(sigma))
     }
 
@@ -209,17 +210,15 @@ impl<T: Real> FreeFast<T> {
         if support > MAX_SUPPORT {
             return Err(FreeError::GridTooLarge);
         }
-        let (mut m, mut mp) = ([0; 3], [0; 3]);
-        let mut factors = [fft::Factors::new(1).ok_or(FreeError::GridTooLarge)?; 3];
+        let mut m = [0; 3];
         for d in 0..3 {
             let need = libm::ceil(extent[d] / h) + support as f64 + 2.0;
             if !(2.0 * need <= MAX_GRID as f64) {
                 return Err(FreeError::GridTooLarge);
             }
             m[d] = need as usize;
-            mp[d] = good_size(2 * m[d]);
-            factors[d] = fft::Factors::new(mp[d]).ok_or(FreeError::GridTooLarge)?;
         }
+        let plan = spectral::Plan::new(m).ok_or(FreeError::GridTooLarge)?;
         let r_cut = (2.0 * sigma * libm::sqrt(2.0 * (dig + 2.0))).max(2.0 * a);
         let alias = libm::exp(-1.5 * PI * PI * sigma * sigma / (h * h));
         let window = libm::exp(-0.5 * reach * reach / (sigma * sigma)) * (2.0 * dig + 4.0);
@@ -232,12 +231,7 @@ impl<T: Real> FreeFast<T> {
             h,
             reach,
             support,
-            m,
-            grid: fft::Grid3 {
-                m: mp,
-                factors,
-                comps: 3,
-            },
+            plan,
             r_cut,
             estimate: alias + window + near,
         })
@@ -245,10 +239,9 @@ impl<T: Real> FreeFast<T> {
 
     /// Storage [`FreeFast::apply`] needs for `n` spheres.
     pub fn storage(&self, n: usize) -> FreeSize {
-        let [px, py, pz] = self.grid.m;
         FreeSize {
-            complex: 3 * px * py * pz + self.grid.scratch_len() + px + py + pz,
-            reals: 6 * px * py * pz,
+            complex: self.plan.complex_len(),
+            reals: self.plan.reals_len(),
             index: 3 * n + 1,
         }
     }
@@ -268,7 +261,7 @@ impl<T: Real> FreeFast<T> {
     }
     /// Padded grid points per axis.
     pub fn grid(&self) -> [usize; 3] {
-        self.grid.m
+        self.plan.p
     }
     /// Window points per axis.
     pub fn support(&self) -> usize {
@@ -289,11 +282,16 @@ impl<T: Real> FreeFast<T> {
         store: &mut FreeStorage<'_, T>,
     ) -> Result<(), FreeError> {
         let lo = self.check(eta, pos, radius, force, out, store)?;
-        self.near(eta, pos, radius, force, out, store.index)?;
+        let cut = T::from_f64(self.r_cut);
+        let list = CellList::build::<T>(pos, None, cut, store.index).map(|(l, _)| l);
+        self.near(eta, pos, radius, force, out, list.as_ref())?;
         let key = [
-            self.grid.m[0] as u64,
-            self.grid.m[1] as u64,
-            self.grid.m[2] as u64,
+            self.plan.p[0] as u64,
+            self.plan.p[1] as u64,
+            self.plan.p[2] as u64,
+            self.plan.m[0] as u64,
+            self.plan.m[1] as u64,
+            self.plan.m[2] as u64,
             self.h.to_bits(),
             self.sigma.to_bits(),
         ];
@@ -302,7 +300,9 @@ impl<T: Real> FreeFast<T> {
             grid::kernel(self, store.complex, store.reals);
             store.ready = Some(key);
         }
-        let spheres = (pos, radius);
+        // Spheres cell by cell: their windows overlap, so the grid stays in cache.
+        let order = list.as_ref().map(|l| l.order());
+        let spheres = (pos, radius, order);
         grid::far(
             self,
             eta,
@@ -369,23 +369,29 @@ impl<T: Real> FreeFast<T> {
         radius: &[T],
         force: &[T::V3],
         out: &mut [T::V3],
-        index: &mut [usize],
+        list: Option<&CellList<'_>>,
     ) -> Result<(), FreeError> {
-        let b = 1.0 / (2.0 * SQRT_2 * self.sigma);
-        let beta = 2.0 * self.sigma * self.sigma;
+        let rad = radial::Radial::new(
+            1.0 / (2.0 * SQRT_2 * self.sigma),
+            2.0 * self.sigma * self.sigma,
+        );
         let cut2 = self.r_cut * self.r_cut;
         let inv_eta = 1.0 / eta.to_f64();
-        let cut = T::from_f64(self.r_cut);
-        let list = CellList::build::<T>(pos, None, cut, index).map(|(l, _)| l);
-        for i in 0..pos.len() {
+        for (i, o) in out.iter_mut().enumerate() {
+            let alpha = radius[i].to_f64() * radius[i].to_f64() / 6.0;
+            let (c_self, _) = rad.far((alpha, alpha), 0.0);
+            *o = force[i] * (self_tt(eta, radius[i]) - T::from_f64(c_self * inv_eta));
+        }
+        // Each pair once (`j < i`), its symmetric block applied both ways; rows cell by
+        // cell, so the neighbours of consecutive rows are near in memory.
+        for k in 0..pos.len() {
+            let i = list.map_or(k, |l| l.order()[k]);
             let ai = radius[i];
             let alpha_i = ai.to_f64() * ai.to_f64() / 6.0;
-            let (c_self, _) = radial::far(b, beta, (alpha_i, alpha_i), 0.0);
-            let own = self_tt(eta, ai) - T::from_f64(c_self * inv_eta);
-            let mut acc = force[i] * own;
+            let mut acc = T::V3_ZERO;
             let mut err = None;
             let mut pair = |j: usize| {
-                if j == i || err.is_some() {
+                if j >= i || err.is_some() {
                     return;
                 }
                 let r = pos[i] - pos[j];
@@ -394,27 +400,25 @@ impl<T: Real> FreeFast<T> {
                     return;
                 }
                 let Some(rpy) = pair_tt(Hydro::Rpy, eta, ai, radius[j], r) else {
-                    err = Some(FreeError::Particle(ParticleError::Nested {
-                        i: j.min(i),
-                        j: j.max(i),
-                    }));
+                    err = Some(FreeError::Particle(ParticleError::Nested { i: j, j: i }));
                     return;
                 };
                 let aj = radius[j].to_f64();
-                let (ci, crr) = radial::far(b, beta, (alpha_i, aj * aj / 6.0), u);
-                let f = force[j];
-                let far =
-                    f * T::from_f64(ci * inv_eta) + r * (T::dot(r, f) * T::from_f64(crr * inv_eta));
-                acc += rpy * f - far;
+                let (ci, crr) = rad.far((alpha_i, aj * aj / 6.0), u);
+                let (ci, crr) = (T::from_f64(ci * inv_eta), T::from_f64(crr * inv_eta));
+                let far = |f: T::V3| f * ci + r * (T::dot(r, f) * crr);
+                let (fi, fj) = (force[i], force[j]);
+                acc += rpy * fj - far(fj);
+                out[j] += rpy * fi - far(fi);
             };
-            match &list {
+            match list {
                 Some(l) => l.near::<T>(pos[i], &mut pair),
-                None => (0..pos.len()).for_each(&mut pair),
+                None => (0..i).for_each(&mut pair),
             }
             if let Some(e) = err {
                 return Err(e);
             }
-            out[i] = acc;
+            out[i] += acc;
         }
         Ok(())
     }

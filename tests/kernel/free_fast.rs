@@ -210,3 +210,16 @@ fn bad_input_is_a_typed_error() {
         Err(FreeError::BadParameter(_))
     ));
 }
+
+/// The storage holds the spectrum of the cloud's planes and one octant of the kernel's
+/// transform, not the padded grid: under a third of three complex values a padded
+/// point, and under two reals a padded point (the padded grid's six).
+#[test]
+fn storage_is_a_fraction_of_the_padded_grid() {
+    let ff = FreeFast::<f64>::new(1.0, 1e-4, [100.0; 3], 10_000).unwrap();
+    let padded: usize = ff.grid().iter().product();
+    let size = ff.storage(10_000);
+    println!("padded {padded}: {size:?}");
+    assert!(3 * size.complex < 3 * padded, "{size:?}");
+    assert!(size.reals < 2 * padded, "{size:?}");
+}

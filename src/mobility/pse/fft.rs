@@ -17,7 +17,7 @@ use crate::real::Real;
 pub type Cx<T> = [T; 2];
 
 /// Lines transformed together (the scratch's width).
-pub(super) const CHUNK: usize = 32;
+pub(crate) const CHUNK: usize = 32;
 
 /// At most this many radix stages (a length below `4^16`).
 const MAX_STAGES: usize = 24;
@@ -182,7 +182,7 @@ fn stage<T: Real, const R: usize>(
 
 /// The transform of `batch` interleaved lines of length `n` held in `a`; `b` is the
 /// ping-pong buffer. Returns whether the result ended in `b`.
-fn transform<T: Real>(
+pub(crate) fn transform<T: Real>(
     a: &mut [Cx<T>],
     b: &mut [Cx<T>],
     n: usize,
