@@ -36,6 +36,17 @@ fn band_free<T: Real, const K: usize>(
             y[q][k] = T::m3_diag(self_tt(src.eta, src.radius[i])) * x[q][i];
         }
     }
+    if src.level == Hydro::FreeDraining {
+        // No pair term: every pair block is zero, and the sums below would add `+0` to
+        // each row (which turns a `-0` into `+0`, nothing else). Nested spheres are the
+        // step's start and acceptance checks' to refuse (through the cell list).
+        for yq in y.iter_mut() {
+            for v in yq.iter_mut() {
+                *v += T::V3_ZERO;
+            }
+        }
+        return Ok(());
+    }
     let mut buf = [T::M3_ZERO; SPAN];
     for k in 0..m {
         let i = b0 + k;

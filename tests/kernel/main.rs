@@ -24,6 +24,7 @@ mod contacts;
 mod determinism;
 mod docs;
 mod dynamics;
+mod free_draining;
 #[cfg(feature = "fast-free")]
 mod free_fast;
 mod fuzz_step;
