@@ -5,8 +5,8 @@
 //!   near field's perpendicular mobility near the wall is Brenner's, which vanishes at
 //!   contact (lubrication) and so has a large divergence there; the midpoint drift must
 //!   supply `kT d mu_perp / dh` exactly, or the heights follow
-//!   `exp(-W h / kT) / mu_perp(h)` instead (what the uncorrected scheme gives; asserted
-//!   too, so the test can tell). Statistic as in `wall_barometric.rs`: the mean excess
+//!   `exp(-W h / kT) / mu_perp(h)` instead, in the limit of small steps (the uncorrected
+//!   scheme's bias is asserted too, so the test can tell). Statistic as in `wall_barometric.rs`: the mean excess
 //!   height above `h0`, `E[h - h0 | h > h0]`, which is the decay length `kT / W = 1`
 //!   whatever `h0`.
 //! * A freely jointed trimer whose beads are within the near field's cutoff of each
@@ -93,16 +93,18 @@ fn excess(h: &[f64], h0: f64, blocks: usize) -> (f64, f64) {
     mean_se(&means)
 }
 
-/// `dt = 0.5`, 400 000 steps per scheme, a sample every 10 steps, 40 blocks: the
-/// midpoint within 3 standard errors of the exact 1, the uncorrected scheme within 3 of
-/// its own (biased) equilibrium and more than 3 from 1; the two answers more than 6
-/// standard errors apart (the test's power).
+/// `dt = 0.5`, 600 000 steps per scheme, a sample every 10 steps, 40 blocks (about
+/// 20 s per scheme in release): the midpoint within 3 standard errors of the exact 1,
+/// the uncorrected scheme more than 3 from it, below it (towards its biased
+/// equilibrium; at this `dt`, where a step's move near contact is comparable to the
+/// gap, it lies beyond that equilibrium: 0.65 for 0.79 in `f64`). The test's power: the
+/// exact and the biased equilibria are more than 5 standard errors apart.
 fn barometric_with_the_near_field<T: Real>() {
     let h0 = 1.0 + ABOVE;
     let (exact, biased) = (1.0, biased_mean(h0));
     let mut results = Vec::new();
     for (drift, seed) in [(Drift::Midpoint, 5), (Drift::Uncorrected, 6)] {
-        let h = heights::<T>(drift, 0.5, 400_000, 10, seed);
+        let h = heights::<T>(drift, 0.5, 600_000, 10, seed);
         let (m, se) = excess(&h, h0, 40);
         eprintln!(
             "near field, {drift:?}: E[h - h0 | h > h0] = {m:.4} +- {se:.4} (exact {exact}, uncorrected equilibrium {biased:.4})"
@@ -111,20 +113,16 @@ fn barometric_with_the_near_field<T: Real>() {
     }
     let ((mid, se_mid), (unc, se_unc)) = (results[0], results[1]);
     assert!(
-        (exact - biased).abs() > 6.0 * se_mid.max(se_unc),
-        "too few samples"
+        (exact - biased).abs() > 5.0 * se_mid,
+        "too few samples (se {se_mid})"
     );
     assert!(
         (mid - exact).abs() < 3.0 * se_mid,
         "midpoint {mid} +- {se_mid} vs {exact}"
     );
     assert!(
-        (unc - exact).abs() > 3.0 * se_unc,
-        "uncorrected {unc} +- {se_unc} shows no bias"
-    );
-    assert!(
-        (unc - biased).abs() < 3.0 * se_unc,
-        "uncorrected {unc} +- {se_unc} vs its equilibrium {biased}"
+        exact - unc > 3.0 * se_unc,
+        "uncorrected {unc} +- {se_unc} shows no bias towards {biased}"
     );
 }
 

@@ -147,7 +147,7 @@ impl RawScene {
             &flow,
             contact,
             brownian,
-            (wall.is_some(), pse),
+            (wall.is_some(), pse, near_field.is_some()),
         );
         let every_span = self
             .output
