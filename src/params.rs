@@ -6,6 +6,16 @@ use crate::mobility::Hydro;
 use crate::noise::lanczos::Lanczos;
 use crate::real::Real;
 
+/// Stokesian dynamics' near-field parameters ([`Params::near`]).
+#[cfg(feature = "near")]
+pub use crate::stokesian::NearField;
+
+/// Without the kernel's `near` feature: no near field, and no value of this type
+/// ([`Params::near`] is `None`).
+#[cfg(not(feature = "near"))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NearField<T>(core::convert::Infallible, core::marker::PhantomData<T>);
+
 /// Which integrator [`step`](crate::integrate::step) runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Method {
@@ -314,8 +324,10 @@ pub struct Params<T: Real> {
     /// levels, [`Params::matrix_free`], a periodic box, Lanczos noise
     /// ([`NoiseSqrt::Lanczos`], or [`NoiseSqrt::Auto`] above [`LANCZOS_CROSSOVER`]).
     /// `docs/NEAR.md`. Default `None`: the far field alone, the same bits as before.
-    #[cfg(feature = "near")]
-    pub near: Option<crate::stokesian::NearField<T>>,
+    /// The field exists without the `near` feature too (so that a struct literal, a
+    /// firmware's `const` parameters, compiles either way), with a type that has no
+    /// value there: only `None`.
+    pub near: Option<NearField<T>>,
 }
 
 impl<T: Real> Params<T> {
@@ -355,7 +367,6 @@ impl<T: Real> Params<T> {
             compact_products: false,
             resolve_tensions: T::EPSILON.to_f64() > 1e-10,
             pse: None,
-            #[cfg(feature = "near")]
             near: None,
         }
     }
@@ -364,10 +375,7 @@ impl<T: Real> Params<T> {
     /// always `false` without the kernel's `near` feature).
     #[inline(always)]
     pub const fn near_on(&self) -> bool {
-        #[cfg(feature = "near")]
-        return self.near.is_some();
-        #[cfg(not(feature = "near"))]
-        return false;
+        cfg!(feature = "near") && self.near.is_some()
     }
 
     /// Ambient fluid velocity at `r`: `V_inf + Omega_inf x r`.
