@@ -35,14 +35,25 @@ fn two_sphere(level: Hydro, near: bool) -> (f64, f64) {
     if near {
         let (nb, nd) = storage(2);
         let (mut packed, mut m) = (vec![glam::DMat3::ZERO; nb], vec![0.0; nd]);
-        mobility(1.0, None, &pos, &radius, NearField::default(), &mut packed, &mut m)
-            .expect("two spheres");
+        mobility(
+            1.0,
+            None,
+            &pos,
+            &radius,
+            NearField::default(),
+            &mut packed,
+            &mut m,
+        )
+        .expect("two spheres");
         return ((m[2 * 12 + 2] + m[2 * 12 + 5]) / u0, (m[0] + m[3]) / u0);
     }
     let mut mu = [glam::DMat3::ZERO; tri(2)];
     hydrorattle::mobility::assemble_tt(level, 1.0, &pos, &radius, &mut mu).expect("pair");
     let (s, c) = (mu[0], mu[1]);
-    ((s.z_axis.z + c.z_axis.z) / u0, (s.x_axis.x + c.x_axis.x) / u0)
+    (
+        (s.z_axis.z + c.z_axis.z) / u0,
+        (s.x_axis.x + c.x_axis.x) / u0,
+    )
 }
 
 /// Seconds per step of the Figure 1 (c) chain at `level` (with the near field if

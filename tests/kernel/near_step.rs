@@ -33,13 +33,16 @@ fn near<T: Real>(method: Method, kind: SolverKind) -> hydrorattle::Params<T> {
     p
 }
 
+/// One vector a sphere.
+type Vecs = Vec<[f64; 3]>;
+
 /// One step of `spheres` with `bonds` (a chain when `true`) under `p`; the velocities
 /// and spins after it.
 fn one_step<T: Real, const N: usize>(
     p: &hydrorattle::Params<T>,
     spheres: &[Sphere],
     bonded: bool,
-) -> Result<(Vec<[f64; 3]>, Vec<[f64; 3]>), StepError> {
+) -> Result<(Vecs, Vecs), StepError> {
     let mut ps: ParticleSet<T, N> = particles(spheres);
     ps.noise = Some(hydrorattle::Noise::new(1));
     let bonds: BondSet<T, N> = match bonded {

@@ -135,7 +135,9 @@ impl SavedParams {
             wall: p.wall.map(|w| b(w.height)),
             periodic: p.periodic.map(|c| c.size().map(b)),
             resolve_tensions: p.resolve_tensions,
-            near: p.near.map(|n| [b(n.cutoff), b(n.wall_cutoff), b(n.min_gap)]),
+            near: p
+                .near
+                .map(|n| [b(n.cutoff), b(n.wall_cutoff), b(n.min_gap)]),
         }
     }
 
@@ -182,11 +184,13 @@ impl SavedParams {
             None => None,
         };
         p.resolve_tensions = self.resolve_tensions;
-        p.near = self.near.map(|[c, w, g]| hydrorattle::stokesian::NearField {
-            cutoff: f(c),
-            wall_cutoff: f(w),
-            min_gap: f(g),
-        });
+        p.near = self
+            .near
+            .map(|[c, w, g]| hydrorattle::stokesian::NearField {
+                cutoff: f(c),
+                wall_cutoff: f(w),
+                min_gap: f(g),
+            });
         Ok(p)
     }
 }
