@@ -307,9 +307,9 @@ pub struct Params<T: Real> {
     /// [`pse_storage`](crate::integrate::pse_storage)). Read only with a box (and not
     /// with free draining). Default `None`: the Ewald sums, the same bits as before.
     pub pse: Option<f64>,
-    /// Stokesian dynamics' near field ([`NearField`](crate::stokesian::NearField), kernel
+    /// Stokesian dynamics' near field ([`NearField`], kernel
     /// feature `near`): the step's mobility is the dense Stokesian dynamics grand
-    /// mobility [`stokesian::mobility`](crate::stokesian::mobility), `M_SD = (M_far^-1 +
+    /// mobility (`stokesian::mobility`), `M_SD = (M_far^-1 +
     /// R_near)^-1` with the exact two-sphere and sphere-wall lubrication of the pairs
     /// and spheres inside the cutoffs, instead of the far field alone. Torque-free
     /// spheres move with its translational blocks, `U = M_SD,tt F`; with
