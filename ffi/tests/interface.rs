@@ -384,7 +384,10 @@ fn every_status_has_a_message() {
 fn the_near_field_is_a_choice_of_the_parameters() {
     let off = scene_params(HrMethod::Overdamped2);
     assert_eq!(off.near_field, 0);
-    assert_eq!((off.near_cutoff, off.near_wall_cutoff, off.near_min_gap), (4.0, 4.0, 1e-3));
+    assert_eq!(
+        (off.near_cutoff, off.near_wall_cutoff, off.near_min_gap),
+        (4.0, 4.0, 1e-3)
+    );
     let mut on = off;
     on.near_field = 1;
     let bytes = |p: &HrParamsF32| unsafe { hr_storage_bytes_f32(p, 25, 24) };
