@@ -6,6 +6,16 @@ use crate::mobility::Hydro;
 use crate::noise::lanczos::Lanczos;
 use crate::real::Real;
 
+/// Stokesian dynamics' near-field parameters ([`Params::near`]).
+#[cfg(feature = "near")]
+pub use crate::stokesian::NearField;
+
+/// Without the kernel's `near` feature: no near field, and no value of this type
+/// ([`Params::near`] is `None`).
+#[cfg(not(feature = "near"))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NearField<T>(core::convert::Infallible, core::marker::PhantomData<T>);
+
 /// Which integrator [`step`](crate::integrate::step) runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Method {
@@ -297,6 +307,27 @@ pub struct Params<T: Real> {
     /// [`pse_storage`](crate::integrate::pse_storage)). Read only with a box (and not
     /// with free draining). Default `None`: the Ewald sums, the same bits as before.
     pub pse: Option<f64>,
+    /// Stokesian dynamics' near field ([`NearField`], kernel
+    /// feature `near`): the step's mobility is the dense Stokesian dynamics grand
+    /// mobility (`stokesian::mobility`), `M_SD = (M_far^-1 +
+    /// R_near)^-1` with the exact two-sphere and sphere-wall lubrication of the pairs
+    /// and spheres inside the cutoffs, instead of the far field alone. Torque-free
+    /// spheres move with its translational blocks, `U = M_SD,tt F`; with
+    /// [`Params::rotation`] they spin with `W = M_SD,rt F`. Everything that reads the
+    /// stored mobility reads these blocks: the constraint solvers' metric (sweep,
+    /// Newton, Krylov), the contacts' and the wall's projection, and the thermal
+    /// noise's Cholesky factor with its midpoint drift. [`Hydro::Rpy`] in free space or
+    /// above a wall; [`Method::Overdamped`] and [`Method::Overdamped2`]; storage
+    /// `tri(2n)` blocks and `(6n)^2` scalars more, with the stored mobility in blocks
+    /// of nine ([`Layout::for_params`](crate::Layout::for_params)). Refused with
+    /// [`StepError::Unsupported`](crate::StepError::Unsupported): the other methods and
+    /// levels, [`Params::matrix_free`], a periodic box, Lanczos noise
+    /// ([`NoiseSqrt::Lanczos`], or [`NoiseSqrt::Auto`] above [`LANCZOS_CROSSOVER`]).
+    /// `docs/NEAR.md`. Default `None`: the far field alone, the same bits as before.
+    /// The field exists without the `near` feature too (so that a struct literal, a
+    /// firmware's `const` parameters, compiles either way), with a type that has no
+    /// value there: only `None`.
+    pub near: Option<NearField<T>>,
 }
 
 impl<T: Real> Params<T> {
@@ -336,7 +367,15 @@ impl<T: Real> Params<T> {
             compact_products: false,
             resolve_tensions: T::EPSILON.to_f64() > 1e-10,
             pse: None,
+            near: None,
         }
+    }
+
+    /// Whether the step's mobility has Stokesian dynamics' near field ([`Params::near`];
+    /// always `false` without the kernel's `near` feature).
+    #[inline(always)]
+    pub const fn near_on(&self) -> bool {
+        cfg!(feature = "near") && self.near.is_some()
     }
 
     /// Ambient fluid velocity at `r`: `V_inf + Omega_inf x r`.
@@ -409,6 +448,7 @@ impl<T: Real> Params<T> {
             && (self.brownian.is_none() || crate::noise::reduced::for_noise(self, n))
             && !self.matrix_free
             && self.place().stores_symmetric()
+            && !self.near_on()
             && core::mem::size_of::<T>() == 8
             && n >= crate::noise::reduced::REDUCED_MIN
             && matches!(self.solver_kind(n, bonds), SolverKind::Krylov)

@@ -199,6 +199,16 @@ typedef struct {
   float temperature;
   // An [`HrDrift`] value (used when `temperature > 0`).
   uint32_t drift;
+  // Step with Stokesian dynamics' near field (the kernel's `Params::near`,
+  // `docs/NEAR.md`): RPY with the exact two-sphere and sphere-wall lubrication of the
+  // pairs and spheres within the cutoffs below. Overdamped and Overdamped2, dense.
+  uint8_t near_field;
+  // Pairs whose surface gap is below this many mean radii are corrected (default 4).
+  float near_cutoff;
+  // Spheres nearer the wall than this many radii are corrected (default 4).
+  float near_wall_cutoff;
+  // The smallest gap the near field sees, in radii (> 0; default 1e-3).
+  float near_min_gap;
 } HrParams_f32;
 
 // `f32` parameters.
@@ -244,6 +254,16 @@ typedef struct {
   double temperature;
   // An [`HrDrift`] value (used when `temperature > 0`).
   uint32_t drift;
+  // Step with Stokesian dynamics' near field (the kernel's `Params::near`,
+  // `docs/NEAR.md`): RPY with the exact two-sphere and sphere-wall lubrication of the
+  // pairs and spheres within the cutoffs below. Overdamped and Overdamped2, dense.
+  uint8_t near_field;
+  // Pairs whose surface gap is below this many mean radii are corrected (default 4).
+  double near_cutoff;
+  // Spheres nearer the wall than this many radii are corrected (default 4).
+  double near_wall_cutoff;
+  // The smallest gap the near field sees, in radii (> 0; default 1e-3).
+  double near_min_gap;
 } HrParams_f64;
 
 // `f64` parameters.

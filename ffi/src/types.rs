@@ -165,6 +165,16 @@ pub struct HrParams<T> {
     pub temperature: T,
     /// An [`HrDrift`] value (used when `temperature > 0`).
     pub drift: u32,
+    /// Step with Stokesian dynamics' near field (the kernel's `Params::near`,
+    /// `docs/NEAR.md`): RPY with the exact two-sphere and sphere-wall lubrication of the
+    /// pairs and spheres within the cutoffs below. Overdamped and Overdamped2, dense.
+    pub near_field: u8,
+    /// Pairs whose surface gap is below this many mean radii are corrected (default 4).
+    pub near_cutoff: T,
+    /// Spheres nearer the wall than this many radii are corrected (default 4).
+    pub near_wall_cutoff: T,
+    /// The smallest gap the near field sees, in radii (> 0; default 1e-3).
+    pub near_min_gap: T,
 }
 
 /// `f32` parameters.
@@ -254,6 +264,7 @@ impl<T: Real> HrParams<T> {
     /// The kernel's defaults.
     pub fn from_kernel(p: &Params<T>) -> Self {
         let v = |v: T::V3| T::xyz(v);
+        let near = p.near.unwrap_or_default();
         Self {
             dt: p.dt,
             viscosity: p.viscosity,
@@ -291,6 +302,10 @@ impl<T: Real> HrParams<T> {
                 Drift::Midpoint => HrDrift::Midpoint,
                 Drift::Uncorrected => HrDrift::Uncorrected,
             } as u32,
+            near_field: p.near.is_some().into(),
+            near_cutoff: near.cutoff,
+            near_wall_cutoff: near.wall_cutoff,
+            near_min_gap: near.min_gap,
         }
     }
 
@@ -338,6 +353,11 @@ impl<T: Real> HrParams<T> {
             1 => Drift::Uncorrected,
             _ => return Err(HrStatus::Enum),
         };
+        p.near = (self.near_field != 0).then_some(kernel::stokesian::NearField {
+            cutoff: self.near_cutoff,
+            wall_cutoff: self.near_wall_cutoff,
+            min_gap: self.near_min_gap,
+        });
         // kT = 0 is the deterministic step (and its storage); anything else, even a
         // bad value, goes to the kernel, which refuses what is invalid.
         if self.temperature != T::ZERO {

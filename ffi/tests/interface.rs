@@ -376,3 +376,31 @@ fn every_status_has_a_message() {
         assert!(!m.to_bytes().is_empty());
     }
 }
+
+/// `HrParams::near_field` reaches the kernel's `Params::near`: off by default with the
+/// kernel's defaults beside it, its storage counted only when on, the chain steps with
+/// it (and moves otherwise than without), and a method it does not serve is refused.
+#[test]
+fn the_near_field_is_a_choice_of_the_parameters() {
+    let off = scene_params(HrMethod::Overdamped2);
+    assert_eq!(off.near_field, 0);
+    assert_eq!(
+        (off.near_cutoff, off.near_wall_cutoff, off.near_min_gap),
+        (4.0, 4.0, 1e-3)
+    );
+    let mut on = off;
+    on.near_field = 1;
+    let bytes = |p: &HrParamsF32| unsafe { hr_storage_bytes_f32(p, 25, 24) };
+    assert!(bytes(&on) > bytes(&off));
+    let (mut c1, mut c2) = (chain(), chain());
+    let (s, _, far) = run(&mut c1, &off, 2);
+    assert_eq!(s, HrStatus::Ok);
+    let (s, _, near) = run(&mut c2, &on, 2);
+    assert_eq!(s, HrStatus::Ok);
+    let moved = |st: &HrStateF32| unsafe { *st.pos };
+    assert_ne!(moved(&far), moved(&near));
+    let mut rattle = scene_params(HrMethod::Rattle);
+    rattle.near_field = 1;
+    let (s, _, _) = run(&mut chain(), &rattle, 1);
+    assert_eq!(s, HrStatus::Unsupported);
+}

@@ -96,6 +96,36 @@ fn capacity(x: &Bound<'_, PyAny>) -> PyResult<usize> {
     Ok(c)
 }
 
+/// `near_field=`: `False` or `None` (off), `True` (the kernel's defaults), or a dict of
+/// `cutoff`, `wall_cutoff`, `min_gap` (radii; the others default). Its range checks
+/// are the kernel's, when the system is built.
+fn near_field<T: Real>(
+    x: &Bound<'_, PyAny>,
+) -> PyResult<Option<hydrorattle::stokesian::NearField<T>>> {
+    let mut near = hydrorattle::stokesian::NearField::<T>::default();
+    if x.is_none() {
+        return Ok(None);
+    }
+    let Ok(d) = x.cast::<PyDict>() else {
+        return Ok(flag("near_field", x)?.then_some(near));
+    };
+    for (k, v) in d.iter() {
+        let k: String = k.extract()?;
+        let v = T::from_f64(get(&k, &v, "a real number")?);
+        match k.as_str() {
+            "cutoff" => near.cutoff = v,
+            "wall_cutoff" => near.wall_cutoff = v,
+            "min_gap" => near.min_gap = v,
+            other => {
+                return Err(PyTypeError::new_err(format!(
+                    "near_field got an unexpected key {other:?} (cutoff, wall_cutoff, min_gap)"
+                )));
+            }
+        }
+    }
+    Ok(Some(near))
+}
+
 /// Kernel parameters in precision `T` from keyword arguments with the kernel's names
 /// and defaults ([`Params::new`]); the seed and thread count come back beside them.
 /// A value of the wrong type is a `TypeError`, a value out of range a `ValueError`,
@@ -164,6 +194,7 @@ pub fn params_from<T: Real>(kw: Option<&Bound<'_, PyDict>>) -> PyResult<(Params<
             "noise_sqrt" => p.noise_sqrt = pick::<NoiseSqrt>("noise_sqrt", &name(&x)?)?,
             "lanczos_tolerance" => p.lanczos.tolerance = real(&x)?,
             "lanczos_max_iterations" => p.lanczos.max_iterations = count(k, &x)?,
+            "near_field" => p.near = near_field::<T>(&x)?,
             other => {
                 return Err(PyTypeError::new_err(format!(
                     "System got an unexpected parameter {other:?}"

@@ -113,3 +113,30 @@ def test_box_with_wall_and_other_levels_are_refused():
         hr.mobility([[1, 1, 1], [3, 1, 1]], 1.0, hydro="oseen", near_field=True)
     with pytest.raises(ValueError, match="size ratio"):
         hr.mobility([[0, 0, 0], [0, 0, 13]], [1.0, 11.0], near_field=True)
+
+
+RHO1 = 3.0 / (4.0 * math.pi)  # unit buoyant weight of the unit sphere, g = 1
+
+
+@pytest.mark.parametrize("method", ["overdamped", "overdamped2"])
+def test_system_steps_with_the_near_field(method):
+    # Two spheres at s = 2.1 fall along their line of centres at Stimson and Jeffery's
+    # speed; without the near field RPY is 4.6 % fast.
+    pos = [[0, 0, -1.05], [0, 0, 1.05]]
+    exact = bispherical_sum(math.acosh(1.05), wall=False) * U0
+    for near, close in [(True, True), ({"cutoff": 4.0, "min_gap": 1e-3}, True), (False, False)]:
+        s = hr.System(pos, 1.0, RHO1, dt=0.01, method=method, near_field=near)
+        s.step()
+        u = -s.velocities[:, 2]
+        assert (abs(u / exact - 1) < 5e-3).all() == close, (near, u, exact)
+
+
+def test_system_near_field_above_the_wall_and_refusals():
+    s = hr.System([[0, 0, 1.1]], 1.0, RHO1, dt=0.1, wall=0.0, near_field=True)
+    s.step()
+    exact = bispherical_sum(math.acosh(1.1), wall=True) * U0
+    assert abs(-s.velocities[0, 2] / exact - 1) < 5e-3
+    with pytest.raises(ValueError):
+        hr.System([[0, 0, 0], [0, 0, 2.5]], 1.0, RHO1, dt=0.1, method="rattle", near_field=True)
+    with pytest.raises(TypeError):
+        hr.System([[0, 0, 0], [0, 0, 2.5]], 1.0, RHO1, dt=0.1, near_field={"cutof": 1.0})

@@ -70,6 +70,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         basis,
         krylov_t,
         links,
+        mut near,
         ..
     } = v;
     // Deterministic velocity at the start: U_inf + mu F. When the noise's products will
@@ -85,6 +86,9 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
             parallel::assemble_apply_then(par, pairs, a, force, u, bands, copy, pack)
         })
         .map_err(StepError::from)?;
+    } else if p.near_on() {
+        let at_start = mu.reborrow();
+        super::near::assemble_apply(p, s.pos, s.radius, at_start, force, u, &mut near)?;
     } else {
         let at_start = mu.reborrow();
         mobility_product(p, s.ewald, s.pos, s.radius, at_start, force, u, par, bands)?;
@@ -105,6 +109,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         bands,
         copied,
         at_mid: mu2,
+        near: (&mut *near.0, &mut *near.1),
     };
     let (noise_iterations, midpoint) =
         kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held), krylov)?;
@@ -131,7 +136,12 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, xi);
     add_constraint_forces(r.held, grad, lambda, force);
-    spin(p, s.ewald, s.pos, s.radius, force, mid)?;
+    if p.near_on() {
+        // The midpoint's mobility has taken the dense storage: formed again at the start.
+        super::near::spin(p, s.pos, s.radius, force, mid, (&mut near, false))?;
+    } else {
+        spin(p, s.ewald, s.pos, s.radius, force, mid)?;
+    }
     Ok(StepReport {
         noise_iterations,
         contacts: r.contacts,
@@ -163,6 +173,8 @@ pub(super) struct Krylov<'a, T: Real> {
     pub(super) bands: &'a mut [T::V3],
     pub(super) copied: bool,
     pub(super) at_mid: MobMut<'a, T>,
+    /// The near field's storage ([`Views::near`]; empty without it).
+    pub(super) near: super::near::Store<'a, T>,
 }
 
 /// Whether the noise's products read the reduced copy of the stored mobility
@@ -228,6 +240,7 @@ pub(super) fn kick<T: Real>(
         bands,
         copied,
         at_mid,
+        mut near,
     } = krylov;
 
     // In a box without bonds to project onto, the midpoint's mean is `kT dt div M`,
@@ -253,7 +266,7 @@ pub(super) fn kick<T: Real>(
             }
             Drift::Midpoint => {
                 let mids = (mu, storage_at_mid(lanczos, at_mid, fac), xi, mid, dx);
-                midpoint(p, b, s, mids, held, (par, bands), lanczos)?
+                midpoint(p, b, s, mids, held, (par, bands, &mut near), lanczos)?
             }
         };
         return Ok((iterations, projected));
@@ -303,7 +316,7 @@ pub(super) fn kick<T: Real>(
                 linalg::solve_upper::<T>(fac, n, xi);
             }
             let mids = (mu, storage_at_mid(lanczos, at_mid, fac), xi, mid, dx);
-            projected = midpoint(p, b, s, mids, held, (par, bands), lanczos)?;
+            projected = midpoint(p, b, s, mids, held, (par, bands, &mut near), lanczos)?;
         }
     }
     Ok((iterations, projected))
@@ -352,7 +365,7 @@ fn midpoint<T: Real>(
         &mut [T::V3],
     ),
     held: Option<Held<'_, '_, T>>,
-    (par, bands): (&dyn Parallel, &mut [T::V3]),
+    (par, bands, near): (&dyn Parallel, &mut [T::V3], &mut super::near::Store<'_, T>),
     lanczos: bool,
 ) -> Result<u32, StepError> {
     let (n, dt, kt) = (s.pos.len(), p.dt, b.temperature);
@@ -373,6 +386,11 @@ fn midpoint<T: Real>(
     let mu_mid: Mob<'_, T> = if same {
         with_blocks!(mu, a => parallel::product::<T>(par, a, n, xi, dx, bands));
         mu
+    } else if p.near_on() {
+        // The near field's mobility at the midpoint: its drift supplies `div M_SD`.
+        let assembled = at_mid.reborrow();
+        super::near::assemble_apply(p, mid, s.radius, assembled, xi, dx, near)?;
+        at_mid.into_ref()
     } else {
         let assembled = at_mid.reborrow();
         mobility_product(p, s.ewald, mid, s.radius, assembled, xi, dx, par, bands)?;

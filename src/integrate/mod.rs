@@ -19,6 +19,7 @@ mod brownian;
 mod checks;
 mod contacts;
 pub mod geometry;
+mod near;
 mod overdamped;
 #[cfg(feature = "periodic")]
 mod periodic;

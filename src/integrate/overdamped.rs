@@ -2,6 +2,7 @@
 //! mobility, `r' = r* + dt mu G^T lambda`. First order, and a second-order
 //! predictor-corrector with the same projection.
 
+use super::near;
 use super::{
     Projection, Start, StepReport, Sums, add_constraint_forces, add_flow, assemble_tt,
     bond_vectors, check_resolved, hydro, max_tension, mobility_metric, mobility_product,
@@ -41,6 +42,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         links,
         par,
         bands,
+        mut near,
         ..
     } = v;
     // Forces and mobility at the start; unconstrained velocity U_inf + mu F.
@@ -59,6 +61,9 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
             (par, bands),
             copy,
         )?;
+    } else if p.near_on() {
+        let at_start = mu.reborrow();
+        near::assemble_apply(p, s.pos, s.radius, at_start, force, u, &mut near)?;
     } else {
         let at_start = mu.reborrow();
         mobility_product(p, s.ewald, s.pos, s.radius, at_start, force, u, par, bands)?;
@@ -85,7 +90,11 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     let r = project_overdamped(p, bonds, s.pos, s.radius, mu, views, new_pos, free)?;
     step_velocity(s.pos, new_pos, dt, new_vel);
     add_constraint_forces(r.held, grad, lambda, force);
-    spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
+    if p.near_on() {
+        near::spin(p, s.pos, s.radius, force, new_omega, (&mut near, true))?;
+    } else {
+        spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
+    }
     Ok(StepReport {
         contacts: r.contacts,
         wall_contacts: r.wall_contacts,
@@ -188,10 +197,15 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         kappa,
         scratch: mut sc,
         mut links,
+        mut near,
         ..
     } = v;
     // Predictor: projected velocity at r, one projected Euler step.
-    assemble_tt(p, s.ewald, s.pos, s.radius, mu0.reborrow())?;
+    if p.near_on() {
+        near::assemble_tt(p, s.pos, s.radius, mu0.reborrow(), &mut near)?;
+    } else {
+        assemble_tt(p, s.ewald, s.pos, s.radius, mu0.reborrow())?;
+    }
     let mu0 = mu0.into_ref();
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     projected_velocity(
@@ -201,7 +215,11 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
     let tension = max_tension(bonds, kappa);
     add_constraint_forces(bonds, grad, kappa, force);
-    spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
+    if p.near_on() {
+        near::spin(p, s.pos, s.radius, force, new_omega, (&mut near, true))?;
+    } else {
+        spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
+    }
     let predict = |x: &mut [T::V3]| {
         for i in 0..n {
             x[i] = s.pos[i] + f0[i] * dt;
@@ -218,7 +236,11 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     };
     project_overdamped(p, bonds, s.pos, s.radius, mu0, views, x_p, predict)?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
-    assemble_tt(p, s.ewald, x_p, s.radius, mu1.reborrow())?;
+    if p.near_on() {
+        near::assemble_tt(p, x_p, s.radius, mu1.reborrow(), &mut near)?;
+    } else {
+        assemble_tt(p, s.ewald, x_p, s.radius, mu1.reborrow())?;
+    }
     let mu1 = mu1.into_ref();
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
     projected_velocity(

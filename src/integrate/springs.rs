@@ -74,6 +74,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
                 bands,
                 copied: false,
                 at_mid: mu2,
+                near: (&mut [], &mut []),
             };
             (noise_iterations, _) = kick(
                 p, b, s, mu, fac, new_vel, new_omega, dx, noise, None, krylov,

@@ -108,7 +108,9 @@ pub(super) fn mobility_metric<'a, T: Real>(
     }
     let n = pos.len();
     // Without a wall every block is symmetric: the table reads lower triangles only.
-    let sym = hydro(p, ew).symmetric();
+    // With the near field the blocks are the Stokesian dynamics mobility's, in general
+    // not symmetric.
+    let sym = hydro(p, ew).symmetric() && !p.near_on();
     constraints::tabulate(mu, bonds, grad, scale, n, sym, disp);
     let disp = &disp[..n * bonds.len()];
     Metric::Dense { disp, n, grad }

@@ -21,10 +21,21 @@ pub(crate) const SYM: usize = 6;
 /// nine-scalar blocks in the block array.
 pub(crate) const fn symmetric<T: Real>(p: &Params<T>) -> bool {
     p.place().symmetric()
+        && !p.near_on()
         && matches!(
             p.method,
             Method::Overdamped | Method::Overdamped2 | Method::Springs
         )
+}
+
+/// Blocks the near field's packed far-field grand mobility takes ([`Params::near`]).
+pub(crate) const fn near_blocks(n: usize) -> usize {
+    tri(2 * n)
+}
+
+/// Scalars the near field's dense `6n x 6n` mobility takes ([`Params::near`]).
+pub(crate) const fn near_scalars(n: usize) -> usize {
+    36 * n * n
 }
 
 /// Stored mobilities a method keeps as symmetric blocks when it stores them (the start's,
@@ -162,6 +173,17 @@ impl Layout {
         };
         let l = if p.matrix_free {
             l.matrix_free(p.method, p.solver_kind(n, bonds), n, c)
+        } else {
+            l
+        };
+        // Stokesian dynamics' near field: the far-field grand mobility's packed blocks
+        // and the dense `6n x 6n` mobility formed from them (`stokesian::storage`).
+        let l = if p.near_on() {
+            Self {
+                blocks: l.blocks + near_blocks(n),
+                scalars: l.scalars + near_scalars(n),
+                ..l
+            }
         } else {
             l
         };

@@ -49,6 +49,9 @@ pub(crate) struct Views<'a, T: Real> {
     /// The caller's PSE arrays ([`Workspace::with_pse`]).
     #[cfg(feature = "pse")]
     pub pse: super::PseSlices<'a, T>,
+    /// The near field's packed far-field grand mobility and its dense Stokesian
+    /// dynamics mobility ([`Params::near`]; empty without).
+    pub near: (&'a mut [T::M3], &'a mut [T]),
 }
 
 /// The storage of the one-sided constraints (contacts, wall links): the link list
@@ -203,6 +206,13 @@ impl<T: Real> Workspace<'_, T> {
         let cap = p.lanczos.max_iterations as usize;
         let basis = ve.take(if lanczos { lanczos_vectors(cap, n) } else { 0 });
         let krylov_t = sc.take(if lanczos { lanczos_scalars(cap) } else { 0 });
+        let near = match p.near_on() {
+            true => (
+                bl.take(super::layout::near_blocks(n)),
+                sc.take(super::layout::near_scalars(n)),
+            ),
+            false => (bl.take(0), sc.take(0)),
+        };
         Ok(Views {
             mu,
             mu2,
@@ -233,6 +243,7 @@ impl<T: Real> Workspace<'_, T> {
             bands,
             #[cfg(feature = "pse")]
             pse: (&mut *self.pse.0, &mut *self.pse.1, &mut *self.pse.2),
+            near,
         })
     }
 }

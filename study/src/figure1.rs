@@ -172,7 +172,27 @@ pub fn figure1_wall(
     at: &[f64],
     wall: Option<f64>,
 ) -> Result<Figure1Summary> {
+    figure1_near(out, max_steps, at, wall, None)
+}
+
+/// [`figure1_wall`] with Stokesian dynamics' near field on every chain (`figure1
+/// --near-field`; `docs/NEAR.md`): the same runs on the top rung of the model ladder.
+pub fn figure1_near(
+    out: &Path,
+    max_steps: Option<usize>,
+    at: &[f64],
+    wall: Option<f64>,
+    near: Option<hydrorattle_host::scene::NearField>,
+) -> Result<Figure1Summary> {
     let mut scenes = Scene::figure1()?;
+    if let Some(n) = near {
+        for (case, scene) in scenes.iter_mut() {
+            *scene = scene
+                .clone()
+                .with_near_field(n)
+                .map_err(|e| anyhow::anyhow!("--near-field, case ({case}): {e}"))?;
+        }
+    }
     if let Some(h) = wall {
         for (case, scene) in scenes.iter_mut() {
             *scene = scene

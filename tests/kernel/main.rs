@@ -40,6 +40,10 @@ mod midpoint_storage;
 mod mobility;
 #[cfg(feature = "near")]
 mod near;
+#[cfg(feature = "near")]
+mod near_brownian;
+#[cfg(feature = "near")]
+mod near_step;
 mod observables;
 #[cfg(all(feature = "contacts", feature = "periodic", feature = "wall"))]
 mod pair_search;

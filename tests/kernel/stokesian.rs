@@ -12,7 +12,11 @@ use hydrorattle::stokesian::{NearField, SdError, mobility, storage};
 use proptest::prelude::*;
 
 /// The dense `6n x 6n` SD mobility, viscosity 1.
-fn sd<T: Real>(wall: Option<f64>, pos: &[[f64; 3]], a: &[f64]) -> Result<Vec<T>, SdError> {
+pub(crate) fn sd<T: Real>(
+    wall: Option<f64>,
+    pos: &[[f64; 3]],
+    a: &[f64],
+) -> Result<Vec<T>, SdError> {
     let (nb, nd) = storage(pos.len());
     let mut packed = vec![T::M3_ZERO; nb];
     let mut out = vec![T::ZERO; nd];
@@ -33,7 +37,7 @@ fn sd<T: Real>(wall: Option<f64>, pos: &[[f64; 3]], a: &[f64]) -> Result<Vec<T>,
 
 /// Stimson and Jeffery's drag factor of two equal spheres (radius 1) falling along
 /// their line of centres, centres `s` apart: `U / U0 = 1 / lambda`.
-fn stimson_jeffery(s: f64) -> f64 {
+pub(crate) fn stimson_jeffery(s: f64) -> f64 {
     let al = (s / 2.0).acosh();
     let mut sum = 0.0;
     for n in 1..2000 {
@@ -52,7 +56,7 @@ fn stimson_jeffery(s: f64) -> f64 {
 
 /// Brenner's exact drag factor of a sphere (radius 1) moving towards a wall, centre at
 /// height `h`: the perpendicular mobility is `1 / lambda` times Stokes'.
-fn brenner(h: f64) -> f64 {
+pub(crate) fn brenner(h: f64) -> f64 {
     let al = h.acosh();
     let mut sum = 0.0;
     for n in 1..20000 {

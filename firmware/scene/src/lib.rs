@@ -215,6 +215,7 @@ const fn deterministic_f32(method: Method, rotation: bool) -> Params<f32> {
         // The kernel's f32 default: the inertial methods' tensions from the displacements.
         resolve_tensions: true,
         pse: None,
+        near: None,
     }
 }
 

@@ -30,17 +30,26 @@ pub struct Figure1 {
     /// final states on the wall.
     #[arg(long, value_name = "H", allow_negative_numbers = true)]
     wall: Option<f64>,
+    /// Step with Stokesian dynamics' near field (the exact two-sphere lubrication of
+    /// every pair within 4 mean radii, docs/NEAR.md; the defaults of `[near_field]`):
+    /// dense, some ten times the cost of a step.
+    #[arg(long)]
+    near_field: bool,
 }
 
 impl Figure1 {
     /// Runs the three cases and prints their table.
     pub fn run(self) -> Result<()> {
         let (out, wall) = (&self.out, self.wall);
-        let s = hydrorattle_study::figure1::figure1_wall(
+        let near = self
+            .near_field
+            .then(hydrorattle_host::scene::NearField::default);
+        let s = hydrorattle_study::figure1::figure1_near(
             out,
             self.quick.then_some(2000),
             &self.at,
             wall,
+            near,
         )?;
         println!(
             "case  D     head   extension verticality twist_rate head_speed outcome          t(ext>=0.95) wall_s"

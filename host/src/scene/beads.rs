@@ -180,6 +180,7 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
         .filter(|b| b.method == scene::BoxMethod::Pse)
         .map(|b| b.tolerance);
     p.matrix_free |= p.pse.is_some();
+    p.near = scene.near_field.map(|n| n.kernel());
     p
 }
 

@@ -70,6 +70,8 @@ impl KeySpans {
             span(box_span(raw), "a periodic box"),
             span(box_span(raw), "periodic"),
             span(pinned_span(raw), "pinned"),
+            span(raw.near_field.as_ref().map(|n| n.span()), "the near field"),
+            span(raw.near_field.as_ref().map(|n| n.span()), "near"),
         ];
         KeySpans {
             keys: keys.into_iter().flatten().collect(),

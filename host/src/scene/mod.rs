@@ -25,6 +25,7 @@
 //! | `[box]` | `size = [Lx, Ly, Lz]` (required unless `[suspension]` sets it; finite, > 0), `method = "ewald"\|"pse"\|"auto"`, `tolerance` (`1e-12` to `0.1`): a periodic box (see [`PeriodicBox`]) | no box; auto, 1e-6 |
 //! | `[suspension]` | `count` (required, >= 1), `fraction` (required, `0 < phi <=` [`MAX_FRACTION`]), `radius`, `polydispersity` (`0 <= p < 1`), `density`, `seed`: spheres placed at random in a cubic box (see [`Suspension`]) | 1, 0, 4.5, 1 |
 //! | `[floor]` | `radius` (> 0), `density` (>= 0): a pinned square lattice under the `[suspension]` (see [`Floor`]) | the suspension's radius and density |
+//! | `[near_field]` | `cutoff` (>= 0), `wall_cutoff` (>= 0), `min_gap` (> 0), in radii: Stokesian dynamics' near field on the RPY far field (`hydrodynamics = "rpy"`, level manual, `method = "overdamped"` or `"overdamped2"`, free space or `[wall]`; see [`NearField`], `docs/NEAR.md`) | no near field; 4, 4, 1e-3 |
 //!
 //! A scene gives one of a `[helix]` table, a `[suspension]` table (which needs a
 //! `[box]` table, without `size`) or explicit `[[particle]]` (and optionally
@@ -61,6 +62,7 @@ mod helix;
 mod kernel;
 mod model;
 pub mod names;
+mod near;
 mod periodic;
 mod precision;
 mod raw;
@@ -83,6 +85,7 @@ pub use model::{
     Bond, Flow, Fluid, Hydrodynamics, Integrator, Level, Method, Model, Output, Overlap, Particle,
     Precision, Solver,
 };
+pub use near::NearField;
 pub use periodic::{BoxMethod, DEFAULT_BOX_TOLERANCE, PeriodicBox, PseUnsupported, pse_fits};
 pub use resolve::MAX_TURN_PER_STEP;
 pub use suspension::{GAP, MAX_FRACTION, Suspension, TRIALS_PER_SPHERE};
@@ -192,6 +195,10 @@ pub struct Scene {
     /// pin rows (`fixed = true` on a `[[particle]]`, or the `[floor]`'s spheres).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pinned: Vec<usize>,
+    /// Stokesian dynamics' near field (`[near_field]`); `None`: the far field alone.
+    /// Left out of the JSON when `None`, as the box is.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub near_field: Option<NearField>,
     /// Species (type name) of each particle: `head` and `tail` for a helix; the
     /// `species` key, or one name per distinct radius and density, for explicit
     /// particles. The generators' names are borrowed: a sweep resolves a scene per

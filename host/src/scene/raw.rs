@@ -31,6 +31,7 @@ pub(super) struct RawScene {
     pub(super) periodic: S<super::periodic::RawBox>,
     pub(super) suspension: S<super::suspension::RawSuspension>,
     pub(super) floor: S<super::floor::RawFloor>,
+    pub(super) near_field: S<super::near::RawNearField>,
 }
 
 #[derive(Deserialize)]

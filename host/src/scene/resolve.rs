@@ -119,6 +119,10 @@ impl RawScene {
         if let (Some(b), Some(_)) = (&self.periodic, &self.wall) {
             return Err(super::periodic::refuse_wall(b));
         }
+        let near_field = match &self.near_field {
+            None => None,
+            Some(raw) => Some(super::near::resolve(raw, &model)?),
+        };
         let every = match self.output.as_ref().and_then(|o| o.every.as_ref()) {
             None => integrator.steps().div_ceil(TARGET_FRAMES).max(1),
             Some(e) if *e.get_ref() == 0 => {
@@ -143,7 +147,7 @@ impl RawScene {
             &flow,
             contact,
             brownian,
-            (wall.is_some(), pse),
+            (wall.is_some(), pse, near_field.is_some()),
         );
         let every_span = self
             .output
@@ -222,6 +226,7 @@ impl RawScene {
             suspension: body.suspension.map(|(s, _)| s),
             floor: body.floor,
             pinned: body.pinned,
+            near_field,
         };
         // "pse" where the scene needs the assembled mobility: placed at the method.
         if let (Err(e), Some(raw)) = (scene.check_box_runs(None), &self.periodic) {

@@ -131,6 +131,9 @@ pub struct Plan {
     /// The box summed by PSE (`[box] method = "pse"`): the solver `"auto"` is Krylov
     /// (the kernel's `Params::solver_kind`).
     pub pse: bool,
+    /// Stokesian dynamics' near field (`[near_field]`): its dense `6n x 6n` mobility
+    /// and the far field's grand blocks.
+    pub near: bool,
 }
 
 impl Plan {
@@ -149,6 +152,7 @@ impl Plan {
             pse: scene
                 .periodic
                 .is_some_and(|b| b.method == super::BoxMethod::Pse),
+            near: scene.near_field.is_some(),
         }
     }
 
@@ -181,6 +185,10 @@ impl Plan {
                     drift: t.drift,
                 });
                 p.noise_sqrt = t.sqrt;
+            }
+            // Any parameters: only whether it is on sizes the storage.
+            if self.near {
+                p.near = Some(hydrorattle::stokesian::NearField::default());
             }
             Layout::for_params(&p, n, b)
         })
@@ -230,6 +238,7 @@ mod tests {
             matrix_free: false,
             compact_products: false,
             pse: false,
+            near: false,
         }
     }
 

@@ -104,6 +104,14 @@ impl Scene {
         if let Some(w) = self.wall {
             t.insert("wall".into(), table([("height", value(w.height))]));
         }
+        if let Some(n) = self.near_field {
+            let nt = table([
+                ("cutoff", value(n.cutoff)),
+                ("wall_cutoff", value(n.wall_cutoff)),
+                ("min_gap", value(n.min_gap)),
+            ]);
+            t.insert("near_field".into(), nt);
+        }
         if let Some(b) = self.periodic {
             let mut bt = table([
                 ("method", value(b.method)),

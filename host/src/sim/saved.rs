@@ -50,6 +50,10 @@ pub struct SavedParams {
     wall: Option<u64>,
     periodic: Option<[u64; 3]>,
     resolve_tensions: bool,
+    /// Stokesian dynamics' near field: cutoff, wall cutoff, minimum gap. Absent in
+    /// systems saved before the key, and without a near field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    near: Option<[u64; 3]>,
 }
 
 /// A system as plain data ([`Engine::save`], [`Engine::restore`]); unknown keys are
@@ -131,6 +135,9 @@ impl SavedParams {
             wall: p.wall.map(|w| b(w.height)),
             periodic: p.periodic.map(|c| c.size().map(b)),
             resolve_tensions: p.resolve_tensions,
+            near: p
+                .near
+                .map(|n| [b(n.cutoff), b(n.wall_cutoff), b(n.min_gap)]),
         }
     }
 
@@ -177,6 +184,13 @@ impl SavedParams {
             None => None,
         };
         p.resolve_tensions = self.resolve_tensions;
+        p.near = self
+            .near
+            .map(|[c, w, g]| hydrorattle::stokesian::NearField {
+                cutoff: f(c),
+                wall_cutoff: f(w),
+                min_gap: f(g),
+            });
         Ok(p)
     }
 }

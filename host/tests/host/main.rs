@@ -11,6 +11,7 @@ mod box_sweep;
 mod fuzz_scene;
 mod jam_retry;
 mod layers;
+mod near_field_scene;
 mod packing;
 mod recovery;
 mod wall_scene;

@@ -429,7 +429,13 @@ class System:
     ``temperature`` (None: no thermal noise; ``kT``), ``drift`` ("midpoint",
     "uncorrected"), ``seed`` (1), ``noise_sqrt`` ("auto": Lanczos above
     ``LANCZOS_CROSSOVER`` beads, "cholesky", "lanczos"), ``lanczos_tolerance`` (1e-3,
-    the noise's estimated relative error) and ``lanczos_max_iterations`` (64). A particle's mass is ``4/3 pi a^3 density``; gravity
+    the noise's estimated relative error) and ``lanczos_max_iterations`` (64),
+    ``near_field`` (False; True or a dict of ``cutoff``, ``wall_cutoff``, ``min_gap``
+    in radii, defaults 4, 4, 1e-3: steps with the Stokesian dynamics mobility of
+    :func:`mobility` ``(..., near_field=True)``, the RPY far field plus the exact
+    two-sphere and sphere-wall lubrication, as its constraint metric and noise too;
+    "overdamped" and "overdamped2", free space or ``wall``, noise by Cholesky; dense,
+    docs/NEAR.md). A particle's mass is ``4/3 pi a^3 density``; gravity
     acts on the buoyant mass (``density - fluid_density``).
 
     Everything the first step would refuse is refused here: a parameter of the wrong

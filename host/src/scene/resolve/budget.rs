@@ -37,7 +37,7 @@ pub(super) fn plans(
     flow: &Flow,
     contact: Option<Contact>,
     brownian: Option<Thermal>,
-    (wall, pse): (bool, bool),
+    (wall, pse, near): (bool, bool, bool),
 ) -> Vec<Plan> {
     let plan = |(method, rotation)| Plan {
         method,
@@ -50,6 +50,7 @@ pub(super) fn plans(
         matrix_free: integrator.matrix_free,
         compact_products: integrator.compact_products,
         pse,
+        near,
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],

@@ -1,0 +1,188 @@
+//! Stokesian dynamics' near field in a step ([`Params::near`]): the step's stored
+//! mobility is the translational part of the dense Stokesian dynamics grand mobility
+//! ([`crate::stokesian::mobility`]), and the spins read its rotation-translation part.
+//!
+//! Why the translational blocks alone: the spheres are torque-free, so the force-torque
+//! balance `(U, W) = M_SD (F, 0)` gives `U = M_SD,tt F` and `W = M_SD,rt F`. With
+//! `M_SD,tt` stored where the far field's `mu_tt` would be (nine-scalar blocks: the
+//! near field's many-body blocks need not be symmetric), every stage that reads the
+//! stored mobility reads it unchanged: the unconstrained move, the constraint solvers'
+//! metric (sweep, Newton, Krylov), the contacts' and the wall's projection, and the
+//! thermal noise's Cholesky factor and midpoint. The dense `6n x 6n` matrix and the
+//! far field's packed blocks it is formed from are the step's storage
+//! ([`Views::near`](crate::workspace::Views), sized by
+//! [`Layout::for_params`](crate::Layout::for_params) only with the near field on).
+//!
+//! Without the kernel's `near` feature [`Params::near_on`] is `false` as a constant, so
+//! every call here folds away; the functions then refuse, never reached.
+
+use crate::error::StepError;
+use crate::linalg::{MobMut, tri, with_blocks};
+use crate::params::{Method, Params};
+use crate::real::Real;
+
+/// The near field's storage: the far field's packed grand mobility and the dense
+/// Stokesian dynamics mobility ([`crate::stokesian::storage`]).
+pub(super) type Store<'a, T> = (&'a mut [<T as Real>::M3], &'a mut [T]);
+
+/// Refuses the combinations the near field does not serve (a typed
+/// [`StepError::Unsupported`] naming each), and parameters out of range.
+pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(), StepError> {
+    if !p.near_on() {
+        return Ok(());
+    }
+    #[cfg(feature = "near")]
+    if let Some(nf) = p.near {
+        let ok = |v: T| v.is_finite() && v >= T::ZERO;
+        if !(ok(nf.cutoff) && ok(nf.wall_cutoff) && ok(nf.min_gap) && nf.min_gap > T::ZERO) {
+            return Err(StepError::BadParameter(
+                "near (cutoff and wall_cutoff finite and >= 0, min_gap finite and > 0)",
+            ));
+        }
+    }
+    let refuse = |what| Err(StepError::Unsupported(what));
+    if p.hydro != crate::mobility::Hydro::Rpy {
+        return refuse("the near field with a far field other than RPY");
+    }
+    if !matches!(p.method, Method::Overdamped | Method::Overdamped2) {
+        return refuse("the near field with a method other than Overdamped or Overdamped2");
+    }
+    if p.matrix_free {
+        return refuse("the near field matrix-free (its mobility is dense)");
+    }
+    if p.periodic.is_some() {
+        return refuse("the near field in a periodic box");
+    }
+    if thermal && p.lanczos_noise(n) {
+        return refuse(
+            "the near field with Lanczos noise (noise_sqrt = Cholesky, or Auto up to LANCZOS_CROSSOVER beads)",
+        );
+    }
+    Ok(())
+}
+
+/// The Stokesian dynamics grand mobility at `pos` into the store's dense matrix, and its
+/// translational blocks into `mu` (packed lower triangle, nine scalars a block).
+pub(super) fn assemble_tt<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    mu: MobMut<'_, T>,
+    store: &mut Store<'_, T>,
+) -> Result<(), StepError> {
+    let n = pos.len();
+    dense(p, pos, radius, store)?;
+    let (m, d) = (6 * n, &*store.1);
+    let mu = mu.general();
+    if mu.len() < tri(n) {
+        return Err(StepError::Unsupported(
+            "the near field with symmetric stored blocks",
+        ));
+    }
+    for i in 0..n {
+        for j in 0..=i {
+            let col = |c: usize| {
+                let at = |r: usize| d[(3 * i + r) * m + 3 * j + c];
+                T::v3(at(0), at(1), at(2))
+            };
+            mu[tri(i) + j] = T::m3_cols(col(0), col(1), col(2));
+        }
+    }
+    Ok(())
+}
+
+/// `u = M_SD,tt(pos) f`: assembled into `mu` ([`assemble_tt`]) and applied.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn assemble_apply<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    mut mu: MobMut<'_, T>,
+    f: &[T::V3],
+    u: &mut [T::V3],
+    store: &mut Store<'_, T>,
+) -> Result<(), StepError> {
+    assemble_tt(p, pos, radius, mu.reborrow(), store)?;
+    let n = pos.len();
+    with_blocks!(mu.as_ref(), a => crate::linalg::sym_matvec::<T>(a, n, f, u));
+    Ok(())
+}
+
+/// Angular velocities of torque-free spheres, `W = Omega_inf + M_SD,rt F` (`f` the force
+/// each sphere exerts on the fluid), with [`Params::rotation`]; `Omega_inf` alone
+/// otherwise. The store's dense matrix must hold `M_SD` at `pos`, else `fresh` is
+/// `false` and it is formed again here.
+pub(super) fn spin<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    f: &[T::V3],
+    out: &mut [T::V3],
+    (store, fresh): (&mut Store<'_, T>, bool),
+) -> Result<(), StepError> {
+    out.fill(p.vorticity);
+    if !p.rotation {
+        return Ok(());
+    }
+    if !fresh {
+        dense(p, pos, radius, store)?;
+    }
+    let n = pos.len();
+    let (m, d) = (6 * n, &*store.1);
+    for (i, w) in out.iter_mut().enumerate() {
+        let mut acc = [T::ZERO; 3];
+        for (k, a) in acc.iter_mut().enumerate() {
+            let row = &d[(3 * (n + i) + k) * m..][..3 * n];
+            for (j, &fj) in f.iter().enumerate() {
+                let [x, y, z] = T::xyz(fj);
+                *a += row[3 * j] * x + row[3 * j + 1] * y + row[3 * j + 2] * z;
+            }
+        }
+        *w += T::v3(acc[0], acc[1], acc[2]);
+    }
+    Ok(())
+}
+
+/// `M_SD(pos)` into the store's dense matrix (free space, or above the step's wall).
+#[cfg(feature = "near")]
+fn dense<T: Real>(
+    p: &Params<T>,
+    pos: &[T::V3],
+    radius: &[T],
+    store: &mut Store<'_, T>,
+) -> Result<(), StepError> {
+    use crate::stokesian::{SdError, mobility};
+    let Some(nf) = p.near else {
+        return Err(StepError::Unsupported(
+            "the near field's mobility without Params::near",
+        ));
+    };
+    let wall = super::wall_height(p);
+    let (packed, out) = (&mut *store.0, &mut *store.1);
+    mobility(p.viscosity, wall, pos, radius, nf, packed, out).map_err(|e| match e {
+        SdError::Particle(e) => StepError::Particle(e),
+        SdError::NotPositiveDefinite(error) => StepError::Linalg {
+            stage: crate::error::Stage::Mobility,
+            error,
+        },
+        SdError::Near { .. } => StepError::Unsupported(
+            "the near field of a pair whose size ratio is outside 0.1 to 10 (or a sphere's radius not positive)",
+        ),
+        SdError::Params => StepError::BadParameter("near"),
+        SdError::Storage => StepError::Unsupported("the near field without its storage"),
+    })
+}
+
+/// Without the `near` feature there is no near field to form (never reached:
+/// [`Params::near_on`] is `false`).
+#[cfg(not(feature = "near"))]
+fn dense<T: Real>(
+    _: &Params<T>,
+    _: &[T::V3],
+    _: &[T],
+    _: &mut Store<'_, T>,
+) -> Result<(), StepError> {
+    Err(StepError::Unsupported(
+        "the near field: the kernel was built without its `near` feature",
+    ))
+}

@@ -1,0 +1,189 @@
+//! Brownian steps with Stokesian dynamics' near field (`Params::near`, noise by
+//! Cholesky): the equilibria the Boltzmann weight gives, whatever the mobility.
+//!
+//! * A sphere above the wall under gravity: its heights follow `exp(-W h / kT)`. The
+//!   near field's perpendicular mobility near the wall is Brenner's, which vanishes at
+//!   contact (lubrication) and so has a large divergence there; the midpoint drift must
+//!   supply `kT d mu_perp / dh` exactly, or the heights follow
+//!   `exp(-W h / kT) / mu_perp(h)` instead, in the limit of small steps (the uncorrected
+//!   scheme's bias is asserted too, so the test can tell). Statistic as in `wall_barometric.rs`: the mean excess
+//!   height above `h0`, `E[h - h0 | h > h0]`, which is the decay length `kT / W = 1`
+//!   whatever `h0`.
+//! * A freely jointed trimer whose beads are within the near field's cutoff of each
+//!   other: its bond angle follows the flexible (stiff-bond) distribution, uniform in
+//!   the cosine `c`, `<c^2> = 1/3`, not the rigid one (0.32102). Long, and not yet
+//!   within its tolerance: `#[ignore]`d, outside `.ci/run` (docs/NEAR.md).
+//!
+//! Units: `a = 1`, `eta = 1`, `kT = 1`, weight `W = 1` (density `3 / (4 pi)`, `g = 1`).
+
+use crate::common;
+use crate::stokesian::brenner;
+
+use std::f64::consts::PI;
+
+use common::thermal::*;
+use common::*;
+use hydrorattle::stokesian::NearField;
+use hydrorattle::{
+    BondSet, Brownian, Drift, Hydro, Layout, Method, NoForce, Noise, NoiseSqrt, ParticleSet, Real,
+    SolverKind, Wall,
+};
+use hydrorattle_heap::Buffers;
+
+/// The threshold above contact: `h0 = a + 0.5`.
+const ABOVE: f64 = 0.5;
+
+/// `E[h - h0 | h > h0]` for the density `exp(-(h - h0)) / mu_perp(h)`, `mu_perp` Brenner's
+/// (the uncorrected scheme's equilibrium with the exact mobility; beyond the near field's
+/// cutoff the far field differs from it by 0.1 %, far below the statistics).
+fn biased_mean(h0: f64) -> f64 {
+    let (n, top) = (20_000, 40.0);
+    let dh = top / n as f64;
+    let (mut z, mut m) = (0.0, 0.0);
+    for k in 0..n {
+        let y = (k as f64 + 0.5) * dh;
+        let w = (-y).exp() / brenner(h0 + y);
+        z += w;
+        m += w * y;
+    }
+    m / z
+}
+
+/// Heights above the wall (at 0) of a lone Brownian sphere with the near field, one
+/// sample every `every` steps.
+fn heights<T: Real>(drift: Drift, dt: f64, steps: usize, every: usize, seed: u64) -> Vec<f64> {
+    let mut p = params::<T>(dt, Method::Overdamped, SolverKind::Auto);
+    p.wall = Some(Wall::new(T::ZERO));
+    p.brownian = Some(Brownian {
+        temperature: T::ONE,
+        drift,
+    });
+    p.noise_sqrt = NoiseSqrt::Cholesky;
+    p.near = Some(NearField::default());
+    let mut ps: ParticleSet<T, 1> = particles(&[Sphere {
+        pos: [0.0, 0.0, 2.0],
+        radius: 1.0,
+        density: 3.0 / (4.0 * PI),
+    }]);
+    let bonds: BondSet<T, 1> = BondSet::new();
+    let mut buf = Buffers::<T>::new(Layout::for_params(&p, 1, 0));
+    let mut ws = buf.workspace();
+    let mut noise = Noise::new(seed);
+    let mut out = Vec::with_capacity(steps / every);
+    for k in 0..steps {
+        step_thermal(&mut ps, &bonds, &p, &mut ws, &mut NoForce, &mut noise)
+            .unwrap_or_else(|e| panic!("{drift:?} step {k}: {e}"));
+        if k % every == 0 {
+            out.push(f64s::<T>(ps.pos[0])[2]);
+        }
+    }
+    out
+}
+
+/// `E[h - h0 | h > h0]` and its standard error from `blocks` consecutive blocks.
+fn excess(h: &[f64], h0: f64, blocks: usize) -> (f64, f64) {
+    let len = h.len() / blocks;
+    let means: Vec<f64> = h
+        .chunks_exact(len)
+        .map(|c| {
+            let above: Vec<f64> = c.iter().filter(|&&x| x > h0).map(|x| x - h0).collect();
+            above.iter().sum::<f64>() / above.len() as f64
+        })
+        .collect();
+    mean_se(&means)
+}
+
+/// `dt = 0.5`, 600 000 steps per scheme, a sample every 10 steps, 40 blocks (about
+/// 20 s per scheme in release): the midpoint within 3 standard errors of the exact 1,
+/// the uncorrected scheme more than 3 from it, below it (towards its biased
+/// equilibrium; at this `dt`, where a step's move near contact is comparable to the
+/// gap, it lies beyond that equilibrium: 0.65 for 0.79 in `f64`). The test's power: the
+/// exact and the biased equilibria are more than 5 standard errors apart.
+fn barometric_with_the_near_field<T: Real>() {
+    let h0 = 1.0 + ABOVE;
+    let (exact, biased) = (1.0, biased_mean(h0));
+    let mut results = Vec::new();
+    for (drift, seed) in [(Drift::Midpoint, 5), (Drift::Uncorrected, 6)] {
+        let h = heights::<T>(drift, 0.5, 600_000, 10, seed);
+        let (m, se) = excess(&h, h0, 40);
+        eprintln!(
+            "near field, {drift:?}: E[h - h0 | h > h0] = {m:.4} +- {se:.4} (exact {exact}, uncorrected equilibrium {biased:.4})"
+        );
+        results.push((m, se));
+    }
+    let ((mid, se_mid), (unc, se_unc)) = (results[0], results[1]);
+    assert!(
+        (exact - biased).abs() > 5.0 * se_mid,
+        "too few samples (se {se_mid})"
+    );
+    assert!(
+        (mid - exact).abs() < 3.0 * se_mid,
+        "midpoint {mid} +- {se_mid} vs {exact}"
+    );
+    assert!(
+        exact - unc > 3.0 * se_unc,
+        "uncorrected {unc} +- {se_unc} shows no bias towards {biased}"
+    );
+}
+
+both_precisions! {
+    barometric => barometric_with_the_near_field;
+}
+
+/// `<c^2>` of a freely jointed trimer (unit radii, bonds 3: gaps of one radius, inside
+/// the cutoff) with the near field, and its standard error. A minimum gap of 0.1 radii
+/// (the roughness parameter) keeps the squeeze resistance of the end beads, which may
+/// overlap, finite enough to sample.
+fn trimer(steps: usize, seed: u64) -> (f64, f64) {
+    let d = 3.0;
+    let mut ps: ParticleSet<f64, 3> = particles(&[
+        Sphere {
+            pos: [0.0; 3],
+            radius: 1.0,
+            density: 0.0,
+        },
+        Sphere {
+            pos: [d, 0.0, 0.0],
+            radius: 1.0,
+            density: 0.0,
+        },
+        Sphere {
+            pos: [d, d, 0.0],
+            radius: 1.0,
+            density: 0.0,
+        },
+    ]);
+    let bonds: BondSet<f64, 2> = BondSet::chain(&ps.pos[..3]).unwrap();
+    let mut p = thermal::<f64>(0.045, 1.0 / (6.0 * PI), Hydro::Rpy, Drift::Midpoint);
+    p.allow_overlap = true;
+    p.noise_sqrt = NoiseSqrt::Cholesky;
+    p.near = Some(NearField {
+        min_gap: 0.1,
+        ..NearField::default()
+    });
+    let mut c2 = Vec::with_capacity(steps);
+    sample(&mut ps, &bonds, &p, seed, steps, |ps| {
+        let at = |i: usize| ps.pos[i].to_array();
+        let b1 = sub(at(0), at(1));
+        let b2 = sub(at(1), at(2));
+        let c = dot(b1, b2) / (norm(b1) * norm(b2));
+        c2.push(c * c);
+    });
+    block_mean(&c2, 50)
+}
+
+/// 1 200 000 steps (about 75 s in release on one core): `<c^2>` within 0.005 of
+/// the flexible 1/3, more than 4 standard errors from the rigid 0.32102, standard error
+/// below 0.0018. Not yet passing: 0.32416 +- 0.00198 measured (docs/NEAR.md, "Steps with
+/// the near field"); kept out of `.ci/run` until it does.
+#[test]
+#[ignore = "about 75 s, and not yet within its tolerance (docs/NEAR.md)"]
+fn trimer_bond_angle_with_the_near_field() {
+    let rigid = (PI / 3.0 - 3f64.sqrt() / 4.0) / (PI / 3.0 + 3f64.sqrt() / 2.0);
+    let flexible = 1.0 / 3.0;
+    let (m, se) = trimer(1_200_000, 21);
+    eprintln!("trimer with the near field: <c^2> = {m:.5} +- {se:.5}, want {flexible:.5}");
+    assert!(se < 0.0018, "too few samples (se {se})");
+    assert!((m - flexible).abs() < 0.005, "{m} vs {flexible}");
+    assert!((m - rigid).abs() > 4.0 * se, "cannot tell");
+}
