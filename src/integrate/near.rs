@@ -170,6 +170,11 @@ fn dense<T: Real>(
         ),
         SdError::Params => StepError::BadParameter("near"),
         SdError::Storage => StepError::Unsupported("the near field without its storage"),
+        // The dense free-space and wall mobility raises neither (the box and the
+        // iterative product have no step yet).
+        SdError::Periodic(_) | SdError::NotConverged { .. } => {
+            StepError::Unsupported("the near field in a periodic box or by iterations in a step")
+        }
     })
 }
 
