@@ -1,8 +1,9 @@
 //! The model ladder's speed and accuracy on the Figure 1 chain: free draining, Oseen,
 //! RPY, and RPY with Stokesian dynamics' near field (`Params::near`).
 //!
-//! `cargo run --release --example near_ladder [steps]` (default 20) prints CSV
-//! (`bench/results/near_ladder.csv`): for each rung, the seconds of one step of the
+//! `cargo run --release --example near_ladder [steps]` (default 20) prints CSV, and
+//! appends it to `bench/results/near_ladder.csv` as records where
+//! `HYDRORATTLE_BENCH_MACHINE` names the machine: for each rung, the seconds of one step of the
 //! Figure 1 (c) chain (a head of radius 2 and 24 tails, bonds `D = 1.05`, settling from
 //! its helix: `Overdamped2`, Newton, hard contacts, `dt = 0.1`, f64, one core; the mean
 //! over `steps` steps from the start), and the error of its two-sphere mobility at the
@@ -11,6 +12,9 @@
 //! `tests/kernel/stokesian.rs`) and across it at 1.3917 `U0` (the published value).
 
 use std::time::Instant;
+
+#[path = "shared/record.rs"]
+mod record;
 
 use glam::DVec3;
 use hydrorattle::helix::{HeadEnd, Helix};
@@ -103,13 +107,25 @@ fn main() {
         ("rpy", Hydro::Rpy, false),
         ("rpy+near", Hydro::Rpy, true),
     ];
+    let command = format!("target/release/examples/near_ladder {steps}");
+    let mut rec = record::Recorder::new(env!("CARGO_MANIFEST_DIR"), "near_ladder", command);
+    let table = "model ladder, Figure 1 (c) chain, f64, one core";
     for (name, level, near) in rungs {
         let (along, across) = two_sphere(level, near);
         let (ea, ec) = (along / ALONG - 1.0, across / ACROSS - 1.0);
         let cost = step_cost(level, near, steps);
-        println!(
-            "{name},{cost:.3e},{along:.5},{across:.5},{ea:+.4},{ec:+.4},{:.4}",
-            ea.abs().max(ec.abs())
-        );
+        let worst = ea.abs().max(ec.abs());
+        println!("{name},{cost:.3e},{along:.5},{across:.5},{ea:+.4},{ec:+.4},{worst:.4}");
+        for (quantity, value) in [
+            ("s a step", format!("{cost:.3e}")),
+            ("along, U0 (s = 2.1)", format!("{along:.5}")),
+            ("across, U0 (s = 2.1)", format!("{across:.5}")),
+            ("along, relative error", format!("{ea:+.4}")),
+            ("across, relative error", format!("{ec:+.4}")),
+            ("largest relative error", format!("{worst:.4}")),
+        ] {
+            rec.row(table, name, quantity, &value);
+        }
     }
+    rec.finish().expect("appending the records");
 }
