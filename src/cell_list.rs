@@ -191,7 +191,9 @@ impl<'s> CellList<'s> {
         }
     }
 
-    /// The spheres cell by cell: an order in which neighbours are near in memory.
+    /// The spheres cell by cell: an order in which neighbours are near in memory (read by
+    /// the fast free-space product alone).
+    #[cfg(feature = "fast-free")]
     pub(crate) fn order(&self) -> &[usize] {
         self.order
     }
