@@ -33,22 +33,6 @@ use hydrorattle_heap::Buffers;
 /// The threshold above contact: `h0 = a + 0.5`.
 const ABOVE: f64 = 0.5;
 
-/// `E[h - h0 | h > h0]` for the density `exp(-(h - h0)) / mu_perp(h)`, `mu_perp` Brenner's
-/// (the uncorrected scheme's equilibrium with the exact mobility; beyond the near field's
-/// cutoff the far field differs from it by 0.1 %, far below the statistics).
-fn biased_mean(h0: f64) -> f64 {
-    let (n, top) = (20_000, 40.0);
-    let dh = top / n as f64;
-    let (mut z, mut m) = (0.0, 0.0);
-    for k in 0..n {
-        let y = (k as f64 + 0.5) * dh;
-        let w = (-y).exp() / brenner(h0 + y);
-        z += w;
-        m += w * y;
-    }
-    m / z
-}
-
 /// Heights above the wall (at 0) of a lone Brownian sphere with the near field, one
 /// sample every `every` steps.
 fn heights<T: Real>(drift: Drift, dt: f64, steps: usize, every: usize, seed: u64) -> Vec<f64> {
@@ -101,7 +85,7 @@ fn excess(h: &[f64], h0: f64, blocks: usize) -> (f64, f64) {
 /// exact and the biased equilibria are more than 5 standard errors apart.
 fn barometric_with_the_near_field<T: Real>() {
     let h0 = 1.0 + ABOVE;
-    let (exact, biased) = (1.0, biased_mean(h0));
+    let (exact, biased) = (1.0, thermal::biased_mean(h0, 20_000, brenner));
     let mut results = Vec::new();
     for (drift, seed) in [(Drift::Midpoint, 5), (Drift::Uncorrected, 6)] {
         let h = heights::<T>(drift, 0.5, 600_000, 10, seed);

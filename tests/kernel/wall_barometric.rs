@@ -44,21 +44,6 @@ fn mu_perp(h: f64) -> f64 {
     (1.0 - 1.125 * x + 0.5 * x.powi(3) - 0.125 * x.powi(5)) / (6.0 * PI)
 }
 
-/// `E[h - h0 | h > h0]` for the density `exp(-(h - h0)) / mu_perp(h)` (the uncorrected
-/// scheme's equilibrium; midpoint rule on [h0, h0 + 40]).
-fn biased_mean(h0: f64) -> f64 {
-    let (n, top) = (400_000, 40.0);
-    let dh = top / n as f64;
-    let (mut z, mut m) = (0.0, 0.0);
-    for k in 0..n {
-        let y = (k as f64 + 0.5) * dh;
-        let w = (-y).exp() / mu_perp(h0 + y);
-        z += w;
-        m += w * y;
-    }
-    m / z
-}
-
 /// Heights above the wall of a lone Brownian sphere, one sample every `every` steps.
 fn heights<T: Real>(drift: Drift, dt: f64, steps: usize, every: usize, seed: u64) -> Vec<f64> {
     let mut p = params::<T>(dt, Method::Overdamped, SolverKind::Auto);
@@ -107,7 +92,7 @@ fn excess(h: &[f64], h0: f64, blocks: usize) -> (f64, f64, f64) {
 
 fn barometric<T: Real>(dt: f64, steps: usize) {
     let h0 = 1.0 + ABOVE;
-    let (exact, biased) = (1.0, biased_mean(h0));
+    let (exact, biased) = (1.0, thermal::biased_mean(h0, 400_000, mu_perp));
     let tol = pick::<T>(2e-5, 1e-9) * 2.0;
     let mut results = Vec::new();
     for (drift, seed) in [(Drift::Midpoint, 3), (Drift::Uncorrected, 4)] {

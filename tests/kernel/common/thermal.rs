@@ -128,3 +128,18 @@ pub fn over_seeds(seeds: u64, run: impl Fn(u64) -> f64 + Sync) -> (f64, f64) {
     });
     mean_se(&per)
 }
+
+/// `E[h - h0 | h > h0]` for the height density `exp(-(h - h0)) / mu_perp(h)` (`kT = 1`,
+/// unit weight): the equilibrium of a Brownian step above a wall that leaves out the drift
+/// `kT d(mu_perp)/dh`; midpoint rule on `[h0, h0 + 40]` with `nodes` nodes.
+pub fn biased_mean(h0: f64, nodes: usize, mu_perp: impl Fn(f64) -> f64) -> f64 {
+    let dh = 40.0 / nodes as f64;
+    let (mut z, mut m) = (0.0, 0.0);
+    for k in 0..nodes {
+        let y = (k as f64 + 0.5) * dh;
+        let w = (-y).exp() / mu_perp(h0 + y);
+        z += w;
+        m += w * y;
+    }
+    m / z
+}
