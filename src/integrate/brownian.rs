@@ -18,6 +18,8 @@
 //! so the unconstrained drift `kT div mu` vanishes: no term for it here. The midpoint
 //! would supply it anyway (it differentiates `P mu` as a whole).
 
+use core::cell::Cell;
+
 use super::{
     Projection, Start, StepReport, add_constraint_forces, add_flow, bond_vectors, free_product,
     mobility_metric, mobility_product, project_overdamped, report, spin, step_velocity,
@@ -70,9 +72,11 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         basis,
         krylov_t,
         links,
-        mut near,
+        near,
         ..
     } = v;
+    let formed = Cell::new(0);
+    let mut near = (near.0, near.1, &formed);
     // Deterministic velocity at the start: U_inf + mu F. When the noise's products will
     // read the reduced copy of `mu`, each band of the assembly writes its part of the
     // copy while its blocks are in cache.
@@ -88,7 +92,10 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         .map_err(StepError::from)?;
     } else if p.near_on() {
         let at_start = mu.reborrow();
-        super::near::assemble_apply(p, s.pos, s.radius, at_start, force, u, &mut near)?;
+        super::near::assemble_apply(p, s.ewald, s.pos, s.radius, at_start, force, u, &mut near)?;
+        if p.rotation {
+            super::near::keep_spin(n, &mut near);
+        }
     } else {
         let at_start = mu.reborrow();
         mobility_product(p, s.ewald, s.pos, s.radius, at_start, force, u, par, bands)?;
@@ -109,7 +116,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         bands,
         copied,
         at_mid: mu2,
-        near: (&mut *near.0, &mut *near.1),
+        near: (&mut *near.0, &mut *near.1, near.2),
     };
     let (noise_iterations, midpoint) =
         kick(p, b, s, mu, fac, xi, mid, dx, noise, Some(held), krylov)?;
@@ -137,13 +144,15 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     step_velocity(s.pos, new_pos, dt, xi);
     add_constraint_forces(r.held, grad, lambda, force);
     if p.near_on() {
-        // The midpoint's mobility has taken the dense storage: formed again at the start.
-        super::near::spin(p, s.pos, s.radius, force, mid, (&mut near, false))?;
+        // The midpoint's mobility has taken the dense storage: the start's kept blocks.
+        let at_start = (&mut near, super::near::Spins::Kept);
+        super::near::spin(p, s.ewald, s.pos, s.radius, force, mid, at_start)?;
     } else {
         spin(p, s.ewald, s.pos, s.radius, force, mid)?;
     }
     Ok(StepReport {
         noise_iterations,
+        near_formations: formed.get(),
         contacts: r.contacts,
         wall_contacts: r.wall_contacts,
         contact_rounds: r.rounds,
@@ -247,9 +256,11 @@ pub(super) fn kick<T: Real>(
     // zero for the box's RPY mobility (each Fourier mode is transverse, `P(k) k = 0`),
     // so the midpoint (a second assembly on the Ewald path, a solve of some 30 to 50
     // products on PSE's) is left out: the uncorrected draw, whose covariance is `M`
-    // exactly. In free space the midpoint stays (the run's bits are kept there).
+    // exactly. In free space the midpoint stays (the run's bits are kept there). With
+    // the near field the box's mobility is `M_SD`, whose divergence is not zero (the
+    // pairs' lubrication varies with their gaps): the midpoint stays, for its drift.
     let bonded = held.as_ref().is_some_and(|h| !h.bonds.is_empty());
-    let drift = match s.ewald.is_some() && !bonded {
+    let drift = match s.ewald.is_some() && !bonded && !p.near_on() {
         true => Drift::Uncorrected,
         false => b.drift,
     };
@@ -389,7 +400,7 @@ fn midpoint<T: Real>(
     } else if p.near_on() {
         // The near field's mobility at the midpoint: its drift supplies `div M_SD`.
         let assembled = at_mid.reborrow();
-        super::near::assemble_apply(p, mid, s.radius, assembled, xi, dx, near)?;
+        super::near::assemble_apply(p, s.ewald, mid, s.radius, assembled, xi, dx, near)?;
         at_mid.into_ref()
     } else {
         let assembled = at_mid.reborrow();

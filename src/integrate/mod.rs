@@ -81,6 +81,11 @@ pub struct StepReport<T> {
     /// ([`Params::pse`]): the near field's Lanczos iterations plus, with bonds and the
     /// midpoint, the conjugate-gradient iterations of its solve `M^-1 L w`.
     pub noise_iterations: u32,
+    /// Times the step formed the dense Stokesian dynamics mobility `M_SD`
+    /// ([`Params::near`]; 0 without): each is two dense inversions of `6n x 6n` when a
+    /// pair or a sphere is inside its cutoff. The first-order step forms it once, at the
+    /// start; the predictor-corrector twice; a Brownian step with the midpoint twice.
+    pub near_formations: u32,
 }
 
 /// Read-only view of the state at the start of a step.

@@ -16,14 +16,33 @@
 //! Without the kernel's `near` feature [`Params::near_on`] is `false` as a constant, so
 //! every call here folds away; the functions then refuse, never reached.
 
+use core::cell::Cell;
+
 use crate::error::StepError;
 use crate::linalg::{MobMut, tri, with_blocks};
 use crate::params::{Method, Params};
 use crate::real::Real;
+#[cfg(feature = "near")]
+use crate::stokesian::Far;
 
-/// The near field's storage: the far field's packed grand mobility and the dense
-/// Stokesian dynamics mobility ([`crate::stokesian::storage`]).
-pub(super) type Store<'a, T> = (&'a mut [<T as Real>::M3], &'a mut [T]);
+use super::stages::Sums;
+
+/// The near field's storage: the far field's packed grand mobility, the dense
+/// Stokesian dynamics mobility ([`crate::stokesian::storage`]) followed, in a Brownian
+/// step with rotation, by the start's rotation-translation blocks kept for the spins
+/// ([`keep_spin`]), and the count of `M_SD` formed in the step
+/// ([`StepReport::near_formations`](super::StepReport::near_formations)).
+pub(super) type Store<'a, T> = (&'a mut [<T as Real>::M3], &'a mut [T], &'a Cell<u32>);
+
+/// Where [`spin`] reads `M_SD,rt` at the start of the step.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Spins {
+    /// The store's dense matrix holds `M_SD` at the start.
+    Dense,
+    /// The copy [`keep_spin`] made (the midpoint's mobility has since taken the dense
+    /// matrix); formed again if the storage has no room for it.
+    Kept,
+}
 
 /// Refuses the combinations the near field does not serve (a typed
 /// [`StepError::Unsupported`] naming each), and parameters out of range.
@@ -50,8 +69,10 @@ pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(
     if p.matrix_free {
         return refuse("the near field matrix-free (its mobility is dense)");
     }
-    if p.periodic.is_some() {
-        return refuse("the near field in a periodic box");
+    if p.periodic.is_some() && p.pse.is_some() {
+        return refuse(
+            "the near field with the PSE sums in a box (its dense mobility reads the Ewald sums' blocks: pse = None)",
+        );
     }
     if thermal && p.lanczos_noise(n) {
         return refuse(
@@ -65,13 +86,14 @@ pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(
 /// translational blocks into `mu` (packed lower triangle, nine scalars a block).
 pub(super) fn assemble_tt<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     mu: MobMut<'_, T>,
     store: &mut Store<'_, T>,
 ) -> Result<(), StepError> {
     let n = pos.len();
-    dense(p, pos, radius, store)?;
+    dense(p, ew, pos, radius, store)?;
     let (m, d) = (6 * n, &*store.1);
     let mu = mu.general();
     if mu.len() < tri(n) {
@@ -95,6 +117,7 @@ pub(super) fn assemble_tt<T: Real>(
 #[allow(clippy::too_many_arguments)]
 pub(super) fn assemble_apply<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     mut mu: MobMut<'_, T>,
@@ -102,7 +125,7 @@ pub(super) fn assemble_apply<T: Real>(
     u: &mut [T::V3],
     store: &mut Store<'_, T>,
 ) -> Result<(), StepError> {
-    assemble_tt(p, pos, radius, mu.reborrow(), store)?;
+    assemble_tt(p, ew, pos, radius, mu.reborrow(), store)?;
     let n = pos.len();
     with_blocks!(mu.as_ref(), a => crate::linalg::sym_matvec::<T>(a, n, f, u));
     Ok(())
@@ -110,29 +133,37 @@ pub(super) fn assemble_apply<T: Real>(
 
 /// Angular velocities of torque-free spheres, `W = Omega_inf + M_SD,rt F` (`f` the force
 /// each sphere exerts on the fluid), with [`Params::rotation`]; `Omega_inf` alone
-/// otherwise. The store's dense matrix must hold `M_SD` at `pos`, else `fresh` is
-/// `false` and it is formed again here.
+/// otherwise. `M_SD,rt` at `pos` is read where `from` says ([`Spins`]).
 pub(super) fn spin<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     f: &[T::V3],
     out: &mut [T::V3],
-    (store, fresh): (&mut Store<'_, T>, bool),
+    (store, from): (&mut Store<'_, T>, Spins),
 ) -> Result<(), StepError> {
     out.fill(p.vorticity);
     if !p.rotation {
         return Ok(());
     }
-    if !fresh {
-        dense(p, pos, radius, store)?;
-    }
     let n = pos.len();
-    let (m, d) = (6 * n, &*store.1);
+    let (m, kept) = (6 * n, 9 * n * n);
+    let read_kept = from == Spins::Kept && store.1.len() >= m * m + kept;
+    if from == Spins::Kept && !read_kept {
+        dense(p, ew, pos, radius, store)?;
+    }
+    let d = &*store.1;
+    // Row `k` of sphere `i`'s spin: the dense matrix's row `3 (n + i) + k`, columns
+    // `0..3n`, or the same scalars in the kept copy (the same sums, the same bits).
+    let row = |i: usize, k: usize| match read_kept {
+        true => &d[m * m + (3 * i + k) * 3 * n..][..3 * n],
+        false => &d[(3 * (n + i) + k) * m..][..3 * n],
+    };
     for (i, w) in out.iter_mut().enumerate() {
         let mut acc = [T::ZERO; 3];
         for (k, a) in acc.iter_mut().enumerate() {
-            let row = &d[(3 * (n + i) + k) * m..][..3 * n];
+            let row = row(i, k);
             for (j, &fj) in f.iter().enumerate() {
                 let [x, y, z] = T::xyz(fj);
                 *a += row[3 * j] * x + row[3 * j + 1] * y + row[3 * j + 2] * z;
@@ -143,23 +174,62 @@ pub(super) fn spin<T: Real>(
     Ok(())
 }
 
-/// `M_SD(pos)` into the store's dense matrix (free space, or above the step's wall).
+/// Copies `M_SD,rt` (rows `3n..6n`, columns `0..3n`) from the store's dense matrix,
+/// which must hold `M_SD` at the start, to the room after it, where the storage has it
+/// ([`crate::Layout::for_params`] counts it in a Brownian step with rotation): the
+/// midpoint's mobility then takes the dense matrix, and the spins read the copy instead
+/// of forming `M_SD` at the start a second time (two dense inversions of `6n x 6n`).
+pub(super) fn keep_spin<T: Real>(n: usize, store: &mut Store<'_, T>) {
+    let m = 6 * n;
+    let Some((d, kept)) = store.1.split_at_mut_checked(m * m) else {
+        return;
+    };
+    let Some(kept) = kept.get_mut(..9 * n * n) else {
+        return;
+    };
+    for (r, row) in kept.chunks_exact_mut(3 * n).enumerate() {
+        row.copy_from_slice(&d[(3 * n + r) * m..][..3 * n]);
+    }
+}
+
+/// The far field the step's near field corrects: the box's Ewald sums (`ew`), the
+/// step's wall, or free space.
+#[cfg(feature = "near")]
+fn far<'a, T: Real>(p: &Params<T>, ew: Sums<'a, T>) -> Result<Far<'a, T>, StepError> {
+    #[cfg(feature = "periodic")]
+    if super::cell(p).is_some() {
+        // `check` has refused PSE, so a box summed for RPY holds Ewald's parameters.
+        return match ew.and_then(|s| s.ewald()) {
+            Some(e) => Ok(Far::Box(e)),
+            None => Err(StepError::Unsupported(
+                "the near field in a box without the Ewald sums",
+            )),
+        };
+    }
+    let _ = ew;
+    Ok(super::wall_height(p).map_or(Far::Free, Far::Wall))
+}
+
+/// `M_SD(pos)` into the store's dense matrix (free space, above the step's wall, or in
+/// the step's periodic box with its Ewald sums `ew`).
 #[cfg(feature = "near")]
 fn dense<T: Real>(
     p: &Params<T>,
+    ew: Sums<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     store: &mut Store<'_, T>,
 ) -> Result<(), StepError> {
-    use crate::stokesian::{SdError, mobility};
+    use crate::stokesian::{SdError, mobility_in};
     let Some(nf) = p.near else {
         return Err(StepError::Unsupported(
             "the near field's mobility without Params::near",
         ));
     };
-    let wall = super::wall_height(p);
+    let far = far(p, ew)?;
+    store.2.set(store.2.get() + 1);
     let (packed, out) = (&mut *store.0, &mut *store.1);
-    mobility(p.viscosity, wall, pos, radius, nf, packed, out).map_err(|e| match e {
+    mobility_in(p.viscosity, far, pos, radius, nf, packed, out).map_err(|e| match e {
         SdError::Particle(e) => StepError::Particle(e),
         SdError::NotPositiveDefinite(error) => StepError::Linalg {
             stage: crate::error::Stage::Mobility,
@@ -170,10 +240,10 @@ fn dense<T: Real>(
         ),
         SdError::Params => StepError::BadParameter("near"),
         SdError::Storage => StepError::Unsupported("the near field without its storage"),
-        // The dense free-space and wall mobility raises neither (the box and the
-        // iterative product have no step yet).
-        SdError::Periodic(_) | SdError::NotConverged { .. } => {
-            StepError::Unsupported("the near field in a periodic box or by iterations in a step")
+        SdError::Periodic(e) => e.into(),
+        // The dense mobility never iterates (the iterative product has no step).
+        SdError::NotConverged { .. } => {
+            StepError::Unsupported("the near field by iterations in a step")
         }
     })
 }
@@ -183,6 +253,7 @@ fn dense<T: Real>(
 #[cfg(not(feature = "near"))]
 fn dense<T: Real>(
     _: &Params<T>,
+    _: Sums<'_, T>,
     _: &[T::V3],
     _: &[T],
     _: &mut Store<'_, T>,

@@ -2,6 +2,8 @@
 //! mobility, `r' = r* + dt mu G^T lambda`. First order, and a second-order
 //! predictor-corrector with the same projection.
 
+use core::cell::Cell;
+
 use super::near;
 use super::{
     Projection, Start, StepReport, Sums, add_constraint_forces, add_flow, assemble_tt,
@@ -42,9 +44,11 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         links,
         par,
         bands,
-        mut near,
+        near,
         ..
     } = v;
+    let formed = Cell::new(0);
+    let mut near = (near.0, near.1, &formed);
     // Forces and mobility at the start; unconstrained velocity U_inf + mu F.
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     // With `Params::compact_products` the assembly also writes each row of the compact
@@ -63,7 +67,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         )?;
     } else if p.near_on() {
         let at_start = mu.reborrow();
-        near::assemble_apply(p, s.pos, s.radius, at_start, force, u, &mut near)?;
+        near::assemble_apply(p, s.ewald, s.pos, s.radius, at_start, force, u, &mut near)?;
     } else {
         let at_start = mu.reborrow();
         mobility_product(p, s.ewald, s.pos, s.radius, at_start, force, u, par, bands)?;
@@ -91,11 +95,13 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
     step_velocity(s.pos, new_pos, dt, new_vel);
     add_constraint_forces(r.held, grad, lambda, force);
     if p.near_on() {
-        near::spin(p, s.pos, s.radius, force, new_omega, (&mut near, true))?;
+        let at_start = (&mut near, near::Spins::Dense);
+        near::spin(p, s.ewald, s.pos, s.radius, force, new_omega, at_start)?;
     } else {
         spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
     }
     Ok(StepReport {
+        near_formations: formed.get(),
         contacts: r.contacts,
         wall_contacts: r.wall_contacts,
         contact_rounds: r.rounds,
@@ -197,12 +203,14 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         kappa,
         scratch: mut sc,
         mut links,
-        mut near,
+        near,
         ..
     } = v;
+    let formed = Cell::new(0);
+    let mut near = (near.0, near.1, &formed);
     // Predictor: projected velocity at r, one projected Euler step.
     if p.near_on() {
-        near::assemble_tt(p, s.pos, s.radius, mu0.reborrow(), &mut near)?;
+        near::assemble_tt(p, s.ewald, s.pos, s.radius, mu0.reborrow(), &mut near)?;
     } else {
         assemble_tt(p, s.ewald, s.pos, s.radius, mu0.reborrow())?;
     }
@@ -216,7 +224,8 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     let tension = max_tension(bonds, kappa);
     add_constraint_forces(bonds, grad, kappa, force);
     if p.near_on() {
-        near::spin(p, s.pos, s.radius, force, new_omega, (&mut near, true))?;
+        let at_start = (&mut near, near::Spins::Dense);
+        near::spin(p, s.ewald, s.pos, s.radius, force, new_omega, at_start)?;
     } else {
         spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
     }
@@ -237,7 +246,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     project_overdamped(p, bonds, s.pos, s.radius, mu0, views, x_p, predict)?;
     // Corrector: projected velocity at the predicted point, trapezoidal average.
     if p.near_on() {
-        near::assemble_tt(p, x_p, s.radius, mu1.reborrow(), &mut near)?;
+        near::assemble_tt(p, s.ewald, x_p, s.radius, mu1.reborrow(), &mut near)?;
     } else {
         assemble_tt(p, s.ewald, x_p, s.radius, mu1.reborrow())?;
     }
@@ -265,6 +274,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     step_velocity(s.pos, new_pos, dt, new_vel);
     Ok(StepReport {
         max_tension: tension,
+        near_formations: formed.get(),
         contacts: r.contacts,
         wall_contacts: r.wall_contacts,
         contact_rounds: r.rounds,

@@ -74,7 +74,7 @@ pub(super) fn springs<T: Real, E: ExternalForce<T>>(
                 bands,
                 copied: false,
                 at_mid: mu2,
-                near: (&mut [], &mut []),
+                near: (&mut [], &mut [], &core::cell::Cell::new(0)),
             };
             (noise_iterations, _) = kick(
                 p, b, s, mu, fac, new_vel, new_omega, dx, noise, None, krylov,

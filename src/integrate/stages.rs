@@ -331,5 +331,6 @@ pub(super) fn report<T: Real>(
         wall_contacts: 0,
         contact_rounds: 0,
         noise_iterations: 0,
+        near_formations: 0,
     }
 }

@@ -33,9 +33,18 @@ pub(crate) const fn near_blocks(n: usize) -> usize {
     tri(2 * n)
 }
 
-/// Scalars the near field's dense `6n x 6n` mobility takes ([`Params::near`]).
-pub(crate) const fn near_scalars(n: usize) -> usize {
-    36 * n * n
+/// Scalars the near field's dense `6n x 6n` mobility takes ([`Params::near`]), and with
+/// `kept` (a Brownian step with rotation) the start's `3n x 3n` rotation-translation
+/// blocks after it, which the spins read once the midpoint's mobility has taken the
+/// dense matrix.
+pub(crate) const fn near_scalars(n: usize, kept: bool) -> usize {
+    36 * n * n + if kept { 9 * n * n } else { 0 }
+}
+
+/// Whether the near field keeps the start's rotation-translation blocks
+/// ([`near_scalars`]).
+pub(crate) const fn near_kept<T: Real>(p: &Params<T>) -> bool {
+    p.rotation && p.brownian.is_some()
 }
 
 /// Stored mobilities a method keeps as symmetric blocks when it stores them (the start's,
@@ -181,7 +190,7 @@ impl Layout {
         let l = if p.near_on() {
             Self {
                 blocks: l.blocks + near_blocks(n),
-                scalars: l.scalars + near_scalars(n),
+                scalars: l.scalars + near_scalars(n, near_kept(p)),
                 ..l
             }
         } else {

@@ -209,7 +209,7 @@ impl<T: Real> Workspace<'_, T> {
         let near = match p.near_on() {
             true => (
                 bl.take(super::layout::near_blocks(n)),
-                sc.take(super::layout::near_scalars(n)),
+                sc.take(super::layout::near_scalars(n, super::layout::near_kept(p))),
             ),
             false => (bl.take(0), sc.take(0)),
         };

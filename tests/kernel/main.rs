@@ -40,6 +40,8 @@ mod midpoint_storage;
 mod mobility;
 #[cfg(feature = "near")]
 mod near;
+#[cfg(all(feature = "near", feature = "periodic"))]
+mod near_box;
 #[cfg(feature = "near")]
 mod near_brownian;
 #[cfg(feature = "near")]

@@ -239,9 +239,10 @@ fn unsupported_combinations_are_refused() {
     ));
     let cell = Periodic::new([20.0; 3]).unwrap();
     cases.push((
-        "box",
+        "box by PSE",
         hydrorattle::Params {
             periodic: Some(cell),
+            pse: Some(1e-3),
             ..base
         },
     ));

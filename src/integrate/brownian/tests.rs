@@ -141,7 +141,7 @@ fn kicked<T: Real>(nine: Option<&mut [T::M3]>) -> Result<Kicked<T>, StepError> {
             Some(a) => MobMut::Full(a),
             None => mu2,
         },
-        near: (&mut [], &mut []),
+        near: (&mut [], &mut [], &core::cell::Cell::new(0)),
     };
     let mut noise = Noise::new(5);
     let mu = mu.into_ref();
