@@ -10,9 +10,11 @@
 //!
 //! It is the kernel's `Params::near` (`docs/NEAR.md`): the step's mobility becomes the
 //! dense Stokesian dynamics mobility `(M_far^-1 + R_near)^-1`, the far field RPY
-//! (`hydrodynamics = "rpy"`), in free space or above a `[wall]`, with methods
+//! (`hydrodynamics = "rpy"`), in free space, above a `[wall]` or in a periodic box (its
+//! Ewald sums), with methods
 //! `"overdamped"` and `"overdamped2"` (level manual), and thermal noise by Cholesky.
-//! The kernel's first-step check refuses the rest (matrix-free, a box, Lanczos noise)
+//! The kernel's first-step check refuses the rest (matrix-free, the box's PSE sums,
+//! Lanczos noise)
 //! at this table. Dense: a few hundred spheres at most.
 
 use serde::{Deserialize, Serialize};
