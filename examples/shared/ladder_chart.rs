@@ -52,7 +52,10 @@ pub fn draw(records: &str) -> String {
                         x,
                         y: e.abs().max(FLOOR),
                         series: k,
-                        label: format!("{label} {:+.1}%", 100.0 * e),
+                        label: match e.abs() < 1e-3 {
+                            true => format!("{label} {e:+.0e}"),
+                            false => format!("{label} {:+.1}%", 100.0 * e),
+                        },
                     }),
                     None => notes.push(format!("{name}, {label}: refused")),
                 }
