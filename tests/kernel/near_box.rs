@@ -299,3 +299,26 @@ fn m_sd_is_formed_once_a_stage() {
         assert_eq!(w_det, w_th, "box {l:?}: spins");
     }
 }
+
+/// The start's `M_SD,rt` kept for the spins takes `(3n)^2` scalars more, only in a
+/// Brownian step with rotation (the one whose midpoint takes the dense matrix).
+#[test]
+fn kept_spins_storage_only_with_rotation_and_noise() {
+    let n = 5;
+    let layout = |rotation: bool, thermal: bool| {
+        let mut p = near::<f64>(Method::Overdamped, None);
+        p.rotation = rotation;
+        if thermal {
+            p.brownian = Some(Brownian::new(1.0));
+            p.noise_sqrt = NoiseSqrt::Cholesky;
+        }
+        Layout::for_params(&p, n, 0)
+    };
+    assert_eq!(layout(true, false), layout(false, false));
+    let (with, without) = (layout(true, true), layout(false, true));
+    assert_eq!(with.scalars, without.scalars + 9 * n * n);
+    assert_eq!(
+        (with.blocks, with.vectors),
+        (without.blocks, without.vectors)
+    );
+}
