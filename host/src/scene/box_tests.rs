@@ -345,3 +345,24 @@ fn bad_suspensions_are_refused_at_their_line() {
     assert_eq!(e.line(), Some(13), "{e}");
     assert!(e.message.contains("leave [box] size out"), "{e}");
 }
+
+/// The near field forms its mobility from the assembled far-field blocks, which PSE
+/// never builds: `"pse"` with `[near_field]` is refused at the method's line and
+/// `"auto"` stays on the Ewald sum (the kernel refuses PSE with the near field).
+#[test]
+fn the_near_field_in_a_box_needs_the_ewald_sum() {
+    let text = |m: &str| {
+        BOXED.replace(
+            "size = [10, 10, 12]",
+            &format!("size = [10, 10, 12]\nmethod = \"{m}\""),
+        ) + "\n[near_field]\n"
+    };
+    let e = Scene::parse(&text("pse"), "b.toml").unwrap_err();
+    assert_eq!(e.line(), Some(14));
+    assert!(e.message.contains("[near_field]"), "{}", e.message);
+    let run = Scene::parse(&text("auto"), "b.toml")
+        .unwrap()
+        .with_box_resolved();
+    assert_eq!(run.periodic.unwrap().method, BoxMethod::Ewald);
+    assert!(!run.integrator.matrix_free);
+}

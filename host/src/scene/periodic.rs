@@ -287,14 +287,19 @@ pub fn pse_fits(size: [f64; 3], a_max: f64, tolerance: f64) -> bool {
 /// (so PSE cannot run it), or `None` where mobility products suffice: the overdamped
 /// or springs method (matrix-free), `level = "manual"` (the automatic level may pick
 /// another method), no rotation, the `"auto"` or `"krylov"` solver (Sweep and Newton
-/// read single blocks) and no Cholesky noise. Known before the body is generated, so
-/// that a scene is sized for the path it will run.
+/// read single blocks), no Cholesky noise and no near field (`near`: the Stokesian
+/// dynamics mobility is formed from the assembled far-field blocks). Known before the
+/// body is generated, so that a scene is sized for the path it will run.
 pub fn needs_matrix(
     model: &super::Model,
     i: &super::Integrator,
     brownian: Option<super::Thermal>,
+    near: bool,
 ) -> Option<&'static str> {
     use super::{Level, Method, Solver, Sqrt};
+    if near {
+        return Some("[near_field]");
+    }
     if !matches!(i.method, Method::Overdamped | Method::Springs) {
         return Some("a method other than overdamped or springs");
     }
@@ -319,7 +324,12 @@ impl super::Scene {
     /// `None` where mobility products suffice (the rule reads the model, the
     /// integrator and the noise only, so the parser applies it before the body).
     pub fn needs_matrix(&self) -> Option<&'static str> {
-        needs_matrix(&self.model, &self.integrator, self.brownian)
+        needs_matrix(
+            &self.model,
+            &self.integrator,
+            self.brownian,
+            self.near_field.is_some(),
+        )
     }
 
     /// Whether this scene needs mobility products only ([`needs_matrix`](Self::needs_matrix)).

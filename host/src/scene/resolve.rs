@@ -135,7 +135,9 @@ impl RawScene {
         // A box PSE will sum (named, or "auto" where products suffice: the sizes where
         // storage matters are PSE's) is sized without the stored mobility; its grid is
         // checked once the box is known (`box_cost::check_pse`).
-        let products = super::periodic::needs_matrix(&model, &integrator, brownian).is_none();
+        let products =
+            super::periodic::needs_matrix(&model, &integrator, brownian, near_field.is_some())
+                .is_none();
         let pse = match self.periodic.as_ref().map(|b| b.get_ref().method()) {
             Some(super::BoxMethod::Pse) => true,
             Some(super::BoxMethod::Auto) => products,
