@@ -41,8 +41,8 @@ fn cloud(n: usize, phi: f64, seed: u64) -> Vec<V> {
 }
 
 /// One step of `p` from `pos0` (the generator `seed` where thermal): CPU seconds, the
-/// positions after, the fast storage in bytes.
-fn one(p: &Params<f64>, pos0: &[V], seed: u64) -> (f64, Vec<V>, usize) {
+/// positions after (or the step's error), the fast storage in bytes.
+fn one(p: &Params<f64>, pos0: &[V], seed: u64) -> (f64, Result<Vec<V>, String>, usize) {
     let n = pos0.len();
     let rad = vec![1.0; n];
     let density: Vec<f64> = (0..n).map(|i| 1.0 + (i % 3) as f64).collect();
@@ -71,12 +71,12 @@ fn one(p: &Params<f64>, pos0: &[V], seed: u64) -> (f64, Vec<V>, usize) {
     };
     let c0 = cpu::cpu();
     let t0 = std::time::Instant::now();
-    step_slices(state, &[], p, &mut ws, &mut NoForce).unwrap();
+    let r = step_slices(state, &[], p, &mut ws, &mut NoForce);
     let t = match (c0, cpu::cpu()) {
         (Some(a), Some(b)) => b - a,
         _ => t0.elapsed().as_secs_f64(),
     };
-    (t, pos, bytes)
+    (t, r.map(|_| pos).map_err(|e| e.to_string()), bytes)
 }
 
 fn main() {
@@ -108,6 +108,13 @@ fn main() {
                     p.brownian = Some(Brownian::new(1.0));
                 }
                 let (t, pos, bytes) = one(&p, &pos0, 11);
+                let pos = match pos {
+                    Ok(pos) => pos,
+                    Err(e) => {
+                        println!("{n},{thermal},{path},{t:.3},refused: {e},");
+                        continue;
+                    }
+                };
                 let disp = pos
                     .iter()
                     .zip(&pos0)
