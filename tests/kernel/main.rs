@@ -24,6 +24,8 @@ mod contacts;
 mod determinism;
 mod docs;
 mod dynamics;
+#[cfg(feature = "fast-free")]
+mod fast_step;
 mod free_draining;
 #[cfg(feature = "fast-free")]
 mod free_fast;
