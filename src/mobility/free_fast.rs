@@ -22,16 +22,20 @@
 //! there. Serial, in a fixed order: the same inputs give the same bits.
 
 mod grid;
+mod pieces;
 mod radial;
 mod spectral;
 
+use core::convert::Infallible;
 use core::fmt;
 
 use crate::cell_list::CellList;
 use crate::fault::ParticleError;
 use crate::mobility::pse::fft::Cx;
 use crate::mobility::{Hydro, pair_tt, self_tt};
+use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
+use pieces::{JOBS, before, none, range, rows};
 
 /// The tolerances [`FreeFast::new`] accepts (from [`min_tolerance`] on in the precision).
 pub const MIN_TOLERANCE: f64 = 1e-10;
@@ -110,20 +114,23 @@ impl fmt::Display for FreeError {
 pub struct FreeSize {
     /// Complex values: the padded grid (3 per point), FFT scratch and twiddles.
     pub complex: usize,
-    /// Reals: the kernel's transform (6 per padded point).
+    /// Reals: the kernel's transform (one octant, 6 per point), the cloud's grid (3 per
+    /// point), and per sphere a row of results and the near part's partial sums.
     pub reals: usize,
-    /// Indices: the cell list.
+    /// Indices: the cell list and each sphere's place in it.
     pub index: usize,
 }
 
-/// Caller-owned storage of [`FreeFast::apply`], at least [`FreeFast::storage`]. It keeps
-/// the kernel's transform between products with the same parameters.
+/// Caller-owned storage of [`FreeFast::apply`], at least [`FreeFast::storage`], and the
+/// [`Parallel`] that runs its pieces ([`Serial`] unless [`FreeStorage::with_parallel`]).
+/// It keeps the kernel's transform between products with the same parameters.
 pub struct FreeStorage<'a, T: Real> {
     complex: &'a mut [Cx<T>],
     reals: &'a mut [T],
     index: &'a mut [usize],
     /// The parameters whose kernel `reals` holds.
     ready: Option<[u64; 8]>,
+    parallel: &'a dyn Parallel,
 }
 
 impl<'a, T: Real> FreeStorage<'a, T> {
@@ -134,7 +141,14 @@ impl<'a, T: Real> FreeStorage<'a, T> {
             reals,
             index,
             ready: None,
+            parallel: &Serial,
         }
+    }
+
+    /// Runs the product's pieces through `parallel` (a host's thread pool): the same
+    /// bits as [`Serial`], whatever the number of threads.
+    pub fn with_parallel(self, parallel: &'a dyn Parallel) -> Self {
+        Self { parallel, ..self }
     }
 }
 
@@ -241,8 +255,8 @@ impl<T: Real> FreeFast<T> {
     pub fn storage(&self, n: usize) -> FreeSize {
         FreeSize {
             complex: self.plan.complex_len(),
-            reals: self.plan.reals_len(),
-            index: 3 * n + 1,
+            reals: self.plan.reals_len() + 3 * n + partial_len(n),
+            index: 4 * n + 1,
         }
     }
 
@@ -282,9 +296,25 @@ impl<T: Real> FreeFast<T> {
         store: &mut FreeStorage<'_, T>,
     ) -> Result<(), FreeError> {
         let lo = self.check(eta, pos, radius, force, out, store)?;
+        let n = pos.len();
+        let par = store.parallel;
         let cut = T::from_f64(self.r_cut);
-        let list = CellList::build::<T>(pos, None, cut, store.index).map(|(l, _)| l);
-        self.near(eta, pos, radius, force, out, list.as_ref())?;
+        let (cells, rank) = store.index.split_at_mut(3 * n + 1);
+        let rank = &mut rank[..n];
+        let list = CellList::build::<T>(pos, None, cut, cells).map(|(l, _)| l);
+        let order = list.as_ref().map(|l| l.order());
+        match order {
+            Some(o) => o.iter().enumerate().for_each(|(k, &i)| rank[i] = k),
+            None => rank.iter_mut().enumerate().for_each(|(i, r)| *r = i),
+        }
+        let at = |k: usize| order.map_or(k, |o| o[k]);
+        let (grid_reals, extra) = store.reals.split_at_mut(self.plan.reals_len());
+        let (rows_buf, partial) = extra.split_at_mut(3 * n);
+        let ctx = (list.as_ref(), &*rank);
+        self.near(eta, (pos, radius, force), ctx, (rows_buf, partial), par)?;
+        for (k, r) in rows_buf.chunks_exact(3).enumerate() {
+            out[at(k)] = T::v3(r[0], r[1], r[2]);
+        }
         let key = [
             self.plan.p[0] as u64,
             self.plan.p[1] as u64,
@@ -297,21 +327,16 @@ impl<T: Real> FreeFast<T> {
         ];
         if store.ready != Some(key) {
             store.ready = None;
-            grid::kernel(self, store.complex, store.reals);
+            grid::kernel(self, store.complex, grid_reals);
             store.ready = Some(key);
         }
         // Spheres cell by cell: their windows overlap, so the grid stays in cache.
-        let order = list.as_ref().map(|l| l.order());
         let spheres = (pos, radius, order);
-        grid::far(
-            self,
-            eta,
-            lo,
-            spheres,
-            force,
-            (store.complex, store.reals),
-            out,
-        );
+        let storage = (&mut *store.complex, grid_reals, &mut *rows_buf);
+        grid::far(self, eta, lo, spheres, force, storage, par);
+        for (k, r) in rows_buf.chunks_exact(3).enumerate() {
+            out[at(k)] += T::v3(r[0], r[1], r[2]);
+        }
         Ok(())
     }
 
@@ -361,67 +386,112 @@ impl<T: Real> FreeFast<T> {
         Ok(lo)
     }
 
-    /// `out = M^near F`: self blocks, and RPY minus far for pairs within the cutoff.
+    /// `rows[k] = M^near F` for sphere `order[k]` (3 reals each): self blocks, and RPY
+    /// minus far for pairs within the cutoff, each pair once (from the later row in the
+    /// list's order), its symmetric block applied both ways. Rows by pieces through
+    /// `par`: a piece adds to its own rows, and to the earlier pieces' rows in its
+    /// partial sums (`partial`), which a second round adds in piece order.
     fn near(
         &self,
         eta: T,
-        pos: &[T::V3],
-        radius: &[T],
-        force: &[T::V3],
-        out: &mut [T::V3],
-        list: Option<&CellList<'_>>,
+        (pos, radius, force): (&[T::V3], &[T], &[T::V3]),
+        (list, rank): (Option<&CellList<'_>>, &[usize]),
+        (rows_buf, partial): (&mut [T], &mut [T]),
+        par: &dyn Parallel,
     ) -> Result<(), FreeError> {
+        let n = pos.len();
         let rad = radial::Radial::new(
             1.0 / (2.0 * SQRT_2 * self.sigma),
             2.0 * self.sigma * self.sigma,
         );
         let cut2 = self.r_cut * self.r_cut;
         let inv_eta = 1.0 / eta.to_f64();
-        for (i, o) in out.iter_mut().enumerate() {
-            let alpha = radius[i].to_f64() * radius[i].to_f64() / 6.0;
-            let (c_self, _) = rad.far((alpha, alpha), 0.0);
-            *o = force[i] * (self_tt(eta, radius[i]) - T::from_f64(c_self * inv_eta));
-        }
-        // Each pair once (`j < i`), its symmetric block applied both ways; rows cell by
-        // cell, so the neighbours of consecutive rows are near in memory.
-        for k in 0..pos.len() {
-            let i = list.map_or(k, |l| l.order()[k]);
-            let ai = radius[i];
-            let alpha_i = ai.to_f64() * ai.to_f64() / 6.0;
-            let mut acc = T::V3_ZERO;
-            let mut err = None;
-            let mut pair = |j: usize| {
-                if j >= i || err.is_some() {
-                    return;
-                }
-                let r = pos[i] - pos[j];
-                let u = T::norm2(r).to_f64();
-                if u >= cut2 {
-                    return;
-                }
-                let Some(rpy) = pair_tt(Hydro::Rpy, eta, ai, radius[j], r) else {
-                    err = Some(FreeError::Particle(ParticleError::Nested { i: j, j: i }));
-                    return;
+        let at = |k: usize| list.map_or(k, |l| l.order()[k]);
+        let add = |s: &mut [T], q: usize, v: T::V3| {
+            for (x, c) in s[3 * q..3 * q + 3].iter_mut().zip(T::xyz(v)) {
+                *x += c;
+            }
+        };
+        let cuts = (
+            (&mut rows_buf[..3 * n], &rows(3) as _),
+            (&mut partial[..partial_len(n)], &before(3) as _),
+            none(),
+        );
+        pieces::pieces(par, n, cuts, |[a, b], r, sc, _| {
+            sc.fill(T::ZERO);
+            for k in a..b {
+                let i = at(k);
+                let alpha = radius[i].to_f64() * radius[i].to_f64() / 6.0;
+                let (c_self, _) = rad.far((alpha, alpha), 0.0);
+                let v = force[i] * (self_tt(eta, radius[i]) - T::from_f64(c_self * inv_eta));
+                r[3 * (k - a)..3 * (k - a) + 3].copy_from_slice(&T::xyz(v));
+            }
+            // Rows cell by cell, so the neighbours of consecutive rows are near in memory.
+            for k in a..b {
+                let i = at(k);
+                let ai = radius[i];
+                let alpha_i = ai.to_f64() * ai.to_f64() / 6.0;
+                let mut acc = T::V3_ZERO;
+                let mut err = None;
+                let mut pair = |j: usize| {
+                    let q = rank[j];
+                    if q >= k || err.is_some() {
+                        return;
+                    }
+                    let d = pos[i] - pos[j];
+                    let u = T::norm2(d).to_f64();
+                    if u >= cut2 {
+                        return;
+                    }
+                    let Some(rpy) = pair_tt(Hydro::Rpy, eta, ai, radius[j], d) else {
+                        err = Some(FreeError::Particle(ParticleError::Nested { i: j, j: i }));
+                        return;
+                    };
+                    let aj = radius[j].to_f64();
+                    let (ci, crr) = rad.far((alpha_i, aj * aj / 6.0), u);
+                    let (ci, crr) = (T::from_f64(ci * inv_eta), T::from_f64(crr * inv_eta));
+                    let far = |f: T::V3| f * ci + d * (T::dot(d, f) * crr);
+                    let (fi, fj) = (force[i], force[j]);
+                    acc += rpy * fj - far(fj);
+                    match q >= a {
+                        true => add(&mut *r, q - a, rpy * fi - far(fi)),
+                        false => add(&mut *sc, q, rpy * fi - far(fi)),
+                    }
                 };
-                let aj = radius[j].to_f64();
-                let (ci, crr) = rad.far((alpha_i, aj * aj / 6.0), u);
-                let (ci, crr) = (T::from_f64(ci * inv_eta), T::from_f64(crr * inv_eta));
-                let far = |f: T::V3| f * ci + r * (T::dot(r, f) * crr);
-                let (fi, fj) = (force[i], force[j]);
-                acc += rpy * fj - far(fj);
-                out[j] += rpy * fi - far(fi);
-            };
-            match list {
-                Some(l) => l.near::<T>(pos[i], &mut pair),
-                None => (0..i).for_each(&mut pair),
+                match list {
+                    Some(l) => l.near::<T>(pos[i], &mut pair),
+                    None => (0..i).for_each(&mut pair),
+                }
+                if let Some(e) = err {
+                    return Err(e);
+                }
+                add(&mut *r, k - a, acc);
             }
-            if let Some(e) = err {
-                return Err(e);
+            Ok(())
+        })?;
+        // Each piece's rows gain the later pieces' partial sums, in piece order.
+        let partial = &*partial;
+        let cuts = ((&mut rows_buf[..3 * n], &rows(3) as _), none(), none());
+        pieces::pieces(par, n, cuts, |[a, b], r, _, _| {
+            let mut offset = 0;
+            for t in 0..JOBS {
+                let [at, _] = range(n, t);
+                if at >= b && b > a {
+                    let src = &partial[offset + 3 * a..offset + 3 * b];
+                    r.iter_mut().zip(src).for_each(|(x, s)| *x += *s);
+                }
+                offset += 3 * at;
             }
-            out[i] += acc;
-        }
-        Ok(())
+            Ok::<(), Infallible>(())
+        })
+        .map_err(|e| match e {})
     }
+}
+
+/// Reals of the near part's partial sums for `n` spheres: piece `t` keeps one row for
+/// each sphere of the pieces before it.
+fn partial_len(n: usize) -> usize {
+    (0..JOBS).map(|t| 3 * range(n, t)[0]).sum()
 }
 
 const PI: f64 = core::f64::consts::PI;

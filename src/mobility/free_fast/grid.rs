@@ -5,8 +5,12 @@
 //! the window's reach. The kernel is sampled at the offsets `-(m - 1) ..= m - 1` per
 //! axis (smooth, so sampling it is spectrally accurate).
 
+use core::convert::Infallible;
+
+use super::pieces::{none, pieces, rows};
 use super::{FreeFast, radial, spectral};
 use crate::mobility::pse::fft::Cx;
+use crate::parallel::Parallel;
 use crate::real::Real;
 
 /// The kernel's transform into its octant of `reals`, with the quadrature weight `h^3`
@@ -35,6 +39,11 @@ pub(super) fn kernel<T: Real>(ff: &FreeFast<T>, cx: &mut [Cx<T>], reals: &mut [T
     spectral::kernel(plan, cx, octant, table, (ff.h, weight));
 }
 
+/// The first grid point of a window along an axis whose grid starts at `origin`.
+fn first<T: Real>(ff: &FreeFast<T>, origin: f64, p: f64) -> usize {
+    libm::ceil((p - origin - ff.reach) / ff.h).max(0.0) as usize
+}
+
 /// One sphere's window: first grid index per axis, the Gaussian factor and the squared
 /// distance of each point per axis.
 struct Window {
@@ -52,7 +61,7 @@ impl Window {
         };
         let half = 1.0 / (2.0 * ff.sigma * ff.sigma);
         for d in 0..3 {
-            let g0 = libm::ceil((p[d] - origin[d] - ff.reach) / ff.h).max(0.0) as usize;
+            let g0 = first(ff, origin[d], p[d]);
             w.first[d] = g0;
             for t in 0..ff.support {
                 let x = origin[d] + (g0 + t) as f64 * ff.h - p[d];
@@ -63,20 +72,22 @@ impl Window {
         w
     }
 
-    /// Calls `f(point, weight)` over the window, `weight` the Gaussian with the sphere
-    /// factor `(1 + alpha lap)` and the normalisation `norm`.
+    /// Calls `f(point, weight)` over the window's points in the planes `z0 .. z1`
+    /// (`point` counted from plane `z0`), `weight` the Gaussian with the sphere factor
+    /// `(1 + alpha lap)` and the normalisation `norm`.
     fn visit(
         &self,
         (sigma, n): (f64, usize),
         alpha: f64,
-        px: [usize; 2],
+        (px, [z0, z1]): ([usize; 2], [usize; 2]),
         mut f: impl FnMut(usize, f64),
     ) {
         let s2 = sigma * sigma;
         let norm = libm::pow(2.0 * core::f64::consts::PI * s2, -1.5);
         let (a0, a1) = (1.0 - 3.0 * alpha / s2, alpha / (s2 * s2));
-        for tz in 0..n {
-            let z = self.first[2] + tz;
+        let fz = self.first[2];
+        for tz in z0.saturating_sub(fz)..n.min(z1.saturating_sub(fz)) {
+            let z = fz + tz - z0;
             for ty in 0..n {
                 let y = self.first[1] + ty;
                 let wyz = norm * self.gauss[2][tz] * self.gauss[1][ty];
@@ -94,49 +105,67 @@ impl Window {
     }
 }
 
-/// `out += M^far F` for the spheres `(pos, radius)` whose bounding box starts at `lo`,
-/// visited in `order` (all of them, else in index order); `reals` holds [`kernel`].
+/// `rows[k] = M^far F` for sphere `order[k]` (3 reals each) for the spheres `(pos,
+/// radius)` whose bounding box starts at `lo`, `order` the cell list's (else index
+/// order); `reals` holds [`kernel`]. Spreading by slabs of planes (every sphere in order,
+/// each adding its terms to the slab's points), the convolution by pieces
+/// ([`spectral::convolve`]) and interpolation by rows, each piece through `par`.
 pub(super) fn far<T: Real>(
     ff: &FreeFast<T>,
     eta: T,
     lo: [f64; 3],
     (pos, radius, order): (&[T::V3], &[T], Option<&[usize]>),
     force: &[T::V3],
-    (cx, reals): (&mut [Cx<T>], &mut [T]),
-    out: &mut [T::V3],
+    (cx, reals, rows_out): (&mut [Cx<T>], &mut [T], &mut [T]),
+    par: &dyn Parallel,
 ) {
     let plan = &ff.plan;
-    let [mx, my, _] = plan.m;
+    let [mx, my, mz] = plan.m;
     let (octant, cloud) = plan.split_reals(reals);
-    cloud.fill(T::ZERO);
     let origin = [0, 1, 2].map(|d| lo[d] - ff.reach - ff.h);
     let shape = (ff.sigma, ff.support);
     let index = |k: usize| order.map_or(k, |o| o[k]);
-    for k in 0..pos.len() {
-        let j = index(k);
-        let (p, a) = (pos[j], radius[j]);
-        let w = Window::new(ff, origin, T::v3_to_f64(p));
-        let f = T::xyz(force[j]).map(|c| c.to_f64());
-        let alpha = a.to_f64() * a.to_f64() / 6.0;
-        w.visit(shape, alpha, [mx, my], |q, wt| {
-            for c in 0..3 {
-                cloud[3 * q + c] += T::from_f64(wt * f[c]);
+    let n = pos.len();
+    let cuts = ((&mut *cloud, &rows(3 * mx * my) as _), none(), none());
+    let _ = pieces(par, mz, cuts, |[z0, z1], cl, _, _| {
+        cl.fill(T::ZERO);
+        for k in 0..n {
+            let j = index(k);
+            let p = T::v3_to_f64(pos[j]);
+            let fz = first(ff, origin[2], p[2]);
+            if fz >= z1 || fz + ff.support <= z0 {
+                continue;
             }
-        });
-    }
-    spectral::convolve(plan, cx, octant, cloud);
+            let w = Window::new(ff, origin, p);
+            let f = T::xyz(force[j]).map(|c| c.to_f64());
+            let alpha = radius[j].to_f64() * radius[j].to_f64() / 6.0;
+            w.visit(shape, alpha, ([mx, my], [z0, z1]), |q, wt| {
+                for c in 0..3 {
+                    cl[3 * q + c] += T::from_f64(wt * f[c]);
+                }
+            });
+        }
+        Ok::<(), Infallible>(())
+    });
+    spectral::convolve(plan, cx, octant, cloud, par);
     let scale = ff.h * ff.h * ff.h / eta.to_f64();
-    for k in 0..pos.len() {
-        let i = index(k);
-        let (p, a) = (pos[i], radius[i]);
-        let w = Window::new(ff, origin, T::v3_to_f64(p));
-        let alpha = a.to_f64() * a.to_f64() / 6.0;
-        let mut u = [0.0f64; 3];
-        w.visit(shape, alpha, [mx, my], |q, wt| {
-            for (c, uc) in u.iter_mut().enumerate() {
-                *uc += wt * cloud[3 * q + c].to_f64();
+    let cloud = &*cloud;
+    let cuts = ((&mut rows_out[..3 * n], &rows(3) as _), none(), none());
+    let _ = pieces(par, n, cuts, |[a, b], r, _, _| {
+        for k in a..b {
+            let i = index(k);
+            let w = Window::new(ff, origin, T::v3_to_f64(pos[i]));
+            let alpha = radius[i].to_f64() * radius[i].to_f64() / 6.0;
+            let mut u = [0.0f64; 3];
+            w.visit(shape, alpha, ([mx, my], [0, mz]), |q, wt| {
+                for (c, uc) in u.iter_mut().enumerate() {
+                    *uc += wt * cloud[3 * q + c].to_f64();
+                }
+            });
+            for c in 0..3 {
+                r[3 * (k - a) + c] = T::from_f64(u[c] * scale);
             }
-        });
-        out[i] += T::v3_from(u.map(|c| c * scale));
-    }
+        }
+        Ok::<(), Infallible>(())
+    });
 }
