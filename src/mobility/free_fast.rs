@@ -22,20 +22,19 @@
 //! there. Serial, in a fixed order: the same inputs give the same bits.
 
 mod grid;
+mod near;
 mod pieces;
 mod radial;
 mod spectral;
 
-use core::convert::Infallible;
 use core::fmt;
 
 use crate::cell_list::CellList;
 use crate::fault::ParticleError;
 use crate::mobility::pse::fft::Cx;
-use crate::mobility::{Hydro, pair_tt, self_tt};
 use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
-use pieces::{JOBS, before, none, range, rows};
+use near::{Spheres, partial_len};
 
 /// The tolerances [`FreeFast::new`] accepts (from [`min_tolerance`] on in the precision).
 pub const MIN_TOLERANCE: f64 = 1e-10;
@@ -255,8 +254,16 @@ impl<T: Real> FreeFast<T> {
     pub fn storage(&self, n: usize) -> FreeSize {
         FreeSize {
             complex: self.plan.complex_len(),
-            reals: self.plan.reals_len() + 3 * n + partial_len(n),
+            reals: self.plan.reals_len() + 3 * n + partial_len(n, 3),
             index: 4 * n + 1,
+        }
+    }
+
+    /// Storage [`FreeFast::apply_grand`] needs for `n` spheres (and [`FreeFast::apply`]).
+    pub fn storage_grand(&self, n: usize) -> FreeSize {
+        FreeSize {
+            reals: self.plan.reals_len() + 6 * n + partial_len(n, 6),
+            ..self.storage(n)
         }
     }
 
@@ -295,13 +302,58 @@ impl<T: Real> FreeFast<T> {
         out: &mut [T::V3],
         store: &mut FreeStorage<'_, T>,
     ) -> Result<(), FreeError> {
-        let lo = self.check(eta, pos, radius, force, out, store)?;
-        let n = pos.len();
+        let s = Spheres {
+            pos,
+            radius,
+            force,
+            torque: None,
+        };
+        self.product(eta, s, (out, None), store)
+    }
+
+    /// `(U, W) = M (F, T)`: the free-space RPY grand mobility (viscosity `eta`) of the
+    /// spheres at `pos` with radii `radius` in `(0, a_max]` applied to the forces
+    /// `force` and torques `torque`: velocities into `vel`, rotations into `spin`, to
+    /// the tolerance. The storage at least [`FreeFast::storage_grand`]. As
+    /// [`FreeFast::apply`] otherwise.
+    #[allow(clippy::too_many_arguments)]
+    pub fn apply_grand(
+        &self,
+        eta: T,
+        (pos, radius): (&[T::V3], &[T]),
+        force: &[T::V3],
+        torque: &[T::V3],
+        vel: &mut [T::V3],
+        spin: &mut [T::V3],
+        store: &mut FreeStorage<'_, T>,
+    ) -> Result<(), FreeError> {
+        if torque.len() != pos.len() || spin.len() != pos.len() {
+            return Err(FreeError::Length);
+        }
+        let s = Spheres {
+            pos,
+            radius,
+            force,
+            torque: Some(torque),
+        };
+        self.product(eta, s, (vel, Some(spin)), store)
+    }
+
+    /// The near part into the rows, then the far part added, each in a fixed order.
+    fn product(
+        &self,
+        eta: T,
+        s: Spheres<'_, T>,
+        (out, mut spin): (&mut [T::V3], Option<&mut [T::V3]>),
+        store: &mut FreeStorage<'_, T>,
+    ) -> Result<(), FreeError> {
+        let lo = self.check(eta, s, out, store)?;
+        let (n, w) = (s.pos.len(), s.width());
         let par = store.parallel;
         let cut = T::from_f64(self.r_cut);
         let (cells, rank) = store.index.split_at_mut(3 * n + 1);
         let rank = &mut rank[..n];
-        let list = CellList::build::<T>(pos, None, cut, cells).map(|(l, _)| l);
+        let list = CellList::build::<T>(s.pos, None, cut, cells).map(|(l, _)| l);
         let order = list.as_ref().map(|l| l.order());
         match order {
             Some(o) => o.iter().enumerate().for_each(|(k, &i)| rank[i] = k),
@@ -309,11 +361,15 @@ impl<T: Real> FreeFast<T> {
         }
         let at = |k: usize| order.map_or(k, |o| o[k]);
         let (grid_reals, extra) = store.reals.split_at_mut(self.plan.reals_len());
-        let (rows_buf, partial) = extra.split_at_mut(3 * n);
+        let (rows_buf, partial) = extra.split_at_mut(w * n);
         let ctx = (list.as_ref(), &*rank);
-        self.near(eta, (pos, radius, force), ctx, (rows_buf, partial), par)?;
-        for (k, r) in rows_buf.chunks_exact(3).enumerate() {
-            out[at(k)] = T::v3(r[0], r[1], r[2]);
+        self.near(eta, s, ctx, (&mut *rows_buf, partial), par)?;
+        let v3 = |r: &[T]| T::v3(r[0], r[1], r[2]);
+        for (k, r) in rows_buf.chunks_exact(w).enumerate() {
+            out[at(k)] = v3(r);
+            if let Some(sp) = spin.as_deref_mut() {
+                sp[at(k)] = v3(&r[3..]);
+            }
         }
         let key = [
             self.plan.p[0] as u64,
@@ -331,11 +387,13 @@ impl<T: Real> FreeFast<T> {
             store.ready = Some(key);
         }
         // Spheres cell by cell: their windows overlap, so the grid stays in cache.
-        let spheres = (pos, radius, order);
         let storage = (&mut *store.complex, grid_reals, &mut *rows_buf);
-        grid::far(self, eta, lo, spheres, force, storage, par);
-        for (k, r) in rows_buf.chunks_exact(3).enumerate() {
-            out[at(k)] += T::v3(r[0], r[1], r[2]);
+        grid::far(self, eta, lo, (s, order), storage, par);
+        for (k, r) in rows_buf.chunks_exact(w).enumerate() {
+            out[at(k)] += v3(r);
+            if let Some(sp) = spin.as_deref_mut() {
+                sp[at(k)] += v3(&r[3..]);
+            }
         }
         Ok(())
     }
@@ -345,17 +403,24 @@ impl<T: Real> FreeFast<T> {
     fn check(
         &self,
         eta: T,
-        pos: &[T::V3],
-        radius: &[T],
-        force: &[T::V3],
+        s: Spheres<'_, T>,
         out: &[T::V3],
         store: &FreeStorage<'_, T>,
     ) -> Result<[f64; 3], FreeError> {
+        let Spheres {
+            pos,
+            radius,
+            force,
+            torque,
+        } = s;
         let n = pos.len();
         if radius.len() != n || force.len() != n || out.len() != n {
             return Err(FreeError::Length);
         }
-        let size = self.storage(n);
+        let size = match torque {
+            Some(_) => self.storage_grand(n),
+            None => self.storage(n),
+        };
         let need = [size.complex, size.reals, size.index];
         let have = [store.complex.len(), store.reals.len(), store.index.len()];
         if need.iter().zip(&have).any(|(n, h)| h < n) {
@@ -366,7 +431,8 @@ impl<T: Real> FreeFast<T> {
         }
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
-            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) {
+            let t = torque.map_or(T::V3_ZERO, |t| t[i]);
+            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) || !T::v3_is_finite(t) {
                 return Err(FreeError::Particle(ParticleError::NonFinite {
                     particle: i,
                 }));
@@ -385,113 +451,6 @@ impl<T: Real> FreeFast<T> {
         }
         Ok(lo)
     }
-
-    /// `rows[k] = M^near F` for sphere `order[k]` (3 reals each): self blocks, and RPY
-    /// minus far for pairs within the cutoff, each pair once (from the later row in the
-    /// list's order), its symmetric block applied both ways. Rows by pieces through
-    /// `par`: a piece adds to its own rows, and to the earlier pieces' rows in its
-    /// partial sums (`partial`), which a second round adds in piece order.
-    fn near(
-        &self,
-        eta: T,
-        (pos, radius, force): (&[T::V3], &[T], &[T::V3]),
-        (list, rank): (Option<&CellList<'_>>, &[usize]),
-        (rows_buf, partial): (&mut [T], &mut [T]),
-        par: &dyn Parallel,
-    ) -> Result<(), FreeError> {
-        let n = pos.len();
-        let rad = radial::Radial::new(
-            1.0 / (2.0 * SQRT_2 * self.sigma),
-            2.0 * self.sigma * self.sigma,
-        );
-        let cut2 = self.r_cut * self.r_cut;
-        let inv_eta = 1.0 / eta.to_f64();
-        let at = |k: usize| list.map_or(k, |l| l.order()[k]);
-        let add = |s: &mut [T], q: usize, v: T::V3| {
-            for (x, c) in s[3 * q..3 * q + 3].iter_mut().zip(T::xyz(v)) {
-                *x += c;
-            }
-        };
-        let cuts = (
-            (&mut rows_buf[..3 * n], &rows(3) as _),
-            (&mut partial[..partial_len(n)], &before(3) as _),
-            none(),
-        );
-        pieces::pieces(par, n, cuts, |[a, b], r, sc, _| {
-            sc.fill(T::ZERO);
-            for k in a..b {
-                let i = at(k);
-                let alpha = radius[i].to_f64() * radius[i].to_f64() / 6.0;
-                let (c_self, _) = rad.far((alpha, alpha), 0.0);
-                let v = force[i] * (self_tt(eta, radius[i]) - T::from_f64(c_self * inv_eta));
-                r[3 * (k - a)..3 * (k - a) + 3].copy_from_slice(&T::xyz(v));
-            }
-            // Rows cell by cell, so the neighbours of consecutive rows are near in memory.
-            for k in a..b {
-                let i = at(k);
-                let ai = radius[i];
-                let alpha_i = ai.to_f64() * ai.to_f64() / 6.0;
-                let mut acc = T::V3_ZERO;
-                let mut err = None;
-                let mut pair = |j: usize| {
-                    let q = rank[j];
-                    if q >= k || err.is_some() {
-                        return;
-                    }
-                    let d = pos[i] - pos[j];
-                    let u = T::norm2(d).to_f64();
-                    if u >= cut2 {
-                        return;
-                    }
-                    let Some(rpy) = pair_tt(Hydro::Rpy, eta, ai, radius[j], d) else {
-                        err = Some(FreeError::Particle(ParticleError::Nested { i: j, j: i }));
-                        return;
-                    };
-                    let aj = radius[j].to_f64();
-                    let (ci, crr) = rad.far((alpha_i, aj * aj / 6.0), u);
-                    let (ci, crr) = (T::from_f64(ci * inv_eta), T::from_f64(crr * inv_eta));
-                    let far = |f: T::V3| f * ci + d * (T::dot(d, f) * crr);
-                    let (fi, fj) = (force[i], force[j]);
-                    acc += rpy * fj - far(fj);
-                    match q >= a {
-                        true => add(&mut *r, q - a, rpy * fi - far(fi)),
-                        false => add(&mut *sc, q, rpy * fi - far(fi)),
-                    }
-                };
-                match list {
-                    Some(l) => l.near::<T>(pos[i], &mut pair),
-                    None => (0..i).for_each(&mut pair),
-                }
-                if let Some(e) = err {
-                    return Err(e);
-                }
-                add(&mut *r, k - a, acc);
-            }
-            Ok(())
-        })?;
-        // Each piece's rows gain the later pieces' partial sums, in piece order.
-        let partial = &*partial;
-        let cuts = ((&mut rows_buf[..3 * n], &rows(3) as _), none(), none());
-        pieces::pieces(par, n, cuts, |[a, b], r, _, _| {
-            let mut offset = 0;
-            for t in 0..JOBS {
-                let [at, _] = range(n, t);
-                if at >= b && b > a {
-                    let src = &partial[offset + 3 * a..offset + 3 * b];
-                    r.iter_mut().zip(src).for_each(|(x, s)| *x += *s);
-                }
-                offset += 3 * at;
-            }
-            Ok::<(), Infallible>(())
-        })
-        .map_err(|e| match e {})
-    }
-}
-
-/// Reals of the near part's partial sums for `n` spheres: piece `t` keeps one row for
-/// each sphere of the pieces before it.
-fn partial_len(n: usize) -> usize {
-    (0..JOBS).map(|t| 3 * range(n, t)[0]).sum()
 }
 
 const PI: f64 = core::f64::consts::PI;
