@@ -120,9 +120,7 @@ fn grand_matches_dense_within_tolerance() {
 
 /// With no torque the velocities are the translation product's, to rounding; a lone
 /// sphere turns by Stokes' law `W = T / (8 pi eta a^3)` and a force turns nothing, to
-/// tolerances 1e-3 to 1e-6 (at 1e-8 its error is 1.8e-8: the lone sphere's grid part,
-/// `(a / sigma)^3` times its rotation at the narrowest `sigma`, is where the rule's
-/// margin is thinnest; see docs/FREE.md).
+/// tolerances 1e-3 to 1e-6 (at 1e-8 its error is 1.8e-8, docs/FREE.md "Accuracy").
 #[test]
 fn grand_reduces_to_translation_and_stokes() {
     let (pos, rad, f, _, _) = cloud(200, 10.0, 14);

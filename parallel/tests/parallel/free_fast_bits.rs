@@ -1,5 +1,5 @@
-//! The fast free-space product (`mobility::free_fast`) on a thread pool gives the bits of
-//! one thread: its pieces (near rows and their partial sums, slabs of grid planes,
+//! The fast free-space product (`mobility::free_fast`), and its grand product, on a
+//! thread pool give the bits of one thread: its pieces (near rows and their partial sums, slabs of grid planes,
 //! rounds of `z` lines, interpolation rows) depend on the sizes alone, and each value's
 //! arithmetic is the same in whichever piece it falls.
 
@@ -12,7 +12,7 @@ use hydrorattle_parallel::Threads;
 use crate::fuzz::Rng;
 
 /// `M F` as bits, with `par`, twice on the same storage (the second with the kernel
-/// kept).
+/// kept), then the grand product with torques `f` reversed.
 fn product(
     ff: &FreeFast<f64>,
     pos: &[DVec3],
@@ -21,7 +21,7 @@ fn product(
     par: &dyn Parallel,
 ) -> Vec<u64> {
     let n = pos.len();
-    let size = ff.storage(n);
+    let size = ff.storage_grand(n);
     let mut cx = vec![[0.0; 2]; size.complex];
     let mut re = vec![0.0; size.reals];
     let mut ix = vec![0usize; size.index];
@@ -32,6 +32,15 @@ fn product(
         ff.apply(1.0, pos, rad, f, &mut out, &mut store).unwrap();
         bits.extend(out.iter().flat_map(|u| u.to_array().map(f64::to_bits)));
     }
+    let t: Vec<DVec3> = f.iter().rev().copied().collect();
+    let (mut u, mut w) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+    ff.apply_grand(1.0, (pos, rad), f, &t, &mut u, &mut w, &mut store)
+        .unwrap();
+    bits.extend(
+        u.iter()
+            .chain(&w)
+            .flat_map(|v| v.to_array().map(f64::to_bits)),
+    );
     bits
 }
 
