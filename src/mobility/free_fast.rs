@@ -43,6 +43,8 @@ pub const MAX_TOLERANCE: f64 = 0.1;
 /// Machine epsilons below which no tolerance is accepted (the transforms' rounding, as
 /// in PSE): `f32` takes tolerances from about 1.9e-6 on.
 pub const EPSILONS: f64 = 16.0;
+/// The margin of [`FreeFast::new_grand`]'s rule over [`FreeFast::new`]'s.
+pub const GRAND_MARGIN: f64 = 4.0;
 /// The largest padded grid edge, in points.
 pub const MAX_GRID: usize = 2048;
 /// The largest window per axis, in grid points.
@@ -168,6 +170,8 @@ pub struct FreeFast<T: Real> {
     plan: spectral::Plan,
     r_cut: f64,
     estimate: f64,
+    /// Made by [`FreeFast::new_grand`].
+    grand: bool,
 }
 
 impl<T: Real> FreeFast<T> {
@@ -185,16 +189,35 @@ impl<T: Real> FreeFast<T> {
     ///   `~ erfc(r_c / (2 sqrt(2) sigma))`, below the tolerance, and every overlapping
     ///   pair inside.
     pub fn new(a_max: T, tol: f64, extent: [T; 3], n: usize) -> Result<Self, FreeError> {
+        let sigma = Self::sigma(a_max, extent, n);
+        Self::with_sigma(a_max, tol, extent, sigma)
+    }
+
+    /// [`FreeFast::new`]'s rule with a fourfold margin: parameters for the grand product
+    /// ([`FreeFast::apply_grand`]), whose rotations need it (a lone sphere's rotation
+    /// reaches twice the tolerance under [`FreeFast::new`]'s parameters). They serve
+    /// [`FreeFast::apply`] too, a little more accurately and slowly.
+    pub fn new_grand(a_max: T, tol: f64, extent: [T; 3], n: usize) -> Result<Self, FreeError> {
+        let sigma = Self::sigma(a_max, extent, n);
+        Self::build(a_max, tol, extent, sigma, GRAND_MARGIN)
+    }
+
+    /// The spreading width of [`FreeFast::new`]'s rule.
+    fn sigma(a_max: T, extent: [T; 3], n: usize) -> T {
         let e = extent.map(|e| e.to_f64());
         let a = a_max.to_f64();
         let vol = e.iter().map(|e| e + 2.0 * a).product::<f64>();
-        let sigma = (0.75 * a).max(0.31 * libm::cbrt(vol / n.max(1) as f64));
-        Self::with_sigma(a_max, tol, extent, T::from_f64(sigma))
+        T::from_f64((0.75 * a).max(0.31 * libm::cbrt(vol / n.max(1) as f64)))
     }
 
     /// [`FreeFast::new`]'s parameters for a given spreading width `sigma` (at least
     /// `a_max / 2`: narrower, the sphere factors' growth `(a k)^4` spoils the rule).
     pub fn with_sigma(a_max: T, tol: f64, extent: [T; 3], sigma: T) -> Result<Self, FreeError> {
+        Self::build(a_max, tol, extent, sigma, 1.0)
+    }
+
+    /// The rule at `tol / margin`.
+    fn build(a_max: T, tol: f64, extent: [T; 3], sigma: T, margin: f64) -> Result<Self, FreeError> {
         if !(MIN_TOLERANCE..=MAX_TOLERANCE).contains(&tol) {
             return Err(FreeError::BadParameter("tolerance"));
         }
@@ -212,7 +235,7 @@ impl<T: Real> FreeFast<T> {
         }
         // The truncations' polynomial prefactors: measured errors reach 6 times
         // `exp(-D)` at 1e-3 (a lone sphere), so the rule runs 12 times below the tolerance.
-        let dig = -libm::log(tol) + libm::log(12.0);
+        let dig = -libm::log(tol) + libm::log(12.0 * margin);
         let sigma = sigma.to_f64();
         if !(sigma >= 0.5 * a && sigma.is_finite()) {
             return Err(FreeError::BadParameter("sigma"));
@@ -247,6 +270,7 @@ impl<T: Real> FreeFast<T> {
             plan,
             r_cut,
             estimate: alias + window + near,
+            grand: margin >= GRAND_MARGIN,
         })
     }
 
@@ -314,8 +338,9 @@ impl<T: Real> FreeFast<T> {
     /// `(U, W) = M (F, T)`: the free-space RPY grand mobility (viscosity `eta`) of the
     /// spheres at `pos` with radii `radius` in `(0, a_max]` applied to the forces
     /// `force` and torques `torque`: velocities into `vel`, rotations into `spin`, to
-    /// the tolerance. The storage at least [`FreeFast::storage_grand`]. As
-    /// [`FreeFast::apply`] otherwise.
+    /// the tolerance. The parameters from [`FreeFast::new_grand`] (else
+    /// [`FreeError::BadParameter`]), the storage at least [`FreeFast::storage_grand`].
+    /// As [`FreeFast::apply`] otherwise.
     #[allow(clippy::too_many_arguments)]
     pub fn apply_grand(
         &self,
@@ -327,6 +352,11 @@ impl<T: Real> FreeFast<T> {
         spin: &mut [T::V3],
         store: &mut FreeStorage<'_, T>,
     ) -> Result<(), FreeError> {
+        if !self.grand {
+            return Err(FreeError::BadParameter(
+                "parameters (FreeFast::new_grand's)",
+            ));
+        }
         if torque.len() != pos.len() || spin.len() != pos.len() {
             return Err(FreeError::Length);
         }

@@ -90,7 +90,7 @@ fn params(rad: &[f64], pos: &[DVec3], tol: f64) -> FreeFast<f64> {
     let a_max = rad.iter().cloned().fold(0.0, f64::max);
     let lo = pos.iter().fold(DVec3::INFINITY, |m, p| m.min(*p));
     let hi = pos.iter().fold(DVec3::NEG_INFINITY, |m, p| m.max(*p));
-    FreeFast::new(a_max, tol, (hi - lo).to_array(), pos.len()).unwrap()
+    FreeFast::new_grand(a_max, tol, (hi - lo).to_array(), pos.len()).unwrap()
 }
 
 /// Random polydisperse clouds with overlapping pairs, dense (cell list) and dilute, at
@@ -120,7 +120,7 @@ fn grand_matches_dense_within_tolerance() {
 
 /// With no torque the velocities are the translation product's, to rounding; a lone
 /// sphere turns by Stokes' law `W = T / (8 pi eta a^3)` and a force turns nothing, to
-/// tolerances 1e-3 to 1e-6 (at 1e-8 its error is 1.8e-8, docs/FREE.md "Accuracy").
+/// tolerances 1e-3 to 1e-8; parameters from `FreeFast::new` are refused.
 #[test]
 fn grand_reduces_to_translation_and_stokes() {
     let (pos, rad, f, _, _) = cloud(200, 10.0, 14);
@@ -136,9 +136,14 @@ fn grand_reduces_to_translation_and_stokes() {
     ff.apply(1.0, &pos, &rad, &f, &mut u, &mut store).unwrap();
     let e = rel_err(&got[..n], &u);
     assert!(e < 1e-12, "{e:e}");
-    for tol in [1e-3, 1e-5, 1e-6] {
+    let plain = FreeFast::<f64>::new(1.0, 1e-6, [10.0; 3], n).unwrap();
+    assert!(matches!(
+        fast(&plain, (&pos, &rad), &f, &zero),
+        Err(FreeError::BadParameter(_))
+    ));
+    for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {
         let a = 0.7;
-        let ff = FreeFast::<f64>::new(a, tol, [0.0; 3], 1).unwrap();
+        let ff = FreeFast::<f64>::new_grand(a, tol, [0.0; 3], 1).unwrap();
         let (p, t) = ([DVec3::new(1.0, -2.0, 3.0)], [DVec3::new(0.3, -0.7, 1.1)]);
         let got = fast(&ff, (&p, &[a]), &[DVec3::new(0.5, 0.2, -0.4)], &t).unwrap();
         let want = t[0] / (8.0 * std::f64::consts::PI * a * a * a);

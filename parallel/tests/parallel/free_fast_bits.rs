@@ -62,7 +62,7 @@ fn same_bits_on_any_thread_count() {
         let f: Vec<DVec3> = (0..n)
             .map(|_| f64::v3(s.unit() - 0.5, s.unit() - 0.5, s.unit() - 0.5))
             .collect();
-        let ff = FreeFast::new(1.0, tol, [edge; 3], n).unwrap();
+        let ff = FreeFast::new_grand(1.0, tol, [edge; 3], n).unwrap();
         let one = product(&ff, &pos, &rad, &f, &Serial);
         for t in [1, 2, 3] {
             let pool = Threads::new(t).unwrap();

@@ -17,6 +17,8 @@ use crate::mobility::{Hydro, pair_blocks, pair_tt, self_rr, self_tt};
 use crate::parallel::Parallel;
 use crate::real::Real;
 
+const PI: f64 = core::f64::consts::PI;
+
 /// The spheres and what acts on them: forces, and torques for the grand product.
 #[derive(Clone, Copy)]
 pub(super) struct Spheres<'s, T: Real> {
@@ -119,11 +121,26 @@ impl<T: Real> FreeFast<T> {
                     let nested = FreeError::Particle(ParticleError::Nested { i: j, j: i });
                     let aj = radius[j].to_f64();
                     let alpha = (alpha_i, aj * aj / 6.0);
-                    let (ci, crr) = rad.far(alpha, u);
-                    let (ci, crr) = (sc(ci), sc(crr));
-                    let far = |f: T::V3| f * ci + d * (T::dot(d, f) * crr);
                     let (fi, fj) = (force[i], force[j]);
+                    let (ci, crr) = rad.far(alpha, u);
+                    let far = |f: T::V3| f * sc(ci) + d * (T::dot(d, f) * sc(crr));
                     let Some(tq) = torque else {
+                        if u > (ai.to_f64() + aj) * (ai.to_f64() + aj) {
+                            // Apart: RPY's far branch, `((1 + A / (3 r^2)) I + (1 - A /
+                            // r^2) e e) / (8 pi r)`, less the far block as two scalars in
+                            // f64 (no block formed, no cancellation in `T`).
+                            let a2 = alpha_i * 6.0 + aj * aj;
+                            let c = 1.0 / (8.0 * PI * libm::sqrt(u));
+                            let (ri, rr) = (c * (1.0 + a2 / (3.0 * u)), c * (1.0 - a2 / u) / u);
+                            let (ni, nrr) = (sc(ri - ci), sc(rr - crr));
+                            let near = |f: T::V3| f * ni + d * (T::dot(d, f) * nrr);
+                            acc += near(fj);
+                            match q >= a {
+                                true => put(r, q - a, near(fi), None),
+                                false => put(part, q, near(fi), None),
+                            }
+                            return;
+                        }
                         let Some(rpy) = pair_tt(Hydro::Rpy, eta, ai, radius[j], d) else {
                             err = Some(nested);
                             return;
