@@ -346,7 +346,7 @@ pub(super) fn convolve<T: Real>(
             Ok::<(), Infallible>(())
         });
     }
-    z_convolve(plan, (&mut *spec, &mut *scratch, zbuf), tw, kernel, par);
+    z_convolve(plan, [&mut *spec, &mut *scratch, zbuf], tw, kernel, par);
     let cuts = (
         (spec, &rows(plane) as _),
         (cloud, &rows(3 * mx * my) as _),
@@ -366,7 +366,7 @@ pub(super) fn convolve<T: Real>(
 /// then the pieces by planes write the round back.
 fn z_convolve<T: Real>(
     plan: &Plan,
-    (spec, scratch, zbuf): (&mut [Cx<T>], &mut [Cx<T>], &mut [Cx<T>]),
+    [spec, scratch, zbuf]: [&mut [Cx<T>]; 3],
     tw: Tw<'_, T>,
     kernel: &[T],
     par: &dyn Parallel,
