@@ -1,4 +1,5 @@
-//! A fast free-space RPY product `u = M F` (translation), `O(N log N)`: the
+//! A fast free-space RPY product `u = M F` (translation, [`FreeFast::apply`]) and grand
+//! product `(U, W) = M (F, T)` (rotation too, [`FreeFast::apply_grand`]), `O(N log N)`: the
 //! positively split product of the periodic box ([`crate::mobility::pse`]) carried to
 //! open space.
 //!
@@ -19,7 +20,9 @@
 //! ([`FreeFast::new`], `docs/FREE.md`); [`FreeFast::estimate`] reports the error the
 //! chosen parameters give. The caller owns the storage ([`FreeFast::storage`],
 //! [`FreeStorage`]); the kernel's transform is computed on the first product and kept
-//! there. Serial, in a fixed order: the same inputs give the same bits.
+//! there. Its work runs in a fixed partition of pieces through the storage's
+//! [`Parallel`] ([`FreeStorage::with_parallel`]; `pieces.rs`), each value summed in a
+//! fixed order: the same inputs give the same bits on any number of threads.
 
 mod grid;
 mod near;
