@@ -10,7 +10,8 @@
 //! sums), spreading, the `x` and `y` transforms forward, the `z` lines with the kernel
 //! (in rounds), the `y` and `x` transforms back, interpolation; "serial" is the rest (the
 //! checks, the cell list, the rows put in place). With `HYDRORATTLE_BENCH_MACHINE` set,
-//! the rows go to `bench/results/free_fast_threads.csv`.
+//! the rows go to `bench/results/free_fast_threads.csv`. With `GRAND=1`, the grand
+//! product (`new_grand`'s parameters, torques as well as forces).
 
 mod common;
 #[path = "../../examples/shared/record.rs"]
@@ -93,14 +94,21 @@ fn main() {
             args.join(" ")
         ),
     );
+    let grand = std::env::var("GRAND").is_ok_and(|g| g == "1");
+    let what = if grand { "grand product" } else { "product" };
     let table = format!(
-        "fast free-space RPY product on threads, unit spheres in a ball at volume fraction 0.05, f64, tolerance {tol:e}, wall seconds (best of 3)"
+        "fast free-space RPY {what} on threads, unit spheres in a ball at volume fraction 0.05, f64, tolerance {tol:e}, wall seconds (best of 3)"
     );
     for &n in &ns {
         let (pos, f, radius) = cloud(n, 0.05, 7 + n as u64);
         let rad = vec![1.0; n];
-        let ff = FreeFast::<f64>::new(1.0, tol, [2.0 * radius; 3], n).unwrap();
-        let size = ff.storage(n);
+        let ff = match grand {
+            true => FreeFast::<f64>::new_grand(1.0, tol, [2.0 * radius; 3], n),
+            false => FreeFast::<f64>::new(1.0, tol, [2.0 * radius; 3], n),
+        }
+        .unwrap();
+        let size = ff.storage_grand(n);
+        let torque: Vec<DVec3> = f.iter().rev().copied().collect();
         let mut cx = vec![[0.0; 2]; size.complex];
         let mut re = vec![0.0; size.reals];
         let mut ix = vec![0usize; size.index];
@@ -115,14 +123,18 @@ fn main() {
                 log: Mutex::new(Vec::new()),
             };
             let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix).with_parallel(&timed);
-            let mut out = vec![DVec3::ZERO; n];
+            let (mut out, mut spin) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+            let mut product = |out: &mut [DVec3], store: &mut FreeStorage<'_, f64>| match grand {
+                true => ff.apply_grand(1.0, (&pos, &rad), &f, &torque, out, &mut spin, store),
+                false => ff.apply(1.0, &pos, &rad, &f, out, store),
+            };
             // The first product computes the kernel's transform.
-            ff.apply(1.0, &pos, &rad, &f, &mut out, &mut store).unwrap();
+            product(&mut out, &mut store).unwrap();
             let (mut best, mut split) = (f64::INFINITY, [0.0; 8]);
             for _ in 0..3 {
                 timed.log.lock().unwrap().clear();
                 let t0 = Instant::now();
-                ff.apply(1.0, &pos, &rad, &f, &mut out, &mut store).unwrap();
+                product(&mut out, &mut store).unwrap();
                 let wall = t0.elapsed().as_secs_f64();
                 if wall < best {
                     best = wall;
@@ -132,7 +144,10 @@ fn main() {
             results.push((t, best, split, out));
         }
         let same = results[0].3 == results[1].3;
-        let case = format!("N = {n}");
+        let case = match grand {
+            true => format!("N = {n}, grand product"),
+            false => format!("N = {n}"),
+        };
         for (t, best, split, _) in &results {
             let parts: Vec<String> = PHASES
                 .iter()
@@ -144,12 +159,16 @@ fn main() {
                 ff.grid(),
                 parts.join(", ")
             );
+            let busy: f64 = split.iter().sum();
+            println!("  sum of the phases: {busy:.3} s");
             rows.row(
                 &table,
                 &case,
                 &format!("seconds, one product, {t} thread(s)"),
                 &format!("{best:.3}"),
             );
+            let q = format!("seconds, sum of the phases, {t} thread(s)");
+            rows.row(&table, &case, &q, &format!("{busy:.3}"));
             for (p, s) in PHASES.iter().zip(split) {
                 let q = format!("seconds, {p} (busiest thread), {t} thread(s)");
                 rows.row(&table, &case, &q, &format!("{s:.3}"));
