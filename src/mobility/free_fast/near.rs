@@ -122,7 +122,11 @@ impl<T: Real> FreeFast<T> {
                     let aj = radius[j].to_f64();
                     let alpha = (alpha_i, aj * aj / 6.0);
                     let (fi, fj) = (force[i], force[j]);
-                    let (ci, crr) = rad.far(alpha, u);
+                    // One evaluation of the radial functions for every block.
+                    let ((ci, crr), rot) = match torque {
+                        Some(_) => rad.grand(alpha, u),
+                        None => (rad.far(alpha, u), [0.0; 4]),
+                    };
                     let far = |f: T::V3| f * sc(ci) + d * (T::dot(d, f) * sc(crr));
                     let Some(tq) = torque else {
                         if u > (ai.to_f64() + aj) * (ai.to_f64() + aj) {
@@ -156,7 +160,7 @@ impl<T: Real> FreeFast<T> {
                         err = Some(nested);
                         return;
                     };
-                    let [hi, hj, ri, rrr] = rad.rotation(alpha, u).map(sc);
+                    let [hi, hj, ri, rrr] = rot.map(sc);
                     let rr = |t: T::V3| e.rr * t - (t * ri + d * (T::dot(d, t) * rrr));
                     let (ti, tj) = (tq[i], tq[j]);
                     // `tr_ij = rt_ji^T`: the translation of `i` from the torque on `j`.

@@ -103,7 +103,11 @@ impl Radial {
     /// makes the far field the plain Stokeslet beyond the Gaussian: a Gaussian of
     /// variance `s^2` alone would leave `(s^2 / 2) lap G`, a `1 / r^3` field.
     pub(super) fn far(&self, alpha: (f64, f64), u: f64) -> (f64, f64) {
-        let (d1, d2) = self.derivatives(u);
+        self.far_from(alpha, u, self.derivatives(u))
+    }
+
+    /// [`Radial::far`] from [`Radial::derivatives`] at `u`.
+    fn far_from(&self, alpha: (f64, f64), u: f64, (d1, d2): ([f64; 4], [f64; 4])) -> (f64, f64) {
         let (s, p) = (alpha.0 + alpha.1, alpha.0 * alpha.1);
         let beta = self.beta;
         // lap Phi = psi, lap psi = -g, lap g = zeta.
@@ -126,7 +130,16 @@ impl Radial {
     /// f_uu`. Far away `h = -1 / (8 pi r^3)` and `(3 e e - I) / (16 pi r^3)`: RPY's
     /// rotlet and rotation blocks.
     pub(super) fn rotation(&self, alpha: (f64, f64), u: f64) -> [f64; 4] {
-        let (d1, d2) = self.derivatives(u);
+        self.rotation_from(alpha, u, self.derivatives(u))
+    }
+
+    /// [`Radial::far`] and [`Radial::rotation`] from one evaluation of the functions.
+    pub(super) fn grand(&self, alpha: (f64, f64), u: f64) -> ((f64, f64), [f64; 4]) {
+        let d = self.derivatives(u);
+        (self.far_from(alpha, u, d), self.rotation_from(alpha, u, d))
+    }
+
+    fn rotation_from(&self, alpha: (f64, f64), u: f64, (d1, d2): ([f64; 4], [f64; 4])) -> [f64; 4] {
         let beta = self.beta;
         // lap F = psi - (alpha - beta) g + beta alpha zeta.
         let h = |a: f64| d1[1] - (a - beta) * d1[2] + beta * a * d1[3];
