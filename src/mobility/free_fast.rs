@@ -1,4 +1,5 @@
-//! A fast free-space RPY product `u = M F` (translation), `O(N log N)`: the
+//! A fast free-space RPY product `u = M F` (translation, [`FreeFast::apply`]) and grand
+//! product `(U, W) = M (F, T)` (rotation too, [`FreeFast::apply_grand`]), `O(N log N)`: the
 //! positively split product of the periodic box ([`crate::mobility::pse`]) carried to
 //! open space.
 //!
@@ -19,9 +20,13 @@
 //! ([`FreeFast::new`], `docs/FREE.md`); [`FreeFast::estimate`] reports the error the
 //! chosen parameters give. The caller owns the storage ([`FreeFast::storage`],
 //! [`FreeStorage`]); the kernel's transform is computed on the first product and kept
-//! there. Serial, in a fixed order: the same inputs give the same bits.
+//! there. Its work runs in a fixed partition of pieces through the storage's
+//! [`Parallel`] ([`FreeStorage::with_parallel`]; `pieces.rs`), each value summed in a
+//! fixed order: the same inputs give the same bits on any number of threads.
 
 mod grid;
+mod near;
+mod pieces;
 mod radial;
 mod spectral;
 
@@ -30,8 +35,9 @@ use core::fmt;
 use crate::cell_list::CellList;
 use crate::fault::ParticleError;
 use crate::mobility::pse::fft::Cx;
-use crate::mobility::{Hydro, pair_tt, self_tt};
+use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
+use near::{Spheres, partial_len};
 
 /// The tolerances [`FreeFast::new`] accepts (from [`min_tolerance`] on in the precision).
 pub const MIN_TOLERANCE: f64 = 1e-10;
@@ -40,6 +46,8 @@ pub const MAX_TOLERANCE: f64 = 0.1;
 /// Machine epsilons below which no tolerance is accepted (the transforms' rounding, as
 /// in PSE): `f32` takes tolerances from about 1.9e-6 on.
 pub const EPSILONS: f64 = 16.0;
+/// The margin of [`FreeFast::new_grand`]'s rule over [`FreeFast::new`]'s.
+pub const GRAND_MARGIN: f64 = 4.0;
 /// The largest padded grid edge, in points.
 pub const MAX_GRID: usize = 2048;
 /// The largest window per axis, in grid points.
@@ -110,20 +118,23 @@ impl fmt::Display for FreeError {
 pub struct FreeSize {
     /// Complex values: the padded grid (3 per point), FFT scratch and twiddles.
     pub complex: usize,
-    /// Reals: the kernel's transform (6 per padded point).
+    /// Reals: the kernel's transform (one octant, 6 per point), the cloud's grid (3 per
+    /// point), and per sphere a row of results and the near part's partial sums.
     pub reals: usize,
-    /// Indices: the cell list.
+    /// Indices: the cell list and each sphere's place in it.
     pub index: usize,
 }
 
-/// Caller-owned storage of [`FreeFast::apply`], at least [`FreeFast::storage`]. It keeps
-/// the kernel's transform between products with the same parameters.
+/// Caller-owned storage of [`FreeFast::apply`], at least [`FreeFast::storage`], and the
+/// [`Parallel`] that runs its pieces ([`Serial`] unless [`FreeStorage::with_parallel`]).
+/// It keeps the kernel's transform between products with the same parameters.
 pub struct FreeStorage<'a, T: Real> {
     complex: &'a mut [Cx<T>],
     reals: &'a mut [T],
     index: &'a mut [usize],
     /// The parameters whose kernel `reals` holds.
     ready: Option<[u64; 8]>,
+    parallel: &'a dyn Parallel,
 }
 
 impl<'a, T: Real> FreeStorage<'a, T> {
@@ -134,7 +145,14 @@ impl<'a, T: Real> FreeStorage<'a, T> {
             reals,
             index,
             ready: None,
+            parallel: &Serial,
         }
+    }
+
+    /// Runs the product's pieces through `parallel` (a host's thread pool): the same
+    /// bits as [`Serial`], whatever the number of threads.
+    pub fn with_parallel(self, parallel: &'a dyn Parallel) -> Self {
+        Self { parallel, ..self }
     }
 }
 
@@ -155,6 +173,8 @@ pub struct FreeFast<T: Real> {
     plan: spectral::Plan,
     r_cut: f64,
     estimate: f64,
+    /// Made by [`FreeFast::new_grand`].
+    grand: bool,
 }
 
 impl<T: Real> FreeFast<T> {
@@ -172,16 +192,35 @@ impl<T: Real> FreeFast<T> {
     ///   `~ erfc(r_c / (2 sqrt(2) sigma))`, below the tolerance, and every overlapping
     ///   pair inside.
     pub fn new(a_max: T, tol: f64, extent: [T; 3], n: usize) -> Result<Self, FreeError> {
+        let sigma = Self::sigma(a_max, extent, n);
+        Self::with_sigma(a_max, tol, extent, sigma)
+    }
+
+    /// [`FreeFast::new`]'s rule with a fourfold margin: parameters for the grand product
+    /// ([`FreeFast::apply_grand`]), whose rotations need it (a lone sphere's rotation
+    /// reaches twice the tolerance under [`FreeFast::new`]'s parameters). They serve
+    /// [`FreeFast::apply`] too, a little more accurately and slowly.
+    pub fn new_grand(a_max: T, tol: f64, extent: [T; 3], n: usize) -> Result<Self, FreeError> {
+        let sigma = Self::sigma(a_max, extent, n);
+        Self::build(a_max, tol, extent, sigma, GRAND_MARGIN)
+    }
+
+    /// The spreading width of [`FreeFast::new`]'s rule.
+    fn sigma(a_max: T, extent: [T; 3], n: usize) -> T {
         let e = extent.map(|e| e.to_f64());
         let a = a_max.to_f64();
         let vol = e.iter().map(|e| e + 2.0 * a).product::<f64>();
-        let sigma = (0.75 * a).max(0.31 * libm::cbrt(vol / n.max(1) as f64));
-        Self::with_sigma(a_max, tol, extent, T::from_f64(sigma))
+        T::from_f64((0.75 * a).max(0.31 * libm::cbrt(vol / n.max(1) as f64)))
     }
 
     /// [`FreeFast::new`]'s parameters for a given spreading width `sigma` (at least
     /// `a_max / 2`: narrower, the sphere factors' growth `(a k)^4` spoils the rule).
     pub fn with_sigma(a_max: T, tol: f64, extent: [T; 3], sigma: T) -> Result<Self, FreeError> {
+        Self::build(a_max, tol, extent, sigma, 1.0)
+    }
+
+    /// The rule at `tol / margin`.
+    fn build(a_max: T, tol: f64, extent: [T; 3], sigma: T, margin: f64) -> Result<Self, FreeError> {
         if !(MIN_TOLERANCE..=MAX_TOLERANCE).contains(&tol) {
             return Err(FreeError::BadParameter("tolerance"));
         }
@@ -199,7 +238,7 @@ impl<T: Real> FreeFast<T> {
         }
         // The truncations' polynomial prefactors: measured errors reach 6 times
         // `exp(-D)` at 1e-3 (a lone sphere), so the rule runs 12 times below the tolerance.
-        let dig = -libm::log(tol) + libm::log(12.0);
+        let dig = -libm::log(tol) + libm::log(12.0 * margin);
         let sigma = sigma.to_f64();
         if !(sigma >= 0.5 * a && sigma.is_finite()) {
             return Err(FreeError::BadParameter("sigma"));
@@ -234,6 +273,7 @@ impl<T: Real> FreeFast<T> {
             plan,
             r_cut,
             estimate: alias + window + near,
+            grand: margin >= GRAND_MARGIN,
         })
     }
 
@@ -241,8 +281,16 @@ impl<T: Real> FreeFast<T> {
     pub fn storage(&self, n: usize) -> FreeSize {
         FreeSize {
             complex: self.plan.complex_len(),
-            reals: self.plan.reals_len(),
-            index: 3 * n + 1,
+            reals: self.plan.reals_len() + 3 * n + partial_len(n, 3),
+            index: 4 * n + 1,
+        }
+    }
+
+    /// Storage [`FreeFast::apply_grand`] needs for `n` spheres (and [`FreeFast::apply`]).
+    pub fn storage_grand(&self, n: usize) -> FreeSize {
+        FreeSize {
+            reals: self.plan.reals_len() + 6 * n + partial_len(n, 6),
+            ..self.storage(n)
         }
     }
 
@@ -285,10 +333,81 @@ impl<T: Real> FreeFast<T> {
         out: &mut [T::V3],
         store: &mut FreeStorage<'_, T>,
     ) -> Result<(), FreeError> {
-        let lo = self.check(eta, pos, radius, force, out, store)?;
+        let s = Spheres {
+            pos,
+            radius,
+            force,
+            torque: None,
+        };
+        self.product(eta, s, (out, None), store)
+    }
+
+    /// `(U, W) = M (F, T)`: the free-space RPY grand mobility (viscosity `eta`) of the
+    /// spheres at `pos` with radii `radius` in `(0, a_max]` applied to the forces
+    /// `force` and torques `torque`: velocities into `vel`, rotations into `spin`, to
+    /// the tolerance. The parameters from [`FreeFast::new_grand`] (else
+    /// [`FreeError::BadParameter`]), the storage at least [`FreeFast::storage_grand`].
+    /// As [`FreeFast::apply`] otherwise.
+    #[allow(clippy::too_many_arguments)]
+    pub fn apply_grand(
+        &self,
+        eta: T,
+        (pos, radius): (&[T::V3], &[T]),
+        force: &[T::V3],
+        torque: &[T::V3],
+        vel: &mut [T::V3],
+        spin: &mut [T::V3],
+        store: &mut FreeStorage<'_, T>,
+    ) -> Result<(), FreeError> {
+        if !self.grand {
+            return Err(FreeError::BadParameter(
+                "parameters (FreeFast::new_grand's)",
+            ));
+        }
+        if torque.len() != pos.len() || spin.len() != pos.len() {
+            return Err(FreeError::Length);
+        }
+        let s = Spheres {
+            pos,
+            radius,
+            force,
+            torque: Some(torque),
+        };
+        self.product(eta, s, (vel, Some(spin)), store)
+    }
+
+    /// The near part into the rows, then the far part added, each in a fixed order.
+    fn product(
+        &self,
+        eta: T,
+        s: Spheres<'_, T>,
+        (out, mut spin): (&mut [T::V3], Option<&mut [T::V3]>),
+        store: &mut FreeStorage<'_, T>,
+    ) -> Result<(), FreeError> {
+        let lo = self.check(eta, s, out, store)?;
+        let (n, w) = (s.pos.len(), s.width());
+        let par = store.parallel;
         let cut = T::from_f64(self.r_cut);
-        let list = CellList::build::<T>(pos, None, cut, store.index).map(|(l, _)| l);
-        self.near(eta, pos, radius, force, out, list.as_ref())?;
+        let (cells, rank) = store.index.split_at_mut(3 * n + 1);
+        let rank = &mut rank[..n];
+        let list = CellList::build::<T>(s.pos, None, cut, cells).map(|(l, _)| l);
+        let order = list.as_ref().map(|l| l.order());
+        match order {
+            Some(o) => o.iter().enumerate().for_each(|(k, &i)| rank[i] = k),
+            None => rank.iter_mut().enumerate().for_each(|(i, r)| *r = i),
+        }
+        let at = |k: usize| order.map_or(k, |o| o[k]);
+        let (grid_reals, extra) = store.reals.split_at_mut(self.plan.reals_len());
+        let (rows_buf, partial) = extra.split_at_mut(w * n);
+        let ctx = (list.as_ref(), &*rank);
+        self.near(eta, s, ctx, (&mut *rows_buf, partial), par)?;
+        let v3 = |r: &[T]| T::v3(r[0], r[1], r[2]);
+        for (k, r) in rows_buf.chunks_exact(w).enumerate() {
+            out[at(k)] = v3(r);
+            if let Some(sp) = spin.as_deref_mut() {
+                sp[at(k)] = v3(&r[3..]);
+            }
+        }
         let key = [
             self.plan.p[0] as u64,
             self.plan.p[1] as u64,
@@ -301,21 +420,18 @@ impl<T: Real> FreeFast<T> {
         ];
         if store.ready != Some(key) {
             store.ready = None;
-            grid::kernel(self, store.complex, store.reals);
+            grid::kernel(self, store.complex, grid_reals);
             store.ready = Some(key);
         }
         // Spheres cell by cell: their windows overlap, so the grid stays in cache.
-        let order = list.as_ref().map(|l| l.order());
-        let spheres = (pos, radius, order);
-        grid::far(
-            self,
-            eta,
-            lo,
-            spheres,
-            force,
-            (store.complex, store.reals),
-            out,
-        );
+        let storage = (&mut *store.complex, grid_reals, &mut *rows_buf);
+        grid::far(self, eta, lo, (s, order), storage, par);
+        for (k, r) in rows_buf.chunks_exact(w).enumerate() {
+            out[at(k)] += v3(r);
+            if let Some(sp) = spin.as_deref_mut() {
+                sp[at(k)] += v3(&r[3..]);
+            }
+        }
         Ok(())
     }
 
@@ -324,17 +440,24 @@ impl<T: Real> FreeFast<T> {
     fn check(
         &self,
         eta: T,
-        pos: &[T::V3],
-        radius: &[T],
-        force: &[T::V3],
+        s: Spheres<'_, T>,
         out: &[T::V3],
         store: &FreeStorage<'_, T>,
     ) -> Result<[f64; 3], FreeError> {
+        let Spheres {
+            pos,
+            radius,
+            force,
+            torque,
+        } = s;
         let n = pos.len();
         if radius.len() != n || force.len() != n || out.len() != n {
             return Err(FreeError::Length);
         }
-        let size = self.storage(n);
+        let size = match torque {
+            Some(_) => self.storage_grand(n),
+            None => self.storage(n),
+        };
         let need = [size.complex, size.reals, size.index];
         let have = [store.complex.len(), store.reals.len(), store.index.len()];
         if need.iter().zip(&have).any(|(n, h)| h < n) {
@@ -345,7 +468,8 @@ impl<T: Real> FreeFast<T> {
         }
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
-            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) {
+            let t = torque.map_or(T::V3_ZERO, |t| t[i]);
+            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) || !T::v3_is_finite(t) {
                 return Err(FreeError::Particle(ParticleError::NonFinite {
                     particle: i,
                 }));
@@ -363,68 +487,6 @@ impl<T: Real> FreeFast<T> {
             return Err(FreeError::Extent);
         }
         Ok(lo)
-    }
-
-    /// `out = M^near F`: self blocks, and RPY minus far for pairs within the cutoff.
-    fn near(
-        &self,
-        eta: T,
-        pos: &[T::V3],
-        radius: &[T],
-        force: &[T::V3],
-        out: &mut [T::V3],
-        list: Option<&CellList<'_>>,
-    ) -> Result<(), FreeError> {
-        let rad = radial::Radial::new(
-            1.0 / (2.0 * SQRT_2 * self.sigma),
-            2.0 * self.sigma * self.sigma,
-        );
-        let cut2 = self.r_cut * self.r_cut;
-        let inv_eta = 1.0 / eta.to_f64();
-        for (i, o) in out.iter_mut().enumerate() {
-            let alpha = radius[i].to_f64() * radius[i].to_f64() / 6.0;
-            let (c_self, _) = rad.far((alpha, alpha), 0.0);
-            *o = force[i] * (self_tt(eta, radius[i]) - T::from_f64(c_self * inv_eta));
-        }
-        // Each pair once (`j < i`), its symmetric block applied both ways; rows cell by
-        // cell, so the neighbours of consecutive rows are near in memory.
-        for k in 0..pos.len() {
-            let i = list.map_or(k, |l| l.order()[k]);
-            let ai = radius[i];
-            let alpha_i = ai.to_f64() * ai.to_f64() / 6.0;
-            let mut acc = T::V3_ZERO;
-            let mut err = None;
-            let mut pair = |j: usize| {
-                if j >= i || err.is_some() {
-                    return;
-                }
-                let r = pos[i] - pos[j];
-                let u = T::norm2(r).to_f64();
-                if u >= cut2 {
-                    return;
-                }
-                let Some(rpy) = pair_tt(Hydro::Rpy, eta, ai, radius[j], r) else {
-                    err = Some(FreeError::Particle(ParticleError::Nested { i: j, j: i }));
-                    return;
-                };
-                let aj = radius[j].to_f64();
-                let (ci, crr) = rad.far((alpha_i, aj * aj / 6.0), u);
-                let (ci, crr) = (T::from_f64(ci * inv_eta), T::from_f64(crr * inv_eta));
-                let far = |f: T::V3| f * ci + r * (T::dot(r, f) * crr);
-                let (fi, fj) = (force[i], force[j]);
-                acc += rpy * fj - far(fj);
-                out[j] += rpy * fi - far(fi);
-            };
-            match list {
-                Some(l) => l.near::<T>(pos[i], &mut pair),
-                None => (0..i).for_each(&mut pair),
-            }
-            if let Some(e) = err {
-                return Err(e);
-            }
-            out[i] += acc;
-        }
-        Ok(())
     }
 }
 

@@ -29,6 +29,8 @@ mod fast_step;
 mod free_draining;
 #[cfg(feature = "fast-free")]
 mod free_fast;
+#[cfg(feature = "fast-free")]
+mod free_fast_grand;
 mod fuzz_step;
 mod helix;
 mod inertial_thermal;

@@ -11,6 +11,7 @@ mod bits;
 mod block;
 mod compact;
 mod ewald_bits;
+mod free_fast_bits;
 mod pair_bits;
 mod pool;
 mod pse_bits;

@@ -103,7 +103,11 @@ impl Radial {
     /// makes the far field the plain Stokeslet beyond the Gaussian: a Gaussian of
     /// variance `s^2` alone would leave `(s^2 / 2) lap G`, a `1 / r^3` field.
     pub(super) fn far(&self, alpha: (f64, f64), u: f64) -> (f64, f64) {
-        let (d1, d2) = self.derivatives(u);
+        self.far_from(alpha, u, self.derivatives(u))
+    }
+
+    /// [`Radial::far`] from [`Radial::derivatives`] at `u`.
+    fn far_from(&self, alpha: (f64, f64), u: f64, (d1, d2): ([f64; 4], [f64; 4])) -> (f64, f64) {
         let (s, p) = (alpha.0 + alpha.1, alpha.0 * alpha.1);
         let beta = self.beta;
         // lap Phi = psi, lap psi = -g, lap g = zeta.
@@ -111,6 +115,36 @@ impl Radial {
         let f_u: f64 = (0..4).map(|k| c[k] * d1[k]).sum();
         let f_uu: f64 = (0..4).map(|k| c[k] * d2[k]).sum();
         (4.0 * f_u + 4.0 * u * f_uu, -4.0 * f_uu)
+    }
+
+    /// The far part's rotation scalars at `u = r^2`, with `r = x_i - x_j`: `[h_i, h_j,
+    /// c_I, c_rr]`, the rotation of `i` from a force on `j` being `h_j r x F` (and the
+    /// translation of `i` from a torque on `j`, `h_i r x T`), and from a torque
+    /// `(c_I I + c_rr r r^T) T` (all over `eta`).
+    ///
+    /// A torque is the force density `curl(T g) / 2` and a rotation half the curl of
+    /// the velocity, so with `G = (I lap - grad grad) F`: `curl (G F) / 2 = (lap F)_u r x
+    /// F` for `F = (1 - beta lap)(1 + alpha lap) Phi` (the sphere factor on the
+    /// translating side alone), and `curl curl (G T) / 4 = (grad grad f - I lap f) T / 4`
+    /// for `f = lap F = psi + beta g` (no sphere factor): `c_I = -f_u - u f_uu`, `c_rr =
+    /// f_uu`. Far away `h = -1 / (8 pi r^3)` and `(3 e e - I) / (16 pi r^3)`: RPY's
+    /// rotlet and rotation blocks.
+    pub(super) fn rotation(&self, alpha: (f64, f64), u: f64) -> [f64; 4] {
+        self.rotation_from(alpha, u, self.derivatives(u))
+    }
+
+    /// [`Radial::far`] and [`Radial::rotation`] from one evaluation of the functions.
+    pub(super) fn grand(&self, alpha: (f64, f64), u: f64) -> ((f64, f64), [f64; 4]) {
+        let d = self.derivatives(u);
+        (self.far_from(alpha, u, d), self.rotation_from(alpha, u, d))
+    }
+
+    fn rotation_from(&self, alpha: (f64, f64), u: f64, (d1, d2): ([f64; 4], [f64; 4])) -> [f64; 4] {
+        let beta = self.beta;
+        // lap F = psi - (alpha - beta) g + beta alpha zeta.
+        let h = |a: f64| d1[1] - (a - beta) * d1[2] + beta * a * d1[3];
+        let (f_u, f_uu) = (d1[1] + beta * d1[2], d2[1] + beta * d2[2]);
+        [h(alpha.0), h(alpha.1), -f_u - u * f_uu, f_uu]
     }
 }
 
@@ -166,5 +200,13 @@ mod tests {
         let want_rr = (1.0 - a2 / (r * r)) / (8.0 * PI * r * r * r);
         assert!((ci - want_i).abs() <= 1e-13 * want_i, "{ci} {want_i}");
         assert!((crr - want_rr).abs() <= 1e-13 * want_rr, "{crr} {want_rr}");
+        // The rotlet `-1 / (8 pi r^3)` (of `r x F`) and `(3 e e - I) / (16 pi r^3)`.
+        let [hi, hj, ri, rrr] = rad.rotation((ai * ai / 6.0, aj * aj / 6.0), r * r);
+        let rot = -1.0 / (8.0 * PI * r * r * r);
+        let rr_i = -1.0 / (16.0 * PI * r * r * r);
+        let rr_rr = 3.0 / (16.0 * PI * r * r * r * r * r);
+        for (got, want) in [(hi, rot), (hj, rot), (ri, rr_i), (rrr, rr_rr)] {
+            assert!((got - want).abs() <= 1e-13 * want.abs(), "{got} {want}");
+        }
     }
 }

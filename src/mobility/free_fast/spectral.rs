@@ -19,7 +19,11 @@
 //! Every line's arithmetic is its own and the lines run in a fixed order: the same
 //! inputs give the same bits.
 
+use core::convert::Infallible;
+
+use super::pieces::{JOBS, fixed, none, pieces, range, rows};
 use crate::mobility::pse::fft::{CHUNK, Cx, Factors, good_size, transform};
+use crate::parallel::Parallel;
 use crate::real::Real;
 
 /// The padded transform's shape.
@@ -33,14 +37,29 @@ pub(super) struct Plan {
     factors: [Factors; 3],
 }
 
-/// The parts of the complex storage: spectrum, two scratch buffers, twiddles of the
-/// half `x` length, of `p_x` (`k <= p_x / 2`), `p_y` and `p_z`.
+/// The parts of the complex storage: spectrum, each piece's two scratch buffers and
+/// its share of a round of `z` lines ([`Plan::round`]), twiddles of the half `x`
+/// length, of `p_x` (`k <= p_x / 2`), `p_y` and `p_z`.
 struct Parts<'c, T> {
     spec: &'c mut [Cx<T>],
-    a: &'c mut [Cx<T>],
-    b: &'c mut [Cx<T>],
-    tw: [&'c [Cx<T>]; 4],
+    scratch: &'c mut [Cx<T>],
+    zbuf: &'c mut [Cx<T>],
+    tw: Tw<'c, T>,
 }
+
+/// The twiddles.
+type Tw<'c, T> = [&'c [Cx<T>]; 4];
+
+/// One piece's scratch: two buffers of [`Plan::scratch`] values.
+type Scratch<'s, T> = (&'s mut [Cx<T>], &'s mut [Cx<T>]);
+
+fn halves<T>(s: &mut [Cx<T>]) -> Scratch<'_, T> {
+    let n = s.len() / 2;
+    s.split_at_mut(n)
+}
+
+/// `z` lines per piece and round (a multiple of the batch `CHUNK / 3`).
+const ROUND: usize = 4 * (CHUNK / 3);
 
 /// Kernel components: `xx, yy, zz, xy, xz, yz`, by pairs of axes.
 pub(super) const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
@@ -77,11 +96,22 @@ impl Plan {
         CHUNK * (self.p[0] / 2).max(self.p[1]).max(self.p[2])
     }
 
-    /// Complex values needed: the spectrum of the cloud's planes (3 per point), the
-    /// scratch and the twiddles.
+    /// A piece's share of a round of `z` lines: [`ROUND`] lines of the cloud's planes.
+    fn round(&self) -> usize {
+        3 * ROUND * self.m[2]
+    }
+
+    /// Values of one spectral plane.
+    fn plane(&self) -> usize {
+        3 * self.hx() * self.p[1]
+    }
+
+    /// Complex values needed: the spectrum of the cloud's planes (3 per point), each
+    /// piece's scratch and round, and the twiddles.
     pub(super) fn complex_len(&self) -> usize {
         let [px, py, pz] = self.p;
-        3 * self.hx() * py * self.m[2] + 2 * self.scratch() + px / 2 + self.hx() + py + pz
+        let pieces = JOBS * (2 * self.scratch() + self.round());
+        self.plane() * self.m[2] + pieces + px / 2 + self.hx() + py + pz
     }
 
     /// Reals needed: the kernel's octant (6 per point) and the cloud's grid (3 per point).
@@ -99,9 +129,9 @@ impl Plan {
 
     fn parts<'c, T: Real>(&self, cx: &'c mut [Cx<T>]) -> Parts<'c, T> {
         let [px, py, pz] = self.p;
-        let (spec, rest) = cx.split_at_mut(3 * self.hx() * py * self.m[2]);
-        let (a, rest) = rest.split_at_mut(self.scratch());
-        let (b, rest) = rest.split_at_mut(self.scratch());
+        let (spec, rest) = cx.split_at_mut(self.plane() * self.m[2]);
+        let (scratch, rest) = rest.split_at_mut(JOBS * 2 * self.scratch());
+        let (zbuf, rest) = rest.split_at_mut(JOBS * self.round());
         let (th, rest) = rest.split_at_mut(px / 2);
         let (tx, rest) = rest.split_at_mut(self.hx());
         let (ty, rest) = rest.split_at_mut(py);
@@ -120,8 +150,8 @@ impl Plan {
         let [th, tx, ty, tz] = [th, tx, ty, tz].map(|t| &*t);
         Parts {
             spec,
-            a,
-            b,
+            scratch,
+            zbuf,
             tw: [th, tx, ty, tz],
         }
     }
@@ -132,13 +162,15 @@ impl Plan {
     /// stride `hx p_y`).
     fn x_forward<T: Real>(
         &self,
-        parts: &mut Parts<'_, T>,
+        (a, b): Scratch<'_, T>,
+        tw: Tw<'_, T>,
+        spec: &mut [Cx<T>],
         (comps, lines, nx): (usize, [usize; 2], usize),
         value: impl Fn(usize, usize, usize, usize) -> T,
     ) {
         let (h, hx, py) = (self.p[0] / 2, self.hx(), self.p[1]);
         let total = comps * lines[0] * lines[1];
-        let [th, tx, _, _] = parts.tw;
+        let [th, tx, _, _] = tw;
         let mut first = 0;
         while first < total {
             let batch = CHUNK.min(total - first);
@@ -150,20 +182,20 @@ impl Plan {
                 for l in 0..batch {
                     let (c, y, z) = at(l);
                     let v = |x: usize| if x < nx { value(c, x, y, z) } else { T::ZERO };
-                    parts.a[j * batch + l] = [v(2 * j), v(2 * j + 1)];
+                    a[j * batch + l] = [v(2 * j), v(2 * j + 1)];
                 }
             }
             let n = h * batch;
             let in_b = transform(
-                &mut parts.a[..n],
-                &mut parts.b[..n],
+                &mut a[..n],
+                &mut b[..n],
                 h,
                 batch,
                 &self.factors[0],
                 th,
                 false,
             );
-            let out: &[Cx<T>] = if in_b { &*parts.b } else { &*parts.a };
+            let out: &[Cx<T>] = if in_b { &*b } else { &*a };
             for k in 0..hx {
                 for l in 0..batch {
                     let (c, y, z) = at(l);
@@ -178,7 +210,7 @@ impl Plan {
                         e[0] + w[0] * o[0] - w[1] * o[1],
                         e[1] + w[0] * o[1] + w[1] * o[0],
                     ];
-                    parts.spec[(k + hx * (y + py * z)) * comps + c] = x;
+                    spec[(k + hx * (y + py * z)) * comps + c] = x;
                 }
             }
             first += batch;
@@ -187,11 +219,17 @@ impl Plan {
 
     /// The inverse of [`Plan::x_forward`] on the cloud's lines (3 components): `out(c, x,
     /// y, z, value)` for `x < m_x`, unnormalised (`p_x` times the line's values).
-    fn x_inverse<T: Real>(&self, parts: &mut Parts<'_, T>, mut out: impl FnMut(usize, T)) {
+    fn x_inverse<T: Real>(
+        &self,
+        (a, b): Scratch<'_, T>,
+        tw: Tw<'_, T>,
+        (spec, mz): (&[Cx<T>], usize),
+        mut out: impl FnMut(usize, T),
+    ) {
         let (h, hx, py) = (self.p[0] / 2, self.hx(), self.p[1]);
-        let [mx, my, mz] = self.m;
+        let [mx, my, _] = self.m;
         let total = 3 * my * mz;
-        let [th, tx, _, _] = parts.tw;
+        let [th, tx, _, _] = tw;
         let mut first = 0;
         while first < total {
             let batch = CHUNK.min(total - first);
@@ -203,27 +241,27 @@ impl Plan {
                 for l in 0..batch {
                     let (c, y, z) = at(l);
                     let row = hx * (y + py * z);
-                    let xk = parts.spec[(k + row) * 3 + c];
-                    let xc = parts.spec[(h - k + row) * 3 + c];
+                    let xk = spec[(k + row) * 3 + c];
+                    let xc = spec[(h - k + row) * 3 + c];
                     // `Z_k = (X_k + conj X_{h-k}) + i w^{-k} (X_k - conj X_{h-k})`.
                     let s = [xk[0] + xc[0], xk[1] - xc[1]];
                     let d = [xk[0] - xc[0], xk[1] + xc[1]];
                     let w = tx[k];
                     let wd = [w[0] * d[0] + w[1] * d[1], w[0] * d[1] - w[1] * d[0]];
-                    parts.a[k * batch + l] = [s[0] - wd[1], s[1] + wd[0]];
+                    a[k * batch + l] = [s[0] - wd[1], s[1] + wd[0]];
                 }
             }
             let n = h * batch;
             let in_b = transform(
-                &mut parts.a[..n],
-                &mut parts.b[..n],
+                &mut a[..n],
+                &mut b[..n],
                 h,
                 batch,
                 &self.factors[0],
                 th,
                 true,
             );
-            let res: &[Cx<T>] = if in_b { &*parts.b } else { &*parts.a };
+            let res: &[Cx<T>] = if in_b { &*b } else { &*a };
             for j in 0..h {
                 for l in 0..batch {
                     let (c, y, z) = at(l);
@@ -245,7 +283,9 @@ impl Plan {
     /// times `sign`; `None`: zero), points `j < keep` written back.
     fn y_pass<T: Real>(
         &self,
-        parts: &mut Parts<'_, T>,
+        scratch: Scratch<'_, T>,
+        tw: Tw<'_, T>,
+        spec: &mut [Cx<T>],
         (planes, inverse): (usize, bool),
         load: impl Fn(usize, usize) -> Option<(usize, T)>,
         keep: usize,
@@ -253,13 +293,12 @@ impl Plan {
         let (hx, py) = (self.hx(), self.p[1]);
         // Line `l = c + 3 (k + hx z)`: point `j` at `3 (k + hx (j + py z)) + c`.
         let at = |l: usize, j: usize| (l % (3 * hx)) + 3 * hx * (j + py * (l / (3 * hx)));
-        let axis = (py, &self.factors[1], parts.tw[2], inverse);
-        let scratch = (&mut *parts.a, &mut *parts.b);
+        let axis = (py, &self.factors[1], tw[2], inverse);
         lines(
             scratch,
             axis,
             3 * hx * planes,
-            &mut *parts.spec,
+            spec,
             |spec, l, j| {
                 load(l % 3, j).map_or([T::ZERO; 2], |(jj, s)| {
                     let v = spec[at(l, jj)];
@@ -274,48 +313,138 @@ impl Plan {
 
 /// `cloud` (3 reals per cloud grid point, `x` fastest) convolved with the kernel whose
 /// octant `kernel` holds ([`kernel`]), in place, unnormalised as the kernel is scaled.
-pub(super) fn convolve<T: Real>(plan: &Plan, cx: &mut [Cx<T>], kernel: &[T], cloud: &mut [T]) {
-    let mut parts = plan.parts(cx);
+/// The `x` and `y` passes by slabs of the cloud's planes, the `z` lines by rounds
+/// ([`z_convolve`]), each piece through `par`.
+pub(super) fn convolve<T: Real>(
+    plan: &Plan,
+    cx: &mut [Cx<T>],
+    kernel: &[T],
+    cloud: &mut [T],
+    par: &dyn Parallel,
+) {
+    let Parts {
+        spec,
+        scratch,
+        zbuf,
+        tw,
+    } = plan.parts(cx);
     let [mx, my, mz] = plan.m;
     let py = plan.p[1];
-    plan.x_forward(&mut parts, (3, [my, mz], mx), |c, x, y, z| {
-        cloud[3 * (x + mx * (y + my * z)) + c]
-    });
-    plan.y_pass(
-        &mut parts,
-        (mz, false),
-        |_, j| (j < my).then_some((j, T::ONE)),
-        py,
+    let (plane, each) = (plan.plane(), 2 * plan.scratch());
+    {
+        let cloud = &*cloud;
+        let cuts = (
+            (&mut *spec, &rows(plane) as _),
+            (&mut *scratch, &fixed(each) as _),
+            none(),
+        );
+        let _ = pieces(par, mz, cuts, |[z0, z1], sp, scr, _| {
+            let value = |c, x, y, z| cloud[3 * (x + mx * (y + my * (z0 + z))) + c];
+            plan.x_forward(halves(scr), tw, sp, (3, [my, z1 - z0], mx), value);
+            let load = |_, j| (j < my).then_some((j, T::ONE));
+            plan.y_pass(halves(scr), tw, sp, (z1 - z0, false), load, py);
+            Ok::<(), Infallible>(())
+        });
+    }
+    z_convolve(plan, [&mut *spec, &mut *scratch, zbuf], tw, kernel, par);
+    let cuts = (
+        (spec, &rows(plane) as _),
+        (cloud, &rows(3 * mx * my) as _),
+        (scratch, &fixed(each) as _),
     );
-    z_convolve(plan, &mut parts, kernel);
-    plan.y_pass(&mut parts, (mz, true), |_, j| Some((j, T::ONE)), my);
-    plan.x_inverse(&mut parts, |q, v| cloud[q] = v);
+    let _ = pieces(par, mz, cuts, |[z0, z1], sp, cl, scr| {
+        let load = |_, j| Some((j, T::ONE));
+        plan.y_pass(halves(scr), tw, sp, (z1 - z0, true), load, my);
+        plan.x_inverse(halves(scr), tw, (sp, z1 - z0), |q, v| cl[q] = v);
+        Ok::<(), Infallible>(())
+    });
 }
 
 /// Along `z`, every line of the spectrum: forward, the kernel applied, inverse; the
-/// cloud's planes written back.
-fn z_convolve<T: Real>(plan: &Plan, parts: &mut Parts<'_, T>, kernel: &[T]) {
+/// cloud's planes written back. The lines run in rounds of [`ROUND`] per piece: the
+/// pieces read the spectrum and keep their lines' results in their share of `zbuf`,
+/// then the pieces by planes write the round back.
+fn z_convolve<T: Real>(
+    plan: &Plan,
+    [spec, scratch, zbuf]: [&mut [Cx<T>]; 3],
+    tw: Tw<'_, T>,
+    kernel: &[T],
+    par: &dyn Parallel,
+) {
+    let (hx, mz) = (plan.hx(), plan.m[2]);
+    let points = hx * plan.p[1];
+    let (plane, each, share) = (plan.plane(), 2 * plan.scratch(), plan.round());
+    let mut g0 = 0;
+    while g0 < points {
+        let gn = (JOBS * ROUND).min(points - g0);
+        {
+            let spec = &*spec;
+            let cuts = (
+                (&mut *zbuf, &fixed(share) as _),
+                (&mut *scratch, &fixed(each) as _),
+                none(),
+            );
+            let _ = pieces(par, gn, cuts, |[a, b], out, scr, _| {
+                z_lines(
+                    plan,
+                    (spec, out),
+                    halves(scr),
+                    tw[3],
+                    kernel,
+                    [g0 + a, b - a],
+                );
+                Ok::<(), Infallible>(())
+            });
+        }
+        let zbuf = &*zbuf;
+        let cuts = ((&mut *spec, &rows(plane) as _), none(), none());
+        let _ = pieces(par, mz, cuts, |[z0, z1], sp, _, _| {
+            for z in z0..z1 {
+                for t in 0..JOBS {
+                    let [a, b] = range(gn, t);
+                    let n = 3 * (b - a);
+                    let src = &zbuf[t * share + z * n..][..n];
+                    sp[(z - z0) * plane + 3 * (g0 + a)..][..n].copy_from_slice(src);
+                }
+            }
+            Ok::<(), Infallible>(())
+        });
+        g0 += gn;
+    }
+}
+
+/// The `z` lines of the points `first .. first + count` (`x + h_x y`) of `spec`: forward,
+/// the kernel applied, inverse; the cloud's planes into `out` (plane `z` at `3 count
+/// z`, 3 values a point).
+fn z_lines<T: Real>(
+    plan: &Plan,
+    (spec, out): (&[Cx<T>], &mut [Cx<T>]),
+    (a, b): Scratch<'_, T>,
+    tz: &[Cx<T>],
+    kernel: &[T],
+    [first, count]: [usize; 2],
+) {
     let (hx, [_, py, pz], mz) = (plan.hx(), plan.p, plan.m[2]);
     let oy = plan.octant()[0];
     let points = hx * py;
     let per = CHUNK / 3;
-    let tz = parts.tw[3];
-    let mut first = 0;
-    while first < points {
-        let np = per.min(points - first);
+    let mut q0 = 0;
+    while q0 < count {
+        let np = per.min(count - q0);
         let batch = 3 * np;
+        let p0 = first + q0;
         for j in 0..pz {
             for l in 0..batch {
-                parts.a[j * batch + l] = match j < mz {
-                    true => parts.spec[3 * (first + points * j) + l],
+                a[j * batch + l] = match j < mz {
+                    true => spec[3 * (p0 + points * j) + l],
                     false => [T::ZERO; 2],
                 };
             }
         }
         let n = pz * batch;
         let in_b = transform(
-            &mut parts.a[..n],
-            &mut parts.b[..n],
+            &mut a[..n],
+            &mut b[..n],
             pz,
             batch,
             &plan.factors[2],
@@ -323,13 +452,13 @@ fn z_convolve<T: Real>(plan: &Plan, parts: &mut Parts<'_, T>, kernel: &[T]) {
             false,
         );
         let (x, other) = match in_b {
-            true => (&mut parts.b[..n], &mut parts.a[..n]),
-            false => (&mut parts.a[..n], &mut parts.b[..n]),
+            true => (&mut b[..n], &mut a[..n]),
+            false => (&mut a[..n], &mut b[..n]),
         };
         for kz in 0..pz {
             let (oz, sz) = fold(kz, pz);
             for q in 0..np {
-                let p = first + q;
+                let p = p0 + q;
                 let (oy_, sy) = fold(p / hx, py);
                 let kq = 6 * (p % hx + hx * (oy_ + oy * oz));
                 let k = &kernel[kq..kq + 6];
@@ -346,13 +475,11 @@ fn z_convolve<T: Real>(plan: &Plan, parts: &mut Parts<'_, T>, kernel: &[T]) {
             }
         }
         let back = transform(x, other, pz, batch, &plan.factors[2], tz, true);
-        let out: &[Cx<T>] = if back { &*other } else { &*x };
+        let res: &[Cx<T>] = if back { &*other } else { &*x };
         for j in 0..mz {
-            for l in 0..batch {
-                parts.spec[3 * (first + points * j) + l] = out[j * batch + l];
-            }
+            out[3 * count * j + 3 * q0..][..batch].copy_from_slice(&res[j * batch..][..batch]);
         }
-        first += np;
+        q0 += np;
     }
 }
 
@@ -375,7 +502,7 @@ pub(super) fn kernel<T: Real>(
     table: &[T],
     (h, weight): (f64, f64),
 ) {
-    let mut parts = plan.parts(cx);
+    let parts = plan.parts(cx);
     let [mx, my, mz] = plan.m;
     let [px, py, pz] = plan.p;
     let hx = plan.hx();
@@ -391,31 +518,38 @@ pub(super) fn kernel<T: Real>(
         _ if j + m > p => Some((p - j, if odd { -T::ONE } else { T::ONE })),
         _ => None,
     };
+    let each = 2 * plan.scratch();
     for half in 0..2 {
-        plan.x_forward(&mut parts, (3, [my, mz], px), |c, x, y, z| {
-            let Some((ax, sx)) = mirror(x, px, mx, odd(half, c, 0)) else {
-                return T::ZERO;
-            };
-            let t = 2 * (ax + mx * (y + my * z));
-            let (ci, crr) = (table[t], table[t + 1]);
-            let d = [
-                T::from_f64(ax as f64) * h,
-                T::from_f64(y as f64) * h,
-                T::from_f64(z as f64) * h,
-            ];
-            let (k, l) = PAIRS[3 * half + c];
-            let diag = if k == l { ci } else { T::ZERO };
-            (diag + crr * d[k] * d[l]) * weight * sx
-        });
+        let scr = &mut parts.scratch[..each];
+        plan.x_forward(
+            halves(scr),
+            parts.tw,
+            parts.spec,
+            (3, [my, mz], px),
+            |c, x, y, z| {
+                let Some((ax, sx)) = mirror(x, px, mx, odd(half, c, 0)) else {
+                    return T::ZERO;
+                };
+                let t = 2 * (ax + mx * (y + my * z));
+                let (ci, crr) = (table[t], table[t + 1]);
+                let d = [
+                    T::from_f64(ax as f64) * h,
+                    T::from_f64(y as f64) * h,
+                    T::from_f64(z as f64) * h,
+                ];
+                let (k, l) = PAIRS[3 * half + c];
+                let diag = if k == l { ci } else { T::ZERO };
+                (diag + crr * d[k] * d[l]) * weight * sx
+            },
+        );
         let load_y = |c: usize, j: usize| mirror(j, py, my, odd(half, c, 1));
-        plan.y_pass(&mut parts, (mz, false), load_y, oy);
+        plan.y_pass(halves(scr), parts.tw, parts.spec, (mz, false), load_y, oy);
         // Along `z`, the lines `(c, k, ky)` of the octant, into `kernel`.
         let at = |l: usize| (l % 3, (l / 3) % hx, l / (3 * hx));
         let axis = (pz, &plan.factors[2], parts.tw[3], false);
-        let scratch = (&mut *parts.a, &mut *parts.b);
         let data = (&*parts.spec, &mut *kernel);
         lines(
-            scratch,
+            halves(scr),
             axis,
             3 * hx * oy,
             data,
