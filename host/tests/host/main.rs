@@ -8,6 +8,8 @@ mod fuzz;
 
 mod auto;
 mod box_sweep;
+mod cloud;
+mod falling_cloud;
 mod fuzz_scene;
 mod jam_retry;
 mod layers;
