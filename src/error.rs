@@ -342,6 +342,40 @@ impl From<crate::mobility::pse::PseError> for StepError {
     }
 }
 
+/// A fast free-space product's error as the step's own
+/// ([`crate::mobility::free_fast::FreeError`]): particles as the pair blocks', the rest
+/// named (no new variant reaches callers' matches).
+#[cfg(feature = "fast-free")]
+impl From<crate::mobility::free_fast::FreeError> for StepError {
+    fn from(e: crate::mobility::free_fast::FreeError) -> Self {
+        use crate::mobility::free_fast::FreeError as E;
+        match e {
+            E::BadParameter("tolerance") => Self::BadParameter(
+                "pse (the fast free-space product's tolerance, mobility::free_fast::MIN_TOLERANCE to MAX_TOLERANCE)",
+            ),
+            E::BadParameter("viscosity") => Self::BadParameter("viscosity"),
+            E::BadParameter(_) => Self::BadParameter(
+                "the fast free-space product's parameters (a largest radius and a cloud's extent finite and > 0)",
+            ),
+            E::Precision { .. } => Self::BadParameter(
+                "a fast free-space tolerance below what the precision can reach (mobility::free_fast::min_tolerance)",
+            ),
+            E::GridTooLarge => Self::Unsupported(
+                "a fast free-space tolerance and cloud whose grid exceeds the bounds (mobility::free_fast::MAX_GRID, MAX_SUPPORT)",
+            ),
+            E::Length => Self::StateLength,
+            E::Particle(e) => Self::Particle(e),
+            E::Radius { particle } => Self::Particle(ParticleError::BadRadius { particle }),
+            E::Extent => Self::Unsupported(
+                "a fast free-space product beyond the cloud's extent widened by integrate::FAST_MARGIN radii (a step's trial positions that far from its start)",
+            ),
+            E::Storage { .. } => Self::BadParameter(
+                "the workspace's fast free-space storage (Workspace::with_fast, at least integrate::fast_storage)",
+            ),
+        }
+    }
+}
+
 /// A failed Lanczos square root (the noise's, or PSE's real part's) as the step's error,
 /// at the mobility stage.
 impl From<crate::noise::lanczos::LanczosError> for StepError {

@@ -295,17 +295,24 @@ pub struct Params<T: Real> {
     /// [`StepReport::max_tension`](crate::StepReport::max_tension). The other methods
     /// ignore it. Default: on in `f32`, off in `f64` (where both agree to rounding).
     pub resolve_tensions: bool,
-    /// Sum the periodic box's mobility by PSE, the `O(N log N)` fast path
-    /// ([`mobility::pse`](crate::mobility::pse), kernel feature `pse`), to this relative
-    /// tolerance (`1e-3` to `1e-6` measured; `docs/PERIODIC.md`), instead of the exact
-    /// Ewald sums. PSE gives products only, so it needs [`Params::matrix_free`]
-    /// ([`Method::Overdamped`], [`Method::Springs`]; the noise by Lanczos from PSE
-    /// products) and, with constraints, the Krylov solver ([`SolverKind::Auto`]
-    /// resolves to it); the rest is refused with
-    /// [`StepError::Unsupported`](crate::StepError::Unsupported). Its storage is the
-    /// caller's ([`Workspace::with_pse`](crate::Workspace::with_pse), sized by
-    /// [`pse_storage`](crate::integrate::pse_storage)). Read only with a box (and not
-    /// with free draining). Default `None`: the Ewald sums, the same bits as before.
+    /// The `O(N log N)` fast product, to this relative tolerance. In a periodic box:
+    /// its mobility summed by PSE ([`mobility::pse`](crate::mobility::pse), kernel
+    /// feature `pse`; `1e-3` to `1e-6` measured, `docs/PERIODIC.md`) instead of the
+    /// exact Ewald sums. In free space (no box, no wall): the fast free-space RPY
+    /// product ([`mobility::free_fast`](crate::mobility::free_fast), kernel feature
+    /// `fast-free`; `docs/FREE.md`, "Steps on the fast product") instead of the pair
+    /// blocks, with [`Hydro::Rpy`] (Oseen is refused; free draining, which has no pair
+    /// blocks, ignores it). Either gives products only, so it needs
+    /// [`Params::matrix_free`] ([`Method::Overdamped`], [`Method::Springs`]; the noise
+    /// by Lanczos from the fast products) and, with constraints, the Krylov solver
+    /// ([`SolverKind::Auto`] resolves to it); the rest (rotation included) is refused
+    /// with [`StepError::Unsupported`](crate::StepError::Unsupported), and so is a
+    /// wall. Its storage is the caller's: in a box
+    /// [`Workspace::with_pse`](crate::Workspace::with_pse), sized by
+    /// [`pse_storage`](crate::integrate::pse_storage); in free space
+    /// [`Workspace::with_fast`](crate::Workspace::with_fast), sized by
+    /// [`fast_storage`](crate::integrate::fast_storage). Default `None`: the Ewald
+    /// sums in a box, the pair blocks in free space, the same bits as before.
     pub pse: Option<f64>,
     /// Stokesian dynamics' near field ([`NearField`], kernel
     /// feature `near`): the step's mobility is the dense Stokesian dynamics grand
@@ -424,11 +431,13 @@ impl<T: Real> Params<T> {
     /// held in one round. [`Layout::for_params`](crate::Layout::for_params) sizes the
     /// storage from this same choice, and every stage of the step runs it, so the two
     /// cannot disagree.
-    /// With PSE in a box ([`Params::pse`]) `Auto` is Krylov at every size: the only
-    /// solver that needs products alone.
+    /// With a fast product ([`Params::pse`]: PSE in a box, the fast free-space product
+    /// without a wall) `Auto` is Krylov at every size: the only solver that needs
+    /// products alone.
     pub const fn solver_kind(&self, n: usize, bonds: usize) -> SolverKind {
         match (self.solver.kind, self.pse, self.periodic) {
             (SolverKind::Auto, Some(_), Some(_)) => SolverKind::Krylov,
+            (SolverKind::Auto, Some(_), None) if self.wall.is_none() => SolverKind::Krylov,
             (kind, ..) => kind.resolve(self.constraints(n, bonds)),
         }
     }

@@ -12,12 +12,16 @@
 //! step's tensions solved again (reported, never integrated), `contacts.rs` the hard
 //! contacts of the position projection.
 
+#[cfg(feature = "fast-free")]
+pub use fast::{FAST_MARGIN, fast_storage};
 #[cfg(feature = "pse")]
 pub use periodic::pse_storage;
 
 mod brownian;
 mod checks;
 mod contacts;
+#[cfg(feature = "fast-free")]
+mod fast;
 pub mod geometry;
 mod near;
 mod overdamped;
@@ -185,7 +189,8 @@ fn advance<T: Real, E: ExternalForce<T>>(
         #[cfg(feature = "pse")]
         let store = {
             let slices = core::mem::take(&mut v.pse);
-            periodic::pse_store(sums.as_ref(), n, slices, v.par)?
+            let spheres = (&*state.pos, state.radius);
+            periodic::pse_store(sums.as_ref(), spheres, slices, v.par)?
         };
         let s = Start {
             pos: state.pos,

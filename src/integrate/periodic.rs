@@ -30,6 +30,22 @@ pub(super) enum Held<T: Real> {
     /// The PSE fast path.
     #[cfg(feature = "pse")]
     Pse(Pse<T>),
+    /// Free space's fast product ([`Params::pse`](crate::Params::pse) without a box):
+    /// the parameters derived for the cloud at the step's start (`integrate::fast`).
+    #[cfg(feature = "fast-free")]
+    Fast(crate::mobility::free_fast::FreeFast<T>),
+}
+
+/// The storage of a step's fast products, over the caller's arrays. One per step, on
+/// its stack: the fast variant's parameters are held by value (no allocation to box them).
+#[cfg(feature = "pse")]
+#[allow(clippy::large_enum_variant)]
+pub(super) enum Store<'a, T: Real> {
+    /// PSE's, in a box.
+    Pse(PseStep<'a, T>),
+    /// The fast free-space product's.
+    #[cfg(feature = "fast-free")]
+    Fast(super::fast::FastStep<'a, T>),
 }
 
 /// The largest radius of the step (the sums accept every radius up to it).
@@ -65,17 +81,25 @@ pub(super) fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>
     Ok(Ewald::new(cell, a_max(radius))?)
 }
 
-/// The caller's PSE arrays as the step's storage, after checking them against the
-/// step's PSE parameters (`None` where the step sums by Ewald or has no box).
+/// The caller's fast arrays as the step's storage, after checking them against the
+/// step's PSE parameters, or fitting the fast free-space product's to them
+/// (`integrate::fast`); `None` where the step sums by Ewald or takes the pair blocks.
 #[cfg(feature = "pse")]
 pub(super) fn pse_store<'a, T: Real>(
     held: Option<&'a Held<T>>,
-    n: usize,
-    (complex, index, vectors): crate::workspace::PseSlices<'a, T>,
+    spheres: (&[T::V3], &[T]),
+    (complex, index, vectors, _reals): crate::workspace::PseSlices<'a, T>,
     par: &'a dyn crate::parallel::Parallel,
-) -> Result<Option<PseStep<'a, T>>, StepError> {
-    let Some(Held::Pse(pse)) = held else {
-        return Ok(None);
+) -> Result<Option<Store<'a, T>>, StepError> {
+    let n = spheres.0.len();
+    let pse = match held {
+        Some(Held::Pse(pse)) => pse,
+        #[cfg(feature = "fast-free")]
+        Some(Held::Fast(fast)) => {
+            let step = super::fast::FastStep::new(fast, spheres, (complex, index, _reals))?;
+            return Ok(Some(Store::Fast(step)));
+        }
+        _ => return Ok(None),
     };
     let need = pse.storage(n);
     if complex.len() < need.complex || index.len() < need.index || vectors.len() < need.vectors {
@@ -86,7 +110,7 @@ pub(super) fn pse_store<'a, T: Real>(
         .into());
     }
     let store = PseStorage::new(complex, index, vectors).with_parallel(par);
-    Ok(Some(PseStep::new(pse, store)))
+    Ok(Some(Store::Pse(PseStep::new(pse, store))))
 }
 
 /// The step's sums ([`super::stages::Sums`]) over what its checks hold and, for PSE,
@@ -94,13 +118,17 @@ pub(super) fn pse_store<'a, T: Real>(
 #[cfg(feature = "pse")]
 pub(super) fn sums<'a, T: Real>(
     held: Option<&'a Held<T>>,
-    store: Option<&'a PseStep<'_, T>>,
+    store: Option<&'a Store<'_, T>>,
 ) -> super::stages::Sums<'a, T> {
     match (held?, store) {
         (Held::Ewald(e), _) => Some(BoxSums::Ewald(e)),
-        (Held::Pse(_), Some(s)) => Some(BoxSums::Pse(s)),
-        // `pse_store` makes the storage for every PSE step.
-        (Held::Pse(_), None) => None,
+        (_, Some(Store::Pse(s))) => Some(BoxSums::Pse(s)),
+        // The fast free-space product gives products only, as PSE does: the stages read
+        // it through the same variant.
+        #[cfg(feature = "fast-free")]
+        (_, Some(Store::Fast(s))) => Some(BoxSums::Pse(s)),
+        // `pse_store` makes the storage for every fast step.
+        (_, None) => None,
     }
 }
 

@@ -30,6 +30,8 @@ pub(super) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
         super::periodic::Held::Ewald(e) => Some(crate::geometry::sums::BoxSums::Ewald(e)),
         #[cfg(feature = "pse")]
         super::periodic::Held::Pse(_) => None,
+        #[cfg(feature = "fast-free")]
+        super::periodic::Held::Fast(_) => None,
     }
 }
 

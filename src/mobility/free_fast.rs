@@ -255,6 +255,10 @@ impl<T: Real> FreeFast<T> {
     pub fn estimate(&self) -> f64 {
         self.estimate
     }
+    /// The spreading Gaussian's standard deviation `sigma`.
+    pub fn sigma(&self) -> f64 {
+        self.sigma
+    }
     /// The real-space cutoff.
     pub fn r_cut(&self) -> f64 {
         self.r_cut

@@ -39,18 +39,22 @@ pub struct Workspace<'a, T: Real> {
     pub(crate) indices: &'a mut [usize],
     pub(crate) links: &'a mut [Bond<T>],
     pub(crate) parallel: &'a dyn Parallel,
-    /// PSE's arrays (complex, index, vectors) for a step with [`Params::pse`](crate::Params::pse).
+    /// The fast products' arrays (complex, index, vectors, reals) for a step with
+    /// [`Params::pse`](crate::Params::pse): PSE's in a box, the fast free-space
+    /// product's (complex, index, reals) in free space.
     #[cfg(feature = "pse")]
     pub(crate) pse: PseSlices<'a, T>,
 }
 
-/// The caller's PSE arrays: complex values, indices, vectors
-/// ([`crate::mobility::pse::PseStorage`]).
+/// The caller's fast products' arrays: complex values, indices, vectors
+/// ([`crate::mobility::pse::PseStorage`]) and reals (the fast free-space product's
+/// kernel, `mobility::free_fast::FreeStorage`).
 #[cfg(feature = "pse")]
 pub(crate) type PseSlices<'a, T> = (
     &'a mut [crate::mobility::pse::Cx<T>],
     &'a mut [usize],
     &'a mut [<T as Real>::V3],
+    &'a mut [T],
 );
 
 impl<'a, T: Real> Workspace<'a, T> {
@@ -69,7 +73,7 @@ impl<'a, T: Real> Workspace<'a, T> {
             links: &mut [],
             parallel: &Serial,
             #[cfg(feature = "pse")]
-            pse: (&mut [], &mut [], &mut []),
+            pse: (&mut [], &mut [], &mut [], &mut []),
         }
     }
 
@@ -100,7 +104,30 @@ impl<'a, T: Real> Workspace<'a, T> {
         vectors: &'a mut [T::V3],
     ) -> Self {
         Self {
-            pse: (complex, index, vectors),
+            pse: (complex, index, vectors, &mut []),
+            ..self
+        }
+    }
+
+    /// This workspace with the arrays of the fast free-space product of a step with
+    /// [`Params::pse`](crate::Params::pse) and no box: at least
+    /// [`fast_storage`](crate::integrate::fast_storage) (complex values, reals,
+    /// indices, as [`FreeSize`](crate::mobility::free_fast::FreeSize) counts them). Less
+    /// complex values or reals than that is served by a coarser grid (a wider
+    /// spreading, more near pairs, the same tolerance: `docs/FREE.md`); storage that
+    /// no grid within the bounds fits, or indices below `3 n + 1`, is refused with
+    /// [`StepError::BadParameter`](crate::StepError::BadParameter) before anything is
+    /// touched. Not counted by [`Layout`]: the grid depends on the cloud and the
+    /// tolerance at run time.
+    #[cfg(feature = "fast-free")]
+    pub fn with_fast(
+        self,
+        complex: &'a mut [crate::mobility::pse::Cx<T>],
+        reals: &'a mut [T],
+        index: &'a mut [usize],
+    ) -> Self {
+        Self {
+            pse: (complex, index, &mut [], reals),
             ..self
         }
     }

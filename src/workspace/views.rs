@@ -46,7 +46,7 @@ pub(crate) struct Views<'a, T: Real> {
     pub par: &'a dyn Parallel,
     /// The stored `mu_tt` product's band partial sums ([`band_scratch`]).
     pub bands: &'a mut [T::V3],
-    /// The caller's PSE arrays ([`Workspace::with_pse`]).
+    /// The caller's fast products' arrays ([`Workspace::with_pse`], `Workspace::with_fast`).
     #[cfg(feature = "pse")]
     pub pse: super::PseSlices<'a, T>,
     /// The near field's packed far-field grand mobility and its dense Stokesian
@@ -242,7 +242,12 @@ impl<T: Real> Workspace<'_, T> {
             par: self.parallel,
             bands,
             #[cfg(feature = "pse")]
-            pse: (&mut *self.pse.0, &mut *self.pse.1, &mut *self.pse.2),
+            pse: (
+                &mut *self.pse.0,
+                &mut *self.pse.1,
+                &mut *self.pse.2,
+                &mut *self.pse.3,
+            ),
             near,
         })
     }

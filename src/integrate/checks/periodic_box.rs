@@ -27,7 +27,7 @@ pub(super) fn check_periodic<T: Real>(
     bonds: &[Bond<T>],
 ) -> Result<HeldSums<T>, StepError> {
     let Some(c) = p.place().cell() else {
-        return Ok(None);
+        return fast_sums(p, state, bonds.len());
     };
     let summed = box_geometry(p, state.radius)?;
     if let Some(particle) = unresolved(state.pos, state.radius) {
@@ -133,16 +133,8 @@ fn pse_sums<T: Real>(
             "PSE (Params::pse): the kernel was built without its `pse` feature",
         ));
     }
-    let constrained = p.method != Method::Springs && p.constraints(state.len(), bonds) > 0;
-    let krylov = p.solver_kind(state.len(), bonds) == crate::constraints::SolverKind::Krylov;
-    if !p.matrix_free || (constrained && !krylov) {
-        return Err(StepError::Unsupported(PSE_ASSEMBLED));
-    }
-    if p.rotation {
-        return Err(StepError::Unsupported(
-            "PSE with rotation (its rt and rr products are not built: Ewald sums them)",
-        ));
-    }
+    let rotation = "PSE with rotation (its rt and rr products are not built: Ewald sums them)";
+    products_only(p, state.len(), bonds, (PSE_ASSEMBLED, rotation))?;
     #[cfg(feature = "pse")]
     return Ok(Some(periodic::Held::Pse(periodic::pse(
         c,
@@ -152,6 +144,79 @@ fn pse_sums<T: Real>(
     #[cfg(not(feature = "pse"))]
     {
         let _ = (c, tol);
+        Ok(None)
+    }
+}
+
+/// A fast product gives products only: the step must need nothing else (matrix free;
+/// with constraints the Krylov solver; no Cholesky noise, which `matrix_free` refuses
+/// already), else `assembled`; no rotation (translation products only), else `rotation`.
+fn products_only<T: Real>(
+    p: &Params<T>,
+    n: usize,
+    bonds: usize,
+    (assembled, rotation): (&'static str, &'static str),
+) -> Result<(), StepError> {
+    let constrained = p.method != Method::Springs && p.constraints(n, bonds) > 0;
+    let krylov = p.solver_kind(n, bonds) == crate::constraints::SolverKind::Krylov;
+    if !p.matrix_free || (constrained && !krylov) {
+        return Err(StepError::Unsupported(assembled));
+    }
+    if p.rotation {
+        return Err(StepError::Unsupported(rotation));
+    }
+    Ok(())
+}
+
+/// Why the fast free-space product cannot serve a stage that needs the assembled
+/// mobility.
+const FAST_ASSEMBLED: &str = "the fast free-space product (Params::pse without a box) where \
+     the step needs the assembled mobility (without matrix_free, Cholesky noise, the Sweep \
+     or Newton solver, RattleStable): it gives products only";
+
+/// Free space with [`Params::pse`]: the fast free-space product (kernel feature
+/// `fast-free`), RPY only, products only, no wall, no rotation; its parameters derived
+/// from the cloud at the step's start (`integrate::fast`). `None` without `pse`, and
+/// with free draining (no pair blocks to replace).
+fn fast_sums<T: Real>(
+    p: &Params<T>,
+    state: &State<'_, T>,
+    bonds: usize,
+) -> Result<HeldSums<T>, StepError> {
+    let Some(tol) = p.pse else {
+        return Ok(None);
+    };
+    if p.place().wall().is_some() {
+        return Err(StepError::Unsupported(
+            "the fast free-space product (Params::pse without a box) above a wall",
+        ));
+    }
+    if p.hydro == Hydro::FreeDraining {
+        return Ok(None);
+    }
+    if !cfg!(feature = "fast-free") {
+        return Err(StepError::Unsupported(
+            "the fast free-space product (Params::pse without a box): the kernel was built without its `fast-free` feature",
+        ));
+    }
+    if p.hydro == Hydro::Oseen {
+        return Err(StepError::Unsupported(
+            "the fast free-space product with Hydro::Oseen (it is RPY's)",
+        ));
+    }
+    let rotation =
+        "the fast free-space product with rotation (its rt and rr products are not built)";
+    products_only(p, state.len(), bonds, (FAST_ASSEMBLED, rotation))?;
+    #[cfg(feature = "fast-free")]
+    return Ok(Some(periodic::Held::Fast(super::super::fast::params(
+        tol,
+        state.pos,
+        state.radius,
+        [usize::MAX; 2],
+    )?)));
+    #[cfg(not(feature = "fast-free"))]
+    {
+        let _ = tol;
         Ok(None)
     }
 }
