@@ -103,7 +103,12 @@ pub(super) fn resolve(raw: &Spanned<RawCloud>) -> Result<Cloud, Issue> {
             format!("cloud polydispersity must be below 1 (radii stay positive), not {p}"),
         ));
     }
-    let density = number(&r.density, DEFAULT_DENSITY, "cloud density", Bound::NonNegative)?;
+    let density = number(
+        &r.density,
+        DEFAULT_DENSITY,
+        "cloud density",
+        Bound::NonNegative,
+    )?;
     let centre = match &r.centre {
         None => [0.0; 3],
         Some(c) => finite_vector(c, "cloud centre")?,

@@ -107,7 +107,10 @@ pub(super) fn resolve(raw: &Spanned<RawFreeSpace>, cx: &Context<'_>) -> Result<F
             ),
         ));
     }
-    let method = r.method.as_ref().map_or(FreeMethod::Dense, |m| *m.get_ref());
+    let method = r
+        .method
+        .as_ref()
+        .map_or(FreeMethod::Dense, |m| *m.get_ref());
     if let (FreeMethod::Fast, Some(at)) = (method, r.method.as_ref().map(|m| m.span())) {
         if let Some(why) = unsupported(cx) {
             return Err(issue(at, format!("method = \"fast\" {why}")));
@@ -132,7 +135,9 @@ fn unsupported(cx: &Context<'_>) -> Option<&'static str> {
         _ if m.hydrodynamics != Hydrodynamics::Rpy => {
             "gives the RPY product only: hydrodynamics = \"rpy\""
         }
-        _ if !matches!(i.method, Method::Overdamped | Method::Springs) || m.level != Level::Manual => {
+        _ if !matches!(i.method, Method::Overdamped | Method::Springs)
+            || m.level != Level::Manual =>
+        {
             "gives products only: it needs method = \"overdamped\" or \"springs\" and level = \"manual\" \
              (the other methods store or factorise the mobility)"
         }

@@ -50,18 +50,18 @@
 pub mod auto;
 mod beads;
 mod bodies;
-mod cloud;
 pub mod box_cost;
 #[cfg(test)]
 mod box_cost_tests;
 #[cfg(test)]
 mod box_tests;
+mod cloud;
 mod contact;
 mod error;
 mod floor;
-mod free_space;
 #[cfg(test)]
 mod floor_tests;
+mod free_space;
 mod helix;
 mod kernel;
 mod model;

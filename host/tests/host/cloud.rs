@@ -6,9 +6,7 @@
 use hydrorattle_host::scene::{Cloud, Scene};
 
 fn scene(cloud: &str) -> String {
-    format!(
-        "[cloud]\n{cloud}\n[integrator]\nmethod = \"overdamped\"\ndt = 0.1\nduration = 0.1\n"
-    )
+    format!("[cloud]\n{cloud}\n[integrator]\nmethod = \"overdamped\"\ndt = 0.1\nduration = 0.1\n")
 }
 
 fn cloud(count: usize, cloud_radius: f64, polydispersity: f64, seed: u64) -> Cloud {
@@ -79,10 +77,7 @@ fn centres_are_uniform_in_their_ball() {
         .map(|(k, &x)| (x - k as f64 / n as f64).max((k + 1) as f64 / n as f64 - x))
         .fold(0.0, f64::max);
     // Kolmogorov: P(sqrt(n) D > 1.63) = 1 %.
-    assert!(
-        (n as f64).sqrt() * d < 1.63,
-        "KS distance {d} at n = {n}"
-    );
+    assert!((n as f64).sqrt() * d < 1.63, "KS distance {d} at n = {n}");
     for axis in 0..3 {
         let mean = ps
             .iter()
@@ -114,7 +109,10 @@ fn refusals_are_placed_at_their_line() {
     };
     let (at, m) = line("count = 1000\ncloud_radius = 10.0");
     assert_eq!(at, Some(3), "{m}");
-    assert!(m.contains("jams") && m.contains("cloud_radius >= 14.1"), "{m}");
+    assert!(
+        m.contains("jams") && m.contains("cloud_radius >= 14.1"),
+        "{m}"
+    );
     let (at, m) = line("count = 10\ncloud_radius = 1.5\nradius = 2.0");
     assert_eq!(at, Some(3), "{m}");
     assert!(m.contains("no sphere fits"), "{m}");
@@ -143,5 +141,8 @@ fn a_placement_that_jams_is_refused_naming_the_draws() {
     let e = cloud(3000, (3000f64 / 0.345).cbrt(), 0.0, 1)
         .generate()
         .unwrap_err();
-    assert!(e.contains("too dense for random sequential addition"), "{e}");
+    assert!(
+        e.contains("too dense for random sequential addition"),
+        "{e}"
+    );
 }
