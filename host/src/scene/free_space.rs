@@ -111,10 +111,10 @@ pub(super) fn resolve(raw: &Spanned<RawFreeSpace>, cx: &Context<'_>) -> Result<F
         .method
         .as_ref()
         .map_or(FreeMethod::Dense, |m| *m.get_ref());
-    if let (FreeMethod::Fast, Some(at)) = (method, r.method.as_ref().map(|m| m.span())) {
-        if let Some(why) = unsupported(cx) {
-            return Err(issue(at, format!("method = \"fast\" {why}")));
-        }
+    if let (FreeMethod::Fast, Some(at)) = (method, r.method.as_ref().map(|m| m.span()))
+        && let Some(why) = unsupported(cx)
+    {
+        return Err(issue(at, format!("method = \"fast\" {why}")));
     }
     Ok(FreeSpace { method, tolerance })
 }
