@@ -2,7 +2,8 @@
 //! (PyO3). The Python package `hydrorattle` (in `pysrc/`) wraps it:
 //!
 //! * [`mobility`]: the dense RPY / Oseen / free-draining mobility and its product
-//!   (in a box by PSE where it fits: [`pse`]);
+//!   (in a box by PSE where it fits: [`pse`]; in free space by the fast product on
+//!   request: [`free`]);
 //! * [`system`]: a system stepped by the kernel through the host library's
 //!   [`Engine`](hydrorattle_host::sim::Engine);
 //! * [`runs`]: scene files and runs, through the CLI's own library code;
@@ -15,6 +16,7 @@ use pyo3::prelude::*;
 mod alloc;
 mod dense;
 mod errors;
+mod free;
 mod input;
 mod mobility;
 mod near;

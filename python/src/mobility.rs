@@ -319,8 +319,15 @@ pub fn mobility_dot<'py>(
     let level = crate::input::hydro(hydro)?;
     let g = geometry(wall, r#box);
     g.spheres_fit(py, is_f32(precision)?, pos, radii)?;
-    let asked = crate::pse::method(method, tolerance)?;
     let rotation = rotation || t.is_some();
+    if method == "fast" {
+        let tol = crate::free::check(wall, r#box, level, rotation, tolerance)?;
+        return Ok(match is_f32(precision)? {
+            true => fast_product::<f32>(py, pos, radii, f, eta, tol)?.into_any(),
+            false => fast_product::<f64>(py, pos, radii, f, eta, tol)?.into_any(),
+        });
+    }
+    let asked = crate::pse::method(method, tolerance)?;
     if let Some(size) = r#box.filter(|_| wall.is_none()) {
         if crate::pse::uses_pse(asked, Some(size), radii, level, rotation)? {
             let pse = (size, asked.1);
@@ -358,5 +365,22 @@ fn pse_product<'py, T: Real + Element>(
     let mut u = vec![T::V3_ZERO; n];
     let par = par.as_deref();
     crate::pse::product::<T>(py, size, tolerance, eta, &pos, &r, &f, &mut u, par)?;
+    Ok(to_array::<T>(py, &u))
+}
+
+/// Velocities in precision `T` in free space by the fast product to `tolerance`: the
+/// spheres checked one by one here, pairs (one inside another) in its near part.
+fn fast_product<'py, T: Real + Element>(
+    py: Python<'py>,
+    pos: &[[f64; 3]],
+    radii: &[f64],
+    forces: &[[f64; 3]],
+    eta: f64,
+    tolerance: f64,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let (pos, r) = crate::input::each_sphere::<T>(py, pos, radii, None)?;
+    let f: Vec<T::V3> = forces.iter().map(|&x| T::v3_from(x)).collect();
+    let mut u = vec![T::V3_ZERO; pos.len()];
+    crate::free::product::<T>(py, tolerance, eta, &pos, &r, &f, &mut u)?;
     Ok(to_array::<T>(py, &u))
 }

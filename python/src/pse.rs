@@ -18,11 +18,12 @@ use crate::errors::value_error;
 pub fn method(method: &str, tolerance: Option<f64>) -> PyResult<(BoxMethod, f64)> {
     let m = match method {
         "auto" => BoxMethod::Auto,
-        "ewald" => BoxMethod::Ewald,
+        // The exact product of each geometry: the Ewald sum in a box.
+        "ewald" | "dense" => BoxMethod::Ewald,
         "pse" => BoxMethod::Pse,
         other => {
             return Err(PyValueError::new_err(format!(
-                "method must be \"auto\", \"ewald\" or \"pse\", not {other:?}"
+                "method must be \"auto\", \"dense\", \"fast\", \"ewald\" or \"pse\", not {other:?}"
             )));
         }
     };

@@ -105,7 +105,7 @@ def test_pse_threads_give_the_same_bits():
 @pytest.mark.parametrize(
     "kw,what",
     [
-        ({"method": "fast"}, "method"),
+        ({"method": "quick"}, "method"),
         ({"method": "pse"}, "needs a periodic box"),
         ({"method": "pse", "box": (10, 10, 10), "rotation": True}, "translational"),
         ({"method": "pse", "box": (10, 10, 10), "hydro": "oseen"}, "rpy"),

@@ -179,6 +179,10 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
         .periodic
         .filter(|b| b.method == scene::BoxMethod::Pse)
         .map(|b| b.tolerance);
+    // Free space's fast product: `Params::pse` without a box or wall; products only.
+    if let Some(t) = scene.free_space.and_then(|f| f.fast_tolerance()) {
+        p.pse = Some(t);
+    }
     p.matrix_free |= p.pse.is_some();
     p.near = scene.near_field.map(|n| n.kernel());
     p

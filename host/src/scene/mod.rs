@@ -22,13 +22,15 @@
 //! | `[output]` | `every` (steps between trajectory frames, >= 1) | about [`TARGET_FRAMES`] frames |
 //! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"`, `"springs"` or `"rattle-stable"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
 //! | `[wall]` | `height` (required, finite): a no-slip plane `z = height` below every sphere (`method = "overdamped"` or `"overdamped2"`, level manual; see [`Wall`]) | no wall |
+//! | `[free_space]` | `method = "dense"\|"fast"`, `tolerance` (`1e-10` to `0.1`): how the mobility in open fluid is applied; `"fast"` is the `O(N log N)` product (overdamped or springs, level manual, RPY, no rotation, wall, box or near field; its run is matrix-free; see [`FreeSpace`]) | dense, 1e-4 |
 //! | `[box]` | `size = [Lx, Ly, Lz]` (required unless `[suspension]` sets it; finite, > 0), `method = "ewald"\|"pse"\|"auto"`, `tolerance` (`1e-12` to `0.1`): a periodic box (see [`PeriodicBox`]) | no box; auto, 1e-6 |
 //! | `[suspension]` | `count` (required, >= 1), `fraction` (required, `0 < phi <=` [`MAX_FRACTION`]), `radius`, `polydispersity` (`0 <= p < 1`), `density`, `seed`: spheres placed at random in a cubic box (see [`Suspension`]) | 1, 0, 4.5, 1 |
+//! | `[cloud]` | `count` (required, >= 1), `cloud_radius` (required, > 0), `radius`, `polydispersity` (`0 <= p < 1`), `density`, `centre = [x, y, z]`, `seed`: spheres placed at random, without overlap, in a ball in open fluid (see [`Cloud`]) | 1, 0, 4.5, origin, 1 |
 //! | `[floor]` | `radius` (> 0), `density` (>= 0): a pinned square lattice under the `[suspension]` (see [`Floor`]) | the suspension's radius and density |
 //! | `[near_field]` | `cutoff` (>= 0), `wall_cutoff` (>= 0), `min_gap` (> 0), in radii: Stokesian dynamics' near field on the RPY far field (`hydrodynamics = "rpy"`, level manual, `method = "overdamped"` or `"overdamped2"`, free space or `[wall]`; see [`NearField`], `docs/NEAR.md`) | no near field; 4, 4, 1e-3 |
 //!
 //! A scene gives one of a `[helix]` table, a `[suspension]` table (which needs a
-//! `[box]` table, without `size`) or explicit `[[particle]]` (and optionally
+//! `[box]` table, without `size`), a `[cloud]` table or explicit `[[particle]]` (and optionally
 //! `[[bond]]`) tables. Units are those of `docs/MODEL.md#units`: tail radius
 //! 1, viscosity 1, and the default density 4.5 with gravity `[0, 0, -1]` and fluid
 //! density 0 gives a lone tail a buoyant weight of `6 pi`, so it settles at speed 1.
@@ -53,11 +55,13 @@ pub mod box_cost;
 mod box_cost_tests;
 #[cfg(test)]
 mod box_tests;
+mod cloud;
 mod contact;
 mod error;
 mod floor;
 #[cfg(test)]
 mod floor_tests;
+mod free_space;
 mod helix;
 mod kernel;
 mod model;
@@ -77,9 +81,11 @@ mod write;
 
 pub use beads::{Beads, BuildError, beads, bonds, params, pins};
 pub use box_cost::pse_pays;
+pub use cloud::Cloud;
 pub use contact::{Contact, DEFAULT_CONTACTS_PER_PARTICLE, SOFT_DT, SOFT_STIFFNESS};
 pub use error::{SceneError, line_col};
 pub use floor::{Floor, slab_fraction};
+pub use free_space::{DEFAULT_FREE_TOLERANCE, FreeMethod, FreeSpace};
 pub use helix::{Chain, HeadEnd, Helix};
 pub use model::{
     Bond, Flow, Fluid, Hydrodynamics, Integrator, Level, Method, Model, Output, Overlap, Particle,
@@ -188,6 +194,9 @@ pub struct Scene {
     /// The suspension generator's settings, when the scene used one (`[suspension]`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub suspension: Option<Suspension>,
+    /// The cloud generator's settings, when the scene used one (`[cloud]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cloud: Option<Cloud>,
     /// The pinned floor under the suspension, when the scene lays one (`[floor]`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub floor: Option<Floor>,
@@ -195,6 +204,9 @@ pub struct Scene {
     /// pin rows (`fixed = true` on a `[[particle]]`, or the `[floor]`'s spheres).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pinned: Vec<usize>,
+    /// How the free-space mobility is applied (`[free_space]`); `None`: `"dense"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub free_space: Option<FreeSpace>,
     /// Stokesian dynamics' near field (`[near_field]`); `None`: the far field alone.
     /// Left out of the JSON when `None`, as the box is.
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -30,6 +30,8 @@ pub(super) struct RawScene {
     #[serde(rename = "box")]
     pub(super) periodic: S<super::periodic::RawBox>,
     pub(super) suspension: S<super::suspension::RawSuspension>,
+    pub(super) cloud: S<super::cloud::RawCloud>,
+    pub(super) free_space: S<super::free_space::RawFreeSpace>,
     pub(super) floor: S<super::floor::RawFloor>,
     pub(super) near_field: S<super::near::RawNearField>,
 }

@@ -123,6 +123,24 @@ impl RawScene {
             None => None,
             Some(raw) => Some(super::near::resolve(raw, &model)?),
         };
+        let free_space = match &self.free_space {
+            None => None,
+            Some(raw) => Some(super::free_space::resolve(
+                raw,
+                &super::free_space::Context {
+                    model: &model,
+                    integrator: &integrator,
+                    brownian,
+                    wall: self.wall.as_ref().map(|w| w.span()),
+                    periodic: self.periodic.as_ref().map(|b| b.span()),
+                    near: self.near_field.as_ref().map(|n| n.span()),
+                },
+            )?),
+        };
+        // The fast product gives products only: its run is matrix-free.
+        let fast = free_space.and_then(|f| f.fast_tolerance()).is_some();
+        let mut integrator = integrator;
+        integrator.matrix_free |= fast;
         let every = match self.output.as_ref().and_then(|o| o.every.as_ref()) {
             None => integrator.steps().div_ceil(TARGET_FRAMES).max(1),
             Some(e) if *e.get_ref() == 0 => {
@@ -149,7 +167,7 @@ impl RawScene {
             &flow,
             contact,
             brownian,
-            (wall.is_some(), pse, near_field.is_some()),
+            (wall.is_some(), pse, near_field.is_some(), fast),
         );
         let every_span = self
             .output
@@ -226,6 +244,8 @@ impl RawScene {
             wall,
             periodic,
             suspension: body.suspension.map(|(s, _)| s),
+            cloud: body.cloud,
+            free_space,
             floor: body.floor,
             pinned: body.pinned,
             near_field,

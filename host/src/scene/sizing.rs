@@ -134,6 +134,9 @@ pub struct Plan {
     /// Stokesian dynamics' near field (`[near_field]`): its dense `6n x 6n` mobility
     /// and the far field's grand blocks.
     pub near: bool,
+    /// Free space's fast product (`[free_space] method = "fast"`): matrix-free, its
+    /// constraints by Krylov (the kernel's `Params::solver_kind`); `O(N)` storage.
+    pub fast: bool,
 }
 
 impl Plan {
@@ -153,6 +156,9 @@ impl Plan {
                 .periodic
                 .is_some_and(|b| b.method == super::BoxMethod::Pse),
             near: scene.near_field.is_some(),
+            fast: scene
+                .free_space
+                .is_some_and(|f| f.fast_tolerance().is_some()),
         }
     }
 
@@ -172,11 +178,15 @@ impl Plan {
             p.solver.kind = self.solver;
             p.contacts = contacts.map(Contacts::new);
             p.wall = self.wall.then_some(hydrorattle::Wall::new(0.0));
-            p.matrix_free = self.matrix_free || self.pse;
+            p.matrix_free = self.matrix_free || self.pse || self.fast;
             p.compact_products = self.compact_products;
             if self.pse {
                 // Any box: only the solver's resolution reads it.
                 p.periodic = hydrorattle::Periodic::new([1.0; 3]).ok();
+                p.pse = Some(1e-3);
+            }
+            if self.fast && !self.pse && !self.wall {
+                // Free space's fast product (no box): only its presence sizes the storage.
                 p.pse = Some(1e-3);
             }
             if let Some(t) = self.brownian {
@@ -239,6 +249,7 @@ mod tests {
             compact_products: false,
             pse: false,
             near: false,
+            fast: false,
         }
     }
 

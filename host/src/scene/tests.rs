@@ -141,6 +141,7 @@ fn overdamped() -> Plan {
         matrix_free: false,
         compact_products: false,
         pse: false,
+        fast: false,
         near: false,
     }
 }

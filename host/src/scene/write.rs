@@ -112,6 +112,13 @@ impl Scene {
             ]);
             t.insert("near_field".into(), nt);
         }
+        if let Some(f) = self.free_space {
+            let ft = table([
+                ("method", value(f.method)),
+                ("tolerance", value(f.tolerance)),
+            ]);
+            t.insert("free_space".into(), ft);
+        }
         if let Some(b) = self.periodic {
             let mut bt = table([
                 ("method", value(b.method)),
@@ -123,8 +130,22 @@ impl Scene {
             }
             t.insert("box".into(), bt);
         }
-        match (&self.helix, &self.suspension) {
-            (_, Some(s)) => {
+        match (&self.helix, &self.suspension, self.cloud) {
+            (_, _, Some(c)) => {
+                t.insert(
+                    "cloud".into(),
+                    table([
+                        ("count", value(c.count as i64)),
+                        ("cloud_radius", value(c.cloud_radius)),
+                        ("radius", value(c.radius)),
+                        ("polydispersity", value(c.polydispersity)),
+                        ("density", value(c.density)),
+                        ("centre", value(c.centre)),
+                        ("seed", value(c.seed as i64)),
+                    ]),
+                );
+            }
+            (_, Some(s), None) => {
                 t.insert(
                     "suspension".into(),
                     table([
@@ -143,7 +164,7 @@ impl Scene {
                     );
                 }
             }
-            (Some(h), None) => {
+            (Some(h), None, None) => {
                 t.insert(
                     "helix".into(),
                     table([
@@ -157,7 +178,7 @@ impl Scene {
                     ]),
                 );
             }
-            (None, None) => {
+            (None, None, None) => {
                 let particles = self.particles.iter().zip(&self.species).enumerate();
                 let particles = particles.map(|(k, (p, s))| {
                     let mut pt = table([

@@ -55,6 +55,10 @@ pub struct Engine<T: Real> {
     /// PSE's arrays (complex, indices, vectors) when the box is summed by PSE
     /// ([`hydrorattle::integrate::pse_storage`]); empty otherwise.
     pse: (Vec<[T; 2]>, Vec<usize>, Vec<T::V3>),
+    /// The fast free-space product's kernel transform (reals) when the scene runs on it
+    /// ([`hydrorattle::integrate::fast_storage`]; its grid and cell list in `pse`'s
+    /// complex values and indices); empty otherwise.
+    fast: Vec<T>,
 }
 
 impl<T: Real> Engine<T> {
@@ -147,8 +151,23 @@ impl<T: Real> Engine<T> {
                 index: 0,
                 vectors: 0,
             });
+        // Or the fast free-space product's, sized from the first configuration (the
+        // step keeps within them as the cloud moves: `integrate::fast`).
+        let fast = hydrorattle::integrate::fast_storage(&params, &beads.pos, &beads.radius);
+        let (pse, fast) = match fast.ok().flatten() {
+            Some(f) => (
+                hydrorattle::mobility::pse::PseSize {
+                    complex: f.complex,
+                    index: f.index,
+                    vectors: 0,
+                },
+                f.reals,
+            ),
+            None => (pse, 0),
+        };
         let real = std::mem::size_of::<T>();
         let pse_bytes = pse.complex * 2 * real + pse.index * 8 + pse.vectors * 3 * real;
+        let pse_bytes = pse_bytes + fast * real;
         let bytes = layout.bytes::<T>() + pse_bytes;
         if bytes > limit {
             return Err(TooLarge {
@@ -178,6 +197,7 @@ impl<T: Real> Engine<T> {
                 vec![0; pse.index],
                 vec![T::V3_ZERO; pse.vectors],
             ),
+            fast: vec![T::ZERO; fast],
         })
     }
 
@@ -239,7 +259,10 @@ impl<T: Real> Engine<T> {
             None => self.store.workspace(),
         };
         let (c, i, v) = &mut self.pse;
-        let mut ws = ws.with_pse(c, i, v);
+        let mut ws = match self.fast.is_empty() {
+            true => ws.with_pse(c, i, v),
+            false => ws.with_fast(c, &mut self.fast, i),
+        };
         if !self.pins.is_empty() {
             self.rows.clear();
             self.rows.extend_from_slice(&self.bonds);

@@ -8,6 +8,9 @@ mod fuzz;
 
 mod auto;
 mod box_sweep;
+mod cloud;
+mod falling_cloud;
+mod free_space_scene;
 mod fuzz_scene;
 mod jam_retry;
 mod layers;

@@ -278,8 +278,13 @@ def mobility_dot(
     PSE where it can serve (no torques or rotation, ``hydro="rpy"``) and its grid fits
     the kernel's bounds, the Ewald sum otherwise: the rule of a scene's
     ``[box] method = "auto"``. ``tolerance``: PSE's relative error, ``1e-12`` to
-    ``0.1`` (default ``1e-6``, as in scenes). Outside a box ``method`` is ignored
-    (``"pse"`` is a ``ValueError``).
+    ``0.1`` (default ``1e-6``, as in scenes). ``"dense"`` is the exact product of each
+    geometry (the pair sum in free space and above a wall, the Ewald sum in a box).
+    In free space ``"fast"`` is the fast free-space RPY product (``O(N log N)``,
+    relative error below ``tolerance``, ``1e-10`` to ``0.1``, default ``1e-4`` as a
+    scene's ``[free_space]``; translation and the RPY level only: a box, a wall,
+    torques, ``rotation=True`` or another ``hydro`` are a ``ValueError``); ``"auto"``
+    there is the exact pair sum (``"pse"`` is a ``ValueError``).
 
     ``threads``: the matrix-free product in free space and the PSE product run on this
     many threads (0: every core) from ``N = 512`` on; the result has the same bits on
@@ -291,7 +296,7 @@ def mobility_dot(
     a box, whose Ewald sum adds terms larger than the result, or past f32's range) are
     taken scaled by a power of two to at most 1 and scaled back; velocities that overflow the precision themselves raise
     ``OverflowError``. The arrays the call allocates (the packed grand mobility with
-    rotation, PSE's grid) are sized first: ``MemoryError`` with their sizes where they
+    rotation, PSE's grid, the fast product's grid) are sized first: ``MemoryError`` with their sizes where they
     exceed this machine's memory and swap or cannot be allocated.
     """
     pos = _rows(positions, "positions")

@@ -31,6 +31,8 @@ pub(super) struct Body {
     pub(super) species: Vec<Cow<'static, str>>,
     /// The suspension's settings and its box's size, when the body is a suspension.
     pub(super) suspension: Option<(Suspension, [f64; 3])>,
+    /// The cloud's settings, when the body is a cloud.
+    pub(super) cloud: Option<crate::scene::Cloud>,
     /// The floor laid under the suspension, if any.
     pub(super) floor: Option<Floor>,
     /// The pinned spheres (ascending).
@@ -49,7 +51,7 @@ impl RawScene {
         output_span: Range<usize>,
     ) -> Result<Body, Issue> {
         let limit = limits.storage;
-        let mut suspension = None;
+        let (mut suspension, mut cloud) = (None, None);
         let (mut floor, mut pinned) = (None, Vec::new());
         if let (Some(f), None) = (&self.floor, &self.suspension) {
             return Err(issue(
@@ -58,6 +60,13 @@ impl RawScene {
             ));
         }
         let (particles, bonds, helix, body_span, species) = match (&self.helix, &self.particles) {
+            _ if self.cloud.is_some() => {
+                let (c, particles) = self.generate_cloud(plans, limits, every)?;
+                cloud = Some(c);
+                let species = vec![Cow::Borrowed("sphere"); particles.len()];
+                let spans = BodySpans::Helix(self.cloud.as_ref().map_or(0..0, |c| c.span()));
+                (particles, Vec::new(), None, spans, species)
+            }
             _ if self.suspension.is_some() => {
                 let (s, (mut particles, edge)) = self.generate_suspension(plans, limits, every)?;
                 let mut size = [edge; 3];
@@ -138,6 +147,7 @@ impl RawScene {
             spans: body_span,
             species,
             suspension,
+            cloud,
             floor,
             pinned,
         })
@@ -175,6 +185,42 @@ impl RawScene {
         }
         let body = s.generate().map_err(|m| issue(raw.span(), m))?;
         Ok((s, body))
+    }
+}
+
+impl RawScene {
+    /// The `[cloud]` table's spheres (the only body: no suspension, helix, explicit
+    /// particles or bonds), sized from its count before anything is placed.
+    fn generate_cloud(
+        &self,
+        plans: &[Plan],
+        limits: Limits,
+        every: usize,
+    ) -> Result<(crate::scene::Cloud, Vec<Particle>), Issue> {
+        let Some(raw) = &self.cloud else {
+            return Err(Issue::unplaced("no [cloud] table"));
+        };
+        let other = [
+            self.suspension.as_ref().map(|s| s.span()),
+            self.helix.as_ref().map(|h| h.span()),
+            self.particles.as_ref().map(|p| p.span()),
+            self.bonds.as_ref().map(|b| b.span()),
+        ];
+        if let Some(at) = other.into_iter().flatten().next() {
+            return Err(issue(
+                at,
+                "a [cloud] makes its own spheres (and no bonds): leave out [suspension], [helix], [[particle]] and [[bond]]",
+            ));
+        }
+        let c = crate::scene::cloud::resolve(raw)?;
+        let at = raw.get_ref().count_span().unwrap_or(raw.span());
+        fits(plans, c.count, 0, limits.storage).map_err(|e| too_large(at.clone(), e))?;
+        if let Some(i) = self.integrator.as_ref().map(|i| i.get_ref()) {
+            let i = resolve_integrator(i)?;
+            check_output(&i, every, c.count, limits.output).map_err(|m| issue(at.clone(), m))?;
+        }
+        let particles = c.generate().map_err(|m| issue(raw.span(), m))?;
+        Ok((c, particles))
     }
 }
 

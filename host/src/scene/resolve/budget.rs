@@ -37,7 +37,7 @@ pub(super) fn plans(
     flow: &Flow,
     contact: Option<Contact>,
     brownian: Option<Thermal>,
-    (wall, pse, near): (bool, bool, bool),
+    (wall, pse, near, fast): (bool, bool, bool, bool),
 ) -> Vec<Plan> {
     let plan = |(method, rotation)| Plan {
         method,
@@ -51,6 +51,7 @@ pub(super) fn plans(
         compact_products: integrator.compact_products,
         pse,
         near,
+        fast,
     };
     match model.level {
         Level::Manual => vec![plan((integrator.method, model.rotation))],
