@@ -130,7 +130,8 @@ pub(super) struct FastStep<'s, T: Real> {
 impl<'s, T: Real> FastStep<'s, T> {
     /// The step's products over the caller's arrays (complex values, indices, reals):
     /// the parameters `held` derived in the checks where they fit the arrays, else the
-    /// spreading widened until they do ([`params`]).
+    /// spreading widened until they do ([`params`]); the products run on the step's
+    /// threads `par` (the same bits on any number).
     pub(super) fn new(
         held: &FreeFast<T>,
         spheres: (&[T::V3], &[T]),
@@ -139,6 +140,7 @@ impl<'s, T: Real> FastStep<'s, T> {
             &'s mut [usize],
             &'s mut [T],
         ),
+        par: &'s dyn crate::parallel::Parallel,
     ) -> Result<Self, StepError> {
         let n = spheres.0.len();
         let (size, have) = (held.storage(n), [complex.len(), reals.len()]);
@@ -153,7 +155,7 @@ impl<'s, T: Real> FastStep<'s, T> {
         }
         Ok(Self {
             fast,
-            store: RefCell::new(FreeStorage::new(complex, reals, index)),
+            store: RefCell::new(FreeStorage::new(complex, reals, index).with_parallel(par)),
         })
     }
 }

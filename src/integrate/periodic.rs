@@ -96,7 +96,7 @@ pub(super) fn pse_store<'a, T: Real>(
         Some(Held::Pse(pse)) => pse,
         #[cfg(feature = "fast-free")]
         Some(Held::Fast(fast)) => {
-            let step = super::fast::FastStep::new(fast, spheres, (complex, index, _reals))?;
+            let step = super::fast::FastStep::new(fast, spheres, (complex, index, _reals), par)?;
             return Ok(Some(Store::Fast(step)));
         }
         _ => return Ok(None),
