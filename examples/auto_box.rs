@@ -40,6 +40,10 @@ mod cpu;
 mod best;
 use best::best;
 
+#[path = "shared/fit.rs"]
+mod fit;
+use fit::{fit, misfit};
+
 /// `n` unit spheres at random in a cube of edge `l` (overlaps allowed: equal radii
 /// never nest), and forces.
 fn spheres(n: usize, l: f64, seed: u64) -> (Vec<V>, Vec<f64>, Vec<V>) {
@@ -70,54 +74,6 @@ fn pse_terms(pse: &Pse<f64>, n: usize, l: f64) -> [f64; 4] {
         n as f64 * (s[0] * s[1] * s[2]) as f64,
         m,
     ]
-}
-
-/// Non-negative least squares on relative residuals, by dropping the most negative
-/// coefficient and refitting: `x` rows of terms (a 1 column for a constant), `t` times.
-fn fit(x: &[Vec<f64>], t: &[f64]) -> Vec<f64> {
-    let k = x[0].len();
-    let mut on = vec![true; k];
-    loop {
-        let cols: Vec<usize> = (0..k).filter(|&c| on[c]).collect();
-        let m = cols.len();
-        let mut a = vec![vec![0.0; m + 1]; m];
-        for (row, &ti) in x.iter().zip(t) {
-            let w: Vec<f64> = cols.iter().map(|&c| row[c] / ti).collect();
-            for i in 0..m {
-                for j in 0..m {
-                    a[i][j] += w[i] * w[j];
-                }
-                a[i][m] += w[i];
-            }
-        }
-        // Gauss-Jordan with partial pivoting.
-        for i in 0..m {
-            let p = (i..m)
-                .max_by(|&r, &s| a[r][i].abs().total_cmp(&a[s][i].abs()))
-                .unwrap();
-            a.swap(i, p);
-            let pivot = a[i].clone();
-            for (r, row) in a.iter_mut().enumerate() {
-                if r != i {
-                    let f = row[i] / pivot[i];
-                    for (x, p) in row.iter_mut().zip(&pivot).skip(i) {
-                        *x -= f * p;
-                    }
-                }
-            }
-        }
-        let mut out = vec![0.0; k];
-        for (i, &c) in cols.iter().enumerate() {
-            out[c] = a[i][m] / a[i][i];
-        }
-        match (0..k)
-            .filter(|&c| on[c])
-            .min_by(|&a, &b| out[a].total_cmp(&out[b]))
-        {
-            Some(c) if out[c] < 0.0 => on[c] = false,
-            _ => return out,
-        }
-    }
 }
 
 fn shell(cmd: &str, args: &[&str]) -> String {
@@ -243,18 +199,6 @@ fn main() -> std::io::Result<()> {
         )
         .unwrap();
     }
-    // The fit's worst relative misfit, a check of the model's form.
-    let misfit = |x: &[Vec<f64>], t: &[f64], c: &[f64]| {
-        x.iter()
-            .zip(t)
-            .map(|(r, &ti)| {
-                (r.iter().zip(c).map(|(a, b)| a * b).sum::<f64>() / ti)
-                    .ln()
-                    .abs()
-            })
-            .fold(0.0, f64::max)
-            .exp()
-    };
     println!(
         "worst misfit: Ewald x{:.2}, PSE x{:.2}",
         misfit(&ex, &et, &e),

@@ -20,6 +20,26 @@ pub fn csv_field(text: &str) -> String {
     }
 }
 
+/// The fields of one CSV line as [`csv_field`] writes them (quotes removed, doubled
+/// quotes undone).
+pub fn csv_fields(line: &str) -> Vec<String> {
+    let (mut out, mut cur, mut quoted) = (vec![], String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut cur)),
+            _ => cur.push(c),
+        }
+    }
+    out.push(cur);
+    out
+}
+
 impl<W: Write> CsvWriter<W> {
     /// Writes the header row.
     pub fn new<S: AsRef<str>>(mut inner: W, columns: &[S]) -> io::Result<Self> {

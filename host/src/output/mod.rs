@@ -16,7 +16,7 @@ mod lock;
 mod xyz;
 
 pub use atomic::{AtomicFile, continued_source, name_error, tmp_path, write_atomic, write_json};
-pub use csv::{CsvWriter, csv_field};
+pub use csv::{CsvWriter, csv_field, csv_fields};
 pub use digest::{FileCheck, check_files, fnv1a64, mismatch};
 pub use lock::{FolderLock, LOCK_FILE, Locked};
 pub use xyz::{Frame, XYZ_PROPERTIES, XyzError, XyzWriter, read_xyz, read_xyz_file};

@@ -61,6 +61,9 @@ mod error;
 mod floor;
 #[cfg(test)]
 mod floor_tests;
+pub mod free_cost;
+#[cfg(test)]
+mod free_cost_tests;
 mod free_space;
 mod helix;
 mod kernel;

@@ -171,37 +171,44 @@ impl Plan {
         let c = b
             .saturating_add(contacts.unwrap_or(0))
             .saturating_add(walls);
-        sizable(n, c).then(|| {
-            let mut p = Params::<f64>::new(1.0);
-            p.method = self.method;
-            p.rotation = self.rotation;
-            p.solver.kind = self.solver;
-            p.contacts = contacts.map(Contacts::new);
-            p.wall = self.wall.then_some(hydrorattle::Wall::new(0.0));
-            p.matrix_free = self.matrix_free || self.pse || self.fast;
-            p.compact_products = self.compact_products;
-            if self.pse {
-                // Any box: only the solver's resolution reads it.
-                p.periodic = hydrorattle::Periodic::new([1.0; 3]).ok();
-                p.pse = Some(1e-3);
-            }
-            if self.fast && !self.pse && !self.wall {
-                // Free space's fast product (no box): only its presence sizes the storage.
-                p.pse = Some(1e-3);
-            }
-            if let Some(t) = self.brownian {
-                p.brownian = Some(hydrorattle::Brownian {
-                    temperature: t.temperature,
-                    drift: t.drift,
-                });
-                p.noise_sqrt = t.sqrt;
-            }
-            // Any parameters: only whether it is on sizes the storage.
-            if self.near {
-                p.near = Some(hydrorattle::stokesian::NearField::default());
-            }
-            Layout::for_params(&p, n, b)
-        })
+        sizable(n, c).then(|| Layout::for_params(&self.params(n), n, b))
+    }
+
+    /// The kernel's parameters of this plan for `n` particles: what sizes the storage
+    /// and resolves the solver and the noise (any box, any near field, unit viscosity).
+    pub fn params(&self, n: usize) -> Params<f64> {
+        let mut p = Params::<f64>::new(1.0);
+        p.method = self.method;
+        p.rotation = self.rotation;
+        p.solver.kind = self.solver;
+        p.contacts = self
+            .contact
+            .and_then(|c| c.hard_capacity(n))
+            .map(Contacts::new);
+        p.wall = self.wall.then_some(hydrorattle::Wall::new(0.0));
+        p.matrix_free = self.matrix_free || self.pse || self.fast;
+        p.compact_products = self.compact_products;
+        if self.pse {
+            // Any box: only the solver's resolution reads it.
+            p.periodic = hydrorattle::Periodic::new([1.0; 3]).ok();
+            p.pse = Some(1e-3);
+        }
+        if self.fast && !self.pse && !self.wall {
+            // Free space's fast product (no box): only its presence sizes the storage.
+            p.pse = Some(1e-3);
+        }
+        if let Some(t) = self.brownian {
+            p.brownian = Some(hydrorattle::Brownian {
+                temperature: t.temperature,
+                drift: t.drift,
+            });
+            p.noise_sqrt = t.sqrt;
+        }
+        // Any parameters: only whether it is on sizes the storage.
+        if self.near {
+            p.near = Some(hydrorattle::stokesian::NearField::default());
+        }
+        p
     }
 
     /// Bytes of [`layout`](Self::layout) in this plan's precision.

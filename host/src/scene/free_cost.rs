@@ -1,0 +1,321 @@
+//! What a free-space `auto` weighs: the time of one step's mobility work by each way
+//! of giving it its products, from a cost model whose constants were measured
+//! (`cargo run --release --example free_cost`, rows and fitted constants in
+//! `bench/results/free_cost.csv`; chart `docs/free_crossover.png`, docs/FREE.md).
+//!
+//! * dense: the stored mobility is assembled once a step (twice with the midpoint
+//!   drift), `DENSE_ASSEMBLY_BLOCK` a packed block (`tri(N) = N (N + 1) / 2` of them),
+//!   and each product reads it, `DENSE_PRODUCT_BLOCK` a block; the thermal noise up
+//!   to `LANCZOS_CROSSOVER` spheres is its block Cholesky factor, `CHOLESKY_CUBE N^3`;
+//! * compact: the same assembly, its `f32` copy written on the way
+//!   (`COMPACT_COPY_BLOCK`) and the constraint products read from the copy
+//!   (`COMPACT_PRODUCT_BLOCK`);
+//! * matrix-free: every product evaluates every pair again, `FREE_BLOCK` a block;
+//! * fast (`mobility::free_fast`): `FAST_FIXED + FAST_GRID M log2 M + FAST_NEAR (N + 2
+//!   pairs) + FAST_SPREAD N P^3`, with `M` the padded grid's points, `P^3` the window's
+//!   and `pairs` the pairs within the cutoff, all from the kernel's own parameters
+//!   (`FreeFast::new`); the pairs estimated from the spheres' bounding box.
+//!
+//! Each fit minimises the relative residuals of its rows of the record (every shape,
+//! unit spheres at volume fractions 0.01, 0.1 and 0.3 in a ball and a helical chain,
+//! N = 10 to 1e5; the fast model over tolerances 1e-4 and 1e-6 together).
+//!
+//! A step takes one product, or dozens with a constraint solve and Lanczos noise (the
+//! counts measured for the box, [`box_cost`](super::box_cost)); the stored paths pay
+//! their assembly once and then a few nanoseconds a block a product, the matrix-free
+//! and fast paths pay every product in full. What each path can run decides first
+//! ([`allowed`]), then storage (a path whose storage passes the limit is never taken,
+//! checked before anything is allocated), then the modelled time.
+
+use hydrorattle::mobility::free_fast::FreeFast;
+use hydrorattle::{Method, Params, SolverKind};
+
+use super::box_cost::{PRODUCTS_MIDPOINT, PRODUCTS_NOISE, PRODUCTS_SOLVE};
+use super::sizing::{Plan, TooLarge};
+use super::{Drift, Sqrt};
+
+/// Seconds per dense assembly, fixed part.
+pub const DENSE_ASSEMBLY_FIXED: f64 = 8.1588e-6;
+/// Seconds per dense assembly per packed block (one pair evaluation).
+pub const DENSE_ASSEMBLY_BLOCK: f64 = 1.4739e-8;
+/// Seconds per product from the stored mobility, fixed part.
+pub const DENSE_PRODUCT_FIXED: f64 = 6.5281e-6;
+/// Seconds per product from the stored mobility per packed block.
+pub const DENSE_PRODUCT_BLOCK: f64 = 8.0650e-9;
+/// Seconds per block Cholesky factor, fixed part.
+pub const CHOLESKY_FIXED: f64 = 8.2758e-6;
+/// Seconds per block Cholesky factor per `N^3`.
+pub const CHOLESKY_CUBE: f64 = 1.4981e-9;
+/// Seconds per writing of the compact copy (with its product), fixed part.
+pub const COMPACT_COPY_FIXED: f64 = 0.0000e0;
+/// Seconds per writing of the compact copy (with its product) per packed block.
+pub const COMPACT_COPY_BLOCK: f64 = 1.5617e-8;
+/// Seconds per product from the compact copy, fixed part.
+pub const COMPACT_PRODUCT_FIXED: f64 = 4.1629e-5;
+/// Seconds per product from the compact copy per packed block.
+pub const COMPACT_PRODUCT_BLOCK: f64 = 4.5663e-9;
+/// Seconds per matrix-free product, fixed part.
+pub const FREE_FIXED: f64 = 7.6519e-6;
+/// Seconds per matrix-free product per packed block (one pair evaluation).
+pub const FREE_BLOCK: f64 = 1.9842e-8;
+/// Seconds per fast product, fixed part.
+pub const FAST_FIXED: f64 = 0.0000e0;
+/// Seconds per fast product per `M log2 M` of its padded grid (the FFTs).
+pub const FAST_GRID: f64 = 4.5910e-9;
+/// Seconds per fast product per sphere and per near pair counted twice.
+pub const FAST_NEAR: f64 = 1.0038e-7;
+/// Seconds per fast product per window point of a sphere (spreading and interpolation).
+pub const FAST_SPREAD: f64 = 5.9839e-9;
+
+/// `N (N + 1) / 2` as a real: the packed blocks of `n` spheres.
+fn blocks(n: usize) -> f64 {
+    let n = n as f64;
+    n * (n + 1.0) / 2.0
+}
+
+/// A way of giving a free-space step its mobility products.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FreeChoice {
+    /// The stored mobility (`matrix_free = false`).
+    Dense,
+    /// The stored mobility with its compact `f32` copy for the constraint products
+    /// (`compact_products = true`).
+    Compact,
+    /// Every pair evaluated again in each product (`matrix_free = true`).
+    MatrixFree,
+    /// The fast `O(N log N)` product (`mobility::free_fast`, matrix-free).
+    Fast,
+}
+
+/// The order [`choose`] weighs the paths in (a tie keeps the earlier).
+pub const CHOICES: [FreeChoice; 4] = [
+    FreeChoice::Dense,
+    FreeChoice::Compact,
+    FreeChoice::MatrixFree,
+    FreeChoice::Fast,
+];
+
+/// The spheres a choice is made for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spheres {
+    /// How many.
+    pub n: usize,
+    /// Bonds (constraint rows beside the contacts the plan carries).
+    pub bonds: usize,
+    /// The edges of the box that bounds their centres.
+    pub extent: [f64; 3],
+    /// The largest radius.
+    pub a_max: f64,
+    /// RPY hydrodynamics (the fast product computes RPY only).
+    pub rpy: bool,
+}
+
+impl Spheres {
+    /// The spheres of `scene` as they start: the bonds and pins as constraint rows,
+    /// the bounding box of the centres.
+    pub fn of(scene: &super::Scene) -> Spheres {
+        let ps = &scene.particles;
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in ps {
+            for c in 0..3 {
+                lo[c] = lo[c].min(p.position[c]);
+                hi[c] = hi[c].max(p.position[c]);
+            }
+        }
+        Spheres {
+            n: ps.len(),
+            bonds: scene.bonds.len() + scene.pinned.len(),
+            extent: [0, 1, 2].map(|c| (hi[c] - lo[c]).max(0.0)),
+            a_max: ps.iter().fold(0.0, |m: f64, p| m.max(p.radius)),
+            rpy: scene.model.hydrodynamics == super::Hydrodynamics::Rpy,
+        }
+    }
+}
+
+/// The modelled time of one product by each path, seconds, from the spheres alone; the
+/// fast path's `None` where the kernel refuses its parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FreeCost {
+    /// An assembly of the stored mobility.
+    pub assembly: f64,
+    /// A product from the stored mobility.
+    pub dense: f64,
+    /// The block Cholesky factor of the stored mobility.
+    pub cholesky: f64,
+    /// The compact copy's writing (with one product).
+    pub copy: f64,
+    /// A product from the compact copy.
+    pub compact: f64,
+    /// A matrix-free product.
+    pub matrix_free: f64,
+    /// A fast product at the tolerance.
+    pub fast: Option<f64>,
+}
+
+/// The pairs within `r_cut` of `n` spheres spread evenly over the box of edges
+/// `extent` (padded by a radius each side): each sphere's ball of neighbours clipped to
+/// the box, axis by axis (a chain's ball is a segment of it, a sheet's a disk).
+pub fn near_pairs(n: usize, extent: [f64; 3], a_max: f64, r_cut: f64) -> f64 {
+    let mut share = 1.0;
+    let mut clipped = 0;
+    for e in extent {
+        let e = e + 2.0 * a_max;
+        if 2.0 * r_cut < e {
+            share *= 2.0 * r_cut / e;
+            clipped += 1;
+        }
+    }
+    // The ball's share of its bounding cube in the clipped directions.
+    share *= [
+        1.0,
+        1.0,
+        std::f64::consts::FRAC_PI_4,
+        std::f64::consts::PI / 6.0,
+    ][clipped];
+    let n = n as f64;
+    0.5 * n * (n - 1.0).max(0.0) * share
+}
+
+impl FreeCost {
+    /// The spheres `s` with the fast product at `tolerance`.
+    pub fn of(s: &Spheres, tolerance: f64) -> FreeCost {
+        let (b, n) = (blocks(s.n), s.n as f64);
+        let fast = FreeFast::<f64>::new(s.a_max, tolerance, s.extent, s.n)
+            .ok()
+            .map(|ff| {
+                let g = ff.grid();
+                let m = (g[0] * g[1] * g[2]) as f64;
+                let p3 = (ff.support() as f64).powi(3);
+                let pairs = near_pairs(s.n, s.extent, s.a_max, ff.r_cut());
+                FAST_FIXED
+                    + FAST_GRID * m * m.log2()
+                    + FAST_NEAR * (n + 2.0 * pairs)
+                    + FAST_SPREAD * n * p3
+            });
+        FreeCost {
+            assembly: DENSE_ASSEMBLY_FIXED + DENSE_ASSEMBLY_BLOCK * b,
+            dense: DENSE_PRODUCT_FIXED + DENSE_PRODUCT_BLOCK * b,
+            cholesky: CHOLESKY_FIXED + CHOLESKY_CUBE * n * n * n,
+            copy: COMPACT_COPY_FIXED + COMPACT_COPY_BLOCK * b,
+            compact: COMPACT_PRODUCT_FIXED + COMPACT_PRODUCT_BLOCK * b,
+            matrix_free: FREE_FIXED + FREE_BLOCK * b,
+            fast,
+        }
+    }
+}
+
+/// `plan` with the mobility path `choice`.
+fn with_path(plan: &Plan, choice: FreeChoice) -> Plan {
+    let mut p = *plan;
+    p.matrix_free = matches!(choice, FreeChoice::MatrixFree | FreeChoice::Fast);
+    p.compact_products = choice == FreeChoice::Compact;
+    p
+}
+
+/// What a step of `plan` asks of the mobility, and how each path answers it: the
+/// modelled seconds of one step by `choice`, or `None` where the path cannot run it.
+///
+/// * the stored paths: every method; compact only where the kernel keeps the copy
+///   (`Params::compact_copy`: first-order overdamped, `f64`, Krylov, from
+///   `REDUCED_MIN` spheres), and it changes only the constraint products;
+/// * matrix-free and fast: `Overdamped` and `Springs` (the others factorise or keep a
+///   second mobility), no wall, no near field, no Cholesky noise, and with constraints
+///   the Krylov solver (the dense solvers read the metric entry by entry); fast also
+///   needs RPY without rotation and a grid the kernel accepts.
+pub fn step_cost(plan: &Plan, s: &Spheres, cost: &FreeCost, choice: FreeChoice) -> Option<f64> {
+    let p: Params<f64> = with_path(plan, choice).params(s.n);
+    let rows = p.constraints(s.n, s.bonds);
+    let krylov = p.solver_kind(s.n, s.bonds) == SolverKind::Krylov;
+    let thermal = plan.brownian.is_some_and(|t| t.temperature > 0.0);
+    let midpoint = thermal && rows > 0 && plan.brownian.is_some_and(|t| t.drift == Drift::Midpoint);
+    let solve = if rows > 0 { PRODUCTS_SOLVE } else { 0.0 };
+    let lanczos = thermal && p.lanczos_noise(s.n);
+    let noise = if lanczos { PRODUCTS_NOISE } else { 0.0 };
+    let mid = if midpoint { PRODUCTS_MIDPOINT } else { 0.0 };
+    let products = 1.0 + solve + noise + mid;
+    let assemblies = if midpoint { 2.0 } else { 1.0 };
+    let cholesky = if thermal && !lanczos {
+        cost.cholesky * assemblies
+    } else {
+        0.0
+    };
+    let free_ok = matches!(plan.method, Method::Overdamped | Method::Springs)
+        && !plan.wall
+        && !plan.near
+        && (!thermal || plan.brownian.is_none_or(|t| t.sqrt != Sqrt::Cholesky))
+        && (rows == 0 || krylov);
+    match choice {
+        FreeChoice::Dense => Some(cost.assembly * assemblies + cost.dense * products + cholesky),
+        FreeChoice::Compact => p.compact_copy(s.n, s.bonds).then(|| {
+            let constrained = solve + mid;
+            cost.assembly * assemblies
+                + cost.copy * assemblies
+                + cost.dense * (products - constrained)
+                + cost.compact * constrained
+        }),
+        FreeChoice::MatrixFree => free_ok.then_some(cost.matrix_free * products),
+        FreeChoice::Fast => {
+            let fast_ok = free_ok && s.rpy && !plan.rotation;
+            cost.fast.filter(|_| fast_ok).map(|t| t * products)
+        }
+    }
+}
+
+/// The bytes a step of `plan` with `choice` keeps: the kernel's storage
+/// ([`Plan::bytes`]), and the fast product's grid and lists.
+pub fn storage(plan: &Plan, s: &Spheres, tolerance: f64, choice: FreeChoice) -> Option<usize> {
+    let step = with_path(plan, choice).bytes(s.n, s.bonds)?;
+    if choice != FreeChoice::Fast {
+        return Some(step);
+    }
+    let ff = FreeFast::<f64>::new(s.a_max, tolerance, s.extent, s.n).ok()?;
+    let z = ff.storage(s.n);
+    let grid = z.complex.checked_mul(16)? + z.reals.checked_mul(8)? + z.index.checked_mul(8)?;
+    step.checked_add(grid)
+}
+
+/// The path `auto` takes for a free-space step of `plan` on the spheres `s` with the
+/// fast product at `tolerance`: the fastest modelled ([`step_cost`]) of those that
+/// can run it and whose [`storage`] fits in `limit` bytes, with its modelled seconds a
+/// step; refused, naming the smallest need, where none fits.
+pub fn choose(
+    plan: &Plan,
+    s: &Spheres,
+    tolerance: f64,
+    limit: usize,
+) -> Result<(FreeChoice, f64), TooLarge> {
+    let cost = FreeCost::of(s, tolerance);
+    let mut best: Option<(FreeChoice, f64)> = None;
+    let mut need: Option<usize> = None;
+    for choice in CHOICES {
+        let Some(t) = step_cost(plan, s, &cost, choice) else {
+            continue;
+        };
+        let bytes = storage(plan, s, tolerance, choice);
+        if let Some(b) = bytes {
+            need = Some(need.map_or(b, |m| m.min(b)));
+        }
+        if bytes.is_some_and(|b| b <= limit) && best.is_none_or(|(_, bt)| t < bt) {
+            best = Some((choice, t));
+        }
+    }
+    best.ok_or(TooLarge {
+        particles: s.n,
+        bonds: s.bonds,
+        bytes: need,
+        limit,
+    })
+}
+
+/// [`choose`] for a free-space `scene` as it will run (its level applied): its plan
+/// ([`Plan::of`]), its spheres ([`Spheres::of`]), the fast product at `tolerance` and
+/// the step storage limit `limit`.
+pub fn choose_for(
+    scene: &super::Scene,
+    tolerance: f64,
+    limit: usize,
+) -> Result<(FreeChoice, f64), TooLarge> {
+    choose(&Plan::of(scene), &Spheres::of(scene), tolerance, limit)
+}
