@@ -192,7 +192,7 @@ impl<T: Real> FreeFast<T> {
     ///   `~ erfc(r_c / (2 sqrt(2) sigma))`, below the tolerance, and every overlapping
     ///   pair inside.
     pub fn new(a_max: T, tol: f64, extent: [T; 3], n: usize) -> Result<Self, FreeError> {
-        let sigma = Self::sigma(a_max, extent, n);
+        let sigma = Self::rule_sigma(a_max, extent, n);
         Self::with_sigma(a_max, tol, extent, sigma)
     }
 
@@ -201,12 +201,12 @@ impl<T: Real> FreeFast<T> {
     /// reaches twice the tolerance under [`FreeFast::new`]'s parameters). They serve
     /// [`FreeFast::apply`] too, a little more accurately and slowly.
     pub fn new_grand(a_max: T, tol: f64, extent: [T; 3], n: usize) -> Result<Self, FreeError> {
-        let sigma = Self::sigma(a_max, extent, n);
+        let sigma = Self::rule_sigma(a_max, extent, n);
         Self::build(a_max, tol, extent, sigma, GRAND_MARGIN)
     }
 
     /// The spreading width of [`FreeFast::new`]'s rule.
-    fn sigma(a_max: T, extent: [T; 3], n: usize) -> T {
+    fn rule_sigma(a_max: T, extent: [T; 3], n: usize) -> T {
         let e = extent.map(|e| e.to_f64());
         let a = a_max.to_f64();
         let vol = e.iter().map(|e| e + 2.0 * a).product::<f64>();

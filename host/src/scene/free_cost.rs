@@ -319,3 +319,39 @@ pub fn choose_for(
 ) -> Result<(FreeChoice, f64), TooLarge> {
     choose(&Plan::of(scene), &Spheres::of(scene), tolerance, limit)
 }
+
+impl super::Scene {
+    /// This scene with `[free_space] method = "auto"` resolved for the run: the path
+    /// [`choose_for`] takes under [`DEFAULT_LIMIT`](super::sizing::DEFAULT_LIMIT)
+    /// (`"dense"`, with `compact_products` or `matrix_free` where it picks those, or
+    /// `"fast"`, matrix-free), so that the run's `scene.toml` names the path it ran.
+    /// Where no path fits the limit it takes the fast path, whose storage the run then
+    /// checks and refuses. Other scenes are returned as they are.
+    pub fn with_free_resolved(mut self) -> super::Scene {
+        use super::free_space::FreeMethod;
+        let Some(f) = self.free_space.filter(|f| f.method == FreeMethod::Auto) else {
+            return self;
+        };
+        let choice = choose_for(&self, f.tolerance, super::sizing::DEFAULT_LIMIT)
+            .map_or(FreeChoice::Fast, |(c, _)| c);
+        let method = match choice {
+            FreeChoice::Dense => FreeMethod::Dense,
+            FreeChoice::Compact => {
+                self.integrator.compact_products = true;
+                FreeMethod::Dense
+            }
+            FreeChoice::MatrixFree => {
+                self.integrator.matrix_free = true;
+                FreeMethod::Dense
+            }
+            FreeChoice::Fast => {
+                self.integrator.matrix_free = true;
+                FreeMethod::Fast
+            }
+        };
+        if let Some(fs) = self.free_space.as_mut() {
+            fs.method = method;
+        }
+        self
+    }
+}

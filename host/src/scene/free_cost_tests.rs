@@ -23,6 +23,7 @@ fn plan(method: Method, solver: Solver) -> Plan {
         compact_products: false,
         pse: false,
         near: false,
+        fast: false,
     }
 }
 
@@ -241,7 +242,8 @@ fn auto_picks_dense_for_the_shipped_scenes() {
         let path = entry.unwrap().path();
         let text = std::fs::read_to_string(&path).unwrap();
         let scene = Scene::parse(&text, &path.to_string_lossy()).unwrap();
-        if scene.periodic.is_some() || scene.wall.is_some() {
+        // A scene that names its free-space path (the clouds) keeps it.
+        if scene.periodic.is_some() || scene.wall.is_some() || scene.free_space.is_some() {
             continue;
         }
         let scene = crate::sim::resolve_level(&scene, "shipped").0;
@@ -259,4 +261,35 @@ fn csv_fields_read_what_csv_field_writes() {
     let cells = ["plain", "a, b", "say \"hi\"", "", "x\"y,z"];
     let line: Vec<String> = cells.iter().map(|c| crate::output::csv_field(c)).collect();
     assert_eq!(crate::output::csv_fields(&line.join(",")), cells);
+}
+
+/// `[free_space] method = "auto"`: resolved when the run starts to the path the model
+/// picks (a four-bead chain keeps the stored mobility; a cloud of 20,000 spheres, whose
+/// stored mobility would need 9.6 GB, is read without that estimate and takes the fast
+/// product), written back as what ran; with a wall it is `"dense"` at once.
+#[test]
+fn free_space_auto_resolves_by_the_model() {
+    use super::free_space::FreeMethod;
+    let chain = "[[particle]]\nposition = [0, 0, 0]\nradius = 1\n\n\
+                 [[particle]]\nposition = [2.1, 0, 0]\nradius = 1\n\n\
+                 [[bond]]\nbetween = [0, 1]\n\n\
+                 [free_space]\nmethod = \"auto\"\n\n\
+                 [integrator]\nmethod = \"overdamped\"\ndt = 0.01\nduration = 0.1\n";
+    let s = Scene::parse(chain, "c.toml").unwrap();
+    assert_eq!(s.free_space.unwrap().method, FreeMethod::Auto);
+    let run = crate::sim::resolve_level(&s, "c").0;
+    assert_eq!(run.free_space.unwrap().method, FreeMethod::Dense);
+    assert!(!run.integrator.matrix_free);
+    assert!(run.to_toml().contains("method = \"dense\""));
+    let walled = format!("{chain}\n[wall]\nheight = -5\n");
+    let s = Scene::parse(&walled, "w.toml").unwrap();
+    assert_eq!(s.free_space.unwrap().method, FreeMethod::Dense);
+    let cloud = "[cloud]\ncount = 20000\ncloud_radius = 126\nseed = 3\n\n\
+                 [free_space]\nmethod = \"auto\"\n\n\
+                 [integrator]\nmethod = \"overdamped\"\ndt = 0.01\nduration = 0.1\n";
+    let s = Scene::parse(cloud, "cloud.toml").unwrap();
+    let run = crate::sim::resolve_level(&s, "cloud").0;
+    assert_eq!(run.free_space.unwrap().method, FreeMethod::Fast);
+    assert!(run.integrator.matrix_free);
+    assert_eq!(super::beads::params::<f64>(&run).pse, Some(1e-4));
 }

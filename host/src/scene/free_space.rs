@@ -2,7 +2,7 @@
 //!
 //! ```toml
 //! [free_space]
-//! method = "fast"     # "dense" (default) | "fast"
+//! method = "fast"     # "dense" (default) | "fast" | "auto"
 //! tolerance = 1e-4    # the fast product's relative error (1e-10 to 0.1)
 //! ```
 //!
@@ -17,7 +17,12 @@
 //! products are their own), rotation, another level than RPY, a `[near_field]`, a
 //! method or level that stores the mobility (`matrix_free`'s rule), the Cholesky
 //! factor of the noise. The storage is sized without the mobility (`O(N)`, no `N^2`
-//! term), so a cloud of 10^5 spheres is not refused as dense.
+//! term), so a cloud of 10^5 spheres is not refused as dense. `"auto"` picks, when the
+//! run starts, the path a measured cost model says is fastest among those that fit the
+//! storage limit (`scene::free_cost`: the stored mobility, its compact copy,
+//! matrix-free or fast); where `"fast"` cannot run the scene it is `"dense"` at once.
+//! An `"auto"` scene is sized at read time as the fast path would be (the choice then
+//! checks each path's storage before taking it).
 
 use serde::{Deserialize, Serialize};
 use toml::Spanned;
@@ -35,6 +40,9 @@ pub enum FreeMethod {
     Dense,
     /// The fast free-space product, `O(N log N)`, to `tolerance`.
     Fast,
+    /// Chosen when the run starts by the measured cost model
+    /// ([`Scene::with_free_resolved`](super::Scene::with_free_resolved)).
+    Auto,
 }
 
 /// The default `tolerance` of `"fast"`: the product's measured error is 5 to 55 times
@@ -52,6 +60,12 @@ pub struct FreeSpace {
 }
 
 impl FreeSpace {
+    /// Whether the run may take the fast product (`"fast"`, or `"auto"` not yet
+    /// resolved): the scene is then sized without the `N^2` mobility.
+    pub fn may_be_fast(&self) -> bool {
+        matches!(self.method, FreeMethod::Fast | FreeMethod::Auto)
+    }
+
     /// The kernel's `Params::pse` for this table: the tolerance when `"fast"`.
     pub fn fast_tolerance(&self) -> Option<f64> {
         (self.method == FreeMethod::Fast).then_some(self.tolerance)
@@ -116,6 +130,11 @@ pub(super) fn resolve(raw: &Spanned<RawFreeSpace>, cx: &Context<'_>) -> Result<F
     {
         return Err(issue(at, format!("method = \"fast\" {why}")));
     }
+    // "auto" where the fast product cannot run: the dense paths, resolved at once.
+    let method = match method {
+        FreeMethod::Auto if unsupported(cx).is_some() => FreeMethod::Dense,
+        m => m,
+    };
     Ok(FreeSpace { method, tolerance })
 }
 

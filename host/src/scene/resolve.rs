@@ -141,6 +141,9 @@ impl RawScene {
         let fast = free_space.and_then(|f| f.fast_tolerance()).is_some();
         let mut integrator = integrator;
         integrator.matrix_free |= fast;
+        // "auto" may take the fast product: sized as it would be (`free_cost::choose`
+        // checks each path's storage when the run starts).
+        let fast = free_space.is_some_and(|f| f.may_be_fast());
         let every = match self.output.as_ref().and_then(|o| o.every.as_ref()) {
             None => integrator.steps().div_ceil(TARGET_FRAMES).max(1),
             Some(e) if *e.get_ref() == 0 => {

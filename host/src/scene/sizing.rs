@@ -156,9 +156,7 @@ impl Plan {
                 .periodic
                 .is_some_and(|b| b.method == super::BoxMethod::Pse),
             near: scene.near_field.is_some(),
-            fast: scene
-                .free_space
-                .is_some_and(|f| f.fast_tolerance().is_some()),
+            fast: scene.free_space.is_some_and(|f| f.may_be_fast()),
         }
     }
 

@@ -323,10 +323,11 @@ pub fn run_from(
 }
 
 /// `scene` with `level = "auto"` applied (and what was chosen), or as it is; its box's
-/// `method = "auto"` resolved too ([`crate::scene::BoxMethod::resolve`]), so that the
-/// run's `scene.toml` names the path it ran.
+/// `method = "auto"` resolved too ([`crate::scene::BoxMethod::resolve`]), and free
+/// space's (`Scene::with_free_resolved`), so that the run's `scene.toml` names the
+/// path it ran.
 pub fn resolve_level(scene: &Scene, name: &str) -> (Scene, Option<crate::auto::Choice>) {
-    let scene = scene.clone().with_box_resolved();
+    let scene = scene.clone().with_box_resolved().with_free_resolved();
     if scene.model.level != crate::scene::Level::Auto {
         return (scene, None);
     }
