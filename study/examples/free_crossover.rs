@@ -40,6 +40,7 @@ fn crossover(phi: f64, bonds: usize) -> Option<f64> {
         compact_products: false,
         pse: false,
         near: false,
+        fast: false,
     };
     (40..=200).map(|k| 10f64.powf(k as f64 / 40.0)).find(|&n| {
         let n = n as usize;

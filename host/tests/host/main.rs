@@ -10,6 +10,7 @@ mod auto;
 mod box_sweep;
 mod cloud;
 mod falling_cloud;
+mod free_auto;
 mod free_space_scene;
 mod fuzz_scene;
 mod jam_retry;
