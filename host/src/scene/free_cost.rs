@@ -24,7 +24,7 @@
 //! counts measured for the box, [`box_cost`](super::box_cost)); the stored paths pay
 //! their assembly once and then a few nanoseconds a block a product, the matrix-free
 //! and fast paths pay every product in full. What each path can run decides first
-//! ([`allowed`]), then storage (a path whose storage passes the limit is never taken,
+//! ([`step_cost`] is `None` for a path the step cannot take), then storage (a path whose storage passes the limit is never taken,
 //! checked before anything is allocated), then the modelled time.
 
 use hydrorattle::mobility::free_fast::FreeFast;
