@@ -177,12 +177,7 @@ impl RawScene {
         }
         let s = crate::scene::suspension::resolve(raw)?;
         let at = raw.get_ref().count_span().unwrap_or(raw.span());
-        let integrator = self.integrator.as_ref().map(|i| i.get_ref());
-        fits(plans, s.count, 0, limits.storage).map_err(|e| too_large(at.clone(), e))?;
-        if let Some(i) = integrator {
-            let i = resolve_integrator(i)?;
-            check_output(&i, every, s.count, limits.output).map_err(|m| issue(at.clone(), m))?;
-        }
+        self.check_generated(plans, limits, every, s.count, at)?;
         let body = s.generate().map_err(|m| issue(raw.span(), m))?;
         Ok((s, body))
     }
@@ -214,13 +209,27 @@ impl RawScene {
         }
         let c = crate::scene::cloud::resolve(raw)?;
         let at = raw.get_ref().count_span().unwrap_or(raw.span());
-        fits(plans, c.count, 0, limits.storage).map_err(|e| too_large(at.clone(), e))?;
-        if let Some(i) = self.integrator.as_ref().map(|i| i.get_ref()) {
-            let i = resolve_integrator(i)?;
-            check_output(&i, every, c.count, limits.output).map_err(|m| issue(at.clone(), m))?;
-        }
+        self.check_generated(plans, limits, every, c.count, at)?;
         let particles = c.generate().map_err(|m| issue(raw.span(), m))?;
         Ok((c, particles))
+    }
+
+    /// A generated body of `count` spheres (no bonds) checked against the storage and
+    /// output limits before any sphere is placed, refused at `at` (its `count`).
+    fn check_generated(
+        &self,
+        plans: &[Plan],
+        limits: Limits,
+        every: usize,
+        count: usize,
+        at: Range<usize>,
+    ) -> Result<(), Issue> {
+        fits(plans, count, 0, limits.storage).map_err(|e| too_large(at.clone(), e))?;
+        if let Some(i) = self.integrator.as_ref().map(|i| i.get_ref()) {
+            let i = resolve_integrator(i)?;
+            check_output(&i, every, count, limits.output).map_err(|m| issue(at, m))?;
+        }
+        Ok(())
     }
 }
 
