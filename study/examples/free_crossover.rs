@@ -19,7 +19,7 @@ use anyhow::{Context, Result};
 use hydrorattle_host::output::csv_fields;
 use hydrorattle_host::scene::free_cost::{FreeChoice, Spheres, choose};
 use hydrorattle_host::scene::sizing::Plan;
-use hydrorattle_host::scene::{Method, Precision, Solver};
+use hydrorattle_host::scene::{Method, Solver};
 use hydrorattle_study::render::{LineChart, Series, line_chart};
 
 /// The measured table's name in the record.
@@ -28,20 +28,7 @@ const TABLE: &str = "free-space product paths";
 /// The smallest N (on a grid of 40 a decade) at which `auto` leaves the stored
 /// mobility for a cloud at volume fraction `phi`, with `bonds` bonds (a Krylov solve).
 fn crossover(phi: f64, bonds: usize) -> Option<f64> {
-    let plan = Plan {
-        method: Method::Overdamped,
-        rotation: false,
-        solver: Solver::Krylov,
-        precision: Precision::F64,
-        contact: None,
-        brownian: None,
-        wall: false,
-        matrix_free: false,
-        compact_products: false,
-        pse: false,
-        near: false,
-        fast: false,
-    };
+    let plan = Plan::free(Method::Overdamped, Solver::Krylov);
     (40..=200).map(|k| 10f64.powf(k as f64 / 40.0)).find(|&n| {
         let n = n as usize;
         let r = (n as f64 / phi).cbrt();

@@ -11,20 +11,7 @@ const GIB: usize = 1 << 30;
 /// An overdamped deterministic plan in free space (the Krylov solver unless `solver`
 /// says otherwise).
 fn plan(method: Method, solver: Solver) -> Plan {
-    Plan {
-        method,
-        rotation: false,
-        solver,
-        precision: Precision::F64,
-        contact: None,
-        brownian: None,
-        wall: false,
-        matrix_free: false,
-        compact_products: false,
-        pse: false,
-        near: false,
-        fast: false,
-    }
+    Plan::free(method, solver)
 }
 
 fn overdamped() -> Plan {

@@ -140,6 +140,26 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// A deterministic `f64` plan in free space with nothing beyond `method` and `solver`:
+    /// no rotation, contacts, noise, wall, box, near field or fast product, the mobility
+    /// stored. The other fields are public, to be set after.
+    pub const fn free(method: Method, solver: Solver) -> Plan {
+        Plan {
+            method,
+            rotation: false,
+            solver,
+            precision: Precision::F64,
+            contact: None,
+            brownian: None,
+            wall: false,
+            matrix_free: false,
+            compact_products: false,
+            pse: false,
+            near: false,
+            fast: false,
+        }
+    }
+
     /// The plan of `scene` as it will run (its level already applied).
     pub fn of(scene: &Scene) -> Plan {
         Plan {
@@ -243,18 +263,9 @@ mod tests {
 
     fn plan(method: Method, rotation: bool, precision: Precision) -> Plan {
         Plan {
-            method,
             rotation,
-            solver: Solver::Auto,
             precision,
-            contact: None,
-            brownian: None,
-            wall: false,
-            matrix_free: false,
-            compact_products: false,
-            pse: false,
-            near: false,
-            fast: false,
+            ..Plan::free(method, Solver::Auto)
         }
     }
 

@@ -130,20 +130,7 @@ fn line_of(text: &str, needle: &str) -> usize {
 }
 
 fn overdamped() -> Plan {
-    Plan {
-        method: Method::Overdamped,
-        rotation: false,
-        solver: Solver::Auto,
-        precision: Precision::F64,
-        contact: None,
-        brownian: None,
-        wall: false,
-        matrix_free: false,
-        compact_products: false,
-        pse: false,
-        fast: false,
-        near: false,
-    }
+    Plan::free(Method::Overdamped, Solver::Auto)
 }
 
 #[test]
