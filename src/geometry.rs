@@ -12,35 +12,46 @@
 //! geometry parameter: a type parameter would change that signature for every caller
 //! and need a dispatch from the parameters to one monomorphised step per geometry in
 //! every host (each step compiled four times). Firmware drops what it does not use by
-//! the kernel's features (`wall`, `periodic`, `pse`: a variant and its code compile
-//! away with its feature), as before. The `match` over the variants below is the one
-//! place the choice is made.
+//! the kernel's features (`wall`, `periodic`, `pse`: a variant, its registration line
+//! and its module compile away with its feature), as before.
 //!
 //! **What a geometry gives.** Its blocks, not its loops: a source of blocks for the
 //! band loops written once in `parallel/source.rs` (`Blocks`: what a row needs of a
 //! sphere, the self block, the pair block; the assembly in bands, the matrix-free
 //! banded and serial products and the block at `(p, q)` read them) and, with
-//! rotation, for the grand mobility and the spins of `mobility/grand.rs` (`Grand`).
+//! rotation, for the grand mobility and the spins of `mobility/grand.rs` (`Grand`);
+//! then, in its own module here ([`free`], `wall`, `periodic`), which of those loops
+//! each operation runs and what it refuses: [`Geometry`], for a small struct of what
+//! its blocks are evaluated with. [`Hydrodynamics`] holds one of them; its variants,
+//! its choice ([`Hydrodynamics::at`]) and the forwarding of every operation are written
+//! by the one registration `geometries!` below, a line per geometry.
 //! What its parameters name is asked through [`Place`] ([`Params::place`](crate::Params::place)):
 //! the checks, the workspace's sizes, the noise and the minimum images never read
-//! the parameters' geometry fields by hand. Adding a geometry (a slit between two
-//! walls, say) is its module under `mobility/` with those two implementations, a
-//! variant and its arms here, a variant of [`Place`] (and the parameter that names
-//! it), its own input checks, and its tests.
+//! the parameters' geometry fields by hand.
+//!
+//! **Adding a geometry** (a slit between two walls, say; `docs/GEOMETRY.md`): its
+//! blocks in a module under `mobility/` (`Blocks`, `Grand`), its [`Geometry`] in a
+//! module here, one line of `geometries!`, a variant of [`Place`] with the parameter
+//! that names it, its input checks (a file under `integrate/checks/`, one call in
+//! `check_all`), its feature, and its tests.
 
+pub mod free;
+#[cfg(feature = "periodic")]
+pub mod periodic;
 mod place;
 #[cfg(feature = "periodic")]
 pub mod sums;
+#[cfg(feature = "wall")]
+pub mod wall;
 
 pub use place::Place;
 
 use core::marker::PhantomData;
 
 use crate::error::StepError;
-use crate::linalg::{MobMut, with_blocks};
-use crate::mobility::{self, Hydro};
-use crate::noise::reduced;
-use crate::parallel::{self, Parallel};
+use crate::linalg::MobMut;
+use crate::mobility::Hydro;
+use crate::parallel::Parallel;
 use crate::real::Real;
 
 /// The step's periodic sums ([`sums::BoxSums`]: Ewald, or PSE with
@@ -65,42 +76,158 @@ pub(crate) const PSE_ASSEMBLED: &str = "PSE (Params::pse) where the step needs t
      (without matrix_free, Cholesky noise, the Sweep or Newton solver, RattleStable): \
      PSE gives products only";
 
-/// The hydrodynamics of the geometry a step runs in, with the level and viscosity its
-/// blocks are evaluated at.
-#[derive(Clone, Copy, Debug)]
-pub enum Hydrodynamics<'a, T: Real> {
-    /// Free space (`mobility.rs`; the bands of `parallel/`).
-    Free {
-        /// Hydrodynamic level.
-        level: Hydro,
-        /// Viscosity.
-        eta: T,
-    },
-    /// Above a no-slip wall (`mobility/wall.rs`; feature `wall`).
-    #[cfg(feature = "wall")]
-    Wall {
-        /// Hydrodynamic level.
-        level: Hydro,
-        /// Viscosity.
-        eta: T,
-        /// The wall's height.
-        height: T,
-    },
+/// What a geometry gives a step: each geometry's module (`free.rs`, `wall.rs`,
+/// `periodic.rs` here) implements it for a small struct of what its blocks are
+/// evaluated with, and [`Hydrodynamics`] forwards each call to the one the step runs
+/// in. Its blocks come from the band loops written once (`parallel/source.rs`,
+/// `mobility/grand.rs`); what a geometry writes here is which of them it runs and what
+/// it refuses.
+pub trait Geometry<T: Real>: Copy {
+    /// `mu_tt(pos)` into the packed lower triangle `mu`, on the calling thread.
+    fn assemble_tt(self, pos: &[T::V3], radius: &[T], mu: MobMut<'_, T>) -> Result<(), StepError>;
+
+    /// `u = mu_tt(pos) f` assembled into `mu` and applied, in bands through `par`.
+    fn assemble_apply(
+        self,
+        par: &dyn Parallel,
+        spheres: (&[T::V3], &[T]),
+        mu: MobMut<'_, T>,
+        fu: (&[T::V3], &mut [T::V3]),
+        bands: &mut [T::V3],
+    ) -> Result<(), StepError>;
+
+    /// [`Geometry::assemble_apply`] that also writes the compact copy `copy` of `mu`
+    /// (symmetric blocks only: a geometry without them refuses it).
+    fn assemble_apply_copy(
+        self,
+        par: &dyn Parallel,
+        spheres: (&[T::V3], &[T]),
+        mu: MobMut<'_, T>,
+        fu: (&[T::V3], &mut [T::V3]),
+        bands: &mut [T::V3],
+        copy: &mut [T::M3],
+    ) -> Result<(), StepError>;
+
+    /// `u = mu_tt(pos) f` matrix-free (`bands`: the scratch of the bands through `par`).
+    fn product(
+        self,
+        par: &dyn Parallel,
+        spheres: (&[T::V3], &[T]),
+        fu: (&[T::V3], &mut [T::V3]),
+        bands: &mut [T::V3],
+    ) -> Result<(), StepError>;
+
+    /// The grand mobility (translations then rotations) into `out`.
+    fn assemble_grand(
+        self,
+        pos: &[T::V3],
+        radius: &[T],
+        out: &mut [T::M3],
+    ) -> Result<(), StepError>;
+
+    /// `out_i += sum_j rt_ij f_j`: the spins of torque-free spheres.
+    fn add_spin(
+        self,
+        pos: &[T::V3],
+        radius: &[T],
+        f: &[T::V3],
+        out: &mut [T::V3],
+    ) -> Result<(), StepError>;
+
+    /// The block of `mu_tt` a row-`p` entry of the matrix-free metric reads against
+    /// sphere `q` (`None` where there is none).
+    fn block_at(self, pos: &[T::V3], radius: &[T], p: usize, q: usize) -> Option<T::M3>;
+
+    /// Whether the geometry has pair blocks to read.
+    #[inline(always)]
+    fn has_blocks(self) -> bool {
+        true
+    }
+
+    /// Whether every block is symmetric, so that a table of the metric reads lower
+    /// triangles only.
+    #[inline(always)]
+    fn symmetric(self) -> bool {
+        true
+    }
+
+    /// Whether the metric may read only the lower triangles of its blocks because they
+    /// are known symmetric in bits without reading them.
+    #[inline(always)]
+    fn lower_only(self) -> bool {
+        false
+    }
+}
+
+/// Writes the registration below into [`Hydrodynamics`] (a variant a geometry, with
+/// its feature), [`Hydrodynamics::at`] (the first geometry that claims the place, in
+/// the order listed, free space where none does) and `each!` (a call forwarded to
+/// every variant). `$d` is a `$` handed in, so that the generated `each!` can have
+/// metavariables of its own.
+macro_rules! geometries {
+    ($d:tt $(
+        $(#[doc = $doc:literal])*
+        $(#[cfg($c:meta)])?
+        $V:ident($ty:ty),
+    )* _ => $(#[doc = $fdoc:literal])* $F:ident($fty:ty) $(,)?) => {
+        /// The hydrodynamics of the geometry a step runs in, with the level and
+        /// viscosity its blocks are evaluated at: one variant a geometry, each
+        /// implementing [`Geometry`] in its own module.
+        #[derive(Clone, Copy, Debug)]
+        pub enum Hydrodynamics<'a, T: Real> {
+            $($(#[doc = $doc])* $(#[cfg($c)])? $V($ty),)*
+            $(#[doc = $fdoc])*
+            $F($fty),
+            /// Never built: holds the lifetime where no variant borrows (without the
+            /// `periodic` feature), so that the variants need no twin without it.
+            #[doc(hidden)]
+            Never(core::convert::Infallible, PhantomData<&'a T>),
+        }
+
+        impl<'a, T: Real> Hydrodynamics<'a, T> {
+            /// The geometry of a step at `place` ([`Params::place`](crate::Params::place))
+            /// with its sums: the first registered geometry that claims them, free space
+            /// where none does. What the stages build, so that a new geometry reaches
+            /// them through [`Place`] and its registration alone.
+            #[inline(always)]
+            pub fn at(place: Place<T>, level: Hydro, eta: T, sums: Sums<'a, T>) -> Self {
+                $(
+                    $(#[cfg($c)])?
+                    if let Some(g) = <$ty>::at(place, level, eta, sums) {
+                        return Self::$V(g);
+                    }
+                )*
+                let _ = (place, sums); // Read above only with the geometries' features.
+                Self::$F(<$fty>::new(level, eta))
+            }
+        }
+
+        /// `$e` with `$g` bound to the geometry of the step `$s`, whichever it is.
+        macro_rules! each {
+            ($d s:expr, $d g:ident => $d e:expr) => {
+                match $d s {
+                    $($(#[cfg($c)])? Hydrodynamics::$V($d g) => $d e,)*
+                    Hydrodynamics::$F($d g) => $d e,
+                    Hydrodynamics::Never(never, _) => match never {},
+                }
+            };
+        }
+    };
+}
+
+// The registration: every geometry once, in the order the choice tries them.
+geometries! {$
     /// In a periodic box whose images interact, with the step's sums (Ewald,
     /// `mobility/periodic.rs`, or PSE, `mobility/pse.rs`; feature `periodic`).
     #[cfg(feature = "periodic")]
-    Periodic {
-        /// Hydrodynamic level (what free space would use where the sums have no blocks).
-        level: Hydro,
-        /// Viscosity.
-        eta: T,
-        /// The step's sums.
-        sums: sums::BoxSums<'a, T>,
-    },
-    /// Never built: holds the lifetime where no variant borrows (without the
-    /// `periodic` feature), so that the variants need no twin without it.
-    #[doc(hidden)]
-    Never(core::convert::Infallible, PhantomData<&'a T>),
+    Periodic(periodic::Periodic<'a, T>),
+    /// Above a no-slip wall (`mobility/wall.rs`; feature `wall`).
+    #[cfg(feature = "wall")]
+    Wall(wall::Wall<T>),
+    // Where no other geometry claims the place:
+    _ =>
+    /// Free space (`mobility.rs`; the bands of `parallel/`).
+    Free(free::Free<T>),
 }
 
 impl<'a, T: Real> Hydrodynamics<'a, T> {
@@ -109,25 +236,7 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
     /// free space otherwise.
     #[inline(always)]
     pub fn new(level: Hydro, eta: T, wall: Option<T>, sums: Sums<'a, T>) -> Self {
-        #[cfg(feature = "periodic")]
-        if let Some(sums) = sums {
-            return Self::Periodic { level, eta, sums };
-        }
-        let _ = sums; // Read above only with the `periodic` feature.
-        #[cfg(feature = "wall")]
-        if let Some(height) = wall {
-            return Self::Wall { level, eta, height };
-        }
-        let _ = wall; // Read above only with the `wall` feature.
-        Self::Free { level, eta }
-    }
-
-    /// The geometry of a step at `place` ([`Params::place`](crate::Params::place)) with
-    /// its sums: what the stages build, so that a new geometry reaches them through
-    /// [`Place`] alone.
-    #[inline(always)]
-    pub fn at(place: Place<T>, level: Hydro, eta: T, sums: Sums<'a, T>) -> Self {
-        Self::new(level, eta, place.step_wall(), sums)
+        Self::at(Place::new(wall, None, false), level, eta, sums)
     }
 
     /// `mu_tt(pos)` into the packed lower triangle `mu`, on the calling thread.
@@ -137,28 +246,7 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         radius: &[T],
         mu: MobMut<'_, T>,
     ) -> Result<(), StepError> {
-        match self {
-            Self::Free { level, eta } => {
-                with_blocks!(mut mu, a => mobility::assemble_tt(level, eta, pos, radius, a))
-                    .map_err(StepError::from)
-            }
-            #[cfg(feature = "wall")]
-            Self::Wall { level, eta, height } => {
-                let (serial, mu) = (&parallel::Serial, mu.general());
-                Ok(mobility::wall::assemble(
-                    serial, level, eta, height, pos, radius, mu,
-                )?)
-            }
-            #[cfg(feature = "periodic")]
-            Self::Periodic { eta, sums, .. } => {
-                // PSE has no blocks; the checks refuse it wherever the step assembles.
-                let e = sums.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-                let serial = &parallel::Serial;
-                use mobility::periodic::assemble;
-                Ok(with_blocks!(mut mu, mu => assemble(serial, e, eta, pos, radius, mu))?)
-            }
-            Self::Never(never, _) => match never {},
-        }
+        each!(self, g => g.assemble_tt(pos, radius, mu))
     }
 
     /// `u = mu_tt(pos) f` assembled into `mu` and applied, in bands through `par`
@@ -174,28 +262,7 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         u: &mut [T::V3],
         bands: &mut [T::V3],
     ) -> Result<(), StepError> {
-        match self {
-            Self::Free { level, eta } => with_blocks!(mut mu, a => {
-                parallel::assemble_apply(par, level, eta, pos, radius, a, f, u, bands)
-            })
-            .map_err(StepError::from),
-            #[cfg(feature = "wall")]
-            Self::Wall { level, eta, height } => {
-                // Assembled, then applied.
-                let mu = mu.general();
-                mobility::wall::assemble(par, level, eta, height, pos, radius, mu)?;
-                parallel::product::<T>(par, mu, pos.len(), f, u, bands);
-                Ok(())
-            }
-            #[cfg(feature = "periodic")]
-            Self::Periodic { eta, sums, .. } => {
-                let e = sums.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-                let work = (par, bands);
-                mobility::periodic::assemble_apply(e, eta, (pos, radius), mu, (f, u), work, None)
-                    .map_err(StepError::from)
-            }
-            Self::Never(never, _) => match never {},
-        }
+        each!(self, g => g.assemble_apply(par, (pos, radius), mu, (f, u), bands))
     }
 
     /// [`Hydrodynamics::assemble_apply`] that also writes each row of the compact copy
@@ -215,26 +282,7 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         bands: &mut [T::V3],
         copy: &mut [T::M3],
     ) -> Result<(), StepError> {
-        match self {
-            Self::Free { level, eta } => with_blocks!(mut mu, a => {
-                let side = (copy, reduced::copy_start as fn(usize) -> usize);
-                let (pairs, pack) = ((level, eta, pos, radius), reduced::pack_rows::<T, _>);
-                parallel::assemble_apply_then(par, pairs, a, f, u, bands, side, pack)
-            })
-            .map_err(StepError::from),
-            #[cfg(feature = "wall")]
-            Self::Wall { .. } => Err(StepError::Unsupported(
-                "the compact copy above a wall (its blocks are not symmetric)",
-            )),
-            #[cfg(feature = "periodic")]
-            Self::Periodic { eta, sums, .. } => {
-                let e = sums.ewald().ok_or(StepError::Unsupported(PSE_ASSEMBLED))?;
-                let (work, copy) = ((par, bands), Some(copy));
-                mobility::periodic::assemble_apply(e, eta, (pos, radius), mu, (f, u), work, copy)
-                    .map_err(StepError::from)
-            }
-            Self::Never(never, _) => match never {},
-        }
+        each!(self, g => g.assemble_apply_copy(par, (pos, radius), mu, (f, u), bands, copy))
     }
 
     /// `u = mu_tt(pos) f` matrix-free: every pair block evaluated where it is used. In
@@ -250,46 +298,18 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         u: &mut [T::V3],
         bands: &mut [T::V3],
     ) -> Result<(), StepError> {
-        match self {
-            Self::Free { level, eta } => Ok(parallel::free_product::<T>(
-                par, level, eta, pos, radius, f, u, bands,
-            )?),
-            #[cfg(feature = "wall")]
-            Self::Wall { level, eta, height } => Ok(mobility::wall::free_product(
-                par, level, eta, height, pos, radius, f, u, bands,
-            )?),
-            #[cfg(feature = "periodic")]
-            Self::Periodic { eta, sums, .. } => sums.product(eta, pos, radius, f, u, (par, bands)),
-            Self::Never(never, _) => match never {},
-        }
+        each!(self, g => g.product(par, (pos, radius), (f, u), bands))
     }
 
     /// The grand mobility (`2n x 2n` blocks, translations then rotations, packed as
-    /// [`mobility::assemble_grand`] stores it) into `out`.
+    /// [`crate::mobility::assemble_grand`] stores it) into `out`.
     pub fn assemble_grand(
         self,
         pos: &[T::V3],
         radius: &[T],
         out: &mut [T::M3],
     ) -> Result<(), StepError> {
-        match self {
-            Self::Free { level, eta } => mobility::assemble_grand(level, eta, pos, radius, out)?,
-            #[cfg(feature = "wall")]
-            Self::Wall { level, eta, height } => {
-                mobility::wall::assemble_grand(level, eta, height, pos, radius, out)?
-            }
-            #[cfg(feature = "periodic")]
-            Self::Periodic { eta, sums, .. } => {
-                let Some(e) = sums.ewald() else {
-                    return Err(StepError::Unsupported(
-                        "PSE with rotation (its rt and rr products are not built: Ewald sums them)",
-                    ));
-                };
-                mobility::periodic::assemble_grand(e, eta, pos, radius, out)?
-            }
-            Self::Never(never, _) => match never {},
-        }
-        Ok(())
+        each!(self, g => g.assemble_grand(pos, radius, out))
     }
 
     /// `out_i += sum_j rt_ij f_j`: the spins of torque-free spheres from the forces `f`
@@ -301,27 +321,7 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
         f: &[T::V3],
         out: &mut [T::V3],
     ) -> Result<(), StepError> {
-        let (level, eta) = match self {
-            Self::Free { level, eta } => (level, eta),
-            #[cfg(feature = "wall")]
-            Self::Wall { level, eta, height } => {
-                return Ok(mobility::wall::add_spin(
-                    level, eta, height, pos, radius, f, out,
-                )?);
-            }
-            #[cfg(feature = "periodic")]
-            Self::Periodic { level, eta, sums } => match sums.ewald() {
-                Some(e) => return Ok(mobility::periodic::add_spin(e, eta, pos, radius, f, out)?),
-                // PSE has no rt blocks (the checks refuse it with rotation).
-                None => (level, eta),
-            },
-            Self::Never(never, _) => match never {},
-        };
-        if level == Hydro::FreeDraining {
-            return Ok(());
-        }
-        let src = parallel::Pairs::new(level, eta, pos, radius);
-        Ok(mobility::add_spin_of(&src, pos.len(), f, out)?)
+        each!(self, g => g.add_spin(pos, radius, f, out))
     }
 
     /// The block of `mu_tt` a row-`p` entry of the matrix-free metric reads against
@@ -329,40 +329,20 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
     /// blocks: [`Hydrodynamics::has_blocks`]).
     #[inline(always)]
     pub fn block_at(self, pos: &[T::V3], radius: &[T], p: usize, q: usize) -> Option<T::M3> {
-        match self {
-            Self::Free { level, eta } => mobility::tt_block_at(level, eta, pos, radius, p, q),
-            // The block (q, p), as `sym_block` reads a stored wall mobility.
-            #[cfg(feature = "wall")]
-            Self::Wall { level, eta, height } => {
-                mobility::wall::tt_block_at(level, eta, height, pos, radius, q, p).ok()
-            }
-            #[cfg(feature = "periodic")]
-            Self::Periodic { eta, sums, .. } => {
-                mobility::periodic::tt_block_at(sums.ewald()?, eta, pos, radius, p, q)
-            }
-            Self::Never(never, _) => match never {},
-        }
+        each!(self, g => g.block_at(pos, radius, p, q))
     }
 
     /// Whether the geometry has pair blocks to read (not PSE, which gives products only).
     #[inline(always)]
     pub fn has_blocks(self) -> bool {
-        match self {
-            #[cfg(feature = "periodic")]
-            Self::Periodic { sums, .. } => sums.ewald().is_some(),
-            _ => true,
-        }
+        each!(self, g => g.has_blocks())
     }
 
     /// Whether every block is symmetric (all but the wall's), so that a table of the
     /// metric reads lower triangles only.
     #[inline(always)]
     pub fn symmetric(self) -> bool {
-        match self {
-            #[cfg(feature = "wall")]
-            Self::Wall { .. } => false,
-            _ => true,
-        }
+        each!(self, g => g.symmetric())
     }
 
     /// Whether the metric may read only the lower triangles of its blocks because they
@@ -370,11 +350,7 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
     /// are too, but its entries read all nine, as they always have: the same bits.
     #[inline(always)]
     pub fn lower_only(self) -> bool {
-        match self {
-            #[cfg(feature = "periodic")]
-            Self::Periodic { .. } => true,
-            _ => false,
-        }
+        each!(self, g => g.lower_only())
     }
 }
 
@@ -382,6 +358,7 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
 mod tests {
     use super::*;
     use crate::linalg::{sym_matvec, tri};
+    use crate::parallel;
     use glam::DVec3;
 
     const N: usize = 7;
@@ -443,10 +420,10 @@ mod tests {
     #[test]
     fn the_geometry_is_chosen_in_one_place() {
         let free = Hydrodynamics::new(Hydro::Rpy, 1.0, None, None);
-        assert!(matches!(free, Hydrodynamics::Free { .. }));
+        assert!(matches!(free, Hydrodynamics::Free(_)));
         let wall = Hydrodynamics::<f64>::new(Hydro::Rpy, 1.0, Some(0.0), None);
         assert_eq!(
-            matches!(wall, Hydrodynamics::Free { .. }),
+            matches!(wall, Hydrodynamics::Free(_)),
             !cfg!(feature = "wall")
         );
     }

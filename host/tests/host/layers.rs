@@ -12,7 +12,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Every `.rs` file under `dir`.
-fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
+pub(super) fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
     for e in std::fs::read_dir(dir).unwrap() {
         let p = e.unwrap().path();
         if p.is_dir() {
@@ -95,14 +95,14 @@ fn imports(text: &str, depth: usize) -> Vec<String> {
 }
 
 /// The module name at the start of `s`.
-fn ident(s: &str) -> String {
+pub(super) fn ident(s: &str) -> String {
     s.chars()
         .take_while(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || *c == '_')
         .collect()
 }
 
 /// The first name of each entry of a `use` list (`a, b::{c, d}, e}` gives a, b, e).
-fn braced(list: &str) -> Vec<String> {
+pub(super) fn braced(list: &str) -> Vec<String> {
     let mut names = Vec::new();
     let mut depth = 0;
     let mut start = true;
@@ -157,7 +157,7 @@ fn assert_acyclic(src: &Path) {
     );
 }
 
-fn root() -> PathBuf {
+pub(super) fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .unwrap()

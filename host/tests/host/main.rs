@@ -13,6 +13,7 @@ mod falling_cloud;
 mod free_auto;
 mod free_space_scene;
 mod fuzz_scene;
+mod geometries;
 mod jam_retry;
 mod layers;
 mod near_field_scene;

@@ -1,0 +1,178 @@
+//! Each geometry's hydrodynamics lives in its own modules behind the kernel's one
+//! interface (`src/geometry.rs`: the trait `Geometry`, the enum `Hydrodynamics` and the
+//! registration `geometries!`): the registration file forwards and never implements,
+//! and no file outside a geometry's modules names them, except those listed below,
+//! which a new geometry does not touch. Read from the source, as `layers.rs` reads
+//! the imports.
+
+use std::collections::BTreeSet;
+
+use super::layers::{braced, ident, root, sources};
+
+/// The code of `text`: comment lines dropped (a doc's link names no code).
+fn code(text: &str) -> String {
+    let lines = text.lines().filter(|l| !l.trim_start().starts_with("//"));
+    lines.collect::<Vec<_>>().join("\n")
+}
+
+/// The lower-case names (modules, functions) `text` names after each `module::`: `a`
+/// of `module::a::f`, and the first name of each entry of a list, `a` and `b` of
+/// `module::{a, b::C}`; a type (`module::T`) gives an empty name.
+fn named_in(text: &str, module: &str) -> Vec<String> {
+    let pat = format!("{module}::");
+    let mut names = Vec::new();
+    for (i, _) in text.match_indices(&pat) {
+        // `free_fast::` is not `fast::`.
+        if text[..i].ends_with(|c: char| c.is_ascii_alphanumeric() || c == '_') {
+            continue;
+        }
+        let rest = &text[i + pat.len()..];
+        match rest.strip_prefix('{') {
+            Some(list) => names.extend(braced(list)),
+            None => names.push(ident(rest)),
+        }
+    }
+    names
+}
+
+/// A geometry: its name, the modules that implement it (under `crate::mobility` and
+/// `crate::geometry`), and the files they are (paths under `src/`, a folder's prefix).
+struct Geometry {
+    name: &'static str,
+    modules: &'static [&'static str],
+    files: &'static [&'static str],
+}
+
+const GEOMETRIES: &[Geometry] = &[
+    Geometry {
+        name: "wall",
+        modules: &["wall"],
+        files: &["mobility/wall", "geometry/wall.rs"],
+    },
+    Geometry {
+        name: "periodic box",
+        modules: &["periodic", "pse", "sums"],
+        files: &[
+            "mobility/periodic",
+            "mobility/pse",
+            "geometry/periodic.rs",
+            "geometry/sums.rs",
+        ],
+    },
+];
+
+/// The files outside a geometry's own that still name its modules, `(file, geometry)`:
+/// the box's step-level plumbing (its held sums and PSE's storage in the step, the
+/// workspace's PSE views, its errors), the fast free-space product that borrows PSE's
+/// grid, and the near field's far field (`stokesian`), which picks its geometry
+/// itself. A file may leave this list, never join it.
+const STILL_NAMED: &[(&str, &str)] = &[
+    ("error.rs", "periodic box"),
+    ("integrate/fast.rs", "periodic box"),
+    ("integrate/periodic.rs", "periodic box"),
+    ("integrate/pse_noise.rs", "periodic box"),
+    ("integrate/stages.rs", "periodic box"),
+    ("mobility/free_fast.rs", "periodic box"),
+    ("mobility/free_fast/grid.rs", "periodic box"),
+    ("mobility/free_fast/spectral.rs", "periodic box"),
+    ("stokesian.rs", "wall"),
+    ("stokesian/far.rs", "periodic box"),
+    ("stokesian/far.rs", "wall"),
+    ("workspace/mod.rs", "periodic box"),
+];
+
+/// `(file, geometry)` for every kernel file outside a geometry's own files that names
+/// one of its modules through `crate::mobility` or `crate::geometry`.
+fn naming() -> BTreeSet<(String, &'static str)> {
+    let src = root().join("src");
+    let mut files = Vec::new();
+    sources(&src, &mut files);
+    let mut found = BTreeSet::new();
+    for f in files {
+        let rel = f
+            .strip_prefix(&src)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        let text = code(&std::fs::read_to_string(&f).unwrap());
+        let mut names = named_in(&text, "mobility");
+        names.extend(named_in(&text, "geometry"));
+        for g in GEOMETRIES {
+            let own = g.files.iter().any(|o| rel.starts_with(o));
+            if !own && g.modules.iter().any(|m| names.iter().any(|n| n == m)) {
+                found.insert((rel.clone(), g.name));
+            }
+        }
+    }
+    found
+}
+
+/// The geometries the registration lists (`geometries!` in `src/geometry.rs`): the
+/// name of each variant, the fallback after `_ =>` included.
+fn registered(text: &str) -> Vec<String> {
+    let start = text.find("geometries! {").expect("the registration");
+    let body = &text[start..];
+    let body = &body[..body.find("\n}").expect("the registration's end")];
+    body.lines()
+        .skip(1)
+        .map(str::trim)
+        .filter(|l| !l.starts_with('#') && !l.starts_with("//") && !l.starts_with("_ =>"))
+        .filter_map(|l| l.split_once('(').map(|(v, _)| v.to_string()))
+        .collect()
+}
+
+/// The registration file forwards every call to the geometry's own module: it names
+/// no variant outside the registration (no `match` written by hand), and no function
+/// or module of the modules a geometry implements itself with (`mobility`, `parallel`,
+/// `noise`), only the types its signatures need.
+#[test]
+fn the_registration_file_forwards_and_never_implements() {
+    let text = std::fs::read_to_string(root().join("src/geometry.rs")).unwrap();
+    let variants = registered(&text);
+    assert!(variants.len() >= 2, "{variants:?}");
+    let body = code(&text[..text.find("#[cfg(test)]\nmod tests").unwrap_or(text.len())]);
+    for v in &variants {
+        for pat in [format!("Self::{v}"), format!("Hydrodynamics::{v}")] {
+            assert!(
+                !body.contains(&pat),
+                "src/geometry.rs matches {pat} by hand"
+            );
+        }
+    }
+    for module in ["mobility", "parallel", "noise"] {
+        for name in named_in(&body, module) {
+            assert!(
+                name.is_empty(),
+                "src/geometry.rs names {module}::{name} (a geometry's own code)"
+            );
+        }
+    }
+}
+
+/// No file outside a geometry's own names its modules, but those [`STILL_NAMED`]
+/// lists (printed: `cargo test --release -p hydrorattle-host --test host geometries::
+/// -- --nocapture`).
+#[test]
+fn a_geometrys_modules_are_named_only_where_listed() {
+    let found = naming();
+    for (file, g) in &found {
+        println!("src/{file}: {g}");
+    }
+    let listed: BTreeSet<(String, &str)> = STILL_NAMED
+        .iter()
+        .map(|&(f, g)| (f.to_string(), g))
+        .collect();
+    let extra: Vec<_> = found.difference(&listed).collect();
+    assert!(extra.is_empty(), "named outside their geometry: {extra:?}");
+}
+
+/// The reader sees a path, a `use` list, and not a longer name that ends alike.
+#[test]
+fn every_form_of_naming_is_read() {
+    let text =
+        "use crate::mobility::{Hydro, wall::{a, b}};\nmobility::periodic::f();\nfree_fast::g();";
+    assert_eq!(named_in(text, "mobility"), ["", "wall", "periodic"]);
+    assert!(named_in(text, "fast").is_empty());
+    let reg = "geometries! {$\n    /// Doc.\n    #[cfg(feature = \"wall\")]\n    Wall(wall::Wall<T>),\n    _ =>\n    /// Free.\n    Free(free::Free<T>),\n}\n";
+    assert_eq!(registered(reg), ["Wall", "Free"]);
+}
