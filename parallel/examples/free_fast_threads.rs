@@ -11,9 +11,14 @@
 //! (in rounds), the `y` and `x` transforms back, interpolation; "serial" is the rest (the
 //! checks, the cell list, the rows put in place). With `HYDRORATTLE_BENCH_MACHINE` set,
 //! the rows go to `bench/results/free_fast_threads.csv`. With `GRAND=1`, the grand
-//! product (`new_grand`'s parameters, torques as well as forces).
+//! product (`new_grand`'s parameters, torques as well as forces). With `STEP=1`, steps
+//! of the cloud sedimenting instead (`common/fast_steps.rs`): the first on zeroed arrays
+//! (the kernel's transform computed), the second with it kept, and the second again on
+//! zeroed arrays (the same bits), wall and CPU seconds on 1 and `THREADS` threads.
 
 mod common;
+#[path = "common/fast_steps.rs"]
+mod fast_steps;
 #[path = "../../examples/shared/record.rs"]
 mod record;
 #[path = "../../examples/shared/splitmix.rs"]
@@ -86,11 +91,13 @@ fn main() {
             .map(|s| s.parse::<f64>().unwrap() as usize)
             .collect(),
     };
+    let step_mode = std::env::var("STEP").is_ok_and(|g| g == "1");
     let mut rows = record::Recorder::new(
         env!("CARGO_MANIFEST_DIR"),
         "free_fast_threads",
         format!(
-            "cargo run --release -p hydrorattle-parallel --example free_fast_threads -- {}",
+            "{}cargo run --release -p hydrorattle-parallel --example free_fast_threads -- {}",
+            if step_mode { "STEP=1 " } else { "" },
             args.join(" ")
         ),
     );
@@ -99,8 +106,19 @@ fn main() {
     let table = format!(
         "fast free-space RPY {what} on threads, unit spheres in a ball at volume fraction 0.05, f64, tolerance {tol:e}, wall seconds (best of 3)"
     );
+    let step_table = format!(
+        "a sedimenting cloud's Overdamped step on the fast free-space product, unit spheres in a ball at volume fraction 0.05, densities 1 to 3, dt 0.01, f64, tolerance {tol:e}, one run"
+    );
     for &n in &ns {
         let (pos, f, radius) = cloud(n, 0.05, 7 + n as u64);
+        if step_mode {
+            println!("N {n}, steps:");
+            let case = format!("N = {n}");
+            fast_steps::steps(tol, threads, &pos, |q, v| {
+                rows.row(&step_table, &case, q, v)
+            });
+            continue;
+        }
         let rad = vec![1.0; n];
         let ff = match grand {
             true => FreeFast::<f64>::new_grand(1.0, tol, [2.0 * radius; 3], n),

@@ -1,18 +1,21 @@
 //! The fast free-space product (`mobility::free_fast`), and its grand product, on a
 //! thread pool give the bits of one thread: its pieces (near rows and their partial sums, slabs of grid planes,
 //! rounds of `z` lines, interpolation rows) depend on the sizes alone, and each value's
-//! arithmetic is the same in whichever piece it falls.
+//! arithmetic is the same in whichever piece it falls. The kernel's transform too
+//! (samples by slabs of planes, `x` and `y` passes by slabs, `z` lines by slabs of `y`
+//! frequencies).
 
 use hydrorattle::Real;
 use hydrorattle::glam::DVec3;
-use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage};
+use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage, transform_counts};
 use hydrorattle::parallel::{Parallel, Serial};
 use hydrorattle_parallel::Threads;
 
 use crate::fuzz::Rng;
 
 /// `M F` as bits, with `par`, twice on the same storage (the second with the kernel
-/// kept), then the grand product with torques `f` reversed.
+/// kept), then the grand product with torques `f` reversed, then the reals the storage
+/// holds: the kernel's transform, computed on `par`, and its header.
 fn product(
     ff: &FreeFast<f64>,
     pos: &[DVec3],
@@ -41,6 +44,14 @@ fn product(
             .chain(&w)
             .flat_map(|v| v.to_array().map(f64::to_bits)),
     );
+    drop(store);
+    let counts = transform_counts(&re).expect("a transform held");
+    assert_eq!(
+        (counts.kept, counts.computed),
+        (2, 1),
+        "kept by the later products"
+    );
+    bits.extend(re.iter().map(|x| x.to_bits()));
     bits
 }
 
