@@ -11,7 +11,9 @@
 //! (in rounds), the `y` and `x` transforms back, interpolation; "serial" is the rest (the
 //! checks, the cell list, the rows put in place). With `HYDRORATTLE_BENCH_MACHINE` set,
 //! the rows go to `bench/results/free_fast_threads.csv`. With `GRAND=1`, the grand
-//! product (`new_grand`'s parameters, torques as well as forces). With `STEP=1`, steps
+//! product (`new_grand`'s parameters, torques as well as forces). The product's
+//! relative error at the first 1000 spheres against the direct RPY sum is printed and
+//! recorded. With `STEP=1`, steps
 //! of the cloud sedimenting instead (`common/fast_steps.rs`): the first on zeroed arrays
 //! (the kernel's transform computed), the second with it kept, and the second again on
 //! zeroed arrays (the same bits), wall and CPU seconds on 1 and `THREADS` threads.
@@ -30,6 +32,7 @@ use std::time::Instant;
 use common::timed::{Round, Timed};
 use hydrorattle::glam::DVec3;
 use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage};
+use hydrorattle::mobility::{Hydro, tt_block_at};
 use hydrorattle::{Parallel, Serial};
 use hydrorattle_parallel::Threads;
 use splitmix::Rng;
@@ -78,6 +81,25 @@ fn phases(log: &[Round], wall: f64) -> [f64; 8] {
     p[6] = s(&log[k - 1]);
     p[7] = (wall - log.iter().map(|r| r.wall as f64 * 1e-9).sum::<f64>()).max(0.0);
     p
+}
+
+/// Spheres whose velocities [`error`] checks.
+const ROWS: usize = 1000;
+
+/// The relative error of `u` at the first [`ROWS`] spheres against the direct RPY sum
+/// (the kernel's pair blocks, `mobility::tt_block_at`, viscosity 1).
+fn error(pos: &[DVec3], rad: &[f64], f: &[DVec3], u: &[DVec3]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..ROWS.min(pos.len()) {
+        let mut v = DVec3::ZERO;
+        for (j, fj) in f.iter().enumerate() {
+            let b = tt_block_at(Hydro::Rpy, 1.0, pos, rad, i, j).expect("never nested");
+            v += b * *fj;
+        }
+        num += (u[i] - v).length_squared();
+        den += v.length_squared();
+    }
+    (num / den).sqrt()
 }
 
 fn main() {
@@ -162,6 +184,15 @@ fn main() {
             results.push((t, best, split, out));
         }
         let same = results[0].3 == results[1].3;
+        if !grand {
+            let err = error(&pos, &rad, &f, &results[1].3);
+            println!(
+                "N {n}: error {err:.2e} against the direct RPY sum at the first {ROWS} spheres"
+            );
+            let q =
+                format!("relative error against the direct RPY sum at the first {ROWS} spheres");
+            rows.row(&table, &format!("N = {n}"), &q, &format!("{err:.2e}"));
+        }
         let case = match grand {
             true => format!("N = {n}, grand product"),
             false => format!("N = {n}"),

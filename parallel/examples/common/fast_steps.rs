@@ -70,7 +70,7 @@ pub fn steps(tol: f64, threads: usize, pos: &[DVec3], mut row: impl FnMut(&str, 
     p.matrix_free = true;
     p.pse = Some(tol);
     let pool = Threads::new(threads).unwrap();
-    let mut seconds = |what: &str, t: usize, (wall, cpu): (f64, f64)| {
+    let seconds = |row: &mut dyn FnMut(&str, &str), what: &str, t: usize, (wall, cpu)| {
         println!("  {what}, {t} thread(s): {wall:.3} s wall, {cpu:.3} s CPU");
         row(
             &format!("seconds, {what}, {t} thread(s), wall"),
@@ -88,12 +88,13 @@ pub fn steps(tol: f64, threads: usize, pos: &[DVec3], mut row: impl FnMut(&str, 
     ] {
         let mut a = arrays(&p, pos);
         let (p1, w1, c1) = step(&p, pos, &mut a, par);
-        seconds("first step, transform computed", t, (w1, c1));
+        seconds(&mut row, "first step, transform computed", t, (w1, c1));
         let (p2, w2, c2) = step(&p, &p1, &mut a, par);
-        seconds("second step, transform kept", t, (w2, c2));
+        seconds(&mut row, "second step, transform kept", t, (w2, c2));
         let counts = transform_counts(&a.1).unwrap_or_default();
         let (p3, w3, c3) = step(&p, &p1, &mut arrays(&p, pos), par);
         seconds(
+            &mut row,
             "second step on zeroed arrays, transform computed",
             t,
             (w3, c3),

@@ -28,23 +28,24 @@ fn product(
     let mut cx = vec![[0.0; 2]; size.complex];
     let mut re = vec![0.0; size.reals];
     let mut ix = vec![0usize; size.index];
-    let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix).with_parallel(par);
     let mut bits = vec![];
-    for _ in 0..2 {
-        let mut out = vec![DVec3::ZERO; n];
-        ff.apply(1.0, pos, rad, f, &mut out, &mut store).unwrap();
-        bits.extend(out.iter().flat_map(|u| u.to_array().map(f64::to_bits)));
+    {
+        let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix).with_parallel(par);
+        for _ in 0..2 {
+            let mut out = vec![DVec3::ZERO; n];
+            ff.apply(1.0, pos, rad, f, &mut out, &mut store).unwrap();
+            bits.extend(out.iter().flat_map(|u| u.to_array().map(f64::to_bits)));
+        }
+        let t: Vec<DVec3> = f.iter().rev().copied().collect();
+        let (mut u, mut w) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+        ff.apply_grand(1.0, (pos, rad), f, &t, &mut u, &mut w, &mut store)
+            .unwrap();
+        bits.extend(
+            u.iter()
+                .chain(&w)
+                .flat_map(|v| v.to_array().map(f64::to_bits)),
+        );
     }
-    let t: Vec<DVec3> = f.iter().rev().copied().collect();
-    let (mut u, mut w) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-    ff.apply_grand(1.0, (pos, rad), f, &t, &mut u, &mut w, &mut store)
-        .unwrap();
-    bits.extend(
-        u.iter()
-            .chain(&w)
-            .flat_map(|v| v.to_array().map(f64::to_bits)),
-    );
-    drop(store);
     let counts = transform_counts(&re).expect("a transform held");
     assert_eq!(
         (counts.kept, counts.computed),
