@@ -90,13 +90,13 @@ const ROWS: usize = 1000;
 /// (the kernel's pair blocks, `mobility::tt_block_at`, viscosity 1).
 fn error(pos: &[DVec3], rad: &[f64], f: &[DVec3], u: &[DVec3]) -> f64 {
     let (mut num, mut den) = (0.0, 0.0);
-    for i in 0..ROWS.min(pos.len()) {
+    for (i, ui) in u.iter().enumerate().take(ROWS) {
         let mut v = DVec3::ZERO;
         for (j, fj) in f.iter().enumerate() {
             let b = tt_block_at(Hydro::Rpy, 1.0, pos, rad, i, j).expect("never nested");
             v += b * *fj;
         }
-        num += (u[i] - v).length_squared();
+        num += (*ui - v).length_squared();
         den += v.length_squared();
     }
     (num / den).sqrt()
