@@ -13,8 +13,14 @@ only terms that decay as 1/r^3 beyond contact, so the far field, the part an FMM
 grid does, is the Stokeslet's: the two do the same long-range work. Both on one thread
 (OMP_NUM_THREADS=1 for FMM3D), both timed as CPU seconds.
 
+With THREADS=t (t > 1), both on t threads, timed as wall seconds: FMM3D with
+OMP_NUM_THREADS=t, ours by `parallel/examples/free_fast_threads.rs` on a pool of t
+threads (best of 3, the kernel's transform kept), its error measured against the direct
+RPY sum at the first 1000 points (so at any N).
+
     python3 -m venv /tmp/venv-fmm && /tmp/venv-fmm/bin/pip install fmm3dpy numpy
     /tmp/venv-fmm/bin/python bench/peer/free_fast_fmm.py 1e-4 1000 10000 100000
+    THREADS=2 /tmp/venv-fmm/bin/python bench/peer/free_fast_fmm.py 1e-4 100000
 
 With HYDRORATTLE_BENCH_MACHINE set, both sides' rows go to bench/results/free_fast.csv
 (ours written by the example, which this script runs).
@@ -25,7 +31,8 @@ import subprocess
 import sys
 import time
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
+THREADS = int(os.environ.get("THREADS", "1"))
+os.environ["OMP_NUM_THREADS"] = str(THREADS)
 
 import numpy as np  # noqa: E402
 import fmm3dpy  # noqa: E402
@@ -92,14 +99,40 @@ def ours(tol, ns):
     return res
 
 
+def ours_threads(tol, ns):
+    """Runs the threads example once for all `ns` on THREADS threads; returns {n: (wall
+    seconds, error)}."""
+    # FREE_FAST_THREADS_BIN: an already built example binary (else cargo builds it).
+    exe = os.environ.get("FREE_FAST_THREADS_BIN")
+    cmd = [exe] if exe else ["cargo", "run", "--release", "--quiet", "-p",
+                             "hydrorattle-parallel", "--example", "free_fast_threads", "--"]
+    cmd += [f"{tol:g}", str(THREADS)] + [str(n) for n in ns]
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    secs, errs = {}, {}
+    for line in out.splitlines():
+        head, _, rest = line.partition(":")
+        words = head.replace(",", "").split()
+        if len(words) < 2 or words[0] != "N" or not words[1].isdigit():
+            continue
+        n = int(words[1])
+        if head.endswith(f"{THREADS} thread(s)"):
+            secs[n] = float(rest.split()[0])
+        elif rest.strip().startswith("error"):
+            errs[n] = float(rest.split()[1])
+    return {n: (secs.get(n, float("nan")), errs.get(n, float("nan"))) for n in ns}
+
+
 def main():
     tol = float(sys.argv[1]) if len(sys.argv) > 1 else 1e-4
     ns = [int(float(a)) for a in sys.argv[2:]] or [1000, 10000, 100000]
+    many = THREADS > 1
+    prefix = f"THREADS={THREADS} " if many else "OMP_NUM_THREADS=1 "
     rows = record.Recorder(
-        "free_fast",
-        "OMP_NUM_THREADS=1 python3 bench/peer/free_fast_fmm.py " + " ".join(sys.argv[1:]))
-    mine = ours(tol, ns)
-    print("n,ours_s,ours_error_vs_dense_rpy,fmm3d_eps,fmm3d_s,fmm3d_error_vs_direct_stokeslet")
+        "free_fast", prefix + "python3 bench/peer/free_fast_fmm.py " + " ".join(sys.argv[1:]))
+    mine = ours_threads(tol, ns) if many else ours(tol, ns)
+    clock = time.perf_counter if many else time.process_time
+    unit = f"{THREADS} threads, wall seconds" if many else "one thread, CPU seconds"
+    print("n,ours_s,ours_error_vs_rpy,fmm3d_eps,fmm3d_s,fmm3d_error_vs_direct_stokeslet")
     for n in ns:
         src, f = cloud(n)
         k = min(n, 1000)
@@ -110,18 +143,23 @@ def main():
         for eps in (tol, 10 * tol):
             best = float("inf")
             for _ in range(1 if n >= 100000 else 3):
-                t = time.process_time()
+                t = clock()
                 got = fmm3dpy.stfmm3d(eps=eps, sources=src, stoklet=f, ifppreg=1)
-                best = min(best, time.process_time() - t)
+                best = min(best, clock() - t)
             pot = got.pot.reshape([3, n])[:, :k]
             err = np.linalg.norm(pot - ref) / np.linalg.norm(ref)
             print(f"{n},{o[0]:.4f},{o[1]:.2e},{eps:g},{best:.4f},{err:.2e}")
             table = (f"fmm3dpy stfmm3d (FMM3D Stokes FMM, Stokeslet charges only, potential "
-                     f"at the sources), same points as free_fast_scaling, one thread, eps {eps:g}, "
-                     f"CPU seconds")
+                     f"at the sources), same points as free_fast_scaling, {unit}, eps {eps:g}")
             rows.row(table, f"N = {n}", "seconds, one product", f"{best:.4f}")
             rows.row(table, f"N = {n}", "relative error against the direct sum at 1000 points",
                      f"{err:.2e}")
+        if many:
+            table = (f"fast free-space RPY product (free_fast_threads), same points, {unit} "
+                     f"(best of 3, kernel transform kept), tolerance {tol:g}")
+            rows.row(table, f"N = {n}", "seconds, one product", f"{o[0]:.4f}")
+            rows.row(table, f"N = {n}",
+                     "relative error against the direct RPY sum at 1000 points", f"{o[1]:.2e}")
     rows.finish()
 
 

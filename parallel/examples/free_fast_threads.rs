@@ -11,9 +11,16 @@
 //! (in rounds), the `y` and `x` transforms back, interpolation; "serial" is the rest (the
 //! checks, the cell list, the rows put in place). With `HYDRORATTLE_BENCH_MACHINE` set,
 //! the rows go to `bench/results/free_fast_threads.csv`. With `GRAND=1`, the grand
-//! product (`new_grand`'s parameters, torques as well as forces).
+//! product (`new_grand`'s parameters, torques as well as forces). The product's
+//! relative error at the first 1000 spheres against the direct RPY sum is printed and
+//! recorded. With `STEP=1`, steps
+//! of the cloud sedimenting instead (`common/fast_steps.rs`): the first on zeroed arrays
+//! (the kernel's transform computed), the second with it kept, and the second again on
+//! zeroed arrays (the same bits), wall and CPU seconds on 1 and `THREADS` threads.
 
 mod common;
+#[path = "common/fast_steps.rs"]
+mod fast_steps;
 #[path = "../../examples/shared/record.rs"]
 mod record;
 #[path = "../../examples/shared/splitmix.rs"]
@@ -25,6 +32,7 @@ use std::time::Instant;
 use common::timed::{Round, Timed};
 use hydrorattle::glam::DVec3;
 use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage};
+use hydrorattle::mobility::{Hydro, tt_block_at};
 use hydrorattle::{Parallel, Serial};
 use hydrorattle_parallel::Threads;
 use splitmix::Rng;
@@ -75,6 +83,25 @@ fn phases(log: &[Round], wall: f64) -> [f64; 8] {
     p
 }
 
+/// Spheres whose velocities [`error`] checks.
+const ROWS: usize = 1000;
+
+/// The relative error of `u` at the first [`ROWS`] spheres against the direct RPY sum
+/// (the kernel's pair blocks, `mobility::tt_block_at`, viscosity 1).
+fn error(pos: &[DVec3], rad: &[f64], f: &[DVec3], u: &[DVec3]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (i, ui) in u.iter().enumerate().take(ROWS) {
+        let mut v = DVec3::ZERO;
+        for (j, fj) in f.iter().enumerate() {
+            let b = tt_block_at(Hydro::Rpy, 1.0, pos, rad, i, j).expect("never nested");
+            v += b * *fj;
+        }
+        num += (*ui - v).length_squared();
+        den += v.length_squared();
+    }
+    (num / den).sqrt()
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let tol: f64 = args.first().map_or(1e-4, |s| s.parse().unwrap());
@@ -86,11 +113,13 @@ fn main() {
             .map(|s| s.parse::<f64>().unwrap() as usize)
             .collect(),
     };
+    let step_mode = std::env::var("STEP").is_ok_and(|g| g == "1");
     let mut rows = record::Recorder::new(
         env!("CARGO_MANIFEST_DIR"),
         "free_fast_threads",
         format!(
-            "cargo run --release -p hydrorattle-parallel --example free_fast_threads -- {}",
+            "{}cargo run --release -p hydrorattle-parallel --example free_fast_threads -- {}",
+            if step_mode { "STEP=1 " } else { "" },
             args.join(" ")
         ),
     );
@@ -99,8 +128,19 @@ fn main() {
     let table = format!(
         "fast free-space RPY {what} on threads, unit spheres in a ball at volume fraction 0.05, f64, tolerance {tol:e}, wall seconds (best of 3)"
     );
+    let step_table = format!(
+        "a sedimenting cloud's Overdamped step on the fast free-space product, unit spheres in a ball at volume fraction 0.05, densities 1 to 3, dt 0.01, f64, tolerance {tol:e}, one run"
+    );
     for &n in &ns {
         let (pos, f, radius) = cloud(n, 0.05, 7 + n as u64);
+        if step_mode {
+            println!("N {n}, steps:");
+            let case = format!("N = {n}");
+            fast_steps::steps(tol, threads, &pos, |q, v| {
+                rows.row(&step_table, &case, q, v)
+            });
+            continue;
+        }
         let rad = vec![1.0; n];
         let ff = match grand {
             true => FreeFast::<f64>::new_grand(1.0, tol, [2.0 * radius; 3], n),
@@ -144,6 +184,15 @@ fn main() {
             results.push((t, best, split, out));
         }
         let same = results[0].3 == results[1].3;
+        if !grand {
+            let err = error(&pos, &rad, &f, &results[1].3);
+            println!(
+                "N {n}: error {err:.2e} against the direct RPY sum at the first {ROWS} spheres"
+            );
+            let q =
+                format!("relative error against the direct RPY sum at the first {ROWS} spheres");
+            rows.row(&table, &format!("N = {n}"), &q, &format!("{err:.2e}"));
+        }
         let case = match grand {
             true => format!("N = {n}, grand product"),
             false => format!("N = {n}"),

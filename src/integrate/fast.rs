@@ -14,12 +14,18 @@
 //! until the grid fits the caller's arrays: a coarser grid and more near pairs, the
 //! same tolerance; only where no grid within the bounds fits is the step refused. The
 //! storage's lengths are therefore inputs of the step's bits.
+//!
+//! **The kernel's transform kept.** The edges are rounded up to a coarse step
+//! ([`round_extent`]) before the parameters are derived, so a cloud that travels, or
+//! deforms by less than a step, keeps them; the transform, a function of them alone,
+//! stays in the caller's reals between steps and is used again where they match bit for
+//! bit ([`FreeStorage`]). Whether it is kept never changes a step's bits.
 
 use core::cell::RefCell;
 
 use crate::error::StepError;
 use crate::geometry::sums::BoxProduct;
-use crate::mobility::free_fast::{FreeError, FreeFast, FreeSize, FreeStorage};
+use crate::mobility::free_fast::{FreeError, FreeFast, FreeSize, FreeStorage, round_extent};
 use crate::noise::{Noise, lanczos};
 use crate::params::Params;
 use crate::real::Real;
@@ -36,7 +42,8 @@ const TRIES: u32 = 24;
 const WIDEN: f64 = 1.25;
 
 /// The step's fast free-space parameters for these spheres ([`FreeFast::new`]'s rule
-/// over the bounding box widened by [`FAST_MARGIN`]), the spreading widened until
+/// over the bounding box widened by [`FAST_MARGIN`], each edge then rounded up by
+/// [`round_extent`]), the spreading widened until
 /// the grid fits `have` complex values and reals (and its bounds).
 pub(super) fn params<T: Real>(
     tol: f64,
@@ -56,7 +63,10 @@ pub(super) fn params<T: Real>(
         }
     }
     let pad = FAST_MARGIN * a_max.to_f64();
-    let extent: [T; 3] = core::array::from_fn(|d| T::from_f64((hi[d] - lo[d]).max(0.0) + pad));
+    // Edges rounded up to a coarse step: a cloud that travels, or deforms within the
+    // step, keeps its parameters and so the kernel's transform in the caller's reals.
+    let edge = |d: usize| round_extent((hi[d] - lo[d]).max(0.0) + pad, a_max.to_f64());
+    let extent: [T; 3] = core::array::from_fn(|d| T::from_f64(edge(d)));
     let rule = FreeFast::new(a_max, tol, extent, n);
     let mut sigma = match rule {
         Ok(f) if fits(f.storage(n)) => return Ok(f),

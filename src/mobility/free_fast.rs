@@ -20,11 +20,14 @@
 //! ([`FreeFast::new`], `docs/FREE.md`); [`FreeFast::estimate`] reports the error the
 //! chosen parameters give. The caller owns the storage ([`FreeFast::storage`],
 //! [`FreeStorage`]); the kernel's transform is computed on the first product and kept
-//! there. Its work runs in a fixed partition of pieces through the storage's
+//! in the caller's reals, after a header that records the parameters it is for: a later
+//! product, or a later step over the same arrays, whose parameters are bit-identical
+//! keeps it (`keep.rs`; [`transform_counts`]). Its work runs in a fixed partition of pieces through the storage's
 //! [`Parallel`] ([`FreeStorage::with_parallel`]; `pieces.rs`), each value summed in a
 //! fixed order: the same inputs give the same bits on any number of threads.
 
 mod grid;
+mod keep;
 mod near;
 mod pieces;
 mod radial;
@@ -39,6 +42,8 @@ use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
 use near::{Spheres, partial_len};
 
+pub use keep::{HEADER, TransformCounts};
+
 /// The tolerances [`FreeFast::new`] accepts (from [`min_tolerance`] on in the precision).
 pub const MIN_TOLERANCE: f64 = 1e-10;
 /// See [`MIN_TOLERANCE`].
@@ -52,6 +57,30 @@ pub const GRAND_MARGIN: f64 = 4.0;
 pub const MAX_GRID: usize = 2048;
 /// The largest window per axis, in grid points.
 pub const MAX_SUPPORT: usize = 40;
+
+/// How often the kernel's transform held in `reals` (a [`FreeStorage`]'s, as the caller
+/// passes them) was kept and computed since the arrays were zeroed; `None` where they
+/// hold no transform.
+pub fn transform_counts<T: Real>(reals: &[T]) -> Option<TransformCounts> {
+    keep::counts(reals)
+}
+
+/// A cloud's bounding-box edge `edge` (spheres of radius up to `a_max`) rounded up to a
+/// coarse step, so that parameters derived from it ([`FreeFast::new`]) stay the same
+/// while the edge moves within the step, and the kernel's transform is kept: the step is
+/// the smallest `a_max 2^k` above `edge / 32` (at least `a_max`), so the rounding adds
+/// under a sixteenth of the edge (or `a_max`). At least `edge`.
+pub fn round_extent(edge: f64, a_max: f64) -> f64 {
+    if !(edge.is_finite() && a_max > 0.0 && a_max.is_finite()) {
+        return edge;
+    }
+    let mut step = a_max;
+    while 32.0 * step <= edge {
+        step *= 2.0;
+    }
+    let up = libm::ceil(edge / step) * step;
+    if up < edge { up + step } else { up }
+}
 
 /// The smallest tolerance accepted in precision `T`.
 pub fn min_tolerance<T: Real>() -> f64 {
@@ -118,8 +147,8 @@ impl fmt::Display for FreeError {
 pub struct FreeSize {
     /// Complex values: the padded grid (3 per point), FFT scratch and twiddles.
     pub complex: usize,
-    /// Reals: the kernel's transform (one octant, 6 per point), the cloud's grid (3 per
-    /// point), and per sphere a row of results and the near part's partial sums.
+    /// Reals: the header of the kept transform ([`HEADER`]), the kernel's transform (one
+    /// octant, 6 per point), the cloud's grid (3 per point), and per sphere a row of results and the near part's partial sums.
     pub reals: usize,
     /// Indices: the cell list and each sphere's place in it.
     pub index: usize,
@@ -127,13 +156,14 @@ pub struct FreeSize {
 
 /// Caller-owned storage of [`FreeFast::apply`], at least [`FreeFast::storage`], and the
 /// [`Parallel`] that runs its pieces ([`Serial`] unless [`FreeStorage::with_parallel`]).
-/// It keeps the kernel's transform between products with the same parameters.
+/// It keeps the kernel's transform between products with the same parameters, in
+/// `reals` (so between storages over the same arrays: a caller that keeps its arrays
+/// between steps keeps the transform; arrays whose first [`HEADER`] reals are zero hold
+/// none).
 pub struct FreeStorage<'a, T: Real> {
     complex: &'a mut [Cx<T>],
     reals: &'a mut [T],
     index: &'a mut [usize],
-    /// The parameters whose kernel `reals` holds.
-    ready: Option<[u64; 8]>,
     parallel: &'a dyn Parallel,
 }
 
@@ -144,7 +174,6 @@ impl<'a, T: Real> FreeStorage<'a, T> {
             complex,
             reals,
             index,
-            ready: None,
             parallel: &Serial,
         }
     }
@@ -281,7 +310,7 @@ impl<T: Real> FreeFast<T> {
     pub fn storage(&self, n: usize) -> FreeSize {
         FreeSize {
             complex: self.plan.complex_len(),
-            reals: self.plan.reals_len() + 3 * n + partial_len(n, 3),
+            reals: HEADER + self.plan.reals_len() + 3 * n + partial_len(n, 3),
             index: 4 * n + 1,
         }
     }
@@ -289,7 +318,7 @@ impl<T: Real> FreeFast<T> {
     /// Storage [`FreeFast::apply_grand`] needs for `n` spheres (and [`FreeFast::apply`]).
     pub fn storage_grand(&self, n: usize) -> FreeSize {
         FreeSize {
-            reals: self.plan.reals_len() + 6 * n + partial_len(n, 6),
+            reals: HEADER + self.plan.reals_len() + 6 * n + partial_len(n, 6),
             ..self.storage(n)
         }
     }
@@ -397,7 +426,8 @@ impl<T: Real> FreeFast<T> {
             None => rank.iter_mut().enumerate().for_each(|(i, r)| *r = i),
         }
         let at = |k: usize| order.map_or(k, |o| o[k]);
-        let (grid_reals, extra) = store.reals.split_at_mut(self.plan.reals_len());
+        let (header, reals) = store.reals.split_at_mut(HEADER);
+        let (grid_reals, extra) = reals.split_at_mut(self.plan.reals_len());
         let (rows_buf, partial) = extra.split_at_mut(w * n);
         let ctx = (list.as_ref(), &*rank);
         self.near(eta, s, ctx, (&mut *rows_buf, partial), par)?;
@@ -418,10 +448,10 @@ impl<T: Real> FreeFast<T> {
             self.h.to_bits(),
             self.sigma.to_bits(),
         ];
-        if store.ready != Some(key) {
-            store.ready = None;
-            grid::kernel(self, store.complex, grid_reals);
-            store.ready = Some(key);
+        if !keep::keep(header, &key) {
+            let before = keep::forget(header);
+            grid::kernel(self, store.complex, grid_reals, par);
+            keep::done(header, &key, before);
         }
         // Spheres cell by cell: their windows overlap, so the grid stays in cache.
         let storage = (&mut *store.complex, grid_reals, &mut *rows_buf);

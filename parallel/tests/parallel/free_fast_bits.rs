@@ -1,18 +1,21 @@
 //! The fast free-space product (`mobility::free_fast`), and its grand product, on a
 //! thread pool give the bits of one thread: its pieces (near rows and their partial sums, slabs of grid planes,
 //! rounds of `z` lines, interpolation rows) depend on the sizes alone, and each value's
-//! arithmetic is the same in whichever piece it falls.
+//! arithmetic is the same in whichever piece it falls. The kernel's transform too
+//! (samples by slabs of planes, `x` and `y` passes by slabs, `z` lines by slabs of `y`
+//! frequencies).
 
 use hydrorattle::Real;
 use hydrorattle::glam::DVec3;
-use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage};
+use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage, transform_counts};
 use hydrorattle::parallel::{Parallel, Serial};
 use hydrorattle_parallel::Threads;
 
 use crate::fuzz::Rng;
 
 /// `M F` as bits, with `par`, twice on the same storage (the second with the kernel
-/// kept), then the grand product with torques `f` reversed.
+/// kept), then the grand product with torques `f` reversed, then the reals the storage
+/// holds: the kernel's transform, computed on `par`, and its header.
 fn product(
     ff: &FreeFast<f64>,
     pos: &[DVec3],
@@ -25,22 +28,31 @@ fn product(
     let mut cx = vec![[0.0; 2]; size.complex];
     let mut re = vec![0.0; size.reals];
     let mut ix = vec![0usize; size.index];
-    let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix).with_parallel(par);
     let mut bits = vec![];
-    for _ in 0..2 {
-        let mut out = vec![DVec3::ZERO; n];
-        ff.apply(1.0, pos, rad, f, &mut out, &mut store).unwrap();
-        bits.extend(out.iter().flat_map(|u| u.to_array().map(f64::to_bits)));
+    {
+        let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix).with_parallel(par);
+        for _ in 0..2 {
+            let mut out = vec![DVec3::ZERO; n];
+            ff.apply(1.0, pos, rad, f, &mut out, &mut store).unwrap();
+            bits.extend(out.iter().flat_map(|u| u.to_array().map(f64::to_bits)));
+        }
+        let t: Vec<DVec3> = f.iter().rev().copied().collect();
+        let (mut u, mut w) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+        ff.apply_grand(1.0, (pos, rad), f, &t, &mut u, &mut w, &mut store)
+            .unwrap();
+        bits.extend(
+            u.iter()
+                .chain(&w)
+                .flat_map(|v| v.to_array().map(f64::to_bits)),
+        );
     }
-    let t: Vec<DVec3> = f.iter().rev().copied().collect();
-    let (mut u, mut w) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-    ff.apply_grand(1.0, (pos, rad), f, &t, &mut u, &mut w, &mut store)
-        .unwrap();
-    bits.extend(
-        u.iter()
-            .chain(&w)
-            .flat_map(|v| v.to_array().map(f64::to_bits)),
+    let counts = transform_counts(&re).expect("a transform held");
+    assert_eq!(
+        (counts.kept, counts.computed),
+        (2, 1),
+        "kept by the later products"
     );
+    bits.extend(re.iter().map(|x| x.to_bits()));
     bits
 }
 

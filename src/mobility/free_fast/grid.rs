@@ -15,29 +15,40 @@ use crate::parallel::Parallel;
 use crate::real::Real;
 
 /// The kernel's transform into its octant of `reals`, with the quadrature weight `h^3`
-/// and the inverse transform's `1 / P^3` folded in (viscosity 1).
-pub(super) fn kernel<T: Real>(ff: &FreeFast<T>, cx: &mut [Cx<T>], reals: &mut [T]) {
+/// and the inverse transform's `1 / P^3` folded in (viscosity 1). The samples by slabs
+/// of planes and the transform by pieces ([`spectral::kernel`]), each through `par`: a
+/// function of the parameters alone, the same bits on any number of threads.
+pub(super) fn kernel<T: Real>(
+    ff: &FreeFast<T>,
+    cx: &mut [Cx<T>],
+    reals: &mut [T],
+    par: &dyn Parallel,
+) {
     let plan = &ff.plan;
     let [mx, my, mz] = plan.m;
     let points = plan.p.iter().product::<usize>();
     let rad = radial::Radial::new(1.0 / (2.0 * ff.sigma), 2.0 * ff.sigma * ff.sigma);
     let (octant, table) = plan.split_reals(reals);
-    for z in 0..mz {
-        for y in 0..my {
-            for x in 0..mx {
-                let d = [x, y, z].map(|i| i as f64 * ff.h);
-                let u = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                // Hasimoto's factor of the whole split (variance `4 sigma^2`), not the
-                // residual's.
-                let (ci, crr) = rad.far((0.0, 0.0), u);
-                let t = 2 * (x + mx * (y + my * z));
-                table[t] = T::from_f64(ci);
-                table[t + 1] = T::from_f64(crr);
+    let cuts = ((&mut *table, &rows(2 * mx * my) as _), none(), none());
+    let _ = pieces(par, mz, cuts, |[z0, z1], tb, _, _| {
+        for z in z0..z1 {
+            for y in 0..my {
+                for x in 0..mx {
+                    let d = [x, y, z].map(|i| i as f64 * ff.h);
+                    let u = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    // Hasimoto's factor of the whole split (variance `4 sigma^2`), not
+                    // the residual's.
+                    let (ci, crr) = rad.far((0.0, 0.0), u);
+                    let t = 2 * (x + mx * (y + my * (z - z0)));
+                    tb[t] = T::from_f64(ci);
+                    tb[t + 1] = T::from_f64(crr);
+                }
             }
         }
-    }
+        Ok::<(), Infallible>(())
+    });
     let weight = ff.h * ff.h * ff.h / points as f64;
-    spectral::kernel(plan, cx, octant, table, (ff.h, weight));
+    spectral::kernel(plan, cx, octant, table, (ff.h, weight), par);
 }
 
 /// The first grid point of a window along an axis whose grid starts at `origin`.

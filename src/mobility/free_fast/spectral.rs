@@ -425,7 +425,7 @@ fn z_lines<T: Real>(
     [first, count]: [usize; 2],
 ) {
     let (hx, [_, py, pz], mz) = (plan.hx(), plan.p, plan.m[2]);
-    let oy = plan.octant()[0];
+    let oz_n = plan.octant()[1];
     let points = hx * py;
     let per = CHUNK / 3;
     let mut q0 = 0;
@@ -460,7 +460,7 @@ fn z_lines<T: Real>(
             for q in 0..np {
                 let p = p0 + q;
                 let (oy_, sy) = fold(p / hx, py);
-                let kq = 6 * (p % hx + hx * (oy_ + oy * oz));
+                let kq = 6 * (p % hx + hx * (oz + oz_n * oy_));
                 let k = &kernel[kq..kq + 6];
                 let (kxy, kxz, kyz) = (k[3] * sy, k[4] * sz, k[5] * sy * sz);
                 let row = [[k[0], kxy, kxz], [kxy, k[1], kyz], [kxz, kyz, k[2]]];
@@ -492,17 +492,22 @@ fn fold<T: Real>(k: usize, p: usize) -> (usize, T) {
     }
 }
 
-/// The kernel's transform into its octant `kernel` (6 per point), from `table`, which
-/// holds `(c_I, c_rr)` of the kernel `(c_I I + c_rr d d^T) weight` at the offsets
-/// `(x, y, z) h`, `x < m_x` ... (2 per cloud grid point).
+/// The kernel's transform into its octant `kernel` (6 per point, `x` fastest, then `z`,
+/// then `y`: a piece of `y` frequencies owns a slab), from `table`, which holds `(c_I,
+/// c_rr)` of the kernel `(c_I I + c_rr d d^T) weight` at the offsets `(x, y, z) h`, `x <
+/// m_x` ... (2 per cloud grid point). The `x` and `y` passes by slabs of the cloud's
+/// planes, the `z` lines by slabs of `y` frequencies, each piece through `par`.
 pub(super) fn kernel<T: Real>(
     plan: &Plan,
     cx: &mut [Cx<T>],
     kernel: &mut [T],
     table: &[T],
     (h, weight): (f64, f64),
+    par: &dyn Parallel,
 ) {
-    let parts = plan.parts(cx);
+    let Parts {
+        spec, scratch, tw, ..
+    } = plan.parts(cx);
     let [mx, my, mz] = plan.m;
     let [px, py, pz] = plan.p;
     let hx = plan.hx();
@@ -518,18 +523,19 @@ pub(super) fn kernel<T: Real>(
         _ if j + m > p => Some((p - j, if odd { -T::ONE } else { T::ONE })),
         _ => None,
     };
-    let each = 2 * plan.scratch();
+    let (plane, each) = (plan.plane(), 2 * plan.scratch());
     for half in 0..2 {
-        let scr = &mut parts.scratch[..each];
-        plan.x_forward(
-            halves(scr),
-            parts.tw,
-            parts.spec,
-            (3, [my, mz], px),
-            |c, x, y, z| {
+        let cuts = (
+            (&mut *spec, &rows(plane) as _),
+            (&mut *scratch, &fixed(each) as _),
+            none(),
+        );
+        let _ = pieces(par, mz, cuts, |[z0, z1], sp, scr, _| {
+            let value = |c, x, y, z: usize| {
                 let Some((ax, sx)) = mirror(x, px, mx, odd(half, c, 0)) else {
                     return T::ZERO;
                 };
+                let z = z0 + z;
                 let t = 2 * (ax + mx * (y + my * z));
                 let (ci, crr) = (table[t], table[t + 1]);
                 let d = [
@@ -540,32 +546,42 @@ pub(super) fn kernel<T: Real>(
                 let (k, l) = PAIRS[3 * half + c];
                 let diag = if k == l { ci } else { T::ZERO };
                 (diag + crr * d[k] * d[l]) * weight * sx
-            },
-        );
-        let load_y = |c: usize, j: usize| mirror(j, py, my, odd(half, c, 1));
-        plan.y_pass(halves(scr), parts.tw, parts.spec, (mz, false), load_y, oy);
+            };
+            plan.x_forward(halves(scr), tw, sp, (3, [my, z1 - z0], px), value);
+            let load_y = |c: usize, j: usize| mirror(j, py, my, odd(half, c, 1));
+            plan.y_pass(halves(scr), tw, sp, (z1 - z0, false), load_y, oy);
+            Ok::<(), Infallible>(())
+        });
         // Along `z`, the lines `(c, k, ky)` of the octant, into `kernel`.
-        let at = |l: usize| (l % 3, (l / 3) % hx, l / (3 * hx));
-        let axis = (pz, &plan.factors[2], parts.tw[3], false);
-        let data = (&*parts.spec, &mut *kernel);
-        lines(
-            halves(scr),
-            axis,
-            3 * hx * oy,
-            data,
-            |(spec, _), l, j| {
-                let (c, k, ky) = at(l);
-                mirror(j, pz, mz, odd(half, c, 2)).map_or([T::ZERO; 2], |(jj, s)| {
-                    let v = spec[3 * (k + hx * (ky + py * jj)) + c];
-                    [v[0] * s, v[1] * s]
-                })
-            },
-            oz,
-            |(_, kernel), l, kz, v| {
-                let (c, k, ky) = at(l);
-                kernel[6 * (k + hx * (ky + oy * kz)) + 3 * half + c] = v[0];
-            },
+        let spec = &*spec;
+        let cuts = (
+            (&mut *kernel, &rows(6 * hx * oz) as _),
+            (&mut *scratch, &fixed(each) as _),
+            none(),
         );
+        let _ = pieces(par, oy, cuts, |[y0, y1], kn, scr, _| {
+            let at = |l: usize| (l % 3, (l / 3) % hx, y0 + l / (3 * hx));
+            let axis = (pz, &plan.factors[2], tw[3], false);
+            lines(
+                halves(scr),
+                axis,
+                3 * hx * (y1 - y0),
+                (spec, kn),
+                |(spec, _), l, j| {
+                    let (c, k, ky) = at(l);
+                    mirror(j, pz, mz, odd(half, c, 2)).map_or([T::ZERO; 2], |(jj, s)| {
+                        let v = spec[3 * (k + hx * (ky + py * jj)) + c];
+                        [v[0] * s, v[1] * s]
+                    })
+                },
+                oz,
+                |(_, kn), l, kz, v| {
+                    let (c, k, ky) = at(l);
+                    kn[6 * (k + hx * (kz + oz * (ky - y0))) + 3 * half + c] = v[0];
+                },
+            );
+            Ok::<(), Infallible>(())
+        });
     }
 }
 
