@@ -224,6 +224,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
             ewald: sums.as_ref(),
         };
         // The iterative near field (`near_iter.rs`; deterministic: `near::check`).
+        #[cfg(feature = "near")]
         let iterative = p.near_on() && p.matrix_free;
         match (p.method, thermal, drawn.as_mut()) {
             #[cfg(feature = "near")]

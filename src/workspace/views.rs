@@ -55,6 +55,7 @@ pub(crate) struct Views<'a, T: Real> {
     /// The iterative near field's vectors and indices ([`Params::near`] with
     /// [`Params::matrix_free`]; empty otherwise): `near` then holds the far field's
     /// packed grand mobility and the close pairs' scalars.
+    #[cfg_attr(not(feature = "near"), allow(dead_code))]
     pub near_iter: (&'a mut [T::V3], &'a mut [usize]),
 }
 
