@@ -11,9 +11,11 @@
 //!   and 24 tails, settling from its helix: `Overdamped2`, Newton, hard contacts,
 //!   `dt = 0.1`; the mean over `steps` steps), with its counts: mobilities formed, pairs
 //!   inside the near field's cutoff, dense flops.
-//! * `near_ladder box N [near]`: the cost of one `Overdamped` step of `N` spheres in a
-//!   periodic box (volume fraction 0.25, radii 0.8 to 1.2) at each far-field rung, and
-//!   with `near` the dense near-field step too (minutes at `N = 1000`).
+//! * `near_ladder box N [near|iter]`: the cost of one `Overdamped` step of `N` spheres
+//!   in a periodic box (volume fraction 0.25, radii 0.8 to 1.2) at each far-field rung,
+//!   and with `near` the dense near-field step too (minutes at `N = 1000`), with `iter`
+//!   the iterative one (`Params::matrix_free`) and its counts: close pairs, conjugate-
+//!   gradient iterations, far-field products.
 //! * `near_ladder work N ...`: the near field's own work in that box: the pairs inside
 //!   the cutoff (found through the cell list) and the seconds to find them and form each
 //!   pair's correction `R_near`.
@@ -215,8 +217,10 @@ fn chain(steps: usize, rec: &mut record::Recorder) {
     }
 }
 
-/// One `Overdamped` step of the suspension of `n` spheres in its box at each rung.
-fn box_cost(n: usize, with_near: bool, rec: &mut record::Recorder) {
+/// One `Overdamped` step of the suspension of `n` spheres in its box at each rung; the
+/// near field's rung dense (`near = "near"`), iterative (`"iter"`) or left out.
+fn box_cost(n: usize, near_mode: &str, rec: &mut record::Recorder) {
+    let (with_near, iterative) = (near_mode == "near", near_mode == "iter");
     let (pos, rad, l) = suspension::suspension(n, 0.25);
     let table = box_table(n);
     let cell = Periodic::new([l; 3]).expect("box");
@@ -225,11 +229,16 @@ fn box_cost(n: usize, with_near: bool, rec: &mut record::Recorder) {
     println!("N = {n}, edge {l:.3}, {pairs} pairs inside the cutoff");
     println!("rung,step_s");
     for (name, level, near) in RUNGS {
-        if near && !with_near {
+        if near && !(with_near || iterative) {
             continue;
         }
         let mut p = params(level, near, 1e-4);
         p.periodic = Some(cell);
+        p.matrix_free = near && iterative;
+        let name = match p.matrix_free {
+            true => "rpy+near iterative",
+            false => name,
+        };
         let list: Vec<Particle<f64>> = (0..n)
             .map(|i| Particle::new(pos[i], rad[i], RHO1))
             .collect();
@@ -239,6 +248,22 @@ fn box_cost(n: usize, with_near: bool, rec: &mut record::Recorder) {
         let mut ws = buf.workspace();
         let t = Instant::now();
         let value = match step(&mut ps, &bonds, &p, &mut ws, &mut NoForce) {
+            Ok(r) if p.matrix_free => {
+                let counts = [
+                    ("close pairs corrected", r.near_pairs),
+                    ("conjugate-gradient iterations", r.near_iterations),
+                    (
+                        "far-field products",
+                        r.near_iterations + 2 * r.near_products,
+                    ),
+                ];
+                let t = format!("{:.3e}", t.elapsed().as_secs_f64());
+                for (quantity, k) in counts {
+                    println!("{name},{quantity},{k}");
+                    rec.row(&table, name, quantity, &k.to_string());
+                }
+                t
+            }
             Ok(_) => format!("{:.3e}", t.elapsed().as_secs_f64()),
             Err(e) => format!("refused: {e}"),
         };
@@ -246,6 +271,22 @@ fn box_cost(n: usize, with_near: bool, rec: &mut record::Recorder) {
         rec.row(&table, name, "s a step", &value);
     }
     rec.row(&table, "all", "pairs inside the cutoff", &pairs.to_string());
+    if iterative {
+        // The iterative step's far field alone: the Ewald grand mobility's assembly.
+        let mut packed = vec![glam::DMat3::ZERO; 2 * n * (2 * n + 1) / 2];
+        let t = Instant::now();
+        Far::Box(&ew)
+            .assemble_grand(1.0, &pos, &rad, &mut packed)
+            .expect("grand mobility");
+        let value = format!("{:.3e}", t.elapsed().as_secs_f64());
+        println!("grand mobility assembly,{value}");
+        rec.row(
+            &table,
+            "rpy+near iterative",
+            "s to assemble the grand mobility",
+            &value,
+        );
+    }
 }
 
 /// The near field's own work at each `n`: pairs inside the cutoff, and the seconds to
@@ -313,7 +354,7 @@ fn main() {
         "chain" => chain(num(1, 20), &mut rec),
         "box" => box_cost(
             num(1, 1000),
-            args.get(2).is_some_and(|s| s == "near"),
+            args.get(2).map_or("", |s| s.as_str()),
             &mut rec,
         ),
         "work" => {

@@ -102,7 +102,10 @@ pub use names::{Named, UnknownName};
 pub use noise::Noise;
 pub use noise::lanczos::{Lanczos, LanczosError};
 pub use parallel::{Parallel, Serial};
-pub use params::{Brownian, Contacts, Drift, LANCZOS_CROSSOVER, Method, NoiseSqrt, Params, Wall};
+pub use params::{
+    Brownian, Contacts, Drift, LANCZOS_CROSSOVER, Method, NEAR_PAIRS_PER_SPHERE, NoiseSqrt, Params,
+    Wall,
+};
 pub use particles::{Particle, ParticleSet, State};
 pub use real::Real;
 pub use workspace::{Layout, Storage, Workspace};

@@ -16,6 +16,14 @@ pub use crate::stokesian::NearField;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NearField<T>(core::convert::Infallible, core::marker::PhantomData<T>);
 
+/// Close pairs a sphere the iterative near field's storage has room for
+/// ([`Params::near`] with [`Params::matrix_free`]; [`Layout::for_params`](crate::Layout::for_params)
+/// counts `n` times this): 48 is 96 neighbours inside the cutoff, which the default
+/// cutoff (4 mean radii) reaches for equal spheres near a volume fraction of 0.45
+/// (0.25 has 52). A step with more close pairs is refused
+/// ([`StepError::Unsupported`](crate::StepError::Unsupported)), its state unchanged.
+pub const NEAR_PAIRS_PER_SPHERE: usize = 48;
+
 /// Which integrator [`step`](crate::integrate::step) runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Method {
@@ -205,8 +213,9 @@ pub struct Params<T: Real> {
     /// same bands); above a wall or in a periodic box the same bits as the stored path
     /// below [`BANDED_MIN`](crate::parallel::BANDED_MIN) beads, on one thread. Honoured by [`Method::Overdamped`] and
     /// [`Method::Springs`]; the other methods factorise or keep a second mobility and
-    /// refuse it ([`StepError::BadParameter`](crate::StepError::BadParameter)).
-    /// Default false.
+    /// refuse it ([`StepError::BadParameter`](crate::StepError::BadParameter)). With
+    /// [`Params::near`] it means the near field's iterative products (`M_SD` never
+    /// formed; [`Method::Overdamped2`] too): see there. Default false.
     pub matrix_free: bool,
     /// Constraint solver. Default [`SolverKind::Auto`], tolerance 1e-10 (f64) / 1e-5 (f32), cap 100.
     pub solver: Solver<T>,
@@ -328,9 +337,15 @@ pub struct Params<T: Real> {
     /// `tri(2n)` blocks and `(6n)^2` scalars more, with the stored mobility in blocks
     /// of nine ([`Layout::for_params`](crate::Layout::for_params)). Refused with
     /// [`StepError::Unsupported`](crate::StepError::Unsupported): the other methods and
-    /// levels, [`Params::matrix_free`], a periodic box, Lanczos noise
+    /// levels, the box's PSE sums, Lanczos noise
     /// ([`NoiseSqrt::Lanczos`], or [`NoiseSqrt::Auto`] above [`LANCZOS_CROSSOVER`]).
-    /// `docs/NEAR.md`. Default `None`: the far field alone, the same bits as before.
+    /// With [`Params::matrix_free`] `M_SD` is never formed: each mobility is one
+    /// iterative product (`stokesian::iterative`, conjugate gradients over the close
+    /// pairs to [`Solver::tolerance`](crate::Solver::tolerance), the far field's grand
+    /// mobility assembled once), `O(N^2)` like a RPY step instead of `O(N^3)`;
+    /// deterministic `Overdamped` and `Overdamped2` without constraints, in free space
+    /// or in the box (the rest refused), room for [`NEAR_PAIRS_PER_SPHERE`] close pairs
+    /// a sphere. `docs/NEAR.md`. Default `None`: the far field alone, the same bits as before.
     /// The field exists without the `near` feature too (so that a struct literal, a
     /// firmware's `const` parameters, compiles either way), with a type that has no
     /// value there: only `None`.

@@ -93,7 +93,7 @@ pub(super) fn check_all<T: Real>(
     // The box first: a box with a wall is refused as such, not by the wall's check.
     let sums = check_periodic(p, state, bonds)?;
     check_wall(p, state)?;
-    super::near::check(p, state.len(), thermal.is_some())?;
+    super::near::check(p, state.len(), bonds.len(), thermal.is_some())?;
     Ok((thermal, sums))
 }
 
@@ -168,8 +168,10 @@ pub(super) fn check_inputs<T: Real>(
     )?;
     bad(p.solver.max_iterations > 0, "max_iterations")?;
     bad(
-        !p.matrix_free || matches!(p.method, Method::Overdamped | Method::Springs),
-        "matrix_free (Overdamped and Springs only)",
+        !p.matrix_free
+            || matches!(p.method, Method::Overdamped | Method::Springs)
+            || (p.near_on() && p.method == Method::Overdamped2),
+        "matrix_free (Overdamped and Springs only; Overdamped2 too with the near field)",
     )?;
     if p.method == Method::Springs {
         bad(

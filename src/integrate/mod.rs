@@ -24,6 +24,8 @@ mod contacts;
 mod fast;
 pub mod geometry;
 mod near;
+#[cfg(feature = "near")]
+mod near_iter;
 mod overdamped;
 #[cfg(feature = "periodic")]
 mod periodic;
@@ -89,7 +91,18 @@ pub struct StepReport<T> {
     /// ([`Params::near`]; 0 without): each is two dense inversions of `6n x 6n` when a
     /// pair or a sphere is inside its cutoff. The first-order step forms it once, at the
     /// start; the predictor-corrector twice; a Brownian step with the midpoint twice.
+    /// 0 with the iterative near field, which forms none ([`Params::matrix_free`]).
     pub near_formations: u32,
+    /// Close pairs the iterative near field corrected at the step's start
+    /// ([`Params::near`] with [`Params::matrix_free`]; 0 otherwise).
+    pub near_pairs: u32,
+    /// Iterative Stokesian dynamics products the step made (one a mobility: the
+    /// first-order step one, the predictor-corrector two; 0 without the iterative near
+    /// field). Each assembles the far field's grand mobility once.
+    pub near_products: u32,
+    /// Conjugate-gradient iterations of those products, summed; the far field's
+    /// products are these plus two a product.
+    pub near_iterations: u32,
 }
 
 /// Read-only view of the state at the start of a step.
@@ -210,7 +223,14 @@ fn advance<T: Real, E: ExternalForce<T>>(
             #[cfg(not(feature = "periodic"))]
             ewald: sums.as_ref(),
         };
+        // The iterative near field (`near_iter.rs`; deterministic: `near::check`).
+        #[cfg(feature = "near")]
+        let iterative = p.near_on() && p.matrix_free;
         match (p.method, thermal, drawn.as_mut()) {
+            #[cfg(feature = "near")]
+            (Method::Overdamped | Method::Overdamped2, ..) if iterative => {
+                near_iter::overdamped(p, &s, v, ext)
+            }
             (Method::Overdamped, Some(b), Some(g)) => {
                 overdamped_thermal(p, b, &s, bonds, v, ext, g)
             }

@@ -46,7 +46,12 @@ pub(super) enum Spins {
 
 /// Refuses the combinations the near field does not serve (a typed
 /// [`StepError::Unsupported`] naming each), and parameters out of range.
-pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(), StepError> {
+pub(super) fn check<T: Real>(
+    p: &Params<T>,
+    n: usize,
+    bonds: usize,
+    thermal: bool,
+) -> Result<(), StepError> {
     if !p.near_on() {
         return Ok(());
     }
@@ -67,7 +72,7 @@ pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(
         return refuse("the near field with a method other than Overdamped or Overdamped2");
     }
     if p.matrix_free {
-        return refuse("the near field matrix-free (its mobility is dense)");
+        return check_iterative(p, n, bonds, thermal);
     }
     if p.periodic.is_some() && p.pse.is_some() {
         return refuse(
@@ -77,6 +82,38 @@ pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(
     if thermal && p.lanczos_noise(n) {
         return refuse(
             "the near field with Lanczos noise (noise_sqrt = Cholesky, or Auto up to LANCZOS_CROSSOVER beads)",
+        );
+    }
+    Ok(())
+}
+
+/// The iterative near field's refusals ([`Params::matrix_free`], `near_iter.rs`): what
+/// needs `M_SD`'s blocks or a product the iterative path does not have.
+fn check_iterative<T: Real>(
+    p: &Params<T>,
+    n: usize,
+    bonds: usize,
+    thermal: bool,
+) -> Result<(), StepError> {
+    let refuse = |what| Err(StepError::Unsupported(what));
+    if thermal {
+        return refuse(
+            "the iterative near field (matrix_free) with thermal noise: its noise is the dense near field's (matrix_free = false)",
+        );
+    }
+    if bonds > 0 || p.constraints(n, bonds) > 0 {
+        return refuse(
+            "the iterative near field (matrix_free) with constraints (bonds, pins, contacts, the wall's links): their solvers read the dense near field's blocks (matrix_free = false)",
+        );
+    }
+    if super::wall_height(p).is_some() {
+        return refuse(
+            "the iterative near field (matrix_free) above the wall: the wall's sphere corrections are the dense near field's (matrix_free = false)",
+        );
+    }
+    if p.pse.is_some() {
+        return refuse(
+            "the iterative near field with PSE or the fast free-space product: its far field is the assembled grand mobility (pse = None)",
         );
     }
     Ok(())
@@ -195,7 +232,7 @@ pub(super) fn keep_spin<T: Real>(n: usize, store: &mut Store<'_, T>) {
 /// The far field the step's near field corrects: the box's Ewald sums (`ew`), the
 /// step's wall, or free space.
 #[cfg(feature = "near")]
-fn far<'a, T: Real>(p: &Params<T>, ew: Sums<'a, T>) -> Result<Far<'a, T>, StepError> {
+pub(super) fn far<'a, T: Real>(p: &Params<T>, ew: Sums<'a, T>) -> Result<Far<'a, T>, StepError> {
     #[cfg(feature = "periodic")]
     if super::cell(p).is_some() {
         // `check` has refused PSE, so a box summed for RPY holds Ewald's parameters.
@@ -220,7 +257,7 @@ fn dense<T: Real>(
     radius: &[T],
     store: &mut Store<'_, T>,
 ) -> Result<(), StepError> {
-    use crate::stokesian::{SdError, mobility_in};
+    use crate::stokesian::mobility_in;
     let Some(nf) = p.near else {
         return Err(StepError::Unsupported(
             "the near field's mobility without Params::near",
@@ -229,7 +266,14 @@ fn dense<T: Real>(
     let far = far(p, ew)?;
     store.2.set(store.2.get() + 1);
     let (packed, out) = (&mut *store.0, &mut *store.1);
-    mobility_in(p.viscosity, far, pos, radius, nf, packed, out).map_err(|e| match e {
+    mobility_in(p.viscosity, far, pos, radius, nf, packed, out).map_err(sd_error)
+}
+
+/// The step's error for the Stokesian dynamics mobility's.
+#[cfg(feature = "near")]
+pub(super) fn sd_error(e: crate::stokesian::SdError) -> StepError {
+    use crate::stokesian::SdError;
+    match e {
         SdError::Particle(e) => StepError::Particle(e),
         SdError::NotPositiveDefinite(error) => StepError::Linalg {
             stage: crate::error::Stage::Mobility,
@@ -241,11 +285,15 @@ fn dense<T: Real>(
         SdError::Params => StepError::BadParameter("near"),
         SdError::Storage => StepError::Unsupported("the near field without its storage"),
         SdError::Periodic(e) => e.into(),
-        // The dense mobility never iterates (the iterative product has no step).
-        SdError::NotConverged { .. } => {
-            StepError::Unsupported("the near field by iterations in a step")
-        }
-    })
+        SdError::NotConverged {
+            iterations,
+            residual,
+        } => StepError::NoConvergence {
+            stage: crate::error::Stage::Mobility,
+            iterations,
+            residual,
+        },
+    }
 }
 
 /// Without the `near` feature there is no near field to form (never reached:

@@ -334,5 +334,8 @@ pub(super) fn report<T: Real>(
         contact_rounds: 0,
         noise_iterations: 0,
         near_formations: 0,
+        near_pairs: 0,
+        near_products: 0,
+        near_iterations: 0,
     }
 }

@@ -41,6 +41,32 @@ pub(crate) const fn near_scalars(n: usize, kept: bool) -> usize {
     36 * n * n + if kept { 9 * n * n } else { 0 }
 }
 
+/// Whether the near field's products are iterative ([`Params::near`] with
+/// [`Params::matrix_free`]): `M_SD` is never formed, so none of the dense storage.
+pub(crate) const fn near_iterative<T: Real>(p: &Params<T>) -> bool {
+    p.near_on() && p.matrix_free
+}
+
+/// Scalars one close pair of the iterative near field takes: its factor, its
+/// preconditioner's block and five Krylov vectors (`stokesian::iterative::sizes`).
+const NEAR_PAIR_SCALARS: usize = 2 * 144 + 5 * 12;
+
+/// The iterative near field's storage for `n` spheres, room for
+/// [`NEAR_PAIRS_PER_SPHERE`](crate::params::NEAR_PAIRS_PER_SPHERE) close pairs a sphere:
+/// `[blocks, vectors, scalars, indices]`. The far field's packed grand mobility
+/// (`tri(2n)` blocks, assembled once a mobility), the product's force-torque and
+/// velocity-spin vectors and its own `6n` vectors, the pairs' scalars, and the pairs'
+/// indices with the pair search's cell list (`3n + 1`).
+pub(crate) const fn near_iterative_sizes(n: usize) -> [usize; 4] {
+    let pairs = crate::params::NEAR_PAIRS_PER_SPHERE * n;
+    [
+        tri(2 * n),
+        10 * n,
+        NEAR_PAIR_SCALARS * pairs,
+        2 * pairs + 3 * n + 1,
+    ]
+}
+
 /// Whether the near field keeps the start's rotation-translation blocks
 /// ([`near_scalars`]).
 pub(crate) const fn near_kept<T: Real>(p: &Params<T>) -> bool {
@@ -185,9 +211,19 @@ impl Layout {
         } else {
             l
         };
-        // Stokesian dynamics' near field: the far-field grand mobility's packed blocks
-        // and the dense `6n x 6n` mobility formed from them (`stokesian::storage`).
-        let l = if p.near_on() {
+        // Stokesian dynamics' near field: iterative products (`integrate::near_iter`),
+        // or the far-field grand mobility's packed blocks and the dense `6n x 6n`
+        // mobility formed from them (`stokesian::storage`).
+        let l = if near_iterative(p) {
+            let [blocks, vectors, scalars, indices] = near_iterative_sizes(n);
+            Self {
+                blocks: l.blocks + blocks,
+                vectors: l.vectors + vectors,
+                scalars: l.scalars + scalars,
+                indices: l.indices + indices,
+                ..l
+            }
+        } else if p.near_on() {
             Self {
                 blocks: l.blocks + near_blocks(n),
                 scalars: l.scalars + near_scalars(n, near_kept(p)),

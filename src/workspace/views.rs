@@ -52,6 +52,11 @@ pub(crate) struct Views<'a, T: Real> {
     /// The near field's packed far-field grand mobility and its dense Stokesian
     /// dynamics mobility ([`Params::near`]; empty without).
     pub near: (&'a mut [T::M3], &'a mut [T]),
+    /// The iterative near field's vectors and indices ([`Params::near`] with
+    /// [`Params::matrix_free`]; empty otherwise): `near` then holds the far field's
+    /// packed grand mobility and the close pairs' scalars.
+    #[cfg_attr(not(feature = "near"), allow(dead_code))]
+    pub near_iter: (&'a mut [T::V3], &'a mut [usize]),
 }
 
 /// The storage of the one-sided constraints (contacts, wall links): the link list
@@ -206,12 +211,24 @@ impl<T: Real> Workspace<'_, T> {
         let cap = p.lanczos.max_iterations as usize;
         let basis = ve.take(if lanczos { lanczos_vectors(cap, n) } else { 0 });
         let krylov_t = sc.take(if lanczos { lanczos_scalars(cap) } else { 0 });
+        let iterative = super::layout::near_iterative(p);
         let near = match p.near_on() {
+            true if iterative => {
+                let [b, _, s, _] = super::layout::near_iterative_sizes(n);
+                (bl.take(b), sc.take(s))
+            }
             true => (
                 bl.take(super::layout::near_blocks(n)),
                 sc.take(super::layout::near_scalars(n, super::layout::near_kept(p))),
             ),
             false => (bl.take(0), sc.take(0)),
+        };
+        let near_iter = match iterative {
+            true => {
+                let [_, v, _, i] = super::layout::near_iterative_sizes(n);
+                (ve.take(v), ix.take(i))
+            }
+            false => (ve.take(0), ix.take(0)),
         };
         Ok(Views {
             mu,
@@ -249,6 +266,7 @@ impl<T: Real> Workspace<'_, T> {
                 &mut *self.pse.3,
             ),
             near,
+            near_iter,
         })
     }
 }

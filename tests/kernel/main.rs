@@ -50,6 +50,8 @@ mod near;
 mod near_box;
 #[cfg(feature = "near")]
 mod near_brownian;
+#[cfg(all(feature = "near", feature = "periodic"))]
+mod near_iter;
 #[cfg(feature = "near")]
 mod near_step;
 mod observables;

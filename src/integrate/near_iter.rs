@@ -1,0 +1,223 @@
+//! Stokesian dynamics' near field in a step by iterative products ([`Params::near`]
+//! with [`Params::matrix_free`]): `M_SD` is never formed. Each mobility the method
+//! needs is one product `(U, W) = M_SD (F, 0)` of [`crate::stokesian::iterative`]
+//! (Woodbury's identity, conjugate gradients over the close pairs), whose far field is
+//! the grand mobility (`tri(2n)` blocks) assembled once at that configuration and
+//! applied about twenty times: the box has no matrix-free product of the rotation
+//! blocks the near field couples to, and one assembly with cheap products costs about
+//! one RPY assembly (`docs/NEAR.md`).
+//!
+//! Served: `Overdamped` (one product, at the start) and `Overdamped2` (two, at the
+//! start and at the predicted point), deterministic, without constraints, in free space
+//! or in the periodic box with the Ewald sums; the rest is refused by
+//! [`super::near::check`]. The conjugate gradients stop at the relative residual
+//! [`Solver::tolerance`](crate::Solver::tolerance) within its `max_iterations`
+//! (`Params::solver`, the step's one tolerance for its iterations); not converging is
+//! [`StepError::NoConvergence`] at [`Stage::Mobility`], the caller's state unchanged.
+//! The storage is the caller's ([`crate::Layout::for_params`]:
+//! `near_iterative_sizes`), with room for
+//! [`NEAR_PAIRS_PER_SPHERE`](crate::NEAR_PAIRS_PER_SPHERE) close pairs a sphere.
+
+use super::{Start, StepReport, Sums, add_flow, check_resolved, step_velocity};
+use crate::error::{Stage, StepError};
+use crate::forces::{self, ExternalForce};
+use crate::params::{Method, Params};
+use crate::real::Real;
+use crate::stokesian::SdError;
+use crate::stokesian::iterative::{Solver, Storage, packed_product};
+use crate::workspace::Views;
+
+/// The iterative near field's storage ([`Views::near`] and `Views::near_iter`).
+struct Store<'a, T: Real> {
+    /// The far field's packed grand mobility.
+    packed: &'a mut [T::M3],
+    /// The close pairs' factors, preconditioner blocks and Krylov vectors.
+    reals: &'a mut [T],
+    /// The product's `2n` forces and torques, `2n` velocities and spins, and its own
+    /// `6n` vectors.
+    vectors: &'a mut [T::V3],
+    /// The close pairs (two indices each) and the cell list.
+    indices: &'a mut [usize],
+}
+
+impl<'a, T: Real> Store<'a, T> {
+    fn new(v: (&'a mut [T::M3], &'a mut [T]), w: (&'a mut [T::V3], &'a mut [usize])) -> Self {
+        Self {
+            packed: v.0,
+            reals: v.1,
+            vectors: w.0,
+            indices: w.1,
+        }
+    }
+}
+
+/// What the step's products did ([`StepReport`]'s near-field counts).
+#[derive(Default)]
+struct Counts {
+    pairs: u32,
+    products: u32,
+    iterations: u32,
+}
+
+/// The step's error for the iterative product's.
+fn error(e: SdError) -> StepError {
+    match e {
+        SdError::NotConverged {
+            iterations,
+            residual,
+        } => StepError::NoConvergence {
+            stage: Stage::Mobility,
+            iterations,
+            residual,
+        },
+        SdError::Storage => StepError::Unsupported(
+            "the iterative near field with more close pairs than its storage holds (NEAR_PAIRS_PER_SPHERE a sphere)",
+        ),
+        e => super::near::sd_error(e),
+    }
+}
+
+/// `u = M_SD,tt(pos) f` and, where `w` is given, `w = M_SD,rt(pos) f`: one iterative
+/// product of torque-free spheres, the far field assembled at `pos` first.
+#[allow(clippy::too_many_arguments)]
+fn velocities<T: Real>(
+    p: &Params<T>,
+    ew: Sums<'_, T>,
+    (pos, radius): (&[T::V3], &[T]),
+    f: &[T::V3],
+    u: &mut [T::V3],
+    w: Option<&mut [T::V3]>,
+    store: &mut Store<'_, T>,
+    counts: &mut Counts,
+) -> Result<(), StepError> {
+    let n = pos.len();
+    let Some(nf) = p.near else {
+        return Err(StepError::Unsupported(
+            "the near field's mobility without Params::near",
+        ));
+    };
+    let far = super::near::far(p, ew)?;
+    let packed = store.packed.get_mut(..tri2(n)).ok_or(STORAGE)?;
+    far.assemble_grand(p.viscosity, pos, radius, packed)
+        .map_err(error)?;
+    let (io, field) = store.vectors.split_at_mut_checked(4 * n).ok_or(STORAGE)?;
+    let (fin, out) = io.split_at_mut(2 * n);
+    fin[..n].copy_from_slice(f);
+    fin[n..].fill(T::v3(T::ZERO, T::ZERO, T::ZERO));
+    let cap = crate::params::NEAR_PAIRS_PER_SPHERE * n;
+    let (pairs, cells) = store.indices.split_at_mut_checked(2 * cap).ok_or(STORAGE)?;
+    let storage = Storage {
+        pairs: pairs.as_chunks_mut::<2>().0,
+        reals: &mut *store.reals,
+        field,
+        cells,
+    };
+    let mut solver = Solver::new(p.viscosity, far, pos, radius, nf, storage).map_err(error)?;
+    let packed = &*packed;
+    let mut product = |x: &[T::V3], y: &mut [T::V3]| {
+        packed_product::<T>(packed, n, x, y);
+        Ok(())
+    };
+    let (tol, cap) = (p.solver.tolerance, p.solver.max_iterations);
+    let r = solver
+        .product(&mut product, fin, out, tol, cap)
+        .map_err(error)?;
+    if counts.products == 0 {
+        counts.pairs = u32::try_from(r.pairs).unwrap_or(u32::MAX);
+    }
+    counts.products += 1;
+    counts.iterations = counts.iterations.saturating_add(r.iterations);
+    u.copy_from_slice(&out[..n]);
+    if let Some(w) = w {
+        w.copy_from_slice(&out[n..]);
+    }
+    Ok(())
+}
+
+const STORAGE: StepError = StepError::Unsupported("the iterative near field without its storage");
+
+/// Blocks of the packed grand mobility of `n` spheres.
+const fn tri2(n: usize) -> usize {
+    crate::linalg::tri(2 * n)
+}
+
+/// The spins `Omega_inf + M_SD,rt F` from the product's `M_SD,rt F` in `w` (with
+/// [`Params::rotation`]; `Omega_inf` alone otherwise).
+fn spins<T: Real>(p: &Params<T>, w: &mut [T::V3]) {
+    for w in w.iter_mut() {
+        *w = match p.rotation {
+            true => p.vorticity + *w,
+            false => p.vorticity,
+        };
+    }
+}
+
+fn report<T: Real>(c: Counts) -> StepReport<T> {
+    StepReport {
+        near_pairs: c.pairs,
+        near_products: c.products,
+        near_iterations: c.iterations,
+        ..StepReport::default()
+    }
+}
+
+/// `Overdamped` with the iterative near field, `r' = r + dt U(r)`, or `Overdamped2`,
+/// Heun's predictor-corrector `r' = r + dt/2 (U(r) + U(r + dt U(r)))`, where
+/// `U = U_inf + M_SD,tt F`; the spins `Omega_inf + M_SD,rt F` at the start (as the
+/// dense step reports them).
+pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
+    p: &Params<T>,
+    s: &Start<'_, T>,
+    v: Views<'_, T>,
+    ext: &mut E,
+) -> Result<StepReport<T>, StepError> {
+    let (n, dt) = (s.pos.len(), p.dt);
+    let Views {
+        force,
+        work_a: u0,
+        work_b: u1,
+        work_c: x_p,
+        new_pos,
+        new_vel,
+        new_omega,
+        near,
+        near_iter,
+        ..
+    } = v;
+    let mut store = Store::new(near, near_iter);
+    let mut counts = Counts::default();
+    forces::external(p, s.pos, s.radius, s.density, ext, force)?;
+    let w = Some(&mut *new_omega);
+    let at_start = (s.pos, s.radius);
+    velocities(p, s.ewald, at_start, force, u0, w, &mut store, &mut counts)?;
+    add_flow(p, s.pos, u0);
+    check_resolved(s.pos, u0, dt)?;
+    spins(p, new_omega);
+    if p.method == Method::Overdamped2 {
+        // The predictor's point, its velocities, and the trapezoid into `u0`.
+        for i in 0..n {
+            x_p[i] = s.pos[i] + u0[i] * dt;
+        }
+        forces::external(p, x_p, s.radius, s.density, ext, force)?;
+        let predicted = (&*x_p, s.radius);
+        velocities(
+            p,
+            s.ewald,
+            predicted,
+            force,
+            u1,
+            None,
+            &mut store,
+            &mut counts,
+        )?;
+        add_flow(p, x_p, u1);
+        for (a, &b) in u0.iter_mut().zip(&*u1) {
+            *a = (*a + b) * T::HALF;
+        }
+    }
+    for i in 0..n {
+        new_pos[i] = s.pos[i] + u0[i] * dt;
+    }
+    step_velocity(s.pos, new_pos, dt, new_vel);
+    Ok(report(counts))
+}

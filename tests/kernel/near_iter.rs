@@ -1,0 +1,304 @@
+//! Steps with the iterative near field (`Params::near` with `Params::matrix_free`:
+//! conjugate gradients over the close pairs, `M_SD` never formed), against the dense near
+//! step (`near_step.rs`, `near_box.rs`: there checked against Stimson and Jeffery's exact
+//! series and the box's known correction) on clusters with close pairs, to the
+//! iteration's tolerance; against Stimson and Jeffery's exact series and the published
+//! side-by-side values at `s = 2.1` directly; the same bits run to run; and the
+//! refusals, typed, with the state unchanged. Units: `a = 1`, `eta = 1`, buoyant weight
+//! 1 (`U0 = 1 / (6 pi)`).
+#![cfg(all(feature = "near", feature = "periodic"))]
+
+use crate::common;
+use crate::stokesian::stimson_jeffery;
+
+use std::f64::consts::PI;
+
+use common::*;
+use hydrorattle::stokesian::NearField;
+use hydrorattle::{
+    Bond, BondSet, Brownian, Contacts, Method, NoForce, Noise, ParticleSet, Periodic, Real,
+    SolverKind, Stage, StepError, StepReport, Wall, step,
+};
+use hydrorattle_heap::Buffers;
+
+/// Stokes' speed of the unit sphere of unit buoyant weight in the unit fluid.
+const U0: f64 = 1.0 / (6.0 * PI);
+/// Density of unit buoyant weight for a unit sphere (`g = 1`).
+const RHO1: f64 = 3.0 / (4.0 * PI);
+
+/// Positions, velocities and spins after a step.
+type Out = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>);
+
+/// Near-field parameters with the defaults and rotation; iterative when `iterative`; in
+/// the cubic box of edge `l` if given.
+fn near<T: Real>(method: Method, iterative: bool, l: Option<f64>) -> hydrorattle::Params<T> {
+    let mut p = params::<T>(1e-2, method, SolverKind::Auto);
+    p.near = Some(NearField::default());
+    p.rotation = true;
+    p.matrix_free = iterative;
+    p.periodic = l.map(|l| Periodic::new([T::from_f64(l); 3]).unwrap());
+    p
+}
+
+/// One step of `spheres` with `bonds` under `p`: its report and the state after it,
+/// or the error with the state as it was before (asserted bit for bit).
+fn one_step<T: Real>(
+    p: &hydrorattle::Params<T>,
+    spheres: &[Sphere],
+    bonds: &[Bond<T>],
+) -> Result<(StepReport<T>, Out), StepError> {
+    let mut ps: ParticleSet<T, 128> = particles(spheres);
+    // A generator, so that a thermal step is refused by the near field, not for lack of it.
+    ps.noise = Some(Noise::new(1));
+    let mut set: BondSet<T, 128> = BondSet::new();
+    for &b in bonds {
+        set.push(b, spheres.len()).unwrap();
+    }
+    let mut buf = Buffers::<T>::new(hydrorattle::Layout::for_params(
+        p,
+        spheres.len(),
+        bonds.len(),
+    ));
+    let mut ws = buf.workspace();
+    let n = spheres.len();
+    let get = |v: &[T::V3]| -> Vec<[f64; 3]> { (0..n).map(|i| f64s::<T>(v[i])).collect() };
+    let before = (get(&ps.pos), get(&ps.vel), get(&ps.omega));
+    match step(&mut ps, &set, p, &mut ws, &mut NoForce) {
+        Ok(r) => Ok((r, (get(&ps.pos), get(&ps.vel), get(&ps.omega)))),
+        Err(e) => {
+            let after = (get(&ps.pos), get(&ps.vel), get(&ps.omega));
+            assert_eq!(before, after, "{e:?}: the state moved");
+            Err(e)
+        }
+    }
+}
+
+/// A branched cluster of `n` spheres (radii 0.8 to 1.5, densities 0.5 to 2 times
+/// `RHO1`), each new sphere at a gap of 0.005 to 0.6 mean radii from a random earlier
+/// one and clear of all (by the minimum image in the box of edge `l`), about `c`.
+fn cluster(n: usize, seed: u64, l: Option<f64>, c: [f64; 3]) -> Vec<Sphere> {
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut rand = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let image = |d: [f64; 3]| match l {
+        Some(l) => d.map(|x| x - l * (x / l).round()),
+        None => d,
+    };
+    let mut out = vec![Sphere {
+        pos: c,
+        radius: 1.0,
+        density: RHO1,
+    }];
+    while out.len() < n {
+        let k = (rand() * out.len() as f64) as usize;
+        let a = 0.8 + 0.7 * rand();
+        let gap = 0.005 + 0.6 * rand() * rand();
+        let (z, phi) = (2.0 * rand() - 1.0, 2.0 * PI * rand());
+        let r = (1.0 - z * z).sqrt();
+        let e = [r * phi.cos(), r * phi.sin(), z];
+        let d = out[k].radius + a + gap * 0.5 * (out[k].radius + a);
+        let mut pos = add(out[k].pos, scale(e, d));
+        if let Some(l) = l {
+            pos = pos.map(|x| x.rem_euclid(l));
+        }
+        let clear = out.iter().all(|s| {
+            let d = norm(image(sub(pos, s.pos)));
+            d > (s.radius + a) * (1.0 + 0.0025)
+        });
+        if clear {
+            out.push(Sphere {
+                pos,
+                radius: a,
+                density: RHO1 * (0.5 + 1.5 * rand()),
+            });
+        }
+    }
+    out
+}
+
+/// Largest difference of `a` from `b` over the largest of `b`.
+fn relative_gap(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    let big = b.iter().map(|v| norm(*v)).fold(0.0, f64::max);
+    let diff = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| norm(sub(*x, *y)))
+        .fold(0.0, f64::max);
+    diff / big
+}
+
+/// Clusters of 2 to 50 spheres with close pairs, in free space and in a box: the
+/// iterative step's velocities and spins are the dense near step's within the
+/// iteration's tolerance (relative residual 1e-10 in f64, 1e-5 in f32, the solver's
+/// default; the error is that times the inner system's condition, and f32's dense
+/// inversions carry their own rounding), with both overdamped methods; the report
+/// counts the close pairs, the products (one or two) and their iterations.
+fn matches_dense<T: Real>() {
+    let tol = pick::<T>(5e-3, 1e-7);
+    for (n, seed, l) in [
+        (2, 1, None),
+        (7, 2, None),
+        (20, 3, None),
+        (50, 4, None),
+        (6, 5, Some(9.0)),
+        (20, 6, Some(14.0)),
+        (50, 7, Some(20.0)),
+    ] {
+        let c = l.map_or([0.0; 3], |l| [l / 2.0; 3]);
+        let spheres = cluster(n, seed, l, c);
+        for method in [Method::Overdamped, Method::Overdamped2] {
+            let dense = one_step::<T>(&near(method, false, l), &spheres, &[]).unwrap();
+            let (r, iter) = one_step::<T>(&near(method, true, l), &spheres, &[]).unwrap();
+            let what = format!("{n} spheres, {l:?}, {method:?}");
+            let dv = relative_gap(&iter.1, &dense.1.1);
+            let dw = relative_gap(&iter.2, &dense.1.2);
+            println!(
+                "{what}: pairs {}, products {}, iterations {}, velocities {dv:.1e}, spins {dw:.1e}",
+                r.near_pairs, r.near_products, r.near_iterations
+            );
+            assert!(dv < tol && dw < tol, "{what}: {dv:e} {dw:e}");
+            assert!(
+                r.near_pairs as usize >= n - 1,
+                "{what}: a tree's pairs at least"
+            );
+            let products = if method == Method::Overdamped { 1 } else { 2 };
+            assert_eq!(r.near_products, products, "{what}");
+            assert!(r.near_iterations >= products, "{what}");
+            assert_eq!(r.near_formations, 0, "{what}: formed M_SD");
+            assert_eq!(dense.0.near_formations, products, "{what}: dense");
+        }
+    }
+}
+
+/// Two equal spheres at `s = 2.1` by the iterative step, free space: along their line
+/// of centres at Stimson and Jeffery's speed, side by side at 1.3917 `U0` (within
+/// 0.5 %), spinning at 0.137 `U0 / a` (within 2 %), with both overdamped methods.
+fn pair_falls<T: Real>() {
+    let pair = |axis: [f64; 3]| {
+        let d = scale(axis, 1.05);
+        [-1.0, 1.0].map(|s| Sphere {
+            pos: scale(d, s),
+            radius: 1.0,
+            density: RHO1,
+        })
+    };
+    for method in [Method::Overdamped, Method::Overdamped2] {
+        let p = near::<T>(method, true, None);
+        let (r, (_, v, _)) = one_step::<T>(&p, &pair([0.0, 0.0, 1.0]), &[]).unwrap();
+        assert_eq!(r.near_pairs, 1);
+        let want = stimson_jeffery(2.1) * U0;
+        for vi in &v {
+            let e = (-vi[2] / want - 1.0).abs();
+            assert!(e < 5e-3, "{method:?} along: {} U0", -vi[2] / U0);
+        }
+        let (_, (_, v, w)) = one_step::<T>(&p, &pair([1.0, 0.0, 0.0]), &[]).unwrap();
+        for (vi, wi) in v.iter().zip(&w) {
+            let e = (-vi[2] / (1.3917 * U0) - 1.0).abs();
+            assert!(e < 5e-3, "{method:?} across: {} U0", -vi[2] / U0);
+            let e = (norm(*wi) / (0.137 * U0) - 1.0).abs();
+            assert!(e < 0.02, "{method:?} spin: {} U0", norm(*wi) / U0);
+        }
+    }
+}
+
+/// Two runs of three steps of 30 spheres in a box end on the same bits.
+fn same_bits<T: Real>() {
+    let l = 16.0;
+    let spheres = cluster(30, 11, Some(l), [8.0; 3]);
+    let p = near::<T>(Method::Overdamped, true, Some(l));
+    let run = || {
+        let mut s = spheres.clone();
+        for _ in 0..3 {
+            let (_, (x, _, _)) = one_step::<T>(&p, &s, &[]).unwrap();
+            for (s, x) in s.iter_mut().zip(x) {
+                s.pos = x;
+            }
+        }
+        s.iter()
+            .map(|s| s.pos.map(f64::to_bits))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(run(), run());
+}
+
+/// Refused, typed, the state unchanged: what the iterative path does not serve (noise,
+/// bonds, contacts, the wall's hydrodynamics, PSE), the conjugate gradients stopped
+/// before they converge, and more close pairs than the storage holds.
+fn refusals<T: Real>() {
+    let spheres = cluster(20, 21, None, [0.0; 3]);
+    let base = near::<T>(Method::Overdamped, true, None);
+    let unsupported = |p: &hydrorattle::Params<T>, bonds: &[Bond<T>], what: &str| match one_step::<T>(
+        p, &spheres, bonds,
+    ) {
+        Err(StepError::Unsupported(m)) => assert!(m.contains(what), "{m}"),
+        other => panic!("{what}: {other:?}"),
+    };
+    let mut p = base;
+    p.brownian = Some(Brownian::new(T::from_f64(1e-3)));
+    unsupported(&p, &[], "thermal noise");
+    let bond = Bond {
+        i: 0,
+        j: 1,
+        length: T::from_f64(norm(sub(spheres[1].pos, spheres[0].pos))),
+    };
+    unsupported(&base, &[bond], "constraints");
+    let mut p = base;
+    p.contacts = Some(Contacts::new(64));
+    unsupported(&p, &[], "constraints");
+    let mut p = base;
+    p.wall = Some(Wall::new(T::from_f64(-40.0)));
+    unsupported(&p, &[], "wall");
+    let mut p = base;
+    p.pse = Some(1e-3);
+    // (The fast free-space product refuses rotation first.)
+    p.rotation = false;
+    unsupported(&p, &[], "PSE");
+    // One iteration cannot solve twenty coupled spheres.
+    let mut p = base;
+    p.solver.max_iterations = 1;
+    match one_step::<T>(&p, &spheres, &[]) {
+        Err(StepError::NoConvergence {
+            stage: Stage::Mobility,
+            iterations: 1,
+            ..
+        }) => {}
+        other => panic!("one iteration: {other:?}"),
+    }
+    // Every pair of 100 spheres inside a cutoff of 40 radii: 4950 pairs, above the
+    // storage's 48 a sphere.
+    let lattice: Vec<Sphere> = (0..100)
+        .map(|k| Sphere {
+            pos: [(k % 5) as f64, (k / 5 % 5) as f64, (k / 25) as f64].map(|x| 2.5 * x),
+            radius: 1.0,
+            density: RHO1,
+        })
+        .collect();
+    let mut p = base;
+    p.near = Some(NearField {
+        cutoff: T::from_f64(40.0),
+        ..NearField::default()
+    });
+    match one_step::<T>(&p, &lattice, &[]) {
+        Err(StepError::Unsupported(m)) => assert!(m.contains("close pairs"), "{m}"),
+        other => panic!("too many pairs: {other:?}"),
+    }
+}
+
+macro_rules! both {
+    ($($name:ident),*) => {
+        $(mod $name {
+            #[test]
+            fn f32() { super::$name::<f32>() }
+            #[test]
+            fn f64() { super::$name::<f64>() }
+        })*
+    };
+}
+
+both!(matches_dense, pair_falls, same_bits, refusals);
