@@ -25,6 +25,8 @@ mod determinism;
 mod docs;
 mod dynamics;
 #[cfg(feature = "fast-free")]
+mod fast_rotation;
+#[cfg(feature = "fast-free")]
 mod fast_step;
 mod free_draining;
 #[cfg(feature = "fast-free")]
