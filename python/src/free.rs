@@ -52,6 +52,9 @@ fn free_error(py: Python<'_>, e: FreeError) -> PyErr {
     }
 }
 
+/// The grand product's torques in and rotations out.
+pub type Grand<'a, T> = (&'a [<T as Real>::V3], &'a mut [<T as Real>::V3]);
+
 /// `u = M f` of the spheres at `pos` (radii `radius`, viscosity `eta`) by the fast
 /// free-space product to `tolerance`, with the GIL released; with `grand` (torques `t`
 /// and rotations `w`) the grand product `(u, w) = M (f, t)`.
@@ -64,7 +67,7 @@ pub fn product<T: Real>(
     radius: &[T],
     f: &[T::V3],
     u: &mut [T::V3],
-    grand: Option<(&[T::V3], &mut [T::V3])>,
+    grand: Option<Grand<'_, T>>,
 ) -> PyResult<()> {
     if pos.is_empty() {
         return Ok(());
