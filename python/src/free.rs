@@ -12,13 +12,12 @@ use crate::alloc;
 use crate::errors::particle_error;
 
 /// What `method = "fast"` cannot serve, as a `ValueError` saying why: a box, a wall,
-/// rotation or torques, another level; and its tolerance (default
+/// another level; and its tolerance (default
 /// [`DEFAULT_FREE_TOLERANCE`]) out of the kernel's range.
 pub fn check(
     wall: Option<f64>,
     cell: Option<[f64; 3]>,
     level: Hydro,
-    rotation: bool,
     tolerance: Option<f64>,
 ) -> PyResult<f64> {
     let refuse = |why: &str| Err(PyValueError::new_err(format!("method=\"fast\" {why}")));
@@ -28,10 +27,8 @@ pub fn check(
     if wall.is_some() {
         return refuse("is the free-space product: above a wall use method=\"dense\"");
     }
-    if rotation || level != Hydro::Rpy {
-        return refuse(
-            "gives the translational RPY product only: no rotation or torques, hydro=\"rpy\"",
-        );
+    if level != Hydro::Rpy {
+        return refuse("gives the RPY product only: hydro=\"rpy\"");
     }
     let tolerance = tolerance.unwrap_or(DEFAULT_FREE_TOLERANCE);
     let range = hydrorattle::mobility::free_fast::MIN_TOLERANCE
@@ -55,8 +52,13 @@ fn free_error(py: Python<'_>, e: FreeError) -> PyErr {
     }
 }
 
+/// The grand product's torques in and rotations out.
+pub type Grand<'a, T> = (&'a [<T as Real>::V3], &'a mut [<T as Real>::V3]);
+
 /// `u = M f` of the spheres at `pos` (radii `radius`, viscosity `eta`) by the fast
-/// free-space product to `tolerance`, with the GIL released.
+/// free-space product to `tolerance`, with the GIL released; with `grand` (torques `t`
+/// and rotations `w`) the grand product `(u, w) = M (f, t)`.
+#[allow(clippy::too_many_arguments)]
 pub fn product<T: Real>(
     py: Python<'_>,
     tolerance: f64,
@@ -65,6 +67,7 @@ pub fn product<T: Real>(
     radius: &[T],
     f: &[T::V3],
     u: &mut [T::V3],
+    grand: Option<Grand<'_, T>>,
 ) -> PyResult<()> {
     if pos.is_empty() {
         return Ok(());
@@ -81,8 +84,16 @@ pub fn product<T: Real>(
     }
     // A hair over the bounding box: the edges rounded to `T` must still hold it.
     let extent: [f64; 3] = std::array::from_fn(|d| (hi[d] - lo[d]).max(0.0) * (1.0 + 1e-6));
-    let ff = FreeFast::new(a_max, tolerance, extent.map(T::from_f64), pos.len()).map_err(fail)?;
-    let need = ff.storage(pos.len());
+    let (extent, n) = (extent.map(T::from_f64), pos.len());
+    let ff = match grand {
+        Some(_) => FreeFast::new_grand(a_max, tolerance, extent, n),
+        None => FreeFast::new(a_max, tolerance, extent, n),
+    }
+    .map_err(fail)?;
+    let need = match grand {
+        Some(_) => ff.storage_grand(n),
+        None => ff.storage(n),
+    };
     let what = format!("mobility_dot of {} spheres by the fast product", pos.len());
     alloc::Need::new(&what)
         .add::<[T; 2]>("grid", Some(need.complex))
@@ -94,7 +105,11 @@ pub fn product<T: Real>(
     let mut index = alloc::filled(&what, "cell list", need.index, 0usize)?;
     py.detach(|| {
         let mut store = FreeStorage::new(&mut complex, &mut reals, &mut index);
-        ff.apply(T::from_f64(eta), pos, radius, f, u, &mut store)
+        let eta = T::from_f64(eta);
+        match grand {
+            Some((t, w)) => ff.apply_grand(eta, (pos, radius), f, t, u, w, &mut store),
+            None => ff.apply(eta, pos, radius, f, u, &mut store),
+        }
     })
     .map_err(fail)
 }

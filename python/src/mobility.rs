@@ -321,11 +321,12 @@ pub fn mobility_dot<'py>(
     g.spheres_fit(py, is_f32(precision)?, pos, radii)?;
     let rotation = rotation || t.is_some();
     if method == "fast" {
-        let tol = crate::free::check(wall, r#box, level, rotation, tolerance)?;
-        return Ok(match is_f32(precision)? {
-            true => fast_product::<f32>(py, pos, radii, f, eta, tol)?.into_any(),
-            false => fast_product::<f64>(py, pos, radii, f, eta, tol)?.into_any(),
-        });
+        let tol = crate::free::check(wall, r#box, level, tolerance)?;
+        let torques = rotation.then_some(t.unwrap_or(&[]));
+        return match is_f32(precision)? {
+            true => fast_product::<f32>(py, pos, radii, (f, torques), eta, tol),
+            false => fast_product::<f64>(py, pos, radii, (f, torques), eta, tol),
+        };
     }
     let asked = crate::pse::method(method, tolerance)?;
     if let Some(size) = r#box.filter(|_| wall.is_none()) {
@@ -369,18 +370,32 @@ fn pse_product<'py, T: Real + Element>(
 }
 
 /// Velocities in precision `T` in free space by the fast product to `tolerance`: the
-/// spheres checked one by one here, pairs (one inside another) in its near part.
+/// spheres checked one by one here, pairs (one inside another) in its near part. With
+/// rotation (`torques` `Some`, empty for none) the grand product: `(u, w)`.
 fn fast_product<'py, T: Real + Element>(
     py: Python<'py>,
     pos: &[[f64; 3]],
     radii: &[f64],
-    forces: &[[f64; 3]],
+    (forces, torques): (&[[f64; 3]], Option<&[[f64; 3]]>),
     eta: f64,
     tolerance: f64,
-) -> PyResult<Bound<'py, PyArray2<T>>> {
+) -> PyResult<Bound<'py, PyAny>> {
     let (pos, r) = crate::input::each_sphere::<T>(py, pos, radii, None)?;
-    let f: Vec<T::V3> = forces.iter().map(|&x| T::v3_from(x)).collect();
-    let mut u = vec![T::V3_ZERO; pos.len()];
-    crate::free::product::<T>(py, tolerance, eta, &pos, &r, &f, &mut u)?;
-    Ok(to_array::<T>(py, &u))
+    let n = pos.len();
+    let v3 = |v: &[[f64; 3]]| -> Vec<T::V3> { v.iter().map(|&x| T::v3_from(x)).collect() };
+    let f = v3(forces);
+    let mut u = vec![T::V3_ZERO; n];
+    let Some(t) = torques else {
+        crate::free::product::<T>(py, tolerance, eta, &pos, &r, &f, &mut u, None)?;
+        return Ok(to_array::<T>(py, &u).into_any());
+    };
+    let t = match t.is_empty() {
+        true => vec![T::V3_ZERO; n],
+        false => v3(t),
+    };
+    let mut w = vec![T::V3_ZERO; n];
+    let grand = Some((&t[..], &mut w[..]));
+    crate::free::product::<T>(py, tolerance, eta, &pos, &r, &f, &mut u, grand)?;
+    let (u, w) = (to_array::<T>(py, &u), to_array::<T>(py, &w));
+    Ok((u, w).into_pyobject(py)?.into_any())
 }

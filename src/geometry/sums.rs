@@ -48,6 +48,22 @@ pub trait BoxProduct<T: Real> {
         u: &mut [T::V3],
     ) -> Result<(), StepError>;
 
+    /// `out = M_rt F`: the spins of torque-free spheres from the forces `f` they exert
+    /// on the fluid. Only products that carry rotation give it (the fast free-space
+    /// product with [`Params::rotation`](crate::Params::rotation)); the rest refuse.
+    fn spin(
+        &self,
+        eta: T,
+        spheres: (&[T::V3], &[T]),
+        f: &[T::V3],
+        out: &mut [T::V3],
+    ) -> Result<(), StepError> {
+        let _ = (eta, spheres, f, out);
+        Err(StepError::Unsupported(
+            "spins from a fast product without rotation (its rt products are not built)",
+        ))
+    }
+
     /// `out` = a Brownian displacement of covariance `M` by the sums' own noise
     /// ([`Pse::noise_in`]: the real part by Lanczos to `s` from the deviates `z`,
     /// the wave part from white noise on the grid), drawn from `rng`; `basis` and

@@ -35,6 +35,10 @@ use crate::real::Real;
 /// (the Brownian midpoint, a contact round's trial positions).
 pub const FAST_MARGIN: f64 = 4.0;
 
+/// Why a step with rotation on the fast free-space product is refused without its vectors.
+const SPARE: &str = "the workspace's fast free-space vectors with rotation \
+     (Workspace::with_fast_vectors, at least integrate::fast_vectors)";
+
 /// How many times the spreading width grows by [`WIDEN`] before the caller's storage
 /// is declared too small (`1.25^24`, about 200 times the rule's width).
 const TRIES: u32 = 24;
@@ -44,14 +48,23 @@ const WIDEN: f64 = 1.25;
 /// The step's fast free-space parameters for these spheres ([`FreeFast::new`]'s rule
 /// over the bounding box widened by [`FAST_MARGIN`], each edge then rounded up by
 /// [`round_extent`]), the spreading widened until
-/// the grid fits `have` complex values and reals (and its bounds).
+/// the grid fits `have` complex values and reals (and its bounds). With `grand` (a step
+/// with rotation) the grand product's ([`FreeFast::new_grand`], sized by
+/// [`FreeFast::storage_grand`]).
 pub(super) fn params<T: Real>(
-    tol: f64,
+    (tol, grand): (f64, bool),
     pos: &[T::V3],
     radius: &[T],
     have: [usize; 2],
 ) -> Result<FreeFast<T>, FreeError> {
     let fits = |s: FreeSize| s.complex <= have[0] && s.reals <= have[1];
+    let size = |f: &FreeFast<T>, n| {
+        if grand {
+            f.storage_grand(n)
+        } else {
+            f.storage(n)
+        }
+    };
     let n = pos.len();
     let a_max = radius.iter().fold(T::ZERO, |m, &a| m.max(a));
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
@@ -67,9 +80,12 @@ pub(super) fn params<T: Real>(
     // step, keeps its parameters and so the kernel's transform in the caller's reals.
     let edge = |d: usize| round_extent((hi[d] - lo[d]).max(0.0) + pad, a_max.to_f64());
     let extent: [T; 3] = core::array::from_fn(|d| T::from_f64(edge(d)));
-    let rule = FreeFast::new(a_max, tol, extent, n);
+    let rule = match grand {
+        true => FreeFast::new_grand(a_max, tol, extent, n),
+        false => FreeFast::new(a_max, tol, extent, n),
+    };
     let mut sigma = match rule {
-        Ok(f) if fits(f.storage(n)) => return Ok(f),
+        Ok(f) if fits(size(&f, n)) => return Ok(f),
         Ok(f) => f.sigma(),
         // Too fine a grid for the bounds: a wider spreading may fit.
         Err(FreeError::GridTooLarge) => 0.75 * a_max.to_f64(),
@@ -77,15 +93,20 @@ pub(super) fn params<T: Real>(
     };
     for _ in 0..TRIES {
         sigma *= WIDEN;
-        match FreeFast::with_sigma(a_max, tol, extent, T::from_f64(sigma)) {
-            Ok(f) if fits(f.storage(n)) => return Ok(f),
+        let wide = T::from_f64(sigma);
+        let tried = match grand {
+            true => FreeFast::with_sigma_grand(a_max, tol, extent, wide),
+            false => FreeFast::with_sigma(a_max, tol, extent, wide),
+        };
+        match tried {
+            Ok(f) if fits(size(&f, n)) => return Ok(f),
             Ok(_) | Err(FreeError::GridTooLarge) => {}
             Err(e) => return Err(e),
         }
     }
     Err(match rule {
         Ok(f) => {
-            let need = f.storage(n);
+            let need = size(&f, n);
             FreeError::Storage {
                 need: [need.complex, need.reals, need.index],
                 have: [have[0], have[1], 0],
@@ -101,7 +122,8 @@ pub(super) fn params<T: Real>(
 /// at the RPY level), from the parameters the step derives for this cloud; `None` where
 /// it needs none. A host sizes its arrays with it before the first step; as the cloud
 /// moves, the step keeps within them (the module's documentation), so sizing from the
-/// first configuration is enough.
+/// first configuration is enough. With [`Params::rotation`] it is the grand product's
+/// ([`FreeFast::storage_grand`]), and the step needs [`fast_vectors`] vectors too.
 pub fn fast_storage<T: Real>(
     p: &Params<T>,
     pos: &[T::V3],
@@ -112,10 +134,24 @@ pub fn fast_storage<T: Real>(
             if pos.len() != radius.len() {
                 return Err(StepError::StateLength);
             }
-            let fast = params(tol, pos, radius, [usize::MAX; 2])?;
-            Ok(Some(fast.storage(pos.len())))
+            let fast = params((tol, p.rotation), pos, radius, [usize::MAX; 2])?;
+            Ok(Some(match p.rotation {
+                true => fast.storage_grand(pos.len()),
+                false => fast.storage(pos.len()),
+            }))
         }
         _ => Ok(None),
+    }
+}
+
+/// The vectors a fast free-space step of `n` spheres with `p` needs besides
+/// [`fast_storage`] ([`Workspace::with_fast_vectors`](crate::Workspace::with_fast_vectors)):
+/// `2 n` with [`Params::rotation`] (the grand product's zero torques and its discarded
+/// velocities, for the spins `W = M_rt F`), else none.
+pub fn fast_vectors<T: Real>(p: &Params<T>, n: usize) -> usize {
+    match takes_fast(p) && p.rotation {
+        true => 2 * n,
+        false => 0,
     }
 }
 
@@ -135,37 +171,49 @@ pub(super) fn takes_fast<T: Real>(p: &Params<T>) -> bool {
 pub(super) struct FastStep<'s, T: Real> {
     fast: FreeFast<T>,
     store: RefCell<FreeStorage<'s, T>>,
+    /// The spins' zero torques and discarded velocities ([`fast_vectors`]; empty
+    /// without rotation).
+    spare: RefCell<&'s mut [T::V3]>,
 }
 
 impl<'s, T: Real> FastStep<'s, T> {
-    /// The step's products over the caller's arrays (complex values, indices, reals):
-    /// the parameters `held` derived in the checks where they fit the arrays, else the
-    /// spreading widened until they do ([`params`]); the products run on the step's
-    /// threads `par` (the same bits on any number).
+    /// The step's products over the caller's arrays (complex values, indices, vectors,
+    /// reals): the parameters `held` derived in the checks where they fit the arrays,
+    /// else the spreading widened until they do ([`params`]); the products run on the
+    /// step's threads `par` (the same bits on any number). Parameters for the grand
+    /// product (a step with rotation) need [`fast_vectors`] vectors.
     pub(super) fn new(
         held: &FreeFast<T>,
         spheres: (&[T::V3], &[T]),
-        (complex, index, reals): (
-            &'s mut [crate::mobility::pse::Cx<T>],
-            &'s mut [usize],
-            &'s mut [T],
-        ),
+        (complex, index, vectors, reals): crate::workspace::PseSlices<'s, T>,
         par: &'s dyn crate::parallel::Parallel,
     ) -> Result<Self, StepError> {
         let n = spheres.0.len();
-        let (size, have) = (held.storage(n), [complex.len(), reals.len()]);
+        let grand = held.is_grand();
+        let size = match grand {
+            true => held.storage_grand(n),
+            false => held.storage(n),
+        };
+        let have = [complex.len(), reals.len()];
         let fast = match size.complex <= have[0] && size.reals <= have[1] {
             true => *held,
-            false => params(held.tolerance(), spheres.0, spheres.1, have)?,
+            false => params((held.tolerance(), grand), spheres.0, spheres.1, have)?,
         };
         if index.len() < size.index {
             let need = [size.complex, size.reals, size.index];
             let have = [have[0], have[1], index.len()];
             return Err(FreeError::Storage { need, have }.into());
         }
+        let spare = match grand {
+            true => vectors
+                .get_mut(..2 * n)
+                .ok_or(StepError::BadParameter(SPARE))?,
+            false => &mut [],
+        };
         Ok(Self {
             fast,
             store: RefCell::new(FreeStorage::new(complex, reals, index).with_parallel(par)),
+            spare: RefCell::new(spare),
         })
     }
 }
@@ -183,6 +231,31 @@ impl<T: Real> BoxProduct<T> for FastStep<'_, T> {
             StepError::Unsupported("a fast free-space product inside another (storage in use)")
         })?;
         Ok(self.fast.apply(eta, pos, radius, f, u, &mut store)?)
+    }
+
+    /// `out = M_rt F`: the grand product with zero torques, its velocities discarded.
+    fn spin(
+        &self,
+        eta: T,
+        (pos, radius): (&[T::V3], &[T]),
+        f: &[T::V3],
+        out: &mut [T::V3],
+    ) -> Result<(), StepError> {
+        let in_use = StepError::Unsupported(
+            "a fast free-space spin inside another product (storage in use)",
+        );
+        let mut store = self.store.try_borrow_mut().map_err(|_| in_use)?;
+        let mut spare = self.spare.try_borrow_mut().map_err(|_| in_use)?;
+        let n = pos.len();
+        let (torque, vel) = spare
+            .split_at_mut_checked(n)
+            .ok_or(StepError::BadParameter(SPARE))?;
+        let vel = vel.get_mut(..n).ok_or(StepError::BadParameter(SPARE))?;
+        torque.fill(T::V3_ZERO);
+        let spheres = (pos, radius);
+        Ok(self
+            .fast
+            .apply_grand(eta, spheres, f, torque, vel, out, &mut store)?)
     }
 
     /// Lanczos on the fast product, as the matrix-free path draws in free space: the

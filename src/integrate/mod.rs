@@ -13,7 +13,7 @@
 //! contacts of the position projection.
 
 #[cfg(feature = "fast-free")]
-pub use fast::{FAST_MARGIN, fast_storage};
+pub use fast::{FAST_MARGIN, fast_storage, fast_vectors};
 #[cfg(feature = "pse")]
 pub use periodic::pse_storage;
 

@@ -88,7 +88,7 @@ pub(super) fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>
 pub(super) fn pse_store<'a, T: Real>(
     held: Option<&'a Held<T>>,
     spheres: (&[T::V3], &[T]),
-    (complex, index, vectors, _reals): crate::workspace::PseSlices<'a, T>,
+    slices: crate::workspace::PseSlices<'a, T>,
     par: &'a dyn crate::parallel::Parallel,
 ) -> Result<Option<Store<'a, T>>, StepError> {
     let n = spheres.0.len();
@@ -96,11 +96,12 @@ pub(super) fn pse_store<'a, T: Real>(
         Some(Held::Pse(pse)) => pse,
         #[cfg(feature = "fast-free")]
         Some(Held::Fast(fast)) => {
-            let step = super::fast::FastStep::new(fast, spheres, (complex, index, _reals), par)?;
+            let step = super::fast::FastStep::new(fast, spheres, slices, par)?;
             return Ok(Some(Store::Fast(step)));
         }
         _ => return Ok(None),
     };
+    let (complex, index, vectors, _) = slices;
     let need = pse.storage(n);
     if complex.len() < need.complex || index.len() < need.index || vectors.len() < need.vectors {
         return Err(crate::mobility::pse::PseError::Storage {

@@ -229,6 +229,16 @@ pub(super) fn spin<T: Real>(
     if !p.rotation {
         return Ok(());
     }
+    // The fast free-space product's own grand product (PSE in a box, which has no
+    // rt products, is refused with rotation in the step's checks).
+    #[cfg(feature = "fast-free")]
+    if let Some(fast) = ew.and_then(|s| s.pse())
+        && p.place().cell().is_none()
+    {
+        fast.spin(p.viscosity, (pos, radius), f, out)?;
+        out.iter_mut().for_each(|w| *w += p.vorticity);
+        return Ok(());
+    }
     hydro(p, ew).add_spin(pos, radius, f, out)
 }
 

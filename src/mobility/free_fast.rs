@@ -248,6 +248,17 @@ impl<T: Real> FreeFast<T> {
         Self::build(a_max, tol, extent, sigma, 1.0)
     }
 
+    /// [`FreeFast::new_grand`]'s parameters for a given spreading width `sigma` (as
+    /// [`FreeFast::with_sigma`]).
+    pub fn with_sigma_grand(
+        a_max: T,
+        tol: f64,
+        extent: [T; 3],
+        sigma: T,
+    ) -> Result<Self, FreeError> {
+        Self::build(a_max, tol, extent, sigma, GRAND_MARGIN)
+    }
+
     /// The rule at `tol / margin`.
     fn build(a_max: T, tol: f64, extent: [T; 3], sigma: T, margin: f64) -> Result<Self, FreeError> {
         if !(MIN_TOLERANCE..=MAX_TOLERANCE).contains(&tol) {
@@ -323,6 +334,10 @@ impl<T: Real> FreeFast<T> {
         }
     }
 
+    /// Whether the parameters serve [`FreeFast::apply_grand`] ([`FreeFast::new_grand`]'s).
+    pub fn is_grand(&self) -> bool {
+        self.grand
+    }
     /// The tolerance the parameters were derived for.
     pub fn tolerance(&self) -> f64 {
         self.tol

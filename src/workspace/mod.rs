@@ -132,6 +132,20 @@ impl<'a, T: Real> Workspace<'a, T> {
         }
     }
 
+    /// This workspace with the vectors a fast free-space step with
+    /// [`Params::rotation`](crate::Params::rotation) needs for its spins (at least
+    /// [`fast_vectors`](crate::integrate::fast_vectors), else the step is refused with
+    /// [`StepError::BadParameter`](crate::StepError::BadParameter) before anything is
+    /// touched). Call it after [`Workspace::with_fast`].
+    #[cfg(feature = "fast-free")]
+    pub fn with_fast_vectors(self, vectors: &'a mut [T::V3]) -> Self {
+        let (complex, index, _, reals) = self.pse;
+        Self {
+            pse: (complex, index, vectors, reals),
+            ..self
+        }
+    }
+
     /// The element counts this workspace holds.
     pub fn capacity(&self) -> Layout {
         Layout {

@@ -31,9 +31,9 @@ use std::f64::consts::PI;
 
 /// The fast product's arrays for steps of `p` from the spheres `s` (complex values,
 /// reals, indices), each scaled by `shrink` (1: what `fast_storage` asks).
-struct Arrays(Vec<Cx<f64>>, Vec<f64>, Vec<usize>);
+pub(super) struct Arrays(pub Vec<Cx<f64>>, pub Vec<f64>, pub Vec<usize>);
 
-fn arrays(p: &Params<f64>, s: &[Sphere], shrink: [f64; 3]) -> Arrays {
+pub(super) fn arrays(p: &Params<f64>, s: &[Sphere], shrink: [f64; 3]) -> Arrays {
     let pos: Vec<_> = s.iter().map(|x| f64::v3_from(x.pos)).collect();
     let rad: Vec<f64> = s.iter().map(|x| x.radius).collect();
     let z = fast_storage(p, &pos, &rad).unwrap().expect("a fast step");
@@ -46,7 +46,7 @@ fn arrays(p: &Params<f64>, s: &[Sphere], shrink: [f64; 3]) -> Arrays {
 }
 
 /// A particle set that may hold overlapping spheres.
-fn set<const M: usize>(s: &[Sphere]) -> ParticleSet<f64, M> {
+pub(super) fn set<const M: usize>(s: &[Sphere]) -> ParticleSet<f64, M> {
     let list: Vec<Particle<f64>> = s
         .iter()
         .map(|x| Particle::new(f64::v3_from(x.pos), x.radius, x.density))
@@ -80,7 +80,7 @@ fn run_fast<const M: usize, const B: usize, E: ExternalForce<f64>>(
 }
 
 /// `p` on the fast product at `tol` (matrix-free), or on the dense stored mobility.
-fn on(mut p: Params<f64>, tol: Option<f64>) -> Params<f64> {
+pub(super) fn on(mut p: Params<f64>, tol: Option<f64>) -> Params<f64> {
     p.matrix_free = tol.is_some();
     p.pse = tol;
     p.allow_overlap = true;
@@ -102,11 +102,11 @@ fn relative(start: &[Sphere], a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     diff / big
 }
 
-const C: usize = 60;
+pub(super) const C: usize = 60;
 
 /// `C` polydisperse spheres (radii 0.5 to 1, half placed overlapping an earlier one)
 /// in a cube of edge 14, densities 2 to 6 (so the forces differ).
-fn cloud() -> Vec<Sphere> {
+pub(super) fn cloud() -> Vec<Sphere> {
     let (pos, rad) = config_radii(C, 7, [14.0; 3], [0.5, 1.0], true);
     assert_eq!(pos.len(), C);
     let s: Vec<Sphere> = (0..C)
@@ -171,7 +171,7 @@ fn small_storage_coarser_grid_or_refused() {
 }
 
 /// A push along `x` on the first half, against `-x` on the rest.
-struct Push;
+pub(super) struct Push;
 
 impl<T: Real> ExternalForce<T> for Push {
     fn add(&mut self, _pos: &[T::V3], _radius: &[T], force: &mut [T::V3]) {
@@ -183,10 +183,10 @@ impl<T: Real> ExternalForce<T> for Push {
     }
 }
 
-const K: usize = 6;
+pub(super) const K: usize = 6;
 
 /// A chain of `K` beads of unequal radii and its bonds at their lengths.
-fn chain() -> (Vec<Sphere>, BondSet<f64, { K - 1 }>) {
+pub(super) fn chain() -> (Vec<Sphere>, BondSet<f64, { K - 1 }>) {
     let s: Vec<Sphere> = (0..K)
         .map(|k| Sphere {
             pos: [1.7 * k as f64, 0.3 * (k % 2) as f64, 0.2 * k as f64],
@@ -431,8 +431,26 @@ fn same_bits_twice() {
     assert_ne!(first, snapshot(&set::<K>(&s)), "the steps did not move");
 }
 
+/// A step of `p` on the chain `(s, bonds)` (with a noise generator, without fast
+/// storage) refused with `StepError::Unsupported` naming `why`, the state untouched.
+pub(super) fn assert_unsupported(
+    (s, bonds): (&[Sphere], &BondSet<f64, { K - 1 }>),
+    p: &Params<f64>,
+    why: &str,
+    name: &str,
+) {
+    let mut ps = set::<K>(s);
+    ps.noise = Some(Noise::new(1));
+    let before = snapshot(&ps);
+    let mut buf = Buffers::<f64>::new(Layout::for_params(p, K, K - 1));
+    let mut ws = buf.workspace();
+    let r = step(&mut ps, bonds, p, &mut ws, &mut NoForce);
+    let typed = |e: &StepError| matches!(e, StepError::Unsupported(w) if w.contains(why));
+    assert_failed_unchanged(&before, &ps, &r, typed, name);
+}
+
 /// What the fast product cannot serve is refused, typed, the state untouched: a wall,
-/// rotation, the stored path, the Oseen level, a tabulating solver with bonds,
+/// the stored path, the Oseen level, a tabulating solver with bonds,
 /// Cholesky noise; and a step with no fast storage in its workspace.
 #[test]
 fn refusals() {
@@ -448,7 +466,6 @@ fn refusals() {
     };
     let cases: Vec<(&str, Params<f64>, &str)> = vec![
         ("wall", with(&|p| p.wall = Some(Wall::new(-5.0))), "wall"),
-        ("rotation", with(&|p| p.rotation = true), "rotation"),
         ("stored", with(&|p| p.matrix_free = false), "products only"),
         ("Oseen", with(&|p| p.hydro = Hydro::Oseen), "Oseen"),
         (
@@ -472,14 +489,7 @@ fn refusals() {
     ];
     for (name, p, why) in cases {
         assert!(fast_storage(&p, &[f64::V3_ZERO], &[1.0]).is_ok());
-        let mut ps = set::<K>(&s);
-        ps.noise = Some(Noise::new(1));
-        let before = snapshot(&ps);
-        let mut buf = Buffers::<f64>::new(Layout::for_params(&p, K, K - 1));
-        let mut ws = buf.workspace();
-        let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce);
-        let typed = |e: &StepError| matches!(e, StepError::Unsupported(w) if w.contains(why));
-        assert_failed_unchanged(&before, &ps, &r, typed, name);
+        assert_unsupported((&s, &bonds), &p, why, name);
     }
     // No fast storage at all.
     let mut ps = set::<K>(&s);

@@ -27,6 +27,8 @@ mod dynamics;
 #[cfg(feature = "fast-free")]
 mod fast_keep;
 #[cfg(feature = "fast-free")]
+mod fast_rotation;
+#[cfg(feature = "fast-free")]
 mod fast_step;
 mod free_draining;
 #[cfg(feature = "fast-free")]

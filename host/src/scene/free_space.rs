@@ -14,7 +14,7 @@
 //! and no wall): it gives products only, so the run is matrix-free (written back as
 //! `matrix_free = true`) and the constraints are solved by Krylov. A scene that needs
 //! what it does not give is refused at `method`: a `[wall]` or a `[box]` (their
-//! products are their own), rotation, another level than RPY, a `[near_field]`, a
+//! products are their own), another level than RPY, a `[near_field]`, a
 //! method or level that stores the mobility (`matrix_free`'s rule), the Cholesky
 //! factor of the noise. The storage is sized without the mobility (`O(N)`, no `N^2`
 //! term), so a cloud of 10^5 spheres is not refused as dense. `"auto"` picks, when the
@@ -150,7 +150,6 @@ fn unsupported(cx: &Context<'_>) -> Option<&'static str> {
             "is the free-space product: above a [wall] the mobility is the wall's (use \"dense\")"
         }
         _ if cx.near.is_some() => "gives the far field alone: leave out [near_field]",
-        _ if m.rotation => "gives the translational product only: rotation = false",
         _ if m.hydrodynamics != Hydrodynamics::Rpy => {
             "gives the RPY product only: hydrodynamics = \"rpy\""
         }

@@ -57,7 +57,8 @@ pub struct Engine<T: Real> {
     pse: (Vec<[T; 2]>, Vec<usize>, Vec<T::V3>),
     /// The fast free-space product's kernel transform (reals) when the scene runs on it
     /// ([`hydrorattle::integrate::fast_storage`]; its grid and cell list in `pse`'s
-    /// complex values and indices); empty otherwise.
+    /// complex values and indices, with rotation the spins' vectors in its vectors);
+    /// empty otherwise.
     fast: Vec<T>,
 }
 
@@ -159,7 +160,8 @@ impl<T: Real> Engine<T> {
                 hydrorattle::mobility::pse::PseSize {
                     complex: f.complex,
                     index: f.index,
-                    vectors: 0,
+                    // The spins' scratch with rotation.
+                    vectors: hydrorattle::integrate::fast_vectors(&params, n),
                 },
                 f.reals,
             ),
@@ -261,7 +263,7 @@ impl<T: Real> Engine<T> {
         let (c, i, v) = &mut self.pse;
         let mut ws = match self.fast.is_empty() {
             true => ws.with_pse(c, i, v),
-            false => ws.with_fast(c, &mut self.fast, i),
+            false => ws.with_fast(c, &mut self.fast, i).with_fast_vectors(v),
         };
         if !self.pins.is_empty() {
             self.rows.clear();

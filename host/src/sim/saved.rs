@@ -54,6 +54,10 @@ pub struct SavedParams {
     /// systems saved before the key, and without a near field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     near: Option<[u64; 3]>,
+    /// The fast product's tolerance (`Params::pse`: PSE in a box, the fast free-space
+    /// product without one). Absent in systems saved before the key, and without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pse: Option<u64>,
 }
 
 /// A system as plain data ([`Engine::save`], [`Engine::restore`]); unknown keys are
@@ -138,6 +142,7 @@ impl SavedParams {
             near: p
                 .near
                 .map(|n| [b(n.cutoff), b(n.wall_cutoff), b(n.min_gap)]),
+            pse: p.pse.map(f64::to_bits),
         }
     }
 
@@ -191,6 +196,8 @@ impl SavedParams {
                 wall_cutoff: f(w),
                 min_gap: f(g),
             });
+        // Checked on load with the rest ([`Engine::check`]: the step's own checks).
+        p.pse = self.pse.map(f64::from_bits);
         Ok(p)
     }
 }

@@ -1,7 +1,7 @@
 //! `[free_space] method = "fast"`: the kernel parameters it sets (`Params::pse` without
 //! a box, matrix-free), its storage sized without the mobility (a cloud of 10^5
 //! spheres is not refused as dense, as `"dense"` is), each refusal at its line, the
-//! write-back, and a run of the shipped small cloud whose first step moves the cloud at
+//! write-back, rotation's spins against the dense path's, and a run of the shipped small cloud whose first step moves the cloud at
 //! about the continuum speed.
 
 use hydrorattle_host::scene::{FreeMethod, Scene, params};
@@ -64,7 +64,6 @@ fn what_fast_cannot_run_is_refused_at_its_line() {
     let fast = "method = \"fast\"";
     for (extra, says) in [
         ("[wall]\nheight = -30.0", "wall"),
-        ("[model]\nrotation = true", "rotation"),
         ("[model]\nhydrodynamics = \"oseen\"", "rpy"),
         ("[model]\nlevel = \"auto\"", "manual"),
         ("[near_field]", "near_field"),
@@ -85,6 +84,30 @@ fn what_fast_cannot_run_is_refused_at_its_line() {
     assert!(m.contains("[box]"), "{m}");
     let (line, m) = at("", "method = \"quick\"");
     assert_eq!(line, Some(9), "{m}");
+}
+
+/// `rotation = true` runs on the fast product: the spins after a step within the
+/// tolerance of the same scene's on the dense path (`"dense"`).
+#[test]
+fn fast_runs_rotation_with_the_dense_spins() {
+    let rotating = |free: &str| {
+        let s = Scene::parse(&scene("[model]\nrotation = true", free), "c.toml").unwrap();
+        let mut e = Engine::<f64>::new(&s, DEFAULT_LIMIT).unwrap();
+        e.step().unwrap();
+        (params::<f64>(&s), e.beads.omega.clone())
+    };
+    let (pf, fast) = rotating("method = \"fast\"\ntolerance = 1e-6");
+    assert!(pf.rotation && pf.pse == Some(1e-6) && pf.matrix_free);
+    let (pd, dense) = rotating("method = \"dense\"");
+    assert!(pd.rotation && pd.pse.is_none());
+    let big = dense.iter().map(|w| w.length()).fold(0.0, f64::max);
+    let err = fast
+        .iter()
+        .zip(&dense)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f64::max)
+        / big;
+    assert!(big > 0.0 && err < 1e-6 && err > 0.0, "{err}");
 }
 
 #[test]

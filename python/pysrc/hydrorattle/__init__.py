@@ -282,9 +282,10 @@ def mobility_dot(
     geometry (the pair sum in free space and above a wall, the Ewald sum in a box).
     In free space ``"fast"`` is the fast free-space RPY product (``O(N log N)``,
     relative error below ``tolerance``, ``1e-10`` to ``0.1``, default ``1e-4`` as a
-    scene's ``[free_space]``; translation and the RPY level only: a box, a wall,
-    torques, ``rotation=True`` or another ``hydro`` are a ``ValueError``); ``"auto"``
-    there is the exact pair sum (``"pse"`` is a ``ValueError``).
+    scene's ``[free_space]``; the RPY level only: a box, a wall or another ``hydro``
+    are a ``ValueError``; with torques or ``rotation=True`` its grand product gives
+    ``(velocities, spins)`` without the packed grand mobility); ``"auto"`` there is the
+    exact pair sum (``"pse"`` is a ``ValueError``).
 
     ``threads``: the matrix-free product in free space and the PSE product run on this
     many threads (0: every core) from ``N = 512`` on; the result has the same bits on

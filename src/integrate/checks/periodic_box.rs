@@ -175,7 +175,7 @@ const FAST_ASSEMBLED: &str = "the fast free-space product (Params::pse without a
      or Newton solver, RattleStable): it gives products only";
 
 /// Free space with [`Params::pse`]: the fast free-space product (kernel feature
-/// `fast-free`), RPY only, products only, no wall, no rotation; its parameters derived
+/// `fast-free`), RPY only, products only, no wall; its parameters derived
 /// from the cloud at the step's start (`integrate::fast`). `None` without `pse`, and
 /// with free draining (no pair blocks to replace).
 fn fast_sums<T: Real>(
@@ -204,12 +204,15 @@ fn fast_sums<T: Real>(
             "the fast free-space product with Hydro::Oseen (it is RPY's)",
         ));
     }
-    let rotation =
-        "the fast free-space product with rotation (its rt and rr products are not built)";
-    products_only(p, state.len(), bonds, (FAST_ASSEMBLED, rotation))?;
+    // Rotation is served: the spins come from the grand product (`integrate::fast`).
+    let unrotated = Params {
+        rotation: false,
+        ..*p
+    };
+    products_only(&unrotated, state.len(), bonds, (FAST_ASSEMBLED, ""))?;
     #[cfg(feature = "fast-free")]
     return Ok(Some(periodic::Held::Fast(super::super::fast::params(
-        tol,
+        (tol, p.rotation),
         state.pos,
         state.radius,
         [usize::MAX; 2],
