@@ -11,8 +11,8 @@
 //! cargo run --release -p hydrorattle-study --example cloud_torus -- RUN_DIR OUT.png T1,T2,..
 //! ```
 //!
-//! The cloud's initial radius is the largest distance of a centre from the first
-//! frame's mean. With `HYDRORATTLE_BENCH_MACHINE` set, the measures of every frame go
+//! The cloud's initial radius is that of the first frame's centres, as a uniform ball's
+//! (`cloud::ball_radius`). With `HYDRORATTLE_BENCH_MACHINE` set, the measures of every frame go
 //! to `bench/results/cloud_torus.csv` (`CLOUD_TORUS_CASE` names the run there).
 
 #[path = "../../examples/shared/record.rs"]
@@ -23,7 +23,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, anyhow};
 use hydrorattle_host::output::{Frame, read_xyz};
-use hydrorattle_study::cloud::{axis_map, axis_ratio, axis_slice, core};
+use hydrorattle_study::cloud::{axis_map, axis_ratio, axis_slice, ball_radius, core};
 use hydrorattle_study::render::{CloudRow, draw_cloud};
 
 /// The whole frames of an XYZ text (a file still being written may end mid-frame).
@@ -62,12 +62,7 @@ fn main() -> Result<()> {
     let frames = read_frames(Path::new(dir))?;
     let first = frames.first().ok_or_else(|| anyhow!("{dir}: no frame"))?;
     let n = first.positions.len();
-    let mean = core(&first.positions, &[], f64::INFINITY).centre;
-    let radius = first
-        .positions
-        .iter()
-        .map(|p| (0..3).map(|j| (p[j] - mean[j]).powi(2)).sum::<f64>().sqrt())
-        .fold(0.0, f64::max);
+    let radius = ball_radius(&first.positions);
     let predicted = 1.0 + 6.0 * n as f64 / (5.0 * radius);
     println!("{n} spheres, initial radius {radius:.2}: 1 + 6 N a / (5 R) = {predicted:.2}");
     println!("time,core_z,fall_speed,fallen_radii,tail_fraction,axis_ratio");
@@ -138,7 +133,7 @@ fn main() -> Result<()> {
             }
         })
         .collect();
-    draw_cloud(Path::new(out), &what, &rows, 1000, 420)?;
+    draw_cloud(Path::new(out), &what, &rows, 900, 380)?;
     eprintln!("wrote {out}");
     rec.finish()?;
     Ok(())

@@ -76,6 +76,19 @@ pub fn core(positions: &[[f64; 3]], velocities: &[[f64; 3]], radius: f64) -> Cor
     }
 }
 
+/// The radius of a uniform ball of centres estimated from them: `sqrt(5/3)` times their
+/// root-mean-square distance from their mean (a uniform ball's `<r^2>` is `3 R^2 / 5`),
+/// which, unlike the largest distance, does not hang on one sphere or on the mean's
+/// offset from the ball's centre.
+pub fn ball_radius(positions: &[[f64; 3]]) -> f64 {
+    let (m, n) = mean_of(positions, |_| true);
+    let sum: f64 = positions
+        .iter()
+        .map(|p| (0..3).map(|j| (p[j] - m[j]).powi(2)).sum::<f64>())
+        .sum();
+    (5.0 / 3.0 * sum / n.max(1) as f64).sqrt()
+}
+
 /// Number density and mean velocity on a grid in `(r, z)` about the core's vertical
 /// axis: `r` the distance from the axis, `z` the height above the core's centre.
 #[derive(Debug, Clone, PartialEq)]

@@ -3,7 +3,7 @@
 //! hole on the axis), a solid torus (no sphere within `R_t - a_t` of the axis), a ball
 //! with a tail of known size above it, and a rigid motion plus a known radial flow.
 
-use hydrorattle_study::cloud::{axis_map, axis_ratio, axis_slice, core};
+use hydrorattle_study::cloud::{axis_map, axis_ratio, axis_slice, ball_radius, core};
 
 /// A small deterministic generator (xorshift64*), uniform in `[0, 1)`.
 struct Rng(u64);
@@ -75,6 +75,8 @@ fn a_uniform_ball_has_flat_density_and_no_hole() {
         .filter(|p| (p[0] - c[0]).hypot(p[1] - c[1]) < 6.0 && (p[2] - c[2]).abs() < 6.0)
         .count();
     assert_eq!(map.count.iter().sum::<usize>(), inside);
+    // sqrt(5/3 <r^2>): <r^2> scatters by sqrt(3/7 - 9/25) R^2 / sqrt(N), 0.1 % here.
+    assert!((ball_radius(&pts) / r - 1.0).abs() < 0.003);
     let ratio = axis_ratio(&pts, &core, 2.0, 4.0, 8.0).unwrap();
     assert!(ratio > 0.85, "ball's axis ratio {ratio}");
 }
