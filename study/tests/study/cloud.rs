@@ -55,12 +55,8 @@ fn a_uniform_ball_has_flat_density_and_no_hole() {
     let pts = ball(&mut Rng(7), n, r, c);
     let core = core(&pts, &[], r);
     assert_eq!((core.count, core.tail, core.ahead), (n, 0, 0));
-    for j in 0..3 {
-        assert!(
-            (core.centre[j] - c[j]).abs() < 0.05,
-            "centre {:?}",
-            core.centre
-        );
+    for (got, want) in core.centre.iter().zip(c) {
+        assert!((got - want).abs() < 0.05, "centre {:?}", core.centre);
     }
     // Cells well inside the ball (r <= 6, |z| <= 6) hold the ball's density.
     let map = axis_map(&pts, &[], &core, (6.0, 6.0), (3, 3));
@@ -137,12 +133,8 @@ fn velocities_are_taken_in_the_cores_frame() {
         })
         .collect();
     let core = core(&pts, &vel, r);
-    for j in 0..3 {
-        assert!(
-            (core.velocity[j] - fall[j]).abs() < 1e-9,
-            "{:?}",
-            core.velocity
-        );
+    for (got, want) in core.velocity.iter().zip(fall) {
+        assert!((got - want).abs() < 1e-9, "{:?}", core.velocity);
     }
     let map = axis_map(&pts, &vel, &core, (6.0, 6.0), (3, 3));
     for iz in 0..3 {
