@@ -4,6 +4,7 @@
 //! * [`figure1`]: the paper's Figure 1 (three helices settling), its claims and pictures;
 //! * [`mod@reference`]: the Figure 1 runs against a small-dt reference (agreement horizons);
 //! * [`phase`]: the outcome map over the bond gap and head ratio, and the sensitivity table;
+//! * [`cloud`]: a falling cloud's core, tail and density about its axis (the torus);
 //! * [`claims`]: the paper's claims judged on a run's observables;
 //! * [`charts`]: accuracy and speed charts of the integrators and solvers;
 //! * [`render`]: sphere pictures (side and top views, the Figure 1 layout, snapshots,
@@ -14,6 +15,7 @@
 
 pub mod charts;
 pub mod claims;
+pub mod cloud;
 pub mod collect;
 pub mod figure1;
 pub mod fonts;

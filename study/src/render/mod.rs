@@ -10,12 +10,14 @@
 //! last particle green. A scene's wall is a dark line on a grey band in side views.
 //!
 //! * [`panel`]: projections and one sphere panel, a configuration's picture;
+//! * [`cloud`]: a falling cloud's slice through its axis and its density about it;
 //! * [`figure1`]: the Figure 1 layout (own or common scale) and snapshot grids;
 //! * [`charts`]: the line chart; [`map`]: the category map;
 //! * [`timeline`]: state against time; [`animation`]: GIF animations.
 
 pub mod animation;
 pub mod charts;
+pub mod cloud;
 pub mod figure1;
 pub mod map;
 pub mod panel;
@@ -23,6 +25,7 @@ pub mod timeline;
 
 pub use animation::*;
 pub use charts::*;
+pub use cloud::*;
 pub use figure1::*;
 pub use map::*;
 pub use panel::*;

@@ -3,4 +3,5 @@
 //! A new test file `tests/study/NAME.rs` is added by one line below, `mod NAME;`.
 
 mod claims;
+mod cloud;
 mod render;
