@@ -20,6 +20,7 @@ mod krylov;
 mod metric;
 mod newton;
 mod onesided;
+pub mod reuse;
 mod sweep;
 
 pub use krylov::{BAND, krylov};
@@ -241,6 +242,8 @@ pub struct SolveStats<T> {
     pub iterations: u32,
     /// Largest normalised residual left.
     pub residual: T,
+    /// Dense factorisations of the Jacobian (Newton; 0 for the sweep and Krylov).
+    pub factorizations: u32,
 }
 
 /// Solver scratch, each part sized by [`Layout`](crate::workspace::Layout) for the
@@ -265,8 +268,8 @@ pub struct Scratch<'a, T: Real> {
 pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) -> [usize; 3] {
     match kind.resolve(bonds) {
         SolverKind::Newton => [
-            bonds * bonds + bonds,
-            0,
+            bonds * bonds + newton_scalars(bonds),
+            newton_vectors(n),
             index_scratch(SolverKind::Newton, bonds),
         ],
         SolverKind::Krylov => [
@@ -275,6 +278,24 @@ pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) ->
             index_scratch(SolverKind::Krylov, bonds),
         ],
         _ => [0, 0, 0],
+    }
+}
+
+/// Newton's right-hand side, and with contacts compiled in the conjugate gradients'
+/// vectors of a changed active set (`reuse.rs`), for `bonds` rows.
+pub(crate) const fn newton_scalars(bonds: usize) -> usize {
+    match cfg!(feature = "contacts") {
+        true => bonds * (1 + reuse::SCALARS_PER_ROW),
+        false => bonds,
+    }
+}
+
+/// Newton's bead-space scratch for `n` beads: the moves of the conjugate gradients'
+/// products with contacts compiled in (`reuse.rs`), none without.
+pub(crate) const fn newton_vectors(n: usize) -> usize {
+    match cfg!(feature = "contacts") {
+        true => n,
+        false => 0,
     }
 }
 

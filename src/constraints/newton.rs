@@ -1,7 +1,7 @@
 //! Newton on the dense `bonds x bonds` Jacobian, solved by LU: quadratic convergence,
 //! `O(B^3)` per factorisation. The choice for small bond counts.
 
-use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided, worst};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided, reuse, worst};
 use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::linalg;
@@ -50,7 +50,8 @@ pub fn newton<T: Real>(
     let (piv, state) = scratch.piv.split_at_mut(nb);
     #[cfg(not(feature = "contacts"))]
     let (piv, state): (_, &mut [usize]) = (&mut scratch.piv[..nb], &mut []);
-    let (jac, rhs) = (&mut scratch.jac[..nb * nb], &mut scratch.rhs[..nb]);
+    let (jac, (rhs, work)) = (&mut scratch.jac[..nb * nb], scratch.rhs.split_at_mut(nb));
+    let beads = &mut scratch.beads[..];
     let one_sided = from < nb;
     if one_sided {
         onesided::reset(&mut state[..nb]);
@@ -66,6 +67,16 @@ pub fn newton<T: Real>(
     let mut stay = false;
     // `rhs` holds the update applied by the last iteration (none before the first).
     let mut applied = false;
+    // `jac` holds the chord's factor of the current active set: the chord matrix does
+    // not depend on the iterate, so a refresh that the set did not change would
+    // recompute it bit for bit and keeps it instead.
+    let mut fresh = false;
+    // `jac` holds the chord's factor of some set of this solve: a preconditioner for the
+    // next set's system where it is large (`reuse.rs`).
+    let mut factored = false;
+    // The active-set switches when it was factorised (`onesided::switches`).
+    let mut switches = 0;
+    let mut factorizations = 0;
     for it in 0..=solver.max_iterations {
         let (mut changed, mut pushes) = (false, true);
         // The residual at the iterate on the equations the last update solved (the
@@ -82,6 +93,7 @@ pub fn newton<T: Real>(
             false => trial.unwrap_or_else(|| worst(&problem, bonds, x)),
             true => {
                 changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
+                fresh &= !changed;
                 let (r, p) = onesided::residual(&problem, bonds, from, x, mult, state);
                 pushes = p;
                 r
@@ -94,6 +106,7 @@ pub fn newton<T: Real>(
             return Ok(SolveStats {
                 iterations: it,
                 residual,
+                factorizations,
             });
         }
         if it == solver.max_iterations {
@@ -110,15 +123,27 @@ pub fn newton<T: Real>(
         {
             // Named by the chord's self-stress (an LU factor shows only which columns
             // it skipped): refactorised here, on the way out.
-            let c = problem.chord_factor();
-            for k in 0..nb {
-                let row = &mut jac[k * nb..k * nb + k + 1];
-                metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
+            // (Kept where `jac` already holds it: one-sided rows stay on the chord.)
+            let chord_deficient = match chord && fresh {
+                true => Ok(deficient),
+                false => {
+                    let c = problem.chord_factor();
+                    for k in 0..nb {
+                        let row = &mut jac[k * nb..k * nb + k + 1];
+                        metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
+                    }
+                    if one_sided {
+                        decouple(jac, rhs, nb, (from, state), mult, true);
+                    }
+                    factorizations += 1;
+                    linalg::cholesky_dense(jac, nb, floor)
+                }
+            };
+            fresh = chord && chord_deficient.is_ok();
+            factored |= fresh;
+            if fresh && one_sided {
+                switches = onesided::switches(&state[from..nb]);
             }
-            if one_sided {
-                decouple(jac, rhs, nb, (from, state), mult, true);
-            }
-            let chord_deficient = linalg::cholesky_dense(jac, nb, floor);
             if one_sided && chord_deficient == Ok(0) {
                 // Dependent at the iterate only (a pair turned far within the step):
                 // no self-stress to name; the chord, which has none, goes on alone.
@@ -130,16 +155,26 @@ pub fn newton<T: Real>(
                 // (`onesided.rs`); the set changed: refactorised.
                 let v = dependent::null_vector(jac, nb, rhs);
                 if onesided::let_go(&problem, metric, bonds, from, v, x, state) {
-                    previous = None;
+                    (previous, fresh) = (None, false);
                     continue;
                 }
             }
             return Err(dependent::infeasible(metric, bonds, jac, rhs));
         }
+        // `rebuild`: the matrix is formed and factorised again (a refresh on the chord
+        // whose set is unchanged keeps the factor it would recompute).
         let refresh = previous.is_none() || !fast || changed;
         if refresh && previous.is_some() && !changed && !stay && !one_sided {
             chord = false;
         }
+        let rebuild = refresh && !(chord && fresh);
+        // A changed set on a large chord: conjugate gradients on the factor it has first.
+        // (Where the caller's scratch holds its vectors.)
+        let room = work.len() >= reuse::SCALARS_PER_ROW * nb && beads.len() >= x.len();
+        let reuse = rebuild && chord && one_sided && factored && nb >= reuse::ROWS_MIN && room;
+        // Only a change of a few rows: more cost conjugate gradients more than a
+        // factorisation would.
+        let reuse = reuse && onesided::switches(&state[from..nb]) - switches <= reuse::cap(nb) / 2;
         previous = Some(residual);
         for (k, b) in bonds.iter().enumerate() {
             // Without the magnitude (not read here) off 32-bit Arm; the firmware keeps
@@ -149,7 +184,7 @@ pub fn newton<T: Real>(
                 false => problem.eval_with::<false>(b, k, x),
             };
             rhs[k] = -value;
-            if refresh {
+            if rebuild && !reuse {
                 // The chord's lower triangle, or the whole row at the iterate (one call
                 // site, so that firmware inlines it for its one metric).
                 let (dir, len) = match chord {
@@ -159,24 +194,44 @@ pub fn newton<T: Real>(
                 metric.jacobian_row(bonds, k, dir, 0, &mut jac[k * nb..k * nb + len]);
             }
         }
-        if one_sided {
-            decouple(jac, rhs, nb, (from, state), mult, refresh);
-        }
+        let c = problem.chord_factor();
+        let sets = (from, &state[..nb]);
+        if reuse && reuse::solve(metric, bonds, c, sets, mult, jac, rhs, (work, &mut beads[..x.len()])) {
+            fresh = false;
+        } else {
+            if reuse {
+                for k in 0..nb {
+                    let row = &mut jac[k * nb..k * nb + k + 1];
+                    metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
+                }
+            }
+            if one_sided {
+                decouple(jac, rhs, nb, (from, state), mult, rebuild);
+            }
         let fail = |error| StepError::Linalg {
             stage: problem.stage(),
             error,
         };
-        if chord {
-            if refresh {
-                deficient = linalg::cholesky_dense(jac, nb, floor).map_err(fail)?;
+            if rebuild {
+                factorizations += 1;
             }
-            linalg::cholesky_dense_solve(jac, nb, rhs);
-        } else {
-            if refresh {
-                deficient =
-                    linalg::lu_ranked(jac, nb, piv, floor * max_diagonal(jac, nb)).map_err(fail)?;
+            if chord {
+                if rebuild {
+                    deficient = linalg::cholesky_dense(jac, nb, floor).map_err(fail)?;
+                    (fresh, factored) = (true, true);
+                    if one_sided {
+                        switches = onesided::switches(&state[from..nb]);
+                    }
+                }
+                linalg::cholesky_dense_solve(jac, nb, rhs);
+            } else {
+                (fresh, factored) = (false, false);
+                if rebuild {
+                    deficient = linalg::lu_ranked(jac, nb, piv, floor * max_diagonal(jac, nb))
+                        .map_err(fail)?;
+                }
+                linalg::lu_solve(jac, nb, piv, rhs);
             }
-            linalg::lu_solve(jac, nb, piv, rhs);
         }
         for (m, &r) in mult.iter_mut().zip(rhs.iter()) {
             *m += r;

@@ -90,6 +90,10 @@ pub struct StepReport<T> {
     /// pair or a sphere is inside its cutoff. The first-order step forms it once, at the
     /// start; the predictor-corrector twice; a Brownian step with the midpoint twice.
     pub near_formations: u32,
+    /// Dense factorisations of the constraint Jacobian in the step's position
+    /// projection (its last one where there are two; every contact round): the Newton
+    /// solve's cost count (0 for the sweep and Krylov).
+    pub factorizations: u32,
 }
 
 /// Read-only view of the state at the start of a step.

@@ -334,5 +334,6 @@ pub(super) fn report<T: Real>(
         contact_rounds: 0,
         noise_iterations: 0,
         near_formations: 0,
+        factorizations: stats.factorizations,
     }
 }
