@@ -106,7 +106,10 @@ fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> 
 }
 
 fn main() {
-    let args: Vec<usize> = std::env::args().skip(1).map(|a| a.parse().expect("a count")).collect();
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("a count"))
+        .collect();
     let (steps, window) = match args[..] {
         [s, w] => (s, w.min(s)),
         _ => (150, 50),
@@ -116,7 +119,10 @@ fn main() {
     let mut cost = Vec::new();
     for (fence, side, count) in [(15, 3, 100), (25, 5, 300)] {
         let [s, f, it, rounds, held] = run(fence, side, count, steps, window);
-        let d: Vec<u32> = hydrorattle::constraints::reuse::DBG.iter().map(|a| a.swap(0, std::sync::atomic::Ordering::Relaxed)).collect();
+        let d: Vec<u32> = hydrorattle::constraints::reuse::DBG
+            .iter()
+            .map(|a| a.swap(0, std::sync::atomic::Ordering::Relaxed))
+            .collect();
         println!("DBG tries {} ok {} iters {}", d[0], d[1], d[2]);
         println!(
             "{count} spheres: {:.4} s a step, {f:.1} factorisations, {it:.1} Newton \
@@ -135,6 +141,11 @@ fn main() {
         cost.push(s);
     }
     println!("cost ratio 300 / 100: {:.1}", cost[1] / cost[0]);
-    rows.row("pile newton", "300 / 100", "cost_ratio", &format!("{}", cost[1] / cost[0]));
+    rows.row(
+        "pile newton",
+        "300 / 100",
+        "cost_ratio",
+        &format!("{}", cost[1] / cost[0]),
+    );
     rows.finish().expect("bench/results/pile_cost.csv");
 }

@@ -196,7 +196,18 @@ pub fn newton<T: Real>(
         }
         let c = problem.chord_factor();
         let sets = (from, &state[..nb]);
-        if reuse && reuse::solve(metric, bonds, c, sets, mult, jac, rhs, (work, &mut beads[..x.len()])) {
+        if reuse
+            && reuse::solve(
+                metric,
+                bonds,
+                c,
+                sets,
+                mult,
+                jac,
+                rhs,
+                (work, &mut beads[..x.len()]),
+            )
+        {
             fresh = false;
         } else {
             if reuse {
@@ -208,10 +219,10 @@ pub fn newton<T: Real>(
             if one_sided {
                 decouple(jac, rhs, nb, (from, state), mult, rebuild);
             }
-        let fail = |error| StepError::Linalg {
-            stage: problem.stage(),
-            error,
-        };
+            let fail = |error| StepError::Linalg {
+                stage: problem.stage(),
+                error,
+            };
             if rebuild {
                 factorizations += 1;
             }

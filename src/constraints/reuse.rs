@@ -183,4 +183,5 @@ fn product<T: Real>(
 }
 
 /// TEMP
-pub static DBG: [core::sync::atomic::AtomicU32; 3] = [const { core::sync::atomic::AtomicU32::new(0) }; 3];
+pub static DBG: [core::sync::atomic::AtomicU32; 3] =
+    [const { core::sync::atomic::AtomicU32::new(0) }; 3];

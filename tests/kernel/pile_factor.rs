@@ -1,0 +1,108 @@
+//! The dense Newton solve on a large contact pile factorises its Jacobian about once
+//! per active-set round, not once per Newton iteration: after a change of a few rows
+//! the chord system is solved by conjugate gradients preconditioned with the factor it
+//! has (`docs/CONTACTS.md`, "Large piles"), and the pile still lands with every contact
+//! and wall link held to the tolerance.
+
+use hydrorattle::{
+    Bond, Contacts, Layout, Method, NoForce, Params, Real, SolverKind, State, Wall, step_slices,
+};
+use hydrorattle_heap::Buffers;
+
+type V = <f64 as Real>::V3;
+
+/// 76 spheres: a fence of 12 bonded heavy spheres on the wall around a 4 x 4 x 4 column
+/// of unit spheres, jittered by a fixed pattern (over 128 rows once landed).
+fn pile() -> (Vec<V>, Vec<f64>, Vec<f64>, Vec<Bond<f64>>) {
+    let fence = 12;
+    let ring = 1.501 / (std::f64::consts::PI / fence as f64).sin();
+    let (mut pos, mut radius, mut density) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..fence {
+        let a = std::f64::consts::TAU * i as f64 / fence as f64;
+        pos.push(V::new(ring * a.cos(), ring * a.sin(), 1.5));
+        radius.push(1.5);
+        density.push(10.0);
+    }
+    let jitter = |k: usize, c: usize| 0.1 * (((k * 7919 + c * 104_729) % 1000) as f64 / 1e3 - 0.5);
+    for k in 0..64 {
+        let (l, i, j) = (k / 16, (k / 4) % 4, k % 4);
+        pos.push(V::new(
+            2.3 * i as f64 - 3.45 + jitter(k, 1),
+            2.3 * j as f64 - 3.45 + jitter(k, 2),
+            2.6 + 2.3 * l as f64 + jitter(k, 3),
+        ));
+        radius.push(1.0);
+        density.push(4.5);
+    }
+    let bonds = (0..fence)
+        .map(|i| Bond {
+            i,
+            j: (i + 1) % fence,
+            length: 3.002,
+        })
+        .collect();
+    (pos, radius, density, bonds)
+}
+
+#[test]
+fn a_large_pile_factorises_about_once_a_round() {
+    let (mut pos, radius, density, bonds) = pile();
+    let n = pos.len();
+    let mut p = Params::<f64>::new(0.2);
+    p.method = Method::Overdamped;
+    p.solver.kind = SolverKind::Newton;
+    p.solver.tolerance = 1e-10;
+    p.solver.max_iterations = 500;
+    p.wall = Some(Wall::new(0.0));
+    p.contacts = Some(Contacts::new(7 * n));
+    let mut buf = Buffers::<f64>::new(Layout::for_params(&p, n, bonds.len()));
+    let mut ws = buf.workspace();
+    let (mut vel, mut omega, mut time) = (vec![V::ZERO; n], vec![V::ZERO; n], 0.0);
+    let (mut factorizations, mut rounds, mut iterations, mut rows) = (0, 0, 0, 0);
+    for k in 0..60 {
+        let state = State {
+            pos: &mut pos,
+            vel: &mut vel,
+            omega: &mut omega,
+            radius: &radius,
+            density: &density,
+            time: &mut time,
+            noise: None,
+        };
+        let r = step_slices(state, &bonds, &p, &mut ws, &mut NoForce).expect("step");
+        if k >= 30 {
+            factorizations += r.factorizations;
+            rounds += r.contact_rounds;
+            iterations += r.iterations;
+            rows = rows.max(r.contacts + r.wall_contacts + bonds.len() as u32);
+        }
+        // Every pair apart and every sphere above the wall, to the tolerance's order.
+        for i in 0..n {
+            assert!(
+                pos[i].z >= radius[i] * (1.0 - 1e-9),
+                "step {k}: sphere {i} below the wall"
+            );
+            for j in 0..i {
+                let gap = (pos[i] - pos[j]).length() / (radius[i] + radius[j]);
+                assert!(gap >= 1.0 - 1e-9, "step {k}: {i} and {j} overlap ({gap})");
+            }
+        }
+    }
+    println!(
+        "{factorizations} factorisations, {rounds} rounds, {iterations} last-round iterations, {rows} rows"
+    );
+    assert!(
+        rows >= 128,
+        "the pile holds {rows} rows: too few for the reuse"
+    );
+    // Every round factorises at least once; the Newton iterations of one round alone
+    // (the last) outnumber what is allowed for all of them.
+    assert!(
+        factorizations <= 2 * rounds,
+        "{factorizations} factorisations in {rounds} rounds"
+    );
+    assert!(
+        factorizations < iterations,
+        "{factorizations} factorisations, {iterations} iterations"
+    );
+}
