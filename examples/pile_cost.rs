@@ -119,11 +119,6 @@ fn main() {
     let mut cost = Vec::new();
     for (fence, side, count) in [(15, 3, 100), (25, 5, 300)] {
         let [s, f, it, rounds, held] = run(fence, side, count, steps, window);
-        let d: Vec<u32> = hydrorattle::constraints::reuse::DBG
-            .iter()
-            .map(|a| a.swap(0, std::sync::atomic::Ordering::Relaxed))
-            .collect();
-        println!("DBG tries {} ok {} iters {}", d[0], d[1], d[2]);
         println!(
             "{count} spheres: {:.4} s a step, {f:.1} factorisations, {it:.1} Newton \
              iterations (last round), {rounds:.1} rounds a step, {held} rows held at the end",

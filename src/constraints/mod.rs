@@ -20,7 +20,6 @@ mod krylov;
 mod metric;
 mod newton;
 mod onesided;
-pub mod reuse;
 mod sweep;
 
 pub use krylov::{BAND, krylov};
@@ -268,8 +267,8 @@ pub struct Scratch<'a, T: Real> {
 pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) -> [usize; 3] {
     match kind.resolve(bonds) {
         SolverKind::Newton => [
-            bonds * bonds + newton_scalars(bonds),
-            newton_vectors(n),
+            bonds * bonds + bonds,
+            0,
             index_scratch(SolverKind::Newton, bonds),
         ],
         SolverKind::Krylov => [
@@ -278,24 +277,6 @@ pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) ->
             index_scratch(SolverKind::Krylov, bonds),
         ],
         _ => [0, 0, 0],
-    }
-}
-
-/// Newton's right-hand side, and with contacts compiled in the conjugate gradients'
-/// vectors of a changed active set (`reuse.rs`), for `bonds` rows.
-pub(crate) const fn newton_scalars(bonds: usize) -> usize {
-    match cfg!(feature = "contacts") {
-        true => bonds * (1 + reuse::SCALARS_PER_ROW),
-        false => bonds,
-    }
-}
-
-/// Newton's bead-space scratch for `n` beads: the moves of the conjugate gradients'
-/// products with contacts compiled in (`reuse.rs`), none without.
-pub(crate) const fn newton_vectors(n: usize) -> usize {
-    match cfg!(feature = "contacts") {
-        true => n,
-        false => 0,
     }
 }
 

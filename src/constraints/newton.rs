@@ -1,7 +1,7 @@
 //! Newton on the dense `bonds x bonds` Jacobian, solved by LU: quadratic convergence,
 //! `O(B^3)` per factorisation. The choice for small bond counts.
 
-use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided, reuse, worst};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided, worst};
 use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::linalg;
@@ -50,8 +50,7 @@ pub fn newton<T: Real>(
     let (piv, state) = scratch.piv.split_at_mut(nb);
     #[cfg(not(feature = "contacts"))]
     let (piv, state): (_, &mut [usize]) = (&mut scratch.piv[..nb], &mut []);
-    let (jac, (rhs, work)) = (&mut scratch.jac[..nb * nb], scratch.rhs.split_at_mut(nb));
-    let beads = &mut scratch.beads[..];
+    let (jac, rhs) = (&mut scratch.jac[..nb * nb], &mut scratch.rhs[..nb]);
     let one_sided = from < nb;
     if one_sided {
         onesided::reset(&mut state[..nb]);
@@ -71,11 +70,6 @@ pub fn newton<T: Real>(
     // not depend on the iterate, so a refresh that the set did not change would
     // recompute it bit for bit and keeps it instead.
     let mut fresh = false;
-    // `jac` holds the chord's factor of some set of this solve: a preconditioner for the
-    // next set's system where it is large (`reuse.rs`).
-    let mut factored = false;
-    // The active-set switches when it was factorised (`onesided::switches`).
-    let mut switches = 0;
     let mut factorizations = 0;
     for it in 0..=solver.max_iterations {
         let (mut changed, mut pushes) = (false, true);
@@ -140,10 +134,6 @@ pub fn newton<T: Real>(
                 }
             };
             fresh = chord && chord_deficient.is_ok();
-            factored |= fresh;
-            if fresh && one_sided {
-                switches = onesided::switches(&state[from..nb]);
-            }
             if one_sided && chord_deficient == Ok(0) {
                 // Dependent at the iterate only (a pair turned far within the step):
                 // no self-stress to name; the chord, which has none, goes on alone.
@@ -168,13 +158,6 @@ pub fn newton<T: Real>(
             chord = false;
         }
         let rebuild = refresh && !(chord && fresh);
-        // A changed set on a large chord: conjugate gradients on the factor it has first.
-        // (Where the caller's scratch holds its vectors.)
-        let room = work.len() >= reuse::SCALARS_PER_ROW * nb && beads.len() >= x.len();
-        let reuse = rebuild && chord && one_sided && factored && nb >= reuse::ROWS_MIN && room;
-        // Only a change of a few rows: more cost conjugate gradients more than a
-        // factorisation would.
-        let reuse = reuse && onesided::switches(&state[from..nb]) - switches <= reuse::cap(nb) / 2;
         previous = Some(residual);
         for (k, b) in bonds.iter().enumerate() {
             // Without the magnitude (not read here) off 32-bit Arm; the firmware keeps
@@ -184,7 +167,7 @@ pub fn newton<T: Real>(
                 false => problem.eval_with::<false>(b, k, x),
             };
             rhs[k] = -value;
-            if rebuild && !reuse {
+            if rebuild {
                 // The chord's lower triangle, or the whole row at the iterate (one call
                 // site, so that firmware inlines it for its one metric).
                 let (dir, len) = match chord {
@@ -194,55 +177,29 @@ pub fn newton<T: Real>(
                 metric.jacobian_row(bonds, k, dir, 0, &mut jac[k * nb..k * nb + len]);
             }
         }
-        let c = problem.chord_factor();
-        let sets = (from, &state[..nb]);
-        if reuse
-            && reuse::solve(
-                metric,
-                bonds,
-                c,
-                sets,
-                mult,
-                jac,
-                rhs,
-                (work, &mut beads[..x.len()]),
-            )
-        {
-            fresh = false;
-        } else {
-            if reuse {
-                for k in 0..nb {
-                    let row = &mut jac[k * nb..k * nb + k + 1];
-                    metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
-                }
-            }
-            if one_sided {
-                decouple(jac, rhs, nb, (from, state), mult, rebuild);
-            }
-            let fail = |error| StepError::Linalg {
-                stage: problem.stage(),
-                error,
-            };
+        if one_sided {
+            decouple(jac, rhs, nb, (from, state), mult, rebuild);
+        }
+        let fail = |error| StepError::Linalg {
+            stage: problem.stage(),
+            error,
+        };
+        if rebuild {
+            factorizations += 1;
+        }
+        if chord {
             if rebuild {
-                factorizations += 1;
+                deficient = linalg::cholesky_dense(jac, nb, floor).map_err(fail)?;
+                fresh = true;
             }
-            if chord {
-                if rebuild {
-                    deficient = linalg::cholesky_dense(jac, nb, floor).map_err(fail)?;
-                    (fresh, factored) = (true, true);
-                    if one_sided {
-                        switches = onesided::switches(&state[from..nb]);
-                    }
-                }
-                linalg::cholesky_dense_solve(jac, nb, rhs);
-            } else {
-                (fresh, factored) = (false, false);
-                if rebuild {
-                    deficient = linalg::lu_ranked(jac, nb, piv, floor * max_diagonal(jac, nb))
-                        .map_err(fail)?;
-                }
-                linalg::lu_solve(jac, nb, piv, rhs);
+            linalg::cholesky_dense_solve(jac, nb, rhs);
+        } else {
+            fresh = false;
+            if rebuild {
+                deficient =
+                    linalg::lu_ranked(jac, nb, piv, floor * max_diagonal(jac, nb)).map_err(fail)?;
             }
+            linalg::lu_solve(jac, nb, piv, rhs);
         }
         for (m, &r) in mult.iter_mut().zip(rhs.iter()) {
             *m += r;

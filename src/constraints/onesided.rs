@@ -67,12 +67,6 @@ pub(super) fn diagonal<T: Real>(metric: &Metric<'_, T>, bonds: &[Bond<T>], c: T,
 }
 
 /// The start of a solve: every one-sided row inactive, no switch counted.
-/// The switches (on or off) of the rows' states since the solve began: a bound on the
-/// rows whose state differs from an earlier one's, by difference.
-pub(super) fn switches(state: &[usize]) -> usize {
-    state.iter().map(|&s| s >> SHIFT).sum()
-}
-
 pub(super) fn reset(state: &mut [usize]) {
     state.fill(0);
 }

@@ -4,9 +4,7 @@
 use super::{Layout, Workspace};
 use crate::bonds::Bond;
 use crate::constraints::Scratch;
-use crate::constraints::{
-    SolverKind, index_scratch, krylov_scratch_per_bond, newton_scalars, newton_vectors,
-};
+use crate::constraints::{SolverKind, index_scratch, krylov_scratch_per_bond};
 use crate::error::StepError;
 use crate::linalg::{MobMut, tri};
 use crate::noise::lanczos::{scalars as lanczos_scalars, vectors as lanczos_vectors};
@@ -186,7 +184,7 @@ impl<T: Real> Workspace<'_, T> {
         let newton = constrained && matches!(kind, SolverKind::Newton);
         let scratch = Scratch {
             jac: sc.take(if newton { nb * nb } else { 0 }),
-            rhs: sc.take(if newton { newton_scalars(nb) } else { 0 }),
+            rhs: sc.take(if newton { nb } else { 0 }),
             piv: ix.take(match (constrained, kind) {
                 (true, SolverKind::Newton | SolverKind::Krylov) => index_scratch(kind, nb),
                 _ => 0,
@@ -196,10 +194,10 @@ impl<T: Real> Workspace<'_, T> {
             } else {
                 0
             }),
-            beads: ve.take(match (constrained && krylov, newton) {
-                (true, _) => 2 * n + 2 * m + band_scratch(m),
-                (false, true) => newton_vectors(n),
-                _ => 0,
+            beads: ve.take(if constrained && krylov {
+                2 * n + 2 * m + band_scratch(m)
+            } else {
+                0
             }),
             par: self.parallel,
         };
