@@ -127,6 +127,7 @@ pub fn krylov<T: Real>(
             return Ok(SolveStats {
                 iterations: products,
                 residual: worst,
+                factorizations: 0,
             });
         }
         // Chord steps stopped by a self-stress that then fail to halve the residual,

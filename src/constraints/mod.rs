@@ -241,6 +241,8 @@ pub struct SolveStats<T> {
     pub iterations: u32,
     /// Largest normalised residual left.
     pub residual: T,
+    /// Dense factorisations of the Jacobian (Newton; 0 for the sweep and Krylov).
+    pub factorizations: u32,
 }
 
 /// Solver scratch, each part sized by [`Layout`](crate::workspace::Layout) for the

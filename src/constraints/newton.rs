@@ -66,6 +66,11 @@ pub fn newton<T: Real>(
     let mut stay = false;
     // `rhs` holds the update applied by the last iteration (none before the first).
     let mut applied = false;
+    // `jac` holds the chord's factor of the current active set: the chord matrix does
+    // not depend on the iterate, so a refresh that the set did not change would
+    // recompute it bit for bit and keeps it instead.
+    let mut fresh = false;
+    let mut factorizations = 0;
     for it in 0..=solver.max_iterations {
         let (mut changed, mut pushes) = (false, true);
         // The residual at the iterate on the equations the last update solved (the
@@ -82,6 +87,7 @@ pub fn newton<T: Real>(
             false => trial.unwrap_or_else(|| worst(&problem, bonds, x)),
             true => {
                 changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
+                fresh &= !changed;
                 let (r, p) = onesided::residual(&problem, bonds, from, x, mult, state);
                 pushes = p;
                 r
@@ -94,6 +100,7 @@ pub fn newton<T: Real>(
             return Ok(SolveStats {
                 iterations: it,
                 residual,
+                factorizations,
             });
         }
         if it == solver.max_iterations {
@@ -110,15 +117,23 @@ pub fn newton<T: Real>(
         {
             // Named by the chord's self-stress (an LU factor shows only which columns
             // it skipped): refactorised here, on the way out.
-            let c = problem.chord_factor();
-            for k in 0..nb {
-                let row = &mut jac[k * nb..k * nb + k + 1];
-                metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
-            }
-            if one_sided {
-                decouple(jac, rhs, nb, (from, state), mult, true);
-            }
-            let chord_deficient = linalg::cholesky_dense(jac, nb, floor);
+            // (Kept where `jac` already holds it: one-sided rows stay on the chord.)
+            let chord_deficient = match chord && fresh {
+                true => Ok(deficient),
+                false => {
+                    let c = problem.chord_factor();
+                    for k in 0..nb {
+                        let row = &mut jac[k * nb..k * nb + k + 1];
+                        metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
+                    }
+                    if one_sided {
+                        decouple(jac, rhs, nb, (from, state), mult, true);
+                    }
+                    factorizations += 1;
+                    linalg::cholesky_dense(jac, nb, floor)
+                }
+            };
+            fresh = chord && chord_deficient.is_ok();
             if one_sided && chord_deficient == Ok(0) {
                 // Dependent at the iterate only (a pair turned far within the step):
                 // no self-stress to name; the chord, which has none, goes on alone.
@@ -130,16 +145,19 @@ pub fn newton<T: Real>(
                 // (`onesided.rs`); the set changed: refactorised.
                 let v = dependent::null_vector(jac, nb, rhs);
                 if onesided::let_go(&problem, metric, bonds, from, v, x, state) {
-                    previous = None;
+                    (previous, fresh) = (None, false);
                     continue;
                 }
             }
             return Err(dependent::infeasible(metric, bonds, jac, rhs));
         }
+        // `rebuild`: the matrix is formed and factorised again (a refresh on the chord
+        // whose set is unchanged keeps the factor it would recompute).
         let refresh = previous.is_none() || !fast || changed;
         if refresh && previous.is_some() && !changed && !stay && !one_sided {
             chord = false;
         }
+        let rebuild = refresh && !(chord && fresh);
         previous = Some(residual);
         for (k, b) in bonds.iter().enumerate() {
             // Without the magnitude (not read here) off 32-bit Arm; the firmware keeps
@@ -149,7 +167,7 @@ pub fn newton<T: Real>(
                 false => problem.eval_with::<false>(b, k, x),
             };
             rhs[k] = -value;
-            if refresh {
+            if rebuild {
                 // The chord's lower triangle, or the whole row at the iterate (one call
                 // site, so that firmware inlines it for its one metric).
                 let (dir, len) = match chord {
@@ -160,19 +178,24 @@ pub fn newton<T: Real>(
             }
         }
         if one_sided {
-            decouple(jac, rhs, nb, (from, state), mult, refresh);
+            decouple(jac, rhs, nb, (from, state), mult, rebuild);
         }
         let fail = |error| StepError::Linalg {
             stage: problem.stage(),
             error,
         };
+        if rebuild {
+            factorizations += 1;
+        }
         if chord {
-            if refresh {
+            if rebuild {
                 deficient = linalg::cholesky_dense(jac, nb, floor).map_err(fail)?;
+                fresh = true;
             }
             linalg::cholesky_dense_solve(jac, nb, rhs);
         } else {
-            if refresh {
+            fresh = false;
+            if rebuild {
                 deficient =
                     linalg::lu_ranked(jac, nb, piv, floor * max_diagonal(jac, nb)).map_err(fail)?;
             }

@@ -100,6 +100,7 @@ pub fn sweep<T: Real>(
             return Ok(SolveStats {
                 iterations: it,
                 residual,
+                factorizations: 0,
             });
         }
         if it == solver.max_iterations {

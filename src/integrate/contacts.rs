@@ -138,6 +138,8 @@ pub(super) fn project_overdamped<'l, T: Real>(
         }
     }
     let mut round = 0;
+    // Factorisations of every round's solve.
+    let mut factorizations = 0;
     loop {
         round += 1;
         let active = match one_sided {
@@ -163,6 +165,11 @@ pub(super) fn project_overdamped<'l, T: Real>(
         // Contacts and wall links are inequalities inside the solve (`docs/CONTACTS.md`).
         let stats = project_positions(p, active, &metric, x, lambda, scratch, nb, start)
             .map_err(|e| too_long(e, active, nb, start, wall, p))?;
+        factorizations += stats.factorizations;
+        let stats = SolveStats {
+            factorizations,
+            ..stats
+        };
         let Some(c) = one_sided else {
             return Ok(Projected {
                 stats,

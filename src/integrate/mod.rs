@@ -103,6 +103,10 @@ pub struct StepReport<T> {
     /// Conjugate-gradient iterations of those products, summed; the far field's
     /// products are these plus two a product.
     pub near_iterations: u32,
+    /// Dense factorisations of the constraint Jacobian in the step's position
+    /// projection (its last one where there are two; every contact round): the Newton
+    /// solve's cost count (0 for the sweep and Krylov).
+    pub factorizations: u32,
 }
 
 /// Read-only view of the state at the start of a step.

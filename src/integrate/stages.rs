@@ -347,5 +347,6 @@ pub(super) fn report<T: Real>(
         near_pairs: 0,
         near_products: 0,
         near_iterations: 0,
+        factorizations: stats.factorizations,
     }
 }

@@ -65,6 +65,8 @@ mod periodic_brownian;
 mod periodic_digest;
 #[cfg(all(feature = "periodic", feature = "contacts"))]
 mod periodic_step;
+#[cfg(all(feature = "contacts", feature = "wall"))]
+mod pile_factor;
 mod pins;
 #[cfg(feature = "pse")]
 mod pse;

@@ -1,0 +1,146 @@
+//! The cost of a step of a settling contact pile with the dense Newton solve, at two
+//! sizes: 100 and 300 unit spheres dropped in a column into a fence of bonded heavy
+//! spheres on the wall (the geometry of `host/scenes/pile.toml`, dt 0.2, tolerance
+//! 1e-10). Each pile runs `STEPS` steps from the drop; the window of the last `WINDOW`
+//! steps (the pile landed, contacts and wall links forming and releasing) is timed.
+//! Prints, per size, the CPU time a step, the Jacobian factorisations a step
+//! (`StepReport::factorizations`), the Newton iterations and active-set rounds a step
+//! and the constraint rows held; records them in `bench/results/pile_cost.csv` where
+//! `HYDRORATTLE_BENCH_MACHINE` names the machine.
+//!
+//! ```text
+//! cargo run --release --example pile_cost [STEPS WINDOW]
+//! ```
+
+use std::time::Instant;
+
+use hydrorattle::{
+    Bond, Contacts, Layout, Method, NoForce, Params, Real, SolverKind, State, Wall, step_slices,
+};
+use hydrorattle_heap::Buffers;
+
+#[path = "shared/cpu.rs"]
+mod cpu;
+#[path = "shared/record.rs"]
+mod record;
+use cpu::cpu;
+
+type V = <f64 as Real>::V3;
+
+/// A fence of `fence` spheres of radius 1.5 (density 10) 0.002 apart, bonded in a ring,
+/// and `count` unit spheres (density 4.5) in a column `side` wide, 2.3 apart, each
+/// centre jittered by a fixed pattern.
+fn pile(fence: usize, side: usize, count: usize) -> (Vec<V>, Vec<f64>, Vec<f64>, Vec<Bond<f64>>) {
+    let ring = 1.501 / (std::f64::consts::PI / fence as f64).sin();
+    let (mut pos, mut radius, mut density) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..fence {
+        let a = std::f64::consts::TAU * i as f64 / fence as f64;
+        pos.push(V::new(ring * a.cos(), ring * a.sin(), 1.5));
+        radius.push(1.5);
+        density.push(10.0);
+    }
+    let jitter = |k: usize, c: usize| 0.1 * (((k * 7919 + c * 104_729) % 1000) as f64 / 1e3 - 0.5);
+    let off = 1.15 * (side as f64 - 1.0);
+    for k in 0..count {
+        let (l, i, j) = (k / (side * side), (k / side) % side, k % side);
+        pos.push(V::new(
+            2.3 * i as f64 - off + jitter(k, 1),
+            2.3 * j as f64 - off + jitter(k, 2),
+            2.6 + 2.3 * l as f64 + jitter(k, 3),
+        ));
+        radius.push(1.0);
+        density.push(4.5);
+    }
+    let bonds = (0..fence)
+        .map(|i| Bond {
+            i,
+            j: (i + 1) % fence,
+            length: 3.002,
+        })
+        .collect();
+    (pos, radius, density, bonds)
+}
+
+/// Per step over the window: CPU seconds, factorisations, Newton iterations, rounds,
+/// rows held (contacts, wall links and bonds) at the end.
+fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> [f64; 5] {
+    let (mut pos, radius, density, bonds) = pile(fence, side, count);
+    let n = pos.len();
+    let mut p = Params::<f64>::new(0.2);
+    p.method = Method::Overdamped;
+    p.solver.kind = SolverKind::Newton;
+    p.solver.tolerance = 1e-10;
+    p.solver.max_iterations = 500;
+    p.wall = Some(Wall::new(0.0));
+    p.contacts = Some(Contacts::new(7 * n));
+    let mut buf = Buffers::<f64>::new(Layout::for_params(&p, n, bonds.len()));
+    let mut ws = buf.workspace();
+    let (mut vel, mut omega, mut time) = (vec![V::ZERO; n], vec![V::ZERO; n], 0.0);
+    let mut sums = [0.0; 5];
+    for k in 0..steps {
+        let timed = k + window >= steps;
+        let (t, c) = (Instant::now(), cpu());
+        let state = State {
+            pos: &mut pos,
+            vel: &mut vel,
+            omega: &mut omega,
+            radius: &radius,
+            density: &density,
+            time: &mut time,
+            noise: None,
+        };
+        let r = step_slices(state, &bonds, &p, &mut ws, &mut NoForce).expect("step");
+        if timed {
+            sums[0] += match (c, cpu()) {
+                (Some(a), Some(b)) => b - a,
+                _ => t.elapsed().as_secs_f64(),
+            };
+            sums[1] += f64::from(r.factorizations);
+            sums[2] += f64::from(r.iterations);
+            sums[3] += f64::from(r.contact_rounds);
+            sums[4] = f64::from(r.contacts + r.wall_contacts) + bonds.len() as f64;
+        }
+    }
+    let w = window as f64;
+    [sums[0] / w, sums[1] / w, sums[2] / w, sums[3] / w, sums[4]]
+}
+
+fn main() {
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("a count"))
+        .collect();
+    let (steps, window) = match args[..] {
+        [s, w] => (s, w.min(s)),
+        _ => (150, 50),
+    };
+    let command = format!("cargo run --release --example pile_cost {steps} {window}");
+    let mut rows = record::Recorder::new(env!("CARGO_MANIFEST_DIR"), "pile_cost", command);
+    let mut cost = Vec::new();
+    for (fence, side, count) in [(15, 3, 100), (25, 5, 300)] {
+        let [s, f, it, rounds, held] = run(fence, side, count, steps, window);
+        println!(
+            "{count} spheres: {:.4} s a step, {f:.1} factorisations, {it:.1} Newton \
+             iterations (last round), {rounds:.1} rounds a step, {held} rows held at the end",
+            s
+        );
+        let case = format!("{count} spheres");
+        for (q, v) in [
+            ("cpu_s_per_step", s),
+            ("factorizations_per_step", f),
+            ("rounds_per_step", rounds),
+            ("rows_held", held),
+        ] {
+            rows.row("pile newton", &case, q, &format!("{v}"));
+        }
+        cost.push(s);
+    }
+    println!("cost ratio 300 / 100: {:.1}", cost[1] / cost[0]);
+    rows.row(
+        "pile newton",
+        "300 / 100",
+        "cost_ratio",
+        &format!("{}", cost[1] / cost[0]),
+    );
+    rows.finish().expect("bench/results/pile_cost.csv");
+}
