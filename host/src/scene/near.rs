@@ -13,9 +13,11 @@
 //! (`hydrodynamics = "rpy"`), in free space, above a `[wall]` or in a periodic box (its
 //! Ewald sums), with methods
 //! `"overdamped"` and `"overdamped2"` (level manual), and thermal noise by Cholesky.
-//! The kernel's first-step check refuses the rest (matrix-free, the box's PSE sums,
-//! Lanczos noise)
-//! at this table. Dense: a few hundred spheres at most.
+//! Dense: a few hundred spheres at most. With `[integrator] matrix_free = true` the
+//! kernel applies the same mobility by its iterative product instead (no dense matrix;
+//! free space or the Ewald box, no bonds, contacts, wall or noise: `docs/NEAR.md`,
+//! "Iterative steps"). The kernel's first-step check refuses the rest (the box's PSE
+//! sums, Lanczos noise) at this table.
 
 use serde::{Deserialize, Serialize};
 use toml::Spanned;
