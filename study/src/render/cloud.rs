@@ -122,7 +122,7 @@ fn draw_map<DB: DrawingBackend>(
     let m = &row.map;
     let peak = m.peak();
     let caption = format!(
-        "density about the axis (peak {:.2e}) and velocity in the cloud's frame",
+        "density about the axis (peak {:.2e}), cloud-frame velocity",
         peak
     );
     let mut ctx = ChartBuilder::on(area)
