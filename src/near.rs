@@ -32,6 +32,8 @@ pub mod table;
 #[rustfmt::skip]
 pub mod tables;
 pub mod wall;
+#[rustfmt::skip]
+pub mod wall_table;
 
 pub use correction::near_correction;
 pub use lubrication::Func;

@@ -6,7 +6,7 @@ use super::lubrication::Func;
 use super::tables::{N_L, N_T, REM, U_MIN, U_STEP, XI_MAX};
 
 /// Node offset and the four cubic Lagrange weights for grid coordinate `g` on `n` nodes.
-fn stencil(g: f64, n: usize) -> (usize, [f64; 4]) {
+pub(super) fn stencil(g: f64, n: usize) -> (usize, [f64; 4]) {
     let i0 = (libm::floor(g) as i64 - 1).clamp(0, n as i64 - 4) as usize;
     let u = g - i0 as f64;
     let w = [

@@ -8,10 +8,13 @@
 //!   image series `sum_{n>=0} (sinh(alpha) / sinh((n + 1) alpha))^3`, `cosh(alpha) = h/a`;
 //! * parallel translation `Y^A_w`, the coupling `Y^B_w = T / (8 pi eta a^2 U)` (equal to
 //!   `F / (6 pi eta a^2 W)` times 3/4, by reciprocity) and rotation parallel to the wall
-//!   `Y^C_w`: Goldman, Cox and Brenner's (1967) near-contact asymptotes for
-//!   `delta <= DELTA_NEAR` and the method of reflections' series in `a / h` (Faxen; Goldman,
-//!   Cox and Brenner 1967) for `delta >= DELTA_FAR`, joined in between by a cubic in
-//!   `ln(delta)` matching both values and slopes (no exact values there: see docs/NEAR.md).
+//!   `Y^C_w`: the exact bispherical solutions (O'Neill 1964; Dean and O'Neill 1963),
+//!   tabulated by `tools/near-gen` at gaps `1e-5 <= delta <= 10^1.7` (about 50) and read
+//!   with cubic Lagrange interpolation in `log10(delta)`; below the table the
+//!   near-contact form `c ln(1/delta) + const` (Goldman, Cox and Brenner 1967, their
+//!   slopes `c`, the constant from the table's first node), above it the method of
+//!   reflections' series in `a / h` (Faxen; Goldman, Cox and Brenner 1967) plus its
+//!   fading error at the last node (see docs/NEAR.md for the accuracy).
 //!
 //! The blocks, with `n` the wall's unit normal into the fluid:
 //! `F = 6 pi eta a (X^A_w n n + Y^A_w (I - n n)) U + B^T W` and
@@ -21,12 +24,10 @@
 
 use super::NearError;
 use super::axial::csch3_sum;
+use super::table::stencil;
+use super::wall_table::{W_N, W_U_MIN, W_U_STEP, WALL};
 use crate::real::Real;
 
-/// Below this gap the parallel functions are Goldman, Cox and Brenner's asymptotes.
-pub const DELTA_NEAR: f64 = 0.05;
-/// From this gap on the parallel functions are the reflection series.
-pub const DELTA_FAR: f64 = 1.0;
 /// Below this gap the perpendicular function is Cox and Brenner's asymptote.
 pub const DELTA_BRENNER: f64 = 1e-3;
 
@@ -87,62 +88,45 @@ pub fn axial(delta: f64) -> f64 {
     csch3_sum(libm::sinh(alpha), alpha, alpha, 0)
 }
 
-/// Goldman, Cox and Brenner's near-contact forms `(Y^A, Y^B, Y^C)` and their slopes in
-/// `ln(delta)`.
-fn parallel_near(delta: f64) -> ([f64; 3], [f64; 3]) {
-    let l = libm::log(1.0 / delta);
-    (
-        [8.0 / 15.0 * l + 0.9588, 0.1 * l - 0.1895, 0.4 * l + 0.3817],
-        [-8.0 / 15.0, -0.1, -0.4],
-    )
-}
+/// Leading coefficients of `ln(1/delta)` near contact `(Y^A, Y^B, Y^C)` (Goldman, Cox
+/// and Brenner 1967; O'Neill and Stewartson 1967).
+const NEAR_SLOPE: [f64; 3] = [8.0 / 15.0, 0.1, 0.4];
 
-/// The reflection series `(Y^A, Y^B, Y^C)` in `k = a / h` and their slopes in `ln(delta)`.
-fn parallel_far(delta: f64) -> ([f64; 3], [f64; 3]) {
+/// The reflection series `(Y^A, Y^B, Y^C)` in `k = a / h`.
+fn parallel_far(delta: f64) -> [f64; 3] {
     let k = 1.0 / (1.0 + delta);
     let (k3, k4) = (k * k * k, k * k * k * k);
     // Mobilities: parallel translation (Faxen), rotation, and the rotation a force gives.
     let mt = 1.0 - 9.0 / 16.0 * k + k3 / 8.0 - 45.0 / 256.0 * k4 - k4 * k / 16.0;
     let mr = 1.0 - 5.0 / 16.0 * k3;
     let mc = 3.0 / 32.0 * k4;
-    // d/dk of each, then d/d ln(delta) = -k (1 - k) d/dk.
-    let dmt = -9.0 / 16.0 + 3.0 * k * k / 8.0 - 45.0 / 64.0 * k3 - 5.0 * k4 / 16.0;
-    let dmr = -15.0 / 16.0 * k * k;
-    let dmc = 3.0 / 8.0 * k3;
     // Invert the 2x2 mobility [[mt, 4/3 mc], [mc, mr]] (reciprocity) in the resistance normalisation.
     let det = mt * mr - 4.0 / 3.0 * mc * mc;
-    let v = [mr / det, mc / det, mt / det];
-    let ddet = dmt * mr + mt * dmr - 8.0 / 3.0 * mc * dmc;
-    let dv = [
-        (dmr * det - mr * ddet) / (det * det),
-        (dmc * det - mc * ddet) / (det * det),
-        (dmt * det - mt * ddet) / (det * det),
-    ];
-    let chain = -k * (1.0 - k);
-    (v, dv.map(|d| d * chain))
+    [mr / det, mc / det, mt / det]
 }
+
+/// `log10` of the table's last gap.
+const U_LAST: f64 = W_U_MIN + (W_N - 1) as f64 * W_U_STEP;
 
 /// The parallel functions `(Y^A, Y^B, Y^C)`, `delta > 0`.
 pub fn parallel(delta: f64) -> [f64; 3] {
-    if delta <= DELTA_NEAR {
-        return parallel_near(delta).0;
+    let u = libm::log10(delta);
+    if u <= W_U_MIN {
+        // Below the table: the logarithm's exact slope, its constant from the first node
+        // (the remainder is O(delta ln delta), below 2e-4 here).
+        let shift = libm::log(1.0 / delta) - W_U_MIN * -core::f64::consts::LN_10;
+        return core::array::from_fn(|f| WALL[f][0] + NEAR_SLOPE[f] * shift);
     }
-    if delta >= DELTA_FAR {
-        return parallel_far(delta).0;
+    if u >= U_LAST {
+        // Beyond the table: the reflection series plus its error at the last node, which
+        // falls off as (a/h)^6, so the two meet.
+        let d_last = libm::pow(10.0, U_LAST);
+        let (far, far_last) = (parallel_far(delta), parallel_far(d_last));
+        let fade = libm::pow((1.0 + d_last) / (1.0 + delta), 6.0);
+        return core::array::from_fn(|f| far[f] + (WALL[f][W_N - 1] - far_last[f]) * fade);
     }
-    let (x0, x1) = (libm::log(DELTA_NEAR), libm::log(DELTA_FAR));
-    let h = x1 - x0;
-    let t = (libm::log(delta) - x0) / h;
-    let (v0, d0) = parallel_near(DELTA_NEAR);
-    let (v1, d1) = parallel_far(DELTA_FAR);
-    let (t2, t3) = (t * t, t * t * t);
-    let (h00, h10, h01, h11) = (
-        2.0 * t3 - 3.0 * t2 + 1.0,
-        t3 - 2.0 * t2 + t,
-        -2.0 * t3 + 3.0 * t2,
-        t3 - t2,
-    );
-    core::array::from_fn(|i| h00 * v0[i] + h10 * h * d0[i] + h01 * v1[i] + h11 * h * d1[i])
+    let (i0, w) = stencil((u - W_U_MIN) / W_U_STEP, W_N);
+    core::array::from_fn(|f| (0..4).map(|b| w[b] * WALL[f][i0 + b]).sum())
 }
 
 /// The wall functions of a sphere of radius `a` with its centre at height `h`.

@@ -93,3 +93,6 @@ fn the_remainder_series_truncation_stays_within_the_documented_bounds() {
         assert!(upto4 < 2e-4 && all < 6e-4);
     }
 }
+
+#[path = "wall/exact.rs"]
+mod wall_exact;
