@@ -42,6 +42,12 @@ fn translation_torque_equals_rotation_force_by_reciprocity() {
         }
     }
     println!("reciprocity: largest difference {abs:.1e}, relative {rel:.1e} where T > 1e-4");
+    // Goldman, Cox and Brenner's gaps, h/a = cosh(alpha), for comparison with their table.
+    for alpha in [3.0f64, 2.0, 1.5, 1.0, 0.5, 0.3, 0.1] {
+        let h = alpha.cosh();
+        let [ya, yb, yc] = parallel_exact(h - 1.0);
+        println!("h/a {h:.4}: Y^A {ya:.6} Y^B {yb:.4e} Y^C {yc:.6}");
+    }
     assert!(abs < 1e-10 && rel < 1e-10, "{abs} {rel}");
 }
 
