@@ -227,10 +227,14 @@ fn advance<T: Real, E: ExternalForce<T>>(
             #[cfg(not(feature = "periodic"))]
             ewald: sums.as_ref(),
         };
-        // The iterative near field (`near_iter.rs`; deterministic: `near::check`).
+        // The iterative near field (`near_iter.rs`; what it serves: `near::check`).
         #[cfg(feature = "near")]
         let iterative = p.near_on() && p.matrix_free;
         match (p.method, thermal, drawn.as_mut()) {
+            #[cfg(feature = "near")]
+            (Method::Overdamped, Some(b), Some(g)) if iterative => {
+                near_iter::overdamped_thermal(p, b, &s, v, ext, g)
+            }
             #[cfg(feature = "near")]
             (Method::Overdamped | Method::Overdamped2, ..) if iterative => {
                 near_iter::overdamped(p, &s, v, ext)
