@@ -85,7 +85,9 @@ pub struct StepReport<T> {
     /// Lanczos iterations of the thermal noise's square root ([`Params::noise_sqrt`]);
     /// 0 without noise or with the Cholesky factor. On the PSE path
     /// ([`Params::pse`]): the near field's Lanczos iterations plus, with bonds and the
-    /// midpoint, the conjugate-gradient iterations of its solve `M^-1 L w`.
+    /// midpoint, the conjugate-gradient iterations of its solve `M^-1 L w`. With the
+    /// iterative near field ([`Params::near`] with [`Params::matrix_free`]): the
+    /// Lanczos iterations of the far field's root `M_far^(-1/2)` (its noise's share).
     pub noise_iterations: u32,
     /// Times the step formed the dense Stokesian dynamics mobility `M_SD`
     /// ([`Params::near`]; 0 without): each is two dense inversions of `6n x 6n` when a
@@ -97,8 +99,10 @@ pub struct StepReport<T> {
     /// ([`Params::near`] with [`Params::matrix_free`]; 0 otherwise).
     pub near_pairs: u32,
     /// Iterative Stokesian dynamics products the step made (one a mobility: the
-    /// first-order step one, the predictor-corrector two; 0 without the iterative near
-    /// field). Each assembles the far field's grand mobility once.
+    /// first-order step one, the predictor-corrector two; a Brownian step three, the
+    /// velocities, the noise's solve and the midpoint's; 0 without the iterative near
+    /// field). Each configuration assembles the far field's grand mobility once (a
+    /// Brownian step two: the start and the midpoint).
     pub near_products: u32,
     /// Conjugate-gradient iterations of those products, summed; the far field's
     /// products are these plus two a product.
@@ -227,10 +231,14 @@ fn advance<T: Real, E: ExternalForce<T>>(
             #[cfg(not(feature = "periodic"))]
             ewald: sums.as_ref(),
         };
-        // The iterative near field (`near_iter.rs`; deterministic: `near::check`).
+        // The iterative near field (`near_iter.rs`; what it serves: `near::check`).
         #[cfg(feature = "near")]
         let iterative = p.near_on() && p.matrix_free;
         match (p.method, thermal, drawn.as_mut()) {
+            #[cfg(feature = "near")]
+            (Method::Overdamped, Some(b), Some(g)) if iterative => {
+                near_iter::overdamped_thermal(p, b, &s, v, ext, g)
+            }
             #[cfg(feature = "near")]
             (Method::Overdamped | Method::Overdamped2, ..) if iterative => {
                 near_iter::overdamped(p, &s, v, ext)

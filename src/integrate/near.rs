@@ -72,7 +72,7 @@ pub(super) fn check<T: Real>(
         return refuse("the near field with a method other than Overdamped or Overdamped2");
     }
     if p.matrix_free {
-        return check_iterative(p, n, bonds, thermal);
+        return check_iterative(p, n, bonds);
     }
     if p.periodic.is_some() && p.pse.is_some() {
         return refuse(
@@ -89,18 +89,8 @@ pub(super) fn check<T: Real>(
 
 /// The iterative near field's refusals ([`Params::matrix_free`], `near_iter.rs`): what
 /// needs `M_SD`'s blocks or a product the iterative path does not have.
-fn check_iterative<T: Real>(
-    p: &Params<T>,
-    n: usize,
-    bonds: usize,
-    thermal: bool,
-) -> Result<(), StepError> {
+fn check_iterative<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Result<(), StepError> {
     let refuse = |what| Err(StepError::Unsupported(what));
-    if thermal {
-        return refuse(
-            "the iterative near field (matrix_free) with thermal noise: its noise is the dense near field's (matrix_free = false)",
-        );
-    }
     if bonds > 0 || p.constraints(n, bonds) > 0 {
         return refuse(
             "the iterative near field (matrix_free) with constraints (bonds, pins, contacts, the wall's links): their solvers read the dense near field's blocks (matrix_free = false)",

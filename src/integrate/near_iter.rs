@@ -8,8 +8,10 @@
 //! one RPY assembly (`docs/NEAR.md`).
 //!
 //! Served: `Overdamped` (one product, at the start) and `Overdamped2` (two, at the
-//! start and at the predicted point), deterministic, without constraints, in free space
-//! or in the periodic box with the Ewald sums; the rest is refused by
+//! start and at the predicted point), and `Overdamped` with thermal noise
+//! (`near_iter/noise.rs`: three products and a Lanczos root of the far field), without
+//! constraints, in free space or in the periodic box with the Ewald sums; the rest is
+//! refused by
 //! [`super::near::check`]. The conjugate gradients stop at the relative residual
 //! [`Solver::tolerance`](crate::Solver::tolerance) within its `max_iterations`
 //! (`Params::solver`, the step's one tolerance for its iterations); not converging is
@@ -24,8 +26,12 @@ use crate::forces::{self, ExternalForce};
 use crate::params::{Method, Params};
 use crate::real::Real;
 use crate::stokesian::SdError;
-use crate::stokesian::iterative::{Solver, Storage, packed_product};
 use crate::workspace::Views;
+
+mod noise;
+mod solve;
+
+pub(super) use noise::overdamped_thermal;
 
 /// The iterative near field's storage ([`Views::near`] and `Views::near_iter`).
 struct Store<'a, T: Real> {
@@ -83,55 +89,16 @@ fn error(e: SdError) -> StepError {
 fn velocities<T: Real>(
     p: &Params<T>,
     ew: Sums<'_, T>,
-    (pos, radius): (&[T::V3], &[T]),
+    spheres: (&[T::V3], &[T]),
     f: &[T::V3],
     u: &mut [T::V3],
     w: Option<&mut [T::V3]>,
     store: &mut Store<'_, T>,
     counts: &mut Counts,
 ) -> Result<(), StepError> {
-    let n = pos.len();
-    let Some(nf) = p.near else {
-        return Err(StepError::Unsupported(
-            "the near field's mobility without Params::near",
-        ));
-    };
-    let far = super::near::far(p, ew)?;
-    let packed = store.packed.get_mut(..tri2(n)).ok_or(STORAGE)?;
-    far.assemble_grand(p.viscosity, pos, radius, packed)
-        .map_err(error)?;
-    let (io, field) = store.vectors.split_at_mut_checked(4 * n).ok_or(STORAGE)?;
-    let (fin, out) = io.split_at_mut(2 * n);
-    fin[..n].copy_from_slice(f);
-    fin[n..].fill(T::v3(T::ZERO, T::ZERO, T::ZERO));
-    let cap = crate::params::NEAR_PAIRS_PER_SPHERE * n;
-    let (pairs, cells) = store.indices.split_at_mut_checked(2 * cap).ok_or(STORAGE)?;
-    let storage = Storage {
-        pairs: pairs.as_chunks_mut::<2>().0,
-        reals: &mut *store.reals,
-        field,
-        cells,
-    };
-    let mut solver = Solver::new(p.viscosity, far, pos, radius, nf, storage).map_err(error)?;
-    let packed = &*packed;
-    let mut product = |x: &[T::V3], y: &mut [T::V3]| {
-        packed_product::<T>(packed, n, x, y);
-        Ok(())
-    };
-    let (tol, cap) = (p.solver.tolerance, p.solver.max_iterations);
-    let r = solver
-        .product(&mut product, fin, out, tol, cap)
-        .map_err(error)?;
-    if counts.products == 0 {
-        counts.pairs = u32::try_from(r.pairs).unwrap_or(u32::MAX);
-    }
-    counts.products += 1;
-    counts.iterations = counts.iterations.saturating_add(r.iterations);
-    u.copy_from_slice(&out[..n]);
-    if let Some(w) = w {
-        w.copy_from_slice(&out[n..]);
-    }
-    Ok(())
+    solve::at(p, ew, spheres, store, |at| {
+        at.velocities(p, f, u, w, counts)
+    })
 }
 
 const STORAGE: StepError = StepError::Unsupported("the iterative near field without its storage");

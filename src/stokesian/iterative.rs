@@ -31,6 +31,7 @@
 //! run. Not converging within the iterations given is [`SdError::NotConverged`]. The
 //! wall's sphere corrections are not in this path (free space and the box only).
 
+mod noise;
 mod pairs;
 
 use super::{Far, NearField, SdError, pair_correction};

@@ -67,6 +67,20 @@ pub(crate) const fn near_iterative_sizes(n: usize) -> [usize; 4] {
     ]
 }
 
+/// The iterative near field's Brownian storage (`integrate::near_iter::noise`; none
+/// without [`Params::brownian`]): `[vectors, scalars]`. The far field's Lanczos basis
+/// over the `2n` forces and torques (`(cap + 1) 2n` vectors) and its scalars, the
+/// deviates, the root, the noise's forces and torques and its velocities and spins
+/// (`2n` each), and the midpoint (`n`). `O(n)`: no stored mobility beyond the far
+/// field's packed blocks the products already hold.
+pub(crate) const fn near_noise_sizes<T: Real>(p: &Params<T>, n: usize) -> [usize; 2] {
+    if p.brownian.is_none() {
+        return [0, 0];
+    }
+    let cap = p.lanczos.max_iterations as usize;
+    [lanczos::vectors(cap, 2 * n) + 9 * n, lanczos::scalars(cap)]
+}
+
 /// Whether the near field keeps the start's rotation-translation blocks
 /// ([`near_scalars`]).
 pub(crate) const fn near_kept<T: Real>(p: &Params<T>) -> bool {
@@ -191,7 +205,8 @@ impl Layout {
         if p.contacts.is_some() || p.place().wall().is_some() {
             l.links = c;
         }
-        let l = if p.brownian.is_some() {
+        // (The iterative near field's noise has storage of its own: `near_noise_sizes`.)
+        let l = if p.brownian.is_some() && !near_iterative(p) {
             l.thermal(p.method, n, c).noise_sqrt(p, n)
         } else {
             l
@@ -216,10 +231,11 @@ impl Layout {
         // mobility formed from them (`stokesian::storage`).
         let l = if near_iterative(p) {
             let [blocks, vectors, scalars, indices] = near_iterative_sizes(n);
+            let [noise_vectors, noise_scalars] = near_noise_sizes(p, n);
             Self {
                 blocks: l.blocks + blocks,
-                vectors: l.vectors + vectors,
-                scalars: l.scalars + scalars,
+                vectors: l.vectors + vectors + noise_vectors,
+                scalars: l.scalars + scalars + noise_scalars,
                 indices: l.indices + indices,
                 ..l
             }

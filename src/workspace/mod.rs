@@ -21,6 +21,8 @@ mod layout;
 mod views;
 
 pub use crate::error::Layout;
+#[cfg(feature = "near")]
+pub(crate) use layout::near_noise_sizes;
 pub(crate) use layout::{block_rows, symmetric};
 pub(crate) use views::{Links, Views};
 

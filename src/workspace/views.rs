@@ -135,7 +135,9 @@ impl<T: Real> Workspace<'_, T> {
         let table = if krylov || !stored { 0 } else { n * nb };
         // Thermal noise (`Layout::thermal`): the factor, one vector array, the midpoint's
         // bond vectors and multipliers.
-        let thermal = p.brownian.is_some();
+        // (The iterative near field's noise has storage of its own, in `near_iter`.)
+        let iterative = super::layout::near_iterative(p);
+        let thermal = p.brownian.is_some() && !iterative;
         let lanczos =
             thermal && matches!(method, Method::Overdamped | Method::Springs) && p.lanczos_noise(n);
         let uncorrected =
@@ -211,11 +213,11 @@ impl<T: Real> Workspace<'_, T> {
         let cap = p.lanczos.max_iterations as usize;
         let basis = ve.take(if lanczos { lanczos_vectors(cap, n) } else { 0 });
         let krylov_t = sc.take(if lanczos { lanczos_scalars(cap) } else { 0 });
-        let iterative = super::layout::near_iterative(p);
+        let [noise_v, noise_s] = super::layout::near_noise_sizes(p, n);
         let near = match p.near_on() {
             true if iterative => {
                 let [b, _, s, _] = super::layout::near_iterative_sizes(n);
-                (bl.take(b), sc.take(s))
+                (bl.take(b), sc.take(s + noise_s))
             }
             true => (
                 bl.take(super::layout::near_blocks(n)),
@@ -226,7 +228,7 @@ impl<T: Real> Workspace<'_, T> {
         let near_iter = match iterative {
             true => {
                 let [_, v, _, i] = super::layout::near_iterative_sizes(n);
-                (ve.take(v), ix.take(i))
+                (ve.take(v + noise_v), ix.take(i))
             }
             false => (ve.take(0), ix.take(0)),
         };

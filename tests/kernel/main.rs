@@ -54,6 +54,7 @@ mod near_box;
 mod near_brownian;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod near_iter;
+mod near_iter_brownian;
 #[cfg(feature = "near")]
 mod near_step;
 mod observables;

@@ -16,8 +16,8 @@ use std::f64::consts::PI;
 use common::*;
 use hydrorattle::stokesian::NearField;
 use hydrorattle::{
-    Bond, BondSet, Brownian, Contacts, Method, NoForce, Noise, ParticleSet, Periodic, Real,
-    SolverKind, Stage, StepError, StepReport, Wall, step,
+    Bond, BondSet, Contacts, Method, NoForce, Noise, ParticleSet, Periodic, Real, SolverKind,
+    Stage, StepError, StepReport, Wall, step,
 };
 use hydrorattle_heap::Buffers;
 
@@ -48,7 +48,7 @@ fn one_step<T: Real>(
     bonds: &[Bond<T>],
 ) -> Result<(StepReport<T>, Out), StepError> {
     let mut ps: ParticleSet<T, 128> = particles(spheres);
-    // A generator, so that a thermal step is refused by the near field, not for lack of it.
+    // A generator, as a thermal step would need.
     ps.noise = Some(Noise::new(1));
     let mut set: BondSet<T, 128> = BondSet::new();
     for &b in bonds {
@@ -227,9 +227,10 @@ fn same_bits<T: Real>() {
     assert_eq!(run(), run());
 }
 
-/// Refused, typed, the state unchanged: what the iterative path does not serve (noise,
-/// bonds, contacts, the wall's hydrodynamics, PSE), the conjugate gradients stopped
-/// before they converge, and more close pairs than the storage holds.
+/// Refused, typed, the state unchanged: what the iterative path does not serve (bonds,
+/// contacts, the wall's hydrodynamics, PSE), the conjugate gradients stopped before
+/// they converge, and more close pairs than the storage holds (its Brownian steps:
+/// `near_iter_brownian.rs`).
 fn refusals<T: Real>() {
     let spheres = cluster(20, 21, None, [0.0; 3]);
     let base = near::<T>(Method::Overdamped, true, None);
@@ -239,9 +240,6 @@ fn refusals<T: Real>() {
         Err(StepError::Unsupported(m)) => assert!(m.contains(what), "{m}"),
         other => panic!("{what}: {other:?}"),
     };
-    let mut p = base;
-    p.brownian = Some(Brownian::new(T::from_f64(1e-3)));
-    unsupported(&p, &[], "thermal noise");
     let bond = Bond {
         i: 0,
         j: 1,

@@ -8,7 +8,7 @@ use crate::real::Real;
 
 /// The `V3` slot (in the grand layout) of entry `b` (0..4) of pair `(i, j)`.
 #[inline(always)]
-fn slot(n: usize, [i, j]: [usize; 2], b: usize) -> usize {
+pub(super) fn slot(n: usize, [i, j]: [usize; 2], b: usize) -> usize {
     [i, j, n + i, n + j][b]
 }
 

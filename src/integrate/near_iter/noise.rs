@@ -1,0 +1,113 @@
+//! A Brownian `Overdamped` step with the iterative near field: the noise of covariance
+//! `2 kT dt M_SD` and the drift `kT dt div M_SD`, with no matrix stored beyond the far
+//! field's packed blocks the products already hold.
+//!
+//! **Noise: Fiore and Swan's split**, not a Lanczos root of `M_SD` itself. With
+//! `R = M_far^-1 + R_near` and `R_near = L L^T` (the close pairs' factors the product
+//! has made), `b = M_far^(-1/2) z' + L z` (`z'`, `z` standard normal over the `6n`
+//! forces and torques and the `12` unknowns of each close pair) has covariance `R`, so
+//! `M_SD b` has covariance `M_SD R M_SD = M_SD`, and its translational part `M_SD,tt`.
+//! The far field's `M_far^(-1/2) z'` is a Lanczos root on the packed grand mobility
+//! (products of `O(n^2)`, no solve), the near field's `L z` is exact, and the one solve
+//! is an ordinary product. A Lanczos root of `M_SD` would make each of its iterations a
+//! conjugate-gradient solve, on an operator whose lubrication modes make it badly
+//! conditioned (more iterations): `docs/NEAR.md` has the counts.
+//!
+//! **Drift: the dense near path's Fixman midpoint** (`integrate::brownian`), so the two
+//! paths are one method. With `x = M_SD b` (covariance `M_SD`) and
+//! `E[x b^T] = M_SD R = I`, the midpoint `x~ = r + sqrt(kT dt / 2) x_t` and the move
+//! `sqrt(2 kT dt) (M_SD(x~) b)_t` have covariance `2 kT dt M_SD,tt` and mean
+//! `kT dt div M_SD,tt` to leading order (the derivation of `brownian.rs` with the
+//! non-square factor `M_SD [M_far^(-1/2), L]` and `b` in place of `L^-T xi`).
+//! [`Drift::Uncorrected`] moves by `sqrt(2 kT dt) x_t` alone.
+//!
+//! **Cost**: two assemblies of the far field (start, midpoint), three products (the
+//! velocities and the noise's solve share the start's factors), and the far field's
+//! Lanczos iterations ([`StepReport::noise_iterations`]). The Lanczos root stops at
+//! [`Params::lanczos`]'s tolerance within its iterations; not converging is
+//! [`StepError::NoConvergence`], the caller's state unchanged.
+
+use super::{Counts, STORAGE, Store, report, solve, spins};
+use crate::error::StepError;
+use crate::forces::{self, ExternalForce};
+use crate::integrate::{Start, StepReport, add_flow, step_velocity};
+use crate::noise::{Noise, lanczos};
+use crate::params::{Brownian, Drift, Params};
+use crate::real::Real;
+use crate::workspace::{Views, near_noise_sizes};
+
+/// `s` split into its head and its last `k` elements.
+fn tail<X>(s: &mut [X], k: usize) -> Result<(&mut [X], &mut [X]), StepError> {
+    let at = s.len().checked_sub(k).ok_or(STORAGE)?;
+    Ok(s.split_at_mut(at))
+}
+
+/// One `Overdamped` step at `b.temperature > 0` with the iterative near field (see the
+/// module): `r' = r + dt (U_inf + M_SD,tt F) + dx`, the spins `Omega_inf + M_SD,rt F`
+/// at the start, as the deterministic step.
+pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
+    p: &Params<T>,
+    b: Brownian<T>,
+    s: &Start<'_, T>,
+    v: Views<'_, T>,
+    ext: &mut E,
+    noise: &mut Noise,
+) -> Result<StepReport<T>, StepError> {
+    let (n, dt, kt) = (s.pos.len(), p.dt, b.temperature);
+    let Views {
+        force,
+        work_a: u,
+        new_pos,
+        new_vel,
+        new_omega,
+        near,
+        near_iter,
+        ..
+    } = v;
+    let [noise_v, noise_s] = near_noise_sizes(p, n);
+    let (reals, work) = tail(near.1, noise_s)?;
+    let (vectors, rest) = tail(near_iter.0, noise_v)?;
+    let mut store = Store::new((near.0, reals), (vectors, near_iter.1));
+    let cap = p.lanczos.max_iterations as usize;
+    let (basis, rest) = rest.split_at_mut(lanczos::vectors(cap, 2 * n));
+    let (z, rest) = rest.split_at_mut(2 * n);
+    let (root, rest) = rest.split_at_mut(2 * n);
+    let (f, rest) = rest.split_at_mut(2 * n);
+    let (x, mid) = rest.split_at_mut(2 * n);
+    let mut counts = Counts::default();
+    forces::external(p, s.pos, s.radius, s.density, ext, force)?;
+    // At the start: the velocities, then b = M_far^(-1/2) z' + L z and x = M_SD b.
+    noise.fill::<T>(z);
+    let start = (s.pos, s.radius);
+    let iterations = solve::at(p, s.ewald, start, &mut store, |at| {
+        at.velocities(p, force, u, Some(&mut *new_omega), &mut counts)?;
+        let product = |v: &[T::V3], w: &mut [T::V3]| at.far(v, w);
+        let root_it = lanczos::sqrt(p.lanczos, product, z, basis, work, root, Some(&mut *f))?;
+        at.add_near_noise(&mut |v| noise.fill::<T>(v), f)?;
+        at.apply(p, f, x, &mut counts)?;
+        Ok(root_it)
+    })?;
+    add_flow(p, s.pos, u);
+    spins(p, new_omega);
+    let amplitude = (T::TWO * kt * dt).sqrt();
+    if b.drift == Drift::Midpoint {
+        // x~ = r + sqrt(kT dt / 2) x_t; then x = M_SD(x~) b.
+        let half = (kt * dt * T::HALF).sqrt();
+        let mid = &mut mid[..n];
+        for ((m, &r), &d) in mid.iter_mut().zip(s.pos).zip(&*x) {
+            *m = r + d * half;
+        }
+        let at_mid = (&*mid, s.radius);
+        solve::at(p, s.ewald, at_mid, &mut store, |at| {
+            at.apply(p, f, x, &mut counts)
+        })?;
+    }
+    for i in 0..n {
+        new_pos[i] = s.pos[i] + u[i] * dt + x[i] * amplitude;
+    }
+    step_velocity(s.pos, new_pos, dt, new_vel);
+    Ok(StepReport {
+        noise_iterations: iterations,
+        ..report(counts)
+    })
+}
