@@ -207,6 +207,43 @@ fn no_variant_is_matched_outside_its_geometry() {
     assert!(matched.is_empty(), "variants matched by hand: {matched:?}");
 }
 
+/// The parameters' geometry fields (`Params::wall`, `Params::periodic`) are read in
+/// `Params::place` alone: every other kernel file asks the place
+/// (`p.place().wall()`, `.cell()`), which each geometry answers in its own module.
+#[test]
+fn the_geometry_fields_are_read_only_through_the_place() {
+    let src = root().join("src");
+    let mut files = Vec::new();
+    sources(&src, &mut files);
+    let mut read = Vec::new();
+    for f in files {
+        let rel = f
+            .strip_prefix(&src)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        if rel == "params.rs" || rel.starts_with("geometry") {
+            continue;
+        }
+        let text = non_test_code(&std::fs::read_to_string(&f).unwrap());
+        for who in ["p", "params"] {
+            for field in ["wall", "periodic"] {
+                let pat = format!("{who}.{field}");
+                let by_hand = text.match_indices(&pat).any(|(i, _)| {
+                    let before = text[..i].chars().next_back();
+                    let after = text[i + pat.len()..].chars().next();
+                    !before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.')
+                        && !after.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == '(')
+                });
+                if by_hand {
+                    read.push(format!("src/{rel}: {pat}"));
+                }
+            }
+        }
+    }
+    assert!(read.is_empty(), "geometry fields read by hand: {read:?}");
+}
+
 /// No file outside a geometry's own names its modules, but those [`STILL_NAMED`]
 /// lists (printed: `cargo test --release -p hydrorattle-host --test host geometries::
 /// -- --nocapture`).
