@@ -81,20 +81,27 @@ const STILL_NAMED: &[(&str, &str)] = &[
     ("workspace/mod.rs", "periodic box"),
 ];
 
-/// `(file, geometry)` for every kernel file outside a geometry's own files that names
-/// one of its modules through `crate::mobility` or `crate::geometry`.
-fn naming() -> BTreeSet<(String, &'static str)> {
+/// Every kernel file: its path under `src/` and its text.
+fn kernel_files() -> Vec<(String, String)> {
     let src = root().join("src");
     let mut files = Vec::new();
     sources(&src, &mut files);
-    let mut found = BTreeSet::new();
-    for f in files {
-        let rel = f
-            .strip_prefix(&src)
+    let rel = |f: &std::path::Path| {
+        f.strip_prefix(&src)
             .unwrap()
             .to_string_lossy()
-            .replace('\\', "/");
-        let text = code(&std::fs::read_to_string(&f).unwrap());
+            .replace('\\', "/")
+    };
+    let text = |f: &std::path::Path| std::fs::read_to_string(f).unwrap();
+    files.iter().map(|f| (rel(f), text(f))).collect()
+}
+
+/// `(file, geometry)` for every kernel file outside a geometry's own files that names
+/// one of its modules through `crate::mobility` or `crate::geometry`.
+fn naming() -> BTreeSet<(String, &'static str)> {
+    let mut found = BTreeSet::new();
+    for (rel, text) in kernel_files() {
+        let text = code(&text);
         let mut names = named_in(&text, "mobility");
         names.extend(named_in(&text, "geometry"));
         for g in GEOMETRIES {
@@ -171,9 +178,6 @@ fn names_exactly(text: &str, pat: &str) -> bool {
 fn no_variant_is_matched_outside_its_geometry() {
     let reg = std::fs::read_to_string(root().join("src/geometry.rs")).unwrap();
     let variants = registered(&reg);
-    let src = root().join("src");
-    let mut files = Vec::new();
-    sources(&src, &mut files);
     let own = |rel: &str| {
         rel.starts_with("geometry/free.rs")
             || GEOMETRIES
@@ -181,16 +185,11 @@ fn no_variant_is_matched_outside_its_geometry() {
                 .any(|g| g.files.iter().any(|o| rel.starts_with(o)))
     };
     let mut matched = Vec::new();
-    for f in files {
-        let rel = f
-            .strip_prefix(&src)
-            .unwrap()
-            .to_string_lossy()
-            .replace('\\', "/");
+    for (rel, text) in kernel_files() {
         if own(&rel) {
             continue;
         }
-        let text = non_test_code(&std::fs::read_to_string(&f).unwrap());
+        let text = non_test_code(&text);
         let implements = ["Place<", "Hydrodynamics<"]
             .iter()
             .any(|t| text.lines().any(|l| l.starts_with("impl") && l.contains(t)));
@@ -212,20 +211,12 @@ fn no_variant_is_matched_outside_its_geometry() {
 /// (`p.place().wall()`, `.cell()`), which each geometry answers in its own module.
 #[test]
 fn the_geometry_fields_are_read_only_through_the_place() {
-    let src = root().join("src");
-    let mut files = Vec::new();
-    sources(&src, &mut files);
     let mut read = Vec::new();
-    for f in files {
-        let rel = f
-            .strip_prefix(&src)
-            .unwrap()
-            .to_string_lossy()
-            .replace('\\', "/");
+    for (rel, text) in kernel_files() {
         if rel == "params.rs" || rel.starts_with("geometry") {
             continue;
         }
-        let text = non_test_code(&std::fs::read_to_string(&f).unwrap());
+        let text = non_test_code(&text);
         for who in ["p", "params"] {
             for field in ["wall", "periodic"] {
                 let pat = format!("{who}.{field}");
