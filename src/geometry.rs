@@ -12,39 +12,38 @@
 //! geometry parameter: a type parameter would change that signature for every caller
 //! and need a dispatch from the parameters to one monomorphised step per geometry in
 //! every host (each step compiled four times). Firmware drops what it does not use by
-//! the kernel's features (`wall`, `periodic`, `pse`: a variant, its registration line
-//! and its module compile away with its feature), as before.
+//! the kernel's features (`wall`, `periodic`, `pse`: a variant of [`Hydrodynamics`]
+//! and its module's `step` compile away with its feature), as before.
 //!
 //! **What a geometry gives.** Its blocks, not its loops: a source of blocks for the
 //! band loops written once in `parallel/source.rs` (`Blocks`: what a row needs of a
 //! sphere, the self block, the pair block; the assembly in bands, the matrix-free
 //! banded and serial products and the block at `(p, q)` read them) and, with
 //! rotation, for the grand mobility and the spins of `mobility/grand.rs` (`Grand`);
-//! then, in its own module here ([`free`], `wall`, `periodic`), which of those loops
+//! then, in its own module here ([`free`], [`wall`], [`periodic`]), which of those loops
 //! each operation runs and what it refuses: [`Geometry`], for a small struct of what
-//! its blocks are evaluated with. [`Hydrodynamics`] holds one of them; its variants,
+//! its blocks are evaluated with (`step`, with the geometry's feature), and what its
+//! parameters name, for a type of [`Place`]'s (always compiled: the checks refuse a
+//! geometry the kernel was built without). [`Hydrodynamics`] holds one of them; its variants,
 //! its choice ([`Hydrodynamics::at`]) and the forwarding of every operation are written
-//! by the one registration `geometries!` below, a line per geometry.
-//! What its parameters name is asked through [`Place`] ([`Params::place`](crate::Params::place)):
+//! by the one registration `geometries!` below, a line per geometry, and so are
+//! [`Place`]'s variants, its choice ([`Place::new`]) and its forwarding. What the
+//! parameters name is asked through [`Place`] ([`Params::place`](crate::Params::place)):
 //! the checks, the workspace's sizes, the noise and the minimum images never read
 //! the parameters' geometry fields by hand.
 //!
 //! **Adding a geometry** (a slit between two walls, say; `docs/GEOMETRY.md`): its
-//! blocks in a module under `mobility/` (`Blocks`, `Grand`), its [`Geometry`] in a
-//! module here, one line of `geometries!`, a variant of [`Place`] with the parameter
-//! that names it, its input checks (a file under `integrate/checks/`, one call in
+//! blocks in a module under `mobility/` (`Blocks`, `Grand`), its [`Geometry`] and its
+//! answers to [`Place`]'s questions in a module here, one line of `geometries!`, the
+//! parameter that names it (a field of [`Named`], read in `Params::place`), its input
+//! checks (a file under `integrate/checks/`, one call in
 //! `check_all`), its feature, and its tests.
 
 pub mod free;
-#[cfg(feature = "periodic")]
 pub mod periodic;
-mod place;
 #[cfg(feature = "periodic")]
 pub mod sums;
-#[cfg(feature = "wall")]
 pub mod wall;
-
-pub use place::Place;
 
 use core::marker::PhantomData;
 
@@ -159,17 +158,56 @@ pub trait Geometry<T: Real>: Copy {
     }
 }
 
-/// Writes the registration below into [`Hydrodynamics`] (a variant a geometry, with
-/// its feature), [`Hydrodynamics::at`] (the first geometry that claims the place, in
-/// the order listed, free space where none does) and `each!` (a call forwarded to
-/// every variant). `$d` is a `$` handed in, so that the generated `each!` can have
-/// metavariables of its own.
+/// Writes the registration below (`Variant(its step's type, its place's type)`) into
+/// [`Place`] (a variant a geometry, whatever the features), [`Place::new`] (the first
+/// geometry that claims what the parameters name, in the order listed, free space
+/// where none does), `each_place!` (a question forwarded to every place),
+/// [`Hydrodynamics`] (a variant a geometry, with its feature), [`Hydrodynamics::at`]
+/// (the same choice) and `each!` (a call forwarded to every variant). `$d` is a `$`
+/// handed in, so that the generated macros can have metavariables of their own.
 macro_rules! geometries {
     ($d:tt $(
         $(#[doc = $doc:literal])*
         $(#[cfg($c:meta)])?
-        $V:ident($ty:ty),
-    )* _ => $(#[doc = $fdoc:literal])* $F:ident($fty:ty) $(,)?) => {
+        $V:ident($ty:ty, $P:ty),
+    )* _ => $(#[doc = $fdoc:literal])* $F:ident($fty:ty, $fP:ty) $(,)?) => {
+        /// What a step's parameters name ([`Params::place`](crate::Params::place)),
+        /// before the kernel's features are applied (the checks refuse a geometry the
+        /// kernel was built without, and a box with a wall): one variant a geometry,
+        /// each answering in its own module what the checks, the workspace's sizes, the
+        /// noise and the minimum images ask (`place.rs` forwards).
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub enum Place<T: Real> {
+            $($(#[doc = $doc])* $V($P),)*
+            $(#[doc = $fdoc])*
+            $F($fP),
+        }
+
+        impl<T: Real> Place<T> {
+            /// The place of what the parameters name: the first registered geometry
+            /// that claims it, in the order listed, free space where none does.
+            #[inline(always)]
+            pub const fn new(named: Named<T>) -> Self {
+                $(
+                    if let Some(g) = <$P>::claims(named) {
+                        return Self::$V(g);
+                    }
+                )*
+                Self::$F(<$fP>::new())
+            }
+        }
+
+        /// `$e` with `$g` bound to what the parameters name of the place `$s`,
+        /// whichever geometry it is.
+        macro_rules! each_place {
+            ($d s:expr, $d g:ident => $d e:expr) => {
+                match $d s {
+                    $(Place::$V($d g) => $d e,)*
+                    Place::$F($d g) => $d e,
+                }
+            };
+        }
+
         /// The hydrodynamics of the geometry a step runs in, with the level and
         /// viscosity its blocks are evaluated at: one variant a geometry, each
         /// implementing [`Geometry`] in its own module.
@@ -217,18 +255,22 @@ macro_rules! geometries {
 
 // The registration: every geometry once, in the order the choice tries them.
 geometries! {$
-    /// In a periodic box whose images interact, with the step's sums (Ewald,
-    /// `mobility/periodic.rs`, or PSE, `mobility/pse.rs`; feature `periodic`).
+    /// In a periodic box; its step where its images interact, with the step's sums
+    /// (Ewald, `mobility/periodic.rs`, or PSE, `mobility/pse.rs`; feature `periodic`).
     #[cfg(feature = "periodic")]
-    Periodic(periodic::Periodic<'a, T>),
+    Periodic(periodic::step::Periodic<'a, T>, periodic::InBox<T>),
     /// Above a no-slip wall (`mobility/wall.rs`; feature `wall`).
     #[cfg(feature = "wall")]
-    Wall(wall::Wall<T>),
+    Wall(wall::step::Wall<T>, wall::Above<T>),
     // Where no other geometry claims the place:
     _ =>
     /// Free space (`mobility.rs`; the bands of `parallel/`).
-    Free(free::Free<T>),
+    Free(free::Free<T>, free::Anywhere),
 }
+
+mod place;
+
+pub use place::Named;
 
 impl<'a, T: Real> Hydrodynamics<'a, T> {
     /// The geometry of a step: in the box when it has sums, above the wall at `wall`
@@ -236,7 +278,15 @@ impl<'a, T: Real> Hydrodynamics<'a, T> {
     /// free space otherwise.
     #[inline(always)]
     pub fn new(level: Hydro, eta: T, wall: Option<T>, sums: Sums<'a, T>) -> Self {
-        Self::at(Place::new(wall, None, false), level, eta, sums)
+        Self::at(
+            Place::new(Named {
+                wall,
+                ..Named::FREE
+            }),
+            level,
+            eta,
+            sums,
+        )
     }
 
     /// `mu_tt(pos)` into the packed lower triangle `mu`, on the calling thread.

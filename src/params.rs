@@ -415,7 +415,11 @@ impl<T: Real> Params<T> {
             Some(w) => Some(w.height),
             None => None,
         };
-        crate::geometry::Place::new(wall, self.periodic, self.pse.is_some())
+        crate::geometry::Place::new(crate::geometry::Named {
+            wall,
+            cell: self.periodic,
+            pse: self.pse.is_some(),
+        })
     }
 
     /// `true` when a thermal step of `n` beads draws its noise by Lanczos: as

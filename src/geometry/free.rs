@@ -2,6 +2,7 @@
 //! `parallel/` (the band loops of `parallel/source.rs` and `mobility/grand.rs`).
 
 use super::Geometry;
+use crate::cell::Periodic;
 use crate::error::StepError;
 use crate::linalg::{MobMut, with_blocks};
 use crate::mobility::{self, Hydro};
@@ -24,6 +25,48 @@ impl<T: Real> Free<T> {
     #[inline(always)]
     pub const fn new(level: Hydro, eta: T) -> Self {
         Self { level, eta }
+    }
+}
+
+/// The parameters name no other geometry: free space, the registration's fallback.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Anywhere;
+
+impl Anywhere {
+    /// Free space, where no other geometry claims the parameters.
+    #[inline(always)]
+    pub const fn new() -> Self {
+        Self
+    }
+
+    /// No wall.
+    #[inline(always)]
+    pub const fn wall<T: Real>(self) -> Option<T> {
+        None
+    }
+
+    /// No box.
+    #[inline(always)]
+    pub const fn cell<T: Real>(self) -> Option<Periodic<T>> {
+        None
+    }
+
+    /// Free space's blocks are symmetric in bits.
+    #[inline(always)]
+    pub const fn symmetric(self) -> bool {
+        true
+    }
+
+    /// A step stores them as such.
+    #[inline(always)]
+    pub const fn stores_symmetric(self) -> bool {
+        true
+    }
+
+    /// The stored mobility is free space's.
+    #[inline(always)]
+    pub const fn free_blocks(self, _: Hydro) -> bool {
+        true
     }
 }
 

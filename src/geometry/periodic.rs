@@ -1,130 +1,71 @@
-//! In a periodic box whose images interact, with the step's sums ([`super::sums`]):
-//! Ewald's (`mobility/periodic.rs`: blocks, assembly and products) or PSE's
-//! (`mobility/pse.rs`: products only, which the checks hold to steps that need
-//! nothing else). Feature `periodic`.
+//! In a periodic box: what the parameters name ([`InBox`], always compiled, so that the
+//! checks see a box the kernel was built without) and the step's hydrodynamics where its
+//! images interact ([`step`], Ewald or PSE sums, feature `periodic`).
 
-use super::free::Free;
-use super::{Geometry, PSE_ASSEMBLED, Place, Sums, sums::BoxSums};
-use crate::error::StepError;
-use crate::linalg::{MobMut, with_blocks};
-use crate::mobility::{Hydro, periodic};
-use crate::parallel::{self, Parallel};
+#[cfg(feature = "periodic")]
+pub mod step;
+
+use super::Named;
+use crate::cell::Periodic;
+use crate::mobility::Hydro;
 use crate::real::Real;
 
-/// In the box of the step's sums, at a hydrodynamic level and viscosity.
-#[derive(Clone, Copy, Debug)]
-pub struct Periodic<'a, T: Real> {
-    /// Hydrodynamic level (what free space would use where the sums have no blocks).
-    pub level: Hydro,
-    /// Viscosity.
-    pub eta: T,
-    /// The step's sums.
-    pub sums: BoxSums<'a, T>,
+/// The parameters name a periodic box (with a wall also asked for, which the checks
+/// refuse, at `wall`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InBox<T: Real> {
+    /// The box.
+    pub cell: Periodic<T>,
+    /// A wall asked for beside the box.
+    pub wall: Option<T>,
+    /// Summed by PSE ([`Params::pse`](crate::Params::pse): products only, nothing
+    /// stored), not by Ewald.
+    pub pse: bool,
 }
 
-impl<'a, T: Real> Periodic<'a, T> {
-    /// The geometry at `place` where the step has sums (its images interact).
+impl<T: Real> InBox<T> {
+    /// Where the parameters name a box, with or without a wall: the box first, as every
+    /// check takes it.
     #[inline(always)]
-    pub fn at(_: Place<T>, level: Hydro, eta: T, sums: Sums<'a, T>) -> Option<Self> {
-        sums.map(|sums| Self { level, eta, sums })
-    }
-
-    /// The Ewald sums: PSE has none, and the checks refuse it wherever the step assembles.
-    fn ewald(self) -> Result<&'a periodic::Ewald<T>, StepError> {
-        self.sums
-            .ewald()
-            .ok_or(StepError::Unsupported(PSE_ASSEMBLED))
-    }
-}
-
-impl<T: Real> Geometry<T> for Periodic<'_, T> {
-    fn assemble_tt(self, pos: &[T::V3], radius: &[T], mu: MobMut<'_, T>) -> Result<(), StepError> {
-        let (e, eta) = (self.ewald()?, self.eta);
-        let serial = &parallel::Serial;
-        use periodic::assemble;
-        Ok(with_blocks!(mut mu, mu => assemble(serial, e, eta, pos, radius, mu))?)
-    }
-
-    fn assemble_apply(
-        self,
-        par: &dyn Parallel,
-        (pos, radius): (&[T::V3], &[T]),
-        mu: MobMut<'_, T>,
-        (f, u): (&[T::V3], &mut [T::V3]),
-        bands: &mut [T::V3],
-    ) -> Result<(), StepError> {
-        let (e, eta) = (self.ewald()?, self.eta);
-        let work = (par, bands);
-        periodic::assemble_apply(e, eta, (pos, radius), mu, (f, u), work, None)
-            .map_err(StepError::from)
-    }
-
-    fn assemble_apply_copy(
-        self,
-        par: &dyn Parallel,
-        (pos, radius): (&[T::V3], &[T]),
-        mu: MobMut<'_, T>,
-        (f, u): (&[T::V3], &mut [T::V3]),
-        bands: &mut [T::V3],
-        copy: &mut [T::M3],
-    ) -> Result<(), StepError> {
-        let (e, eta) = (self.ewald()?, self.eta);
-        let (work, copy) = ((par, bands), Some(copy));
-        periodic::assemble_apply(e, eta, (pos, radius), mu, (f, u), work, copy)
-            .map_err(StepError::from)
-    }
-
-    fn product(
-        self,
-        par: &dyn Parallel,
-        (pos, radius): (&[T::V3], &[T]),
-        (f, u): (&[T::V3], &mut [T::V3]),
-        bands: &mut [T::V3],
-    ) -> Result<(), StepError> {
-        self.sums.product(self.eta, pos, radius, f, u, (par, bands))
-    }
-
-    fn assemble_grand(
-        self,
-        pos: &[T::V3],
-        radius: &[T],
-        out: &mut [T::M3],
-    ) -> Result<(), StepError> {
-        let Some(e) = self.sums.ewald() else {
-            return Err(StepError::Unsupported(
-                "PSE with rotation (its rt and rr products are not built: Ewald sums them)",
-            ));
-        };
-        Ok(periodic::assemble_grand(e, self.eta, pos, radius, out)?)
-    }
-
-    fn add_spin(
-        self,
-        pos: &[T::V3],
-        radius: &[T],
-        f: &[T::V3],
-        out: &mut [T::V3],
-    ) -> Result<(), StepError> {
-        let Self { level, eta, sums } = self;
-        match sums.ewald() {
-            Some(e) => Ok(periodic::add_spin(e, eta, pos, radius, f, out)?),
-            // PSE has no rt blocks (the checks refuse it with rotation): free space's.
-            None => Free { level, eta }.add_spin(pos, radius, f, out),
+    pub const fn claims(named: Named<T>) -> Option<Self> {
+        match named.cell {
+            Some(cell) => Some(Self {
+                cell,
+                wall: named.wall,
+                pse: named.pse,
+            }),
+            None => None,
         }
     }
 
+    /// The wall asked for beside the box.
     #[inline(always)]
-    fn block_at(self, pos: &[T::V3], radius: &[T], p: usize, q: usize) -> Option<T::M3> {
-        periodic::tt_block_at(self.sums.ewald()?, self.eta, pos, radius, p, q)
+    pub const fn wall(self) -> Option<T> {
+        self.wall
     }
 
+    /// The box.
     #[inline(always)]
-    fn has_blocks(self) -> bool {
-        self.sums.ewald().is_some()
+    pub const fn cell(self) -> Option<Periodic<T>> {
+        Some(self.cell)
     }
 
+    /// The Ewald blocks are symmetric in bits (not with a wall beside the box).
     #[inline(always)]
-    fn lower_only(self) -> bool {
-        true
+    pub const fn symmetric(self) -> bool {
+        self.wall.is_none()
+    }
+
+    /// Symmetric blocks are stored by Ewald, not by PSE, which stores nothing.
+    #[inline(always)]
+    pub const fn stores_symmetric(self) -> bool {
+        self.symmetric() && !self.pse
+    }
+
+    /// The stored mobility is free space's only where the images do not interact (free
+    /// draining: self blocks only, the same in a box as outside it).
+    #[inline(always)]
+    pub const fn free_blocks(self, level: Hydro) -> bool {
+        self.symmetric() && matches!(level, Hydro::FreeDraining)
     }
 }

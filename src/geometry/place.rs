@@ -1,69 +1,71 @@
-//! Where a step's spheres are, as its parameters name it ([`Place`]): free space, above
-//! a wall, or in a periodic box. The parameter-level companion of
-//! [`Hydrodynamics`](super::Hydrodynamics): what the checks, the workspace's sizes, the
-//! noise and every pair geometry (minimum images) ask of the geometry before a step has
-//! its sums, answered in one place instead of by reading
-//! [`Params::wall`](crate::Params::wall) and [`Params::periodic`](crate::Params::periodic)
-//! by hand ([`Params::place`](crate::Params::place)).
+//! Where a step's spheres are, as its parameters name it ([`Place`], written by the
+//! registration `geometries!`): free space, above a wall, or in a periodic box. The
+//! parameter-level companion of [`Hydrodynamics`](super::Hydrodynamics): what the
+//! checks, the workspace's sizes, the noise and every pair geometry (minimum images)
+//! ask of the geometry before a step has its sums. Each geometry answers in its own
+//! module (`free.rs`, `wall.rs`, `periodic.rs`: its variant's type); here the answers
+//! are forwarded, and read by hand from [`Params`](crate::Params) nowhere
+//! ([`Params::place`](crate::Params::place)).
 
+use super::Place;
 use crate::cell::Periodic;
 use crate::mobility::Hydro;
 use crate::real::Real;
 
-/// The geometry a step's parameters name, before the kernel's features are applied
-/// (what is asked: the checks refuse a geometry the kernel was built without, and a box
-/// with a wall).
+/// What a step's parameters name of its geometry, each geometry's parameter read once
+/// ([`Params::place`](crate::Params::place)); [`Place::new`] asks the registered
+/// geometries which of them claims it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Place<T: Real> {
-    /// Free space.
-    Free,
-    /// Above the no-slip wall `z = height`.
-    Wall {
-        /// The wall's height.
-        height: T,
-    },
-    /// In a periodic box (with the wall also asked for, which the checks refuse, at
-    /// `wall`).
-    Box {
-        /// The box.
-        cell: Periodic<T>,
-        /// A wall asked for beside the box.
-        wall: Option<T>,
-        /// Summed by PSE ([`Params::pse`](crate::Params::pse): products only, nothing
-        /// stored), not by Ewald.
-        pse: bool,
-    },
+pub struct Named<T: Real> {
+    /// The wall's height ([`Params::wall`](crate::Params::wall)).
+    pub wall: Option<T>,
+    /// The periodic box ([`Params::periodic`](crate::Params::periodic)).
+    pub cell: Option<Periodic<T>>,
+    /// A box summed by PSE ([`Params::pse`](crate::Params::pse)).
+    pub pse: bool,
+}
+
+impl<T: Real> Named<T> {
+    /// Nothing named: free space.
+    pub const FREE: Self = Self {
+        wall: None,
+        cell: None,
+        pse: false,
+    };
 }
 
 impl<T: Real> Place<T> {
-    /// The place of a wall at `wall` and a box `cell` summed by PSE where `pse` (either
-    /// may be absent): the box first, as every check takes it.
-    #[inline(always)]
-    pub const fn new(wall: Option<T>, cell: Option<Periodic<T>>, pse: bool) -> Self {
-        match (cell, wall) {
-            (Some(cell), wall) => Self::Box { cell, wall, pse },
-            (None, Some(height)) => Self::Wall { height },
-            (None, None) => Self::Free,
-        }
-    }
-
     /// The wall's height where a wall is asked for.
     #[inline(always)]
     pub const fn wall(self) -> Option<T> {
-        match self {
-            Self::Wall { height } => Some(height),
-            Self::Box { wall, .. } => wall,
-            Self::Free => None,
-        }
+        each_place!(self, g => g.wall())
     }
 
     /// The periodic box where one is asked for.
     #[inline(always)]
     pub const fn cell(self) -> Option<Periodic<T>> {
-        match self {
-            Self::Box { cell, .. } => Some(cell),
-            _ => None,
-        }
+        each_place!(self, g => g.cell())
+    }
+
+    /// Whether the stored translational blocks are symmetric in bits, so that the
+    /// mobility may be stored as six scalars a block (not above a wall).
+    #[inline(always)]
+    pub const fn symmetric(self) -> bool {
+        each_place!(self, g => g.symmetric())
+    }
+
+    /// Whether a step stores a mobility of symmetric blocks to copy (not above a wall,
+    /// nor in a box summed by PSE, which stores nothing).
+    #[inline(always)]
+    pub const fn stores_symmetric(self) -> bool {
+        each_place!(self, g => g.stores_symmetric())
+    }
+
+    /// Whether the stored mobility at `level` is free space's (no wall, no box whose
+    /// images interact): what a compact copy and the reduced noise read.
+    #[inline(always)]
+    pub const fn free_blocks(self, level: Hydro) -> bool {
+        each_place!(self, g => g.free_blocks(level))
     }
 
     /// The wall a step runs above: with the kernel's `wall` feature (without it the
@@ -96,28 +98,6 @@ impl<T: Real> Place<T> {
             _ => self.step_cell(),
         }
     }
-
-    /// Whether the stored translational blocks at `level` are symmetric in bits, so
-    /// that the mobility may be stored as six scalars a block: not above a wall.
-    #[inline(always)]
-    pub const fn symmetric(self) -> bool {
-        self.wall().is_none()
-    }
-
-    /// Whether a step stores a mobility of symmetric blocks to copy: not above a wall,
-    /// nor in a box summed by PSE, which stores nothing.
-    #[inline(always)]
-    pub const fn stores_symmetric(self) -> bool {
-        self.symmetric() && !matches!(self, Self::Box { pse: true, .. })
-    }
-
-    /// Whether the stored mobility at `level` is free space's (no wall, no box whose
-    /// images interact): what a compact copy and the reduced noise read.
-    #[inline(always)]
-    pub const fn free_blocks(self, level: Hydro) -> bool {
-        let summed = self.cell().is_some() && !matches!(level, Hydro::FreeDraining);
-        self.symmetric() && !summed
-    }
 }
 
 #[cfg(test)]
@@ -133,7 +113,11 @@ mod tests {
         for wall in [None, Some(-0.5)] {
             for periodic in [None, Some(cell)] {
                 for pse in [false, true] {
-                    let place = Place::<f64>::new(wall, periodic, pse);
+                    let place = Place::<f64>::new(Named {
+                        wall,
+                        cell: periodic,
+                        pse,
+                    });
                     assert_eq!(place.wall(), wall);
                     assert_eq!(place.cell(), periodic);
                     assert_eq!(place.symmetric(), wall.is_none());

@@ -46,7 +46,7 @@ use crate::cell_list::{self, CellList};
 use crate::constraints::{Scratch, SolveStats};
 use crate::error::{Row, Stage, StepError};
 use crate::linalg::Mob;
-use crate::params::{Contacts, Params, Wall};
+use crate::params::{Contacts, Params};
 use crate::real::Real;
 use crate::workspace::Links;
 
@@ -110,7 +110,8 @@ pub(super) fn project_overdamped<'l, T: Real>(
     let (links, cells) = links.split();
     // Constants without the `contacts` feature: the one-sided path folds away.
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
-    let wall = p.wall.filter(|_| cfg!(feature = "contacts"));
+    // The wall's height, as its geometry answers it (`Place::wall`).
+    let wall = p.place().wall().filter(|_| cfg!(feature = "contacts"));
     let nb = bonds.len();
     let cell = super::cell(p);
     // The pool of one-sided constraints: the contacts' capacity, one wall link per
@@ -132,9 +133,9 @@ pub(super) fn project_overdamped<'l, T: Real>(
             let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
             add_pairs(bonds, (start, start), radius, cell, reach, &mut set, cells)?;
         }
-        if let Some(w) = wall {
+        if let Some(h) = wall {
             let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
-            add_wall(start, w.height, radius, reach, &mut set)?;
+            add_wall(start, h, radius, reach, &mut set)?;
         }
     }
     let mut round = 0;
@@ -244,7 +245,7 @@ fn too_long<T: Real>(
     rows: &[Bond<T>],
     one_sided: usize,
     start: &[T::V3],
-    wall: Option<Wall<T>>,
+    wall: Option<T>,
     p: &Params<T>,
 ) -> StepError {
     let StepError::Infeasible { constraints, .. } = e else {
@@ -262,7 +263,7 @@ fn too_long<T: Real>(
         }
         let (gap, d) = match b.is_wall() {
             true => {
-                let h = wall.map_or(T::ZERO, |w| w.height);
+                let h = wall.unwrap_or(T::ZERO);
                 (T::xyz(start[b.i])[2] - h - b.length, b.length)
             }
             false => (
@@ -287,9 +288,9 @@ fn too_long<T: Real>(
 
 /// `z += sign * height` for every position (into the wall's frame with `sign = -1`,
 /// back with `+1`); nothing without a wall.
-fn shift<T: Real>(x: &mut [T::V3], wall: Option<Wall<T>>, sign: T) {
-    if let Some(w) = wall {
-        let dz = T::v3(T::ZERO, T::ZERO, w.height * sign);
+fn shift<T: Real>(x: &mut [T::V3], wall: Option<T>, sign: T) {
+    if let Some(h) = wall {
+        let dz = T::v3(T::ZERO, T::ZERO, h * sign);
         for xi in x.iter_mut() {
             *xi += dz;
         }

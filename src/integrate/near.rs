@@ -74,7 +74,7 @@ pub(super) fn check<T: Real>(
     if p.matrix_free {
         return check_iterative(p, n, bonds);
     }
-    if p.periodic.is_some() && p.pse.is_some() {
+    if p.place().cell().is_some() && p.pse.is_some() {
         return refuse(
             "the near field with the PSE sums in a box (its dense mobility reads the Ewald sums' blocks: pse = None)",
         );

@@ -47,7 +47,7 @@ const GEOMETRIES: &[Geometry] = &[
     Geometry {
         name: "wall",
         modules: &["wall"],
-        files: &["mobility/wall", "geometry/wall.rs"],
+        files: &["mobility/wall", "geometry/wall"],
     },
     Geometry {
         name: "periodic box",
@@ -55,7 +55,7 @@ const GEOMETRIES: &[Geometry] = &[
         files: &[
             "mobility/periodic",
             "mobility/pse",
-            "geometry/periodic.rs",
+            "geometry/periodic",
             "geometry/sums.rs",
         ],
     },
@@ -81,20 +81,27 @@ const STILL_NAMED: &[(&str, &str)] = &[
     ("workspace/mod.rs", "periodic box"),
 ];
 
-/// `(file, geometry)` for every kernel file outside a geometry's own files that names
-/// one of its modules through `crate::mobility` or `crate::geometry`.
-fn naming() -> BTreeSet<(String, &'static str)> {
+/// Every kernel file: its path under `src/` and its text.
+fn kernel_files() -> Vec<(String, String)> {
     let src = root().join("src");
     let mut files = Vec::new();
     sources(&src, &mut files);
-    let mut found = BTreeSet::new();
-    for f in files {
-        let rel = f
-            .strip_prefix(&src)
+    let rel = |f: &std::path::Path| {
+        f.strip_prefix(&src)
             .unwrap()
             .to_string_lossy()
-            .replace('\\', "/");
-        let text = code(&std::fs::read_to_string(&f).unwrap());
+            .replace('\\', "/")
+    };
+    let text = |f: &std::path::Path| std::fs::read_to_string(f).unwrap();
+    files.iter().map(|f| (rel(f), text(f))).collect()
+}
+
+/// `(file, geometry)` for every kernel file outside a geometry's own files that names
+/// one of its modules through `crate::mobility` or `crate::geometry`.
+fn naming() -> BTreeSet<(String, &'static str)> {
+    let mut found = BTreeSet::new();
+    for (rel, text) in kernel_files() {
+        let text = code(&text);
         let mut names = named_in(&text, "mobility");
         names.extend(named_in(&text, "geometry"));
         for g in GEOMETRIES {
@@ -130,7 +137,7 @@ fn the_registration_file_forwards_and_never_implements() {
     let text = std::fs::read_to_string(root().join("src/geometry.rs")).unwrap();
     let variants = registered(&text);
     assert!(variants.len() >= 2, "{variants:?}");
-    let body = code(&text[..text.find("#[cfg(test)]\nmod tests").unwrap_or(text.len())]);
+    let body = non_test_code(&text);
     for v in &variants {
         for pat in [format!("Self::{v}"), format!("Hydrodynamics::{v}")] {
             assert!(
@@ -147,6 +154,85 @@ fn the_registration_file_forwards_and_never_implements() {
             );
         }
     }
+}
+
+/// The code of `text` before its unit tests (`#[cfg(test)] mod tests`), comments dropped.
+fn non_test_code(text: &str) -> String {
+    code(&text[..text.find("#[cfg(test)]\nmod tests").unwrap_or(text.len())])
+}
+
+/// Whether `text` names `pat` not followed by more of a name (`Place::Free`, not
+/// `Place::FreeDraining`).
+fn names_exactly(text: &str, pat: &str) -> bool {
+    text.match_indices(pat).any(|(i, _)| {
+        let after = text[i + pat.len()..].chars().next();
+        !after.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_')
+    })
+}
+
+/// The variants of `Place` and `Hydrodynamics` are the registration's: no kernel file
+/// outside a geometry's own modules names one (`Place::Wall`, `Hydrodynamics::Free`),
+/// and no `impl` of either matches one (`Self::Wall`). What a place answers, each
+/// geometry answers in its own module; the rest forwards through the registration.
+#[test]
+fn no_variant_is_matched_outside_its_geometry() {
+    let reg = std::fs::read_to_string(root().join("src/geometry.rs")).unwrap();
+    let variants = registered(&reg);
+    let own = |rel: &str| {
+        rel.starts_with("geometry/free.rs")
+            || GEOMETRIES
+                .iter()
+                .any(|g| g.files.iter().any(|o| rel.starts_with(o)))
+    };
+    let mut matched = Vec::new();
+    for (rel, text) in kernel_files() {
+        if own(&rel) {
+            continue;
+        }
+        let text = non_test_code(&text);
+        let implements = ["Place<", "Hydrodynamics<"]
+            .iter()
+            .any(|t| text.lines().any(|l| l.starts_with("impl") && l.contains(t)));
+        for v in &variants {
+            let mut pats = vec![format!("Place::{v}"), format!("Hydrodynamics::{v}")];
+            if implements {
+                pats.push(format!("Self::{v}"));
+            }
+            for pat in pats.iter().filter(|p| names_exactly(&text, p)) {
+                matched.push(format!("src/{rel}: {pat}"));
+            }
+        }
+    }
+    assert!(matched.is_empty(), "variants matched by hand: {matched:?}");
+}
+
+/// The parameters' geometry fields (`Params::wall`, `Params::periodic`) are read in
+/// `Params::place` alone: every other kernel file asks the place
+/// (`p.place().wall()`, `.cell()`), which each geometry answers in its own module.
+#[test]
+fn the_geometry_fields_are_read_only_through_the_place() {
+    let mut read = Vec::new();
+    for (rel, text) in kernel_files() {
+        if rel == "params.rs" || rel.starts_with("geometry") {
+            continue;
+        }
+        let text = non_test_code(&text);
+        for who in ["p", "params"] {
+            for field in ["wall", "periodic"] {
+                let pat = format!("{who}.{field}");
+                let by_hand = text.match_indices(&pat).any(|(i, _)| {
+                    let before = text[..i].chars().next_back();
+                    let after = text[i + pat.len()..].chars().next();
+                    !before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.')
+                        && !after.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == '(')
+                });
+                if by_hand {
+                    read.push(format!("src/{rel}: {pat}"));
+                }
+            }
+        }
+    }
+    assert!(read.is_empty(), "geometry fields read by hand: {read:?}");
 }
 
 /// No file outside a geometry's own names its modules, but those [`STILL_NAMED`]
@@ -175,4 +261,6 @@ fn every_form_of_naming_is_read() {
     assert!(named_in(text, "fast").is_empty());
     let reg = "geometries! {$\n    /// Doc.\n    #[cfg(feature = \"wall\")]\n    Wall(wall::Wall<T>),\n    _ =>\n    /// Free.\n    Free(free::Free<T>),\n}\n";
     assert_eq!(registered(reg), ["Wall", "Free"]);
+    assert!(names_exactly("Place::Free(g)", "Place::Free"));
+    assert!(!names_exactly("Hydro::FreeDraining", "Hydro::Free"));
 }
