@@ -96,11 +96,17 @@ pub fn newton<T: Real>(
             match backtrack(measured, halvings, previous, solver.tolerance) {
                 Some(true) => {}
                 Some(false) => {
-                    halvings += 1;
-                    // Half of what stands applied taken back by the next pass.
+                    // Half of what stands applied taken back by the next pass: `-rhs / 2`
+                    // after the update, then half of the last halving (`rhs` holds what
+                    // was last applied, the negative of what stands).
+                    let half = match halvings {
+                        0 => -T::HALF,
+                        _ => T::HALF,
+                    };
                     for v in rhs.iter_mut() {
-                        *v *= -T::HALF;
+                        *v *= half;
                     }
+                    halvings += 1;
                     continue;
                 }
                 None => return Err(problem.no_convergence(next, measured)),
@@ -235,10 +241,9 @@ pub fn newton<T: Real>(
 /// Halvings of a Newton update that made the residual diverge ([`backtrack`]).
 const HALVINGS: u32 = 10;
 
-/// Adds the update `rhs` to `mult` and its moves to `x`. After a halving (`halved`),
-/// `rhs` is negated again, to what stands applied; after a solve's update the released
-/// one-sided rows' multipliers are set to exactly zero (the solve gives `-lambda_k` to
-/// rounding).
+/// Adds the update `rhs` to `mult` and its moves to `x`. After a solve's update (not a
+/// halving's, `halved`) the released one-sided rows' multipliers are set to exactly
+/// zero (the solve gives `-lambda_k` to rounding).
 #[inline(always)]
 fn apply<T: Real>(
     metric: &Metric<'_, T>,
@@ -246,18 +251,14 @@ fn apply<T: Real>(
     (from, state): (usize, &[usize]),
     x: &mut [T::V3],
     mult: &mut [T],
-    rhs: &mut [T],
+    rhs: &[T],
     halved: bool,
 ) {
     for (m, &r) in mult.iter_mut().zip(rhs.iter()) {
         *m += r;
     }
     metric.apply_each(bonds, rhs, x);
-    if halved {
-        for v in rhs.iter_mut() {
-            *v = -*v;
-        }
-    } else {
+    if !halved {
         for k in from..bonds.len() {
             if !onesided::active(state[k]) {
                 mult[k] = T::ZERO;
