@@ -12,7 +12,8 @@
 #           C example built with arm-none-eabi-gcc against the thumbv7em staticlib and
 #           run under QEMU, its digest compared with the host C run and the firmware.
 # Prints a table of flash, RAM and instructions per step (with HYDRORATTLE_BENCH_MACHINE
-# set, also appended to bench/results/m4.csv by bench/record.py). Without the thumbv7em
+# set, also appended to bench/results/m4.csv by bench/record.py); fails where a binary's
+# flash is more than 1 % over its last record there (bench/flash_budget.py). Without the thumbv7em
 # target (or the Debian packages) it says so and runs the host part only.
 set -euo pipefail
 
@@ -204,6 +205,9 @@ for bin in "${bins[@]}" stable_rotation; do
         "$table" "$c" digest "$(digest "$out/$bin.txt")" >>"$out/m4-rows.tsv"
 done
 if command -v python3 >/dev/null 2>&1; then
+    # Each binary's flash within 1 % of its last record, or the run fails (a deliberate
+    # growth: HYDRORATTLE_FLASH_GROWTH=reason, and these rows become the budget).
+    python3 "$root/bench/flash_budget.py" "$root/bench/results/m4.csv" "$out/m4-rows.tsv"
     python3 "$root/bench/record.py" --exact m4 "bash firmware/ci.sh" - <"$out/m4-rows.tsv"
 fi
 echo "host == Cortex-M4 bits for every binary; C example (host and QEMU) == firmware:" \

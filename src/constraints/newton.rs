@@ -71,20 +71,52 @@ pub fn newton<T: Real>(
     // recompute it bit for bit and keeps it instead.
     let mut fresh = false;
     let mut factorizations = 0;
-    for it in 0..=solver.max_iterations {
+    // Halvings of the update `rhs` taken back so far ([`backtrack`]).
+    let mut halvings = 0;
+    let mut next = 0;
+    loop {
         let (mut changed, mut pushes) = (false, true);
+        // The last iteration's update is applied at the start of the next, where its
+        // residual is measured and, if it diverged, a part taken back and measured again
+        // by another pass: one call site each of the update and of the residual, so
+        // that firmware keeps them inline for its one metric (flash).
+        if applied {
+            apply(metric, bonds, (from, state), x, mult, rhs, halvings > 0);
+        }
         // The residual at the iterate on the equations the last update solved (the
-        // active set it was built for), backtracked where that update diverged.
-        let (trial, damped) = match (applied, previous) {
-            (true, Some(p)) => {
-                let limit = (p, solver.tolerance, it);
-                backtrack(&problem, bonds, (from, state), x, mult, rhs, limit, metric)?
-            }
-            _ => (None, false),
+        // active set it was built for; one-sided rows measure it again below, after the
+        // active set's update).
+        let measured = match (one_sided, applied) {
+            (false, _) => worst(&problem, bonds, x),
+            (true, true) => onesided::residual(&problem, bonds, from, x, mult, state).0,
+            (true, false) => T::ZERO,
         };
-        applied = false;
+        let damped = halvings > 0;
+        if applied {
+            match backtrack(measured, halvings, previous, solver.tolerance) {
+                Some(true) => {}
+                Some(false) => {
+                    // Half of what stands applied taken back by the next pass: `-rhs / 2`
+                    // after the update, then half of the last halving (`rhs` holds what
+                    // was last applied, the negative of what stands).
+                    let half = match halvings {
+                        0 => -T::HALF,
+                        _ => T::HALF,
+                    };
+                    for v in rhs.iter_mut() {
+                        *v *= half;
+                    }
+                    halvings += 1;
+                    continue;
+                }
+                None => return Err(problem.no_convergence(next, measured)),
+            }
+        }
+        (applied, halvings) = (false, 0);
+        let it = next;
+        next += 1;
         let residual = match one_sided {
-            false => trial.unwrap_or_else(|| worst(&problem, bonds, x)),
+            false => measured,
             true => {
                 changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
                 fresh &= !changed;
@@ -201,87 +233,65 @@ pub fn newton<T: Real>(
             }
             linalg::lu_solve(jac, nb, piv, rhs);
         }
-        for (m, &r) in mult.iter_mut().zip(rhs.iter()) {
-            *m += r;
-        }
-        metric.apply_each(bonds, rhs, x);
+        // `rhs` is applied at the next iteration's start (the last one returns above).
         applied = true;
-        if one_sided {
-            // Released: exactly zero (the solve gives `-lambda_k` to rounding).
-            for k in from..nb {
-                if !onesided::active(state[k]) {
-                    mult[k] = T::ZERO;
-                }
-            }
-        }
     }
-    // The loop returns on its last pass (it == max_iterations).
-    Err(StepError::NoConvergence {
-        stage: problem.stage(),
-        iterations: solver.max_iterations,
-        residual: f64::NAN,
-    })
 }
 
-/// Halvings of a Newton update that made the residual grow ([`backtrack`]).
+/// Halvings of a Newton update that made the residual diverge ([`backtrack`]).
 const HALVINGS: u32 = 10;
 
-/// The safeguard of a diverging update, a backtracking line search on the residual
-/// (the largest normalised one, as the tolerance is stated): where the update `rhs`
-/// just applied to `x` and `mult` left the residual not finite (far outside the region where the
-/// linearisation holds: a jammed pile's step overshoots by many sphere radii and the
-/// next one diverges), half of what was applied is taken back until the residual is
-/// below `previous` or within `tolerance`, up to [`HALVINGS`] times. A line search rather than a trust
-/// region: the direction is already the solver's (chord or Newton, a zero update on
-/// dependent rows) and only its length is in doubt; the updates are linear in `rhs`,
-/// so the halvings retrace one line at one residual each. Only a diverging update is
-/// damped: the chord and the active set legitimately raise the residual for an
-/// iteration or two, and a converging solve never meets the test and keeps its bits.
-/// Returns the residual reached where it can stand for the iteration's (equalities
-/// only: the one-sided rows' is taken again after the active-set update), whether any
-/// halving was done, and an error where the halvings found no decrease (the step is
-/// too long for the linearisation: a shorter one can pass).
-#[allow(clippy::too_many_arguments)]
-fn backtrack<T: Real>(
-    problem: &Problem<'_, T>,
+/// Adds the update `rhs` to `mult` and its moves to `x`. After a solve's update (not a
+/// halving's, `halved`) the released one-sided rows' multipliers are set to exactly
+/// zero (the solve gives `-lambda_k` to rounding).
+#[inline(always)]
+fn apply<T: Real>(
+    metric: &Metric<'_, T>,
     bonds: &[Bond<T>],
     (from, state): (usize, &[usize]),
     x: &mut [T::V3],
     mult: &mut [T],
-    rhs: &mut [T],
-    (previous, tolerance, it): (T, T, u32),
-    metric: &Metric<'_, T>,
-) -> Result<(Option<T>, bool), StepError> {
-    let one_sided = from < bonds.len();
-    let measure = |x: &[T::V3], mult: &[T]| match one_sided {
-        false => worst(problem, bonds, x),
-        true => onesided::residual(problem, bonds, from, x, mult, state).0,
-    };
-    let mut r = measure(x, mult);
-    // Only a residual that is no longer finite counts as divergence: the solve could
-    // never come back from it, so damping there changes no run that converged
-    // undamped (a finite growth, even a large one, is left to the iteration).
-    if r.is_finite() {
-        return Ok(((!one_sided).then_some(r), false));
+    rhs: &[T],
+    halved: bool,
+) {
+    for (m, &r) in mult.iter_mut().zip(rhs.iter()) {
+        *m += r;
     }
-    for _ in 0..HALVINGS {
-        for v in rhs.iter_mut() {
-            *v *= -T::HALF;
-        }
-        for (m, &v) in mult.iter_mut().zip(rhs.iter()) {
-            *m += v;
-        }
-        metric.apply_each(bonds, rhs, x);
-        // `rhs` is again what stands applied.
-        for v in rhs.iter_mut() {
-            *v = -*v;
-        }
-        r = measure(x, mult);
-        if r < previous || r <= tolerance {
-            return Ok(((!one_sided).then_some(r), true));
+    metric.apply_each(bonds, rhs, x);
+    if !halved {
+        for k in from..bonds.len() {
+            if !onesided::active(state[k]) {
+                mult[k] = T::ZERO;
+            }
         }
     }
-    Err(problem.no_convergence(it, r))
+}
+
+/// The safeguard of a diverging update, a backtracking line search on the residual
+/// (the largest normalised one, as the tolerance is stated), judged after the update
+/// and each halving of it: `Some(true)` where the residual `r` stands, `Some(false)`
+/// where half of what stands applied is to be taken back and `r` measured again, `None`
+/// where [`HALVINGS`] halvings found no decrease (the step is too long for the
+/// linearisation: a shorter one can pass).
+///
+/// Only a residual that is no longer finite after the update counts as divergence (far
+/// outside the region where the linearisation holds: a jammed pile's step overshoots
+/// by many sphere radii and the next one diverges): the solve could never come back
+/// from it, so damping there changes no run that converged undamped (a finite growth,
+/// even a large one, is left to the iteration: the chord and the active set
+/// legitimately raise the residual for an iteration or two). The halvings stop once
+/// the residual is below `previous` or within `tolerance`. A line search rather than a
+/// trust region: the direction is already the solver's (chord or Newton, a zero update
+/// on dependent rows) and only its length is in doubt; the updates are linear in
+/// `rhs`, so the halvings retrace one line at one residual each.
+fn backtrack<T: Real>(r: T, halvings: u32, previous: Option<T>, tolerance: T) -> Option<bool> {
+    if halvings == 0 {
+        return Some(r.is_finite());
+    }
+    if previous.is_some_and(|p| r < p) || r <= tolerance {
+        return Some(true);
+    }
+    (halvings < HALVINGS).then_some(false)
 }
 
 /// The inactive one-sided rows' equations (of the chord's lower triangle) replaced by
