@@ -232,6 +232,10 @@ fn advance<T: Real, E: ExternalForce<T>>(
         let iterative = p.near_on() && p.matrix_free;
         match (p.method, thermal, drawn.as_mut()) {
             #[cfg(feature = "near")]
+            (Method::Overdamped, ..) if iterative && !bonds.is_empty() => {
+                near_iter::constrained::overdamped(p, &s, bonds, v, ext)
+            }
+            #[cfg(feature = "near")]
             (Method::Overdamped | Method::Overdamped2, ..) if iterative => {
                 near_iter::overdamped(p, &s, v, ext)
             }

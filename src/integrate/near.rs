@@ -101,9 +101,19 @@ fn check_iterative<T: Real>(
             "the iterative near field (matrix_free) with thermal noise: its noise is the dense near field's (matrix_free = false)",
         );
     }
-    if bonds > 0 || p.constraints(n, bonds) > 0 {
+    if p.constraints(n, bonds) > bonds {
         return refuse(
-            "the iterative near field (matrix_free) with constraints (bonds, pins, contacts, the wall's links): their solvers read the dense near field's blocks (matrix_free = false)",
+            "the iterative near field (matrix_free) with one-sided constraints (contacts, the wall's links): their projection reads the dense near field's blocks (matrix_free = false)",
+        );
+    }
+    if bonds > 0 && p.method != Method::Overdamped {
+        return refuse(
+            "the iterative near field (matrix_free) with constraints (bonds, pins) in Overdamped2: Overdamped only (or matrix_free = false)",
+        );
+    }
+    if bonds > 0 && p.solver_kind(n, bonds) != crate::constraints::SolverKind::Krylov {
+        return refuse(
+            "the iterative near field (matrix_free) with constraints solved by the sweep or Newton: they read every entry of the metric, the Krylov solve its products only (SolverKind::Krylov or Auto)",
         );
     }
     if super::wall_height(p).is_some() {

@@ -8,15 +8,18 @@
 //! one RPY assembly (`docs/NEAR.md`).
 //!
 //! Served: `Overdamped` (one product, at the start) and `Overdamped2` (two, at the
-//! start and at the predicted point), deterministic, without constraints, in free space
+//! start and at the predicted point), deterministic, in free space
 //! or in the periodic box with the Ewald sums; the rest is refused by
-//! [`super::near::check`]. The conjugate gradients stop at the relative residual
+//! [`super::near::check`]. `Overdamped` with bonds and pins by the Krylov solve along
+//! `M_SD`: `near_iter/constrained.rs`. The conjugate gradients stop at the relative residual
 //! [`Solver::tolerance`](crate::Solver::tolerance) within its `max_iterations`
 //! (`Params::solver`, the step's one tolerance for its iterations); not converging is
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`], the caller's state unchanged.
 //! The storage is the caller's ([`crate::Layout::for_params`]:
 //! `near_iterative_sizes`), with room for
 //! [`NEAR_PAIRS_PER_SPHERE`](crate::NEAR_PAIRS_PER_SPHERE) close pairs a sphere.
+
+pub(super) mod constrained;
 
 use super::{Start, StepReport, Sums, add_flow, check_resolved, step_velocity};
 use crate::error::{Stage, StepError};
