@@ -97,8 +97,11 @@ pub struct StepReport<T> {
     /// ([`Params::near`] with [`Params::matrix_free`]; 0 otherwise).
     pub near_pairs: u32,
     /// Iterative Stokesian dynamics products the step made (one a mobility: the
-    /// first-order step one, the predictor-corrector two; 0 without the iterative near
-    /// field). Each assembles the far field's grand mobility once.
+    /// first-order step one, the predictor-corrector two; with bonds or pins also one
+    /// a Krylov iteration of the constraint solve and, with rotation, one for the
+    /// spins; 0 without the iterative near field). The far field's grand mobility is
+    /// assembled once a configuration (the constrained step's products share the
+    /// start's).
     pub near_products: u32,
     /// Conjugate-gradient iterations of those products, summed; the far field's
     /// products are these plus two a product.
