@@ -323,15 +323,10 @@ fn refusals<T: Real>() {
     assert!(e <= p.solver.tolerance.to_f64() + 8.0 * T::EPSILON.to_f64());
 }
 
-macro_rules! both {
-    ($($name:ident),*) => {
-        $(mod $name {
-            #[test]
-            fn f32() { super::$name::<f32>() }
-            #[test]
-            fn f64() { super::$name::<f64>() }
-        })*
-    };
+both_precisions! {
+    matches_dense => matches_dense;
+    bonded_pair => bonded_pair;
+    bonds_held => bonds_held;
+    same_bits => same_bits;
+    refusals => refusals;
 }
-
-both!(matches_dense, bonded_pair, bonds_held, same_bits, refusals);
