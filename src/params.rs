@@ -452,11 +452,14 @@ impl<T: Real> Params<T> {
     /// cannot disagree.
     /// With a fast product ([`Params::pse`]: PSE in a box, the fast free-space product
     /// without a wall) `Auto` is Krylov at every size: the only solver that needs
-    /// products alone.
+    /// products alone. So with the iterative near field ([`Params::near`] with
+    /// [`Params::matrix_free`]), whose constraint metric is a product of `M_SD`.
     pub const fn solver_kind(&self, n: usize, bonds: usize) -> SolverKind {
         match (self.solver.kind, self.pse, self.periodic) {
             (SolverKind::Auto, Some(_), Some(_)) => SolverKind::Krylov,
             (SolverKind::Auto, Some(_), None) if self.wall.is_none() => SolverKind::Krylov,
+            // The iterative near field's metric has products only (`integrate/near_iter`).
+            (SolverKind::Auto, ..) if self.near_on() && self.matrix_free => SolverKind::Krylov,
             (kind, ..) => kind.resolve(self.constraints(n, bonds)),
         }
     }

@@ -25,6 +25,7 @@
 //!   others are masked out of the conjugate gradients (zero residual, zero product
 //!   rows, a diagonal row of the preconditioner, rebuilt when the set changes).
 
+use super::products::{Exact, Products};
 use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided};
 use crate::bonds::Bond;
 use crate::error::{LinalgError, StepError};
@@ -53,9 +54,33 @@ pub const SCALARS_PER_BOND: usize = 5 + BAND + 1;
 
 /// Solves by chord Newton + PCG, accumulating the multipliers into `mult` and moving `x`.
 #[allow(clippy::too_many_arguments)]
+#[inline]
 pub fn krylov<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,
+    bonds: &[Bond<T>],
+    solver: &Solver<T>,
+    x: &mut [T::V3],
+    mult: &mut [T],
+    scratch: &mut Scratch<'_, T>,
+) -> Result<SolveStats<T>, StepError> {
+    krylov_with(
+        problem,
+        (metric, &mut Exact),
+        bonds,
+        solver,
+        x,
+        mult,
+        scratch,
+    )
+}
+
+/// [`krylov`] with the products made by `op` ([`Products`]), the entries (the
+/// band preconditioner, the curvature test, the one-sided rows) read from `metric`.
+#[allow(clippy::too_many_arguments)]
+pub fn krylov_with<T: Real, P: Products<T>>(
+    problem: Problem<'_, T>,
+    (metric, op): (&Metric<'_, T>, &mut P),
     bonds: &[Bond<T>],
     solver: &Solver<T>,
     x: &mut [T::V3],
@@ -174,7 +199,7 @@ pub fn krylov<T: Real>(
                 z[k] = if off { mult[k] } else { T::ZERO };
                 delta[k] = -z[k];
             }
-            metric.apply_all(bonds, z, w, tmp);
+            op.apply(metric, bonds, z, w, tmp)?;
             products += 1;
             for (k, b) in bonds.iter().enumerate() {
                 if k < from || onesided::active(state[k]) {
@@ -190,7 +215,7 @@ pub fn krylov<T: Real>(
         p.copy_from_slice(z);
         let mut rz = dot(r, z);
         for inner in 0..nb.max(1) {
-            metric.apply_all(bonds, p, w, tmp);
+            op.apply(metric, bonds, p, w, tmp)?;
             products += 1;
             for (k, b) in bonds.iter().enumerate() {
                 q[k] = T::dot(metric.grad(k), b.relative(w)) * c;

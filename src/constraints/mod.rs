@@ -20,9 +20,11 @@ mod krylov;
 mod metric;
 mod newton;
 mod onesided;
+mod products;
 mod sweep;
 
-pub use krylov::{BAND, krylov};
+pub use krylov::{BAND, krylov, krylov_with};
+pub use products::{Exact, Products};
 
 /// Krylov scratch scalars per bond.
 pub(crate) const fn krylov_scratch_per_bond() -> usize {

@@ -100,9 +100,11 @@ pub struct StepReport<T> {
     pub near_pairs: u32,
     /// Iterative Stokesian dynamics products the step made (one a mobility: the
     /// first-order step one, the predictor-corrector two; a Brownian step three, the
-    /// velocities, the noise's solve and the midpoint's; 0 without the iterative near
-    /// field). Each configuration assembles the far field's grand mobility once (a
-    /// Brownian step two: the start and the midpoint).
+    /// velocities, the noise's solve and the midpoint's; with bonds or pins also one a
+    /// Krylov iteration of the constraint solve and, with rotation, one for the spins;
+    /// 0 without the iterative near field). The far field's grand mobility is assembled
+    /// once a configuration (a Brownian step two: the start and the midpoint; the
+    /// constrained step's products share the start's).
     pub near_products: u32,
     /// Conjugate-gradient iterations of those products, summed; the far field's
     /// products are these plus two a product.
@@ -238,6 +240,10 @@ fn advance<T: Real, E: ExternalForce<T>>(
             #[cfg(feature = "near")]
             (Method::Overdamped, Some(b), Some(g)) if iterative => {
                 near_iter::overdamped_thermal(p, b, &s, v, ext, g)
+            }
+            #[cfg(feature = "near")]
+            (Method::Overdamped, ..) if iterative && !bonds.is_empty() => {
+                near_iter::constrained::overdamped(p, &s, bonds, v, ext)
             }
             #[cfg(feature = "near")]
             (Method::Overdamped | Method::Overdamped2, ..) if iterative => {

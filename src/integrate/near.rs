@@ -72,7 +72,7 @@ pub(super) fn check<T: Real>(
         return refuse("the near field with a method other than Overdamped or Overdamped2");
     }
     if p.matrix_free {
-        return check_iterative(p, n, bonds);
+        return check_iterative(p, n, bonds, thermal);
     }
     if p.place().cell().is_some() && p.pse.is_some() {
         return refuse(
@@ -89,11 +89,31 @@ pub(super) fn check<T: Real>(
 
 /// The iterative near field's refusals ([`Params::matrix_free`], `near_iter.rs`): what
 /// needs `M_SD`'s blocks or a product the iterative path does not have.
-fn check_iterative<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Result<(), StepError> {
+fn check_iterative<T: Real>(
+    p: &Params<T>,
+    n: usize,
+    bonds: usize,
+    thermal: bool,
+) -> Result<(), StepError> {
     let refuse = |what| Err(StepError::Unsupported(what));
-    if bonds > 0 || p.constraints(n, bonds) > 0 {
+    if thermal && p.constraints(n, bonds) > 0 {
         return refuse(
-            "the iterative near field (matrix_free) with constraints (bonds, pins, contacts, the wall's links): their solvers read the dense near field's blocks (matrix_free = false)",
+            "the iterative near field (matrix_free) with thermal noise and constraints (bonds, pins, contacts, the wall's links): the dense near field (matrix_free = false)",
+        );
+    }
+    if p.constraints(n, bonds) > bonds {
+        return refuse(
+            "the iterative near field (matrix_free) with one-sided constraints (contacts, the wall's links): their projection reads the dense near field's blocks (matrix_free = false)",
+        );
+    }
+    if bonds > 0 && p.method != Method::Overdamped {
+        return refuse(
+            "the iterative near field (matrix_free) with constraints (bonds, pins) in Overdamped2: Overdamped only (or matrix_free = false)",
+        );
+    }
+    if bonds > 0 && p.solver_kind(n, bonds) != crate::constraints::SolverKind::Krylov {
+        return refuse(
+            "the iterative near field (matrix_free) with constraints solved by the sweep or Newton: they read every entry of the metric, the Krylov solve its products only (SolverKind::Krylov or Auto)",
         );
     }
     if super::wall_height(p).is_some() {

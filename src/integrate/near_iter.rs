@@ -9,16 +9,19 @@
 //!
 //! Served: `Overdamped` (one product, at the start) and `Overdamped2` (two, at the
 //! start and at the predicted point), and `Overdamped` with thermal noise
-//! (`near_iter/noise.rs`: three products and a Lanczos root of the far field), without
-//! constraints, in free space or in the periodic box with the Ewald sums; the rest is
-//! refused by
-//! [`super::near::check`]. The conjugate gradients stop at the relative residual
+//! (`near_iter/noise.rs`: three products and a Lanczos root of the far field), in free
+//! space or in the periodic box with the Ewald sums; `Overdamped` with bonds and pins
+//! (deterministic) by the Krylov solve along `M_SD`: `near_iter/constrained.rs`. The
+//! rest is refused by [`super::near::check`]. The conjugate gradients stop at the
+//! relative residual
 //! [`Solver::tolerance`](crate::Solver::tolerance) within its `max_iterations`
 //! (`Params::solver`, the step's one tolerance for its iterations); not converging is
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`], the caller's state unchanged.
 //! The storage is the caller's ([`crate::Layout::for_params`]:
 //! `near_iterative_sizes`), with room for
 //! [`NEAR_PAIRS_PER_SPHERE`](crate::NEAR_PAIRS_PER_SPHERE) close pairs a sphere.
+
+pub(super) mod constrained;
 
 use super::{Start, StepReport, Sums, add_flow, check_resolved, step_velocity};
 use crate::error::{Stage, StepError};

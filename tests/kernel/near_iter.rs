@@ -227,10 +227,10 @@ fn same_bits<T: Real>() {
     assert_eq!(run(), run());
 }
 
-/// Refused, typed, the state unchanged: what the iterative path does not serve (bonds,
-/// contacts, the wall's hydrodynamics, PSE), the conjugate gradients stopped before
-/// they converge, and more close pairs than the storage holds (its Brownian steps:
-/// `near_iter_brownian.rs`).
+/// Refused, typed, the state unchanged: what the iterative path does not serve (bonds
+/// by the sweep, contacts, the wall's hydrodynamics, PSE), the conjugate gradients
+/// stopped before they converge, and more close pairs than the storage holds (its
+/// Brownian steps: `near_iter_brownian.rs`).
 fn refusals<T: Real>() {
     let spheres = cluster(20, 21, None, [0.0; 3]);
     let base = near::<T>(Method::Overdamped, true, None);
@@ -245,7 +245,10 @@ fn refusals<T: Real>() {
         j: 1,
         length: T::from_f64(norm(sub(spheres[1].pos, spheres[0].pos))),
     };
-    unsupported(&base, &[bond], "constraints");
+    // Bonds by the sweep (`near_con.rs` has the Krylov solve that serves them).
+    let mut p = base;
+    p.solver.kind = SolverKind::Sweep;
+    unsupported(&p, &[bond], "sweep or Newton");
     let mut p = base;
     p.contacts = Some(Contacts::new(64));
     unsupported(&p, &[], "constraints");

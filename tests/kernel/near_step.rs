@@ -115,7 +115,7 @@ fn two_spheres_fall<T: Real>() {
 /// The projection of a dimer's velocity onto its bond, in the test: `U = M (F + G^T
 /// lambda)`, `G = (e, -e)` with `e = r1 - r2`, `lambda` such that `e . (U1 - U2) = 0`;
 /// `M` the translational blocks of the exact two-sphere mobility.
-fn projected(spheres: &[Sphere; 2], weight: [f64; 2]) -> [[f64; 3]; 2] {
+pub(crate) fn projected(spheres: &[Sphere; 2], weight: [f64; 2]) -> [[f64; 3]; 2] {
     let pos = [spheres[0].pos, spheres[1].pos];
     let m = sd::<f64>(None, &pos, &[1.0, 1.0]).unwrap();
     let tt = |u: [f64; 6]| -> [f64; 6] {

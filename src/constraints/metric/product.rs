@@ -100,6 +100,23 @@ impl<T: Real> Metric<'_, T> {
     }
 }
 
+impl<T: Real> Metric<'_, T> {
+    /// `f = scale G^T c`, the forces the multipliers `c` put on the beads, for the
+    /// hydrodynamic metrics ([`Metric::Mobility`], [`Metric::Free`]: their products are
+    /// a mobility times these); `false`, `f` untouched, for the others. What a product
+    /// of another mobility along this metric's gradients takes
+    /// ([`Products`](crate::constraints::Products)).
+    pub fn forces(&self, bonds: &[Bond<T>], c: &[T], f: &mut [T::V3]) -> bool {
+        match *self {
+            Metric::Mobility { grad, scale, .. } | Metric::Free { grad, scale, .. } => {
+                spread(bonds, grad, c, scale, f);
+                true
+            }
+            _ => false,
+        }
+    }
+}
+
 /// `f = scale G^T c`: the forces a multiplier vector puts on the beads.
 fn spread<T: Real>(bonds: &[Bond<T>], grad: &[T::V3], c: &[T], scale: T, f: &mut [T::V3]) {
     f.fill(T::V3_ZERO);
