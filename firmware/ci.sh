@@ -63,7 +63,14 @@ fi
 
 # --- Host -----------------------------------------------------------------------------
 
-fw() { (cd "$here" && CARGO_TARGET_DIR="$root/target/${FW_DIR:-fw}" "$@"); }
+# The firmware's panic locations name source paths: remapped, so that its flash does not
+# depend on where the repository or cargo's registry sits on the machine that builds it.
+cargo_home="${CARGO_HOME:-$HOME/.cargo}"
+remap="--remap-path-prefix=$root=/hydrorattle --remap-path-prefix=$cargo_home=/cargo"
+fw() {
+    (cd "$here" && CARGO_TARGET_DIR="$root/target/${FW_DIR:-fw}" \
+        CARGO_TARGET_THUMBV7EM_NONE_EABIHF_RUSTFLAGS="-C link-arg=-Tlink.x $remap" "$@")
+}
 ffi() { (cd "$root/ffi" && CARGO_TARGET_DIR="$root/target/ffi" "$@"); }
 
 run fw cargo fmt -p hydrorattle-firmware -p hydrorattle-scene -- --check
