@@ -69,7 +69,7 @@ cargo_home="${CARGO_HOME:-$HOME/.cargo}"
 remap="--remap-path-prefix=$root=/hydrorattle --remap-path-prefix=$cargo_home=/cargo"
 fw() {
     (cd "$here" && CARGO_TARGET_DIR="$root/target/${FW_DIR:-fw}" \
-        CARGO_TARGET_THUMBV7EM_NONE_EABIHF_RUSTFLAGS="-C link-arg=-Tlink.x $remap" "$@")
+        CARGO_TARGET_THUMBV7EM_NONE_EABIHF_RUSTFLAGS="$remap" "$@")
 }
 ffi() { (cd "$root/ffi" && CARGO_TARGET_DIR="$root/target/ffi" "$@"); }
 
