@@ -19,7 +19,8 @@
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`](crate::Stage::Mobility), the
 //! caller's state unchanged.
 
-use super::{Counts, STORAGE, Store, error, spins, tri2};
+use super::solve::{self, At};
+use super::{Counts, Store, spins};
 use crate::bonds::Bond;
 use crate::constraints::{Metric, Problem, Products, krylov_with};
 use crate::error::StepError;
@@ -31,60 +32,13 @@ use crate::integrate::{
 use crate::linalg::{Mob, tri};
 use crate::params::Params;
 use crate::real::Real;
-use crate::stokesian::iterative::{Solver, Storage, packed_product};
 use crate::workspace::Views;
 
-/// The factored near field at the start and the far field's packed grand mobility:
-/// `(U, W) = M_SD (F, 0)` by conjugate gradients, as often as the step asks.
-struct Sd<'s, 'v, T: Real> {
-    solver: Solver<'s, T>,
-    packed: &'s [T::M3],
-    /// The product's forces then torques, and its velocities then spins (`2n` each).
-    fin: &'v mut [T::V3],
-    out: &'v mut [T::V3],
-    tol: T,
-    cap: u32,
+/// The constraint solve's products: `M_SD` at the start ([`solve::at`]), counted.
+struct Sd<'a, 's, T: Real> {
+    at: &'a mut At<'s, T>,
+    p: &'a Params<T>,
     counts: Counts,
-}
-
-impl<T: Real> Sd<'_, '_, T> {
-    /// `out = M_SD (f, 0)` from the forces in `fin[..n]` (`fin[n..]` zero).
-    fn run(&mut self) -> Result<(), StepError> {
-        let (n, packed) = (self.fin.len() / 2, self.packed);
-        let mut far = |x: &[T::V3], y: &mut [T::V3]| {
-            packed_product::<T>(packed, n, x, y);
-            Ok(())
-        };
-        let (tol, cap) = (self.tol, self.cap);
-        let r = self
-            .solver
-            .product(&mut far, self.fin, self.out, tol, cap)
-            .map_err(error)?;
-        let c = &mut self.counts;
-        if c.products == 0 {
-            c.pairs = u32::try_from(r.pairs).unwrap_or(u32::MAX);
-        }
-        c.products += 1;
-        c.iterations = c.iterations.saturating_add(r.iterations);
-        Ok(())
-    }
-
-    /// `u = M_SD,tt f` and, where `w` is given, `w = M_SD,rt f`.
-    fn velocities(
-        &mut self,
-        f: &[T::V3],
-        u: &mut [T::V3],
-        w: Option<&mut [T::V3]>,
-    ) -> Result<(), StepError> {
-        let n = f.len();
-        self.fin[..n].copy_from_slice(f);
-        self.run()?;
-        u.copy_from_slice(&self.out[..n]);
-        if let Some(w) = w {
-            w.copy_from_slice(&self.out[n..]);
-        }
-        Ok(())
-    }
 }
 
 impl<T: Real> Products<T> for Sd<'_, '_, T> {
@@ -97,15 +51,14 @@ impl<T: Real> Products<T> for Sd<'_, '_, T> {
         out: &mut [T::V3],
         _: &mut [T::V3],
     ) -> Result<(), StepError> {
-        let n = out.len();
-        if !metric.forces(bonds, c, &mut self.fin[..n]) {
-            return Err(StepError::Unsupported(
+        let fill = |f: &mut [T::V3]| match metric.forces(bonds, c, f) {
+            true => Ok(()),
+            false => Err(StepError::Unsupported(
                 "the iterative near field's constraint products along a metric without forces",
-            ));
-        }
-        self.run()?;
-        out.copy_from_slice(&self.out[..n]);
-        Ok(())
+            )),
+        };
+        self.at
+            .velocities_of(self.p, fill, out, None, &mut self.counts)
     }
 }
 
@@ -133,76 +86,54 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
         near_iter,
         ..
     } = v;
-    let Some(nf) = p.near else {
-        return Err(StepError::Unsupported(
-            "the near field's mobility without Params::near",
-        ));
-    };
-    let store = Store::new(near, near_iter);
+    let mut store = Store::new(near, near_iter);
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     // The far field at the start, and the close pairs factored once.
-    let far = crate::integrate::near::far(p, s.ewald)?;
-    let packed = store.packed.get_mut(..tri2(n)).ok_or(STORAGE)?;
-    far.assemble_grand(p.viscosity, s.pos, s.radius, packed)
-        .map_err(error)?;
-    let (io, field) = store.vectors.split_at_mut_checked(4 * n).ok_or(STORAGE)?;
-    let (fin, out) = io.split_at_mut(2 * n);
-    fin[n..].fill(T::v3(T::ZERO, T::ZERO, T::ZERO));
-    let cap = crate::params::NEAR_PAIRS_PER_SPHERE * n;
-    let (pairs, cells) = store.indices.split_at_mut_checked(2 * cap).ok_or(STORAGE)?;
-    let storage = Storage {
-        pairs: pairs.as_chunks_mut::<2>().0,
-        reals: store.reals,
-        field,
-        cells,
-    };
-    let solver = Solver::new(p.viscosity, far, s.pos, s.radius, nf, storage).map_err(error)?;
-    let packed = &*packed;
-    let mut sd = Sd {
-        solver,
-        packed,
-        fin,
-        out,
-        tol: p.solver.tolerance,
-        cap: p.solver.max_iterations,
-        counts: Counts::default(),
-    };
-    sd.velocities(force, u, None)?;
-    add_flow(p, s.pos, u);
-    check_resolved(s.pos, u, dt)?;
-    for i in 0..n {
-        new_pos[i] = s.pos[i] + u[i] * dt;
-    }
-    // The projection: entries from the far field's `mu_tt` (the grand mobility's first
-    // `n` block rows), moves from `M_SD`.
-    bond_vectors(bonds, s.pos, cell(p), grad);
-    let grad = &*grad;
-    let metric = Metric::Mobility {
-        mu: Mob::Full(&packed[..tri(n)]),
-        grad,
-        scale: dt,
-        par: scratch.par,
-        compact: None,
-    };
-    let problem = Problem::Positions {
-        cell: cell(p),
-        one_sided: usize::MAX,
-        #[cfg(feature = "pins")]
-        anchor: s.pos,
-    };
-    lambda.fill(T::ZERO);
-    let (solver, ops) = (&p.solver, (&metric, &mut sd));
-    let stats = krylov_with(problem, ops, bonds, solver, new_pos, lambda, &mut scratch)?;
-    step_velocity(s.pos, new_pos, dt, new_vel);
-    add_constraint_forces(bonds, grad, lambda, force);
-    if p.rotation {
-        sd.velocities(force, u, Some(&mut *new_omega))?;
-    }
-    spins(p, new_omega);
-    Ok(StepReport {
-        near_pairs: sd.counts.pairs,
-        near_products: sd.counts.products,
-        near_iterations: sd.counts.iterations,
-        ..report(stats, 0, bonds, lambda)
+    solve::at(p, s.ewald, (s.pos, s.radius), &mut store, |at| {
+        let packed = at.packed();
+        let mut sd = Sd {
+            at,
+            p,
+            counts: Counts::default(),
+        };
+        sd.at.velocities(p, force, u, None, &mut sd.counts)?;
+        add_flow(p, s.pos, u);
+        check_resolved(s.pos, u, dt)?;
+        for i in 0..n {
+            new_pos[i] = s.pos[i] + u[i] * dt;
+        }
+        // The projection: entries from the far field's `mu_tt` (the grand mobility's first
+        // `n` block rows), moves from `M_SD`.
+        bond_vectors(bonds, s.pos, cell(p), grad);
+        let grad = &*grad;
+        let metric = Metric::Mobility {
+            mu: Mob::Full(&packed[..tri(n)]),
+            grad,
+            scale: dt,
+            par: scratch.par,
+            compact: None,
+        };
+        let problem = Problem::Positions {
+            cell: cell(p),
+            one_sided: usize::MAX,
+            #[cfg(feature = "pins")]
+            anchor: s.pos,
+        };
+        lambda.fill(T::ZERO);
+        let (solver, ops) = (&p.solver, (&metric, &mut sd));
+        let stats = krylov_with(problem, ops, bonds, solver, new_pos, lambda, &mut scratch)?;
+        step_velocity(s.pos, new_pos, dt, new_vel);
+        add_constraint_forces(bonds, grad, lambda, force);
+        if p.rotation {
+            sd.at
+                .velocities(p, force, u, Some(&mut *new_omega), &mut sd.counts)?;
+        }
+        spins(p, new_omega);
+        Ok(StepReport {
+            near_pairs: sd.counts.pairs,
+            near_products: sd.counts.products,
+            near_iterations: sd.counts.iterations,
+            ..report(stats, 0, bonds, lambda)
+        })
     })
 }

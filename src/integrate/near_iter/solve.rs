@@ -57,7 +57,12 @@ pub(super) fn at<T: Real, R>(
     })
 }
 
-impl<T: Real> At<'_, T> {
+impl<'s, T: Real> At<'s, T> {
+    /// The far field's packed grand mobility at this configuration.
+    pub(super) fn packed(&self) -> &'s [T::M3] {
+        self.packed
+    }
+
     /// `out = M_SD f` over the `2n` forces and torques (velocities and spins out), to the
     /// solver's tolerance ([`Params::solver`]); counted in `counts`.
     pub(super) fn apply(
@@ -94,12 +99,27 @@ impl<T: Real> At<'_, T> {
         w: Option<&mut [T::V3]>,
         counts: &mut Counts,
     ) -> Result<(), StepError> {
+        let fill = |fin: &mut [T::V3]| {
+            fin.copy_from_slice(f);
+            Ok(())
+        };
+        self.velocities_of(p, fill, u, w, counts)
+    }
+
+    /// [`Self::velocities`] of the forces `fill` writes (into `n` zeroed vectors).
+    pub(super) fn velocities_of(
+        &mut self,
+        p: &Params<T>,
+        fill: impl FnOnce(&mut [T::V3]) -> Result<(), StepError>,
+        u: &mut [T::V3],
+        w: Option<&mut [T::V3]>,
+        counts: &mut Counts,
+    ) -> Result<(), StepError> {
         let n = self.n;
         let io = core::mem::take(&mut self.io);
         let (fin, out) = io.split_at_mut(2 * n);
-        fin[..n].copy_from_slice(f);
         fin[n..].fill(T::V3_ZERO);
-        let done = self.apply(p, fin, out, counts);
+        let done = fill(&mut fin[..n]).and_then(|()| self.apply(p, fin, out, counts));
         if done.is_ok() {
             u.copy_from_slice(&out[..n]);
             if let Some(w) = w {
