@@ -1,10 +1,14 @@
 //! Records the code version at build time: `git describe` of the checkout, or the
 //! crate version when there is no git (a source archive).
+//!
+//! The commit is abbreviated to a fixed 12 digits: git's automatic length grows with
+//! the number of objects in the repository, so two builds of one commit (the CLI's and
+//! the Python package's, a few minutes apart) could otherwise name it differently.
 
 use std::process::Command;
 
 fn main() {
-    let described = git(&["describe", "--always", "--dirty", "--tags"]);
+    let described = git(&["describe", "--always", "--abbrev=12", "--dirty", "--tags"]);
     let version = match described {
         Some(d) => format!("{} ({d})", env!("CARGO_PKG_VERSION")),
         None => format!("{} (no git)", env!("CARGO_PKG_VERSION")),

@@ -46,6 +46,13 @@ fn the_summary_records_what_a_rerun_needs() {
     assert_eq!(s["scene_path"], scene.display().to_string());
     let version = s["code_version"].as_str().unwrap();
     assert!(version.starts_with(env!("CARGO_PKG_VERSION")), "{version}");
+    // The commit's name has a fixed length, whatever the repository's object count.
+    let inner = version.split(['(', ')']).nth(1).unwrap_or_default();
+    if inner != "no git" {
+        let hash = inner.trim_end_matches("-dirty").rsplit(['-', 'g']).next().unwrap();
+        assert_eq!(hash.len(), 12, "{version}");
+        assert!(hash.chars().all(|c| c.is_ascii_hexdigit()), "{version}");
+    }
     assert!(s["machine"]["cpus"].as_u64().unwrap() >= 1);
     assert_eq!(s["resolved_scene"]["model"]["level"], "manual");
     assert_eq!(
