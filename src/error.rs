@@ -77,7 +77,10 @@ impl Row {
     /// Row `k` of a step whose rows are `rows`, the one-sided ones (contacts, wall
     /// links) from `one_sided` on.
     pub fn of<T: crate::Real>(rows: &[crate::Bond<T>], k: usize, one_sided: usize) -> Self {
-        let b = &rows[k];
+        // A row past the list (no caller names one) is read as a bond: no panic path.
+        let Some(b) = rows.get(k) else {
+            return Self::Bond(k);
+        };
         match () {
             _ if b.is_pin() => Self::Pin {
                 particle: b.i,

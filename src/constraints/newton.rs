@@ -73,6 +73,9 @@ pub fn newton<T: Real>(
     let mut factorizations = 0;
     // Halvings of the update `rhs` taken back so far ([`backtrack`]).
     let mut halvings = 0;
+    // The factor `apply` scales `rhs` by before adding it: 1 after a solve, -1/2 and
+    // then 1/2 for the halvings (exact: powers of two).
+    let mut scale = T::ONE;
     let mut next = 0;
     loop {
         let (mut changed, mut pushes) = (false, true);
@@ -81,7 +84,7 @@ pub fn newton<T: Real>(
         // by another pass: one call site each of the update and of the residual, so
         // that firmware keeps them inline for its one metric (flash).
         if applied {
-            apply(metric, bonds, (from, state), x, mult, rhs, halvings > 0);
+            apply(metric, bonds, (from, state), x, mult, rhs, scale);
         }
         // The residual at the iterate on the equations the last update solved (the
         // active set it was built for; one-sided rows measure it again below, after the
@@ -99,13 +102,11 @@ pub fn newton<T: Real>(
                     // Half of what stands applied taken back by the next pass: `-rhs / 2`
                     // after the update, then half of the last halving (`rhs` holds what
                     // was last applied, the negative of what stands).
-                    let half = match halvings {
+                    // (Scaled by `apply`, in the loop that adds it: one loop, not two.)
+                    scale = match halvings {
                         0 => -T::HALF,
                         _ => T::HALF,
                     };
-                    for v in rhs.iter_mut() {
-                        *v *= half;
-                    }
                     halvings += 1;
                     continue;
                 }
@@ -234,16 +235,18 @@ pub fn newton<T: Real>(
             linalg::lu_solve(jac, nb, piv, rhs);
         }
         // `rhs` is applied at the next iteration's start (the last one returns above).
-        applied = true;
+        (applied, scale) = (true, T::ONE);
     }
 }
 
 /// Halvings of a Newton update that made the residual diverge ([`backtrack`]).
 const HALVINGS: u32 = 10;
 
-/// Adds the update `rhs` to `mult` and its moves to `x`. After a solve's update (not a
-/// halving's, `halved`) the released one-sided rows' multipliers are set to exactly
-/// zero (the solve gives `-lambda_k` to rounding).
+/// Scales the update `rhs` by `scale` (1 after a solve: exact, the update as solved; a
+/// halving's power of two) and adds it to `mult` (`mult` holds a multiplier a row of
+/// `rhs`), and its moves to `x`. After a solve's update (not a halving's) the released
+/// one-sided rows' multipliers are set to exactly zero (the solve gives `-lambda_k` to
+/// rounding).
 #[inline(always)]
 fn apply<T: Real>(
     metric: &Metric<'_, T>,
@@ -251,14 +254,15 @@ fn apply<T: Real>(
     (from, state): (usize, &[usize]),
     x: &mut [T::V3],
     mult: &mut [T],
-    rhs: &[T],
-    halved: bool,
+    rhs: &mut [T],
+    scale: T,
 ) {
-    for (m, &r) in mult.iter_mut().zip(rhs.iter()) {
-        *m += r;
+    for (m, r) in mult.iter_mut().zip(rhs.iter_mut()) {
+        *r *= scale;
+        *m += *r;
     }
     metric.apply_each(bonds, rhs, x);
-    if !halved {
+    if scale == T::ONE {
         for k in from..bonds.len() {
             if !onesided::active(state[k]) {
                 mult[k] = T::ZERO;

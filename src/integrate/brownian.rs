@@ -152,6 +152,7 @@ pub(super) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     }
     Ok(StepReport {
         noise_iterations,
+        #[cfg(feature = "near")]
         near_formations: formed.get(),
         contacts: r.contacts,
         wall_contacts: r.wall_contacts,

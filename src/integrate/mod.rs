@@ -94,9 +94,11 @@ pub struct StepReport<T> {
     /// pair or a sphere is inside its cutoff. The first-order step forms it once, at the
     /// start; the predictor-corrector twice; a Brownian step with the midpoint twice.
     /// 0 with the iterative near field, which forms none ([`Params::matrix_free`]).
+    #[cfg(feature = "near")]
     pub near_formations: u32,
     /// Close pairs the iterative near field corrected at the step's start
     /// ([`Params::near`] with [`Params::matrix_free`]; 0 otherwise).
+    #[cfg(feature = "near")]
     pub near_pairs: u32,
     /// Iterative Stokesian dynamics products the step made (one a mobility: the
     /// first-order step one, the predictor-corrector two; a Brownian step three, the
@@ -105,15 +107,22 @@ pub struct StepReport<T> {
     /// 0 without the iterative near field). The far field's grand mobility is assembled
     /// once a configuration (a Brownian step two: the start and the midpoint; the
     /// constrained step's products share the start's).
+    #[cfg(feature = "near")]
     pub near_products: u32,
     /// Conjugate-gradient iterations of those products, summed; the far field's
     /// products are these plus two a product.
+    #[cfg(feature = "near")]
     pub near_iterations: u32,
     /// Dense factorisations of the constraint Jacobian in the step's position
     /// projection (its last one where there are two; every contact round): the Newton
     /// solve's cost count (0 for the sweep and Krylov).
     pub factorizations: u32,
 }
+
+// Without the near field its counters are not there: a firmware's report (and the
+// zeroing and copying of it every step) stays nine words.
+#[cfg(not(feature = "near"))]
+const _: () = assert!(core::mem::size_of::<StepReport<f32>>() == 9 * 4);
 
 /// Read-only view of the state at the start of a step.
 pub(super) struct Start<'a, T: Real> {

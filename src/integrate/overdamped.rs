@@ -101,6 +101,7 @@ pub(super) fn overdamped<T: Real, E: ExternalForce<T>>(
         spin(p, s.ewald, s.pos, s.radius, force, new_omega)?;
     }
     Ok(StepReport {
+        #[cfg(feature = "near")]
         near_formations: formed.get(),
         contacts: r.contacts,
         wall_contacts: r.wall_contacts,
@@ -274,6 +275,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     step_velocity(s.pos, new_pos, dt, new_vel);
     Ok(StepReport {
         max_tension: tension,
+        #[cfg(feature = "near")]
         near_formations: formed.get(),
         contacts: r.contacts,
         wall_contacts: r.wall_contacts,

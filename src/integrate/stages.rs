@@ -302,20 +302,18 @@ pub(super) fn check_resolved<T: Real>(pos: &[T::V3], u: &[T::V3], dt: T) -> Resu
         a.abs().max(b.abs()).max(c.abs())
     };
     for (&x, &v) in pos.iter().zip(u) {
-        let moved = largest(v) * dt;
-        if !(moved > T::ZERO) || !moved.is_finite() {
-            // A move that underflows to zero is still a move below the spacing.
-            moving |= largest(v) > T::ZERO;
-            continue;
-        }
-        moving = true;
-        if moved >= T::EPSILON * largest(x) {
+        let speed = largest(v);
+        let moved = speed * dt;
+        // A move `> 0` is a speed `> 0`; one that underflows to zero is still a move
+        // below the spacing.
+        moving |= speed > T::ZERO;
+        if moved > T::ZERO && moved.is_finite() && moved >= T::EPSILON * largest(x) {
             return Ok(());
         }
     }
     match moving {
         true => Err(StepError::BadParameter(
-            "dt (so short that no sphere moves by the spacing of its coordinates' precision: the positions would not change and the velocities would be wrong)",
+            "dt (so short that no sphere moves by its coordinates' spacing)",
         )),
         false => Ok(()),
     }
@@ -343,9 +341,13 @@ pub(super) fn report<T: Real>(
         wall_contacts: 0,
         contact_rounds: 0,
         noise_iterations: 0,
+        #[cfg(feature = "near")]
         near_formations: 0,
+        #[cfg(feature = "near")]
         near_pairs: 0,
+        #[cfg(feature = "near")]
         near_products: 0,
+        #[cfg(feature = "near")]
         near_iterations: 0,
         factorizations: stats.factorizations,
     }
