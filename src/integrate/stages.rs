@@ -294,20 +294,13 @@ pub(super) fn project_positions<T: Real>(
 /// goes as `sqrt(dt)`).
 pub(super) fn check_resolved<T: Real>(pos: &[T::V3], u: &[T::V3], dt: T) -> Result<(), StepError> {
     let mut moving = false;
-    // The largest component, not the norm: the norm's square overflows for speeds
-    // above the square root of the largest number (gravity of 1e160), which would read
-    // as no move at all.
-    let largest = |v: T::V3| {
-        let [a, b, c] = T::xyz(v);
-        a.abs().max(b.abs()).max(c.abs())
-    };
     for (&x, &v) in pos.iter().zip(u) {
-        let speed = largest(v);
+        let speed = largest::<T>(v);
         let moved = speed * dt;
         // A move `> 0` is a speed `> 0`; one that underflows to zero is still a move
         // below the spacing.
         moving |= speed > T::ZERO;
-        if moved > T::ZERO && moved.is_finite() && moved >= T::EPSILON * largest(x) {
+        if moved > T::ZERO && moved.is_finite() && moved >= T::EPSILON * largest::<T>(x) {
             return Ok(());
         }
     }
@@ -317,6 +310,16 @@ pub(super) fn check_resolved<T: Real>(pos: &[T::V3], u: &[T::V3], dt: T) -> Resu
         )),
         false => Ok(()),
     }
+}
+
+/// The largest component's magnitude ([`check_resolved`]), not the norm: the norm's
+/// square overflows for speeds above the square root of the largest number (gravity
+/// of 1e160), which would read as no move at all. Out of line: called twice a sphere,
+/// and firmware keeps one copy of it.
+#[inline(never)]
+fn largest<T: Real>(v: T::V3) -> T {
+    let [a, b, c] = T::xyz(v);
+    a.abs().max(b.abs()).max(c.abs())
 }
 
 /// `v = (x' - x) / dt`.
