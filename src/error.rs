@@ -75,7 +75,7 @@ pub enum Row {
 
 impl Row {
     /// Row `k` of a step whose rows are `rows`, the one-sided ones (contacts, wall
-    /// links) from `one_sided` on.
+    /// links) from `one_sided` on; a `k` past `rows` is named as bond `k`.
     pub fn of<T: crate::Real>(rows: &[crate::Bond<T>], k: usize, one_sided: usize) -> Self {
         // A row past the list (no caller names one) is read as a bond: no panic path.
         let Some(b) = rows.get(k) else {

@@ -414,6 +414,8 @@ fn rows_are_named_by_what_they_hold() {
             "the wall contact of particle 5",
         ]
     );
+    // A row past the list is named as a bond (no panic path in the kernel).
+    assert_eq!(Row::of(&rows, rows.len(), 4), Row::Bond(rows.len()));
     let e = StepError::Degenerate {
         bond: 4,
         row: Row::of(&rows, 4, 4),
