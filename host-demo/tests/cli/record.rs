@@ -49,7 +49,11 @@ fn the_summary_records_what_a_rerun_needs() {
     // The commit's name has a fixed length, whatever the repository's object count.
     let inner = version.split(['(', ')']).nth(1).unwrap_or_default();
     if inner != "no git" {
-        let hash = inner.trim_end_matches("-dirty").rsplit(['-', 'g']).next().unwrap();
+        let hash = inner
+            .trim_end_matches("-dirty")
+            .rsplit(['-', 'g'])
+            .next()
+            .unwrap();
         assert_eq!(hash.len(), 12, "{version}");
         assert!(hash.chars().all(|c| c.is_ascii_hexdigit()), "{version}");
     }
