@@ -212,6 +212,7 @@ pub fn krylov_with<T: Real, P: Products<T>>(
         }
         z.copy_from_slice(r);
         band::solve(pre, nb, BAND, z);
+        op.precondition(r, z);
         p.copy_from_slice(z);
         let mut rz = dot(r, z);
         for inner in 0..nb.max(1) {
@@ -272,6 +273,7 @@ pub fn krylov_with<T: Real, P: Products<T>>(
             }
             z.copy_from_slice(r);
             band::solve(pre, nb, BAND, z);
+            op.precondition(r, z);
             let rz_new = dot(r, z);
             let beta = rz_new / rz;
             rz = rz_new;

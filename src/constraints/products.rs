@@ -30,6 +30,11 @@ pub trait Products<T: Real> {
         out: &mut [T::V3],
         tmp: &mut [T::V3],
     ) -> Result<(), StepError>;
+
+    /// `z += P r`: a share of the preconditioner beside the band's solve (none by
+    /// default: the band alone, the same bits).
+    #[inline(always)]
+    fn precondition(&self, _r: &[T], _z: &mut [T]) {}
 }
 
 /// The metric's own products ([`Metric::apply_all`]): every stored, matrix-free and

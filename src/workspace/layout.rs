@@ -56,13 +56,14 @@ const NEAR_PAIR_SCALARS: usize = 2 * 144 + 5 * 12;
 /// `[blocks, vectors, scalars, indices]`. The far field's packed grand mobility
 /// (`tri(2n)` blocks, assembled once a mobility), the product's force-torque and
 /// velocity-spin vectors and its own `6n` vectors, the pairs' scalars, and the pairs'
-/// indices with the pair search's cell list (`3n + 1`).
-pub(crate) const fn near_iterative_sizes(n: usize) -> [usize; 4] {
+/// indices with the pair search's cell list (`3n + 1`); with `constraints` a scalar
+/// each, their squeeze resistances (`integrate::near_iter::constrained`).
+pub(crate) const fn near_iterative_sizes(n: usize, constraints: usize) -> [usize; 4] {
     let pairs = crate::params::NEAR_PAIRS_PER_SPHERE * n;
     [
         tri(2 * n),
         10 * n,
-        NEAR_PAIR_SCALARS * pairs,
+        NEAR_PAIR_SCALARS * pairs + constraints,
         2 * pairs + 3 * n + 1,
     ]
 }
@@ -230,7 +231,7 @@ impl Layout {
         // or the far-field grand mobility's packed blocks and the dense `6n x 6n`
         // mobility formed from them (`stokesian::storage`).
         let l = if near_iterative(p) {
-            let [blocks, vectors, scalars, indices] = near_iterative_sizes(n);
+            let [blocks, vectors, scalars, indices] = near_iterative_sizes(n, c);
             let [noise_vectors, noise_scalars] = near_noise_sizes(p, n);
             Self {
                 blocks: l.blocks + blocks,

@@ -216,7 +216,7 @@ impl<T: Real> Workspace<'_, T> {
         let [noise_v, noise_s] = super::layout::near_noise_sizes(p, n);
         let near = match p.near_on() {
             true if iterative => {
-                let [b, _, s, _] = super::layout::near_iterative_sizes(n);
+                let [b, _, s, _] = super::layout::near_iterative_sizes(n, nb);
                 (bl.take(b), sc.take(s + noise_s))
             }
             true => (
@@ -227,7 +227,7 @@ impl<T: Real> Workspace<'_, T> {
         };
         let near_iter = match iterative {
             true => {
-                let [_, v, _, i] = super::layout::near_iterative_sizes(n);
+                let [_, v, _, i] = super::layout::near_iterative_sizes(n, nb);
                 (ve.take(v + noise_v), ix.take(i))
             }
             false => (ve.take(0), ix.take(0)),
