@@ -1,51 +1,64 @@
-//! The mobility of a step in a periodic box (feature `periodic`): the Ewald sums of
-//! `mobility::periodic` with parameters derived once per step.
+//! What a step's checks derive once and hold for its products ([`Held`]): the box's
+//! Ewald parameters, PSE's ([`Params::pse`](crate::Params::pse)), or the fast
+//! free-space product's, which gives products only as PSE does and reaches the stages
+//! through the same sums; and the storage of a step's fast products over the caller's
+//! arrays ([`Store`]).
 //!
 //! `xi` and the cutoffs come from the box and the step's largest radius by
-//! [`Ewald::new`], once, in the step's checks (`check_periodic`), and every product,
-//! assembly and matrix-free metric block of the step reads that one copy
-//! ([`super::stages::Sums`]): they depend on the box and the radii only, which a step
-//! does not change. Not held in the parameters: the largest radius is the state's (a
-//! radius above a stored one would be refused) and `Params` stays small and `Copy`.
-//! The assembly and the products run in the bands of [`crate::parallel`] (each block
-//! summed on its own, so the same bits on any number of threads); so does the
-//! matrix-free product's real-space half ([`periodic::free_product`]).
+//! [`Ewald::new`], once, in the step's checks (`integrate/checks/periodic_box.rs`), and
+//! every product, assembly and matrix-free metric block of the step reads that one copy
+//! ([`Sums`]): they depend on the box and the radii only, which a step does not change.
+//! Not held in the parameters: the largest radius is the state's (a radius above a
+//! stored one would be refused) and `Params` stays small and `Copy`. The assembly and
+//! the products run in the bands of [`crate::parallel`] (each block summed on its own,
+//! so the same bits on any number of threads); so does the matrix-free product's
+//! real-space half ([`periodic::free_product`](crate::mobility::periodic::free_product)).
 
 use crate::cell::Periodic;
 use crate::error::StepError;
-use crate::geometry::sums::BoxSums;
+#[cfg(feature = "pse")]
+use crate::geometry::fast::Slices;
+#[cfg(feature = "fast-free")]
+use crate::geometry::free::fast::FastStep;
 #[cfg(feature = "pse")]
 use crate::geometry::sums::PseStep;
+use crate::geometry::{HeldSums, Sums, sums::BoxSums};
+#[cfg(feature = "fast-free")]
+use crate::mobility::free_fast::FreeFast;
 use crate::mobility::periodic::Ewald;
 #[cfg(feature = "pse")]
-use crate::mobility::pse::{Pse, PseSize, PseStorage};
+pub use crate::mobility::pse::PseSize;
+#[cfg(feature = "pse")]
+use crate::mobility::pse::{Pse, PseError, PseStorage};
+#[cfg(feature = "pse")]
+use crate::parallel::Parallel;
 use crate::real::Real;
 
-/// What a step in a box holds for its products ([`super::stages::Sums`] borrows it):
-/// the Ewald parameters, or PSE's ([`Params::pse`](crate::Params::pse)).
+/// What a step holds for its products ([`Sums`] borrows it): the Ewald parameters,
+/// PSE's ([`Params::pse`](crate::Params::pse)), or the fast free-space product's.
 #[derive(Debug)]
-pub(super) enum Held<T: Real> {
+pub(crate) enum Held<T: Real> {
     /// The exact Ewald sums.
     Ewald(Ewald<T>),
     /// The PSE fast path.
     #[cfg(feature = "pse")]
     Pse(Pse<T>),
     /// Free space's fast product ([`Params::pse`](crate::Params::pse) without a box):
-    /// the parameters derived for the cloud at the step's start (`integrate::fast`).
+    /// the parameters derived for the cloud at the step's start (`geometry/free/fast.rs`).
     #[cfg(feature = "fast-free")]
-    Fast(crate::mobility::free_fast::FreeFast<T>),
+    Fast(FreeFast<T>),
 }
 
 /// The storage of a step's fast products, over the caller's arrays. One per step, on
 /// its stack: the fast variant's parameters are held by value (no allocation to box them).
 #[cfg(feature = "pse")]
 #[allow(clippy::large_enum_variant)]
-pub(super) enum Store<'a, T: Real> {
+pub(crate) enum Store<'a, T: Real> {
     /// PSE's, in a box.
     Pse(PseStep<'a, T>),
     /// The fast free-space product's.
     #[cfg(feature = "fast-free")]
-    Fast(super::fast::FastStep<'a, T>),
+    Fast(FastStep<'a, T>),
 }
 
 /// The largest radius of the step (the sums accept every radius up to it).
@@ -53,50 +66,71 @@ fn a_max<T: Real>(radius: &[T]) -> T {
     radius.iter().fold(T::ZERO, |m, &a| m.max(a))
 }
 
-/// The PSE parameters of this box, these spheres and the tolerance `tol`.
-#[cfg(feature = "pse")]
-pub(super) fn pse<T: Real>(cell: Periodic<T>, radius: &[T], tol: f64) -> Result<Pse<T>, StepError> {
-    Ok(Pse::new(cell, a_max(radius), tol)?)
-}
+impl<T: Real> Held<T> {
+    /// The Ewald parameters for this box and these spheres (every radius at most the
+    /// largest, so the sums accept each one).
+    pub(crate) fn ewald(cell: Periodic<T>, radius: &[T]) -> Result<Self, StepError> {
+        Ok(Self::Ewald(ewald(cell, radius)?))
+    }
 
-/// The PSE storage a step of these spheres needs with `p`
-/// ([`Workspace::with_pse`](crate::Workspace::with_pse)): `Some` where the step sums
-/// its box by PSE ([`Params::pse`](crate::Params::pse), a box whose images interact), from the same
-/// parameters the step derives; `None` where it needs none. A host sizes its arrays
-/// with it before the first step (the radii do not change during a run).
-#[cfg(feature = "pse")]
-pub fn pse_storage<T: Real>(
-    p: &crate::Params<T>,
-    radius: &[T],
-) -> Result<Option<PseSize>, StepError> {
-    match (super::stages::ewald_cell(p), p.pse) {
-        (Some(c), Some(tol)) => Ok(Some(pse(c, radius, tol)?.storage(radius.len()))),
-        _ => Ok(None),
+    /// The PSE parameters of this box, these spheres and the tolerance `tol`.
+    #[cfg(feature = "pse")]
+    pub(crate) fn pse(cell: Periodic<T>, radius: &[T], tol: f64) -> Result<Self, StepError> {
+        Ok(Self::Pse(pse(cell, radius, tol)?))
     }
 }
 
-/// The Ewald parameters for this box and these spheres (every radius at most the
-/// largest, so the sums accept each one).
-pub(super) fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>, StepError> {
+/// The Ewald parameters for this box and these spheres.
+fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>, StepError> {
     Ok(Ewald::new(cell, a_max(radius))?)
+}
+
+/// The PSE parameters of this box, these spheres and the tolerance `tol`.
+#[cfg(feature = "pse")]
+fn pse<T: Real>(cell: Periodic<T>, radius: &[T], tol: f64) -> Result<Pse<T>, StepError> {
+    Ok(Pse::new(cell, a_max(radius), tol)?)
+}
+
+/// The PSE storage a step of these spheres in `cell` with the tolerance `tol` needs,
+/// from the same parameters the step derives (`integrate::pse_storage`).
+#[cfg(feature = "pse")]
+pub(crate) fn pse_size<T: Real>(
+    cell: Periodic<T>,
+    radius: &[T],
+    tol: f64,
+) -> Result<PseSize, StepError> {
+    Ok(pse(cell, radius, tol)?.storage(radius.len()))
+}
+
+/// The Ewald sums of what the step's checks hold, as [`Sums`] (none for PSE's or the
+/// fast free-space product's, which need their storage: [`step_sums`]).
+pub(crate) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
+    match held.as_ref()? {
+        Held::Ewald(e) => Some(BoxSums::Ewald(e)),
+        #[cfg(feature = "pse")]
+        Held::Pse(_) => None,
+        #[cfg(feature = "fast-free")]
+        Held::Fast(_) => None,
+    }
 }
 
 /// The caller's fast arrays as the step's storage, after checking them against the
 /// step's PSE parameters, or fitting the fast free-space product's to them
-/// (`integrate::fast`); `None` where the step sums by Ewald or takes the pair blocks.
+/// (`geometry/free/fast.rs`); `None` where the step sums by Ewald or takes the pair
+/// blocks.
 #[cfg(feature = "pse")]
-pub(super) fn pse_store<'a, T: Real>(
+pub(crate) fn fast_store<'a, T: Real>(
     held: Option<&'a Held<T>>,
     spheres: (&[T::V3], &[T]),
-    slices: crate::workspace::PseSlices<'a, T>,
-    par: &'a dyn crate::parallel::Parallel,
+    slices: Slices<'a, T>,
+    par: &'a dyn Parallel,
 ) -> Result<Option<Store<'a, T>>, StepError> {
     let n = spheres.0.len();
     let pse = match held {
         Some(Held::Pse(pse)) => pse,
         #[cfg(feature = "fast-free")]
         Some(Held::Fast(fast)) => {
-            let step = super::fast::FastStep::new(fast, spheres, slices, par)?;
+            let step = FastStep::new(fast, spheres, slices, par)?;
             return Ok(Some(Store::Fast(step)));
         }
         _ => return Ok(None),
@@ -104,7 +138,7 @@ pub(super) fn pse_store<'a, T: Real>(
     let (complex, index, vectors, _) = slices;
     let need = pse.storage(n);
     if complex.len() < need.complex || index.len() < need.index || vectors.len() < need.vectors {
-        return Err(crate::mobility::pse::PseError::Storage {
+        return Err(PseError::Storage {
             need: [need.complex, need.index, need.vectors],
             have: [complex.len(), index.len(), vectors.len()],
         }
@@ -114,13 +148,13 @@ pub(super) fn pse_store<'a, T: Real>(
     Ok(Some(Store::Pse(PseStep::new(pse, store))))
 }
 
-/// The step's sums ([`super::stages::Sums`]) over what its checks hold and, for PSE,
-/// the storage [`pse_store`] made.
+/// The step's sums ([`Sums`]) over what its checks hold and, for PSE, the storage
+/// [`fast_store`] made.
 #[cfg(feature = "pse")]
-pub(super) fn sums<'a, T: Real>(
+pub(crate) fn step_sums<'a, T: Real>(
     held: Option<&'a Held<T>>,
     store: Option<&'a Store<'_, T>>,
-) -> super::stages::Sums<'a, T> {
+) -> Sums<'a, T> {
     match (held?, store) {
         (Held::Ewald(e), _) => Some(BoxSums::Ewald(e)),
         (_, Some(Store::Pse(s))) => Some(BoxSums::Pse(s)),
@@ -128,14 +162,14 @@ pub(super) fn sums<'a, T: Real>(
         // it through the same variant.
         #[cfg(feature = "fast-free")]
         (_, Some(Store::Fast(s))) => Some(BoxSums::Pse(s)),
-        // `pse_store` makes the storage for every fast step.
+        // `fast_store` makes the storage for every fast step.
         (_, None) => None,
     }
 }
 
-/// The step's sums ([`super::stages::Sums`]): Ewald's (no `pse` feature).
+/// The step's sums ([`Sums`]): Ewald's (no `pse` feature).
 #[cfg(not(feature = "pse"))]
-pub(super) fn sums<T: Real>(held: Option<&Held<T>>) -> super::stages::Sums<'_, T> {
+pub(crate) fn step_sums<T: Real>(held: Option<&Held<T>>) -> Sums<'_, T> {
     match held? {
         Held::Ewald(e) => Some(BoxSums::Ewald(e)),
     }
@@ -150,7 +184,6 @@ mod tests {
     use crate::mobility::periodic;
     use crate::noise::reduced;
     use crate::parallel::{self, Serial, band_scratch};
-    use crate::params::Params;
     use crate::real::Real;
     use glam::DVec3;
 
@@ -178,8 +211,8 @@ mod tests {
             DVec3::new(libm::sin(i as f64), 0.5, libm::cos(0.3 * i as f64))
         });
         let cell = Periodic::new([12.0; 3])?;
-        let mut p = Params::<f64>::new(0.01);
-        p.periodic = Some(cell);
+        // The parameters' default viscosity.
+        let eta = 1.0;
         let ew = ewald(cell, &radius)?;
         let mut bands = [DVec3::ZERO; band_scratch(N)];
         let spheres = (&pos[..], &radius[..]);
@@ -189,26 +222,10 @@ mod tests {
         let mut copy = [f64::M3_ZERO; reduced::slots(N)];
         let mu = MobMut::Sym(&mut plain);
         let work = (&Serial as &dyn parallel::Parallel, &mut bands[..]);
-        periodic::assemble_apply(
-            &ew,
-            p.viscosity,
-            spheres,
-            mu,
-            (&f, &mut u_plain),
-            work,
-            None,
-        )?;
+        periodic::assemble_apply(&ew, eta, spheres, mu, (&f, &mut u_plain), work, None)?;
         let mu = MobMut::Sym(&mut packed);
         let (work, side) = ((&Serial as _, &mut bands[..]), Some(&mut copy[..]));
-        periodic::assemble_apply(
-            &ew,
-            p.viscosity,
-            spheres,
-            mu,
-            (&f, &mut u_packed),
-            work,
-            side,
-        )?;
+        periodic::assemble_apply(&ew, eta, spheres, mu, (&f, &mut u_packed), work, side)?;
         let same = |a: &[DVec3], b: &[DVec3]| {
             a.iter()
                 .zip(b)
