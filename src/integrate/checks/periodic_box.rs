@@ -197,7 +197,7 @@ fn fast_sums<T: Real>(
             "the fast free-space product with Hydro::Oseen (it is RPY's)",
         ));
     }
-    // Rotation is served: the spins come from the grand product (`integrate::fast`).
+    // Rotation is served: the spins come from the grand product (`geometry/free/fast.rs`).
     let unrotated = Params {
         rotation: false,
         ..*p
