@@ -1,7 +1,7 @@
 //! What the fast products have in common, whichever geometry they serve (feature
 //! `pse`): PSE's in a periodic box (`geometry/sums.rs`) and the fast free-space
 //! product's (`geometry/free/fast.rs`, feature `fast-free`) give products and noise
-//! only, over the caller's arrays ([`Slices`]), and the step's stages read either
+//! only, over the caller's arrays (`Slices`), and the step's stages read either
 //! through [`FastProduct`].
 
 use crate::error::StepError;
