@@ -73,12 +73,10 @@ pub(crate) type HeldSums<T> = Option<periodic::held::Held<T>>;
 #[cfg(not(feature = "periodic"))]
 pub(crate) type HeldSums<T> = Option<PhantomData<T>>;
 
-#[cfg(feature = "pse")]
-pub use periodic::held::PseSize;
 #[cfg(feature = "periodic")]
 pub(crate) use periodic::held::{Held, held_ewald, step_sums};
 #[cfg(feature = "pse")]
-pub(crate) use periodic::held::{fast_store, pse_size};
+pub(crate) use periodic::held::{PseSize, fast_store, pse_size};
 
 /// The Ewald sums of what the step's checks hold: nothing to hold without the
 /// `periodic` feature.

@@ -12,8 +12,6 @@ use super::Named;
 use crate::cell::{Periodic, PeriodicError};
 use crate::error::{ParticleError, StepError};
 use crate::mobility::Hydro;
-#[cfg(feature = "pse")]
-use crate::mobility::pse::PseError;
 use crate::real::Real;
 
 /// The parameters name a periodic box (with a wall also asked for, which the checks
@@ -98,12 +96,12 @@ impl From<PeriodicError> for StepError {
     }
 }
 
-/// A PSE product's error as the step's own ([`PseError`]): the
+/// A PSE product's error as the step's own (`mobility::pse::PseError`): the
 /// box and particles as the Ewald path's, the rest named.
 #[cfg(feature = "pse")]
-impl From<PseError> for StepError {
-    fn from(e: PseError) -> Self {
-        use PseError as E;
+impl From<crate::mobility::pse::PseError> for StepError {
+    fn from(e: crate::mobility::pse::PseError) -> Self {
+        use crate::mobility::pse::PseError as E;
         match e {
             E::Periodic(e) => e.into(),
             E::GridTooLarge => Self::Unsupported(

@@ -2,7 +2,7 @@
 //! Ewald parameters, PSE's ([`Params::pse`](crate::Params::pse)), or the fast
 //! free-space product's, which gives products only as PSE does and reaches the stages
 //! through the same sums; and the storage of a step's fast products over the caller's
-//! arrays ([`Store`]).
+//! arrays (`Store`).
 //!
 //! `xi` and the cutoffs come from the box and the step's largest radius by
 //! [`Ewald::new`], once, in the step's checks (`integrate/checks/periodic_box.rs`), and
@@ -16,23 +16,12 @@
 
 use crate::cell::Periodic;
 use crate::error::StepError;
-#[cfg(feature = "pse")]
-use crate::geometry::fast::Slices;
-#[cfg(feature = "fast-free")]
-use crate::geometry::free::fast::FastStep;
-#[cfg(feature = "pse")]
-use crate::geometry::sums::PseStep;
 use crate::geometry::{HeldSums, Sums, sums::BoxSums};
-#[cfg(feature = "fast-free")]
-use crate::mobility::free_fast::FreeFast;
 use crate::mobility::periodic::Ewald;
-#[cfg(feature = "pse")]
-pub use crate::mobility::pse::PseSize;
-#[cfg(feature = "pse")]
-use crate::mobility::pse::{Pse, PseError, PseStorage};
-#[cfg(feature = "pse")]
-use crate::parallel::Parallel;
 use crate::real::Real;
+
+#[cfg(feature = "pse")]
+pub(crate) use fast::{PseSize, fast_store, pse_size, step_sums};
 
 /// What a step holds for its products ([`Sums`] borrows it): the Ewald parameters,
 /// PSE's ([`Params::pse`](crate::Params::pse)), or the fast free-space product's.
@@ -42,23 +31,11 @@ pub(crate) enum Held<T: Real> {
     Ewald(Ewald<T>),
     /// The PSE fast path.
     #[cfg(feature = "pse")]
-    Pse(Pse<T>),
+    Pse(crate::mobility::pse::Pse<T>),
     /// Free space's fast product ([`Params::pse`](crate::Params::pse) without a box):
     /// the parameters derived for the cloud at the step's start (`geometry/free/fast.rs`).
     #[cfg(feature = "fast-free")]
-    Fast(FreeFast<T>),
-}
-
-/// The storage of a step's fast products, over the caller's arrays. One per step, on
-/// its stack: the fast variant's parameters are held by value (no allocation to box them).
-#[cfg(feature = "pse")]
-#[allow(clippy::large_enum_variant)]
-pub(crate) enum Store<'a, T: Real> {
-    /// PSE's, in a box.
-    Pse(PseStep<'a, T>),
-    /// The fast free-space product's.
-    #[cfg(feature = "fast-free")]
-    Fast(FastStep<'a, T>),
+    Fast(crate::mobility::free_fast::FreeFast<T>),
 }
 
 /// The largest radius of the step (the sums accept every radius up to it).
@@ -72,12 +49,6 @@ impl<T: Real> Held<T> {
     pub(crate) fn ewald(cell: Periodic<T>, radius: &[T]) -> Result<Self, StepError> {
         Ok(Self::Ewald(ewald(cell, radius)?))
     }
-
-    /// The PSE parameters of this box, these spheres and the tolerance `tol`.
-    #[cfg(feature = "pse")]
-    pub(crate) fn pse(cell: Periodic<T>, radius: &[T], tol: f64) -> Result<Self, StepError> {
-        Ok(Self::Pse(pse(cell, radius, tol)?))
-    }
 }
 
 /// The Ewald parameters for this box and these spheres.
@@ -85,85 +56,14 @@ fn ewald<T: Real>(cell: Periodic<T>, radius: &[T]) -> Result<Ewald<T>, StepError
     Ok(Ewald::new(cell, a_max(radius))?)
 }
 
-/// The PSE parameters of this box, these spheres and the tolerance `tol`.
-#[cfg(feature = "pse")]
-fn pse<T: Real>(cell: Periodic<T>, radius: &[T], tol: f64) -> Result<Pse<T>, StepError> {
-    Ok(Pse::new(cell, a_max(radius), tol)?)
-}
-
-/// The PSE storage a step of these spheres in `cell` with the tolerance `tol` needs,
-/// from the same parameters the step derives (`integrate::pse_storage`).
-#[cfg(feature = "pse")]
-pub(crate) fn pse_size<T: Real>(
-    cell: Periodic<T>,
-    radius: &[T],
-    tol: f64,
-) -> Result<PseSize, StepError> {
-    Ok(pse(cell, radius, tol)?.storage(radius.len()))
-}
-
 /// The Ewald sums of what the step's checks hold, as [`Sums`] (none for PSE's or the
-/// fast free-space product's, which need their storage: [`step_sums`]).
+/// fast free-space product's, which need their storage: `step_sums`).
 pub(crate) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
     match held.as_ref()? {
         Held::Ewald(e) => Some(BoxSums::Ewald(e)),
-        #[cfg(feature = "pse")]
-        Held::Pse(_) => None,
-        #[cfg(feature = "fast-free")]
-        Held::Fast(_) => None,
-    }
-}
-
-/// The caller's fast arrays as the step's storage, after checking them against the
-/// step's PSE parameters, or fitting the fast free-space product's to them
-/// (`geometry/free/fast.rs`); `None` where the step sums by Ewald or takes the pair
-/// blocks.
-#[cfg(feature = "pse")]
-pub(crate) fn fast_store<'a, T: Real>(
-    held: Option<&'a Held<T>>,
-    spheres: (&[T::V3], &[T]),
-    slices: Slices<'a, T>,
-    par: &'a dyn Parallel,
-) -> Result<Option<Store<'a, T>>, StepError> {
-    let n = spheres.0.len();
-    let pse = match held {
-        Some(Held::Pse(pse)) => pse,
-        #[cfg(feature = "fast-free")]
-        Some(Held::Fast(fast)) => {
-            let step = FastStep::new(fast, spheres, slices, par)?;
-            return Ok(Some(Store::Fast(step)));
-        }
-        _ => return Ok(None),
-    };
-    let (complex, index, vectors, _) = slices;
-    let need = pse.storage(n);
-    if complex.len() < need.complex || index.len() < need.index || vectors.len() < need.vectors {
-        return Err(PseError::Storage {
-            need: [need.complex, need.index, need.vectors],
-            have: [complex.len(), index.len(), vectors.len()],
-        }
-        .into());
-    }
-    let store = PseStorage::new(complex, index, vectors).with_parallel(par);
-    Ok(Some(Store::Pse(PseStep::new(pse, store))))
-}
-
-/// The step's sums ([`Sums`]) over what its checks hold and, for PSE, the storage
-/// [`fast_store`] made.
-#[cfg(feature = "pse")]
-pub(crate) fn step_sums<'a, T: Real>(
-    held: Option<&'a Held<T>>,
-    store: Option<&'a Store<'_, T>>,
-) -> Sums<'a, T> {
-    match (held?, store) {
-        (Held::Ewald(e), _) => Some(BoxSums::Ewald(e)),
-        (_, Some(Store::Pse(s))) => Some(BoxSums::Pse(s)),
-        // The fast free-space product gives products only, as PSE does: the stages read
-        // it through the same variant.
-        #[cfg(feature = "fast-free")]
-        (_, Some(Store::Fast(s))) => Some(BoxSums::Pse(s)),
-        // `fast_store` makes the storage for every fast step.
-        (_, None) => None,
+        // PSE's and the fast product's, where the kernel has them.
+        #[allow(unreachable_patterns)]
+        _ => None,
     }
 }
 
@@ -172,6 +72,109 @@ pub(crate) fn step_sums<'a, T: Real>(
 pub(crate) fn step_sums<T: Real>(held: Option<&Held<T>>) -> Sums<'_, T> {
     match held? {
         Held::Ewald(e) => Some(BoxSums::Ewald(e)),
+    }
+}
+
+/// The fast products' part (feature `pse`): PSE's parameters, and the storage of a
+/// step's fast products over the caller's arrays ([`Store`]).
+#[cfg(feature = "pse")]
+mod fast {
+    use super::{Held, a_max};
+    use crate::cell::Periodic;
+    use crate::error::StepError;
+    use crate::geometry::fast::Slices;
+    #[cfg(feature = "fast-free")]
+    use crate::geometry::free::fast::FastStep;
+    use crate::geometry::{Sums, sums::BoxSums, sums::PseStep};
+    pub use crate::mobility::pse::PseSize;
+    use crate::mobility::pse::{Pse, PseError, PseStorage};
+    use crate::parallel::Parallel;
+    use crate::real::Real;
+
+    /// The storage of a step's fast products, over the caller's arrays. One per step, on
+    /// its stack: the fast variant's parameters are held by value (no allocation to box
+    /// them).
+    #[allow(clippy::large_enum_variant)]
+    pub(crate) enum Store<'a, T: Real> {
+        /// PSE's, in a box.
+        Pse(PseStep<'a, T>),
+        /// The fast free-space product's.
+        #[cfg(feature = "fast-free")]
+        Fast(FastStep<'a, T>),
+    }
+
+    impl<T: Real> Held<T> {
+        /// The PSE parameters of this box, these spheres and the tolerance `tol`.
+        pub(crate) fn pse(cell: Periodic<T>, radius: &[T], tol: f64) -> Result<Self, StepError> {
+            Ok(Self::Pse(pse(cell, radius, tol)?))
+        }
+    }
+
+    /// The PSE parameters of this box, these spheres and the tolerance `tol`.
+    fn pse<T: Real>(cell: Periodic<T>, radius: &[T], tol: f64) -> Result<Pse<T>, StepError> {
+        Ok(Pse::new(cell, a_max(radius), tol)?)
+    }
+
+    /// The PSE storage a step of these spheres in `cell` with the tolerance `tol` needs,
+    /// from the same parameters the step derives (`integrate::pse_storage`).
+    pub(crate) fn pse_size<T: Real>(
+        cell: Periodic<T>,
+        radius: &[T],
+        tol: f64,
+    ) -> Result<PseSize, StepError> {
+        Ok(pse(cell, radius, tol)?.storage(radius.len()))
+    }
+
+    /// The caller's fast arrays as the step's storage, after checking them against the
+    /// step's PSE parameters, or fitting the fast free-space product's to them
+    /// (`geometry/free/fast.rs`); `None` where the step sums by Ewald or takes the pair
+    /// blocks.
+    pub(crate) fn fast_store<'a, T: Real>(
+        held: Option<&'a Held<T>>,
+        spheres: (&[T::V3], &[T]),
+        slices: Slices<'a, T>,
+        par: &'a dyn Parallel,
+    ) -> Result<Option<Store<'a, T>>, StepError> {
+        let n = spheres.0.len();
+        let pse = match held {
+            Some(Held::Pse(pse)) => pse,
+            #[cfg(feature = "fast-free")]
+            Some(Held::Fast(fast)) => {
+                let step = FastStep::new(fast, spheres, slices, par)?;
+                return Ok(Some(Store::Fast(step)));
+            }
+            _ => return Ok(None),
+        };
+        let (complex, index, vectors, _) = slices;
+        let need = pse.storage(n);
+        if complex.len() < need.complex || index.len() < need.index || vectors.len() < need.vectors
+        {
+            return Err(PseError::Storage {
+                need: [need.complex, need.index, need.vectors],
+                have: [complex.len(), index.len(), vectors.len()],
+            }
+            .into());
+        }
+        let store = PseStorage::new(complex, index, vectors).with_parallel(par);
+        Ok(Some(Store::Pse(PseStep::new(pse, store))))
+    }
+
+    /// The step's sums ([`Sums`]) over what its checks hold and, for PSE, the storage
+    /// [`fast_store`] made.
+    pub(crate) fn step_sums<'a, T: Real>(
+        held: Option<&'a Held<T>>,
+        store: Option<&'a Store<'_, T>>,
+    ) -> Sums<'a, T> {
+        match (held?, store) {
+            (Held::Ewald(e), _) => Some(BoxSums::Ewald(e)),
+            (_, Some(Store::Pse(s))) => Some(BoxSums::Pse(s)),
+            // The fast free-space product gives products only, as PSE does: the stages
+            // read it through the same variant.
+            #[cfg(feature = "fast-free")]
+            (_, Some(Store::Fast(s))) => Some(BoxSums::Pse(s)),
+            // `fast_store` makes the storage for every fast step.
+            (_, None) => None,
+        }
     }
 }
 
