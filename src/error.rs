@@ -297,54 +297,6 @@ impl From<ParticleError> for StepError {
     }
 }
 
-/// A box or Ewald parameter the step cannot use: typed as the step's own errors (a
-/// radius or particle as [`StepError::Particle`], a parameter as
-/// [`StepError::BadParameter`], a box beyond the sums' bounds as
-/// [`StepError::Unsupported`]), so that no new variant reaches callers' matches.
-impl From<crate::cell::PeriodicError> for StepError {
-    fn from(e: crate::cell::PeriodicError) -> Self {
-        use crate::cell::PeriodicError as E;
-        match e {
-            E::BadEdge { .. } => Self::BadParameter("periodic (every edge finite and > 0)"),
-            E::BadParameter(name) => Self::BadParameter(name),
-            E::SphereTooLarge => {
-                Self::BadParameter("periodic (every radius below half the smallest edge)")
-            }
-            E::TooElongated => Self::Unsupported(
-                "a periodic box too elongated for the Ewald sums (mobility::periodic::MAX_INDEX)",
-            ),
-            E::Radius { particle } => Self::Particle(ParticleError::BadRadius { particle }),
-            E::Particle(e) => Self::Particle(e),
-        }
-    }
-}
-
-/// A PSE product's error as the step's own ([`crate::mobility::pse::PseError`]): the
-/// box and particles as the Ewald path's, the rest named.
-#[cfg(feature = "pse")]
-impl From<crate::mobility::pse::PseError> for StepError {
-    fn from(e: crate::mobility::pse::PseError) -> Self {
-        use crate::mobility::pse::PseError as E;
-        match e {
-            E::Periodic(e) => e.into(),
-            E::GridTooLarge => Self::Unsupported(
-                "a PSE tolerance whose grid exceeds the bounds (mobility::pse::MAX_GRID, MAX_SUPPORT)",
-            ),
-            E::Length => Self::BadParameter("PSE: positions, radii and forces differ in length"),
-            E::LargeSphere => Self::Unsupported(
-                "PSE with a sphere's radius at least a third of the box's smallest edge (mobility::pse::MAX_RADIUS_FRACTION): it misses its tolerance there",
-            ),
-            E::Precision { .. } => Self::BadParameter(
-                "a PSE tolerance below what the precision can reach (mobility::pse::min_tolerance)",
-            ),
-            E::Lanczos(e) => e.into(),
-            E::Storage { .. } => Self::BadParameter(
-                "the workspace's PSE storage (Workspace::with_pse, at least integrate::pse_storage)",
-            ),
-        }
-    }
-}
-
 /// A fast free-space product's error as the step's own
 /// ([`crate::mobility::free_fast::FreeError`]): particles as the pair blocks', the rest
 /// named (no new variant reaches callers' matches).

@@ -39,6 +39,8 @@
 //! checks (a file under `integrate/checks/`, one call in
 //! `check_all`), its feature, and its tests.
 
+#[cfg(feature = "pse")]
+pub mod fast;
 pub mod free;
 pub mod periodic;
 #[cfg(feature = "periodic")]
@@ -62,6 +64,26 @@ pub type Sums<'a, T> = Option<sums::BoxSums<'a, T>>;
 /// The step's periodic sums: none without the `periodic` feature (always `None`).
 #[cfg(not(feature = "periodic"))]
 pub type Sums<'a, T> = Option<&'a PhantomData<T>>;
+
+/// What the step's checks derive once and hold for [`Sums`] to borrow (the box's Ewald
+/// or PSE parameters, the fast free-space product's: `periodic/held.rs`).
+#[cfg(feature = "periodic")]
+pub(crate) type HeldSums<T> = Option<periodic::held::Held<T>>;
+/// What the step's checks hold for [`Sums`] to borrow: nothing without the feature.
+#[cfg(not(feature = "periodic"))]
+pub(crate) type HeldSums<T> = Option<PhantomData<T>>;
+
+#[cfg(feature = "periodic")]
+pub(crate) use periodic::held::{Held, held_ewald, step_sums};
+#[cfg(feature = "pse")]
+pub(crate) use periodic::held::{PseSize, fast_store, pse_size};
+
+/// The Ewald sums of what the step's checks hold: nothing to hold without the
+/// `periodic` feature.
+#[cfg(not(feature = "periodic"))]
+pub(crate) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
+    held.as_ref()
+}
 
 /// Whether a geometry this kernel was built with has pair blocks that are not
 /// symmetric (the wall's: block `(j, i)` is the transpose of `(i, j)`), so that the

@@ -43,7 +43,8 @@
 //!    noise and the bands.
 //! 7. **The step's error**: [`error`] ([`StepError`], which wraps every error below and
 //!    reports a [`Layout`]). Builds on the geometries.
-//! 8. **The geometry a step sees**: [`geometry`] (the periodic sums held for a step), and
+//! 8. **The geometry a step sees**: [`geometry`] (each geometry's step, what a step
+//!    holds for its products: the periodic sums, the fast free-space product), and
 //!    `stokesian` (feature `near`: the dense Stokesian dynamics mobility, far field plus
 //!    the near field's pair and wall corrections, in free space, above the wall or in
 //!    the box, and `stokesian::iterative`, its product for many spheres by conjugate

@@ -16,6 +16,8 @@
 use crate::fault::ParticleError;
 use crate::real::Real;
 
+#[cfg(feature = "pse")]
+pub(crate) mod fft;
 #[cfg(feature = "fast-free")]
 pub mod free_fast;
 mod grand;

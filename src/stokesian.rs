@@ -30,6 +30,7 @@
 
 mod far;
 pub mod iterative;
+mod wall;
 
 pub use far::Far;
 
@@ -37,9 +38,7 @@ use crate::cell::PeriodicError;
 use crate::error::LinalgError;
 use crate::error::ParticleError;
 use crate::linalg::{spd_inverse, tri};
-use crate::mobility::wall::{self_wall, self_wall_rot};
 use crate::mobility::{Hydro, pair_blocks, self_rr, self_tt};
-use crate::near::wall::wall_scalars;
 use crate::near::{NearError, near_correction};
 use crate::real::Real;
 
@@ -170,7 +169,7 @@ pub fn mobility_in<T: Real>(
     spd_inverse(out, m).map_err(SdError::NotPositiveDefinite)?;
     add_pairs(eta, far, pos, radius, near, out)?;
     if let Some(h) = wall {
-        add_walls(eta, h, pos, radius, near, out)?;
+        wall::add_walls(eta, h, pos, radius, near, out)?;
     }
     spd_inverse(out, m).map_err(SdError::NotPositiveDefinite)
 }
@@ -307,55 +306,4 @@ pub fn pair_far<T: Real>(eta: T, a1: T, a2: T, r: T::V3) -> [[T::M3; 4]; 4] {
         f[3][2] = T::transpose(p.rr);
     }
     f
-}
-
-/// Adds each close sphere's wall correction to the resistance in `out`.
-fn add_walls<T: Real>(
-    eta: T,
-    height: T,
-    pos: &[T::V3],
-    radius: &[T],
-    near: NearField<T>,
-    out: &mut [T],
-) -> Result<(), SdError> {
-    let n = pos.len();
-    let m = 6 * n;
-    for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
-        let delta = (T::xyz(p)[2] - height) / a - T::ONE;
-        if !(delta < near.wall_cutoff) {
-            continue;
-        }
-        let delta = if delta < near.min_gap {
-            near.min_gap
-        } else {
-            delta
-        };
-        let h = a * (T::ONE + delta);
-        let w = wall_scalars(a, h).map_err(|why| SdError::Near { i, j: i, why })?;
-        let pi = T::PI * eta;
-        let (ta, ra) = (T::from_f64(6.0) * pi * a, T::from_f64(8.0) * pi * a * a * a);
-        let b = T::from_f64(8.0) * pi * a * a * w.yb;
-        // The far 6x6 self mobility decouples into z-translation, z-rotation and the two
-        // (U_x, W_y), (U_y, W_x) pairs, whose 2x2 inverses are closed forms.
-        let (par, perp) = self_wall(eta, a, h);
-        let (rpar, rperp, c) = self_wall_rot(eta, a, h);
-        let det = par * rpar - c * c;
-        let (t, r) = (i, n + i);
-        let mut put = |bi: usize, k: usize, bj: usize, l: usize, v: T| {
-            out[(3 * bi + k) * m + 3 * bj + l] += v;
-        };
-        put(t, 2, t, 2, ta * w.xa - T::ONE / perp);
-        put(r, 2, r, 2, ra * w.xc - T::ONE / rperp);
-        for k in 0..2 {
-            put(t, k, t, k, ta * w.ya - rpar / det);
-            put(r, k, r, k, ra * w.yc - par / det);
-        }
-        // (U_x, W_y): exact -b, far -c / det; (U_y, W_x): +b and +c / det.
-        let cross = b - c / det;
-        for (k, l, sign) in [(0, 1, -T::ONE), (1, 0, T::ONE)] {
-            put(t, k, r, l, sign * cross);
-            put(r, l, t, k, sign * cross);
-        }
-    }
-    Ok(())
 }

@@ -68,7 +68,7 @@ pub enum Metric<'a, T: Real> {
     /// which refuses nested spheres.
     Free {
         /// The geometry: free space, the wall, or the box with the step's periodic sums
-        /// (derived once per step, not per block: `integrate/periodic.rs`); PSE has
+        /// (derived once per step, not per block: `geometry/periodic/held.rs`); PSE has
         /// products only (its `D_l(p)` entries are zero: the step refuses the solvers
         /// that read them).
         hydro: Hydrodynamics<'a, T>,

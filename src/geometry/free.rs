@@ -1,5 +1,9 @@
 //! Free space: the pair blocks of `rpy.rs` through `mobility.rs`, in the bands of
-//! `parallel/` (the band loops of `parallel/source.rs` and `mobility/grand.rs`).
+//! `parallel/` (the band loops of `parallel/source.rs` and `mobility/grand.rs`); and
+//! the fast free-space product's steps (`free/fast.rs`, feature `fast-free`).
+
+#[cfg(feature = "fast-free")]
+pub(crate) mod fast;
 
 use super::Geometry;
 use crate::cell::Periodic;

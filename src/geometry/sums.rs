@@ -11,13 +11,16 @@
 //! held in a `RefCell` ([`PseStep`]) so that the step's products, which share the
 //! metric and product closures by shared reference, can each borrow it in turn (they
 //! never nest, so a borrow never fails; if one did, the product reports it). The
-//! step's stages see it as a [`BoxProduct`] trait object: the storage's own lifetime
+//! step's stages see it as a [`FastProduct`] trait object (`geometry/fast.rs`, shared
+//! with the fast free-space product): the storage's own lifetime
 //! stays out of their signatures.
 
 #[cfg(feature = "pse")]
 use core::cell::RefCell;
 use core::fmt;
 
+#[cfg(feature = "pse")]
+use super::fast::FastProduct;
 use crate::error::StepError;
 use crate::mobility::periodic::{self, Ewald};
 #[cfg(feature = "pse")]
@@ -33,53 +36,7 @@ pub enum BoxSums<'a, T: Real> {
     Ewald(&'a Ewald<T>),
     /// The PSE product (`docs/PERIODIC.md`, section PSE) with its storage ([`PseStep`]).
     #[cfg(feature = "pse")]
-    Pse(&'a dyn BoxProduct<T>),
-}
-
-/// A product `u = M f` of the box's mobility, over storage the implementor holds.
-pub trait BoxProduct<T: Real> {
-    /// `u = M f` with viscosity `eta` for the spheres at `pos` with radii `radius`.
-    fn product(
-        &self,
-        eta: T,
-        pos: &[T::V3],
-        radius: &[T],
-        f: &[T::V3],
-        u: &mut [T::V3],
-    ) -> Result<(), StepError>;
-
-    /// `out = M_rt F`: the spins of torque-free spheres from the forces `f` they exert
-    /// on the fluid. Only products that carry rotation give it (the fast free-space
-    /// product with [`Params::rotation`](crate::Params::rotation)); the rest refuse.
-    fn spin(
-        &self,
-        eta: T,
-        spheres: (&[T::V3], &[T]),
-        f: &[T::V3],
-        out: &mut [T::V3],
-    ) -> Result<(), StepError> {
-        let _ = (eta, spheres, f, out);
-        Err(StepError::Unsupported(
-            "spins from a fast product without rotation (its rt products are not built)",
-        ))
-    }
-
-    /// `out` = a Brownian displacement of covariance `M` by the sums' own noise
-    /// ([`Pse::noise_in`]: the real part by Lanczos to `s` from the deviates `z`,
-    /// the wave part from white noise on the grid), drawn from `rng`; `basis` and
-    /// `work` hold the Lanczos basis. Returns the Lanczos iterations.
-    #[cfg(feature = "pse")]
-    #[allow(clippy::too_many_arguments)]
-    fn noise(
-        &self,
-        eta: T,
-        spheres: (&[T::V3], &[T]),
-        rng: &mut Noise,
-        s: Lanczos<T>,
-        z: &mut [T::V3],
-        out: &mut [T::V3],
-        scratch: (&mut [T::V3], &mut [T]),
-    ) -> Result<u32, StepError>;
+    Pse(&'a dyn FastProduct<T>),
 }
 
 /// PSE's parameters and the caller's storage for one step's products.
@@ -101,7 +58,7 @@ impl<'s, T: Real> PseStep<'s, T> {
 }
 
 #[cfg(feature = "pse")]
-impl<T: Real> BoxProduct<T> for PseStep<'_, T> {
+impl<T: Real> FastProduct<T> for PseStep<'_, T> {
     fn product(
         &self,
         eta: T,
@@ -159,7 +116,7 @@ impl<T: Real> fmt::Debug for BoxSums<'_, T> {
 impl<'a, T: Real> BoxSums<'a, T> {
     /// The PSE sums' own products and noise, where the step sums by PSE.
     #[cfg(feature = "pse")]
-    pub fn pse(self) -> Option<&'a dyn BoxProduct<T>> {
+    pub fn pse(self) -> Option<&'a dyn FastProduct<T>> {
         match self {
             Self::Ewald(_) => None,
             Self::Pse(p) => Some(p),

@@ -14,8 +14,6 @@
 
 #[cfg(feature = "fast-free")]
 pub use fast::{FAST_MARGIN, fast_storage, fast_vectors};
-#[cfg(feature = "pse")]
-pub use periodic::pse_storage;
 
 mod brownian;
 mod checks;
@@ -27,8 +25,6 @@ mod near;
 #[cfg(feature = "near")]
 mod near_iter;
 mod overdamped;
-#[cfg(feature = "periodic")]
-mod periodic;
 mod pins;
 #[cfg(feature = "pse")]
 mod pse_noise;
@@ -57,6 +53,22 @@ use crate::params::{Method, Params};
 use crate::particles::{ParticleSet, State};
 use crate::real::Real;
 use crate::workspace::Workspace;
+
+/// The PSE storage a step of these spheres needs with `p`
+/// ([`Workspace::with_pse`](crate::Workspace::with_pse)): `Some` where the step sums
+/// its box by PSE ([`Params::pse`], a box whose images interact), from the same
+/// parameters the step derives; `None` where it needs none. A host sizes its arrays
+/// with it before the first step (the radii do not change during a run).
+#[cfg(feature = "pse")]
+pub fn pse_storage<T: Real>(
+    p: &Params<T>,
+    radius: &[T],
+) -> Result<Option<crate::geometry::PseSize>, StepError> {
+    match (stages::ewald_cell(p), p.pse) {
+        (Some(c), Some(tol)) => Ok(Some(crate::geometry::pse_size(c, radius, tol)?)),
+        _ => Ok(None),
+    }
+}
 
 /// What a successful step measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -227,7 +239,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
         let store = {
             let slices = core::mem::take(&mut v.pse);
             let spheres = (&*state.pos, state.radius);
-            periodic::pse_store(sums.as_ref(), spheres, slices, v.par)?
+            crate::geometry::fast_store(sums.as_ref(), spheres, slices, v.par)?
         };
         let s = Start {
             pos: state.pos,
@@ -236,9 +248,9 @@ fn advance<T: Real, E: ExternalForce<T>>(
             radius: state.radius,
             density: state.density,
             #[cfg(feature = "pse")]
-            ewald: periodic::sums(sums.as_ref(), store.as_ref()),
+            ewald: crate::geometry::step_sums(sums.as_ref(), store.as_ref()),
             #[cfg(all(feature = "periodic", not(feature = "pse")))]
-            ewald: periodic::sums(sums.as_ref()),
+            ewald: crate::geometry::step_sums(sums.as_ref()),
             #[cfg(not(feature = "periodic"))]
             ewald: sums.as_ref(),
         };

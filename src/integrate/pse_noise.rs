@@ -12,7 +12,7 @@
 
 use super::Start;
 use crate::error::StepError;
-use crate::geometry::sums::BoxProduct;
+use crate::geometry::fast::FastProduct;
 use crate::noise::Noise;
 use crate::params::{Drift, Params};
 use crate::real::Real;
@@ -33,7 +33,7 @@ pub(super) fn draw<T: Real>(
     p: &Params<T>,
     drift: Drift,
     s: &Start<'_, T>,
-    sums: &dyn BoxProduct<T>,
+    sums: &dyn FastProduct<T>,
     noise: &mut Noise,
     (w, mid, dx): Vectors<'_, T>,
     basis: &mut [T::V3],
@@ -62,7 +62,7 @@ pub(super) fn draw<T: Real>(
 fn solve<T: Real>(
     p: &Params<T>,
     s: &Start<'_, T>,
-    sums: &dyn BoxProduct<T>,
+    sums: &dyn FastProduct<T>,
     b: &[T::V3],
     x: &mut [T::V3],
     r: &mut [T::V3],

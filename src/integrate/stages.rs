@@ -13,7 +13,7 @@ use crate::parallel::Parallel;
 use crate::params::Params;
 use crate::real::Real;
 
-pub(super) use crate::geometry::{PSE_ASSEMBLED, Sums};
+pub(super) use crate::geometry::{HeldSums, PSE_ASSEMBLED, Sums, held_ewald};
 
 /// The step's geometry ([`Hydrodynamics`]) from its parameters and its periodic sums
 /// `ew` ([`Sums`]): the one place a stage turns the parameters into it.
@@ -21,32 +21,6 @@ pub(super) use crate::geometry::{PSE_ASSEMBLED, Sums};
 pub(super) fn hydro<'a, T: Real>(p: &Params<T>, ew: Sums<'a, T>) -> Hydrodynamics<'a, T> {
     Hydrodynamics::at(p.place(), p.hydro, p.viscosity, ew)
 }
-
-/// The Ewald sums of what [`super::checks::check_box`] holds, as [`Sums`] (it never
-/// holds PSE's).
-#[cfg(feature = "periodic")]
-pub(super) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
-    match held.as_ref()? {
-        super::periodic::Held::Ewald(e) => Some(crate::geometry::sums::BoxSums::Ewald(e)),
-        #[cfg(feature = "pse")]
-        super::periodic::Held::Pse(_) => None,
-        #[cfg(feature = "fast-free")]
-        super::periodic::Held::Fast(_) => None,
-    }
-}
-
-/// Nothing to hold without the `periodic` feature.
-#[cfg(not(feature = "periodic"))]
-pub(super) fn held_ewald<T: Real>(held: &HeldSums<T>) -> Sums<'_, T> {
-    held.as_ref()
-}
-
-/// What the step's checks hold for [`Sums`] to borrow.
-#[cfg(feature = "periodic")]
-pub(super) type HeldSums<T> = Option<super::periodic::Held<T>>;
-/// What the step's checks hold for [`Sums`] to borrow: nothing without the feature.
-#[cfg(not(feature = "periodic"))]
-pub(super) type HeldSums<T> = Option<core::marker::PhantomData<T>>;
 
 /// `u = mu_tt(pos) f`: assembled into `mu` and applied in one pass, in bands through
 /// `par` (`bands` holds their partial sums, [`crate::parallel`]), or matrix-free (then

@@ -37,7 +37,7 @@ use core::fmt;
 
 use crate::cell_list::CellList;
 use crate::fault::ParticleError;
-use crate::mobility::pse::fft::Cx;
+use crate::mobility::fft::Cx;
 use crate::parallel::{Parallel, Serial};
 use crate::real::Real;
 use near::{Spheres, partial_len};

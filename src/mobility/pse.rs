@@ -5,7 +5,7 @@
 //! factors `1 - k^2 a^2 / 6`, summed differently:
 //!
 //! * wave space on a grid: Gaussian spreading of `F_j` and `a_j^2 F_j` (`spread.rs`), a
-//!   3D FFT (`fft.rs`), the kernel mode by mode (`wave.rs`), the inverse FFT and
+//!   3D FFT (`mobility/fft.rs`), the kernel mode by mode (`wave.rs`), the inverse FFT and
 //!   Gaussian interpolation;
 //! * real space as a sparse near-field sum with a cell list (`near.rs`), each block the
 //!   Ewald path's real-space block, so the halves add to the same periodic RPY.
@@ -17,7 +17,6 @@
 //! `unsafe`: the caller owns the grid, the cell list and the rows ([`Pse::storage`],
 //! [`PseStorage`]).
 
-pub(crate) mod fft;
 mod jobs;
 mod near;
 mod noise;
@@ -28,7 +27,10 @@ mod wave;
 use core::convert::Infallible;
 use core::fmt;
 
-pub use fft::{Cx, good_size};
+pub use super::fft::{Cx, good_size};
+// The transform is shared with the fast free-space product; named here for the PSE
+// grid's files.
+use super::fft;
 pub use spread::MAX_SUPPORT;
 
 use crate::fault::ParticleError;

@@ -71,9 +71,7 @@ impl<T: Real> Far<'_, T> {
     ) -> Result<(), SdError> {
         match self {
             Self::Free => crate::mobility::assemble_grand(Hydro::Rpy, eta, pos, radius, packed),
-            Self::Wall(h) => {
-                crate::mobility::wall::assemble_grand(Hydro::Rpy, eta, h, pos, radius, packed)
-            }
+            Self::Wall(h) => return super::wall::far_grand(eta, h, pos, radius, packed),
             #[cfg(feature = "periodic")]
             Self::Box(e) => {
                 return crate::mobility::periodic::assemble_grand(e, eta, pos, radius, packed)

@@ -48,16 +48,9 @@ pub struct Workspace<'a, T: Real> {
     pub(crate) pse: PseSlices<'a, T>,
 }
 
-/// The caller's fast products' arrays: complex values, indices, vectors
-/// ([`crate::mobility::pse::PseStorage`]) and reals (the fast free-space product's
-/// kernel, `mobility::free_fast::FreeStorage`).
+/// The caller's fast products' arrays (complex values, indices, vectors, reals).
 #[cfg(feature = "pse")]
-pub(crate) type PseSlices<'a, T> = (
-    &'a mut [crate::mobility::pse::Cx<T>],
-    &'a mut [usize],
-    &'a mut [<T as Real>::V3],
-    &'a mut [T],
-);
+pub(crate) use crate::geometry::fast::Slices as PseSlices;
 
 impl<'a, T: Real> Workspace<'a, T> {
     /// A workspace over four caller-owned slices (contents are overwritten by steps).
@@ -101,7 +94,7 @@ impl<'a, T: Real> Workspace<'a, T> {
     #[cfg(feature = "pse")]
     pub fn with_pse(
         self,
-        complex: &'a mut [crate::mobility::pse::Cx<T>],
+        complex: &'a mut [crate::mobility::fft::Cx<T>],
         index: &'a mut [usize],
         vectors: &'a mut [T::V3],
     ) -> Self {
@@ -124,7 +117,7 @@ impl<'a, T: Real> Workspace<'a, T> {
     #[cfg(feature = "fast-free")]
     pub fn with_fast(
         self,
-        complex: &'a mut [crate::mobility::pse::Cx<T>],
+        complex: &'a mut [crate::mobility::fft::Cx<T>],
         reals: &'a mut [T],
         index: &'a mut [usize],
     ) -> Self {

@@ -6,7 +6,7 @@
 //! off by 0.46 to 15 times the box's (the box removes the mean flow), so a copy of the
 //! wrong blocks fails by far. The copy is packed by `reduced::copy_apply`, whose packer
 //! is the one the box's assembly pass calls row by row; that pass itself (the blocks
-//! and first product unchanged by packing) is checked in `integrate::periodic`'s unit
+//! and first product unchanged by packing) is checked in `geometry::periodic::held`'s unit
 //! test, and whole compact steps in a box in `parallel/tests/parallel/compact.rs`.
 //!
 //! 512 spheres (`BANDED_MIN`: sixteen bands, two column tiles of the copy) on a

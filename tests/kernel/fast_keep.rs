@@ -1,5 +1,5 @@
 //! The fast free-space product's kernel transform kept in the caller's reals between
-//! steps (`mobility::free_fast`, `integrate::fast`): a step whose parameters, derived
+//! steps (`mobility::free_fast`, `geometry::free::fast`): a step whose parameters, derived
 //! from the cloud's rounded bounding box, are those the transform was computed for keeps
 //! it, and gives the bits of the same step on freshly zeroed arrays. Checked:
 //!

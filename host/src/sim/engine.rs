@@ -153,7 +153,7 @@ impl<T: Real> Engine<T> {
                 vectors: 0,
             });
         // Or the fast free-space product's, sized from the first configuration (the
-        // step keeps within them as the cloud moves: `integrate::fast`).
+        // step keeps within them as the cloud moves: the kernel's `src/geometry/free/fast.rs`).
         let fast = hydrorattle::integrate::fast_storage(&params, &beads.pos, &beads.radius);
         let (pse, fast) = match fast.ok().flatten() {
             Some(f) => (

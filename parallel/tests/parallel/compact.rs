@@ -305,7 +305,7 @@ fn compact_products_in_a_box_meet_the_tolerance_near_the_f64_trajectory_with_the
         "golden digest of the compact steps in the box"
     );
     // The two trajectories differ by the rounded mobility's share of the constraint
-    // moves: each product is right to ~3e-7 relative (`integrate/periodic.rs`), the
+    // moves: each product is right to ~3e-7 relative (`geometry/periodic/held.rs`), the
     // constraint moves are at most the beads' moves, `moved`, so after `steps` steps
     // the gap is bounded by `steps x 1e-6 x moved` (a factor of three over the product
     // error for the solve's amplification).

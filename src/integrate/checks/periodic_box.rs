@@ -8,8 +8,6 @@
 use crate::bonds::Bond;
 use crate::cell::Periodic;
 use crate::error::{ParticleError, StepError};
-#[cfg(feature = "periodic")]
-use crate::integrate::periodic;
 use crate::integrate::stages::{HeldSums, PSE_ASSEMBLED};
 use crate::mobility::Hydro;
 use crate::params::{Method, Params};
@@ -108,8 +106,7 @@ fn box_geometry<T: Real>(p: &Params<T>, radius: &[T]) -> Result<Option<Periodic<
 /// The step's Ewald parameters.
 #[cfg(feature = "periodic")]
 fn ewald_sums<T: Real>(c: Periodic<T>, radius: &[T]) -> Result<HeldSums<T>, StepError> {
-    let e = periodic::ewald(c, radius)?;
-    Ok(Some(periodic::Held::Ewald(e)))
+    Ok(Some(crate::geometry::Held::ewald(c, radius)?))
 }
 
 /// Without the `periodic` feature the box was refused above.
@@ -136,11 +133,7 @@ fn pse_sums<T: Real>(
     let rotation = "PSE with rotation (its rt and rr products are not built: Ewald sums them)";
     products_only(p, state.len(), bonds, (PSE_ASSEMBLED, rotation))?;
     #[cfg(feature = "pse")]
-    return Ok(Some(periodic::Held::Pse(periodic::pse(
-        c,
-        state.radius,
-        tol,
-    )?)));
+    return Ok(Some(crate::geometry::Held::pse(c, state.radius, tol)?));
     #[cfg(not(feature = "pse"))]
     {
         let _ = (c, tol);
@@ -176,7 +169,7 @@ const FAST_ASSEMBLED: &str = "the fast free-space product (Params::pse without a
 
 /// Free space with [`Params::pse`]: the fast free-space product (kernel feature
 /// `fast-free`), RPY only, products only, no wall; its parameters derived
-/// from the cloud at the step's start (`integrate::fast`). `None` without `pse`, and
+/// from the cloud at the step's start (`geometry/free/fast.rs`). `None` without `pse`, and
 /// with free draining (no pair blocks to replace).
 fn fast_sums<T: Real>(
     p: &Params<T>,
@@ -204,19 +197,21 @@ fn fast_sums<T: Real>(
             "the fast free-space product with Hydro::Oseen (it is RPY's)",
         ));
     }
-    // Rotation is served: the spins come from the grand product (`integrate::fast`).
+    // Rotation is served: the spins come from the grand product (`geometry/free/fast.rs`).
     let unrotated = Params {
         rotation: false,
         ..*p
     };
     products_only(&unrotated, state.len(), bonds, (FAST_ASSEMBLED, ""))?;
     #[cfg(feature = "fast-free")]
-    return Ok(Some(periodic::Held::Fast(super::super::fast::params(
-        (tol, p.rotation),
-        state.pos,
-        state.radius,
-        [usize::MAX; 2],
-    )?)));
+    return Ok(Some(crate::geometry::Held::Fast(
+        crate::geometry::free::fast::params(
+            (tol, p.rotation),
+            state.pos,
+            state.radius,
+            [usize::MAX; 2],
+        )?,
+    )));
     #[cfg(not(feature = "fast-free"))]
     {
         let _ = tol;

@@ -10,7 +10,7 @@ use core::convert::Infallible;
 use super::near::Spheres;
 use super::pieces::{none, pieces, rows};
 use super::{FreeFast, radial, spectral};
-use crate::mobility::pse::fft::Cx;
+use crate::mobility::fft::Cx;
 use crate::parallel::Parallel;
 use crate::real::Real;
 

@@ -22,7 +22,7 @@
 use core::convert::Infallible;
 
 use super::pieces::{JOBS, fixed, none, pieces, range, rows};
-use crate::mobility::pse::fft::{CHUNK, Cx, Factors, good_size, transform};
+use crate::mobility::fft::{CHUNK, Cx, Factors, good_size, transform};
 use crate::parallel::Parallel;
 use crate::real::Real;
 

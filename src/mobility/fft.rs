@@ -1,4 +1,5 @@
-//! A `no_std` mixed-radix (2, 3, 4, 5) FFT over caller storage, for the PSE grid.
+//! A `no_std` mixed-radix (2, 3, 4, 5) FFT over caller storage, for the grids of PSE
+//! (`mobility/pse.rs`) and of the fast free-space product (`mobility/free_fast.rs`).
 //!
 //! Why our own and not rustfft: the kernel promises the same bits on x86_64, aarch64 and
 //! the M4, with no `unsafe`. rustfft chooses SIMD code paths at run time (so the bits

@@ -1,0 +1,66 @@
+//! What the fast products have in common, whichever geometry they serve (feature
+//! `pse`): PSE's in a periodic box (`geometry/sums.rs`) and the fast free-space
+//! product's (`geometry/free/fast.rs`, feature `fast-free`) give products and noise
+//! only, over the caller's arrays (`Slices`), and the step's stages read either
+//! through [`FastProduct`].
+
+use crate::error::StepError;
+use crate::mobility::fft::Cx;
+use crate::noise::{Noise, lanczos::Lanczos};
+use crate::real::Real;
+
+/// The caller's fast products' arrays: complex values, indices, vectors (PSE's
+/// storage) and reals (the fast free-space product's kernel).
+pub(crate) type Slices<'a, T> = (
+    &'a mut [Cx<T>],
+    &'a mut [usize],
+    &'a mut [<T as Real>::V3],
+    &'a mut [T],
+);
+
+/// A product `u = M f` of a geometry's mobility over storage the implementor holds:
+/// PSE's in a box ([`PseStep`](super::sums::PseStep)), the fast free-space product's
+/// (`geometry/free/fast.rs`).
+pub trait FastProduct<T: Real> {
+    /// `u = M f` with viscosity `eta` for the spheres at `pos` with radii `radius`.
+    fn product(
+        &self,
+        eta: T,
+        pos: &[T::V3],
+        radius: &[T],
+        f: &[T::V3],
+        u: &mut [T::V3],
+    ) -> Result<(), StepError>;
+
+    /// `out = M_rt F`: the spins of torque-free spheres from the forces `f` they exert
+    /// on the fluid. Only products that carry rotation give it (the fast free-space
+    /// product with [`Params::rotation`](crate::Params::rotation)); the rest refuse.
+    fn spin(
+        &self,
+        eta: T,
+        spheres: (&[T::V3], &[T]),
+        f: &[T::V3],
+        out: &mut [T::V3],
+    ) -> Result<(), StepError> {
+        let _ = (eta, spheres, f, out);
+        Err(StepError::Unsupported(
+            "spins from a fast product without rotation (its rt products are not built)",
+        ))
+    }
+
+    /// `out` = a Brownian displacement of covariance `M` by the sums' own noise
+    /// (PSE's [`Pse::noise_in`](crate::mobility::pse::Pse::noise_in): the real part by Lanczos to `s` from the deviates `z`,
+    /// the wave part from white noise on the grid), drawn from `rng`; `basis` and
+    /// `work` hold the Lanczos basis. Returns the Lanczos iterations.
+    #[allow(clippy::too_many_arguments)]
+    fn noise(
+        &self,
+        eta: T,
+        spheres: (&[T::V3], &[T]),
+        rng: &mut Noise,
+        s: Lanczos<T>,
+        z: &mut [T::V3],
+        out: &mut [T::V3],
+        scratch: (&mut [T::V3], &mut [T]),
+    ) -> Result<u32, StepError>;
+}
