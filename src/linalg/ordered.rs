@@ -62,7 +62,10 @@ pub fn ordered_append<T: Real>(
             true => T::ZERO,
             false => {
                 let l_j = &done[j * n..j * n + j];
-                let s = row[..j].iter().zip(l_j).fold(T::ZERO, |s, (&a, &b)| s + a * b);
+                let s = row[..j]
+                    .iter()
+                    .zip(l_j)
+                    .fold(T::ZERO, |s, (&a, &b)| s + a * b);
                 (row[j] - s) * inv
             }
         };
