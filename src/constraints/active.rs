@@ -64,17 +64,16 @@ impl<T: Real> Rows<'_, '_, T> {
     }
 
     /// The factor of `m` rows brought to the current set: released rows removed (from
-    /// the last position up), rows taken in appended in list order. Returns the rows
-    /// added and removed, and the dependent rows counted.
+    /// the last position up), rows taken in appended in list order. Returns the
+    /// dependent rows counted.
     pub fn sync(
         &self,
         state: &[usize],
         order: &mut [usize],
         m: &mut usize,
         jac: &mut [T],
-    ) -> Result<(usize, usize), LinalgError> {
+    ) -> Result<usize, LinalgError> {
         let nb = self.bonds.len();
-        let mut moved = 0;
         for p in (0..*m).rev() {
             if !self.on(state, order[p]) {
                 order.copy_within(p + 1..*m, p);
@@ -83,7 +82,6 @@ impl<T: Real> Rows<'_, '_, T> {
                     self.entry(order[j], order[j])
                 });
                 *m -= 1;
-                moved += 1;
             }
         }
         for k in self.from..nb {
@@ -95,11 +93,9 @@ impl<T: Real> Rows<'_, '_, T> {
                 .map_err(|_| LinalgError::NotPositiveDefinite { row: k })?;
                 order[*m] = k;
                 *m += 1;
-                moved += 1;
             }
         }
-        let deficient = (0..*m).filter(|&i| jac[i * nb + i] == T::ZERO).count();
-        Ok((moved, deficient))
+        Ok((0..*m).filter(|&i| jac[i * nb + i] == T::ZERO).count())
     }
 
     /// The update for the right-hand side `rhs` (all rows): the inactive rows'

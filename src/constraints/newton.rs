@@ -217,7 +217,7 @@ pub fn newton<T: Real>(
                 }
                 Some(mut m) => {
                     if changed {
-                        deficient = rows.sync(state, piv, &mut m, jac).map_err(fail)?.1;
+                        deficient = rows.sync(state, piv, &mut m, jac).map_err(fail)?;
                     }
                     m
                 }
