@@ -15,6 +15,7 @@
 //! ([`Bond::pin`]) are such links along x, y or z, measured from their anchors
 //! ([`Problem::Positions`]), and are equalities among the bonds.
 
+mod active;
 mod dependent;
 mod krylov;
 mod metric;

@@ -1,7 +1,7 @@
 //! Newton on the dense `bonds x bonds` Jacobian, solved by LU: quadratic convergence,
 //! `O(B^3)` per factorisation. The choice for small bond counts.
 
-use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided, worst};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, active, dependent, onesided, worst};
 use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::linalg;
@@ -30,9 +30,10 @@ use crate::real::Real;
 ///   iterate takes over as without dependent rows).
 /// * One-sided rows (contacts, wall links: [`Problem::Positions`]) are inequalities:
 ///   each iteration decides which of them are equalities (`onesided.rs`, the
-///   primal-dual active set); the others get a zero update on a decoupled diagonal
-///   row. A change of the set refactorises. Without one-sided rows nothing of this
-///   runs.
+///   primal-dual active set); the others are left out of the chord's factor, which
+///   is formed once per solve and then follows the set row by row (`active.rs`:
+///   `O(rows^2)` a change instead of `O(rows^3)`). Without one-sided rows nothing of
+///   this runs.
 pub fn newton<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,
@@ -62,8 +63,6 @@ pub fn newton<T: Real>(
     let floor = dependent::rank_floor::<T>();
     // Dependent rows found by the last factorisation.
     let mut deficient = 0;
-    // The chord is kept to the end (one-sided rows dependent at the iterate only).
-    let mut stay = false;
     // `rhs` holds the update applied by the last iteration (none before the first).
     let mut applied = false;
     // `jac` holds the chord's factor of the current active set: the chord matrix does
@@ -77,6 +76,17 @@ pub fn newton<T: Real>(
     // then 1/2 for the halvings (exact: powers of two).
     let mut scale = T::ONE;
     let mut next = 0;
+    // One-sided rows: the chord's factor of the active rows follows the set row by row
+    // (`active.rs`); `piv` holds its rows by position, `held` of them (none before the
+    // first build).
+    let rows = active::Rows {
+        metric,
+        bonds,
+        c: problem.chord_factor(),
+        from,
+        floor,
+    };
+    let mut held: Option<usize> = None;
     loop {
         let (mut changed, mut pushes) = (false, true);
         // The last iteration's update is applied at the start of the next, where its
@@ -148,49 +158,33 @@ pub fn newton<T: Real>(
             && !changed
             && previous.is_some_and(|p| residual > p * T::HALF)
         {
-            // Named by the chord's self-stress (an LU factor shows only which columns
-            // it skipped): refactorised here, on the way out.
-            // (Kept where `jac` already holds it: one-sided rows stay on the chord.)
-            let chord_deficient = match chord && fresh {
-                true => Ok(deficient),
-                false => {
-                    let c = problem.chord_factor();
-                    for k in 0..nb {
-                        let row = &mut jac[k * nb..k * nb + k + 1];
-                        metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
-                    }
-                    if one_sided {
-                        decouple(jac, rhs, nb, (from, state), mult, true);
-                    }
-                    factorizations += 1;
-                    linalg::cholesky_dense(jac, nb, floor)
-                }
-            };
-            fresh = chord && chord_deficient.is_ok();
-            if one_sided && chord_deficient == Ok(0) {
-                // Dependent at the iterate only (a pair turned far within the step):
-                // no self-stress to name; the chord, which has none, goes on alone.
-                (chord, stay, previous) = (true, true, None);
-                continue;
-            }
-            if one_sided {
-                // An active contact that the contradiction asks to open is let go
-                // (`onesided.rs`); the set changed: refactorised.
-                let v = dependent::null_vector(jac, nb, rhs);
+            if let Some(m) = held.filter(|_| one_sided) {
+                // The factor follows the set (it is that of the current one). An active
+                // contact that the contradiction asks to open is let go (`onesided.rs`).
+                let v = linalg::ordered_null(jac, nb, m, piv, rhs);
                 if onesided::let_go(&problem, metric, bonds, from, v, x, state) {
-                    (previous, fresh) = (None, false);
+                    previous = None;
                     continue;
                 }
+                return Err(dependent::self_stress(metric, v));
             }
+            // Named by the chord's self-stress (an LU factor shows only which columns
+            // it skipped): refactorised here, on the way out.
+            let c = problem.chord_factor();
+            for k in 0..nb {
+                let row = &mut jac[k * nb..k * nb + k + 1];
+                metric.jacobian_row(bonds, k, metric.grad(k) * c, 0, row);
+            }
+            let _ = linalg::cholesky_dense(jac, nb, floor);
             return Err(dependent::infeasible(metric, bonds, jac, rhs));
         }
         // `rebuild`: the matrix is formed and factorised again (a refresh on the chord
         // whose set is unchanged keeps the factor it would recompute).
         let refresh = previous.is_none() || !fast || changed;
-        if refresh && previous.is_some() && !changed && !stay && !one_sided {
+        if refresh && previous.is_some() && !changed && !one_sided {
             chord = false;
         }
-        let rebuild = refresh && !(chord && fresh);
+        let rebuild = refresh && !(chord && fresh) && !one_sided;
         previous = Some(residual);
         for (k, b) in bonds.iter().enumerate() {
             // Without the magnitude (not read here) off 32-bit Arm; the firmware keeps
@@ -210,13 +204,30 @@ pub fn newton<T: Real>(
                 metric.jacobian_row(bonds, k, dir, 0, &mut jac[k * nb..k * nb + len]);
             }
         }
-        if one_sided {
-            decouple(jac, rhs, nb, (from, state), mult, rebuild);
-        }
         let fail = |error| StepError::Linalg {
             stage: problem.stage(),
             error,
         };
+        if one_sided {
+            let m = match held {
+                None => {
+                    factorizations += 1;
+                    let (m, d) = rows.build(state, piv, jac).map_err(fail)?;
+                    deficient = d;
+                    m
+                }
+                Some(mut m) => {
+                    if changed {
+                        deficient = rows.sync(state, piv, &mut m, jac).map_err(fail)?;
+                    }
+                    m
+                }
+            };
+            held = Some(m);
+            rows.solve(state, (piv, m), jac, mult, rhs);
+            applied = true;
+            continue;
+        }
         if rebuild {
             factorizations += 1;
         }
@@ -296,43 +307,6 @@ fn backtrack<T: Real>(r: T, halvings: u32, previous: Option<T>, tolerance: T) ->
         return Some(true);
     }
     (halvings < HALVINGS).then_some(false)
-}
-
-/// The inactive one-sided rows' equations (of the chord's lower triangle) replaced by
-/// `A_kk delta_k = -A_kk lambda_k`: their row and column zeroed but the diagonal, the
-/// active rows' right-hand side corrected by `A_jk lambda_k` (the release of `lambda_k`
-/// solved with them, `onesided.rs`). `refresh`: the triangle was just built (otherwise
-/// it is the factor of the same set, every inactive multiplier already zero).
-fn decouple<T: Real>(
-    jac: &mut [T],
-    rhs: &mut [T],
-    nb: usize,
-    (from, state): (usize, &[usize]),
-    mult: &[T],
-    refresh: bool,
-) {
-    for k in from..nb {
-        if onesided::active(state[k]) {
-            continue;
-        }
-        if !refresh {
-            rhs[k] = T::ZERO;
-            continue;
-        }
-        let l = mult[k];
-        for j in 0..nb {
-            if j == k {
-                continue;
-            }
-            let at = if j < k { k * nb + j } else { j * nb + k };
-            rhs[j] += jac[at] * l;
-            jac[at] = T::ZERO;
-        }
-        if !(jac[k * nb + k] > T::ZERO) {
-            jac[k * nb + k] = T::ONE;
-        }
-        rhs[k] = -jac[k * nb + k] * l;
-    }
 }
 
 /// Largest `|A_kk|`: the scale of the LU rank tolerance (the rows of one problem share

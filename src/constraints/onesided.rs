@@ -9,7 +9,7 @@
 //!   pull) the one that pulls hardest is released. A released row's multiplier goes to
 //!   zero in the next linear solve (`delta_k = -lambda_k`, the active rows'
 //!   right-hand side corrected by `A_:k lambda_k`); its row and column are otherwise
-//!   decoupled (Newton: the diagonal alone; Krylov: masked out of the conjugate
+//!   decoupled (Newton: left out of the factor; Krylov: masked out of the conjugate
 //!   gradients). `A_kk` is the chord matrix's diagonal (the scale that turns a
 //!   multiplier into a residual). Where the active equalities contradict each other
 //!   along a self-stress, [`let_go`] releases the contact that can open (Farkas).

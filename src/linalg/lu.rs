@@ -186,7 +186,7 @@ fn column_rows<T: Real, const W: usize>(
 /// `L_kk = sqrt(A_kk - sum_j L_kj^2)` for `row = [L_k0, .., L_k(k-1), A_kk]`; stores and
 /// returns `1 / L_kk`, or zero for a dependent row (`d <= floor A_kk`).
 #[inline(always)]
-fn pivot<T: Real>(row: &mut [T], k: usize, floor: T) -> Result<T, LinalgError> {
+pub(super) fn pivot<T: Real>(row: &mut [T], k: usize, floor: T) -> Result<T, LinalgError> {
     let (head, last) = row.split_at_mut(k);
     let d = head.iter().fold(last[0], |s, &x| s - x * x);
     if !(d > T::ZERO && d.is_finite()) || d <= floor * last[0] {

@@ -20,12 +20,14 @@
 pub mod band;
 pub(crate) mod block;
 mod lu;
+mod ordered;
 pub(crate) mod packed;
 
 pub(crate) use block::with_blocks;
 pub use block::{Block, Mob, MobMut, Sym};
 
 pub use lu::{cholesky_dense, cholesky_dense_solve, lu, lu_ranked, lu_solve, spd_inverse};
+pub use ordered::{ordered_append, ordered_build, ordered_null, ordered_remove, ordered_solve};
 
 use crate::fault::LinalgError;
 use crate::real::Real;

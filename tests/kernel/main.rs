@@ -60,6 +60,7 @@ mod near_iter_brownian;
 #[cfg(feature = "near")]
 mod near_step;
 mod observables;
+mod ordered_factor;
 #[cfg(all(feature = "contacts", feature = "periodic", feature = "wall"))]
 mod pair_search;
 #[cfg(feature = "periodic")]

@@ -1,6 +1,7 @@
 //! `StepReport::factorizations` on a settling contact pile: the dense Newton solve
-//! reports its Jacobian factorisations (at least one per active-set round), the sweep
-//! and Krylov none; the pile lands with every contact and wall link held.
+//! reports its factorisations from scratch (at most one per active-set round: the
+//! factor then follows the active set row by row), the sweep and Krylov none; the pile
+//! lands with every contact and wall link held.
 
 use hydrorattle::{
     Bond, Contacts, Layout, Method, NoForce, Params, Real, SolverKind, State, Wall, step_slices,
@@ -92,12 +93,13 @@ fn counts(kind: SolverKind) -> (u32, u32) {
 fn factorisations_are_counted() {
     let (f, rounds) = counts(SolverKind::Newton);
     println!("Newton: {f} factorisations in {rounds} rounds");
-    // Each round's solve factorises at least once, and at most once an iteration.
+    // The factor of the active rows follows the set row by row: one factorisation from
+    // scratch per round's solve at most, however often the set changes in it (a
+    // factorisation at each change of the set took 303 in these 61 rounds).
     assert!(
-        rounds >= 30 && f >= rounds,
+        rounds >= 30 && f <= rounds,
         "{f} factorisations in {rounds} rounds"
     );
-    assert!(f <= rounds * 5001, "{f} factorisations in {rounds} rounds");
     for kind in [SolverKind::Krylov, SolverKind::Sweep] {
         assert_eq!(counts(kind).0, 0, "{kind:?}");
     }
