@@ -115,6 +115,7 @@ fn auto_path(text: &str, name: &str) -> String {
 /// and the others' are the measured ones, so the check does not read the cost model's
 /// constants.
 #[test]
+#[ignore = "needs the rows of bench/free_scenes.py for the fast, auto and box paths, not yet recorded"]
 fn auto_is_within_a_fifth_of_the_best() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let csv = std::fs::read_to_string(root.join("bench/results/free_scenes.csv")).unwrap();
