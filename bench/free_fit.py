@@ -127,7 +127,7 @@ def main(argv):
                 add("GRAND", terms, number(cell, tag.replace("grand-parameter", "grand product")))
     suffixes = {2: ["FIXED", "BLOCK"], 4: ["FIXED", "GRID", "NEAR", "SPREAD"]}
     suffixes_of = {"CHOLESKY": ["FIXED", "CUBE"]}
-    rows = record.Recorder("free_cost", f"python3 bench/free_fit.py {commit}")
+    rows = record.Recorder("free_cost", f"python3 bench/free_fit.py {commit}", exact=True)
     table = (f"free-space cost model constants (seconds a call per term), fitted to the "
              f"rows of every shape at {commit}")
     for name, (x, t) in data.items():
