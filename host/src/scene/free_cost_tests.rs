@@ -296,9 +296,14 @@ fn the_choice_matches_the_measured_rows() {
                     let spin = if rotation { t("spin pass") } else { Some(0.0) };
                     let pair = |asm: Option<f64>, rest: Option<f64>| Some(asm? + rest? + spin?);
                     let dense = pair(t("dense assembly"), t("dense product").map(|p| k * p));
-                    let compact = t("compact copy").zip(t("compact product")).and_then(|(c, p)| {
-                        pair(t("dense assembly"), Some(c + t("dense product")? + solve * p))
-                    });
+                    let compact = t("compact copy")
+                        .zip(t("compact product"))
+                        .and_then(|(c, p)| {
+                            pair(
+                                t("dense assembly"),
+                                Some(c + t("dense product")? + solve * p),
+                            )
+                        });
                     let free = pair(Some(0.0), t("matrix-free product").map(|p| k * p));
                     let fast = match rotation {
                         false => t("fast product 1e-4").map(|p| k * p),
@@ -344,7 +349,12 @@ fn the_choice_matches_the_measured_rows() {
         }
     }
     assert!(checked >= 100, "{checked} cases");
-    assert!(wrong.is_empty(), "{} of {checked}:\n{}", wrong.len(), wrong.join("\n"));
+    assert!(
+        wrong.is_empty(),
+        "{} of {checked}:\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
 }
 
 /// [`csv_fields`](crate::output::csv_fields) undoes

@@ -185,7 +185,10 @@ fn auto_is_within_a_fifth_of_the_best() {
             "{scene}: auto takes {path} ({t:.3e} s a step), {:.2} times {best} ({t_best:.3e})",
             t / t_best
         );
-        println!("{scene}: auto takes {path}, {:.2} times the best ({best})", t / t_best);
+        println!(
+            "{scene}: auto takes {path}, {:.2} times the best ({best})",
+            t / t_best
+        );
         checked.push(scene.clone());
     }
     for want in [
