@@ -191,16 +191,14 @@ fn auto_is_within_a_fifth_of_the_best() {
         );
         checked.push(scene.clone());
     }
+    // The Figure 1 scenes run one way only (their method stores the mobility, and 25
+    // beads are too few for the compact copy): nothing to choose.
     for want in [
         "brownian_chain",
         "cloud",
         "cloud_small",
         "dimer",
         "fene_dumbbell",
-        "figure1a",
-        "figure1b",
-        "figure1c",
-        "figure1c_near",
         "periodic_chain",
         "periodic_suspension",
         "ring",
