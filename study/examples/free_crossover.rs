@@ -1,9 +1,11 @@
 //! The chart of the free-space products' cost against N (`docs/free_crossover.png`):
 //! the measured seconds a call of each path (`bench/results/free_cost.csv`, written by
-//! `cargo run --release --example free_cost`) for one shape, and the crossovers where
-//! the cost model (`hydrorattle_host::scene::free_cost`) that `auto` chooses by turns
-//! from the stored mobility to the fast product, for a step of one product and for a
-//! step with a constraint solve.
+//! `cargo run --release --example free_cost`) for one shape, without and with rotation,
+//! and the crossovers where the cost model (`hydrorattle_host::scene::free_cost`) that
+//! `auto` chooses by turns from the stored mobility to the fast product, for a step of
+//! one product and for a step with a constraint solve. It prints the measured
+//! crossovers too: the N (interpolated between the measured counts) from which a step
+//! on the fast product costs less than on each other path.
 //!
 //! ```text
 //! cargo run --release -p hydrorattle-study --example free_crossover [-- SHAPE [OUT.png]]
@@ -17,18 +19,21 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use hydrorattle_host::output::csv_fields;
+use hydrorattle_host::scene::box_cost::PRODUCTS_SOLVE;
 use hydrorattle_host::scene::free_cost::{FreeChoice, Spheres, choose};
 use hydrorattle_host::scene::sizing::Plan;
 use hydrorattle_host::scene::{Method, Solver};
 use hydrorattle_study::render::{LineChart, Series, line_chart};
 
-/// The measured table's name in the record.
-const TABLE: &str = "free-space product paths";
+/// The measured table's name in the record (the fast products in the steady state).
+const TABLE: &str = "free-space product paths, unit spheres, f64, one thread, CPU seconds a call (best of two; fast products with the kernel's transform kept)";
 
 /// The smallest N (on a grid of 40 a decade) at which `auto` leaves the stored
-/// mobility for a cloud at volume fraction `phi`, with `bonds` bonds (a Krylov solve).
-fn crossover(phi: f64, bonds: usize) -> Option<f64> {
-    let plan = Plan::free(Method::Overdamped, Solver::Krylov);
+/// mobility for a cloud at volume fraction `phi`, with `bonds` bonds (a Krylov solve),
+/// with or without `rotation`.
+fn crossover(phi: f64, bonds: usize, rotation: bool) -> Option<f64> {
+    let mut plan = Plan::free(Method::Overdamped, Solver::Krylov);
+    plan.rotation = rotation;
     (40..=200).map(|k| 10f64.powf(k as f64 / 40.0)).find(|&n| {
         let n = n as usize;
         let r = (n as f64 / phi).cbrt();
@@ -46,6 +51,43 @@ fn crossover(phi: f64, bonds: usize) -> Option<f64> {
     })
 }
 
+/// Measured seconds by N.
+type Times = BTreeMap<u64, f64>;
+
+/// `f` at every N where each of `parts` was measured.
+fn combine(parts: &[&Times], f: impl Fn(&[f64]) -> f64) -> Times {
+    let Some(first) = parts.first() else {
+        return Times::new();
+    };
+    first
+        .keys()
+        .filter_map(|n| {
+            let v: Option<Vec<f64>> = parts.iter().map(|p| p.get(n).copied()).collect();
+            v.map(|v| (*n, f(&v)))
+        })
+        .collect()
+}
+
+/// The N from which `fast` costs less than `other` and stays so over the measured
+/// counts (log-interpolated between the last count where it did not and the next):
+/// `Some(lowest N)` where it always does, `None` where it never does.
+fn measured_crossover(fast: &Times, other: &Times) -> Option<f64> {
+    let both: Vec<(f64, f64)> = fast
+        .iter()
+        .filter_map(|(n, f)| other.get(n).map(|o| (*n as f64, (f / o).ln())))
+        .collect();
+    let last_worse = both.iter().rposition(|&(_, r)| r >= 0.0);
+    match last_worse {
+        None => both.first().map(|p| p.0),
+        Some(k) if k + 1 == both.len() => None,
+        Some(k) => {
+            let ((n0, r0), (n1, r1)) = (both[k], both[k + 1]);
+            let x = r0 / (r0 - r1);
+            Some((n0.ln() + x * (n1.ln() - n0.ln())).exp())
+        }
+    }
+}
+
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let shape = args.first().map_or("cloud 0.1", String::as_str);
@@ -61,7 +103,7 @@ fn main() -> Result<()> {
         let Some(n) = row[6].strip_prefix(&format!("{shape}, N = ")) else {
             continue;
         };
-        if !row[5].starts_with(TABLE) {
+        if row[5] != TABLE {
             continue;
         }
         if let (Ok(n), Ok(t)) = (n.parse::<u64>(), row[8].parse::<f64>()) {
@@ -69,13 +111,25 @@ fn main() -> Result<()> {
         }
     }
     let get = |q: &str| cells.get(q).cloned().unwrap_or_default();
-    let (asm, prod) = (get("dense assembly"), get("dense product"));
+    let (asm, prod, spin) = (
+        get("dense assembly"),
+        get("dense product"),
+        get("spin pass"),
+    );
+    let (copy, compact, free) = (
+        get("compact copy"),
+        get("compact product"),
+        get("matrix-free product"),
+    );
+    let (fast, fast_g, grand) = (
+        get("fast product 1e-4"),
+        get("fast grand-parameter product 1e-4"),
+        get("fast grand product 1e-4"),
+    );
+    let points = |t: &Times| t.iter().map(|(&n, &t)| (n as f64, t)).collect();
     let mut series = vec![Series {
         name: "dense: assembly and one product".into(),
-        points: asm
-            .iter()
-            .filter_map(|(&n, a)| prod.get(&n).map(|p| (n as f64, a + p)))
-            .collect(),
+        points: points(&combine(&[&asm, &prod], |v| v[0] + v[1])),
     }];
     for (q, name) in [
         ("dense product", "dense: each further product"),
@@ -84,11 +138,59 @@ fn main() -> Result<()> {
         ("fast product 1e-4", "fast, tolerance 1e-4: a product"),
         ("fast product 1e-6", "fast, tolerance 1e-6: a product"),
     ] {
-        let points = get(q).iter().map(|(&n, &t)| (n as f64, t)).collect();
         series.push(Series {
             name: name.into(),
-            points,
+            points: points(&get(q)),
         });
+    }
+    series.push(Series {
+        name: "rotation, dense: assembly, one product and the spins".into(),
+        points: points(&combine(&[&asm, &prod, &spin], |v| v.iter().sum())),
+    });
+    series.push(Series {
+        name: "rotation, fast 1e-4: a product and the spins (grand)".into(),
+        points: points(&combine(&[&fast_g, &grand], |v| v[0] + v[1])),
+    });
+    // The measured crossovers of a step of `k` products, fast against each other path.
+    for (rotation, k, what) in [
+        (false, 1.0, "one product a step"),
+        (false, 1.0 + PRODUCTS_SOLVE, "a constraint solve"),
+        (true, 1.0, "one product a step, rotation"),
+        (true, 1.0 + PRODUCTS_SOLVE, "a constraint solve, rotation"),
+    ] {
+        let s = |t: f64| if rotation { t } else { 0.0 };
+        let fast_step = match rotation {
+            false => combine(&[&fast], |v| k * v[0]),
+            true => combine(&[&fast_g, &grand], |v| k * v[0] + v[1]),
+        };
+        let spins = if rotation {
+            spin.clone()
+        } else {
+            asm.iter().map(|(n, _)| (*n, 0.0)).collect()
+        };
+        let others = [
+            (
+                "dense",
+                combine(&[&asm, &prod, &spins], |v| v[0] + k * v[1] + s(v[2])),
+            ),
+            (
+                "compact",
+                combine(&[&asm, &copy, &prod, &compact, &spins], |v| {
+                    v[0] + v[1] + v[2] + (k - 1.0) * v[3] + s(v[4])
+                }),
+            ),
+            (
+                "matrix-free",
+                combine(&[&free, &spins], |v| k * v[0] + s(v[1])),
+            ),
+        ];
+        for (name, other) in others {
+            let at = measured_crossover(&fast_step, &other)
+                .map_or("not within the measured counts".into(), |n| {
+                    format!("N = {n:.0}")
+                });
+            println!("{shape}, {what}: fast beats {name} from {at} (measured)");
+        }
     }
     let all = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
     let (lo, hi) = all.fold((f64::INFINITY, 0.0f64), |(l, h), t| (l.min(t), h.max(t)));
@@ -96,8 +198,13 @@ fn main() -> Result<()> {
         .strip_prefix("cloud ")
         .and_then(|p| p.parse().ok())
         .unwrap_or(0.1);
-    for (bonds, what) in [(0, "one product a step"), (1, "a constraint solve")] {
-        if let Some(n) = crossover(phi, bonds) {
+    for (bonds, rotation, what) in [
+        (0, false, "one product a step"),
+        (1, false, "a constraint solve"),
+        (0, true, "one product a step, rotation"),
+        (1, true, "a constraint solve, rotation"),
+    ] {
+        if let Some(n) = crossover(phi, bonds, rotation) {
             println!("auto takes the fast product from N = {n:.0} ({what})");
             series.push(Series {
                 name: format!("auto's crossover, {what}: N = {n:.0}"),

@@ -75,7 +75,8 @@ fn the_choice_at_known_points() {
 
 /// Methods that factorise or keep a second mobility run dense at any size, and are
 /// refused (naming their need) when the dense storage does not fit; Cholesky noise,
-/// a wall and rotation keep what they need.
+/// a wall keep what they need; with rotation the fast path runs (its grand product
+/// gives the spins).
 #[test]
 fn what_each_path_can_run() {
     let s = cloud(20_000, 0.1);
@@ -95,7 +96,8 @@ fn what_each_path_can_run() {
     assert_eq!(pick(&thermal, &s, 64 * GIB), FreeChoice::Dense);
     let mut spinning = overdamped();
     spinning.rotation = true;
-    assert_ne!(pick(&spinning, &s, 64 * GIB), FreeChoice::Fast);
+    // Rotation: the fast path's grand product gives the spins.
+    assert_eq!(pick(&spinning, &s, 64 * GIB), FreeChoice::Fast);
     let oseen = Spheres { rpy: false, ..s };
     assert_ne!(pick(&overdamped(), &oseen, 64 * GIB), FreeChoice::Fast);
     // Bonds with the Newton solver: only the stored metric.
@@ -156,7 +158,7 @@ fn monotone_in_n() {
                 let cost = FreeCost::of(&s, 1e-4);
                 let times = CHOICES.map(|c| step_cost(&p, &s, &cost, c).unwrap_or(0.0));
                 for (c, (t, t0)) in CHOICES.iter().zip(times.iter().zip(last.1)) {
-                    let slack = if *c == FreeChoice::Fast { 0.9 } else { 1.0 };
+                    let slack = if *c == FreeChoice::Fast { 0.85 } else { 1.0 };
                     assert!(*t >= slack * t0, "{c:?} at N {n}, phi {phi}: {t} < {t0}");
                 }
                 let r = rank(pick(&p, &s, 64 * GIB));
@@ -200,10 +202,18 @@ fn the_constants_are_the_recorded_fit() {
         ("COMPACT_PRODUCT_BLOCK", COMPACT_PRODUCT_BLOCK),
         ("FREE_FIXED", FREE_FIXED),
         ("FREE_BLOCK", FREE_BLOCK),
+        ("SPIN_FIXED", SPIN_FIXED),
+        ("SPIN_BLOCK", SPIN_BLOCK),
+        ("GRAND_ASSEMBLY_FIXED", GRAND_ASSEMBLY_FIXED),
+        ("GRAND_ASSEMBLY_BLOCK", GRAND_ASSEMBLY_BLOCK),
         ("FAST_FIXED", FAST_FIXED),
         ("FAST_GRID", FAST_GRID),
         ("FAST_NEAR", FAST_NEAR),
         ("FAST_SPREAD", FAST_SPREAD),
+        ("GRAND_FIXED", GRAND_FIXED),
+        ("GRAND_GRID", GRAND_GRID),
+        ("GRAND_NEAR", GRAND_NEAR),
+        ("GRAND_SPREAD", GRAND_SPREAD),
     ];
     let mut recorded = std::collections::HashMap::new();
     for row in csv.lines().skip(1).map(crate::output::csv_fields) {
@@ -215,6 +225,136 @@ fn the_constants_are_the_recorded_fit() {
     for (name, v) in code {
         assert_eq!(recorded.get(name), Some(&v), "{name}");
     }
+}
+
+/// The measured table of `examples/free_cost.rs` (fast products in the steady state).
+const MEASURED: &str = "free-space product paths, unit spheres, f64, one thread, CPU seconds a call (best of two; fast products with the kernel's transform kept)";
+/// The storage past which the example times no path (its `MAX_BYTES`).
+const MEASURED_BYTES: usize = 400_000_000;
+
+/// The helical chain of `examples/shared/free_shapes.rs` (0.6 rad a bead, rising 0.8,
+/// bonds 3): its bounding box.
+fn helix(n: usize) -> Spheres {
+    let (mut at, mut lo, mut hi) = ([0.0f64; 3], [0.0f64; 3], [0.0f64; 3]);
+    for k in 1..n {
+        let t = 0.6 * k as f64;
+        let d = [t.cos(), t.sin(), 0.8];
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        for c in 0..3 {
+            at[c] += 3.0 * d[c] / l;
+            lo[c] = lo[c].min(at[c]);
+            hi[c] = hi[c].max(at[c]);
+        }
+    }
+    Spheres {
+        n,
+        bonds: 0,
+        extent: [0, 1, 2].map(|c| hi[c] - lo[c]),
+        a_max: 1.0,
+        rpy: true,
+    }
+}
+
+/// The model's choice against every measured row of `bench/results/free_cost.csv`
+/// (`examples/free_cost.rs`: every shape, N = 10 to 1e4, CPU seconds a call): for each
+/// shape and count, a step of one product and a step with a constraint solve, without
+/// and with rotation, the path the model picks costs, as measured, at most a fifth more
+/// than the measured fastest of the paths the step can run (as the kernel says, not the
+/// model) within the storage the example times. A step's measured time is composed from the
+/// measured calls as the model composes its own: the assembly and the products (the
+/// solve's count from the box's record), and with rotation the pair paths' spin pass
+/// or the fast path's grand product. The times are the record's, not the model's
+/// constants: the test fails where the model's form or constants pick the wrong path.
+#[test]
+fn the_choice_matches_the_measured_rows() {
+    use super::box_cost::PRODUCTS_SOLVE;
+    let csv = include_str!("../../../bench/results/free_cost.csv");
+    let mut rows = std::collections::HashMap::<(String, String), f64>::new();
+    for row in csv.lines().skip(1).map(crate::output::csv_fields) {
+        if row[5] == MEASURED
+            && let Ok(t) = row[8].parse::<f64>()
+        {
+            rows.insert((row[6].clone(), row[7].clone()), t);
+        }
+    }
+    let shapes: [(&str, Option<f64>); 4] = [
+        ("cloud 0.01", Some(0.01)),
+        ("cloud 0.1", Some(0.1)),
+        ("cloud 0.3", Some(0.3)),
+        ("chain", None),
+    ];
+    let (mut checked, mut wrong) = (0, Vec::new());
+    for (shape, phi) in shapes {
+        for n in [10, 30, 100, 300, 1000, 3000, 10_000] {
+            let case = format!("{shape}, N = {n}");
+            let t = |q: &str| rows.get(&(case.clone(), q.to_string())).copied();
+            let s0 = phi.map_or_else(|| helix(n), |phi| cloud(n, phi));
+            for rotation in [false, true] {
+                for bonds in [0, 1] {
+                    let solve = if bonds > 0 { PRODUCTS_SOLVE } else { 0.0 };
+                    let k = 1.0 + solve;
+                    let spin = if rotation { t("spin pass") } else { Some(0.0) };
+                    let pair = |asm: Option<f64>, rest: Option<f64>| Some(asm? + rest? + spin?);
+                    let dense = pair(t("dense assembly"), t("dense product").map(|p| k * p));
+                    let compact = t("compact copy")
+                        .zip(t("compact product"))
+                        .and_then(|(c, p)| {
+                            pair(
+                                t("dense assembly"),
+                                Some(c + t("dense product")? + solve * p),
+                            )
+                        });
+                    let free = pair(Some(0.0), t("matrix-free product").map(|p| k * p));
+                    let fast = match rotation {
+                        false => t("fast product 1e-4").map(|p| k * p),
+                        true => t("fast grand-parameter product 1e-4")
+                            .zip(t("fast grand product 1e-4"))
+                            .map(|(p, g)| k * p + g),
+                    };
+                    let mut p = overdamped();
+                    p.rotation = rotation;
+                    let s = Spheres { bonds, ..s0 };
+                    // What the step can run is the kernel's, not the model's: an
+                    // overdamped Krylov step of RPY spheres in free space runs every
+                    // path, the compact copy where the kernel keeps it.
+                    let compact_kept = {
+                        let mut pc = p;
+                        pc.compact_products = true;
+                        pc.params(n).compact_copy(n, bonds)
+                    };
+                    let runs = |c: FreeChoice| {
+                        (c != FreeChoice::Compact || compact_kept)
+                            && storage(&p, &s, 1e-4, c).is_some_and(|b| b <= MEASURED_BYTES)
+                    };
+                    let measured: Vec<(FreeChoice, f64)> = CHOICES
+                        .into_iter()
+                        .zip([dense, compact, free, fast])
+                        .filter_map(|(c, m)| m.filter(|_| runs(c)).map(|m| (c, m)))
+                        .collect();
+                    if measured.len() < 2 {
+                        continue;
+                    }
+                    let best = measured.iter().map(|m| m.1).fold(f64::INFINITY, f64::min);
+                    let pick = choose(&p, &s, 1e-4, MEASURED_BYTES).unwrap().0;
+                    let got = measured.iter().find(|m| m.0 == pick).map(|m| m.1);
+                    checked += 1;
+                    if got.is_none_or(|g| g > 1.2 * best) {
+                        wrong.push(format!(
+                            "{case}, rotation {rotation}, bonds {bonds}: picks {pick:?} \
+                             ({got:?} s measured), best {best:.3e} of {measured:?}"
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked >= 100, "{checked} cases");
+    assert!(
+        wrong.is_empty(),
+        "{} of {checked}:\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
 }
 
 /// [`csv_fields`](crate::output::csv_fields) undoes

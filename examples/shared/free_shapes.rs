@@ -1,0 +1,76 @@
+//! The shapes the free-space cost examples time (shared by `#[path]`, with
+//! `shared/splitmix.rs` as the including crate's `splitmix` module): unit spheres in a
+//! ball, the helical chain of `benches/kernel.rs`, their bounding box and near pairs.
+
+use hydrorattle::Real;
+
+use crate::splitmix::Rng;
+
+type V = <f64 as Real>::V3;
+
+/// `n` unit spheres uniformly in a ball at volume fraction `phi`.
+pub fn cloud(n: usize, phi: f64, seed: u64) -> Vec<V> {
+    let radius = (n as f64 / phi).cbrt();
+    let mut rng = Rng(seed);
+    let mut pos = Vec::with_capacity(n);
+    while pos.len() < n {
+        let p = [0, 1, 2].map(|_| radius * (2.0 * rng.unit() - 1.0));
+        if p.iter().map(|x| x * x).sum::<f64>() <= radius * radius {
+            pos.push(f64::v3_from(p));
+        }
+    }
+    pos
+}
+
+/// The chain of `benches/kernel.rs`: turning 0.6 rad per bead, rising 0.8, bonds 3
+/// (unit beads touching at 1.5 times contact).
+pub fn chain(n: usize) -> Vec<V> {
+    let mut at = [0.0f64; 3];
+    (0..n)
+        .map(|k| {
+            let t = 0.6 * k as f64;
+            let d = [t.cos(), t.sin(), 0.8];
+            let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if k > 0 {
+                (0..3).for_each(|c| at[c] += 3.0 * d[c] / l);
+            }
+            f64::v3_from(at)
+        })
+        .collect()
+}
+
+/// The bounding box's edges of `pos`.
+pub fn extent(pos: &[V]) -> [f64; 3] {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in pos {
+        let a = f64::v3_to_f64(*p);
+        for c in 0..3 {
+            lo[c] = lo[c].min(a[c]);
+            hi[c] = hi[c].max(a[c]);
+        }
+    }
+    [0, 1, 2].map(|c| hi[c] - lo[c])
+}
+
+/// Pairs closer than `cut`, counted in cells of edge `cut` (the fast product's near
+/// work).
+pub fn near_pairs(pos: &[V], cut: f64) -> usize {
+    use std::collections::HashMap;
+    let key = |p: &V| f64::v3_to_f64(*p).map(|x| (x / cut).floor() as i64);
+    let mut cells: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (i, p) in pos.iter().enumerate() {
+        cells.entry(key(p)).or_default().push(i);
+    }
+    let mut count = 0;
+    for (i, p) in pos.iter().enumerate() {
+        let k = key(p);
+        for d in 0..27i64 {
+            let c = [k[0] + d % 3 - 1, k[1] + d / 3 % 3 - 1, k[2] + d / 9 - 1];
+            for &j in cells.get(&c).map_or(&[][..], Vec::as_slice) {
+                count += usize::from(j > i && f64::norm2(pos[j] - *p) < cut * cut);
+            }
+        }
+    }
+    count
+}
