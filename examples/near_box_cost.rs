@@ -96,7 +96,9 @@ fn step_cost(n: usize, reps: usize, rec: &mut record::Recorder) {
     let ew = Ewald::new(cell, 1.2).expect("sums");
     let far = Far::Box(&ew);
     let near = NearField::default();
-    let table = format!("near step cost, {n} spheres in a box at volume fraction 0.25, f64, one core, CPU time");
+    let table = format!(
+        "near step cost, {n} spheres in a box at volume fraction 0.25, f64, one core, CPU time"
+    );
     let mut tt = vec![DMat3::ZERO; tri(n)];
     let mut grand = vec![DMat3::ZERO; tri(2 * n)];
     let mut old = vec![DMat3::ZERO; tri(2 * n)];
@@ -109,12 +111,21 @@ fn step_cost(n: usize, reps: usize, rec: &mut record::Recorder) {
         let (rpy, _) = timed(|| one_step(cell, &pos, &rad, false));
         let (sd, r) = timed(|| one_step(cell, &pos, &rad, true));
         let (t_tt, ()) = timed(|| assemble_tt(&ew, 1.0, &pos, &rad, &mut tt).expect("tt"));
-        let (t_grand, ()) = timed(|| far.assemble_grand(1.0, &pos, &rad, &mut grand).expect("grand"));
+        let (t_grand, ()) = timed(|| {
+            far.assemble_grand(1.0, &pos, &rad, &mut grand)
+                .expect("grand")
+        });
         let (t_old, ()) = timed(|| grand_separate(&ew, &pos, &rad, &mut old));
         let (setup, pairs) = timed(|| store.solver(far, &pos, &rad, near).pairs());
         // The one pass gives the separate sums' blocks, bit for bit.
-        let same = grand.iter().zip(&old).all(|(a, b)| a.to_cols_array() == b.to_cols_array());
-        assert!(same, "the grand mobility's blocks differ from the separate sums'");
+        let same = grand
+            .iter()
+            .zip(&old)
+            .all(|(a, b)| a.to_cols_array() == b.to_cols_array());
+        assert!(
+            same,
+            "the grand mobility's blocks differ from the separate sums'"
+        );
         let products = r.near_iterations + 2 * r.near_products;
         println!(
             "{round},{rpy:.2},{sd:.2},{:.2},{t_tt:.2},{t_grand:.2},{t_old:.2},{setup:.3},{pairs},{},{products}",
@@ -128,10 +139,19 @@ fn step_cost(n: usize, reps: usize, rec: &mut record::Recorder) {
             ("near step / RPY step", format!("{:.3}", sd / rpy)),
             ("mu_tt assembly, CPU s", format!("{t_tt:.3e}")),
             ("grand assembly (one pass), CPU s", format!("{t_grand:.3e}")),
-            ("grand assembly (separate sums, before), CPU s", format!("{t_old:.3e}")),
-            ("near set-up (find, correct, factor), CPU s", format!("{setup:.3e}")),
+            (
+                "grand assembly (separate sums, before), CPU s",
+                format!("{t_old:.3e}"),
+            ),
+            (
+                "near set-up (find, correct, factor), CPU s",
+                format!("{setup:.3e}"),
+            ),
             ("close pairs", pairs.to_string()),
-            ("conjugate-gradient iterations", r.near_iterations.to_string()),
+            (
+                "conjugate-gradient iterations",
+                r.near_iterations.to_string(),
+            ),
             ("far-field products", products.to_string()),
         ];
         for (quantity, value) in cells {
@@ -181,7 +201,10 @@ impl Store {
 
 /// Least-squares slope of `ln y` against `ln x`.
 fn exponent(x: &[f64], y: &[f64]) -> f64 {
-    let (lx, ly): (Vec<f64>, Vec<f64>) = (x.iter().map(|v| v.ln()).collect(), y.iter().map(|v| v.ln()).collect());
+    let (lx, ly): (Vec<f64>, Vec<f64>) = (
+        x.iter().map(|v| v.ln()).collect(),
+        y.iter().map(|v| v.ln()).collect(),
+    );
     let k = lx.len() as f64;
     let (mx, my) = (lx.iter().sum::<f64>() / k, ly.iter().sum::<f64>() / k);
     let sxy: f64 = lx.iter().zip(&ly).map(|(a, b)| (a - mx) * (b - my)).sum();
@@ -225,7 +248,11 @@ fn work(list: &[usize], rec: &mut record::Recorder) {
             far_time += t;
             Ok(())
         };
-        let (t, rep) = timed(|| solver.product(&mut diag, &f, &mut u, 1e-10, 10_000).expect("product"));
+        let (t, rep) = timed(|| {
+            solver
+                .product(&mut diag, &f, &mut u, 1e-10, 10_000)
+                .expect("product")
+        });
         let it = (t - far_time) / rep.iterations.max(1) as f64;
         println!(
             "{n},{np},{:.1},{setup:.3},{it:.4},{}",
@@ -234,8 +261,18 @@ fn work(list: &[usize], rec: &mut record::Recorder) {
         );
         let case = format!("N = {n}");
         rec.row(table, &case, "close pairs", &np.to_string());
-        rec.row(table, &case, "near set-up (find, correct, factor), CPU s", &format!("{setup:.3e}"));
-        rec.row(table, &case, "near work an iteration, CPU s", &format!("{it:.3e}"));
+        rec.row(
+            table,
+            &case,
+            "near set-up (find, correct, factor), CPU s",
+            &format!("{setup:.3e}"),
+        );
+        rec.row(
+            table,
+            &case,
+            "near work an iteration, CPU s",
+            &format!("{it:.3e}"),
+        );
         ns.push(n as f64);
         ps.push(np as f64);
         setups.push(setup);
@@ -249,7 +286,12 @@ fn work(list: &[usize], rec: &mut record::Recorder) {
         ];
         for (what, p) in fits {
             println!("{what} ~ N^{p:.2}");
-            rec.row(table, "fit over N", &format!("exponent of {what}"), &format!("{p:.2}"));
+            rec.row(
+                table,
+                "fit over N",
+                &format!("exponent of {what}"),
+                &format!("{p:.2}"),
+            );
         }
     }
 }
@@ -259,7 +301,10 @@ fn main() {
     let mut rec = record::Recorder::new(
         env!("CARGO_MANIFEST_DIR"),
         "near_box_cost",
-        format!("cargo run --release --example near_box_cost -- {}", args.join(" ")),
+        format!(
+            "cargo run --release --example near_box_cost -- {}",
+            args.join(" ")
+        ),
     );
     let nums: Vec<usize> = args.iter().skip(1).filter_map(|a| a.parse().ok()).collect();
     match args.first().map(String::as_str) {

@@ -10,10 +10,10 @@
 //! count), interleaved, the least of several rounds of each.
 #![cfg(feature = "periodic")]
 
+use hydrorattle::Periodic;
 use hydrorattle::glam::{DMat3, DVec3};
 use hydrorattle::linalg::tri;
 use hydrorattle::mobility::periodic::{Ewald, assemble_grand, assemble_tt};
-use hydrorattle::Periodic;
 
 /// This thread's CPU time (user + system), seconds, from `/proc/thread-self/stat`
 /// (clock ticks of 10 ms); `None` off Linux.
@@ -40,7 +40,11 @@ fn suspension(n: usize) -> (Vec<DVec3>, Vec<f64>, f64) {
     };
     let (mut pos, mut rad) = (Vec::new(), Vec::new());
     for k in 0..n {
-        let c = DVec3::new((k % side) as f64, ((k / side) % side) as f64, (k / side / side) as f64);
+        let c = DVec3::new(
+            (k % side) as f64,
+            ((k / side) % side) as f64,
+            (k / side / side) as f64,
+        );
         let jitter = DVec3::new(uniform(), uniform(), uniform()) - 0.5;
         pos.push(c * h + jitter * 0.2);
         rad.push(0.8 + 0.4 * uniform());
@@ -53,7 +57,7 @@ fn box_grand_assembly_costs_well_under_two_tt_assemblies() {
     let Some(_) = cpu() else {
         return; // no per-thread CPU clock off Linux
     };
-    let n = 125;
+    let n = 216;
     let (pos, rad, l) = suspension(n);
     let ew = Ewald::new(Periodic::new([l; 3]).unwrap(), 1.2).unwrap();
     let mut tt = vec![DMat3::ZERO; tri(n)];

@@ -330,11 +330,18 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
         for (l, a_max) in [(4.5, 1.2), (9.0, 2.0), (30.0, 1.0)] {
-            let ew = Ewald::new(Periodic::new([c(l), c(0.9 * l), c(1.1 * l)]).unwrap(), c(a_max))
-                .unwrap();
+            let ew = Ewald::new(
+                Periodic::new([c(l), c(0.9 * l), c(1.1 * l)]).unwrap(),
+                c(a_max),
+            )
+            .unwrap();
             for _ in 0..40 {
                 let (ai, aj) = (c(0.3 + 0.9 * uniform()), c(0.3 + 0.9 * uniform()));
-                let r = T::v3(c(l * (uniform() - 0.5) * 1.6), c(l * (uniform() - 0.5)), c(0.4 * uniform()));
+                let r = T::v3(
+                    c(l * (uniform() - 0.5) * 1.6),
+                    c(l * (uniform() - 0.5)),
+                    c(0.4 * uniform()),
+                );
                 let got = pair_grand(&ew, T::ONE, ai, aj, r);
                 let tt = pair_tt(&ew, T::ONE, ai, aj, r);
                 let rot = pair_rot(&ew, T::ONE, ai, aj, r);
@@ -342,7 +349,8 @@ mod tests {
                     (Some(g), Some(tt), Some((rt_ij, rt_ji, rr))) => {
                         let bits = |a: T::M3, b: T::M3| {
                             (0..9).all(|k| {
-                                let (x, y) = (T::m3_get(a, k / 3, k % 3), T::m3_get(b, k / 3, k % 3));
+                                let (x, y) =
+                                    (T::m3_get(a, k / 3, k % 3), T::m3_get(b, k / 3, k % 3));
                                 x.to_f64().to_bits() == y.to_f64().to_bits()
                             })
                         };
