@@ -5,9 +5,9 @@
 //! translational block; summed in the same pass they add their few products to each
 //! term, not a second evaluation of every image's free-space blocks and every wave
 //! vector's phase. So the grand assembly, four blocks a pair where `assemble_tt` forms
-//! one, must cost well under twice `assemble_tt` (two full sums a pair cost about 2.2
-//! to 2.6 times). Measured in this thread's CPU time (a loaded machine's waits do not
-//! count), interleaved, the least of several rounds of each.
+//! one, must cost well under twice `assemble_tt` (two full sums a pair cost 2.3 to 2.9
+//! times, `examples/near_box_cost.rs`). Measured in this thread's CPU time (a loaded
+//! machine's waits do not count), interleaved, the least of several rounds of each.
 #![cfg(feature = "periodic")]
 
 use hydrorattle::Periodic;
@@ -57,7 +57,7 @@ fn box_grand_assembly_costs_well_under_two_tt_assemblies() {
     let Some(_) = cpu() else {
         return; // no per-thread CPU clock off Linux
     };
-    let n = 216;
+    let n = 160;
     let (pos, rad, l) = suspension(n);
     let ew = Ewald::new(Periodic::new([l; 3]).unwrap(), 1.2).unwrap();
     let mut tt = vec![DMat3::ZERO; tri(n)];
@@ -80,5 +80,5 @@ fn box_grand_assembly_costs_well_under_two_tt_assemblies() {
     let ratio = t_grand / t_tt;
     println!("tt assembly {t_tt:.3} s, grand assembly {t_grand:.3} s: {ratio:.2}");
     assert!(t_tt > 0.05, "too short to time: {t_tt} s");
-    assert!(ratio < 1.7, "grand assembly {ratio:.2} tt assemblies");
+    assert!(ratio < 1.85, "grand assembly {ratio:.2} tt assemblies");
 }
