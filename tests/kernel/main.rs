@@ -36,6 +36,8 @@ mod free_fast;
 #[cfg(feature = "fast-free")]
 mod free_fast_grand;
 mod fuzz_step;
+#[cfg(feature = "periodic")]
+mod grand_cost;
 mod helix;
 mod inertial_thermal;
 #[cfg(feature = "contacts")]

@@ -123,12 +123,46 @@ fn series<T: Real>(v: &Scaled<T>) -> (T, T) {
 /// [`smooth`] in closed form (accurate from `xi s` about 1 on).
 #[inline(always)]
 fn closed<T: Real>(v: &Scaled<T>) -> (T, T) {
+    let (cg, erf) = gauss_erf(v.xi, v.x, v.x2);
+    closed_from(v, cg, erf)
+}
+
+/// The closed forms' transcendental parts at `x = xi s`: `2 xi / sqrt(pi) exp(-x^2)`
+/// and `erf(x)`, shared by [`smooth`]'s and the rotation blocks' closed forms.
+#[inline(always)]
+pub(super) fn gauss_erf<T: Real>(xi: T, x: T, x2: T) -> (T, T) {
+    (T::from_f64(2.0) * xi / T::PI.sqrt() * (-x2).exp(), x.erf())
+}
+
+/// [`smooth`] from both closed forms' shared parts at once: `(A, B)` of [`smooth`] and
+/// `(h'/r, A, B)` of the rotation blocks, the same bits as the two separately (one
+/// exponential and one `erf` instead of two each).
+#[inline(always)]
+pub(super) fn smooth_with<T: Real>(
+    xi: T,
+    alpha: T,
+    beta: T,
+    s: T,
+    rot: impl FnOnce(Option<(T, T)>) -> (T, T, T),
+) -> ((T, T), (T, T, T)) {
+    let v = Scaled::new(xi, alpha, beta, s);
+    if v.x < T::ONE {
+        (series(&v), rot(None))
+    } else {
+        let (cg, erf) = gauss_erf(v.xi, v.x, v.x2);
+        (closed_from(&v, cg, erf), rot(Some((cg, erf))))
+    }
+}
+
+/// [`closed`] with its transcendental parts given ([`gauss_erf`]).
+#[inline(always)]
+fn closed_from<T: Real>(v: &Scaled<T>, cg: T, erf: T) -> (T, T) {
     let c = |v: f64| T::from_f64(v);
     let Scaled {
         xi,
         alpha,
         s,
-        x,
+        x: _,
         x2,
         axi2,
         bxi4,
@@ -136,8 +170,6 @@ fn closed<T: Real>(v: &Scaled<T>) -> (T, T) {
     let xi2 = xi * xi;
     // Phi' = -p1 / (8 pi), Phi'' = -p2 / (8 pi) of the radial potential Phi with
     // eta W = grad grad Phi - I lap Phi; A = -(Phi'' + Phi'/s), B = Phi'' - Phi'/s.
-    let cg = c(2.0) * xi / T::PI.sqrt() * (-x2).exp();
-    let erf = x.erf();
     let inv = T::ONE / s;
     let inv2 = inv * inv;
     let t2p = -(c(2.0) * axi2 * s * cg);

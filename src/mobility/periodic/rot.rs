@@ -13,8 +13,8 @@
 //! `eta W_rt(r) F = (h'(r) / (2 r)) r x F` and
 //! `eta W_rr(r) = ((h'' - h'/r) e e^T - (h'' + h'/r) I) / 4`.
 
-use super::real::for_each_image;
-use super::wave::{add_kk, for_each_mode, for_each_phase, projected};
+use super::real::{for_each_image, gauss_erf, smooth_with};
+use super::wave::{add_kk, for_each_mode, for_each_phase, projected, radius_factor};
 use super::{Ewald, PeriodicError, Sums, check};
 use crate::fault::ParticleError;
 use crate::mobility::{
@@ -61,13 +61,29 @@ fn series<T: Real>(xi: T, s: T) -> (T, T, T) {
 
 /// [`smooth_rot`] in closed form (accurate from `xi s` about 1 on).
 fn closed<T: Real>(xi: T, s: T) -> (T, T, T) {
+    let x = xi * s;
+    let (cg, erf) = gauss_erf(xi, x, x * x);
+    closed_from(xi, s, cg, erf)
+}
+
+/// [`smooth_rot`] at `xi s >= 1` from `(cg, erf)` of [`gauss_erf`], or below by its
+/// series (`None`).
+#[inline(always)]
+fn smooth_rot_from<T: Real>(xi: T, s: T, shared: Option<(T, T)>) -> (T, T, T) {
+    match shared {
+        Some((cg, erf)) => closed_from(xi, s, cg, erf),
+        None => series(xi, s),
+    }
+}
+
+/// [`closed`] with its transcendental parts given.
+#[inline(always)]
+fn closed_from<T: Real>(xi: T, s: T, cg: T, erf: T) -> (T, T, T) {
     let c = |v: f64| T::from_f64(v);
     let (x, xi2) = (xi * s, xi * xi);
     let x2 = x * x;
     // 4 pi h' = c g / s - erf / s^2 - c xi^2 s g,
     // 4 pi h'' = 2 erf / s^3 - 2 c g / s^2 - c xi^2 g (3 - 2 x^2), c = 2 xi / sqrt(pi).
-    let cg = c(2.0) * xi / T::PI.sqrt() * (-x2).exp();
-    let erf = x.erf();
     let inv = T::ONE / s;
     let inv2 = inv * inv;
     let k = T::ONE / (c(4.0) * T::PI);
@@ -143,6 +159,63 @@ pub fn pair_rot<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r: T::V3) -> Optio
     Some((rt_ij + rt, rt_ji - rt, rr + rr_w))
 }
 
+/// Every block of the pair `(i, j)`, `i != j`, at separation `r = r_i - r_j`: `tt` as
+/// [`super::pair_tt`] and `(rt_ij, rt_ji, rr)` as [`pair_rot`], bit for bit, in one
+/// pass over the real-space images and one over the wave vectors. The two halves share
+/// each image's free-space blocks and distance and each wave vector's phase and
+/// Gaussian factor, which dominate a pair's cost, so the grand mobility's pair costs
+/// little more than its `tt` block alone (instead of two full Ewald sums). `None` when
+/// a sphere lies inside an image of the other.
+pub(super) fn pair_grand<T: Real>(
+    ew: &Ewald<T>,
+    eta: T,
+    ai: T,
+    aj: T,
+    r: T::V3,
+) -> Option<PairBlocks<T>> {
+    let r0 = ew.cell.minimum_image(r);
+    // Real space: the arithmetic of `real::real_sum` and `real_rot`, image by image.
+    let six = T::from_f64(6.0);
+    let alpha = (ai * ai + aj * aj) / six;
+    let beta = ai * ai * aj * aj / (six * six);
+    let inv_eta = T::ONE / eta;
+    let (mut tt, mut rt_ij, mut rt_ji, mut rr) = (T::M3_ZERO, T::M3_ZERO, T::M3_ZERO, T::M3_ZERO);
+    for_each_image(&ew.split, r0, |_, rn, s2| {
+        let b = pair_blocks(Hydro::Rpy, eta, ai, aj, rn)?;
+        let (s, inv_s) = s2.root_and_inverse();
+        let e = rn * inv_s;
+        let ee = T::outer(e, e);
+        let rot = |shared| smooth_rot_from(ew.xi, s, shared);
+        let ((a, bt), (h1r, ar, bb)) = smooth_with(ew.xi, alpha, beta, s, rot);
+        tt += b.tt - T::m3_add_diag(ee * (bt * inv_eta), a * inv_eta);
+        let w_rt = T::m3_cross(rn) * (h1r * T::HALF * inv_eta);
+        rr += b.rr - T::m3_add_diag(ee * (bb * inv_eta), ar * inv_eta);
+        rt_ij += b.rt_ij - w_rt;
+        rt_ji += b.rt_ji + w_rt;
+        Some(())
+    })?;
+    // Wave space: the sums of `wave::wave_sum` and `wave_rot`, mode by mode.
+    let (mut d_tt, mut kk_tt) = (T::ZERO, [T::ZERO; 6]);
+    let (mut d_rr, mut kk_rr, mut ks) = (T::ZERO, [T::ZERO; 6], T::V3_ZERO);
+    for_each_phase(ew, r0, |k, k2, inv_k2, base, cos, sin| {
+        let f = base * radius_factor(k2, ai) * radius_factor(k2, aj) * cos;
+        d_tt += f;
+        add_kk(&mut kk_tt, k, f * inv_k2);
+        let f = base * k2 * cos;
+        d_rr += f;
+        add_kk(&mut kk_rr, k, f * inv_k2);
+        ks += k * (base * sin);
+    });
+    let w = T::TWO / (eta * ew.volume);
+    let rt = T::m3_cross(ks) * (-(w * T::HALF));
+    Some(PairBlocks {
+        tt: tt + projected(d_tt, kk_tt, w),
+        rt_ij: rt_ij + rt,
+        rt_ji: rt_ji - rt,
+        rr: rr + projected(d_rr, kk_rr, w * T::from_f64(0.25)),
+    })
+}
+
 /// The `rr` self block of a sphere of radius `a` in the box (for a cubic box of edge
 /// `L`, `(1 - (4 pi / 3)(a/L)^3) / (8 pi eta a^3)`); its `rt` self block is zero.
 pub fn self_rr<T: Real>(ew: &Ewald<T>, eta: T, a: T) -> T::M3 {
@@ -215,15 +288,7 @@ impl<T: Real> Grand<T> for Sums<'_, T> {
     fn pair_grand(&self, i: usize, _: (), j: usize, _: ()) -> Result<PairBlocks<T>, PeriodicError> {
         let (ew, eta, pos, radius) = (self.ew, self.eta, self.pos, self.radius);
         let nested = PeriodicError::Particle(ParticleError::Nested { i: j, j: i });
-        let r = pos[i] - pos[j];
-        let tt = super::pair_tt(ew, eta, radius[i], radius[j], r).ok_or(nested)?;
-        let (rt_ij, rt_ji, rr) = pair_rot(ew, eta, radius[i], radius[j], r).ok_or(nested)?;
-        Ok(PairBlocks {
-            tt,
-            rt_ij,
-            rt_ji,
-            rr,
-        })
+        pair_grand(ew, eta, radius[i], radius[j], pos[i] - pos[j]).ok_or(nested)
     }
     #[inline(always)]
     fn pair_spin(&self, i: usize, _: (), j: usize, _: ()) -> Result<(T::M3, T::M3), PeriodicError> {
@@ -248,7 +313,62 @@ impl<T: Real> Grand<T> for Sums<'_, T> {
 
 #[cfg(test)]
 mod tests {
-    use super::{closed, series, smooth_rot};
+    use super::super::{Ewald, Periodic, pair_tt};
+    use super::{closed, pair_grand, pair_rot, series, smooth_rot};
+    use crate::real::Real;
+
+    /// The grand pair's one pass gives the separate sums' blocks bit for bit, in boxes
+    /// small enough that the real space reaches several images and large ones, for
+    /// unequal radii, separations across the faces and overlapping pairs.
+    fn one_pass_is_the_separate_sums<T: Real>() {
+        let c = |v: f64| T::from_f64(v);
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for (l, a_max) in [(4.5, 1.2), (9.0, 2.0), (30.0, 1.0)] {
+            let ew = Ewald::new(
+                Periodic::new([c(l), c(0.9 * l), c(1.1 * l)]).unwrap(),
+                c(a_max),
+            )
+            .unwrap();
+            for _ in 0..40 {
+                let (ai, aj) = (c(0.3 + 0.9 * uniform()), c(0.3 + 0.9 * uniform()));
+                let r = T::v3(
+                    c(l * (uniform() - 0.5) * 1.6),
+                    c(l * (uniform() - 0.5)),
+                    c(0.4 * uniform()),
+                );
+                let got = pair_grand(&ew, T::ONE, ai, aj, r);
+                let tt = pair_tt(&ew, T::ONE, ai, aj, r);
+                let rot = pair_rot(&ew, T::ONE, ai, aj, r);
+                match (got, tt, rot) {
+                    (Some(g), Some(tt), Some((rt_ij, rt_ji, rr))) => {
+                        let bits = |a: T::M3, b: T::M3| {
+                            (0..9).all(|k| {
+                                let (x, y) =
+                                    (T::m3_get(a, k / 3, k % 3), T::m3_get(b, k / 3, k % 3));
+                                x.to_f64().to_bits() == y.to_f64().to_bits()
+                            })
+                        };
+                        assert!(bits(g.tt, tt) && bits(g.rr, rr));
+                        assert!(bits(g.rt_ij, rt_ij) && bits(g.rt_ji, rt_ji));
+                    }
+                    (None, None, None) => {}
+                    _ => panic!("one pass and the separate sums disagree on nesting"),
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn one_pass_grand_pair_is_the_separate_sums() {
+        one_pass_is_the_separate_sums::<f64>();
+        one_pass_is_the_separate_sums::<f32>();
+    }
 
     /// The series and the closed form agree around the switch at `xi r = 1`, and far
     /// out `W` is the point rotlet and dipole: `h'/r = -1/(4 pi r^3)`,

@@ -56,7 +56,7 @@ pub(super) fn for_each_mode<T: Real>(ew: &Ewald<T>, mut f: impl FnMut([i32; 3]))
 
 /// `1 - k^2 a^2 / 6`: the sphere's factor of the wave-space kernel.
 #[inline(always)]
-fn radius_factor<T: Real>(k2: T, a: T) -> T {
+pub(super) fn radius_factor<T: Real>(k2: T, a: T) -> T {
     T::ONE - k2 * a * a / T::from_f64(6.0)
 }
 
