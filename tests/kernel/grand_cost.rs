@@ -52,7 +52,12 @@ fn suspension(n: usize) -> (Vec<DVec3>, Vec<f64>, f64) {
     (pos, rad, side as f64 * h)
 }
 
+// A timing, so run by hand (`-- --ignored grand_cost::`): on a shared machine CPU times
+// of identical work differ by tens of percent, and the suite's checks must not depend
+// on the load. The one-pass sums are checked bit for bit against the separate sums by
+// `mobility::periodic::rot`'s unit test, which always runs.
 #[test]
+#[ignore = "a CPU-time ratio; run by hand on a quiet machine"]
 fn box_grand_assembly_costs_well_under_two_tt_assemblies() {
     let Some(_) = cpu() else {
         return; // no per-thread CPU clock off Linux
