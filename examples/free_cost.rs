@@ -260,7 +260,6 @@ fn measure(
                 })
             })
             .flatten();
-        drop(store);
         let counts = transform_counts(&re).expect("a transform is held");
         let g = ff.grid();
         let m = (g[0] * g[1] * g[2]) as f64;

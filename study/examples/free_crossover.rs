@@ -166,7 +166,7 @@ fn main() -> Result<()> {
         let spins = if rotation {
             spin.clone()
         } else {
-            asm.iter().map(|(n, _)| (*n, 0.0)).collect()
+            asm.keys().map(|n| (*n, 0.0)).collect()
         };
         let others = [
             (
