@@ -22,6 +22,8 @@
 
 #[path = "shared/cpu.rs"]
 mod cpu;
+#[path = "shared/near_store.rs"]
+mod near_store;
 #[path = "shared/record.rs"]
 mod record;
 #[path = "shared/suspension.rs"]
@@ -31,12 +33,12 @@ use glam::{DMat3, DVec3};
 use hydrorattle::cell::Periodic;
 use hydrorattle::linalg::tri;
 use hydrorattle::mobility::periodic::{Ewald, assemble_tt, pair_rot, pair_tt, self_rr, self_tt};
-use hydrorattle::stokesian::iterative::{Solver, Storage, count_pairs, sizes};
 use hydrorattle::stokesian::{Far, NearField, SdError};
 use hydrorattle::{
     BondSet, Hydro, Layout, Method, NoForce, Params, Particle, ParticleSet, StepReport, step,
 };
 use hydrorattle_heap::Buffers;
+use near_store::Store;
 
 /// Density of unit buoyant weight for a unit sphere (`g = 1`).
 const RHO1: f64 = 3.0 / (4.0 * std::f64::consts::PI);
@@ -157,45 +159,6 @@ fn step_cost(n: usize, reps: usize, rec: &mut record::Recorder) {
         for (quantity, value) in cells {
             rec.row(&table, &case, quantity, &value);
         }
-    }
-}
-
-/// Storage sized for the close pairs of the spheres.
-struct Store {
-    pairs: Vec<[usize; 2]>,
-    reals: Vec<f64>,
-    field: Vec<DVec3>,
-    cells: Vec<usize>,
-}
-
-impl Store {
-    fn new(far: Far<'_, f64>, pos: &[DVec3], rad: &[f64], near: NearField<f64>) -> Self {
-        let n = pos.len();
-        let mut cells = vec![0; 3 * n + 1];
-        let np = count_pairs(far, pos, rad, near, &mut cells).expect("pairs");
-        let (a, b, c, _) = sizes(n, np);
-        Store {
-            pairs: vec![[0; 2]; a],
-            reals: vec![0.0; b],
-            field: vec![DVec3::ZERO; c],
-            cells,
-        }
-    }
-
-    fn solver<'a>(
-        &'a mut self,
-        far: Far<'_, f64>,
-        pos: &[DVec3],
-        rad: &[f64],
-        near: NearField<f64>,
-    ) -> Solver<'a, f64> {
-        let store = Storage {
-            pairs: &mut self.pairs,
-            reals: &mut self.reals,
-            field: &mut self.field,
-            cells: &mut self.cells,
-        };
-        Solver::new(1.0, far, pos, rad, near, store).expect("near field")
     }
 }
 

@@ -15,6 +15,8 @@
 //!
 //! With `HYDRORATTLE_BENCH_MACHINE` set, appends its rows to
 //! `bench/results/near_iterative.csv`.
+#[path = "shared/near_store.rs"]
+mod near_store;
 #[path = "shared/record.rs"]
 mod record;
 #[path = "shared/suspension.rs"]
@@ -26,8 +28,9 @@ use glam::DVec3;
 use hydrorattle::cell::Periodic;
 use hydrorattle::linalg::tri;
 use hydrorattle::mobility::periodic::{Ewald, tt_product};
-use hydrorattle::stokesian::iterative::{Solver, Storage, count_pairs, packed_product, sizes};
+use hydrorattle::stokesian::iterative::packed_product;
 use hydrorattle::stokesian::{Far, NearField, SdError};
+use near_store::Store;
 use suspension::suspension;
 
 /// The best of `k` runs of `f`, seconds.
@@ -37,45 +40,6 @@ fn best(k: usize, mut f: impl FnMut()) -> f64 {
         f();
         m.min(t.elapsed().as_secs_f64())
     })
-}
-
-/// Storage sized for the close pairs of the spheres.
-struct Store {
-    pairs: Vec<[usize; 2]>,
-    reals: Vec<f64>,
-    field: Vec<DVec3>,
-    cells: Vec<usize>,
-}
-
-impl Store {
-    fn new(far: Far<'_, f64>, pos: &[DVec3], rad: &[f64], near: NearField<f64>) -> Self {
-        let n = pos.len();
-        let mut cells = vec![0; 3 * n + 1];
-        let np = count_pairs(far, pos, rad, near, &mut cells).unwrap();
-        let (a, b, c, _) = sizes(n, np);
-        Store {
-            pairs: vec![[0; 2]; a],
-            reals: vec![0.0; b],
-            field: vec![DVec3::ZERO; c],
-            cells,
-        }
-    }
-
-    fn solver<'a>(
-        &'a mut self,
-        far: Far<'_, f64>,
-        pos: &[DVec3],
-        rad: &[f64],
-        near: NearField<f64>,
-    ) -> Solver<'a, f64> {
-        let store = Storage {
-            pairs: &mut self.pairs,
-            reals: &mut self.reals,
-            field: &mut self.field,
-            cells: &mut self.cells,
-        };
-        Solver::new(1.0, far, pos, rad, near, store).unwrap()
-    }
 }
 
 fn main() {
