@@ -5,8 +5,11 @@
 //! steps (the pile landed, contacts and wall links forming and releasing) is timed.
 //! Prints, per size, the CPU time a step, the Jacobian factorisations a step
 //! (`StepReport::factorizations`), the Newton iterations and active-set rounds a step
-//! and the constraint rows held; records them in `bench/results/pile_cost.csv` where
-//! `HYDRORATTLE_BENCH_MACHINE` names the machine.
+//! and the constraint rows held. Then one Krylov step from each pile's state at the end
+//! (the same parameters, `max_iterations` 500: at most 5 000 products) gives the
+//! products the Krylov constraint solve takes there, or where it gave up. Records them
+//! in `bench/results/pile_cost.csv` where `HYDRORATTLE_BENCH_MACHINE` names the
+//! machine.
 //!
 //! ```text
 //! cargo run --release --example pile_cost [STEPS WINDOW]
@@ -15,7 +18,8 @@
 use std::time::Instant;
 
 use hydrorattle::{
-    Bond, Contacts, Layout, Method, NoForce, Params, Real, SolverKind, State, Wall, step_slices,
+    Bond, Contacts, Layout, Method, NoForce, Params, Real, SolverKind, State, StepError, Wall,
+    step_slices,
 };
 use hydrorattle_heap::Buffers;
 
@@ -61,23 +65,33 @@ fn pile(fence: usize, side: usize, count: usize) -> (Vec<V>, Vec<f64>, Vec<f64>,
     (pos, radius, density, bonds)
 }
 
-/// Per step over the window: CPU seconds, factorisations, Newton iterations, rounds,
-/// rows held (contacts, wall links and bonds) at the end.
-fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> [f64; 5] {
-    let (mut pos, radius, density, bonds) = pile(fence, side, count);
-    let n = pos.len();
+/// The piles' parameters with `kind`'s constraint solve.
+fn params(kind: SolverKind, n: usize) -> Params<f64> {
     let mut p = Params::<f64>::new(0.2);
     p.method = Method::Overdamped;
-    p.solver.kind = SolverKind::Newton;
+    p.solver.kind = kind;
     p.solver.tolerance = 1e-10;
     p.solver.max_iterations = 500;
     p.wall = Some(Wall::new(0.0));
     p.contacts = Some(Contacts::new(7 * n));
+    p
+}
+
+/// Per step over the window: CPU seconds, factorisations, Newton iterations, rounds,
+/// rows held (contacts, wall links and bonds) at the end; then one Krylov step from
+/// the state at the end: its products, and whether it converged.
+fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> [f64; 7] {
+    let (mut pos, radius, density, bonds) = pile(fence, side, count);
+    let n = pos.len();
+    let p = params(SolverKind::Newton, n);
+    let krylov = params(SolverKind::Krylov, n);
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, n, bonds.len()));
     let mut ws = buf.workspace();
     let (mut vel, mut omega, mut time) = (vec![V::ZERO; n], vec![V::ZERO; n], 0.0);
     let mut sums = [0.0; 5];
-    for k in 0..steps {
+    let (mut products, mut converged) = (0.0, 0.0);
+    // Steps `0..steps` with Newton, step `steps` with Krylov.
+    for k in 0..=steps {
         let timed = k + window >= steps;
         let (t, c) = (Instant::now(), cpu());
         let state = State {
@@ -89,7 +103,23 @@ fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> 
             time: &mut time,
             noise: None,
         };
-        let r = step_slices(state, &bonds, &p, &mut ws, &mut NoForce).expect("step");
+        let params = if k < steps { &p } else { &krylov };
+        let r = match (
+            step_slices(state, &bonds, params, &mut ws, &mut NoForce),
+            k < steps,
+        ) {
+            (Ok(r), true) => r,
+            (Err(e), true) => panic!("step {k}: {e}"),
+            (Ok(r), false) => {
+                (products, converged) = (f64::from(r.iterations), 1.0);
+                break;
+            }
+            (Err(StepError::NoConvergence { iterations, .. }), false) => {
+                products = f64::from(iterations);
+                break;
+            }
+            (Err(e), false) => panic!("krylov: {e}"),
+        };
         if timed {
             sums[0] += match (c, cpu()) {
                 (Some(a), Some(b)) => b - a,
@@ -102,7 +132,15 @@ fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> 
         }
     }
     let w = window as f64;
-    [sums[0] / w, sums[1] / w, sums[2] / w, sums[3] / w, sums[4]]
+    [
+        sums[0] / w,
+        sums[1] / w,
+        sums[2] / w,
+        sums[3] / w,
+        sums[4],
+        products,
+        converged,
+    ]
 }
 
 fn main() {
@@ -118,11 +156,16 @@ fn main() {
     let mut rows = record::Recorder::new(env!("CARGO_MANIFEST_DIR"), "pile_cost", command);
     let mut cost = Vec::new();
     for (fence, side, count) in [(15, 3, 100), (25, 5, 300)] {
-        let [s, f, it, rounds, held] = run(fence, side, count, steps, window);
+        let [s, f, it, rounds, held, products, converged] = run(fence, side, count, steps, window);
         println!(
             "{count} spheres: {:.4} s a step, {f:.1} factorisations, {it:.1} Newton \
-             iterations (last round), {rounds:.1} rounds a step, {held} rows held at the end",
-            s
+             iterations (last round), {rounds:.1} rounds a step, {held} rows held at the end; \
+             Krylov from there: {products} products ({})",
+            s,
+            match converged == 1.0 {
+                true => "converged",
+                false => "did not converge",
+            }
         );
         let case = format!("{count} spheres");
         for (q, v) in [
@@ -132,6 +175,9 @@ fn main() {
             ("rows_held", held),
         ] {
             rows.row("pile newton", &case, q, &format!("{v}"));
+        }
+        for (q, v) in [("products_one_step", products), ("converged", converged)] {
+            rows.row("pile krylov", &case, q, &format!("{v}"));
         }
         cost.push(s);
     }

@@ -98,6 +98,72 @@ impl<T: Real> Rows<'_, '_, T> {
         Ok((0..*m).filter(|&i| jac[i * nb + i] == T::ZERO).count())
     }
 
+    /// The factor the last solve left (`m` rows at stride `stride`, `order` holding
+    /// them by position, in that solve's indices) brought to this solve's list: the
+    /// `released` row taken out of it (and the rows after it one index down, as the
+    /// list moved them), the factor restrided to this solve's rows. Returns the rows
+    /// left in it.
+    pub fn carried(
+        &self,
+        (m, stride): (usize, usize),
+        released: Option<usize>,
+        order: &mut [usize],
+        jac: &mut [T],
+    ) -> usize {
+        let nb = self.bonds.len();
+        let mut m = m;
+        if let Some(r) = released {
+            let at = order[..m].iter().position(|&k| k == r);
+            for k in order[..m].iter_mut().filter(|k| **k > r) {
+                *k -= 1;
+            }
+            if let Some(p) = at {
+                order.copy_within(p + 1..m, p);
+                let order = &*order;
+                ordered_remove(jac, stride, m, p, self.floor, |j| {
+                    self.entry(order[j], order[j])
+                });
+                m -= 1;
+            }
+        }
+        // Rows from the last up where the stride grows, from the first down where it
+        // shrinks: a row's new place never overwrites a row not yet moved.
+        let row = |i: usize| (i * stride..i * stride + i + 1, i * nb);
+        match nb > stride {
+            true => (0..m).rev().for_each(|i| {
+                let (from, to) = row(i);
+                jac.copy_within(from, to);
+            }),
+            false => (0..m).for_each(|i| {
+                let (from, to) = row(i);
+                jac.copy_within(from, to);
+            }),
+        }
+        m
+    }
+
+    /// Whether bringing the factor of `m` rows (`order`) to the current set row by row
+    /// would cost more than building it: a removal at position `p` costs about `3 (m -
+    /// p)^2` (the rotations of the block below it), an append `m^2` (the forward
+    /// substitution), the factorisation `m^3 / 3`. A carried factor that the first
+    /// iteration's set shrinks to its first rows (the rows appended last go first) is
+    /// cheap to bring; one that has to change all through is not.
+    pub fn rebuild_cheaper(&self, state: &[usize], order: &[usize], m: usize) -> bool {
+        let mut rows = m;
+        let mut cost = 0;
+        for p in (0..m).rev().filter(|&p| !self.on(state, order[p])) {
+            cost += 3 * (rows - p) * (rows - p);
+            rows -= 1;
+        }
+        for k in (self.from..self.bonds.len()).filter(|&k| self.on(state, k)) {
+            if !order[..m].contains(&k) {
+                cost += rows * rows;
+                rows += 1;
+            }
+        }
+        cost > rows * rows * rows / 3
+    }
+
     /// The update for the right-hand side `rhs` (all rows): the inactive rows'
     /// `-lambda_k`, the active rows' solve with their right-hand side corrected by
     /// `A_jk lambda_k`.

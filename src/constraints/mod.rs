@@ -263,6 +263,27 @@ pub struct Scratch<'a, T: Real> {
     pub beads: &'a mut [T::V3],
     /// How the mobility products of the hydrodynamic metric run.
     pub par: &'a dyn crate::parallel::Parallel,
+    /// Newton with one-sided rows: the factor of the active rows that the last solve
+    /// left in `jac` and `piv`, for the next solve on the same chord matrix.
+    pub carry: Carry,
+}
+
+/// Newton's factor of the active rows carried from one solve to the next
+/// (`docs/CONTACTS.md`, "Large piles"): the contact rounds of a step solve on the same
+/// chord matrix (the same start, metric and rows, a round's new rows appended at the
+/// end of the list, a released one taken out of it), so the next round's factor is
+/// the last one brought to its set row by row instead of a factorisation from scratch.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Carry {
+    /// Set by the caller: the next solve's rows are the last solve's (same entries)
+    /// with `released` taken out and new rows appended; otherwise the factor is built
+    /// from scratch.
+    pub keep: bool,
+    /// The row (the last solve's index) taken out of the list since, if any.
+    pub released: Option<usize>,
+    /// Set by Newton: the rows in the factor and the stride (the last solve's rows) it
+    /// is stored with; `None` where it left none.
+    pub held: Option<(usize, usize)>,
 }
 
 /// Scratch sizes `[scalars, vectors, indices]` of `kind` for `n` beads, `m` block rows

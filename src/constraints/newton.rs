@@ -47,6 +47,25 @@ pub fn newton<T: Real>(
     // One-sided rows from `from` on (`usize::MAX`: none, the equality solve as it
     // always was); their states after the pivots.
     let from = problem.one_sided(nb);
+    let floor = dependent::rank_floor::<T>();
+    // One-sided rows: the chord's factor of the active rows follows the set row by row
+    // (`active.rs`); `piv` holds its rows by position, `held` of them (none before the
+    // first build, or the last solve's brought to this one's rows where the caller
+    // keeps it: `Carry`).
+    let rows = active::Rows {
+        metric,
+        bonds,
+        c: problem.chord_factor(),
+        from,
+        floor,
+    };
+    let carry = core::mem::take(&mut scratch.carry);
+    let mut held = match carry.held.filter(|_| carry.keep && from < nb) {
+        Some(h) => Some(rows.carried(h, carry.released, scratch.piv, scratch.jac)),
+        None => None,
+    };
+    // A carried factor is brought to the first iteration's set whatever it is.
+    let mut stale = held.is_some();
     #[cfg(feature = "contacts")]
     let (piv, state) = scratch.piv.split_at_mut(nb);
     #[cfg(not(feature = "contacts"))]
@@ -60,7 +79,6 @@ pub fn newton<T: Real>(
     // iterate, refreshed whenever the residual falls less than tenfold.
     let mut chord = matches!(problem, Problem::Positions { .. });
     let mut previous: Option<T> = None;
-    let floor = dependent::rank_floor::<T>();
     // Dependent rows found by the last factorisation.
     let mut deficient = 0;
     // `rhs` holds the update applied by the last iteration (none before the first).
@@ -76,17 +94,6 @@ pub fn newton<T: Real>(
     // then 1/2 for the halvings (exact: powers of two).
     let mut scale = T::ONE;
     let mut next = 0;
-    // One-sided rows: the chord's factor of the active rows follows the set row by row
-    // (`active.rs`); `piv` holds its rows by position, `held` of them (none before the
-    // first build).
-    let rows = active::Rows {
-        metric,
-        bonds,
-        c: problem.chord_factor(),
-        from,
-        floor,
-    };
-    let mut held: Option<usize> = None;
     loop {
         let (mut changed, mut pushes) = (false, true);
         // The last iteration's update is applied at the start of the next, where its
@@ -140,6 +147,9 @@ pub fn newton<T: Real>(
             return Err(problem.no_convergence(it, residual));
         }
         if residual <= solver.tolerance && pushes {
+            // The factor (of the rows in `piv`, whatever the set now) for the next
+            // solve on this chord matrix.
+            scratch.carry.held = held.map(|m| (m, nb));
             return Ok(SolveStats {
                 iterations: it,
                 residual,
@@ -209,6 +219,11 @@ pub fn newton<T: Real>(
             error,
         };
         if one_sided {
+            // A carried factor that would cost more to bring to the set than to build
+            // is built again.
+            if stale && held.is_some_and(|m| rows.rebuild_cheaper(state, piv, m)) {
+                held = None;
+            }
             let m = match held {
                 None => {
                     factorizations += 1;
@@ -217,12 +232,13 @@ pub fn newton<T: Real>(
                     m
                 }
                 Some(mut m) => {
-                    if changed {
+                    if changed || stale {
                         deficient = rows.sync(state, piv, &mut m, jac).map_err(fail)?;
                     }
                     m
                 }
             };
+            stale = false;
             held = Some(m);
             rows.solve(state, (piv, m), jac, mult, rhs);
             applied = true;

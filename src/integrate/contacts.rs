@@ -141,6 +141,9 @@ pub(super) fn project_overdamped<'l, T: Real>(
     let mut round = 0;
     // Factorisations of every round's solve.
     let mut factorizations = 0;
+    // Newton's factor is carried from round to round (the same chord matrix: the same
+    // start, metric and rows), never into a step.
+    scratch.carry = Default::default();
     loop {
         round += 1;
         let active = match one_sided {
@@ -189,7 +192,13 @@ pub(super) fn project_overdamped<'l, T: Real>(
         if wall.is_some() {
             added += add_wall(x, T::ZERO, radius, reach, &mut set)?;
         }
-        if added == 0 && !set.release_pulling(lambda) {
+        let let_go = match added {
+            0 => set.release_pulling(lambda),
+            _ => None,
+        };
+        scratch.carry.keep = true;
+        scratch.carry.released = let_go;
+        if added == 0 && let_go.is_none() {
             // Every contact must end on the side it started from (a sphere above the
             // wall: `grad = (0, 0, a)`, its relative vector `(0, 0, z)`).
             for (k, l) in links[nb..nb + nc].iter().enumerate() {
@@ -378,8 +387,9 @@ impl<'s, T: Real> Active<'s, T> {
 
     /// Releases the contact whose multiplier pulls hardest (negative: a contact pushes
     /// along `r_i - r_j` with a positive multiplier), keeping the others in order;
-    /// a contact released once in this step is held (anti-cycling).
-    fn release_pulling(&mut self, lambda: &[T]) -> bool {
+    /// a contact released once in this step is held (anti-cycling). Returns its row
+    /// (the bonds' and active ones' index) where one was released.
+    fn release_pulling(&mut self, lambda: &[T]) -> Option<usize> {
         let (nb, nc) = (self.nb, *self.nc);
         let mut worst: Option<(usize, T)> = None;
         for (k, link) in self.held().iter().enumerate() {
@@ -389,9 +399,7 @@ impl<'s, T: Real> Active<'s, T> {
                 worst = Some((k, l));
             }
         }
-        let Some((k, _)) = worst else {
-            return false;
-        };
+        let (k, _) = worst?;
         let link = self.links[nb + k];
         self.links.copy_within(nb + k + 1..nb + nc, nb + k);
         *self.nc -= 1;
@@ -404,7 +412,7 @@ impl<'s, T: Real> Active<'s, T> {
         let slot = end - *self.released;
         self.links.copy_within(slot + 1..end, slot);
         self.links[end - 1] = link;
-        true
+        Some(nb + k)
     }
 }
 

@@ -55,23 +55,44 @@ pub fn ordered_append<T: Real>(
     }
     // Each sum from zero in column order, as `cholesky_dense` forms it: a row appended
     // after rows that are all before it in the caller's list has the bits a
-    // factorisation of the whole would give it.
-    for j in 0..m {
-        let inv = done[j * n + j];
-        row[j] = match inv == T::ZERO {
-            true => T::ZERO,
-            false => {
-                let l_j = &done[j * n..j * n + j];
-                let s = row[..j]
-                    .iter()
-                    .zip(l_j)
-                    .fold(T::ZERO, |s, (&a, &b)| s + a * b);
-                (row[j] - s) * inv
-            }
+    // factorisation of the whole would give it. The sums of `W` entries at a time run
+    // side by side (a single running sum waits on each addition in turn).
+    let mut j = 0;
+    while j < m {
+        j += match m - j {
+            8.. => forward::<T, 8>(done, n, row, j),
+            4.. => forward::<T, 4>(done, n, row, j),
+            2.. => forward::<T, 2>(done, n, row, j),
+            _ => forward::<T, 1>(done, n, row, j),
         };
     }
     row[m] = diagonal;
     Ok(pivot(row, m, floor)? == T::ZERO)
+}
+
+/// Entries `j..j + W` of an appended row (`row[..j]` final, `row[j..j + W]` its
+/// entries against those positions): `L_kj = (A_kj - sum_i L_ki L_ji) / L_jj`, each sum
+/// from zero in `i` order, the `W` of them in registers over the final entries and then
+/// finished one by one within the block. Returns `W`.
+#[inline(always)]
+fn forward<T: Real, const W: usize>(done: &[T], n: usize, row: &mut [T], j: usize) -> usize {
+    let mut s = [T::ZERO; W];
+    for (i, &y) in row[..j].iter().enumerate() {
+        for (q, s) in s.iter_mut().enumerate() {
+            *s += y * done[(j + q) * n + i];
+        }
+    }
+    for q in 0..W {
+        let k = j + q;
+        let inv = done[k * n + k];
+        let l_k = &done[k * n..k * n + k];
+        let s = (j..k).fold(s[q], |s, i| s + row[i] * l_k[i]);
+        row[k] = match inv == T::ZERO {
+            true => T::ZERO,
+            false => (row[k] - s) * inv,
+        };
+    }
+    W
 }
 
 /// Removes position `p` of `m`: the rows below move up one, and the block from `p` on
@@ -120,10 +141,15 @@ pub fn ordered_remove<T: Real>(
 /// Solves `A y = x` for the `m` positions, position `i` reading and writing
 /// `x[order[i]]` (other entries untouched).
 pub fn ordered_solve<T: Real>(a: &[T], n: usize, m: usize, order: &[usize], x: &mut [T]) {
-    for i in 0..m {
-        let row = &a[i * n..i * n + i + 1];
-        let s = (0..i).fold(x[order[i]], |s, j| s - row[j] * x[order[j]]);
-        x[order[i]] = s * row[i];
+    // `W` rows at a time, their sums side by side as in [`ordered_append`].
+    let mut i = 0;
+    while i < m {
+        i += match m - i {
+            8.. => lower::<T, 8>(a, n, order, x, i),
+            4.. => lower::<T, 4>(a, n, order, x, i),
+            2.. => lower::<T, 2>(a, n, order, x, i),
+            _ => lower::<T, 1>(a, n, order, x, i),
+        };
     }
     for i in (0..m).rev() {
         let row = &a[i * n..i * n + i + 1];
@@ -133,6 +159,33 @@ pub fn ordered_solve<T: Real>(a: &[T], n: usize, m: usize, order: &[usize], x: &
             x[order[j]] -= row[j] * v;
         }
     }
+}
+
+/// Positions `i..i + W` of the forward substitution `L y = x` (the positions before
+/// final): `y_k = (x_k - sum_j L_kj y_j) / L_kk`, each running from `x_k` in `j` order.
+/// Returns `W`.
+#[inline(always)]
+fn lower<T: Real, const W: usize>(
+    a: &[T],
+    n: usize,
+    order: &[usize],
+    x: &mut [T],
+    i: usize,
+) -> usize {
+    let mut s: [T; W] = core::array::from_fn(|q| x[order[i + q]]);
+    for (j, &o) in order[..i].iter().enumerate() {
+        let y = x[o];
+        for (q, s) in s.iter_mut().enumerate() {
+            *s -= a[(i + q) * n + j] * y;
+        }
+    }
+    for (q, &s) in s.iter().enumerate() {
+        let k = i + q;
+        let row = &a[k * n..k * n + k + 1];
+        let s = (i..k).fold(s, |s, j| s - row[j] * x[order[j]]);
+        x[order[k]] = s * row[k];
+    }
+    W
 }
 
 /// The self-stress of the first dependent position `q` (`L^T v = 0` above it, `v_q =

@@ -207,6 +207,7 @@ impl<T: Real> Workspace<'_, T> {
                 0
             }),
             par: self.parallel,
+            carry: Default::default(),
         };
         #[cfg(feature = "cells")]
         let cells = ix.take(crate::cell_list::indices(n));
