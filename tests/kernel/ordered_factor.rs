@@ -134,8 +134,8 @@ fn appended_rows_have_the_bits_of_a_build() {
     for first in 0..n {
         let mut f = vec![0.0; n * n];
         ordered_build(&mut f, n, first, FLOOR, |i, j| a[i][j]).unwrap();
-        for m in first..n {
-            ordered_append(&mut f, n, m, FLOOR, a[m][m], |j| a[m][j]).unwrap();
+        for (m, row) in a.iter().enumerate().skip(first) {
+            ordered_append(&mut f, n, m, FLOOR, row[m], |j| row[j]).unwrap();
         }
         for i in 0..n {
             for j in 0..=i {
