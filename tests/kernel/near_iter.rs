@@ -228,7 +228,7 @@ fn same_bits<T: Real>() {
 }
 
 /// Refused, typed, the state unchanged: what the iterative path does not serve (bonds
-/// by the sweep, contacts, the wall's hydrodynamics, PSE), the conjugate gradients
+/// and contacts by the sweep or Newton, the wall's hydrodynamics, PSE), the conjugate gradients
 /// stopped before they converge, and more close pairs than the storage holds (its
 /// Brownian steps: `near_iter_brownian.rs`).
 fn refusals<T: Real>() {
@@ -249,9 +249,12 @@ fn refusals<T: Real>() {
     let mut p = base;
     p.solver.kind = SolverKind::Sweep;
     unsupported(&p, &[bond], "sweep or Newton");
+    // Contacts alone step, by the Krylov solve (`near_contacts.rs`); refused before.
     let mut p = base;
     p.contacts = Some(Contacts::new(64));
-    unsupported(&p, &[], "constraints");
+    one_step::<T>(&p, &spheres, &[]).unwrap();
+    p.solver.kind = SolverKind::Newton;
+    unsupported(&p, &[], "sweep or Newton");
     let mut p = base;
     p.wall = Some(Wall::new(T::from_f64(-40.0)));
     unsupported(&p, &[], "wall");
