@@ -107,11 +107,6 @@ fn check_iterative<T: Real>(
             "the iterative near field (matrix_free) with constraints (bonds, pins, contacts) in Overdamped2: Overdamped only (or matrix_free = false)",
         );
     }
-    if rows > 0 && p.solver_kind(n, bonds) != crate::constraints::SolverKind::Krylov {
-        return refuse(
-            "the iterative near field (matrix_free) with constraints (bonds, pins, contacts) solved by the sweep or Newton: they read every entry of the metric, the Krylov solve its products only (SolverKind::Krylov or Auto)",
-        );
-    }
     if super::wall_height(p).is_some() {
         return refuse(
             "the iterative near field (matrix_free) above the wall: the wall's sphere corrections are the dense near field's (matrix_free = false)",

@@ -285,8 +285,8 @@ fn same_bits<T: Real>() {
     assert_eq!(bits(), bits());
 }
 
-/// Refused, typed, the state unchanged: the sweep and Newton (they read every entry of
-/// `M_SD`), `Overdamped2` with bonds, thermal noise (contacts step); and a product of the
+/// Refused, typed, the state unchanged: `Overdamped2` with bonds, thermal noise (the
+/// sweep, Newton and contacts step); and a product of the
 /// constraint solve that does not converge within the iterations allowed is
 /// `NoConvergence` at the mobility.
 fn refusals<T: Real>() {
@@ -298,10 +298,21 @@ fn refusals<T: Real>() {
         Err(StepError::Unsupported(m)) => assert!(m.contains(what), "{what}: {m}"),
         other => panic!("{what}: {other:?}"),
     };
+    // The sweep and Newton step, on their table of `M_SD`'s columns; refused before.
     for kind in [SolverKind::Sweep, SolverKind::Newton] {
         let mut p = base;
         p.solver.kind = kind;
-        unsupported(&p, "sweep or Newton");
+        let (r, x) = run::<T>(&p, &spheres, &rows, 1).unwrap();
+        assert_eq!(
+            r[0].near_products as usize,
+            rows.len() + 2,
+            "{kind:?}: {r:?}"
+        );
+        let e = bond_error(&rows, &x);
+        assert!(
+            e <= p.solver.tolerance.to_f64() + 8.0 * T::EPSILON.to_f64(),
+            "{kind:?}"
+        );
     }
     let mut p = base;
     p.method = Method::Overdamped2;

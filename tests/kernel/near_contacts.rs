@@ -2,9 +2,10 @@
 //! and `Params::contacts`): spheres settling onto a pinned floor and onto each other,
 //! each step against the dense near step from the same state with the same solver
 //! (`near_step.rs` checks that one against exact two-sphere hydrodynamics); no pair
-//! overlapping beyond the solver's tolerance, measured here from the positions; the
-//! floor's pins held bit for bit; the same bits run to run. Units: `a = 1`, `eta = 1`,
-//! `g = 1`, no fluid density.
+//! overlapping beyond twice the solver's tolerance, measured here from the positions;
+//! the floor's pins held bit for bit; the same bits run to run; with the Krylov solve,
+//! the sweep and Newton (their table of `M_SD`'s columns, one product a row). Units:
+//! `a = 1`, `eta = 1`, `g = 1`, no fluid density.
 #![cfg(all(feature = "contacts", feature = "pins"))]
 
 use crate::common;
@@ -13,10 +14,7 @@ use crate::near_con::{near, run};
 use std::f64::consts::PI;
 
 use common::*;
-use hydrorattle::{
-    Bond, BondSet, Contacts, Layout, NoForce, ParticleSet, Real, SolverKind, StepError, StepReport,
-    step,
-};
+use hydrorattle::{Bond, BondSet, Contacts, Layout, NoForce, ParticleSet, Real, SolverKind, step};
 use hydrorattle_heap::Buffers;
 
 /// Density of a unit sphere of buoyant weight 4 (`g = 1`, no fluid density).
@@ -79,27 +77,46 @@ fn with_contacts<T: Real>(iterative: bool, kind: SolverKind) -> hydrorattle::Par
     let mut p = near::<T>(iterative, 1.0, None);
     p.contacts = Some(Contacts::new(32));
     p.solver.kind = kind;
+    // The sweep converges linearly on a jammed set (`docs/CONTACTS.md`): f64 took more
+    // than the default 100 sweeps here.
+    if kind == SolverKind::Sweep {
+        p.solver.max_iterations = 5000;
+    }
     p
 }
 
-/// Twelve steps of the bed from the iterative step's own states: every step ends
-/// where the dense near step (Krylov, its band reading `M_SD`'s entries) from the same
-/// state ends, within the tolerances (the constraint rows' relative error and the
-/// products' relative residual: 1e-10 in f64, 1e-5 in f32) relative to the step's
-/// move, amplified by the lubrication's conditioning near contact (measured: up to 34
-/// times the tolerance in f64, 20 in f32; the test allows 200): contacts form (floor and pile), as many as the
-/// dense step holds; no pair overlaps beyond the tolerance; the floor does not move,
-/// bit for bit.
+/// Twelve steps of the bed from the iterative step's own states, with each solver:
+/// every step ends where the dense near step with the same solver (its entries read
+/// from the stored `M_SD`) from the same state ends, within the tolerances (the
+/// constraint rows' relative error and the products' relative residual: 1e-10 in f64,
+/// 1e-5 in f32) relative to the step's move, amplified by the lubrication's
+/// conditioning near contact (measured: up to 34 times the tolerance in f64, 20 in
+/// f32; the test allows 200, 1000 for the sweep, which stops anywhere inside its
+/// tolerance): contacts form (floor and pile), as many as the dense step holds; no
+/// pair overlaps beyond twice the tolerance; the floor does not move, bit for bit.
 fn settles_as_dense<T: Real>() {
+    for kind in [SolverKind::Krylov, SolverKind::Newton, SolverKind::Sweep] {
+        settles_with::<T>(kind);
+    }
+}
+
+fn settles_with<T: Real>(kind: SolverKind) {
     let spheres = bed();
     let rows = floor::<T>(&spheres);
-    let kind = SolverKind::Krylov;
     let (pd, pi) = (
         with_contacts::<T>(false, kind),
         with_contacts::<T>(true, kind),
     );
     let tol = pi.solver.tolerance.to_f64();
-    let slack = tol + 8.0 * T::EPSILON.to_f64();
+    // Within twice the tolerance (the over-relaxed sweep stops just inside its own
+    // measure: 1.2e-5 in f32).
+    let slack = 2.0 * tol + 8.0 * T::EPSILON.to_f64();
+    // The sweep stops anywhere in its tolerance band; the others end closer.
+    let allow = if kind == SolverKind::Sweep {
+        1e3
+    } else {
+        200.0
+    };
     let n = spheres.len();
     let mut ps: ParticleSet<T, 16> = particles(&spheres);
     let mut set: BondSet<T, 32> = BondSet::new();
@@ -146,7 +163,7 @@ fn settles_as_dense<T: Real>() {
             "{kind:?} step {k}: {ri:?} / {rd:?}"
         );
         assert!(
-            apart < 200.0 * tol * moved,
+            apart < allow * tol * moved,
             "step {k}: {apart:e} of {moved:e}"
         );
         assert!(overlap(&spheres, &xi) <= slack, "step {k}: overlap");
@@ -171,27 +188,12 @@ fn same_bits<T: Real>() {
         let x: Vec<[u64; 3]> = x.iter().map(|v| v.map(f64::to_bits)).collect();
         (x, r)
     };
-    let (a, b): ((Vec<[u64; 3]>, Vec<StepReport<T>>), _) = (bits(), bits());
+    let (a, b) = (bits(), bits());
     assert!(a.1.iter().any(|r| r.contacts > 0), "no contact: {:?}", a.1);
     assert_eq!(a, b);
-}
-
-/// Contacts with the sweep or Newton on the iterative path are refused, typed, the
-/// state unchanged (`run` asserts it).
-fn refused_by_sweep_and_newton<T: Real>() {
-    let spheres = bed();
-    let rows = floor::<T>(&spheres);
-    for kind in [SolverKind::Sweep, SolverKind::Newton] {
-        let p = with_contacts::<T>(true, kind);
-        match run::<T>(&p, &spheres, &rows, 1) {
-            Err(StepError::Unsupported(m)) => assert!(m.contains("sweep or Newton"), "{m}"),
-            other => panic!("{kind:?}: {other:?}"),
-        }
-    }
 }
 
 both_precisions! {
     settles_as_dense => settles_as_dense;
     same_bits => same_bits;
-    refused_by_sweep_and_newton => refused_by_sweep_and_newton;
 }

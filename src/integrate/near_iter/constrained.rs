@@ -19,21 +19,24 @@
 //! pair's near-field correction): with `R_near` about `G^T K G`, the constraint matrix
 //! is about `(A_far^-1 + K)^-1`, whose inverse `A_far^-1 + K` is the band's solve plus a
 //! diagonal, positive definite. A contact is a close pair too (its squeeze resistance
-//! at the minimum gap dominates its row). This halves the solve's products (to the dense path's,
-//! whose band reads `M_SD`); adding pair mobility corrections to the band's blocks
-//! instead doubles them (a bead's self-mobility is reduced once per close neighbour,
-//! and the band's diagonal can turn negative).
+//! at the minimum gap dominates its row). This halves the solve's products (to the
+//! dense path's, whose band reads `M_SD`); adding pair mobility corrections to the
+//! band's blocks instead doubles them (a bead's self-mobility is reduced once per close
+//! neighbour, and the band's diagonal can turn negative).
 //!
-//! Only the Krylov solver runs here: the sweep and Newton read `D_l(p)` for every row
-//! at every iteration (a table of `n x B` entries, `B` products of `M_SD` to form), and
-//! are refused by `near::check`, typed, as are `Overdamped2`, the wall and noise. A product that does not converge ends the step with
+//! The sweep and Newton read every entry `D_l(p)` at every iteration: they get the
+//! table of `M_SD`'s columns along the round's rows (one product a row, formed each
+//! round, `Metric::Dense` as the dense path tabulates its stored `M_SD`), cheaper than
+//! the Krylov solve's products where the rows are few; `Auto` resolves to Krylov
+//! (`Params::solver_kind`). `Overdamped2`, the wall and noise are refused by
+//! `near::check`, typed. A product that does not converge ends the step with
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`](crate::Stage::Mobility), the
 //! caller's state unchanged.
 
 use super::solve::{self, At};
 use super::{Counts, Store, spins};
 use crate::bonds::Bond;
-use crate::constraints::{Metric, Problem, Products, SolveStats, krylov_with};
+use crate::constraints::{self, Metric, Problem, Products, SolveStats, SolverKind, krylov_with};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
 use crate::integrate::contacts::{Along, Round, project_along};
@@ -89,6 +92,9 @@ struct Iterative<'a, 's, T: Real> {
     sd: Sd<'a, 's, T>,
     packed: &'s [T::M3],
     s: &'a Start<'a, T>,
+    /// The sweep's and Newton's table of `M_SD`'s columns (`n x rows`; empty for
+    /// Krylov).
+    table: &'a mut [T::V3],
 }
 
 impl<T: Real> Along<T> for Iterative<'_, '_, T> {
@@ -118,13 +124,34 @@ impl<T: Real> Along<T> for Iterative<'_, '_, T> {
         };
         let _ = start; // Read only with the `pins` feature.
         lambda.fill(T::ZERO);
-        for ((k, b), &g) in self.sd.stiff.iter_mut().zip(rows).zip(grad) {
-            *k = squeeze(p, self.s, b, g, T::TWO);
+        if p.solver.kind == SolverKind::Krylov {
+            for ((k, b), &g) in self.sd.stiff.iter_mut().zip(rows).zip(grad) {
+                *k = squeeze(p, self.s, b, g, T::TWO);
+            }
+            let ops = (&far, &mut self.sd);
+            return krylov_with(problem, ops, rows, &p.solver, x, lambda, scratch);
         }
-        let ops = (&far, &mut self.sd);
-        krylov_with(problem, ops, rows, &p.solver, x, lambda, scratch)
+        // The sweep and Newton read every entry `D_l(p)`: the table of `M_SD`'s columns
+        // along the rows, one product a row (`Metric::Dense`, as the dense path
+        // tabulates its stored `M_SD`).
+        let table = self.table.get_mut(..n * rows.len()).ok_or(TABLE)?;
+        for (l, column) in table.chunks_exact_mut(n).enumerate() {
+            lambda[l] = T::ONE;
+            let done = self.sd.apply(&far, rows, lambda, column, &mut []);
+            lambda[l] = T::ZERO;
+            done?;
+        }
+        let metric = Metric::Dense {
+            disp: table,
+            n,
+            grad,
+        };
+        constraints::solve(problem, &metric, rows, &p.solver, x, lambda, scratch)
     }
 }
+
+const TABLE: StepError =
+    StepError::Unsupported("the iterative near field's sweep or Newton without its table");
 
 /// Bond `b`'s squeeze resistance `d^T (R_ii + R_jj - R_ij - R_ji) d / 4` (`d` along the
 /// bond) from its pair's near-field correction, over `c dt |g|^2`.
@@ -172,6 +199,7 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
         lambda,
         mut scratch,
         links,
+        disp,
         near,
         near_iter,
         ..
@@ -199,7 +227,12 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
             }
         };
         // The projection: entries from the far field's `mu_tt`, moves from `M_SD`.
-        let mut along = Iterative { sd, packed, s };
+        let mut along = Iterative {
+            sd,
+            packed,
+            s,
+            table: disp,
+        };
         let views = (links, &mut *grad, &mut *lambda, &mut scratch);
         let r = project_along(
             p,
