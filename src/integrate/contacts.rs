@@ -39,7 +39,7 @@
 //! constraints holds one wall link per sphere beside the contacts' capacity
 //! ([`Params::constraints`]).
 
-use super::{bond_vectors, mobility_metric, project_positions};
+use super::{Sums, bond_vectors, mobility_metric, project_positions};
 use crate::bonds::Bond;
 use crate::cell::{Periodic, image};
 use crate::cell_list::{self, CellList};
@@ -78,16 +78,54 @@ pub(super) struct Projected<'l, T: Real> {
     pub rounds: u32,
 }
 
+/// One round's projection ([`Along::project`]): `x` onto `rows` (the bonds, then from
+/// `nb` on the one-sided rows) along the step's metric at `start`, `grad` the rows'
+/// vectors there; the multipliers from zero into `lambda` ([`project_positions`]).
+pub(super) struct Round<'r, 's, T: Real> {
+    pub rows: &'r [Bond<T>],
+    pub grad: &'r [T::V3],
+    pub x: &'r mut [T::V3],
+    pub lambda: &'r mut [T],
+    pub scratch: &'r mut Scratch<'s, T>,
+    pub nb: usize,
+    pub start: &'r [T::V3],
+}
+
+/// Who solves a round's projection ([`project_along`]): [`Stored`] along the step's
+/// mobility, or the iterative near field along `M_SD`'s products
+/// (`near_iter/constrained.rs`), which has no stored blocks to read.
+pub(super) trait Along<T: Real> {
+    /// Solves the round `r` with the step's parameters `p`.
+    fn project(&mut self, p: &Params<T>, r: Round<'_, '_, T>) -> Result<SolveStats<T>, StepError>;
+}
+
+/// Along the mobility at the start as the step holds it (stored, or matrix-free):
+/// [`mobility_metric`] and the step's solver.
+struct Stored<'v, T: Real> {
+    ewald: Sums<'v, T>,
+    radius: &'v [T],
+    mu: Mob<'v, T>,
+    disp: &'v mut [T::V3],
+    compact: &'v [T::M3],
+}
+
+impl<T: Real> Along<T> for Stored<'_, T> {
+    #[inline(always)]
+    fn project(&mut self, p: &Params<T>, r: Round<'_, '_, T>) -> Result<SolveStats<T>, StepError> {
+        let (par, ew, radius, mu) = (r.scratch.par, self.ewald, self.radius, self.mu);
+        let (disp, compact) = (&mut *self.disp, self.compact);
+        let (rows, start, with) = (r.rows, r.start, (par, compact));
+        let metric = mobility_metric(p, ew, rows, start, radius, mu, r.grad, p.dt, disp, with);
+        project_positions(p, rows, &metric, r.x, r.lambda, r.scratch, r.nb, start)
+    }
+}
+
 /// The overdamped position projection along the mobility at `start` (`mu`, scaled by
 /// `dt`): `free` writes the unconstrained move into `x` (once per round), which is then
 /// projected onto the bonds, or onto the bonds and the hard-sphere contacts when
-/// [`Params::contacts`] is on.
-///
-/// Without contacts this is one round over the caller's bonds. Both cases share the
-/// one call of the constraint solve: a second call site would stop the compiler from
-/// inlining it where the parameters are a constant (firmware), and every solver would
-/// be linked.
+/// [`Params::contacts`] is on ([`project_along`] with [`Stored`]).
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub(super) fn project_overdamped<'l, T: Real>(
     p: &Params<T>,
     bonds: &'l [Bond<T>],
@@ -107,6 +145,33 @@ pub(super) fn project_overdamped<'l, T: Real>(
         ewald,
         compact,
     } = v;
+    let mut along = Stored {
+        ewald,
+        radius,
+        mu,
+        disp,
+        compact,
+    };
+    let rows = (links, grad, lambda, scratch);
+    project_along(p, bonds, (start, radius), rows, x, free, &mut along)
+}
+
+/// The position projection of [`project_overdamped`], each round solved by `along`.
+///
+/// Without contacts this is one round over the caller's bonds. Both cases share the
+/// one call of the constraint solve: a second call site would stop the compiler from
+/// inlining it where the parameters are a constant (firmware), and every solver would
+/// be linked.
+#[allow(clippy::type_complexity)]
+pub(super) fn project_along<'l, T: Real, A: Along<T>>(
+    p: &Params<T>,
+    bonds: &'l [Bond<T>],
+    (start, radius): (&[T::V3], &[T]),
+    (links, grad, lambda, scratch): (Links<'l, T>, &mut [T::V3], &mut [T], &mut Scratch<'_, T>),
+    x: &mut [T::V3],
+    free: impl Fn(&mut [T::V3]),
+    along: &mut A,
+) -> Result<Projected<'l, T>, StepError> {
     let (links, cells) = links.split();
     // Constants without the `contacts` feature: the one-sided path folds away.
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
@@ -151,23 +216,20 @@ pub(super) fn project_overdamped<'l, T: Real>(
             None => bonds,
         };
         bond_vectors(active, start, super::cell(p), grad);
-        let par = scratch.par;
-        let metric = mobility_metric(
-            p,
-            ewald,
-            active,
-            start,
-            radius,
-            mu,
-            grad,
-            p.dt,
-            disp,
-            (par, compact),
-        );
         free(x);
         shift(x, wall, -T::ONE);
         // Contacts and wall links are inequalities inside the solve (`docs/CONTACTS.md`).
-        let stats = project_positions(p, active, &metric, x, lambda, scratch, nb, start)
+        let this = Round {
+            rows: active,
+            grad: &*grad,
+            x: &mut *x,
+            lambda: &mut *lambda,
+            scratch: &mut *scratch,
+            nb,
+            start,
+        };
+        let stats = along
+            .project(p, this)
             .map_err(|e| too_long(e, active, nb, start, wall, p))?;
         factorizations += stats.factorizations;
         let stats = SolveStats {

@@ -263,7 +263,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
                 near_iter::overdamped_thermal(p, b, &s, v, ext, g)
             }
             #[cfg(feature = "near")]
-            (Method::Overdamped, ..) if iterative && !bonds.is_empty() => {
+            (Method::Overdamped, ..) if iterative && p.constraints(n, bonds.len()) > 0 => {
                 near_iter::constrained::overdamped(p, &s, bonds, v, ext)
             }
             #[cfg(feature = "near")]

@@ -96,24 +96,15 @@ fn check_iterative<T: Real>(
     thermal: bool,
 ) -> Result<(), StepError> {
     let refuse = |what| Err(StepError::Unsupported(what));
-    if thermal && p.constraints(n, bonds) > 0 {
+    let rows = p.constraints(n, bonds);
+    if thermal && rows > 0 {
         return refuse(
             "the iterative near field (matrix_free) with thermal noise and constraints (bonds, pins, contacts, the wall's links): the dense near field (matrix_free = false)",
         );
     }
-    if p.constraints(n, bonds) > bonds {
+    if rows > 0 && p.method != Method::Overdamped {
         return refuse(
-            "the iterative near field (matrix_free) with one-sided constraints (contacts, the wall's links): their projection reads the dense near field's blocks (matrix_free = false)",
-        );
-    }
-    if bonds > 0 && p.method != Method::Overdamped {
-        return refuse(
-            "the iterative near field (matrix_free) with constraints (bonds, pins) in Overdamped2: Overdamped only (or matrix_free = false)",
-        );
-    }
-    if bonds > 0 && p.solver_kind(n, bonds) != crate::constraints::SolverKind::Krylov {
-        return refuse(
-            "the iterative near field (matrix_free) with constraints solved by the sweep or Newton: they read every entry of the metric, the Krylov solve its products only (SolverKind::Krylov or Auto)",
+            "the iterative near field (matrix_free) with constraints (bonds, pins, contacts) in Overdamped2: Overdamped only (or matrix_free = false)",
         );
     }
     if super::wall_height(p).is_some() {

@@ -11,8 +11,9 @@
 //! Served: `Overdamped` (one product, at the start) and `Overdamped2` (two, at the
 //! start and at the predicted point), and `Overdamped` with thermal noise
 //! (`near_iter/noise.rs`: three products and a Lanczos root of the far field), in free
-//! space or in the periodic box with the Ewald sums; `Overdamped` with bonds and pins
-//! (deterministic) by the Krylov solve along `M_SD`: `near_iter/constrained.rs`. The
+//! space or in the periodic box with the Ewald sums; `Overdamped` with bonds, pins and
+//! hard contacts (deterministic) by the Krylov solve along `M_SD`:
+//! `near_iter/constrained.rs`. The
 //! rest is refused by [`super::near::check`]. The conjugate gradients stop at the
 //! relative residual
 //! [`Solver::tolerance`](crate::Solver::tolerance) within its `max_iterations`

@@ -233,9 +233,15 @@ impl Layout {
         let l = if near_iterative(p) {
             let [blocks, vectors, scalars, indices] = near_iterative_sizes(n, c);
             let [noise_vectors, noise_scalars] = near_noise_sizes(p, n);
+            // The sweep's and Newton's table of `M_SD`'s columns (`integrate::near_iter`),
+            // which the matrix-free layout leaves out.
+            let table = match (p.method, p.solver_kind(n, bonds)) {
+                (Method::Overdamped, SolverKind::Sweep | SolverKind::Newton) => n * c,
+                _ => 0,
+            };
             Self {
                 blocks: l.blocks + blocks,
-                vectors: l.vectors + vectors + noise_vectors,
+                vectors: l.vectors + vectors + noise_vectors + table,
                 scalars: l.scalars + scalars + noise_scalars,
                 indices: l.indices + indices,
                 ..l

@@ -132,11 +132,16 @@ impl<T: Real> Workspace<'_, T> {
         let (force, grad) = (ve.take(m), ve.take(nb));
         let stored = !(p.matrix_free && matches!(method, Method::Overdamped | Method::Springs));
         // The dense solvers' table of displacements (see `Layout::with_solver`).
-        let table = if krylov || !stored { 0 } else { n * nb };
+        // (The iterative near field's sweep and Newton read one too: `near_iter`.)
+        let iterative = super::layout::near_iterative(p);
+        let table = if krylov || !(stored || iterative) {
+            0
+        } else {
+            n * nb
+        };
         // Thermal noise (`Layout::thermal`): the factor, one vector array, the midpoint's
         // bond vectors and multipliers.
         // (The iterative near field's noise has storage of its own, in `near_iter`.)
-        let iterative = super::layout::near_iterative(p);
         let thermal = p.brownian.is_some() && !iterative;
         let lanczos =
             thermal && matches!(method, Method::Overdamped | Method::Springs) && p.lanczos_noise(n);

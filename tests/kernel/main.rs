@@ -57,6 +57,8 @@ mod near_brownian;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod near_con;
 #[cfg(all(feature = "near", feature = "periodic"))]
+mod near_contacts;
+#[cfg(all(feature = "near", feature = "periodic"))]
 mod near_iter;
 mod near_iter_brownian;
 #[cfg(feature = "near")]

@@ -31,7 +31,7 @@ const RHO1: f64 = 3.0 / (4.0 * PI);
 /// Near-field parameters with rotation and the Krylov solver (`Auto` resolves to it on
 /// the iterative path), time step `dt`; iterative when `iterative`; in the cubic box
 /// of edge `l` if given.
-fn near<T: Real>(iterative: bool, dt: f64, l: Option<f64>) -> hydrorattle::Params<T> {
+pub(crate) fn near<T: Real>(iterative: bool, dt: f64, l: Option<f64>) -> hydrorattle::Params<T> {
     let mut p = params::<T>(dt, Method::Overdamped, SolverKind::Krylov);
     p.near = Some(NearField::default());
     p.rotation = true;
@@ -41,11 +41,11 @@ fn near<T: Real>(iterative: bool, dt: f64, l: Option<f64>) -> hydrorattle::Param
 }
 
 /// What a run returns: each step's report and the positions after the last.
-type Run<T> = (Vec<StepReport<T>>, Vec<[f64; 3]>);
+pub(crate) type Run<T> = (Vec<StepReport<T>>, Vec<[f64; 3]>);
 
 /// `steps` steps of `spheres` with `rows` (bonds and pins) under `p` in one workspace,
 /// or the first error with the state as it was before that step (asserted bit for bit).
-fn run<T: Real>(
+pub(crate) fn run<T: Real>(
     p: &hydrorattle::Params<T>,
     spheres: &[Sphere],
     rows: &[Bond<T>],
@@ -285,8 +285,8 @@ fn same_bits<T: Real>() {
     assert_eq!(bits(), bits());
 }
 
-/// Refused, typed, the state unchanged: the sweep and Newton (they read every entry of
-/// `M_SD`), `Overdamped2` with bonds, thermal noise, contacts; and a product of the
+/// Refused, typed, the state unchanged: `Overdamped2` with bonds, thermal noise (the
+/// sweep, Newton and contacts step); and a product of the
 /// constraint solve that does not converge within the iterations allowed is
 /// `NoConvergence` at the mobility.
 fn refusals<T: Real>() {
@@ -298,10 +298,21 @@ fn refusals<T: Real>() {
         Err(StepError::Unsupported(m)) => assert!(m.contains(what), "{what}: {m}"),
         other => panic!("{what}: {other:?}"),
     };
+    // The sweep and Newton step, on their table of `M_SD`'s columns; refused before.
     for kind in [SolverKind::Sweep, SolverKind::Newton] {
         let mut p = base;
         p.solver.kind = kind;
-        unsupported(&p, "sweep or Newton");
+        let (r, x) = run::<T>(&p, &spheres, &rows, 1).unwrap();
+        assert_eq!(
+            r[0].near_products as usize,
+            rows.len() + 2,
+            "{kind:?}: {r:?}"
+        );
+        let e = bond_error(&rows, &x);
+        assert!(
+            e <= p.solver.tolerance.to_f64() + 8.0 * T::EPSILON.to_f64(),
+            "{kind:?}"
+        );
     }
     let mut p = base;
     p.method = Method::Overdamped2;
@@ -309,9 +320,12 @@ fn refusals<T: Real>() {
     let mut p = base;
     p.brownian = Some(Brownian::new(T::from_f64(1e-3)));
     unsupported(&p, "thermal noise");
+    // Contacts with the Krylov solve step (`near_contacts.rs`); refused before.
     let mut p = base;
     p.contacts = Some(Contacts::new(16));
-    unsupported(&p, "contacts");
+    let (r, x) = run::<T>(&p, &spheres, &rows, 1).unwrap();
+    assert!(r[0].iterations > 0, "{r:?}");
+    assert!(bond_error(&rows, &x) <= p.solver.tolerance.to_f64() + 8.0 * T::EPSILON.to_f64());
     // Weightless beads whose bonds are 2 % short of their separations: the start's
     // product has nothing to solve, the constraint solve's products do, and two
     // conjugate-gradient iterations cannot solve six coupled close beads.

@@ -227,8 +227,8 @@ fn same_bits<T: Real>() {
     assert_eq!(run(), run());
 }
 
-/// Refused, typed, the state unchanged: what the iterative path does not serve (bonds
-/// by the sweep, contacts, the wall's hydrodynamics, PSE), the conjugate gradients
+/// Refused, typed, the state unchanged: what the iterative path does not serve (the
+/// wall's hydrodynamics, PSE), the conjugate gradients
 /// stopped before they converge, and more close pairs than the storage holds (its
 /// Brownian steps: `near_iter_brownian.rs`).
 fn refusals<T: Real>() {
@@ -245,13 +245,16 @@ fn refusals<T: Real>() {
         j: 1,
         length: T::from_f64(norm(sub(spheres[1].pos, spheres[0].pos))),
     };
-    // Bonds by the sweep (`near_con.rs` has the Krylov solve that serves them).
+    // Bonds by the sweep, contacts alone by Krylov and by Newton step
+    // (`near_con.rs`, `near_contacts.rs`); refused before.
     let mut p = base;
     p.solver.kind = SolverKind::Sweep;
-    unsupported(&p, &[bond], "sweep or Newton");
+    one_step::<T>(&p, &spheres, &[bond]).unwrap();
     let mut p = base;
     p.contacts = Some(Contacts::new(64));
-    unsupported(&p, &[], "constraints");
+    one_step::<T>(&p, &spheres, &[]).unwrap();
+    p.solver.kind = SolverKind::Newton;
+    one_step::<T>(&p, &spheres, &[]).unwrap();
     let mut p = base;
     p.wall = Some(Wall::new(T::from_f64(-40.0)));
     unsupported(&p, &[], "wall");

@@ -15,8 +15,8 @@
 //! `"overdamped"` and `"overdamped2"` (level manual), and thermal noise by Cholesky.
 //! Dense: a few hundred spheres at most. With `[integrator] matrix_free = true` the
 //! kernel applies the same mobility by its iterative product instead (no dense matrix;
-//! free space or the Ewald box; bonds and pins with `"overdamped"` by the Krylov solve,
-//! `solver = "auto"` or `"krylov"`; no contacts, wall or noise: `docs/NEAR.md`,
+//! free space or the Ewald box; bonds, pins and hard contacts with `"overdamped"`, any
+//! solver (`"auto"` is Krylov there); no wall or noise: `docs/NEAR.md`,
 //! "Iterative steps"). The kernel's first-step check refuses the rest (the box's PSE
 //! sums, Lanczos noise) at this table.
 

@@ -1,6 +1,9 @@
-//! `Overdamped` with constraints (bonds, pins) on the iterative near field: the
-//! constraint move goes along the Stokesian dynamics mobility, `r' = r* + dt M_SD,tt
-//! G^T lambda`, as the dense near step's does, with `M_SD` known only through products.
+//! `Overdamped` with constraints (bonds, pins, hard contacts) on the iterative near
+//! field: the constraint move goes along the Stokesian dynamics mobility, `r' = r* + dt
+//! M_SD,tt G^T lambda`, as the dense near step's does, with `M_SD` known only through
+//! products. The contacts are the dense path's: the same active-set rounds
+//! (`integrate/contacts.rs`, [`project_along`]), each round's solve the Krylov solve
+//! with the one-sided rows inside it (`docs/CONTACTS.md`), along these products.
 //!
 //! The close pairs are found and factored once, at the start; every mobility the step
 //! needs is then one product of that factored near field ([`Sd`]): the unconstrained
@@ -15,27 +18,30 @@
 //! field), so the preconditioner adds each bond's squeeze resistance `K_k` (from its
 //! pair's near-field correction): with `R_near` about `G^T K G`, the constraint matrix
 //! is about `(A_far^-1 + K)^-1`, whose inverse `A_far^-1 + K` is the band's solve plus a
-//! diagonal, positive definite. This halves the solve's products (to the dense path's,
-//! whose band reads `M_SD`); adding pair mobility corrections to the band's blocks
-//! instead doubles them (a bead's self-mobility is reduced once per close neighbour,
-//! and the band's diagonal can turn negative).
+//! diagonal, positive definite. A contact is a close pair too (its squeeze resistance
+//! at the minimum gap dominates its row). This halves the solve's products (to the
+//! dense path's, whose band reads `M_SD`); adding pair mobility corrections to the
+//! band's blocks instead doubles them (a bead's self-mobility is reduced once per close
+//! neighbour, and the band's diagonal can turn negative).
 //!
-//! Only the Krylov solver runs here: the sweep and Newton read `D_l(p)` for every bond
-//! at every iteration (a table of `n x B` entries, `B` products of `M_SD` to form), and
-//! are refused by `near::check`, typed, as are `Overdamped2`, contacts, the wall and
-//! noise. A product that does not converge ends the step with
+//! The sweep and Newton read every entry `D_l(p)` at every iteration: they get the
+//! table of `M_SD`'s columns along the round's rows (one product a row, formed each
+//! round, `Metric::Dense` as the dense path tabulates its stored `M_SD`), cheaper than
+//! the Krylov solve's products where the rows are few; `Auto` resolves to Krylov
+//! (`Params::solver_kind`). `Overdamped2`, the wall and noise are refused by
+//! `near::check`, typed. A product that does not converge ends the step with
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`](crate::Stage::Mobility), the
 //! caller's state unchanged.
 
 use super::solve::{self, At};
 use super::{Counts, Store, spins};
 use crate::bonds::Bond;
-use crate::constraints::{Metric, Problem, Products, krylov_with};
+use crate::constraints::{self, Metric, Problem, Products, SolveStats, SolverKind, krylov_with};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
+use crate::integrate::contacts::{Along, Round, project_along};
 use crate::integrate::{
-    Start, StepReport, add_constraint_forces, add_flow, bond_vectors, cell, check_resolved, report,
-    step_velocity,
+    Start, StepReport, add_constraint_forces, add_flow, cell, check_resolved, report, step_velocity,
 };
 use crate::linalg::{Mob, tri};
 use crate::params::Params;
@@ -47,8 +53,9 @@ struct Sd<'a, 's, T: Real> {
     at: &'a mut At<'s, T>,
     p: &'a Params<T>,
     counts: Counts,
-    /// Each bond's squeeze resistance over `c dt |g|^2`: the preconditioner's diagonal.
-    stiff: &'a [T],
+    /// Each row's squeeze resistance over `c dt |g|^2`: the preconditioner's diagonal
+    /// (the rows of the round being solved).
+    stiff: &'a mut [T],
 }
 
 impl<T: Real> Products<T> for Sd<'_, '_, T> {
@@ -72,11 +79,79 @@ impl<T: Real> Products<T> for Sd<'_, '_, T> {
     }
 
     fn precondition(&self, r: &[T], z: &mut [T]) {
-        for ((z, &r), &k) in z.iter_mut().zip(r).zip(self.stiff) {
+        for ((z, &r), &k) in z.iter_mut().zip(r).zip(self.stiff.iter()) {
             *z += k * r;
         }
     }
 }
+
+/// Each round of the projection ([`project_along`]: the bonds, and the contacts the
+/// rounds hold) by the Krylov solve, its products [`Sd`]'s, its entries the far
+/// field's `mu_tt` (the grand mobility's first `n` block rows).
+struct Iterative<'a, 's, T: Real> {
+    sd: Sd<'a, 's, T>,
+    packed: &'s [T::M3],
+    s: &'a Start<'a, T>,
+    /// The sweep's and Newton's table of `M_SD`'s columns (`n x rows`; empty for
+    /// Krylov).
+    table: &'a mut [T::V3],
+}
+
+impl<T: Real> Along<T> for Iterative<'_, '_, T> {
+    fn project(&mut self, p: &Params<T>, r: Round<'_, '_, T>) -> Result<SolveStats<T>, StepError> {
+        let Round {
+            rows,
+            grad,
+            x,
+            lambda,
+            scratch,
+            nb,
+            start,
+        } = r;
+        let n = x.len();
+        let far = Metric::Mobility {
+            mu: Mob::Full(&self.packed[..tri(n)]),
+            grad,
+            scale: p.dt,
+            par: scratch.par,
+            compact: None,
+        };
+        let problem = Problem::Positions {
+            cell: cell(p),
+            one_sided: nb,
+            #[cfg(feature = "pins")]
+            anchor: start,
+        };
+        let _ = start; // Read only with the `pins` feature.
+        lambda.fill(T::ZERO);
+        if p.solver.kind == SolverKind::Krylov {
+            for ((k, b), &g) in self.sd.stiff.iter_mut().zip(rows).zip(grad) {
+                *k = squeeze(p, self.s, b, g, T::TWO);
+            }
+            let ops = (&far, &mut self.sd);
+            return krylov_with(problem, ops, rows, &p.solver, x, lambda, scratch);
+        }
+        // The sweep and Newton read every entry `D_l(p)`: the table of `M_SD`'s columns
+        // along the rows, one product a row (`Metric::Dense`, as the dense path
+        // tabulates its stored `M_SD`).
+        let table = self.table.get_mut(..n * rows.len()).ok_or(TABLE)?;
+        for (l, column) in table.chunks_exact_mut(n).enumerate() {
+            lambda[l] = T::ONE;
+            let done = self.sd.apply(&far, rows, lambda, column, &mut []);
+            lambda[l] = T::ZERO;
+            done?;
+        }
+        let metric = Metric::Dense {
+            disp: table,
+            n,
+            grad,
+        };
+        constraints::solve(problem, &metric, rows, &p.solver, x, lambda, scratch)
+    }
+}
+
+const TABLE: StepError =
+    StepError::Unsupported("the iterative near field's sweep or Newton without its table");
 
 /// Bond `b`'s squeeze resistance `d^T (R_ii + R_jj - R_ij - R_ji) d / 4` (`d` along the
 /// bond) from its pair's near-field correction, over `c dt |g|^2`.
@@ -102,9 +177,10 @@ fn squeeze<T: Real>(p: &Params<T>, s: &Start<'_, T>, b: &Bond<T>, g: T::V3, c: T
     (k / (c * p.dt * g2)).max(T::ZERO)
 }
 
-/// `Overdamped` with bonds (and pins) on the iterative near field: `r* = r + dt U(r)`,
-/// `U = U_inf + M_SD,tt F`, projected onto the constraints along `dt M_SD,tt G^T`
-/// by the Krylov solve; the spins `Omega_inf + M_SD,rt (F + G^T lambda)`.
+/// `Overdamped` with bonds, pins and contacts on the iterative near field: `r* = r +
+/// dt U(r)`, `U = U_inf + M_SD,tt F`, projected onto the constraints along `dt M_SD,tt
+/// G^T` by the Krylov solve, the contacts found by the active-set rounds of the dense
+/// path (`integrate/contacts.rs`); the spins `Omega_inf + M_SD,rt (F + G^T lambda)`.
 pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
     p: &Params<T>,
     s: &Start<'_, T>,
@@ -122,12 +198,15 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
         grad,
         lambda,
         mut scratch,
+        links,
+        disp,
         near,
         near_iter,
         ..
     } = v;
-    let nb = bonds.len();
-    let (reals, stiff) = near.1.split_at_mut(near.1.len().saturating_sub(nb));
+    // Room for every row the step may solve: the bonds and the contacts' capacity.
+    let rows = p.constraints(n, bonds.len());
+    let (reals, stiff) = near.1.split_at_mut(near.1.len().saturating_sub(rows));
     let mut store = Store::new((near.0, reals), near_iter);
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     // The far field at the start, and the close pairs factored once.
@@ -137,40 +216,36 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
             at,
             p,
             counts: Counts::default(),
-            stiff: &[],
+            stiff,
         };
         sd.at.velocities(p, force, u, None, &mut sd.counts)?;
         add_flow(p, s.pos, u);
         check_resolved(s.pos, u, dt)?;
-        for i in 0..n {
-            new_pos[i] = s.pos[i] + u[i] * dt;
-        }
-        // The projection: entries from the far field's `mu_tt` (the grand mobility's first
-        // `n` block rows), moves from `M_SD`.
-        bond_vectors(bonds, s.pos, cell(p), grad);
-        let grad = &*grad;
-        for ((k, b), &g) in stiff.iter_mut().zip(bonds).zip(grad.iter()) {
-            *k = squeeze(p, s, b, g, T::TWO);
-        }
-        sd.stiff = &*stiff;
-        let metric = Metric::Mobility {
-            mu: Mob::Full(&packed[..tri(n)]),
-            grad,
-            scale: dt,
-            par: scratch.par,
-            compact: None,
+        let free = |x: &mut [T::V3]| {
+            for i in 0..n {
+                x[i] = s.pos[i] + u[i] * dt;
+            }
         };
-        let problem = Problem::Positions {
-            cell: cell(p),
-            one_sided: usize::MAX,
-            #[cfg(feature = "pins")]
-            anchor: s.pos,
+        // The projection: entries from the far field's `mu_tt`, moves from `M_SD`.
+        let mut along = Iterative {
+            sd,
+            packed,
+            s,
+            table: disp,
         };
-        lambda.fill(T::ZERO);
-        let (solver, ops) = (&p.solver, (&metric, &mut sd));
-        let stats = krylov_with(problem, ops, bonds, solver, new_pos, lambda, &mut scratch)?;
+        let views = (links, &mut *grad, &mut *lambda, &mut scratch);
+        let r = project_along(
+            p,
+            bonds,
+            (s.pos, s.radius),
+            views,
+            new_pos,
+            free,
+            &mut along,
+        )?;
+        let sd = &mut along.sd;
         step_velocity(s.pos, new_pos, dt, new_vel);
-        add_constraint_forces(bonds, grad, lambda, force);
+        add_constraint_forces(r.held, grad, lambda, force);
         if p.rotation {
             sd.at
                 .velocities(p, force, u, Some(&mut *new_omega), &mut sd.counts)?;
@@ -180,7 +255,10 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
             near_pairs: sd.counts.pairs,
             near_products: sd.counts.products,
             near_iterations: sd.counts.iterations,
-            ..report(stats, 0, bonds, lambda)
+            contacts: r.contacts,
+            wall_contacts: r.wall_contacts,
+            contact_rounds: r.rounds,
+            ..report(r.stats, 0, bonds, lambda)
         })
     })
 }
