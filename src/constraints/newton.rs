@@ -34,6 +34,9 @@ use crate::real::Real;
 ///   is formed once per solve and then follows the set row by row (`active.rs`:
 ///   `O(rows^2)` a change instead of `O(rows^3)`). Without one-sided rows nothing of
 ///   this runs.
+// Out of line on 32-bit Arm: inlined into a firmware's one caller, it ran more
+// instructions a step (register pressure in the step's one large function) for less flash.
+#[cfg_attr(target_arch = "arm", inline(never))]
 pub fn newton<T: Real>(
     problem: Problem<'_, T>,
     metric: &Metric<'_, T>,

@@ -348,7 +348,11 @@ where
         p.method, p.rotation as u8
     )?;
     if let Some(b) = p.brownian {
-        write!(w, "kT={} seed={SEED} ", Hex(b.temperature))?;
+        // The seed through `decimal`: core's `u64` formatting would link a software
+        // 64-bit division on 32-bit Arm.
+        write!(w, "kT={} seed=", Hex(b.temperature))?;
+        decimal(w, SEED)?;
+        w.write_str(" ")?;
     }
     match outcome {
         Ok(o) => writeln!(
@@ -372,6 +376,48 @@ where
             w.write_str("\n")
         }
     }
+}
+
+/// `n` in decimal, as `{}` writes it, through [`div_rem`] (the firmware's cost line:
+/// core's `u64` formatting links a software 64-bit division on 32-bit Arm). The
+/// leading digits first, by recursion (at most 19 deep): a digit buffer's bound would
+/// let the compiler unroll the loop 20 times.
+#[inline(never)]
+pub fn decimal(w: &mut impl Write, n: u64) -> fmt::Result {
+    const DIGITS: [&str; 10] = ["0", "1", "2", "3", "4", "5", "6", "7", "8", "9"];
+    let (rest, digit) = div_rem(n, 10);
+    if rest != 0 {
+        decimal(w, rest)?;
+    }
+    w.write_str(DIGITS[digit as usize])
+}
+
+/// `(n / d, n % d)` as `u64` division gives them, for a divisor of 32 bits (`d = 0`
+/// divides by 1): the high word by the 32-bit divide, the low word bit by bit with
+/// shifts and compares, so that 32-bit Arm links no software 64-bit division. Out of
+/// line, and the bit loop ends on a marker bit rather than a count, so that the
+/// compiler keeps it one small loop rather than 32 copies (flash).
+#[inline(never)]
+pub fn div_rem(n: u64, d: u32) -> (u64, u32) {
+    let (d, hi) = (d.max(1), (n >> 32) as u32);
+    // The remainder stays below `d`: shifted once, it fits 33 bits.
+    let (q_hi, mut r) = (u64::from(hi / d), u64::from(hi % d));
+    let d = u64::from(d);
+    // The low word's bits, most significant first, above a marker bit that reaches the
+    // top once all 32 are out.
+    const DONE: u64 = 1 << 63;
+    let mut bits = (n << 32) | (1 << 31);
+    let mut q_lo = 0u64;
+    while bits != DONE {
+        r = (r << 1) | (bits >> 63);
+        bits <<= 1;
+        q_lo <<= 1;
+        if r >= d {
+            r -= d;
+            q_lo |= 1;
+        }
+    }
+    ((q_hi << 32) | q_lo, r as u32)
 }
 
 /// The summary lines of the [`RUNS`] named in `only` (all when empty), computed on

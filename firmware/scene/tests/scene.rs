@@ -83,3 +83,46 @@ fn firmware_output_matches_the_host() {
         );
     }
 }
+
+/// The firmware's `u64` division and decimal printing against the host's `/`, `%` and
+/// `{}`: powers of two and ten about every word boundary, the extremes, and a spread.
+#[test]
+fn wide_division_and_decimal_match_u64() {
+    use hydrorattle_scene::{decimal, div_rem};
+    let mut ns = vec![0, 1, 9, 10, 11, u64::MAX, u64::MAX - 1];
+    for k in 0..64 {
+        ns.extend([1u64 << k, (1u64 << k) - 1, (1u64 << k) + 1]);
+    }
+    for k in 0..20 {
+        let p = 10u64.pow(k);
+        ns.extend([p, p - 1, p + 1]);
+    }
+    // SplitMix64's increment as a stride: a spread of every magnitude's bits.
+    let mut x = 0u64;
+    for _ in 0..1000 {
+        x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        ns.extend([x, x >> 17, x >> 40]);
+    }
+    let ds = [
+        1u32,
+        2,
+        3,
+        7,
+        10,
+        200,
+        1_000_000,
+        199_999_999,
+        0x00ff_ffff * 200,
+        u32::MAX,
+    ];
+    for &n in &ns {
+        for &d in &ds {
+            let want = (n / u64::from(d), (n % u64::from(d)) as u32);
+            assert_eq!(div_rem(n, d), want, "{n} / {d}");
+        }
+        let mut s = String::new();
+        decimal(&mut s, n).unwrap();
+        assert_eq!(s, n.to_string());
+    }
+    assert_eq!(div_rem(7, 0), (7, 0), "a zero divisor divides by 1");
+}
