@@ -1,5 +1,6 @@
 //! The model ladder's speed and accuracy: free draining, Oseen, RPY, and RPY with
-//! Stokesian dynamics' near field (`Params::near`). f64, one core. Modes:
+//! Stokesian dynamics' near field (`Params::near`), dense and iterative
+//! (`Params::matrix_free`). f64, one core. Modes:
 //!
 //! * `near_ladder chain [steps]` (default 20): each rung's error against exact values
 //!   nobody here computed, from one `Overdamped` step of the kernel (unit spheres, unit
@@ -8,14 +9,18 @@
 //!   (Stimson and Jeffery: 1.53633 `U0`) and side by side (1.3917 `U0`, each spinning at
 //!   0.137 `U0 / a`), and a sphere at `h / a = 1.1` approaching the wall (Brenner:
 //!   0.087266 `U0`); and the cost of a step of the Figure 1 (c) chain (a head of radius 2
-//!   and 24 tails, settling from its helix: `Overdamped2`, Newton, hard contacts,
-//!   `dt = 0.1`; the mean over `steps` steps), with its counts: mobilities formed, pairs
-//!   inside the near field's cutoff, dense flops.
-//! * `near_ladder box N [near|iter]`: the cost of one `Overdamped` step of `N` spheres
-//!   in a periodic box (volume fraction 0.25, radii 0.8 to 1.2) at each far-field rung,
-//!   and with `near` the dense near-field step too (minutes at `N = 1000`), with `iter`
-//!   the iterative one (`Params::matrix_free`) and its counts: close pairs, conjugate-
-//!   gradient iterations, far-field products.
+//!   and 24 tails, settling from its helix, `dt = 0.1`; the mean over `steps` steps)
+//!   twice: as the paper steps it (`Overdamped2`, Newton, hard contacts), which the
+//!   iterative rung refuses, and as every rung steps it (`Overdamped`, Krylov, rotation,
+//!   no contacts), with the iterative rung's distance from the dense one's positions;
+//!   with their counts: mobilities formed, pairs inside the near field's cutoff, dense
+//!   flops.
+//! * `near_ladder box N [near|iter|both]`: the cost of one `Overdamped` step of `N`
+//!   spheres in a periodic box (volume fraction 0.25, radii 0.8 to 1.2) at each
+//!   far-field rung, and with `near` the dense near-field step too (minutes at
+//!   `N = 1000`), with `iter` the iterative one and its counts: close pairs,
+//!   conjugate-gradient iterations, far-field products; `both` runs the two and records
+//!   the iterative step's velocities against the dense step's.
 //! * `near_ladder work N ...`: the near field's own work in that box: the pairs inside
 //!   the cutoff (found through the cell list) and the seconds to find them and form each
 //!   pair's correction `R_near`.
@@ -52,12 +57,23 @@ use hydrorattle_heap::Buffers;
 const U0: f64 = 1.0 / (6.0 * std::f64::consts::PI);
 /// Density of unit buoyant weight for a unit sphere (`g = 1`).
 const RHO1: f64 = 3.0 / (4.0 * std::f64::consts::PI);
+/// The near field of a rung.
+#[derive(Clone, Copy, PartialEq)]
+enum Near {
+    Off,
+    /// `M_SD` formed and inverted (`Params::near`).
+    Dense,
+    /// Products of `M_SD` by conjugate gradients (`Params::near` and `matrix_free`).
+    Iterative,
+}
+
 /// The rungs: name, far field, near field.
-const RUNGS: [(&str, Hydro, bool); 4] = [
-    ("free-draining", Hydro::FreeDraining, false),
-    ("oseen", Hydro::Oseen, false),
-    ("rpy", Hydro::Rpy, false),
-    ("rpy+near", Hydro::Rpy, true),
+const RUNGS: [(&str, Hydro, Near); 5] = [
+    ("free-draining", Hydro::FreeDraining, Near::Off),
+    ("oseen", Hydro::Oseen, Near::Off),
+    ("rpy", Hydro::Rpy, Near::Off),
+    ("rpy+near", Hydro::Rpy, Near::Dense),
+    ("rpy+near iterative", Hydro::Rpy, Near::Iterative),
 ];
 /// The accuracy checks: record quantity, short label, exact value.
 const EXACT: [(&str, &str, f64); 4] = [
@@ -68,6 +84,9 @@ const EXACT: [(&str, &str, f64); 4] = [
 ];
 const ACCURACY: &str = "model ladder, one step against exact values, f64";
 const CHAIN: &str = "model ladder, Figure 1 (c) chain, f64, one core";
+/// The chain as every rung steps it (the chart's chain panel).
+const CHAIN_KRYLOV: &str =
+    "model ladder, Figure 1 (c) chain, Overdamped, Krylov, rotation, no contacts, f64, one core";
 const WORK: &str = "near field's own work, box at volume fraction 0.25, f64, one core";
 
 fn box_table(n: usize) -> String {
@@ -75,11 +94,12 @@ fn box_table(n: usize) -> String {
 }
 
 /// Parameters of a rung.
-fn params(level: Hydro, near: bool, dt: f64) -> Params<f64> {
+fn params(level: Hydro, near: Near, dt: f64) -> Params<f64> {
     let mut p = Params::new(dt);
     p.method = Method::Overdamped;
     p.hydro = level;
-    p.near = near.then(NearField::default);
+    p.near = (near != Near::Off).then(NearField::default);
+    p.matrix_free = near == Near::Iterative;
     p
 }
 
@@ -105,7 +125,7 @@ fn one_step<const N: usize>(
 }
 
 /// The rung's values of [`EXACT`] (`Err` where the kernel refuses the case).
-fn accuracy(level: Hydro, near: bool) -> [Result<f64, String>; 4] {
+fn accuracy(level: Hydro, near: Near) -> [Result<f64, String>; 4] {
     let mut p = params(level, near, 1e-3);
     p.rotation = true;
     let pair = |e: DVec3| [(-1.05 * e, 1.0), (1.05 * e, 1.0)];
@@ -118,9 +138,20 @@ fn accuracy(level: Hydro, near: bool) -> [Result<f64, String>; 4] {
     [along, across, spin, wall]
 }
 
-/// Seconds per step of the Figure 1 (c) chain at `level` (with the near field if
-/// `near`), over `steps` steps, and the `M_SD` formed a step.
-fn chain_cost(level: Hydro, near: bool, steps: usize) -> (f64, f64, Vec<DVec3>, Vec<f64>) {
+/// A chain step's cost: seconds a step, `M_SD` formed a step, the start's positions and
+/// radii, the end's positions.
+struct ChainCost {
+    per_step: f64,
+    formed: f64,
+    start: Vec<DVec3>,
+    radii: Vec<f64>,
+    end: Vec<DVec3>,
+}
+
+/// `steps` steps of the Figure 1 (c) chain at a rung: as the paper steps it (`paper`:
+/// `Overdamped2`, Newton, hard contacts) or as every rung can (`Overdamped`, Krylov,
+/// rotation, no contacts). `Err` where the kernel refuses it.
+fn chain_cost(level: Hydro, near: Near, steps: usize, paper: bool) -> Result<ChainCost, String> {
     let h = Helix {
         tails: 24,
         head_ratio: 2.0,
@@ -140,25 +171,32 @@ fn chain_cost(level: Hydro, near: bool, steps: usize) -> (f64, f64, Vec<DVec3>, 
     let mut ps = ParticleSet::<f64, 25>::from_slice(&list, true).expect("chain");
     let bonds = BondSet::<f64, 24>::chain(&ps.pos[..25]).expect("bonds");
     let mut p = params(level, near, 0.1);
-    p.method = Method::Overdamped2;
-    p.solver.kind = SolverKind::Newton;
     p.allow_overlap = true;
-    p.contacts = Some(Contacts::new(4 * 25));
+    if paper {
+        p.method = Method::Overdamped2;
+        p.solver.kind = SolverKind::Newton;
+        p.contacts = Some(Contacts::new(4 * 25));
+    } else {
+        p.solver.kind = SolverKind::Krylov;
+        p.solver.tolerance = 1e-10;
+        p.rotation = true;
+    }
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, 25, 24));
     let mut ws = buf.workspace();
     let (t, mut formed) = (Instant::now(), 0);
     for k in 0..steps {
         let r = step(&mut ps, &bonds, &p, &mut ws, &mut NoForce)
-            .unwrap_or_else(|e| panic!("{level:?} near {near}: step {k}: {e}"));
+            .map_err(|e| format!("refused: {e} (step {k})"))?;
         formed += r.near_formations;
     }
     let per = steps as f64;
-    (
-        t.elapsed().as_secs_f64() / per,
-        formed as f64 / per,
+    Ok(ChainCost {
+        per_step: t.elapsed().as_secs_f64() / per,
+        formed: formed as f64 / per,
         start,
         radii,
-    )
+        end: ps.pos[..25].to_vec(),
+    })
 }
 
 /// Pairs inside the default cutoff (the minimum image in the box).
@@ -186,41 +224,63 @@ fn chain(steps: usize, rec: &mut record::Recorder) {
             }
         }
     }
-    println!("rung,step_s,formed_a_step,pairs_in_cutoff,dense_flops_a_step");
-    for (name, level, near) in RUNGS {
-        let (cost, formed, pos, rad) = chain_cost(level, near, steps);
-        let pairs = if near {
-            close_pairs(Far::Free, &pos, &rad)
-        } else {
-            0
-        };
-        // Each formation: two `spd_inverse` of `6N x 6N`, about `2/3 m^3` flops each.
-        let m = 6.0 * pos.len() as f64;
-        let flops = formed * 2.0 * (2.0 / 3.0) * m * m * m;
-        println!("{name},{cost:.3e},{formed},{pairs},{flops:.3e}");
-        rec.row(CHAIN, name, "s a step", &format!("{cost:.3e}"));
-        if near {
-            rec.row(CHAIN, name, "M_SD formed a step", &format!("{formed}"));
-            rec.row(
-                CHAIN,
-                name,
-                "pairs inside the cutoff (start)",
-                &pairs.to_string(),
+    println!("chain,rung,step_s,formed_a_step,pairs_in_cutoff,dense_flops_a_step");
+    for (table, paper) in [(CHAIN, true), (CHAIN_KRYLOV, false)] {
+        let mut dense_end = None;
+        for (name, level, near) in RUNGS {
+            let c = match chain_cost(level, near, steps, paper) {
+                Ok(c) => c,
+                Err(e) => {
+                    println!("{paper},{name},{e}");
+                    rec.row(table, name, "s a step", &e);
+                    continue;
+                }
+            };
+            let pairs = match near {
+                Near::Off => 0,
+                _ => close_pairs(Far::Free, &c.start, &c.radii),
+            };
+            // Each formation: two `spd_inverse` of `6N x 6N`, about `2/3 m^3` flops each.
+            let m = 6.0 * c.start.len() as f64;
+            let flops = c.formed * 2.0 * (2.0 / 3.0) * m * m * m;
+            println!(
+                "{paper},{name},{:.3e},{},{pairs},{flops:.3e}",
+                c.per_step, c.formed
             );
-            rec.row(
-                CHAIN,
-                name,
-                "dense inversion flops a step",
-                &format!("{flops:.3e}"),
-            );
+            rec.row(table, name, "s a step", &format!("{:.3e}", c.per_step));
+            if near == Near::Off {
+                continue;
+            }
+            let counts = [
+                ("M_SD formed a step", c.formed.to_string()),
+                ("pairs inside the cutoff (start)", pairs.to_string()),
+                ("dense inversion flops a step", format!("{flops:.3e}")),
+            ];
+            for (quantity, value) in counts {
+                rec.row(table, name, quantity, &value);
+            }
+            match (near, &dense_end) {
+                (Near::Dense, _) => dense_end = Some((c.start, c.end)),
+                (Near::Iterative, Some((start, end))) => {
+                    // How far the iterative chain ends from the dense one, against the
+                    // distance the dense chain's head fell.
+                    let apart = (0..25).map(|i| (c.end[i] - end[i]).length());
+                    let apart = apart.fold(0.0, f64::max) / (start[0] - end[0]).length();
+                    println!("{paper},{name},apart from the dense step,{apart:.3e}");
+                    let q = "largest distance from the dense step's beads, over the head's fall";
+                    rec.row(table, name, q, &format!("{apart:.3e}"));
+                }
+                _ => {}
+            }
         }
     }
 }
 
 /// One `Overdamped` step of the suspension of `n` spheres in its box at each rung; the
-/// near field's rung dense (`near = "near"`), iterative (`"iter"`) or left out.
+/// near field's rungs as `near_mode` says: `near` (dense), `iter` (iterative), `both`.
 fn box_cost(n: usize, near_mode: &str, rec: &mut record::Recorder) {
-    let (with_near, iterative) = (near_mode == "near", near_mode == "iter");
+    let both = near_mode == "both";
+    let (with_dense, with_iter) = (both || near_mode == "near", both || near_mode == "iter");
     let (pos, rad, l) = suspension::suspension(n, 0.25);
     let table = box_table(n);
     let cell = Periodic::new([l; 3]).expect("box");
@@ -228,17 +288,13 @@ fn box_cost(n: usize, near_mode: &str, rec: &mut record::Recorder) {
     let pairs = close_pairs(Far::Box(&ew), &pos, &rad);
     println!("N = {n}, edge {l:.3}, {pairs} pairs inside the cutoff");
     println!("rung,step_s");
+    let mut dense_vel: Option<Vec<DVec3>> = None;
     for (name, level, near) in RUNGS {
-        if near && !(with_near || iterative) {
+        if (near == Near::Dense && !with_dense) || (near == Near::Iterative && !with_iter) {
             continue;
         }
         let mut p = params(level, near, 1e-4);
         p.periodic = Some(cell);
-        p.matrix_free = near && iterative;
-        let name = match p.matrix_free {
-            true => "rpy+near iterative",
-            false => name,
-        };
         let list: Vec<Particle<f64>> = (0..n)
             .map(|i| Particle::new(pos[i], rad[i], RHO1))
             .collect();
@@ -248,7 +304,8 @@ fn box_cost(n: usize, near_mode: &str, rec: &mut record::Recorder) {
         let mut ws = buf.workspace();
         let t = Instant::now();
         let value = match step(&mut ps, &bonds, &p, &mut ws, &mut NoForce) {
-            Ok(r) if p.matrix_free => {
+            Ok(r) if near == Near::Iterative => {
+                let t = format!("{:.3e}", t.elapsed().as_secs_f64());
                 let counts = [
                     ("close pairs corrected", r.near_pairs),
                     ("conjugate-gradient iterations", r.near_iterations),
@@ -257,21 +314,34 @@ fn box_cost(n: usize, near_mode: &str, rec: &mut record::Recorder) {
                         r.near_iterations + 2 * r.near_products,
                     ),
                 ];
-                let t = format!("{:.3e}", t.elapsed().as_secs_f64());
                 for (quantity, k) in counts {
                     println!("{name},{quantity},{k}");
                     rec.row(&table, name, quantity, &k.to_string());
                 }
+                if let Some(dense) = &dense_vel {
+                    // The iterative step's velocities against the dense step's.
+                    let big = dense.iter().map(|v| v.length()).fold(0.0, f64::max);
+                    let diff = (0..n).map(|i| (ps.vel[i] - dense[i]).length());
+                    let rel = diff.fold(0.0, f64::max) / big;
+                    println!("{name},velocities against the dense step,{rel:.3e}");
+                    let q = "largest velocity difference from the dense step, over the largest velocity";
+                    rec.row(&table, name, q, &format!("{rel:.3e}"));
+                }
                 t
             }
-            Ok(_) => format!("{:.3e}", t.elapsed().as_secs_f64()),
+            Ok(_) => {
+                if near == Near::Dense {
+                    dense_vel = Some(ps.vel[..n].to_vec());
+                }
+                format!("{:.3e}", t.elapsed().as_secs_f64())
+            }
             Err(e) => format!("refused: {e}"),
         };
         println!("{name},{value}");
         rec.row(&table, name, "s a step", &value);
     }
     rec.row(&table, "all", "pairs inside the cutoff", &pairs.to_string());
-    if iterative {
+    if with_iter {
         // The iterative step's far field alone: the Ewald grand mobility's assembly.
         let mut packed = vec![glam::DMat3::ZERO; 2 * n * (2 * n + 1) / 2];
         let t = Instant::now();

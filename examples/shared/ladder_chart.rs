@@ -1,13 +1,14 @@
 //! `near_ladder chart`: the speed-accuracy chart from the latest records of
 //! `bench/results/near_ladder.csv` (the last row of each measurement, case and
 //! quantity): x the cost of a step, y each check's relative error against its exact
-//! value; one panel for the Figure 1 (c) chain, one for 1,000 spheres in a box. A rung
-//! the kernel refuses, or one not measured, is named under its panel.
+//! value; one panel for the Figure 1 (c) chain (stepped as every rung can: `Overdamped`,
+//! Krylov, no contacts), one for 1,000 spheres in a box. A rung the kernel refuses, or
+//! one not measured, is named under its panel.
 
 use std::collections::HashMap;
 
 use super::svg::{Panel, Point, chart};
-use super::{ACCURACY, CHAIN, EXACT, RUNGS, box_table};
+use super::{ACCURACY, CHAIN_KRYLOV, EXACT, RUNGS, box_table};
 
 /// Errors shown below this are drawn at it (a log axis has no zero).
 const FLOOR: f64 = 1e-6;
@@ -74,7 +75,10 @@ pub fn draw(records: &str) -> String {
         "Model ladder: cost of a step against error from exact two-sphere and wall values",
         &names,
         &[
-            panel("Figure 1 (c) chain, 25 spheres", CHAIN),
+            panel(
+                "Figure 1 (c) chain, 25 spheres (Overdamped, Krylov)",
+                CHAIN_KRYLOV,
+            ),
             panel("1,000 spheres in a periodic box", &box_table(1000)),
         ],
     )

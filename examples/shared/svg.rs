@@ -137,7 +137,7 @@ fn panel(s: &mut String, x0: f64, p: &Panel) {
     for q in &p.points {
         // Rungs of equal cost and error would hide each other: each series' markers
         // and labels are set off by a few pixels.
-        let off = q.series as f64 - 1.5;
+        let off = q.series as f64 - 2.0;
         let (x, y, c) = (
             sx(q.x) + 5.0 * off,
             sy(q.y),

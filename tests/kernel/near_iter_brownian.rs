@@ -254,24 +254,20 @@ fn stokes_einstein<T: Real>() {
     }
 }
 
-/// The Boltzmann moments `<r>` and `<r^2>` of the spring's `r^2 exp(-k (r - r0)^2 / 2)`.
-fn boltzmann(k: f64, r0: f64) -> (f64, f64) {
-    let (mut z, mut m1, mut m2) = (0.0, 0.0, 0.0);
-    let h = 1e-4;
-    for i in 1..200_000 {
-        let r = i as f64 * h;
-        let w = r * r * (-0.5 * k * (r - r0) * (r - r0)).exp();
-        z += w;
-        m1 += w * r;
-        m2 += w * r * r;
-    }
-    (m1 / z, m2 / z)
-}
-
 /// Distances of two unit spheres joined by a spring of stiffness `k` and rest length
-/// `r0`, one sample every `every` steps.
-fn pair<T: Real>(drift: Drift, k: f64, r0: f64, steps: usize, every: usize) -> Vec<f64> {
-    let p = iterative::<T>(2e-3, 1.0, drift, None);
+/// `r0`, with the near field's minimum gap `min_gap`, one sample every `every` steps.
+fn pair<T: Real>(
+    drift: Drift,
+    (k, r0, min_gap): (f64, f64, f64),
+    dt: f64,
+    steps: usize,
+    every: usize,
+) -> Vec<f64> {
+    let mut p = iterative::<T>(dt, 1.0, drift, None);
+    p.near = Some(NearField {
+        min_gap: T::from_f64(min_gap),
+        ..NearField::default()
+    });
     let mut ps: ParticleSet<T, 2> = particles(&[
         Sphere {
             pos: [0.0; 3],
@@ -306,48 +302,157 @@ fn pair<T: Real>(drift: Drift, k: f64, r0: f64, steps: usize, every: usize) -> V
     out
 }
 
-/// A pair near contact (rest distance 2.2, spread 0.12: the overlap, about a twentieth
-/// of the time, is allowed, `Params::allow_overlap`, the near field clamped at its
-/// minimum gap), `dt = 2e-3`, 400 000 steps a scheme (about a minute of one core for
-/// both): the mean distance and its spread within four standard errors (40 blocks) of
-/// the Boltzmann moments with the midpoint; the uncorrected scheme's mean more than four
-/// below (squeezed towards contact, where `M_SD`'s relative mobility vanishes: the
-/// missing drift `kT div M_SD` pushes apart). `f64` only: the step is the same in `f32`
-/// (the covariance and the bits are checked in both above), and a minute is enough.
+/// The spring of the pair near contact: stiffness (spread 0.12) and rest distance.
+const SPRING: (f64, f64) = (1.0 / (0.12 * 0.12), 2.2);
+/// The near-contact distance of the share [`PairStats::near`] measures.
+const NEAR: f64 = 2.05;
+
+/// What a run of the pair near contact measured, each with its standard error (40
+/// blocks), or what the Boltzmann weight gives (standard errors 0).
+#[derive(Debug, Clone, Copy)]
+struct PairStats {
+    /// `<r>`.
+    mean: (f64, f64),
+    /// `<(r - <r>_Boltzmann)^2>`.
+    spread2: (f64, f64),
+    /// The share of time below [`NEAR`].
+    near: (f64, f64),
+    /// The share of time in overlap (`r < 2`).
+    overlap: (f64, f64),
+}
+
+impl PairStats {
+    /// The Boltzmann weight's values (`r^2 exp(-k (r - r0)^2 / 2)`, by quadrature).
+    fn boltzmann() -> PairStats {
+        let (k, r0) = SPRING;
+        let (mut z, mut m1, mut m2, mut below, mut over) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        let h = 1e-4;
+        for i in 1..200_000 {
+            let r = i as f64 * h;
+            let w = r * r * (-0.5 * k * (r - r0) * (r - r0)).exp();
+            z += w;
+            m1 += w * r;
+            m2 += w * r * r;
+            below += if r < NEAR { w } else { 0.0 };
+            over += if r < 2.0 { w } else { 0.0 };
+        }
+        let (m1, m2) = (m1 / z, m2 / z);
+        PairStats {
+            mean: (m1, 0.0),
+            spread2: (m2 - m1 * m1, 0.0),
+            near: (below / z, 0.0),
+            overlap: (over / z, 0.0),
+        }
+    }
+
+    /// A run of `span` time units (a sample every 0.02) at `dt`.
+    fn run(drift: Drift, min_gap: f64, dt: f64, span: f64) -> PairStats {
+        let (k, r0) = SPRING;
+        let every = (0.02 / dt).round() as usize;
+        let r = pair::<f64>(drift, (k, r0, min_gap), dt, (span / dt) as usize, every);
+        let m1 = PairStats::boltzmann().mean.0;
+        let dev: Vec<f64> = r.iter().map(|x| (x - m1) * (x - m1)).collect();
+        let below =
+            |y: f64| -> Vec<f64> { r.iter().map(|&x| f64::from(u8::from(x < y))).collect() };
+        PairStats {
+            mean: block_mean(&r, 40),
+            spread2: block_mean(&dev, 40),
+            near: block_mean(&below(NEAR), 40),
+            overlap: block_mean(&below(2.0), 40),
+        }
+    }
+
+    /// Each quantity's distance from `want`'s in this run's standard errors.
+    fn off(&self, want: &PairStats) -> [f64; 3] {
+        let z = |(x, se): (f64, f64), (w, _): (f64, f64)| (x - w) / se;
+        [
+            z(self.mean, want.mean),
+            z(self.spread2, want.spread2),
+            z(self.near, want.near),
+        ]
+    }
+}
+
+/// A pair near contact (rest distance 2.2, spread 0.12: the overlap, about a
+/// twenty-fifth of the time, is allowed, `Params::allow_overlap`, the near field
+/// clamped at its minimum gap 0.02), `dt = 2e-3`, 800 time units (400 000 steps; under a
+/// minute of one core) with the midpoint: the mean distance, its spread and the share of
+/// time below `r = 2.05` within four standard errors (40 blocks) of the Boltzmann
+/// weight's. Why the minimum gap 0.02: the step must resolve the gap where the pair's
+/// mobility varies (`dt << xi 6 pi eta a^3 / (8 kT)`, docs/NEAR.md); at the default 1e-3
+/// `dt = 2e-3` does not, and the midpoint's pair visits overlap several times less often
+/// than the Boltzmann weight says (`pair_near_contact_in_dt`). The missing drift's bias
+/// (the uncorrected scheme is squeezed towards contact, at every `dt`) is a few
+/// standard errors of this run only, the pair's sojourns near contact being long: the
+/// drift is told apart where it acts, in one step (`pair_drift`). `f64` only: the step
+/// is the same in `f32` (the covariance and the bits are checked in both above).
 #[test]
 fn pair_near_contact() {
-    type T = f64;
-    let (k, r0) = (1.0 / (0.12f64 * 0.12), 2.2);
-    let (m1, m2) = boltzmann(k, r0);
-    let sd = (m2 - m1 * m1).sqrt();
-    let mut means = Vec::new();
-    for drift in [Drift::Midpoint, Drift::Uncorrected] {
-        let r = pair::<T>(drift, k, r0, 400_000, 10);
-        let (m, se) = block_mean(&r, 40);
-        let dev: Vec<f64> = r.iter().map(|x| (x - m1) * (x - m1)).collect();
-        let (v, se_v) = block_mean(&dev, 40);
-        println!(
-            "{drift:?}: <r> = {m:.4} +- {se:.4} (Boltzmann {m1:.4}), spread {:.4} (Boltzmann {sd:.4}, se {:.4})",
-            v.sqrt(),
-            se_v / (2.0 * v.sqrt())
+    let want = PairStats::boltzmann();
+    let got = PairStats::run(Drift::Midpoint, 0.02, 2e-3, 800.0);
+    let off = got.off(&want);
+    println!("Boltzmann {want:?}\nmidpoint {got:?}, {off:.1?} standard errors");
+    for (z, what) in off.into_iter().zip(["<r>", "spread", "share below 2.05"]) {
+        assert!(
+            z.abs() < 4.0,
+            "{what}: {z:.1} standard errors off ({got:?})"
         );
-        means.push((m, se, v, se_v));
     }
-    let (m, se, v, se_v) = means[0];
-    assert!(
-        (m - m1).abs() < 4.0 * se,
-        "midpoint <r> {m} +- {se} vs {m1}"
+}
+
+/// The drift where it is large: two unit spheres at a gap of 0.05 (`s = 2.05`), no
+/// force, 150 000 single steps of `dt = 2e-3` from the same start a scheme (half a
+/// minute of one core for both):
+/// the mean relative displacement along their line of centres is
+/// `kT dt div M_rel = kT dt (mu_par' + 2 (mu_par - mu_perp) / r)`, `M_rel` the
+/// relative mobility of the dense `M_SD,tt` (its along and across values, the slope by
+/// central differences), with the midpoint within four standard errors, and without it
+/// zero within four; the prediction is more than eight standard errors from zero, so
+/// the test tells the schemes apart. (The step resolves this gap: it moves the pair
+/// `sqrt(2 kT dt mu_par)`, about an eighth of it.)
+#[test]
+fn pair_drift() {
+    type T = f64;
+    let (r, dt, samples) = (2.05, 2e-3, 150_000);
+    let pair_at = |x: f64| {
+        [0.0, x].map(|x| Sphere {
+            pos: [x, 0.0, 0.0],
+            radius: 1.0,
+            density: 0.0,
+        })
+    };
+    // The relative mobility `M11 + M22 - M12 - M21` along and across the line of centres.
+    let rel = |x: f64| {
+        let m = dense_tt::<T>(1.0, &pair_at(x), None);
+        let block = |i: usize, j: usize, a: usize| m[(3 * i + a) * 6 + 3 * j + a];
+        let rel = |a: usize| block(0, 0, a) + block(1, 1, a) - block(0, 1, a) - block(1, 0, a);
+        (rel(0), rel(1))
+    };
+    let h = 1e-4;
+    let (par, perp) = rel(r);
+    let slope = (rel(r + h).0 - rel(r - h).0) / (2.0 * h);
+    let want = dt * (slope + 2.0 * (par - perp) / r);
+    let se_want = (2.0 * dt * par / samples as f64).sqrt();
+    println!(
+        "mu_par {par:.5}, mu_perp {perp:.5}, slope {slope:.5}: drift {want:.4e} ({:.1} standard errors)",
+        want / se_want
     );
-    assert!(
-        (v - sd * sd).abs() < 4.0 * se_v,
-        "midpoint spread {v} vs {}",
-        sd * sd
-    );
-    let (mu, seu, ..) = means[1];
-    assert!(
-        m1 - mu > 4.0 * seu,
-        "uncorrected {mu} +- {seu} shows no bias"
-    );
+    assert!(want > 8.0 * se_want, "{want} vs {se_want}: cannot tell");
+    for (drift, seed, expect) in [(Drift::Midpoint, 7, want), (Drift::Uncorrected, 8, 0.0)] {
+        let p = iterative::<T>(dt, 1.0, drift, None);
+        let (dx, _) = kicks(&p, &pair_at(r), samples, seed);
+        let scale = (2.0 * dt).sqrt();
+        let along: Vec<f64> = dx.iter().map(|x| (x[3] - x[0]) * scale).collect();
+        let (m, se) = mean_se(&along);
+        println!(
+            "{drift:?}: {m:.4e} +- {se:.1e}, want {expect:.4e} ({:+.1} standard errors)",
+            (m - expect) / se
+        );
+        assert!(
+            (m - expect).abs() < 4.0 * se,
+            "{drift:?}: {m} +- {se} vs {expect}"
+        );
+    }
 }
 
 /// Two runs of five Brownian steps of 20 spheres with close pairs in a box end on the
@@ -446,4 +551,28 @@ both_precisions! {
     stokes_einstein => stokes_einstein;
     same_bits => same_bits;
     refusals => refusals;
+}
+
+/// The pair near contact against the time step, at the near field's minimum gap 0.02
+/// (the suite's) and the default 1e-3, 400 time units each: each scheme's mean, spread
+/// and share below `r = 2.05` against the Boltzmann weight's, in standard errors, and
+/// the share in overlap. About ten minutes of one core.
+#[test]
+#[ignore = "ten minutes: the pair near contact against the time step"]
+fn pair_near_contact_in_dt() {
+    let want = PairStats::boltzmann();
+    println!("Boltzmann {want:?}");
+    for min_gap in [0.02, 1e-3] {
+        for dt in [2e-3, 5e-4] {
+            for drift in [Drift::Midpoint, Drift::Uncorrected] {
+                let got = PairStats::run(drift, min_gap, dt, 400.0);
+                let (o, se_o) = got.overlap;
+                println!(
+                    "min_gap {min_gap} dt {dt:.0e} {drift:?}: {got:?}, {:.1?} se; in overlap {o:.4} +- {se_o:.4} (Boltzmann {:.4})",
+                    got.off(&want),
+                    want.overlap.0
+                );
+            }
+        }
+    }
 }
