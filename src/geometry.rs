@@ -65,6 +65,15 @@ pub type Sums<'a, T> = Option<sums::BoxSums<'a, T>>;
 #[cfg(not(feature = "periodic"))]
 pub type Sums<'a, T> = Option<&'a PhantomData<T>>;
 
+/// The step's sums that have blocks, as the near field's far field holds them
+/// (`crate::stokesian::Far`): the Ewald sums, not PSE's products and storage, so that
+/// it is `Send` and `Sync`; from [`Sums`] by `TryFrom`, back by `From`.
+#[cfg(feature = "periodic")]
+pub type BlockSums<'a, T> = Option<sums::Blocks<'a, T>>;
+/// The step's sums that have blocks: none without the `periodic` feature.
+#[cfg(not(feature = "periodic"))]
+pub type BlockSums<'a, T> = Sums<'a, T>;
+
 /// What the step's checks derive once and hold for [`Sums`] to borrow (the box's Ewald
 /// or PSE parameters, the fast free-space product's: `periodic/held.rs`).
 #[cfg(feature = "periodic")]
