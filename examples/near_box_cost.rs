@@ -96,7 +96,7 @@ fn step_cost(n: usize, reps: usize, rec: &mut record::Recorder) {
     let (pos, rad, l) = suspension::suspension(n, 0.25);
     let cell = Periodic::new([l; 3]).expect("box");
     let ew = Ewald::new(cell, 1.2).expect("sums");
-    let far = Far::Box(&ew);
+    let far = Far::periodic(&ew);
     let near = NearField::default();
     let table = format!(
         "near step cost, {n} spheres in a box at volume fraction 0.25, f64, one core, CPU time"
@@ -183,7 +183,7 @@ fn work(list: &[usize], rec: &mut record::Recorder) {
     for &n in list {
         let (pos, rad, l) = suspension::suspension(n, 0.25);
         let ew = Ewald::new(Periodic::new([l; 3]).expect("box"), 1.2).expect("sums");
-        let far = Far::Box(&ew);
+        let far = Far::periodic(&ew);
         let mut store = Store::new(far, &pos, &rad, near);
         // The best of three set-ups (CPU time, 10 ms ticks).
         let setup = (0..3)

@@ -70,7 +70,7 @@ fn root_of_msd(
     (pos, rad, l): (&[DVec3], &[f64], f64),
 ) -> (Result<u32, String>, u32, f64) {
     let ew = Ewald::new(Periodic::new([l; 3]).expect("box"), 1.2).expect("sums");
-    let far = Far::Box(&ew);
+    let far = Far::periodic(&ew);
     let nf = NearField::default();
     let mut packed = vec![DMat3::ZERO; 2 * n * (2 * n + 1) / 2];
     far.assemble_grand(1.0, pos, rad, &mut packed)

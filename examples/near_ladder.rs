@@ -238,7 +238,7 @@ fn chain(steps: usize, rec: &mut record::Recorder) {
             };
             let pairs = match near {
                 Near::Off => 0,
-                _ => close_pairs(Far::Free, &c.start, &c.radii),
+                _ => close_pairs(Far::FREE, &c.start, &c.radii),
             };
             // Each formation: two `spd_inverse` of `6N x 6N`, about `2/3 m^3` flops each.
             let m = 6.0 * c.start.len() as f64;
@@ -285,7 +285,7 @@ fn box_cost(n: usize, near_mode: &str, rec: &mut record::Recorder) {
     let table = box_table(n);
     let cell = Periodic::new([l; 3]).expect("box");
     let ew = Ewald::new(cell, 1.2).expect("sums");
-    let pairs = close_pairs(Far::Box(&ew), &pos, &rad);
+    let pairs = close_pairs(Far::periodic(&ew), &pos, &rad);
     println!("N = {n}, edge {l:.3}, {pairs} pairs inside the cutoff");
     println!("rung,step_s");
     let mut dense_vel: Option<Vec<DVec3>> = None;
@@ -345,7 +345,7 @@ fn box_cost(n: usize, near_mode: &str, rec: &mut record::Recorder) {
         // The iterative step's far field alone: the Ewald grand mobility's assembly.
         let mut packed = vec![glam::DMat3::ZERO; 2 * n * (2 * n + 1) / 2];
         let t = Instant::now();
-        Far::Box(&ew)
+        Far::periodic(&ew)
             .assemble_grand(1.0, &pos, &rad, &mut packed)
             .expect("grand mobility");
         let value = format!("{:.3e}", t.elapsed().as_secs_f64());
@@ -366,7 +366,7 @@ fn work(sizes: &[usize], rec: &mut record::Recorder) {
     for &n in sizes {
         let (pos, rad, l) = suspension::suspension(n, 0.25);
         let ew = Ewald::new(Periodic::new([l; 3]).expect("box"), 1.2).expect("sums");
-        let far = Far::Box(&ew);
+        let far = Far::periodic(&ew);
         let t = Instant::now();
         let pairs = close_pairs(far, &pos, &rad);
         let find = t.elapsed().as_secs_f64();

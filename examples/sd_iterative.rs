@@ -65,7 +65,7 @@ fn main() {
     for &n in &list {
         let (pos, rad, l) = suspension(n, 0.25);
         let ew = Ewald::new(Periodic::new([l; 3]).unwrap(), 1.2).unwrap();
-        let far = Far::Box(&ew);
+        let far = Far::periodic(&ew);
         let f: Vec<DVec3> = (0..2 * n)
             .map(|k| DVec3::new((k as f64).sin(), (0.3 * k as f64).cos(), -1.0))
             .collect();

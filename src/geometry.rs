@@ -34,10 +34,12 @@
 //!
 //! **Adding a geometry** (a slit between two walls, say; `docs/GEOMETRY.md`): its
 //! blocks in a module under `mobility/` (`Blocks`, `Grand`), its [`Geometry`] and its
-//! answers to [`Place`]'s questions in a module here, one line of `geometries!`, the
-//! parameter that names it (a field of [`Named`], read in `Params::place`), its input
-//! checks (a file under `integrate/checks/`, one call in
-//! `check_all`), its feature, and its tests.
+//! answers to [`Place`]'s questions (its hard surfaces among them, [`Surfaces`]) in a
+//! module here, one line of `geometries!`, the parameter that names it (a field of
+//! [`Named`], read in `Params::place`), its input checks (a file under
+//! `integrate/checks/`, one call in `check_all`), its part of the near field where it
+//! has one (a file under `stokesian/`: its far field is its place and sums), its
+//! feature, and its tests.
 
 #[cfg(feature = "pse")]
 pub mod fast;
@@ -64,6 +66,15 @@ pub type Sums<'a, T> = Option<sums::BoxSums<'a, T>>;
 /// The step's periodic sums: none without the `periodic` feature (always `None`).
 #[cfg(not(feature = "periodic"))]
 pub type Sums<'a, T> = Option<&'a PhantomData<T>>;
+
+/// The step's sums that have blocks, as the near field's far field holds them
+/// (`crate::stokesian::Far`): the Ewald sums, not PSE's products and storage, so that
+/// it is `Send` and `Sync`; from [`Sums`] by `TryFrom`, back by `From`.
+#[cfg(feature = "periodic")]
+pub type BlockSums<'a, T> = Option<sums::Blocks<'a, T>>;
+/// The step's sums that have blocks: none without the `periodic` feature.
+#[cfg(not(feature = "periodic"))]
+pub type BlockSums<'a, T> = Sums<'a, T>;
 
 /// What the step's checks derive once and hold for [`Sums`] to borrow (the box's Ewald
 /// or PSE parameters, the fast free-space product's: `periodic/held.rs`).
@@ -291,8 +302,10 @@ geometries! {$
 }
 
 mod place;
+pub mod surface;
 
 pub use place::Named;
+pub use surface::{Surface, Surfaces};
 
 impl<'a, T: Real> Hydrodynamics<'a, T> {
     /// The geometry of a step: in the box when it has sums, above the wall at `wall`

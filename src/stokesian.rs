@@ -2,9 +2,12 @@
 //! in a periodic box ([`Far`]): `M_SD = R^-1`, `R = M_far^-1 + sum R_near`, translation
 //! and rotation (`6N x 6N`). The iterative product for large `N` is [`iterative`].
 //!
-//! * `M_far`: the kernel's RPY grand mobility ([`crate::mobility::assemble_grand`],
-//!   [`crate::mobility::wall::assemble_grand`] above the wall, the Ewald sums'
-//!   `crate::mobility::periodic::assemble_grand` in the box).
+//! * `M_far`: the geometry's RPY grand mobility, through the kernel's geometry
+//!   interface ([`Far::assemble_grand`]: [`crate::mobility::assemble_grand`] in free
+//!   space, [`crate::mobility::wall::assemble_grand`] above the wall, the Ewald sums'
+//!   `crate::mobility::periodic::assemble_grand` in the box). A geometry's own part
+//!   lives in its file here: the box's far field (`periodic.rs`), the wall's sphere
+//!   corrections (`wall.rs`).
 //! * Pairs whose surface gap is below [`NearField::cutoff`] mean radii (in the box, at
 //!   their minimum image, and only while it is shorter than half the smallest edge, so
 //!   that a pair has one image at most): the pair's
@@ -30,13 +33,13 @@
 
 mod far;
 pub mod iterative;
+#[cfg(feature = "periodic")]
+mod periodic;
 mod wall;
 
 pub use far::Far;
 
-use crate::cell::PeriodicError;
-use crate::error::LinalgError;
-use crate::error::ParticleError;
+use crate::error::{LinalgError, ParticleError, StepError};
 use crate::linalg::{spd_inverse, tri};
 use crate::mobility::{Hydro, pair_blocks, self_rr, self_tt};
 use crate::near::{NearError, near_correction};
@@ -72,11 +75,12 @@ impl<T: Real> Default for NearField<T> {
 /// Why the Stokesian dynamics mobility was not formed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SdError {
-    /// The far field refused the spheres (nested spheres, a centre below the wall).
+    /// The far field refused the spheres (nested spheres, a centre below the wall, a
+    /// radius above the box sums' largest, a sphere inside another's image).
     Particle(ParticleError),
-    /// The box's sums refused the spheres (a radius above the sums' largest, a sphere
-    /// inside another's image).
-    Periodic(PeriodicError),
+    /// The far field's geometry refused its grand mobility otherwise: its step's error
+    /// ([`Far::assemble_grand`]).
+    Far(StepError),
     /// A pair's near field has no value (a size ratio outside `0.1..=10`, a radius that
     /// is not positive), or a sphere's wall functions.
     Near {
@@ -91,7 +95,7 @@ pub enum SdError {
     NotPositiveDefinite(LinalgError),
     /// A parameter is not finite, a cutoff is negative or `min_gap` is not positive (or,
     /// for [`iterative`], a tolerance that is not positive, or the wall, which that path
-    /// does not model).
+    /// does not model), or the far field names a geometry the kernel was built without.
     Params,
     /// The storage is shorter than [`storage`] asks.
     Storage,
@@ -115,7 +119,7 @@ pub fn storage(n: usize) -> (usize, usize) {
 /// a fluid of viscosity `eta`, above the wall at height `wall` if given; into `out`
 /// (`(6n)^2`, row-major), with `packed` as scratch ([`storage`]). On an error `out` and
 /// `packed` hold no meaningful values (they are the caller's buffers, not state).
-/// [`mobility_in`] with `Far::Wall` or `Far::Free`.
+/// [`mobility_in`] with [`Far::above`] or [`Far::FREE`].
 pub fn mobility<T: Real>(
     eta: T,
     wall: Option<T>,
@@ -125,7 +129,7 @@ pub fn mobility<T: Real>(
     packed: &mut [T::M3],
     out: &mut [T],
 ) -> Result<(), SdError> {
-    let far = wall.map_or(Far::Free, Far::Wall);
+    let far = wall.map_or(Far::FREE, Far::above);
     mobility_in(eta, far, pos, radius, near, packed, out)
 }
 

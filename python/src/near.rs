@@ -50,9 +50,9 @@ pub fn dense<'py, T: Real + Element>(
     let mut out = alloc::filled(&what, "resistance", nd, T::ZERO)?;
     let eta = T::from_f64(eta);
     let far = match (&ewald, wall) {
-        (Some(e), _) => Far::Box(e),
-        (None, Some(h)) => Far::Wall(T::from_f64(h)),
-        (None, None) => Far::Free,
+        (Some(e), _) => Far::periodic(e),
+        (None, Some(h)) => Far::above(T::from_f64(h)),
+        (None, None) => Far::FREE,
     };
     let near = NearField::default();
     py.detach(|| mobility_in(eta, far, &p, &r, near, &mut packed, &mut out))
@@ -85,7 +85,7 @@ fn sd_error(py: Python<'_>, e: SdError) -> PyErr {
         SdError::NotPositiveDefinite(l) => PyValueError::new_err(format!(
             "the near-field resistance is not positive definite in this precision ({l})"
         )),
-        SdError::Periodic(p) => PyValueError::new_err(format!("box: {p}")),
+        SdError::Far(e) => PyValueError::new_err(format!("far field: {e}")),
         SdError::Params | SdError::Storage | SdError::NotConverged { .. } => {
             PyValueError::new_err(format!("near-field mobility refused: {e:?}"))
         }

@@ -5,7 +5,7 @@
 #[cfg(feature = "fast-free")]
 pub(crate) mod fast;
 
-use super::Geometry;
+use super::{Geometry, Surfaces};
 use crate::cell::Periodic;
 use crate::error::StepError;
 use crate::linalg::{MobMut, with_blocks};
@@ -53,6 +53,12 @@ impl Anywhere {
     #[inline(always)]
     pub const fn cell<T: Real>(self) -> Option<Periodic<T>> {
         None
+    }
+
+    /// No hard surface.
+    #[inline(always)]
+    pub const fn surfaces<T: Real>(self) -> Surfaces<T> {
+        Surfaces::NONE
     }
 
     /// Free space's blocks are symmetric in bits.

@@ -8,7 +8,7 @@ pub(crate) mod held;
 #[cfg(feature = "periodic")]
 pub mod step;
 
-use super::Named;
+use super::{Named, Surface, Surfaces};
 use crate::cell::{Periodic, PeriodicError};
 use crate::error::{ParticleError, StepError};
 use crate::mobility::Hydro;
@@ -52,6 +52,15 @@ impl<T: Real> InBox<T> {
     #[inline(always)]
     pub const fn cell(self) -> Option<Periodic<T>> {
         Some(self.cell)
+    }
+
+    /// None but the wall asked for beside the box (which the checks refuse).
+    #[inline(always)]
+    pub const fn surfaces(self) -> Surfaces<T> {
+        match self.wall {
+            Some(h) => Surfaces::one(Surface::floor(h)),
+            None => Surfaces::NONE,
+        }
     }
 
     /// The Ewald blocks are symmetric in bits (not with a wall beside the box).

@@ -7,7 +7,7 @@
 //! are forwarded, and read by hand from [`Params`](crate::Params) nowhere
 //! ([`Params::place`](crate::Params::place)).
 
-use super::Place;
+use super::{Place, Surfaces};
 use crate::cell::Periodic;
 use crate::mobility::Hydro;
 use crate::real::Real;
@@ -45,6 +45,14 @@ impl<T: Real> Place<T> {
     #[inline(always)]
     pub const fn cell(self) -> Option<Periodic<T>> {
         each_place!(self, g => g.cell())
+    }
+
+    /// The hard surfaces the spheres may not cross (the wall's plane; none in free
+    /// space or in a box): what the acceptance checks, the workspace holds links for
+    /// and the contacts hold.
+    #[inline(always)]
+    pub const fn surfaces(self) -> Surfaces<T> {
+        each_place!(self, g => g.surfaces())
     }
 
     /// Whether the stored translational blocks are symmetric in bits, so that the
@@ -119,6 +127,9 @@ mod tests {
                         pse,
                     });
                     assert_eq!(place.wall(), wall);
+                    // The wall's plane is the one hard surface, a floor.
+                    assert_eq!(place.surfaces().floor(), wall);
+                    assert_eq!(place.surfaces().len(), usize::from(wall.is_some()));
                     assert_eq!(place.cell(), periodic);
                     assert_eq!(place.symmetric(), wall.is_none());
                     let stored = wall.is_none() && !(periodic.is_some() && pse);

@@ -95,6 +95,27 @@ impl<T: Real> FastProduct<T> for PseStep<'_, T> {
     }
 }
 
+/// The sums a far field holds ([`BlockSums`](super::BlockSums)): the Ewald sums'
+/// blocks alone, `Send` and `Sync`, unlike a PSE step's storage.
+pub type Blocks<'a, T> = &'a Ewald<T>;
+
+/// The Ewald sums as the step's.
+impl<'a, T: Real> From<&'a Ewald<T>> for BoxSums<'a, T> {
+    fn from(e: &'a Ewald<T>) -> Self {
+        Self::Ewald(e)
+    }
+}
+
+/// The Ewald sums of the step's, where it sums by Ewald (the sums back on PSE's path,
+/// which has no blocks).
+impl<'a, T: Real> TryFrom<BoxSums<'a, T>> for &'a Ewald<T> {
+    type Error = BoxSums<'a, T>;
+
+    fn try_from(sums: BoxSums<'a, T>) -> Result<Self, Self::Error> {
+        sums.ewald().ok_or(sums)
+    }
+}
+
 impl<T: Real> Clone for BoxSums<'_, T> {
     fn clone(&self) -> Self {
         *self

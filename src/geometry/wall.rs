@@ -5,7 +5,7 @@
 #[cfg(feature = "wall")]
 pub mod step;
 
-use super::Named;
+use super::{Named, Surface, Surfaces};
 use crate::cell::Periodic;
 use crate::mobility::Hydro;
 use crate::real::Real;
@@ -37,6 +37,12 @@ impl<T: Real> Above<T> {
     #[inline(always)]
     pub const fn cell(self) -> Option<Periodic<T>> {
         None
+    }
+
+    /// The wall's plane, a floor: the spheres stay above it.
+    #[inline(always)]
+    pub const fn surfaces(self) -> Surfaces<T> {
+        Surfaces::one(Surface::floor(self.height))
     }
 
     /// The wall's pair blocks are not symmetric (block `(j, i)` is the transpose of

@@ -16,7 +16,7 @@ mod wall;
 pub(super) use acceptance::accept;
 pub(super) use periodic_box::check_box;
 use periodic_box::check_periodic;
-use wall::{below_wall, check_wall};
+use wall::check_wall;
 
 use crate::bonds::Bond;
 use crate::constraints::Solver;

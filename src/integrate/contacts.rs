@@ -175,8 +175,13 @@ pub(super) fn project_along<'l, T: Real, A: Along<T>>(
     let (links, cells) = links.split();
     // Constants without the `contacts` feature: the one-sided path folds away.
     let contacts = p.contacts.filter(|_| cfg!(feature = "contacts"));
-    // The wall's height, as its geometry answers it (`Place::wall`).
-    let wall = p.place().wall().filter(|_| cfg!(feature = "contacts"));
+    // The floor the wall links hold, as the geometry answers its hard surfaces
+    // (`Place::surfaces`: the wall's plane).
+    let wall = p
+        .place()
+        .surfaces()
+        .floor()
+        .filter(|_| cfg!(feature = "contacts"));
     let nb = bonds.len();
     let cell = super::cell(p);
     // The pool of one-sided constraints: the contacts' capacity, one wall link per

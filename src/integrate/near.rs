@@ -230,22 +230,14 @@ pub(super) fn keep_spin<T: Real>(n: usize, store: &mut Store<'_, T>) {
     }
 }
 
-/// The far field the step's near field corrects: the box's Ewald sums (`ew`), the
-/// step's wall, or free space.
+/// The far field the step's near field corrects: the step's geometry with its sums
+/// (`ew`: the box's Ewald sums).
 #[cfg(feature = "near")]
 pub(super) fn far<'a, T: Real>(p: &Params<T>, ew: Sums<'a, T>) -> Result<Far<'a, T>, StepError> {
-    #[cfg(feature = "periodic")]
-    if super::cell(p).is_some() {
-        // `check` has refused PSE, so a box summed for RPY holds Ewald's parameters.
-        return match ew.and_then(|s| s.ewald()) {
-            Some(e) => Ok(Far::Box(e)),
-            None => Err(StepError::Unsupported(
-                "the near field in a box without the Ewald sums",
-            )),
-        };
-    }
-    let _ = ew;
-    Ok(super::wall_height(p).map_or(Far::Free, Far::Wall))
+    // `check` has refused PSE, so a box summed for RPY holds Ewald's parameters.
+    Far::at(p.place(), ew).ok_or(StepError::Unsupported(
+        "the near field in a box without the Ewald sums",
+    ))
 }
 
 /// `M_SD(pos)` into the store's dense matrix (free space, above the step's wall, or in
@@ -285,7 +277,7 @@ pub(super) fn sd_error(e: crate::stokesian::SdError) -> StepError {
         ),
         SdError::Params => StepError::BadParameter("near"),
         SdError::Storage => StepError::Unsupported("the near field without its storage"),
-        SdError::Periodic(e) => e.into(),
+        SdError::Far(e) => e,
         SdError::NotConverged {
             iterations,
             residual,

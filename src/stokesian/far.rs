@@ -1,44 +1,78 @@
 //! The geometry whose far field the near field corrects ([`Far`]): the far field's
 //! grand mobility, and the separation at which a pair's near field is evaluated.
+//!
+//! A far field is a geometry's place and sums ([`crate::geometry::Place`],
+//! [`crate::geometry::BlockSums`]: those with blocks, `Send` and `Sync`), the same a
+//! step runs in: its grand mobility is the
+//! geometry's own ([`Geometry::assemble_grand`](crate::geometry::Geometry), through the
+//! registration's [`Hydrodynamics`] at the RPY level), its minimum images the place's
+//! box. Nothing here names a geometry: a geometry's constructor of its far field (the
+//! box's [`Far::periodic`]) and its sphere corrections (the wall's) live in its own
+//! file under `stokesian/`.
 
 use super::SdError;
+use crate::cell::Periodic;
+use crate::error::StepError;
+use crate::geometry::{BlockSums, Hydrodynamics, Named, Place, Sums};
 use crate::mobility::Hydro;
-#[cfg(feature = "periodic")]
-use crate::mobility::periodic::Ewald;
 use crate::real::Real;
 
-/// The far field the near field corrects: free space, the wall at a height, or the
-/// periodic box with its Ewald sums (feature `periodic`).
+/// The far field the near field corrects: free space ([`Far::FREE`]), the no-slip wall
+/// at a height ([`Far::above`]), the periodic box of an Ewald sum ([`Far::periodic`],
+/// feature `periodic`; `From<&Ewald>`), or the geometry of a step ([`Far::at`]).
 #[derive(Clone, Copy, Debug)]
-pub enum Far<'a, T: Real> {
-    /// Free space.
-    Free,
-    /// Above the no-slip wall at this height.
-    Wall(T),
-    /// In the periodic box of these sums; pairs meet at their minimum image.
-    #[cfg(feature = "periodic")]
-    Box(&'a Ewald<T>),
-    /// Never built: holds the lifetime without the `periodic` feature.
-    #[cfg(not(feature = "periodic"))]
-    #[doc(hidden)]
-    Never(core::convert::Infallible, core::marker::PhantomData<&'a T>),
+pub struct Far<'a, T: Real> {
+    /// Where the spheres are.
+    pub(super) place: Place<T>,
+    /// The place's sums with blocks (a box's Ewald sums): set by a geometry's own
+    /// constructor (`stokesian/periodic.rs`), which names both.
+    pub(super) sums: BlockSums<'a, T>,
 }
 
-impl<T: Real> Far<'_, T> {
+impl<'a, T: Real> Far<'a, T> {
+    /// Free space.
+    pub const FREE: Self = Self {
+        place: Place::new(Named::FREE),
+        sums: None,
+    };
+
+    /// Above the no-slip wall at `height` (with the kernel's `wall` feature: without it
+    /// the grand mobility refuses the wall, [`SdError::Params`]).
+    pub const fn above(height: T) -> Self {
+        let named = Named {
+            wall: Some(height),
+            ..Named::FREE
+        };
+        Self {
+            place: Place::new(named),
+            sums: None,
+        }
+    }
+
+    /// The far field of a step at `place` ([`Params::place`](crate::Params::place))
+    /// with its sums: `None` where the place's box has none (sums the step never
+    /// derived) or they have no blocks to assemble (PSE's, products only).
+    pub fn at(place: Place<T>, sums: Sums<'a, T>) -> Option<Self> {
+        let sums: BlockSums<'a, T> = sums.and_then(|s| s.try_into().ok());
+        let summed = place.summed_cell(Hydro::Rpy).is_some() == sums.is_some();
+        summed.then_some(Self { place, sums })
+    }
+
     /// The wall's height, where there is one.
     pub fn wall(self) -> Option<T> {
-        match self {
-            Self::Wall(h) => Some(h),
-            _ => None,
-        }
+        self.place.wall()
+    }
+
+    /// The periodic box, where there is one: pairs meet at their minimum image.
+    pub fn cell(self) -> Option<Periodic<T>> {
+        self.place.step_cell()
     }
 
     /// The separation `r_j - r_i` the pair's near field sees: the minimum image in the box.
     pub fn separation(self, pi: T::V3, pj: T::V3) -> T::V3 {
-        match self {
-            #[cfg(feature = "periodic")]
-            Self::Box(e) => e.cell().minimum_image(pj - pi),
-            _ => pj - pi,
+        match self.cell() {
+            Some(c) => c.minimum_image(pj - pi),
+            None => pj - pi,
         }
     }
 
@@ -47,21 +81,19 @@ impl<T: Real> Far<'_, T> {
     /// near field (two images would be equally close at half an edge, and a correction
     /// that picked one would break the box's translation invariance).
     pub(super) fn unique(self, r: T::V3) -> bool {
-        match self {
-            #[cfg(feature = "periodic")]
-            Self::Box(e) => {
-                let [x, y, z] = e.cell().size();
+        match self.cell() {
+            Some(c) => {
+                let [x, y, z] = c.size();
                 let h = x.min(y).min(z) * T::HALF;
                 T::norm2(r) < h * h
             }
-            _ => {
-                let _ = r;
-                true
-            }
+            None => true,
         }
     }
 
-    /// The RPY grand mobility of the spheres, packed as `assemble_grand` stores it.
+    /// The RPY grand mobility of the spheres, packed as `assemble_grand` stores it: the
+    /// geometry's own. A geometry the kernel was built without is refused
+    /// ([`SdError::Params`]), not taken for free space.
     pub fn assemble_grand(
         self,
         eta: T,
@@ -69,17 +101,16 @@ impl<T: Real> Far<'_, T> {
         radius: &[T],
         packed: &mut [T::M3],
     ) -> Result<(), SdError> {
-        match self {
-            Self::Free => crate::mobility::assemble_grand(Hydro::Rpy, eta, pos, radius, packed),
-            Self::Wall(h) => return super::wall::far_grand(eta, h, pos, radius, packed),
-            #[cfg(feature = "periodic")]
-            Self::Box(e) => {
-                return crate::mobility::periodic::assemble_grand(e, eta, pos, radius, packed)
-                    .map_err(SdError::Periodic);
-            }
-            #[cfg(not(feature = "periodic"))]
-            Self::Never(never, _) => match never {},
+        let p = self.place;
+        if p.wall() != p.step_wall() || p.cell() != p.step_cell() {
+            return Err(SdError::Params);
         }
-        .map_err(SdError::Particle)
+        let geometry = Hydrodynamics::at(p, Hydro::Rpy, eta, self.sums.map(Into::into));
+        geometry
+            .assemble_grand(pos, radius, packed)
+            .map_err(|e| match e {
+                StepError::Particle(e) => SdError::Particle(e),
+                e => SdError::Far(e),
+            })
     }
 }

@@ -97,13 +97,7 @@ fn each_pair<T: Real>(
     };
     let a_max = cell_list::largest(radius);
     let reach = a_max * (T::TWO + near.cutoff);
-    #[cfg(feature = "periodic")]
-    let cell = match far {
-        Far::Box(e) => Some(e.cell()),
-        _ => None,
-    };
-    #[cfg(not(feature = "periodic"))]
-    let cell = None;
+    let cell = far.cell();
     match CellList::build(pos, cell.as_ref(), reach, cells) {
         Some((list, row)) => {
             for i in 0..pos.len() {

@@ -1,23 +1,12 @@
 //! The wall's part of Stokesian dynamics: each close sphere's sphere-wall correction
 //! (the exact resistance of `near/wall.rs` minus the inverse of the sphere's own wall
-//! mobility block), and the far field above the wall.
+//! mobility block). Its far field is the wall's grand mobility, through the geometry
+//! interface ([`Far::above`](super::Far::above)).
 
 use super::{NearField, SdError};
-use crate::mobility::Hydro;
-use crate::mobility::wall::{assemble_grand, self_wall, self_wall_rot};
+use crate::mobility::wall::{self_wall, self_wall_rot};
 use crate::near::wall::wall_scalars;
 use crate::real::Real;
-
-/// The RPY grand mobility above the wall at `height`, packed as `assemble_grand` stores it.
-pub(super) fn far_grand<T: Real>(
-    eta: T,
-    height: T,
-    pos: &[T::V3],
-    radius: &[T],
-    packed: &mut [T::M3],
-) -> Result<(), SdError> {
-    assemble_grand(Hydro::Rpy, eta, height, pos, radius, packed).map_err(SdError::Particle)
-}
 
 /// Adds each close sphere's wall correction to the resistance in `out`.
 pub(super) fn add_walls<T: Real>(

@@ -197,13 +197,13 @@ impl Layout {
 
     /// Storage for one step with parameters `p` (method, rotation flag, solver, the
     /// matrix-free flag, thermal noise and contacts), `n` particles and `bonds` bonds.
-    /// Contacts count as constraints beside the bonds (up to their capacity), a wall as
-    /// one more per sphere ([`Params::constraints`]), and both add the list of links
+    /// Contacts count as constraints beside the bonds (up to their capacity), a hard
+    /// surface (the wall) as one more per sphere ([`Params::constraints`]), and both add the list of links
     /// they are solved over.
     pub const fn for_params<T: Real>(p: &Params<T>, n: usize, bonds: usize) -> Self {
         let c = p.constraints(n, bonds);
         let mut l = Self::with_solver(p.method, p.rotation, p.solver_kind(n, bonds), n, c);
-        if p.contacts.is_some() || p.place().wall().is_some() {
+        if p.contacts.is_some() || !p.place().surfaces().is_empty() {
             l.links = c;
         }
         // (The iterative near field's noise has storage of its own: `near_noise_sizes`.)

@@ -94,6 +94,8 @@ mod stokesian;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod stokesian_box;
 #[cfg(feature = "near")]
+mod stokesian_far;
+#[cfg(feature = "near")]
 mod stokesian_iter;
 mod tensions;
 mod transactional;

@@ -60,7 +60,7 @@ fn dense_tt<T: Real>(eta: f64, spheres: &[Sphere], l: Option<f64>) -> Vec<f64> {
         let cell = Periodic::new([T::from_f64(l); 3]).unwrap();
         Ewald::new(cell, T::from_f64(a_max)).unwrap()
     });
-    let far = ew.as_ref().map_or(Far::Free, Far::Box);
+    let far = ew.as_ref().map_or(Far::FREE, Far::periodic);
     let nf = NearField::default();
     mobility_in(T::from_f64(eta), far, &pos, &rad, nf, &mut packed, &mut out).unwrap();
     let m = 6 * n;

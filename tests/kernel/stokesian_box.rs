@@ -30,7 +30,7 @@ fn sd<T: Real>(l: Option<f64>, pos: &[[f64; 3]], a: &[f64]) -> Result<Vec<T>, Sd
         let cell = Periodic::new([T::from_f64(l); 3]).unwrap();
         Ewald::new(cell, T::from_f64(a_max)).unwrap()
     });
-    let far = ew.as_ref().map_or(Far::Free, Far::Box);
+    let far = ew.as_ref().map_or(Far::FREE, Far::periodic);
     let near = NearField::default();
     mobility_in(T::ONE, far, &p, &r, near, &mut packed, &mut out)?;
     Ok(out)

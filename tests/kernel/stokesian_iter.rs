@@ -120,7 +120,7 @@ fn the_iterative_product_is_the_dense_one_in_free_space() {
         (150, 1e-3, 3, 1e-4),
     ] {
         let (pos, rad) = cluster(n, gap, seed);
-        let (got, want, it) = both::<f64>(Far::Free, &pos, &rad, tol, 500).unwrap();
+        let (got, want, it) = both::<f64>(Far::FREE, &pos, &rad, tol, 500).unwrap();
         let e = rel(&got, &want);
         println!("n = {n}, smallest gap {gap}, tol {tol:e}: {it} iterations, error {e:.2e}");
         assert!(e < 10.0 * tol.max(1e-12), "n = {n}: error {e}");
@@ -130,7 +130,7 @@ fn the_iterative_product_is_the_dense_one_in_free_space() {
 #[test]
 fn the_iterative_product_is_the_dense_one_in_f32() {
     let (pos, rad) = cluster(60, 1e-2, 4);
-    let (got, want, it) = both::<f32>(Far::Free, &pos, &rad, 1e-4, 500).unwrap();
+    let (got, want, it) = both::<f32>(Far::FREE, &pos, &rad, 1e-4, 500).unwrap();
     let e = rel(&got, &want);
     println!("f32: {it} iterations, error {e:.2e}");
     assert!(e < 1e-2, "error {e}");
@@ -146,7 +146,7 @@ fn the_iterative_product_is_the_dense_one_in_the_box() {
     let l = 24.0;
     let cell = Periodic::new([l; 3]).unwrap();
     let ew = Ewald::new(cell, 3.0).unwrap();
-    let (got, want, it) = both::<f64>(Far::Box(&ew), &pos, &rad, 1e-8, 500).unwrap();
+    let (got, want, it) = both::<f64>(Far::periodic(&ew), &pos, &rad, 1e-8, 500).unwrap();
     let e = rel(&got, &want);
     println!("box: {it} iterations, error {e:.2e}");
     assert!(e < 1e-7, "error {e}");
@@ -159,7 +159,7 @@ fn iterations_against_the_smallest_gap() {
     let mut counts = Vec::new();
     for gap in [1e-1, 1e-2, 1e-3, 1e-4] {
         let (pos, rad) = cluster(60, gap, 6);
-        let (got, want, it) = both::<f64>(Far::Free, &pos, &rad, 1e-8, 500).unwrap();
+        let (got, want, it) = both::<f64>(Far::FREE, &pos, &rad, 1e-8, 500).unwrap();
         println!(
             "smallest gap {gap:e}: {it} iterations, error {:.2e}",
             rel(&got, &want)
@@ -172,14 +172,14 @@ fn iterations_against_the_smallest_gap() {
 #[test]
 fn the_same_bits_on_rerun_and_errors_are_typed() {
     let (pos, rad) = cluster(70, 1e-3, 8);
-    let a = both::<f64>(Far::Free, &pos, &rad, 1e-8, 500).unwrap().0;
-    let b = both::<f64>(Far::Free, &pos, &rad, 1e-8, 500).unwrap().0;
+    let a = both::<f64>(Far::FREE, &pos, &rad, 1e-8, 500).unwrap().0;
+    let b = both::<f64>(Far::FREE, &pos, &rad, 1e-8, 500).unwrap().0;
     assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
-    let r = both::<f64>(Far::Free, &pos, &rad, 1e-12, 2);
+    let r = both::<f64>(Far::FREE, &pos, &rad, 1e-12, 2);
     assert!(
         matches!(r, Err(SdError::NotConverged { iterations: 2, .. })),
         "{r:?}"
     );
-    let r = both::<f64>(Far::Wall(-1000.0), &pos, &rad, 1e-8, 500);
+    let r = both::<f64>(Far::above(-1000.0), &pos, &rad, 1e-8, 500);
     assert_eq!(r.err(), Some(SdError::Params));
 }

@@ -1,10 +1,9 @@
 //! The third stage of a step: accepting the candidate state before it is committed
-//! (finite, above the wall, no nested or, unless allowed, overlapping spheres). Apart
-//! from the input checks because it is a pair search: in the mobility's bands through
-//! the host's threads, over every pair or a cell list's neighbours, with the same
-//! answer on any number of threads.
+//! (finite, clear of the place's hard surfaces, no nested or, unless allowed,
+//! overlapping spheres). Apart from the input checks because it is a pair search: in
+//! the mobility's bands through the host's threads, over every pair or a cell list's
+//! neighbours, with the same answer on any number of threads.
 
-use super::below_wall;
 use crate::cell::image;
 use crate::cell_list::CellList;
 use crate::error::{ParticleError, StepError};
@@ -36,10 +35,11 @@ pub(in crate::integrate) fn accept<T: Real>(
             return Err(StepError::NonFinite { particle: i });
         }
     }
-    if let Some(height) = p.place().wall()
-        && let Some(particle) = below_wall(pos, radius, height, p.solver.tolerance)
-    {
-        return Err(ParticleError::BelowWall { particle }.into());
+    // No sphere past a hard surface of the place (the wall's plane).
+    for s in p.place().surfaces().iter() {
+        if let Some(particle) = s.first_crossed(pos, radius, p.solver.tolerance) {
+            return Err(ParticleError::BelowWall { particle }.into());
+        }
     }
     if p.place().cell().is_some()
         && let Some(particle) = super::periodic_box::unresolved(pos, radius)

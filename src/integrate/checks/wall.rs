@@ -1,8 +1,9 @@
 //! The wall's part of a step's checks: its height, the kernel's features and the
-//! method that holds it, and no sphere below it (at the start, [`check_wall`], and in
-//! a candidate, [`below_wall`] for the acceptance).
+//! method that holds it, and no sphere below it at the start ([`check_wall`]; in a
+//! candidate, the acceptance asks every hard surface of the place, `Surface`).
 
 use crate::error::{ParticleError, StepError};
+use crate::geometry::Surface;
 use crate::params::{Method, Params};
 use crate::particles::State;
 use crate::real::Real;
@@ -34,26 +35,8 @@ pub(super) fn check_wall<T: Real>(p: &Params<T>, state: &State<'_, T>) -> Result
             "a wall with a method other than Overdamped or Overdamped2",
         ));
     }
-    match below_wall(state.pos, state.radius, height, p.solver.tolerance) {
+    match Surface::floor(height).first_crossed(state.pos, state.radius, p.solver.tolerance) {
         Some(particle) => Err(ParticleError::BelowWall { particle }.into()),
         None => Ok(()),
     }
-}
-
-/// The first sphere whose centre is below `height + a_i (1 - 2 tol)`, less the
-/// rounding of the numbers compared (4 epsilons of `|z| + |height| + a_i`): far from
-/// the origin a sphere put or held at contact is off by an ulp of its coordinates,
-/// which can exceed `2 tol a_i`. A centre that is not strictly above the plane in the
-/// step's precision (`z - height <= 0`: the coordinates' spacing there exceeds the
-/// radius, f32 far from the origin) is below it whatever that rounding: the wall's
-/// mobility has no value there (`mobility::wall`), and a scene checked with this test
-/// at parse time is not refused at its first step by that one.
-pub(super) fn below_wall<T: Real>(pos: &[T::V3], radius: &[T], height: T, tol: T) -> Option<usize> {
-    let reach = T::ONE - tol * T::TWO;
-    let ulps = T::EPSILON * T::from_f64(4.0);
-    pos.iter().zip(radius).position(|(&r, &a)| {
-        let z = T::xyz(r)[2];
-        let rounding = (z.abs() + height.abs() + a) * ulps;
-        !(z - height > T::ZERO && z - height + rounding >= a * reach)
-    })
 }
