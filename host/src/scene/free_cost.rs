@@ -41,7 +41,8 @@
 use hydrorattle::mobility::free_fast::FreeFast;
 use hydrorattle::{Method, Params, SolverKind};
 
-use super::box_cost::{PRODUCTS_MIDPOINT, PRODUCTS_NOISE, PRODUCTS_SOLVE};
+use super::box_cost::{PRODUCTS_MIDPOINT, PRODUCTS_SOLVE};
+use super::free_noise;
 use super::sizing::{Plan, TooLarge};
 use super::{Drift, Sqrt};
 
@@ -281,18 +282,47 @@ fn with_path(plan: &Plan, choice: FreeChoice) -> Plan {
 /// * rotation: the pair paths add a pass of the pairs' rotation blocks a step (the
 ///   inertial method instead assembles the grand mobility, `tri(2N)` blocks); the fast
 ///   path runs every product under the grand parameters ([`FreeFast::new_grand`]) and
-///   its spins are one grand product.
+///   its spins are one grand product;
+/// * thermal noise ([`free_noise`]): the stored paths by the Cholesky factor up to the
+///   kernel's crossover, else every path by Lanczos, whose modelled iterations each
+///   cost a product (the stored paths' from the reduced copy where the kernel reads
+///   it); the pair paths keep the midpoint (the inverse root, a second mobility), the
+///   fast path without bonds draws once. A path whose modelled iterations pass the
+///   kernel's cap (`Params::lanczos`) cannot run.
 pub fn step_cost(plan: &Plan, s: &Spheres, cost: &FreeCost, choice: FreeChoice) -> Option<f64> {
     let p: Params<f64> = with_path(plan, choice).params(s.n);
     let rows = p.constraints(s.n, s.bonds);
     let krylov = p.solver_kind(s.n, s.bonds) == SolverKind::Krylov;
     let thermal = plan.brownian.is_some_and(|t| t.temperature > 0.0);
-    let midpoint = thermal && rows > 0 && plan.brownian.is_some_and(|t| t.drift == Drift::Midpoint);
+    let drift = thermal && plan.brownian.is_some_and(|t| t.drift == Drift::Midpoint);
+    let fast = choice == FreeChoice::Fast;
+    // The midpoint's projection onto the constraints (a second solve).
+    let projection = drift && rows > 0;
+    // A thermal step's midpoint: always on the pair paths in free space (a second
+    // mobility); on the fast path only with bonds (without, the uncorrected draw).
+    let midpoint = drift && (!fast || s.bonds > 0);
     let solve = if rows > 0 { PRODUCTS_SOLVE } else { 0.0 };
     let lanczos = thermal && p.lanczos_noise(s.n);
-    let noise = if lanczos { PRODUCTS_NOISE } else { 0.0 };
-    let mid = if midpoint { PRODUCTS_MIDPOINT } else { 0.0 };
-    let products = 1.0 + solve + noise + mid;
+    // The fast path's midpoint solves `M^-1 M^(1/2) w` by conjugate gradients: its
+    // Lanczos run gives the root alone.
+    let inverse = midpoint && !fast;
+    let iterations = if lanczos {
+        free_noise::iterations(s, inverse)
+    } else {
+        0.0
+    };
+    if iterations > f64::from(p.lanczos.max_iterations) {
+        // The kernel refuses a step whose Lanczos run does not converge by its cap.
+        return None;
+    }
+    let mid = match (projection, fast && midpoint) {
+        (true, _) | (false, true) => PRODUCTS_MIDPOINT,
+        _ => 0.0,
+    };
+    // Products beside the noise's: the step's own, the solve's, the midpoint's (its
+    // mobility applied once, and the projection or the fast path's solve).
+    let at_mid = if midpoint && !fast { 1.0 } else { 0.0 };
+    let products = 1.0 + solve + mid + at_mid;
     let assemblies = if midpoint { 2.0 } else { 1.0 };
     // With rotation the inertial method assembles the grand mobility and reads its
     // spins from it; the others add one pass of the pairs' rotation blocks a step.
@@ -307,34 +337,47 @@ pub fn step_cost(plan: &Plan, s: &Spheres, cost: &FreeCost, choice: FreeChoice) 
     } else {
         0.0
     };
-    let cholesky = if thermal && !lanczos {
-        cost.cholesky * assemblies
-    } else {
-        0.0
+    // The stored paths' noise: the Cholesky factor and its two triangular products, or
+    // Lanczos on the stored mobility, from `REDUCED_MIN` spheres (midpoint drift, f64)
+    // on its reduced copy, written by the first product.
+    let reduced = lanczos
+        && inverse
+        && plan.precision == super::Precision::F64
+        && matches!(plan.method, Method::Overdamped | Method::Springs)
+        && hydrorattle::noise::reduced::usable::<f64>(s.n);
+    let stored_noise = match (thermal, lanczos, reduced) {
+        (false, _, _) => 0.0,
+        (true, false, _) => cost.cholesky + 2.0 * cost.dense,
+        (true, true, true) => cost.copy + (iterations - 1.0) * cost.compact,
+        (true, true, false) => iterations * cost.dense,
     };
     let free_ok = matches!(plan.method, Method::Overdamped | Method::Springs)
         && !plan.wall
         && !plan.near
         && (!thermal || plan.brownian.is_none_or(|t| t.sqrt != Sqrt::Cholesky))
         && (rows == 0 || krylov);
+    let every = products + iterations;
     match choice {
-        FreeChoice::Dense => Some(assembly * assemblies + cost.dense * products + cholesky + spin),
+        FreeChoice::Dense => {
+            Some(assembly * assemblies + cost.dense * products + stored_noise + spin)
+        }
         FreeChoice::Compact => p.compact_copy(s.n, s.bonds).then(|| {
             let constrained = solve + mid;
             cost.assembly * assemblies
                 + cost.copy * assemblies
                 + cost.dense * (products - constrained)
                 + cost.compact * constrained
+                + stored_noise
                 + spin
         }),
-        FreeChoice::MatrixFree => free_ok.then_some(cost.matrix_free * products + spin),
+        FreeChoice::MatrixFree => free_ok.then_some(cost.matrix_free * every + spin),
         // With rotation every product runs under the grand parameters, and the spins
         // are one grand product.
         FreeChoice::Fast if plan.rotation => cost
             .fast_grand
             .filter(|_| free_ok && s.rpy)
-            .map(|(t, g)| t * products + g),
-        FreeChoice::Fast => cost.fast.filter(|_| free_ok && s.rpy).map(|t| t * products),
+            .map(|(t, g)| t * every + g),
+        FreeChoice::Fast => cost.fast.filter(|_| free_ok && s.rpy).map(|t| t * every),
     }
 }
 

@@ -64,6 +64,7 @@ mod floor_tests;
 pub mod free_cost;
 #[cfg(test)]
 mod free_cost_tests;
+pub mod free_noise;
 mod free_space;
 mod helix;
 mod kernel;
