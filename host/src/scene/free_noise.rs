@@ -13,42 +13,49 @@
 //!
 //! The iterations grow with the mobility's spread of eigenvalues: the collective mode
 //! (the whole cloud falling, `1 + 6 N a / (5 R)` times a lone sphere's mobility for a
-//! ball of radius `R`) at the top, the overlapping pairs at the bottom. The model is
-//! `c0 + c1 ln N + c2 sqrt(S)`, `S = 1 + 6 N a_max / (5 R)` with `R` half the longest
-//! edge of the spheres' bounding box plus a radius: a cloud's collective mobility, a
-//! chain's (a line: `S` near 2, its iterations grow as `ln N`). Fitted to the recorded
-//! iterations of every shape and count by `python3 bench/free_fit.py --brownian COMMIT`.
+//! ball of radius `R`) at the top, the overlapping pairs of a dense cloud at the
+//! bottom. The model is `c0 + c1 sqrt(S) + c2 sqrt(f)`: `S = 1 + 6 N a_max / (5 R)`,
+//! `R` half the longest edge of the spheres' bounding box plus a radius (a cloud's
+//! collective mobility; a chain's `S` stays near 2), and the box's fill
+//! `f = N a_max^3 / V`, `V` the box with a radius added each side (the overlaps). Fitted
+//! to the recorded iterations of every shape and count by `python3 bench/free_fit.py
+//! --brownian COMMIT...`; worst misfit in [`MIDPOINT_MISFIT`] and [`ROOT_MISFIT`].
 
 use super::free_cost::Spheres;
 
 /// Lanczos iterations with the inverse root (the midpoint drift), fixed part.
-pub const MIDPOINT_FIXED: f64 = 0.0;
-/// Lanczos iterations with the inverse root per `ln N`.
-pub const MIDPOINT_LOG_N: f64 = 0.0;
+pub const MIDPOINT_FIXED: f64 = 0.0000e0;
 /// Lanczos iterations with the inverse root per `sqrt(S)`.
-pub const MIDPOINT_SPREAD: f64 = 0.0;
+pub const MIDPOINT_SPREAD: f64 = 5.1868e0;
+/// Lanczos iterations with the inverse root per `sqrt(f)`.
+pub const MIDPOINT_FILL: f64 = 4.1480e1;
+/// The fit's worst factor between modelled and measured iterations, inverse root.
+pub const MIDPOINT_MISFIT: f64 = 1.36;
 /// Lanczos iterations of the root alone (the uncorrected draw), fixed part.
-pub const ROOT_FIXED: f64 = 0.0;
-/// Lanczos iterations of the root alone per `ln N`.
-pub const ROOT_LOG_N: f64 = 0.0;
+pub const ROOT_FIXED: f64 = 1.6357e0;
 /// Lanczos iterations of the root alone per `sqrt(S)`.
-pub const ROOT_SPREAD: f64 = 0.0;
+pub const ROOT_SPREAD: f64 = 2.1602e0;
+/// Lanczos iterations of the root alone per `sqrt(f)`.
+pub const ROOT_FILL: f64 = 4.5737e1;
+/// The fit's worst factor between modelled and measured iterations, root alone.
+pub const ROOT_MISFIT: f64 = 1.21;
 
-/// The iteration model's terms for `s`: `[1, ln N, sqrt(S)]`.
+/// The iteration model's terms for `s`: `[1, sqrt(S), sqrt(f)]`.
 pub fn terms(s: &Spheres) -> [f64; 3] {
-    let n = s.n.max(1) as f64;
+    let n = s.n as f64;
+    let a = s.a_max.max(f64::MIN_POSITIVE);
     let longest = s.extent.iter().fold(0.0f64, |m, &e| m.max(e));
-    let r = 0.5 * longest + s.a_max.max(f64::MIN_POSITIVE);
-    let spread = 1.0 + 1.2 * n * s.a_max / r;
-    [1.0, n.ln(), spread.sqrt()]
+    let spread = 1.0 + 1.2 * n * a / (0.5 * longest + a);
+    let volume: f64 = s.extent.iter().map(|e| e + 2.0 * a).product();
+    [1.0, spread.sqrt(), (n * a * a * a / volume).sqrt()]
 }
 
 /// The modelled Lanczos iterations of a thermal step of `s`: with the inverse root
 /// (`midpoint`) or the root alone; at least one.
 pub fn iterations(s: &Spheres, midpoint: bool) -> f64 {
     let c = match midpoint {
-        true => [MIDPOINT_FIXED, MIDPOINT_LOG_N, MIDPOINT_SPREAD],
-        false => [ROOT_FIXED, ROOT_LOG_N, ROOT_SPREAD],
+        true => [MIDPOINT_FIXED, MIDPOINT_SPREAD, MIDPOINT_FILL],
+        false => [ROOT_FIXED, ROOT_SPREAD, ROOT_FILL],
     };
     let x = terms(s);
     (c[0] * x[0] + c[1] * x[1] + c[2] * x[2]).max(1.0)
