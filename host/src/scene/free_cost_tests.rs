@@ -19,7 +19,7 @@ fn overdamped() -> Plan {
 }
 
 /// `n` unit spheres in a ball at volume fraction `phi` (its bounding cube).
-fn cloud(n: usize, phi: f64) -> Spheres {
+pub(super) fn cloud(n: usize, phi: f64) -> Spheres {
     let r = (n as f64 / phi).cbrt();
     Spheres {
         n,
@@ -186,7 +186,8 @@ fn near_pairs_match_their_shapes() {
 }
 
 /// The table `bench/free_fit.py` records its fit over every shape in.
-const FIT: &str = "free-space cost model constants (seconds a call per term), fitted to the rows of every shape";
+const FIT: &str =
+    "free-space cost model constants (seconds a call per term), fitted to the rows of every shape";
 
 /// The constants in the code are the last recorded fit over every shape
 /// (`bench/results/free_cost.csv`).
@@ -239,7 +240,7 @@ const MEASURED_BYTES: usize = 400_000_000;
 
 /// The helical chain of `examples/shared/free_shapes.rs` (0.6 rad a bead, rising 0.8,
 /// bonds 3): its bounding box.
-fn helix(n: usize) -> Spheres {
+pub(super) fn helix(n: usize) -> Spheres {
     let (mut at, mut lo, mut hi) = ([0.0f64; 3], [0.0f64; 3], [0.0f64; 3]);
     for k in 1..n {
         let t = 0.6 * k as f64;
@@ -291,7 +292,9 @@ fn the_choice_matches_the_measured_rows() {
     ];
     let (mut checked, mut wrong) = (0, Vec::new());
     for (shape, phi) in shapes {
-        for n in [10, 30, 100, 300, 1000, 3000, 10_000, 20_000, 50_000, 100_000] {
+        for n in [
+            10, 30, 100, 300, 1000, 3000, 10_000, 20_000, 50_000, 100_000,
+        ] {
             let case = format!("{shape}, N = {n}");
             let t = |q: &str| rows.get(&(case.clone(), q.to_string())).copied();
             let s0 = phi.map_or_else(|| helix(n), |phi| cloud(n, phi));
