@@ -444,7 +444,7 @@ pub fn choose(
         if let Some(b) = bytes {
             need = Some(need.map_or(b, |m| m.min(b)));
         }
-        if !bytes.is_some_and(|b| b <= limit) {
+        if bytes.is_none_or(|b| b > limit) {
             continue;
         }
         let capped = within_cap(plan, s, choice);
