@@ -15,6 +15,16 @@ Forms, minimising relative residuals with non-negative constants (as the example
 
     python3 bench/free_fit.py COMMIT            # prints the constants
     HYDRORATTLE_BENCH_MACHINE=<id> python3 bench/free_fit.py COMMIT   # and records them
+    python3 bench/free_fit.py --brownian COMMIT...   # the Lanczos iterations' constants
+
+`--brownian` fits `host/src/scene/free_noise.rs`: the Lanczos iterations that
+`examples/free_brownian.rs` recorded (at the commits given, every shape and count),
+with the inverse root (the matrix-free path's midpoint; the stored path's is the same
+run) and without (the fast path), each against `c0 + c1 sqrt(S) + c2 sqrt(f)`,
+`S = 1 + 6 N a / (5 R)` with `R` half the longest edge of the bounding box plus a
+radius, `f = N a^3 / V` with `V` the box widened by a radius each side (a cloud's
+edges `2 (N / phi)^(1/3)`; the helical chain's from its recurrence), as the model
+computes them.
 
 With HYDRORATTLE_BENCH_MACHINE set the constants go to bench/results/free_cost.csv as
 rows of "free-space cost model constants", which the host test
@@ -142,5 +152,68 @@ def main(argv):
     rows.finish()
 
 
+BROWNIAN = "free-space Brownian steps, unit spheres, f64, one thread, CPU seconds a step"
+
+
+def helix_extent(n):
+    """The bounding box's edges of the helical chain of `examples/shared/free_shapes.rs`."""
+    at, lo, hi = [0.0] * 3, [0.0] * 3, [0.0] * 3
+    for k in range(1, n):
+        t = 0.6 * k
+        d = [math.cos(t), math.sin(t), 0.8]
+        norm = math.sqrt(sum(x * x for x in d))
+        for c in range(3):
+            at[c] += 3.0 * d[c] / norm
+            lo[c], hi[c] = min(lo[c], at[c]), max(hi[c], at[c])
+    return [h - l for h, l in zip(hi, lo)]
+
+
+def iteration_terms(case):
+    """`[1, sqrt(S), sqrt(f)]` of a case named "SHAPE, N = n" (unit spheres)."""
+    shape, n = case.split(", N = ")
+    n = int(n)
+    if shape.startswith("cloud "):
+        extent = [2.0 * (n / float(shape.split()[1])) ** (1 / 3)] * 3
+    else:
+        extent = helix_extent(n)
+    r = 0.5 * max(extent) + 1.0
+    volume = math.prod(e + 2.0 for e in extent)
+    return [1.0, math.sqrt(1.0 + 1.2 * n / r), math.sqrt(n / volume)]
+
+
+def brownian(commits):
+    """Fits and records the Lanczos iterations' constants."""
+    data = {"MIDPOINT": ([], []), "ROOT": ([], [])}
+    paths = {"matrix-free": "MIDPOINT", "fast 1e-4": "ROOT"}
+    with open(ROOT / "bench" / "results" / "free_cost.csv", newline="") as f:
+        for r in csv.DictReader(f):
+            if r["commit"] not in commits or not r["measurement"].startswith(BROWNIAN):
+                continue
+            for path, name in paths.items():
+                if r["quantity"] == f"{path} Brownian step: Lanczos iterations":
+                    m = float(r["value"])
+                    if m > 0:  # 0: the Cholesky factor
+                        data[name][0].append(iteration_terms(r["case"]))
+                        data[name][1].append(m)
+    rows = record.Recorder("free_cost", f"python3 bench/free_fit.py --brownian {' '.join(commits)}",
+                           exact=True)
+    table = (f"free-space Lanczos iterations model constants (iterations per term), fitted "
+             f"to the Brownian steps at {' '.join(commits)}")
+    for name, (x, t) in data.items():
+        if not t:
+            sys.exit(f"no Lanczos iterations of {name} at {commits}")
+        c = fit(x, t)
+        for s, v in zip(["FIXED", "SPREAD", "FILL"], c):
+            print(f"pub const {name}_{s}: f64 = {v:.4e};")
+            rows.row(table, name.lower(), f"{name}_{s}", f"{v:.4e}")
+        worst = misfit(x, t, c)
+        print(f"pub const {name}_MISFIT: f64 = {worst:.2f};  // {len(t)} rows")
+        rows.row(table, name.lower(), f"{name}_MISFIT", f"{worst:.2f}")
+    rows.finish()
+
+
 if __name__ == "__main__":
-    main(sys.argv)
+    if sys.argv[1:2] == ["--brownian"]:
+        brownian(sys.argv[2:])
+    else:
+        main(sys.argv)

@@ -31,8 +31,12 @@
 //! (grand assembly, at N = 10). The test `the_choice_matches_the_measured_rows` checks
 //! the choice against the measured rows themselves.
 //!
+//! * thermal noise: the Lanczos iterations modelled by [`free_noise`] (measured on
+//!   whole Brownian steps, `cargo run --release --example free_brownian`), a product
+//!   each; the pair paths' midpoint a second mobility.
+//!
 //! A step takes one product, or dozens with a constraint solve and Lanczos noise (the
-//! counts measured for the box, [`box_cost`](super::box_cost)); the stored paths pay
+//! solve's count measured for the box, [`box_cost`](super::box_cost)); the stored paths pay
 //! their assembly once and then a few nanoseconds a block a product, the matrix-free
 //! and fast paths pay every product in full. What each path can run decides first
 //! ([`step_cost`] is `None` for a path the step cannot take), then storage (a path whose storage passes the limit is never taken,
@@ -41,7 +45,8 @@
 use hydrorattle::mobility::free_fast::FreeFast;
 use hydrorattle::{Method, Params, SolverKind};
 
-use super::box_cost::{PRODUCTS_MIDPOINT, PRODUCTS_NOISE, PRODUCTS_SOLVE};
+use super::box_cost::{PRODUCTS_MIDPOINT, PRODUCTS_SOLVE};
+use super::free_noise;
 use super::sizing::{Plan, TooLarge};
 use super::{Drift, Sqrt};
 
@@ -281,18 +286,43 @@ fn with_path(plan: &Plan, choice: FreeChoice) -> Plan {
 /// * rotation: the pair paths add a pass of the pairs' rotation blocks a step (the
 ///   inertial method instead assembles the grand mobility, `tri(2N)` blocks); the fast
 ///   path runs every product under the grand parameters ([`FreeFast::new_grand`]) and
-///   its spins are one grand product.
+///   its spins are one grand product;
+/// * thermal noise ([`free_noise`]): the stored paths by the Cholesky factor up to the
+///   kernel's crossover, else every path by Lanczos, whose modelled iterations each
+///   cost a product (the stored paths' from the reduced copy where the kernel reads
+///   it); the pair paths keep the midpoint (the inverse root, a second mobility), the
+///   fast path without bonds draws once ([`within_cap`] says whether the modelled
+///   iterations stay under the kernel's cap).
 pub fn step_cost(plan: &Plan, s: &Spheres, cost: &FreeCost, choice: FreeChoice) -> Option<f64> {
     let p: Params<f64> = with_path(plan, choice).params(s.n);
     let rows = p.constraints(s.n, s.bonds);
     let krylov = p.solver_kind(s.n, s.bonds) == SolverKind::Krylov;
     let thermal = plan.brownian.is_some_and(|t| t.temperature > 0.0);
-    let midpoint = thermal && rows > 0 && plan.brownian.is_some_and(|t| t.drift == Drift::Midpoint);
+    let drift = thermal && plan.brownian.is_some_and(|t| t.drift == Drift::Midpoint);
+    let fast = choice == FreeChoice::Fast;
+    // The midpoint's projection onto the constraints (a second solve).
+    let projection = drift && rows > 0;
+    // A thermal step's midpoint: always on the pair paths in free space (a second
+    // mobility); on the fast path only with bonds (without, the uncorrected draw).
+    let midpoint = drift && (!fast || s.bonds > 0);
     let solve = if rows > 0 { PRODUCTS_SOLVE } else { 0.0 };
     let lanczos = thermal && p.lanczos_noise(s.n);
-    let noise = if lanczos { PRODUCTS_NOISE } else { 0.0 };
-    let mid = if midpoint { PRODUCTS_MIDPOINT } else { 0.0 };
-    let products = 1.0 + solve + noise + mid;
+    // The fast path's midpoint solves `M^-1 M^(1/2) w` by conjugate gradients: its
+    // Lanczos run gives the root alone.
+    let inverse = midpoint && !fast;
+    let iterations = if lanczos {
+        free_noise::iterations(s, inverse)
+    } else {
+        0.0
+    };
+    let mid = match (projection, fast && midpoint) {
+        (true, _) | (false, true) => PRODUCTS_MIDPOINT,
+        _ => 0.0,
+    };
+    // Products beside the noise's: the step's own, the solve's, the midpoint's (its
+    // mobility applied once, and the projection or the fast path's solve).
+    let at_mid = if midpoint && !fast { 1.0 } else { 0.0 };
+    let products = 1.0 + solve + mid + at_mid;
     let assemblies = if midpoint { 2.0 } else { 1.0 };
     // With rotation the inertial method assembles the grand mobility and reads its
     // spins from it; the others add one pass of the pairs' rotation blocks a step.
@@ -307,35 +337,67 @@ pub fn step_cost(plan: &Plan, s: &Spheres, cost: &FreeCost, choice: FreeChoice) 
     } else {
         0.0
     };
-    let cholesky = if thermal && !lanczos {
-        cost.cholesky * assemblies
-    } else {
-        0.0
+    // The stored paths' noise: the Cholesky factor and its two triangular products, or
+    // Lanczos on the stored mobility, from `REDUCED_MIN` spheres (midpoint drift, f64)
+    // on its reduced copy, written by the first product.
+    let reduced = lanczos
+        && inverse
+        && plan.precision == super::Precision::F64
+        && matches!(plan.method, Method::Overdamped | Method::Springs)
+        && hydrorattle::noise::reduced::usable::<f64>(s.n);
+    let stored_noise = match (thermal, lanczos, reduced) {
+        (false, _, _) => 0.0,
+        (true, false, _) => cost.cholesky + 2.0 * cost.dense,
+        (true, true, true) => cost.copy + (iterations - 1.0) * cost.compact,
+        (true, true, false) => iterations * cost.dense,
     };
     let free_ok = matches!(plan.method, Method::Overdamped | Method::Springs)
         && !plan.wall
         && !plan.near
         && (!thermal || plan.brownian.is_none_or(|t| t.sqrt != Sqrt::Cholesky))
         && (rows == 0 || krylov);
+    let every = products + iterations;
     match choice {
-        FreeChoice::Dense => Some(assembly * assemblies + cost.dense * products + cholesky + spin),
+        FreeChoice::Dense => {
+            Some(assembly * assemblies + cost.dense * products + stored_noise + spin)
+        }
         FreeChoice::Compact => p.compact_copy(s.n, s.bonds).then(|| {
             let constrained = solve + mid;
             cost.assembly * assemblies
                 + cost.copy * assemblies
                 + cost.dense * (products - constrained)
                 + cost.compact * constrained
+                + stored_noise
                 + spin
         }),
-        FreeChoice::MatrixFree => free_ok.then_some(cost.matrix_free * products + spin),
+        FreeChoice::MatrixFree => free_ok.then_some(cost.matrix_free * every + spin),
         // With rotation every product runs under the grand parameters, and the spins
         // are one grand product.
         FreeChoice::Fast if plan.rotation => cost
             .fast_grand
             .filter(|_| free_ok && s.rpy)
-            .map(|(t, g)| t * products + g),
-        FreeChoice::Fast => cost.fast.filter(|_| free_ok && s.rpy).map(|t| t * products),
+            .map(|(t, g)| t * every + g),
+        FreeChoice::Fast => cost.fast.filter(|_| free_ok && s.rpy).map(|t| t * every),
     }
+}
+
+/// Whether a thermal step of `plan` by `choice` takes no more Lanczos iterations than
+/// the kernel's cap (`Params::lanczos`, 64 by default), as modelled ([`free_noise`]):
+/// the kernel refuses a step whose run has not converged by then. The pair paths'
+/// midpoint needs the inverse root too, and more iterations (measured: refused at
+/// 3000 spheres at volume fraction 0.3, where the fast path's root alone took 40).
+/// `true` for a deterministic step and for the Cholesky factor.
+pub fn within_cap(plan: &Plan, s: &Spheres, choice: FreeChoice) -> bool {
+    let p: Params<f64> = with_path(plan, choice).params(s.n);
+    let Some(t) = plan.brownian.filter(|t| t.temperature > 0.0) else {
+        return true;
+    };
+    if !p.lanczos_noise(s.n) {
+        return true;
+    }
+    let fast = choice == FreeChoice::Fast;
+    let inverse = t.drift == Drift::Midpoint && !fast;
+    free_noise::iterations(s, inverse) <= f64::from(p.lanczos.max_iterations)
 }
 
 /// The bytes a step of `plan` with `choice` keeps: the kernel's storage
@@ -361,7 +423,9 @@ pub fn storage(plan: &Plan, s: &Spheres, tolerance: f64, choice: FreeChoice) -> 
 /// The path `auto` takes for a free-space step of `plan` on the spheres `s` with the
 /// fast product at `tolerance`: the fastest modelled ([`step_cost`]) of those that
 /// can run it and whose [`storage`] fits in `limit` bytes, with its modelled seconds a
-/// step; refused, naming the smallest need, where none fits.
+/// step, preferring those whose Lanczos iterations stay [`within_cap`] (where none
+/// does, the fastest of all that fit); refused, naming the smallest need, where none
+/// fits.
 pub fn choose(
     plan: &Plan,
     s: &Spheres,
@@ -369,7 +433,8 @@ pub fn choose(
     limit: usize,
 ) -> Result<(FreeChoice, f64), TooLarge> {
     let cost = FreeCost::of(s, tolerance);
-    let mut best: Option<(FreeChoice, f64)> = None;
+    // The best under the cap, and the best of all.
+    let mut best: [Option<(FreeChoice, f64)>; 2] = [None, None];
     let mut need: Option<usize> = None;
     for choice in CHOICES {
         let Some(t) = step_cost(plan, s, &cost, choice) else {
@@ -379,11 +444,17 @@ pub fn choose(
         if let Some(b) = bytes {
             need = Some(need.map_or(b, |m| m.min(b)));
         }
-        if bytes.is_some_and(|b| b <= limit) && best.is_none_or(|(_, bt)| t < bt) {
-            best = Some((choice, t));
+        if bytes.is_none_or(|b| b > limit) {
+            continue;
+        }
+        let capped = within_cap(plan, s, choice);
+        for (k, b) in best.iter_mut().enumerate() {
+            if (k == 1 || capped) && b.is_none_or(|(_, bt)| t < bt) {
+                *b = Some((choice, t));
+            }
         }
     }
-    best.ok_or(TooLarge {
+    best[0].or(best[1]).ok_or(TooLarge {
         particles: s.n,
         bonds: s.bonds,
         bytes: need,

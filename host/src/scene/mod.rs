@@ -64,6 +64,9 @@ mod floor_tests;
 pub mod free_cost;
 #[cfg(test)]
 mod free_cost_tests;
+pub mod free_noise;
+#[cfg(test)]
+mod free_noise_tests;
 mod free_space;
 mod helix;
 mod kernel;
