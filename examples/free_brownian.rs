@@ -43,7 +43,7 @@ mod free_shapes;
 mod record;
 #[path = "shared/splitmix.rs"]
 mod splitmix;
-use free_shapes::{chain, cloud};
+use free_shapes::{COUNTS, SHAPES, chain, cloud};
 
 /// The paths, as the rows name them.
 const PATHS: [&str; 3] = ["dense", "matrix-free", "fast 1e-4"];
@@ -138,15 +138,7 @@ fn main() -> std::io::Result<()> {
         "free_cost",
         format!("cargo run --release --example free_brownian -- {range}{named}"),
     );
-    let shapes: [(&str, Option<f64>); 4] = [
-        ("cloud 0.01", Some(0.01)),
-        ("cloud 0.1", Some(0.1)),
-        ("cloud 0.3", Some(0.3)),
-        ("chain", None),
-    ];
-    let counts = [
-        10, 30, 100, 300, 1000, 3000, 10_000, 20_000, 50_000, 100_000,
-    ];
+    let (shapes, counts) = (SHAPES, COUNTS);
     for (shape, phi) in shapes {
         if !(only.is_empty() || only.contains(&shape)) {
             continue;

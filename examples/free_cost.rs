@@ -73,7 +73,7 @@ mod splitmix;
 use splitmix::Rng;
 #[path = "shared/free_shapes.rs"]
 mod free_shapes;
-use free_shapes::{chain, cloud, extent, near_pairs};
+use free_shapes::{COUNTS, SHAPES, chain, cloud, extent, near_pairs};
 
 /// Storage past which a path is not timed (bytes).
 const MAX_BYTES: f64 = 4e8;
@@ -302,15 +302,7 @@ fn main() -> std::io::Result<()> {
     );
     let table = "free-space product paths, unit spheres, f64, one thread, CPU seconds a call \
                  (best of two; fast products with the kernel's transform kept)";
-    let shapes: [(&str, Option<f64>); 4] = [
-        ("cloud 0.01", Some(0.01)),
-        ("cloud 0.1", Some(0.1)),
-        ("cloud 0.3", Some(0.3)),
-        ("chain", None),
-    ];
-    let counts = [
-        10, 30, 100, 300, 1000, 3000, 10_000, 20_000, 50_000, 100_000,
-    ];
+    let (shapes, counts) = (SHAPES, COUNTS);
     let mut fits: Vec<Fit> = NAMES.iter().map(|_| Fit::default()).collect();
     for (shape, phi) in shapes {
         if !(only.is_empty() || only.contains(&shape)) {

@@ -8,6 +8,19 @@ use crate::splitmix::Rng;
 
 type V = <f64 as Real>::V3;
 
+/// The shapes timed, by name: clouds at three volume fractions and the chain (`None`).
+pub const SHAPES: [(&str, Option<f64>); 4] = [
+    ("cloud 0.01", Some(0.01)),
+    ("cloud 0.1", Some(0.1)),
+    ("cloud 0.3", Some(0.3)),
+    ("chain", None),
+];
+
+/// The sphere counts timed (each example stops at its own largest).
+pub const COUNTS: [usize; 10] = [
+    10, 30, 100, 300, 1000, 3000, 10_000, 20_000, 50_000, 100_000,
+];
+
 /// `n` unit spheres uniformly in a ball at volume fraction `phi`.
 pub fn cloud(n: usize, phi: f64, seed: u64) -> Vec<V> {
     let radius = (n as f64 / phi).cbrt();
