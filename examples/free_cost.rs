@@ -20,8 +20,8 @@
 //!
 //! Shapes: unit spheres uniformly in a ball at volume fractions 0.01, 0.1 and 0.3
 //! (overlaps allowed: equal radii never nest) and the helical chain of
-//! `benches/kernel.rs`. Counts 10 to MAX_N (1e4 by default); the matrix-free and fast
-//! products of the cloud at 0.1 also at 2e4, 5e4 and 1e5 when MAX_N allows (the stored
+//! `benches/kernel/shared.rs`. Counts 10 to MAX_N (1e4 by default); the matrix-free and
+//! fast products of the cloud at 0.1 also at 2e4, 5e4 and 1e5 when MAX_N allows (the stored
 //! paths' storage is past any bound there). A path is not timed above the
 //! count where its storage passes 400 MB, or where one call took more than 2 s (the
 //! `N^2` paths; the next count would take 20 s) or 8 s (the fast products); the

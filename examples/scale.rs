@@ -11,7 +11,7 @@
 //! instruction counts: `valgrind --tool=callgrind --collect-atstart=no
 //! --toggle-collect='*step_slices*' target/profiling/examples/scale o auto 1024` (built
 //! with `--profile profiling`: release code with symbols).
-//! `CHAIN=1` takes the kernel bench's chain (`benches/kernel.rs`, `brownian/...`)
+//! `CHAIN=1` takes the kernel bench's chain (`benches/kernel/shared.rs`, `brownian/...`)
 //! instead of the helix. `BOX=L` runs in a cubic periodic box of edge `L` (the Ewald
 //! mobility, `docs/PERIODIC.md`). `COMPACT=1` sets `Params::compact_products` (the
 //! Krylov constraint products from the compact `f32` copy, where the kernel takes it:
@@ -42,7 +42,7 @@ fn helix(n: usize) -> (Vec<glam::DVec3>, Vec<f64>) {
     (pos, rad)
 }
 
-/// The chain of `benches/kernel.rs` (`chain_geometry`): turning 0.6 rad per bead,
+/// The chain of `benches/kernel/shared.rs` (`chain_geometry`): turning 0.6 rad per bead,
 /// rising 0.8, bonds 1.5 (a_i + a_j).
 fn chain(n: usize) -> (Vec<glam::DVec3>, Vec<f64>) {
     let (mut pos, mut rad) = (Vec::with_capacity(n), Vec::with_capacity(n));

@@ -1,6 +1,7 @@
 //! The shapes the free-space cost examples time (shared by `#[path]`, with
 //! `shared/splitmix.rs` as the including crate's `splitmix` module): unit spheres in a
-//! ball, the helical chain of `benches/kernel.rs`, their bounding box and near pairs.
+//! ball, the helical chain of `benches/kernel/shared.rs`, their bounding box and near
+//! pairs.
 
 use hydrorattle::Real;
 
@@ -35,7 +36,7 @@ pub fn cloud(n: usize, phi: f64, seed: u64) -> Vec<V> {
     pos
 }
 
-/// The chain of `benches/kernel.rs`: turning 0.6 rad per bead, rising 0.8, bonds 3
+/// The chain of `benches/kernel/shared.rs`: turning 0.6 rad per bead, rising 0.8, bonds 3
 /// (unit beads touching at 1.5 times contact).
 pub fn chain(n: usize) -> Vec<V> {
     let mut at = [0.0f64; 3];

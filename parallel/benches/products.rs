@@ -1,5 +1,5 @@
 //! Criterion benchmarks of the product paths, `f64` kernel, on the kernel
-//! bench's N-bead chain (`benches/kernel.rs`: head 2^(1/3), tails 1, bonds 1.5 (a_i + a_j)):
+//! bench's N-bead chain (`benches/kernel/shared.rs`: head 2^(1/3), tails 1, bonds 1.5 (a_i + a_j)):
 //!
 //! * `block/{stored,stored9,compact,recompute}/k{1,2,4}/N` (N = 1024, 4096, one thread):
 //!   one block product of `k` vectors (`parallel::products`, `noise::reduced::apply_k`,
