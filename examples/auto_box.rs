@@ -25,7 +25,8 @@ use std::fmt::Write as _;
 
 use hydrorattle::Real;
 use hydrorattle::mobility::periodic::{Ewald, Periodic, tt_product};
-use hydrorattle::mobility::pse::{Part, Pse, PseStorage};
+use hydrorattle::mobility::pse::{Part, Pse};
+use hydrorattle_heap::PseBuffers;
 
 type V = <f64 as Real>::V3;
 
@@ -151,12 +152,10 @@ fn main() -> std::io::Result<()> {
             let (pos, rad, f) = spheres(n, l, 9);
             let pse = Pse::new(Periodic::new([l; 3]).unwrap(), 1.0, tol).unwrap();
             let size = pse.storage(n);
-            let mut cx = vec![[0.0; 2]; size.complex];
-            let mut ix = vec![0usize; size.index];
-            let mut vx = vec![V::ZERO; size.vectors];
+            let mut arrays = PseBuffers::new(size);
             let mut y = vec![V::ZERO; n];
             let t = best(3, || {
-                let mut st = PseStorage::new(&mut cx, &mut ix, &mut vx);
+                let mut st = arrays.storage();
                 pse.apply(Part::Both, 1.0, &pos, &rad, &f, &mut y, &mut st)
                     .unwrap();
             });

@@ -17,6 +17,7 @@
 
 use hydrorattle::integrate::{fast_storage, step_slices};
 use hydrorattle::{Brownian, Layout, Method, NoForce, Noise, Params, Real, State};
+use hydrorattle_heap::FreeBuffers;
 
 type V = <f64 as Real>::V3;
 
@@ -47,17 +48,10 @@ fn one(p: &Params<f64>, pos0: &[V], seed: u64) -> (f64, Result<Vec<V>, String>, 
     let rad = vec![1.0; n];
     let density: Vec<f64> = (0..n).map(|i| 1.0 + (i % 3) as f64).collect();
     let size = fast_storage(p, pos0, &rad).unwrap();
-    let (mut cx, mut re, mut ix) = match size {
-        Some(z) => (
-            vec![[0.0; 2]; z.complex],
-            vec![0.0; z.reals],
-            vec![0; z.index],
-        ),
-        None => (vec![], vec![], vec![]),
-    };
-    let bytes = cx.len() * 16 + re.len() * 8 + ix.len() * 8;
+    let mut arrays = FreeBuffers::<f64>::for_step(size);
+    let bytes = arrays.bytes();
     let mut buf = hydrorattle_heap::Buffers::<f64>::new(Layout::for_params(p, n, 0));
-    let mut ws = buf.workspace().with_fast(&mut cx, &mut re, &mut ix);
+    let mut ws = arrays.attach(buf.workspace());
     let (mut pos, mut vel, mut omega) = (pos0.to_vec(), vec![V::ZERO; n], vec![V::ZERO; n]);
     let (mut time, mut rng) = (0.0, Noise::new(seed));
     let state = State {

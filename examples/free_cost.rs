@@ -50,10 +50,11 @@ use hydrorattle::Real;
 use hydrorattle::geometry::Geometry;
 use hydrorattle::geometry::free::Free;
 use hydrorattle::linalg::{cholesky, tri};
-use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage, transform_counts};
+use hydrorattle::mobility::free_fast::{FreeFast, transform_counts};
 use hydrorattle::mobility::{Hydro, assemble_grand, tt_product};
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{Serial, assemble, band_scratch, product};
+use hydrorattle_heap::FreeBuffers;
 
 type V = <f64 as Real>::V3;
 type M = <f64 as Real>::M3;
@@ -237,15 +238,13 @@ fn measure(
             false => ff.storage(n),
             true => ff.storage_grand(n),
         };
-        let bytes = (size.complex * 16 + size.reals * 8 + size.index * 8) as f64;
+        let bytes = FreeBuffers::<f64>::bytes_of(size) as f64;
         if stopped[k] || bytes > MAX_BYTES {
             stopped[k] = true;
             continue;
         }
-        let mut cx = vec![[0.0; 2]; size.complex];
-        let mut re = vec![0.0; size.reals];
-        let mut ix = vec![0usize; size.index];
-        let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix);
+        let mut arrays = FreeBuffers::<f64>::new(size);
+        let mut store = arrays.storage();
         // The first product transforms the kernel; the step keeps it (steady state).
         ff.apply(1.0, pos, &rad, &f, &mut y, &mut store).unwrap();
         let Some(t) = time(k, bytes, stopped, &mut || {
@@ -262,7 +261,7 @@ fn measure(
                 })
             })
             .flatten();
-        let counts = transform_counts(&re).expect("a transform is held");
+        let counts = transform_counts(&arrays.reals).expect("a transform is held");
         let g = ff.grid();
         let m = (g[0] * g[1] * g[2]) as f64;
         let p3 = ff.support().pow(3) as f64;

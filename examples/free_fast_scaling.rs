@@ -18,8 +18,9 @@
 use std::time::Instant;
 
 use hydrorattle::Real;
-use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage};
+use hydrorattle::mobility::free_fast::FreeFast;
 use hydrorattle::mobility::{Hydro, tt_product};
+use hydrorattle_heap::FreeBuffers;
 
 type V = <f64 as Real>::V3;
 
@@ -105,12 +106,10 @@ fn main() {
         };
         let ff = make().unwrap();
         let size = ff.storage(n);
-        let mut cx = vec![[0.0; 2]; size.complex];
-        let mut re = vec![0.0; size.reals];
-        let mut ix = vec![0usize; size.index];
-        let mb = (size.complex * 16 + size.reals * 8 + size.index * 8) as f64 / 1e6;
+        let mut arrays = FreeBuffers::<f64>::new(size);
+        let mb = arrays.bytes() as f64 / 1e6;
         let mut out = vec![f64::V3_ZERO; n];
-        let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix);
+        let mut store = arrays.storage();
         // The setup: the parameters and the kernel's transform (on a first product,
         // which keeps the kernel in the storage).
         let first = best(1, || {

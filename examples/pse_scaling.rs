@@ -20,8 +20,9 @@
 use std::time::Instant;
 
 use hydrorattle::mobility::periodic::{Ewald, Periodic, tt_product};
-use hydrorattle::mobility::pse::{Part, Pse, PseStorage};
+use hydrorattle::mobility::pse::{Part, Pse};
 use hydrorattle::{Lanczos, Noise, Real};
+use hydrorattle_heap::PseBuffers;
 
 type V = <f64 as Real>::V3;
 
@@ -90,12 +91,10 @@ use record::Recorder;
 const PRODUCT: &str = "PSE product in a periodic box, volume fraction 0.1, f64, one thread";
 
 /// Heap storage for one `Pse` and `n` spheres, and the product into `out`.
-struct Store(Vec<[f64; 2]>, Vec<usize>, Vec<V>);
+struct Store(PseBuffers<f64>);
 impl Store {
     fn new(pse: &Pse<f64>, n: usize) -> Self {
-        let size = pse.storage(n);
-        let v = vec![V::ZERO; size.vectors];
-        Self(vec![[0.0; 2]; size.complex], vec![0; size.index], v)
+        Self(PseBuffers::new(pse.storage(n)))
     }
     fn apply(
         &mut self,
@@ -105,7 +104,7 @@ impl Store {
         f: &[V],
         out: &mut [V],
     ) {
-        let mut store = PseStorage::new(&mut self.0, &mut self.1, &mut self.2);
+        let mut store = self.0.storage();
         pse.apply(part, 1.0, pos, rad, f, out, &mut store).unwrap();
     }
 }
@@ -274,7 +273,7 @@ fn noise(rows: &mut Recorder) {
         let mut out = vec![V::ZERO; n];
         let mut iterations = 0;
         let t = best(if n >= 100_000 { 1 } else { 2 }, || {
-            let mut st = PseStorage::new(&mut store.0, &mut store.1, &mut store.2);
+            let mut st = store.0.storage();
             let w = (&mut basis[..], &mut work[..]);
             iterations = pse
                 .noise(1.0, (&pos, &rad), &mut rng, s, &mut out, &mut st, w)
@@ -315,11 +314,9 @@ fn steps(rows: &mut Recorder, ns: &[usize]) {
                 drift,
             });
             let size = pse_storage(&p, &rad).unwrap().unwrap();
-            let mut cx = vec![[0.0; 2]; size.complex];
-            let mut ix = vec![0usize; size.index];
-            let mut vx = vec![V::ZERO; size.vectors];
+            let mut arrays = PseBuffers::new(size);
             let mut buf = hydrorattle_heap::Buffers::<f64>::new(Layout::for_params(&p, n, 0));
-            let mut ws = buf.workspace().with_pse(&mut cx, &mut ix, &mut vx);
+            let mut ws = arrays.attach(buf.workspace());
             let density = vec![1.0; n];
             let (mut pos, mut vel, mut omega) = (pos0.clone(), vec![V::ZERO; n], vec![V::ZERO; n]);
             let (mut time, mut rng) = (0.0, Noise::new(11));

@@ -23,7 +23,7 @@ use hydrorattle::integrate::pse_storage;
 use hydrorattle::{
     Contacts, Layout, Method, NoForce, Params, Periodic, Real, SolverKind, State, step_slices,
 };
-use hydrorattle_heap::Buffers;
+use hydrorattle_heap::{Buffers, PseBuffers};
 
 type V = <f64 as Real>::V3;
 
@@ -150,15 +150,8 @@ fn run(l: f64, start: &[[f64; 3]], tol: Option<f64>, steps: usize) -> Run {
     let mut time = 0.0;
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, n, 0));
     let size = pse_storage(&p, &radius).unwrap();
-    let (mut c, mut ix, mut ve) = match size {
-        Some(z) => (
-            vec![[0.0; 2]; z.complex],
-            vec![0; z.index],
-            vec![V::ZERO; z.vectors],
-        ),
-        None => (vec![], vec![], vec![]),
-    };
-    let mut ws = buf.workspace().with_pse(&mut c, &mut ix, &mut ve);
+    let mut arrays = PseBuffers::for_step(size);
+    let mut ws = arrays.attach(buf.workspace());
     let (mut sum, mut contacts, mut gap) = (0.0, 0, f64::INFINITY);
     let (mut rounds, mut most_rounds) = (0, 0);
     let mut cpu_sum = Some(0.0);

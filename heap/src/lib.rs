@@ -5,7 +5,11 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+mod fast;
+
 use std::collections::TryReserveError;
+
+pub use fast::{FreeBuffers, PseBuffers};
 
 use hydrorattle::particles::sphere_volume;
 use hydrorattle::{Bond, Layout, Noise, ParticleError, Real, State, Workspace};

@@ -34,6 +34,7 @@ use hydrorattle::glam::DVec3;
 use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage};
 use hydrorattle::mobility::{Hydro, tt_block_at};
 use hydrorattle::{Parallel, Serial};
+use hydrorattle_heap::FreeBuffers;
 use hydrorattle_parallel::Threads;
 use splitmix::Rng;
 
@@ -149,9 +150,7 @@ fn main() {
         .unwrap();
         let size = ff.storage_grand(n);
         let torque: Vec<DVec3> = f.iter().rev().copied().collect();
-        let mut cx = vec![[0.0; 2]; size.complex];
-        let mut re = vec![0.0; size.reals];
-        let mut ix = vec![0usize; size.index];
+        let mut arrays = FreeBuffers::new(size);
         let pool = Threads::new(threads).unwrap();
         let mut results: Vec<(usize, f64, [f64; 8], Vec<DVec3>)> = Vec::new();
         for (t, inner) in [
@@ -162,7 +161,7 @@ fn main() {
                 inner,
                 log: Mutex::new(Vec::new()),
             };
-            let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix).with_parallel(&timed);
+            let mut store = arrays.storage().with_parallel(&timed);
             let (mut out, mut spin) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
             let mut product = |out: &mut [DVec3], store: &mut FreeStorage<'_, f64>| match grand {
                 true => ff.apply_grand(1.0, (&pos, &rad), &f, &torque, out, &mut spin, store),

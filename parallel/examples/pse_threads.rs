@@ -9,8 +9,9 @@
 use std::time::Instant;
 
 use hydrorattle::glam::DVec3;
-use hydrorattle::mobility::pse::{Part, Pse, PseStorage};
+use hydrorattle::mobility::pse::{Part, Pse};
 use hydrorattle::{Parallel, Periodic, Serial};
+use hydrorattle_heap::PseBuffers;
 use hydrorattle_parallel::Threads;
 
 fn main() {
@@ -41,10 +42,9 @@ fn main() {
     let rad = vec![1.0; n];
     let pse = Pse::new(Periodic::new([l; 3]).unwrap(), 1.0, 1e-4).unwrap();
     let size = pse.storage(n);
-    let (mut cx, mut ix) = (vec![[0.0; 2]; size.complex], vec![0usize; size.index]);
-    let mut v = vec![DVec3::ZERO; size.vectors];
+    let mut arrays = PseBuffers::new(size);
     let mut run = |par: &dyn Parallel| {
-        let mut store = PseStorage::new(&mut cx, &mut ix, &mut v).with_parallel(par);
+        let mut store = arrays.storage().with_parallel(par);
         let mut out = vec![DVec3::ZERO; n];
         let best = (0..3)
             .map(|_| {

@@ -14,12 +14,9 @@
 //! `cargo test --release --test kernel fast_keep::`.
 
 use hydrorattle::integrate::{fast_storage, step_slices};
-use hydrorattle::mobility::free_fast::{
-    FreeFast, FreeStorage, TransformCounts, round_extent, transform_counts,
-};
-use hydrorattle::mobility::pse::Cx;
+use hydrorattle::mobility::free_fast::{FreeFast, TransformCounts, round_extent, transform_counts};
 use hydrorattle::{Layout, Method, NoForce, Params, Real, State};
-use hydrorattle_heap::Buffers;
+use hydrorattle_heap::{Buffers, FreeBuffers};
 
 type V = <f64 as Real>::V3;
 
@@ -61,23 +58,22 @@ fn params() -> Params<f64> {
     p
 }
 
-/// The fast arrays, zeroed, sized for `pos`.
-struct Arrays(Vec<Cx<f64>>, Vec<f64>, Vec<usize>);
+/// The fast product's arrays.
+type Arrays = FreeBuffers<f64>;
 
+/// The fast arrays, zeroed, sized for `pos`.
 fn arrays(p: &Params<f64>, pos: &[V]) -> Arrays {
     arrays_for(p, &[pos])
 }
 
 /// The fast arrays, zeroed, large enough for each cloud of `clouds`.
 fn arrays_for(p: &Params<f64>, clouds: &[&[V]]) -> Arrays {
-    let mut a = Arrays(vec![], vec![], vec![]);
+    let mut a = Arrays::default();
     for pos in clouds {
         let z = fast_storage(p, pos, &vec![1.0; pos.len()])
             .unwrap()
             .unwrap();
-        a.0.resize(a.0.len().max(z.complex), [0.0; 2]);
-        a.1.resize(a.1.len().max(z.reals), 0.0);
-        a.2.resize(a.2.len().max(z.index), 0);
+        a.grow(z);
     }
     a
 }
@@ -88,7 +84,7 @@ fn step_on(p: &Params<f64>, pos: &[V], a: &mut Arrays) -> Vec<u64> {
     let rad = vec![1.0; n];
     let density: Vec<f64> = (0..n).map(|i| 1.0 + (i % 3) as f64).collect();
     let mut buf = Buffers::<f64>::new(Layout::for_params(p, n, 0));
-    let mut ws = buf.workspace().with_fast(&mut a.0, &mut a.1, &mut a.2);
+    let mut ws = a.attach(buf.workspace());
     let (mut pos, mut vel, mut omega) = (pos.to_vec(), vec![V::ZERO; n], vec![V::ZERO; n]);
     let mut time = 0.0;
     let state = State {
@@ -119,7 +115,7 @@ fn from_bits(b: &[u64]) -> Vec<V> {
 }
 
 fn counts(a: &Arrays) -> TransformCounts {
-    transform_counts(&a.1).expect("a transform held")
+    transform_counts(&a.reals).expect("a transform held")
 }
 
 #[test]
@@ -127,7 +123,11 @@ fn kept_transform_gives_the_bits_of_fresh_arrays_as_a_cloud_falls() {
     let p = params();
     let mut pos = ball(400);
     let mut kept = arrays(&p, &pos);
-    assert_eq!(transform_counts(&kept.1), None, "zeroed arrays hold none");
+    assert_eq!(
+        transform_counts(&kept.reals),
+        None,
+        "zeroed arrays hold none"
+    );
     for k in 0..5 {
         let after = step_on(&p, &pos, &mut kept);
         let fresh = step_on(&p, &pos, &mut arrays(&p, &pos));
@@ -181,17 +181,12 @@ fn other_content_holds_no_transform() {
     let ff = FreeFast::<f64>::new(1.0, 1e-4, [20.0; 3], n).unwrap();
     let z = ff.storage(n);
     let run = |fill: f64| {
-        let (mut cx, mut re, mut ix) = (
-            vec![[0.0; 2]; z.complex],
-            vec![fill; z.reals],
-            vec![0usize; z.index],
-        );
+        let mut a = Arrays::new(z);
+        a.reals.fill(fill);
         let mut out = vec![V::ZERO; n];
-        {
-            let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix);
-            ff.apply(1.0, &pos, &rad, &f, &mut out, &mut store).unwrap();
-        }
-        let c = transform_counts(&re).unwrap();
+        ff.apply(1.0, &pos, &rad, &f, &mut out, &mut a.storage())
+            .unwrap();
+        let c = transform_counts(&a.reals).unwrap();
         (out, c)
     };
     let (zero, c) = run(0.0);

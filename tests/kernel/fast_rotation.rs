@@ -43,10 +43,10 @@ fn run<const M: usize, const B: usize, E: ExternalForce<f64>>(
     let mut buf = Buffers::<f64>::new(Layout::for_params(p, n, bonds.len()));
     let mut a = match p.pse {
         Some(_) => arrays(p, s, [1.0; 3]),
-        None => crate::fast_step::Arrays(vec![], vec![], vec![]),
+        None => hydrorattle_heap::FreeBuffers::default(),
     };
     let mut v = vec![f64::V3_ZERO; fast_vectors(p, n)];
-    let ws = buf.workspace().with_fast(&mut a.0, &mut a.1, &mut a.2);
+    let ws = a.attach(buf.workspace());
     let mut ws = ws.with_fast_vectors(&mut v);
     let mut noise = seed.map(Noise::new);
     let mut out = vec![];
@@ -254,7 +254,7 @@ fn refusals_with_rotation() {
     let before = snapshot(&ps);
     let mut buf = Buffers::<f64>::new(Layout::for_params(&fast, K, K - 1));
     let mut a = arrays(&fast, &s, [1.0; 3]);
-    let mut ws = buf.workspace().with_fast(&mut a.0, &mut a.1, &mut a.2);
+    let mut ws = a.attach(buf.workspace());
     let r = step(&mut ps, &bonds, &fast, &mut ws, &mut NoForce);
     let typed = |e: &StepError| matches!(e, StepError::BadParameter(w) if w.contains("fast free-space vectors"));
     assert_failed_unchanged(&before, &ps, &r, typed, "no vectors");

@@ -21,28 +21,26 @@ use common::thermal::*;
 use common::*;
 use hydrorattle::integrate::fast_storage;
 use hydrorattle::linalg::{sym_get, tri};
-use hydrorattle::mobility::{assemble_tt, pse::Cx};
+use hydrorattle::mobility::assemble_tt;
 use hydrorattle::{
     Bond, BondSet, Brownian, Contacts, Drift, ExternalForce, Hydro, Layout, Method, NoForce, Noise,
     Params, Particle, ParticleSet, Real, SolverKind, StepError, Wall, step,
 };
-use hydrorattle_heap::Buffers;
+use hydrorattle_heap::{Buffers, FreeBuffers};
 use std::f64::consts::PI;
 
 /// The fast product's arrays for steps of `p` from the spheres `s` (complex values,
 /// reals, indices), each scaled by `shrink` (1: what `fast_storage` asks).
-pub(super) struct Arrays(pub Vec<Cx<f64>>, pub Vec<f64>, pub Vec<usize>);
-
-pub(super) fn arrays(p: &Params<f64>, s: &[Sphere], shrink: [f64; 3]) -> Arrays {
+pub(super) fn arrays(p: &Params<f64>, s: &[Sphere], shrink: [f64; 3]) -> FreeBuffers<f64> {
     let pos: Vec<_> = s.iter().map(|x| f64::v3_from(x.pos)).collect();
     let rad: Vec<f64> = s.iter().map(|x| x.radius).collect();
     let z = fast_storage(p, &pos, &rad).unwrap().expect("a fast step");
     let len = |k: usize, n: usize| (n as f64 * shrink[k]) as usize;
-    Arrays(
-        vec![[0.0; 2]; len(0, z.complex)],
-        vec![0.0; len(1, z.reals)],
-        vec![0; len(2, z.index)],
-    )
+    let mut a = FreeBuffers::new(z);
+    a.complex.truncate(len(0, z.complex));
+    a.reals.truncate(len(1, z.reals));
+    a.index.truncate(len(2, z.index));
+    a
 }
 
 /// A particle set that may hold overlapping spheres.
@@ -68,9 +66,9 @@ fn run_fast<const M: usize, const B: usize, E: ExternalForce<f64>>(
     let mut buf = Buffers::<f64>::new(Layout::for_params(p, s.len(), bonds.len()));
     let mut a = match p.pse {
         Some(_) => arrays(p, s, shrink),
-        None => Arrays(vec![], vec![], vec![]),
+        None => FreeBuffers::default(),
     };
-    let mut ws = buf.workspace().with_fast(&mut a.0, &mut a.1, &mut a.2);
+    let mut ws = a.attach(buf.workspace());
     let mut out = vec![];
     for _ in 0..steps {
         step(&mut ps, bonds, p, &mut ws, ext)?;
@@ -163,7 +161,7 @@ fn small_storage_coarser_grid_or_refused() {
         let before = snapshot(&ps);
         let mut buf = Buffers::<f64>::new(Layout::for_params(&fast, C, 0));
         let mut a = arrays(&fast, &s, shrink);
-        let mut ws = buf.workspace().with_fast(&mut a.0, &mut a.1, &mut a.2);
+        let mut ws = a.attach(buf.workspace());
         let r = step(&mut ps, &none, &fast, &mut ws, &mut NoForce);
         let storage = |e: &StepError| matches!(e, StepError::BadParameter(w) if w.contains("fast free-space storage"));
         assert_failed_unchanged(&before, &ps, &r, storage, "small storage");
@@ -309,7 +307,7 @@ fn noise_covariance_matches_dense() {
     let mut ps = set::<4>(&s);
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, n, 0));
     let mut a = arrays(&p, &s, [1.0; 3]);
-    let mut ws = buf.workspace().with_fast(&mut a.0, &mut a.1, &mut a.2);
+    let mut ws = a.attach(buf.workspace());
     let bonds = BondSet::<f64, 0>::new();
     let mut noise = Noise::new(17);
     let start = ps.pos;
@@ -385,7 +383,7 @@ fn lone_sphere_diffuses_as_stokes_einstein() {
     let mut ps = set::<1>(&s);
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, 1, 0));
     let mut a = arrays(&p, &s, [1.0; 3]);
-    let mut ws = buf.workspace().with_fast(&mut a.0, &mut a.1, &mut a.2);
+    let mut ws = a.attach(buf.workspace());
     let bonds = BondSet::<f64, 0>::new();
     let mut noise = Noise::new(0x9E37_79B9);
     let mut sq = Vec::with_capacity(steps);
@@ -419,7 +417,7 @@ fn same_bits_twice() {
         let mut ps = set::<K>(&s);
         let mut buf = Buffers::<f64>::new(Layout::for_params(&p, K, K - 1));
         let mut a = arrays(&p, &s, [1.0; 3]);
-        let mut ws = buf.workspace().with_fast(&mut a.0, &mut a.1, &mut a.2);
+        let mut ws = a.attach(buf.workspace());
         let mut noise = Noise::new(3);
         for _ in 0..3 {
             step_thermal(&mut ps, &bonds, &p, &mut ws, &mut Push, &mut noise).unwrap();

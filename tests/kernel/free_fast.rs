@@ -4,9 +4,10 @@
 //! same bits on reruns.
 #![cfg(feature = "fast-free")]
 
-use hydrorattle::mobility::free_fast::{FreeError, FreeFast, FreeStorage};
+use hydrorattle::mobility::free_fast::{FreeError, FreeFast};
 use hydrorattle::mobility::{Hydro, tt_product};
 use hydrorattle::{ParticleError, Real};
+use hydrorattle_heap::FreeBuffers;
 
 /// SplitMix64 in `[0, 1)`.
 struct Rng(u64);
@@ -83,10 +84,8 @@ fn fast<T: Real>(
     f: &[[f64; 3]],
 ) -> Result<(Vec<[f64; 3]>, bool), FreeError> {
     let size = ff.storage(pos.len());
-    let mut cx = vec![[T::ZERO; 2]; size.complex];
-    let mut re = vec![T::ZERO; size.reals];
-    let mut ix = vec![0usize; size.index];
-    let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix);
+    let mut arrays = FreeBuffers::new(size);
+    let mut store = arrays.storage();
     let (p, f) = (to_v::<T>(pos), to_v::<T>(f));
     let r: Vec<T> = rad.iter().map(|&a| T::from_f64(a)).collect();
     let mut out = vec![T::V3_ZERO; pos.len()];

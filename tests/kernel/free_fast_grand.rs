@@ -7,8 +7,9 @@
 use hydrorattle::Real;
 use hydrorattle::glam::DVec3;
 use hydrorattle::linalg::tri;
-use hydrorattle::mobility::free_fast::{FreeError, FreeFast, FreeStorage};
+use hydrorattle::mobility::free_fast::{FreeError, FreeFast};
 use hydrorattle::mobility::{Hydro, assemble_grand};
+use hydrorattle_heap::FreeBuffers;
 
 use crate::common::fuzz::Rng;
 
@@ -66,10 +67,8 @@ fn fast(
 ) -> Result<Vec<DVec3>, FreeError> {
     let n = pos.len();
     let size = ff.storage_grand(n);
-    let mut cx = vec![[0.0; 2]; size.complex];
-    let mut re = vec![0.0; size.reals];
-    let mut ix = vec![0usize; size.index];
-    let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix);
+    let mut arrays = FreeBuffers::new(size);
+    let mut store = arrays.storage();
     let (mut u, mut w) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
     ff.apply_grand(1.0, (pos, rad), f, t, &mut u, &mut w, &mut store)?;
     Ok(u.into_iter().chain(w).collect())
@@ -129,9 +128,8 @@ fn grand_reduces_to_translation_and_stokes() {
     let zero = vec![DVec3::ZERO; n];
     let got = fast(&ff, (&pos, &rad), &f, &zero).unwrap();
     let size = ff.storage(n);
-    let (mut cx, mut re) = (vec![[0.0; 2]; size.complex], vec![0.0; size.reals]);
-    let mut ix = vec![0usize; size.index];
-    let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix);
+    let mut arrays = FreeBuffers::new(size);
+    let mut store = arrays.storage();
     let mut u = vec![DVec3::ZERO; n];
     ff.apply(1.0, &pos, &rad, &f, &mut u, &mut store).unwrap();
     let e = rel_err(&got[..n], &u);

@@ -94,20 +94,14 @@ fn bits<T: Real>(v: &[T::V3]) -> Vec<u64> {
 /// PSE's arrays (complex values, indices, vectors) as the step sizes them, when the box
 /// is summed by PSE; a grid past a few million points gets none (the step refuses that,
 /// typed).
-type PseArrays<T> = (Vec<[T; 2]>, Vec<usize>, Vec<<T as Real>::V3>);
+type PseArrays<T> = hydrorattle_heap::PseBuffers<T>;
 
 #[cfg(feature = "pse")]
 fn pse_arrays<T: Real>(p: &Params<T>, radius: &[T]) -> Option<PseArrays<T>> {
     let s = hydrorattle::integrate::pse_storage(p, radius)
         .ok()
         .flatten()?;
-    (s.complex <= 1 << 22).then(|| {
-        (
-            vec![[T::ZERO; 2]; s.complex],
-            vec![0usize; s.index],
-            vec![T::V3_ZERO; s.vectors],
-        )
-    })
+    (s.complex <= 1 << 22).then(|| PseArrays::new(s))
 }
 
 #[cfg(not(feature = "pse"))]
@@ -303,7 +297,7 @@ fn case<T: Real>(rng: &mut Draw) -> Result<(bool, bool), String> {
     let ws = store.workspace();
     #[cfg(feature = "pse")]
     let ws = match arrays.as_mut() {
-        Some((cx, ix, vx)) => ws.with_pse(cx, ix, vx),
+        Some(a) => a.attach(ws),
         None => ws,
     };
     let mut ws = ws;

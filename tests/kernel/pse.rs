@@ -13,6 +13,7 @@ use hydrorattle::linalg::{cholesky, tri};
 use hydrorattle::mobility::periodic::{Ewald, Periodic, PeriodicError, assemble_tt, tt_product};
 use hydrorattle::mobility::pse::{Part, Pse, PseError, PseStorage};
 use hydrorattle::{Lanczos, Noise, Real};
+use hydrorattle_heap::PseBuffers;
 use proptest::prelude::*;
 
 /// `M F` by PSE.
@@ -29,9 +30,8 @@ fn pse_part<T: Real>(
     f: &[T::V3],
 ) -> Vec<T::V3> {
     let size = pse.storage(pos.len());
-    let (mut cx, mut ix) = (vec![[T::ZERO; 2]; size.complex], vec![0usize; size.index]);
-    let mut v = vec![T::V3_ZERO; size.vectors];
-    let mut store = PseStorage::new(&mut cx, &mut ix, &mut v);
+    let mut arrays = PseBuffers::new(size);
+    let mut store = arrays.storage();
     let mut out = vec![T::V3_ZERO; pos.len()];
     pse.apply(part, T::ONE, pos, rad, f, &mut out, &mut store)
         .unwrap();
@@ -322,9 +322,8 @@ fn errors() {
     );
     let pse = Pse::new(cell, 1.0, 1e-4).unwrap();
     let size = pse.storage(2);
-    let (mut cx, mut ix) = (vec![[0.0; 2]; size.complex], vec![0usize; size.index]);
-    let mut v = vec![f64::V3_ZERO; size.vectors];
-    let mut store = PseStorage::new(&mut cx, &mut ix, &mut v);
+    let mut arrays = PseBuffers::new(size);
+    let mut store = arrays.storage();
     let mut out = vec![f64::V3_ZERO; 2];
     let f = [f64::v3(1.0, 0.0, 0.0); 2];
     // Nested through the boundary: centres 0.2 apart across the face, radii 1 and 0.5.
@@ -358,10 +357,18 @@ fn errors() {
     );
     let e = pse.apply(Part::Both, 1.0, &pos, &[1.0], &f, &mut out, &mut store);
     assert_eq!(e, Err(PseError::Length));
-    let mut short = PseStorage::new(&mut cx[..10], &mut ix, &mut v);
+    let mut short = PseStorage::new(
+        &mut arrays.complex[..10],
+        &mut arrays.index,
+        &mut arrays.vectors,
+    );
     let e = pse.apply(Part::Both, 1.0, &pos, &[1.0, 1.0], &f, &mut out, &mut short);
     assert!(matches!(e, Err(PseError::Storage { .. })), "{e:?}");
-    let mut short = PseStorage::new(&mut cx, &mut ix, &mut v[..1]);
+    let mut short = PseStorage::new(
+        &mut arrays.complex,
+        &mut arrays.index,
+        &mut arrays.vectors[..1],
+    );
     let e = pse.apply(Part::Both, 1.0, &pos, &[1.0, 1.0], &f, &mut out, &mut short);
     assert!(
         matches!(
@@ -454,9 +461,8 @@ fn noise_covariance() {
             max_iterations: 3 * n as u32,
         };
         let size = pse.storage(n);
-        let (mut cx, mut ix) = (vec![[0.0; 2]; size.complex], vec![0usize; size.index]);
-        let mut v = vec![f64::V3_ZERO; size.vectors];
-        let mut store = PseStorage::new(&mut cx, &mut ix, &mut v);
+        let mut arrays = PseBuffers::new(size);
+        let mut store = arrays.storage();
         let (nv, ns) = Pse::noise_storage(&s, n);
         let (mut basis, mut work) = (vec![f64::V3_ZERO; nv], vec![0.0; ns]);
         let mut rng = Noise::new(seed);

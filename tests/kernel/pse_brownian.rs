@@ -21,11 +21,10 @@ use common::*;
 use hydrorattle::integrate::pse_storage;
 use hydrorattle::linalg::{sym_get, tri};
 use hydrorattle::mobility::periodic::{Ewald, assemble_tt};
-use hydrorattle::mobility::pse::Cx;
 use hydrorattle::{
     BondSet, Drift, Hydro, Layout, NoForce, Noise, Params, ParticleSet, Periodic, Real, StepError,
 };
-use hydrorattle_heap::Buffers;
+use hydrorattle_heap::{Buffers, PseBuffers};
 use std::f64::consts::PI;
 
 /// Hasimoto (1959): `D(L) / D0` of a sphere in a simple cubic array at `x = a/L`.
@@ -34,15 +33,8 @@ fn hasimoto(x: f64) -> f64 {
 }
 
 /// PSE's arrays for steps of `p` over `radius`.
-type Arrays = (Vec<Cx<f64>>, Vec<usize>, Vec<<f64 as Real>::V3>);
-
-fn arrays(p: &Params<f64>, radius: &[f64]) -> Arrays {
-    let z = pse_storage(p, radius).unwrap().expect("a PSE step");
-    (
-        vec![[0.0; 2]; z.complex],
-        vec![0; z.index],
-        vec![f64::V3_ZERO; z.vectors],
-    )
+fn arrays(p: &Params<f64>, radius: &[f64]) -> PseBuffers<f64> {
+    PseBuffers::new(pse_storage(p, radius).unwrap().expect("a PSE step"))
 }
 
 /// `draws` steps of `p` from the same configuration `s` (reset before each), the
@@ -56,8 +48,8 @@ fn displacements<const M: usize>(
     let mut ps: ParticleSet<f64, M> = particles_overlapping(s);
     let radius: Vec<f64> = s.iter().map(|x| x.radius).collect();
     let mut buf = Buffers::<f64>::new(Layout::for_params(p, s.len(), 0));
-    let (mut cx, mut ix, mut v) = arrays(p, &radius);
-    let mut ws = buf.workspace().with_pse(&mut cx, &mut ix, &mut v);
+    let mut arrays = arrays(p, &radius);
+    let mut ws = arrays.attach(buf.workspace());
     let bonds = BondSet::<f64, 0>::new();
     let mut noise = Noise::new(seed);
     let start = ps.pos;
@@ -177,8 +169,8 @@ fn lone_sphere(l: f64, steps: usize, seed: u64) -> (f64, f64, f64) {
     p.pse = Some(1e-4);
     let mut ps: ParticleSet<f64, 1> = particles(&s);
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, 1, 0));
-    let (mut cx, mut ix, mut v) = arrays(&p, &[1.0]);
-    let mut ws = buf.workspace().with_pse(&mut cx, &mut ix, &mut v);
+    let mut arrays = arrays(&p, &[1.0]);
+    let mut ws = arrays.attach(buf.workspace());
     let bonds = BondSet::<f64, 0>::new();
     let mut noise = Noise::new(seed);
     let mut sq = Vec::with_capacity(steps);
@@ -252,8 +244,8 @@ fn refusal_keeps_state_and_repeats_bits() {
     let run = |p: &Params<f64>, steps: usize| -> Result<Vec<u64>, StepError> {
         let mut ps: ParticleSet<f64, 12> = particles(&s);
         let mut buf = Buffers::<f64>::new(Layout::for_params(p, 12, 0));
-        let (mut cx, mut ix, mut v) = arrays(p, &rad);
-        let mut ws = buf.workspace().with_pse(&mut cx, &mut ix, &mut v);
+        let mut arrays = arrays(p, &rad);
+        let mut ws = arrays.attach(buf.workspace());
         let mut noise = Noise::new(9);
         let bonds = BondSet::<f64, 0>::new();
         for _ in 0..steps {
@@ -336,8 +328,8 @@ fn chain_r2(seed: u64, steps: usize) -> f64 {
     p.pse = Some(1e-4);
     ps.noise = Some(Noise::new(seed));
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, C, C - 1));
-    let (mut cx, mut ix, mut v) = arrays(&p, &[1.0; C]);
-    let mut ws = buf.workspace().with_pse(&mut cx, &mut ix, &mut v);
+    let mut arrays = arrays(&p, &[1.0; C]);
+    let mut ws = arrays.attach(buf.workspace());
     let (burn, every) = ((20.0 / dt) as usize, (0.5 / dt) as usize);
     let mut out = Vec::new();
     for k in 0..steps {

@@ -8,9 +8,8 @@ use crate::common;
 use common::fuzz::Rng;
 use hydrorattle::Real;
 use hydrorattle::mobility::periodic::{Ewald, Periodic, tt_product};
-use hydrorattle::mobility::pse::{
-    MAX_RADIUS_FRACTION, Part, Pse, PseError, PseStorage, min_tolerance,
-};
+use hydrorattle::mobility::pse::{MAX_RADIUS_FRACTION, Part, Pse, PseError, min_tolerance};
+use hydrorattle_heap::PseBuffers;
 
 /// `|a - b| / |b|` of PSE's product in precision `T` against the Ewald sum, or PSE's
 /// refusal.
@@ -26,9 +25,8 @@ fn pse_error<T: Real>(
     let pse = Pse::<T>::new(cell, T::from_f64(a), tol)?;
     let n = pos.len();
     let s = pse.storage(n);
-    let (mut cx, mut ix) = (vec![[T::ZERO; 2]; s.complex], vec![0usize; s.index]);
-    let mut vx = vec![T::V3_ZERO; s.vectors];
-    let mut st = PseStorage::new(&mut cx, &mut ix, &mut vx);
+    let mut arrays = PseBuffers::new(s);
+    let mut st = arrays.storage();
     let ps: Vec<T::V3> = pos.iter().map(|&x| T::v3_from(x)).collect();
     let rs: Vec<T> = rad.iter().map(|&x| T::from_f64(x)).collect();
     let fs: Vec<T::V3> = f.iter().map(|&x| T::v3_from(x)).collect();

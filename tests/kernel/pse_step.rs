@@ -11,30 +11,18 @@ use crate::common;
 use common::boxes::config_radii;
 use common::*;
 use hydrorattle::integrate::pse_storage;
-use hydrorattle::mobility::pse::Cx;
 use hydrorattle::{
     Bond, BondSet, Brownian, Contacts, ExternalForce, Layout, Method, NoForce, NoiseSqrt, Params,
     ParticleSet, Periodic, Real, SolverKind, StepError, step,
 };
-use hydrorattle_heap::Buffers;
+use hydrorattle_heap::{Buffers, PseBuffers};
 
 const L: f64 = 9.0;
 const N: usize = 16;
 
 /// PSE's arrays for a step of `p` over `ps` (empty where the step needs none).
-struct PseArrays<T: Real>(Vec<Cx<T>>, Vec<usize>, Vec<T::V3>);
-
-impl<T: Real> PseArrays<T> {
-    fn for_step<const M: usize>(p: &Params<T>, ps: &ParticleSet<T, M>) -> Self {
-        match pse_storage(p, &ps.radius[..ps.len()]).expect("pse parameters") {
-            Some(z) => Self(
-                vec![[T::ZERO; 2]; z.complex],
-                vec![0; z.index],
-                vec![T::V3_ZERO; z.vectors],
-            ),
-            None => Self(vec![], vec![], vec![]),
-        }
-    }
+fn pse_arrays<T: Real, const M: usize>(p: &Params<T>, ps: &ParticleSet<T, M>) -> PseBuffers<T> {
+    PseBuffers::for_step(pse_storage(p, &ps.radius[..ps.len()]).expect("pse parameters"))
 }
 
 /// `steps` steps of `p`; the positions after each.
@@ -46,10 +34,8 @@ fn run<T: Real, const M: usize, const B: usize, E: ExternalForce<T>>(
     steps: usize,
 ) -> Result<Vec<Vec<[f64; 3]>>, StepError> {
     let mut buf = Buffers::<T>::new(Layout::for_params(p, ps.len(), bonds.len()));
-    let mut arrays = PseArrays::for_step(p, ps);
-    let mut ws = buf
-        .workspace()
-        .with_pse(&mut arrays.0, &mut arrays.1, &mut arrays.2);
+    let mut arrays = pse_arrays(p, ps);
+    let mut ws = arrays.attach(buf.workspace());
     let mut out = vec![];
     for _ in 0..steps {
         step(ps, bonds, p, &mut ws, ext)?;

@@ -30,7 +30,8 @@
 //! 1e-4 of the speed, relative) is some 50 times smaller.
 
 use hydrorattle::Real;
-use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage};
+use hydrorattle::mobility::free_fast::FreeFast;
+use hydrorattle_heap::FreeBuffers;
 use hydrorattle_host::scene::Cloud;
 
 #[test]
@@ -40,12 +41,8 @@ fn a_falling_cloud_moves_at_the_continuum_speed_within_its_finite_n_correction()
     let u0 = 1.0 / (6.0 * std::f64::consts::PI * eta * a);
     let ff = FreeFast::<f64>::new(a, 1e-4, [2.0 * room; 3], n).unwrap();
     let size = ff.storage(n);
-    let (mut cx, mut re, mut ix) = (
-        vec![[0.0; 2]; size.complex],
-        vec![0.0; size.reals],
-        vec![0usize; size.index],
-    );
-    let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix);
+    let mut arrays = FreeBuffers::new(size);
+    let mut store = arrays.storage();
     let seeds = [1, 2, 3];
     let mut speeds = Vec::new();
     for seed in seeds {

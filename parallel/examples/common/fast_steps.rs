@@ -11,23 +11,17 @@ use hydrorattle::glam::DVec3;
 use hydrorattle::integrate::{fast_storage, step_slices};
 use hydrorattle::mobility::free_fast::transform_counts;
 use hydrorattle::{Layout, Method, NoForce, Parallel, Params, Serial, State};
-use hydrorattle_heap::Buffers;
+use hydrorattle_heap::{Buffers, FreeBuffers};
 use hydrorattle_parallel::Threads;
 
 use crate::common::cpu_ns;
 
 /// The arrays of the fast product for steps of `p` from `pos`.
-struct Arrays(Vec<[f64; 2]>, Vec<f64>, Vec<usize>);
-
-fn arrays(p: &Params<f64>, pos: &[DVec3]) -> Arrays {
+fn arrays(p: &Params<f64>, pos: &[DVec3]) -> FreeBuffers<f64> {
     let z = fast_storage(p, pos, &vec![1.0; pos.len()])
         .unwrap()
         .unwrap();
-    Arrays(
-        vec![[0.0; 2]; z.complex],
-        vec![0.0; z.reals],
-        vec![0; z.index],
-    )
+    FreeBuffers::new(z)
 }
 
 /// One step of `p` from `pos` over `a` on `par`: the positions after, wall and CPU
@@ -35,7 +29,7 @@ fn arrays(p: &Params<f64>, pos: &[DVec3]) -> Arrays {
 fn step(
     p: &Params<f64>,
     pos: &[DVec3],
-    a: &mut Arrays,
+    a: &mut FreeBuffers<f64>,
     par: &dyn Parallel,
 ) -> (Vec<DVec3>, f64, f64) {
     let n = pos.len();
@@ -43,7 +37,7 @@ fn step(
     let density: Vec<f64> = (0..n).map(|i| 1.0 + (i % 3) as f64).collect();
     let mut buf = Buffers::<f64>::new(Layout::for_params(p, n, 0));
     let ws = buf.workspace().with_parallel(par);
-    let mut ws = ws.with_fast(&mut a.0, &mut a.1, &mut a.2);
+    let mut ws = a.attach(ws);
     let (mut pos, mut vel, mut omega) = (pos.to_vec(), vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
     let mut time = 0.0;
     let state = State {
@@ -91,7 +85,7 @@ pub fn steps(tol: f64, threads: usize, pos: &[DVec3], mut row: impl FnMut(&str, 
         seconds(&mut row, "first step, transform computed", t, (w1, c1));
         let (p2, w2, c2) = step(&p, &p1, &mut a, par);
         seconds(&mut row, "second step, transform kept", t, (w2, c2));
-        let counts = transform_counts(&a.1).unwrap_or_default();
+        let counts = transform_counts(&a.reals).unwrap_or_default();
         let (p3, w3, c3) = step(&p, &p1, &mut arrays(&p, pos), par);
         seconds(
             &mut row,

@@ -7,8 +7,9 @@
 
 use hydrorattle::Real;
 use hydrorattle::glam::DVec3;
-use hydrorattle::mobility::free_fast::{FreeFast, FreeStorage, transform_counts};
+use hydrorattle::mobility::free_fast::{FreeFast, transform_counts};
 use hydrorattle::parallel::{Parallel, Serial};
+use hydrorattle_heap::FreeBuffers;
 use hydrorattle_parallel::Threads;
 
 use crate::fuzz::Rng;
@@ -25,12 +26,10 @@ fn product(
 ) -> Vec<u64> {
     let n = pos.len();
     let size = ff.storage_grand(n);
-    let mut cx = vec![[0.0; 2]; size.complex];
-    let mut re = vec![0.0; size.reals];
-    let mut ix = vec![0usize; size.index];
+    let mut arrays = FreeBuffers::new(size);
     let mut bits = vec![];
     {
-        let mut store = FreeStorage::new(&mut cx, &mut re, &mut ix).with_parallel(par);
+        let mut store = arrays.storage().with_parallel(par);
         for _ in 0..2 {
             let mut out = vec![DVec3::ZERO; n];
             ff.apply(1.0, pos, rad, f, &mut out, &mut store).unwrap();
@@ -46,13 +45,13 @@ fn product(
                 .flat_map(|v| v.to_array().map(f64::to_bits)),
         );
     }
-    let counts = transform_counts(&re).expect("a transform held");
+    let counts = transform_counts(&arrays.reals).expect("a transform held");
     assert_eq!(
         (counts.kept, counts.computed),
         (2, 1),
         "kept by the later products"
     );
-    bits.extend(re.iter().map(|x| x.to_bits()));
+    bits.extend(arrays.reals.iter().map(|x| x.to_bits()));
     bits
 }
 

@@ -4,9 +4,10 @@
 
 use hydrorattle::Real;
 use hydrorattle::glam::DVec3;
-use hydrorattle::mobility::pse::{Part, Pse, PseStorage};
+use hydrorattle::mobility::pse::{Part, Pse};
 use hydrorattle::parallel::{Parallel, Serial};
 use hydrorattle::{Periodic, PeriodicError};
+use hydrorattle_heap::PseBuffers;
 use hydrorattle_parallel::Threads;
 
 use crate::fuzz::Rng;
@@ -15,9 +16,8 @@ use crate::fuzz::Rng;
 fn product(pse: &Pse<f64>, pos: &[DVec3], f: &[DVec3], par: &dyn Parallel) -> Vec<u64> {
     let n = pos.len();
     let size = pse.storage(n);
-    let (mut cx, mut ix) = (vec![[0.0; 2]; size.complex], vec![0usize; size.index]);
-    let mut v = vec![DVec3::ZERO; size.vectors];
-    let mut store = PseStorage::new(&mut cx, &mut ix, &mut v).with_parallel(par);
+    let mut arrays = PseBuffers::new(size);
+    let mut store = arrays.storage().with_parallel(par);
     let rad = vec![1.0; n];
     let mut bits = vec![];
     for part in [Part::Both, Part::Near, Part::Wave] {
