@@ -3,6 +3,7 @@
 //! counts, and the constants against their record.
 
 use super::free_cost::*;
+use super::free_pick_tests::{Picks, SHAPES, numbers};
 use super::sizing::Plan;
 use super::*;
 
@@ -275,23 +276,9 @@ pub(super) fn helix(n: usize) -> Spheres {
 #[test]
 fn the_choice_matches_the_measured_rows() {
     use super::box_cost::PRODUCTS_SOLVE;
-    let csv = include_str!("../../../bench/results/free_cost.csv");
-    let mut rows = std::collections::HashMap::<(String, String), f64>::new();
-    for row in csv.lines().skip(1).map(crate::output::csv_fields) {
-        if row[5] == MEASURED
-            && let Ok(t) = row[8].parse::<f64>()
-        {
-            rows.insert((row[6].clone(), row[7].clone()), t);
-        }
-    }
-    let shapes: [(&str, Option<f64>); 4] = [
-        ("cloud 0.01", Some(0.01)),
-        ("cloud 0.1", Some(0.1)),
-        ("cloud 0.3", Some(0.3)),
-        ("chain", None),
-    ];
-    let (mut checked, mut wrong) = (0, Vec::new());
-    for (shape, phi) in shapes {
+    let rows = numbers(MEASURED);
+    let mut picks = Picks::default();
+    for (shape, phi) in SHAPES {
         for n in [
             10, 30, 100, 300, 1000, 3000, 10_000, 20_000, 50_000, 100_000,
         ] {
@@ -343,27 +330,14 @@ fn the_choice_matches_the_measured_rows() {
                     if measured.len() < 2 {
                         continue;
                     }
-                    let best = measured.iter().map(|m| m.1).fold(f64::INFINITY, f64::min);
                     let pick = choose(&p, &s, 1e-4, MEASURED_BYTES).unwrap().0;
-                    let got = measured.iter().find(|m| m.0 == pick).map(|m| m.1);
-                    checked += 1;
-                    if got.is_none_or(|g| g > 1.2 * best) {
-                        wrong.push(format!(
-                            "{case}, rotation {rotation}, bonds {bonds}: picks {pick:?} \
-                             ({got:?} s measured), best {best:.3e} of {measured:?}"
-                        ));
-                    }
+                    let label = format!("{case}, rotation {rotation}, bonds {bonds}");
+                    picks.check(&label, pick, &measured);
                 }
             }
         }
     }
-    assert!(checked >= 100, "{checked} cases");
-    assert!(
-        wrong.is_empty(),
-        "{} of {checked}:\n{}",
-        wrong.len(),
-        wrong.join("\n")
-    );
+    picks.assert_all(100);
 }
 
 /// [`csv_fields`](crate::output::csv_fields) undoes

@@ -6,6 +6,7 @@
 use super::free_cost::*;
 use super::free_cost_tests::{cloud, helix};
 use super::free_noise;
+use super::free_pick_tests::{Picks, SHAPES, cells};
 use super::sizing::{DEFAULT_LIMIT, Plan};
 use super::*;
 
@@ -27,25 +28,6 @@ fn thermal() -> Plan {
     p
 }
 
-const SHAPES: [(&str, Option<f64>); 4] = [
-    ("cloud 0.01", Some(0.01)),
-    ("cloud 0.1", Some(0.1)),
-    ("cloud 0.3", Some(0.3)),
-    ("chain", None),
-];
-
-/// The recorded cells of `table`: `(case, quantity) -> value`, later rows over earlier.
-fn cells(table: &str) -> std::collections::HashMap<(String, String), String> {
-    let csv = include_str!("../../../bench/results/free_cost.csv");
-    let mut rows = std::collections::HashMap::new();
-    for row in csv.lines().skip(1).map(crate::output::csv_fields) {
-        if row[5] == table {
-            rows.insert((row[6].clone(), row[7].clone()), row[8].clone());
-        }
-    }
-    rows
-}
-
 /// The model's choice for a thermal step against every measured Brownian step
 /// (`examples/free_brownian.rs`: every shape, N = 10 to 1e4 and the cloud at 0.1 past
 /// it; whole steps, CPU seconds): the path it picks costs, as measured, at most a fifth
@@ -62,7 +44,7 @@ fn the_brownian_choice_matches_the_measured_steps() {
         (FreeChoice::MatrixFree, "matrix-free"),
         (FreeChoice::Fast, "fast 1e-4"),
     ];
-    let (mut checked, mut wrong) = (0, Vec::new());
+    let mut picks = Picks::default();
     for (shape, phi) in SHAPES {
         for n in [10, 30, 100, 300, 1000, 3000, 10_000, 20_000, 50_000] {
             let case = format!("{shape}, N = {n}");
@@ -83,24 +65,11 @@ fn the_brownian_choice_matches_the_measured_steps() {
             if measured.is_empty() || (measured.len() < 2 && !refused) {
                 continue;
             }
-            let best = measured.iter().map(|m| m.1).fold(f64::INFINITY, f64::min);
             let pick = choose(&p, &s, 1e-4, BROWNIAN_BYTES).unwrap().0;
-            let got = measured.iter().find(|m| m.0 == pick).map(|m| m.1);
-            checked += 1;
-            if got.is_none_or(|g| g > 1.2 * best) {
-                wrong.push(format!(
-                    "{case}: picks {pick:?} ({got:?} s measured), best {best:.3e} of {measured:?}"
-                ));
-            }
+            picks.check(&case, pick, &measured);
         }
     }
-    assert!(checked >= 20, "{checked} cases");
-    assert!(
-        wrong.is_empty(),
-        "{} of {checked}:\n{}",
-        wrong.len(),
-        wrong.join("\n")
-    );
+    picks.assert_all(20);
 }
 
 /// The modelled Lanczos iterations against every recorded count, within a factor 1.4 (the

@@ -67,6 +67,8 @@ mod free_cost_tests;
 pub mod free_noise;
 #[cfg(test)]
 mod free_noise_tests;
+#[cfg(test)]
+mod free_pick_tests;
 mod free_space;
 mod helix;
 mod kernel;
