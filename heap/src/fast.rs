@@ -118,3 +118,46 @@ impl<T: Real> PseBuffers<T> {
         ws.with_pse(&mut self.complex, &mut self.index, &mut self.vectors)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hydrorattle::mobility::free_fast::FreeFast;
+    use hydrorattle::mobility::pse::Pse;
+    use hydrorattle::{Periodic, Real};
+
+    #[test]
+    fn free_buffers_hold_the_sizes_asked_and_run_the_product() {
+        let n = 8;
+        let ff = FreeFast::<f64>::new(1.0, 1e-4, [24.0; 3], n).unwrap();
+        let z = ff.storage(n);
+        let mut a = FreeBuffers::<f64>::new(z);
+        let lens = |a: &FreeBuffers<f64>| (a.complex.len(), a.reals.len(), a.index.len());
+        assert_eq!(lens(&a), (z.complex, z.reals, z.index));
+        assert_eq!(a.bytes(), FreeBuffers::<f64>::bytes_of(z));
+        let pos: Vec<_> = (0..n).map(|i| f64::v3(3.0 * i as f64, 0.0, 0.0)).collect();
+        let f = vec![f64::v3(0.0, 0.0, -1.0); n];
+        let mut u = vec![f64::V3_ZERO; n];
+        ff.apply(1.0, &pos, &vec![1.0; n], &f, &mut u, &mut a.storage())
+            .unwrap();
+        assert!(u.iter().all(|v| f64::xyz(*v)[2] < 0.0));
+        // Growing keeps the larger of each count.
+        a.grow(FreeSize {
+            complex: 1,
+            reals: z.reals + 5,
+            index: 0,
+        });
+        assert_eq!(lens(&a), (z.complex, z.reals + 5, z.index));
+        assert_eq!(lens(&FreeBuffers::for_step(None)), (0, 0, 0));
+    }
+
+    #[test]
+    fn pse_buffers_hold_the_sizes_asked() {
+        let pse = Pse::<f64>::new(Periodic::new([10.0; 3]).unwrap(), 1.0, 1e-4).unwrap();
+        let z = pse.storage(4);
+        let a = PseBuffers::<f64>::new(z);
+        let got = (a.complex.len(), a.index.len(), a.vectors.len());
+        assert_eq!(got, (z.complex, z.index, z.vectors));
+        assert!(PseBuffers::<f64>::for_step(None).complex.is_empty());
+    }
+}
