@@ -1,5 +1,5 @@
-//! `Overdamped` with constraints (bonds, pins, hard contacts) on the iterative near
-//! field: the constraint move goes along the Stokesian dynamics mobility, `r' = r* + dt
+//! `Overdamped` with constraints (bonds, pins, hard contacts, the wall's links) on the
+//! iterative near field: the constraint move goes along the Stokesian dynamics mobility, `r' = r* + dt
 //! M_SD,tt G^T lambda`, as the dense near step's does, with `M_SD` known only through
 //! products. The contacts are the dense path's: the same active-set rounds
 //! (`integrate/contacts.rs`, [`project_along`]), each round's solve the Krylov solve
@@ -28,8 +28,9 @@
 //! table of `M_SD`'s columns along the round's rows (one product a row, formed each
 //! round, `Metric::Dense` as the dense path tabulates its stored `M_SD`), cheaper than
 //! the Krylov solve's products where the rows are few; `Auto` resolves to Krylov
-//! (`Params::solver_kind`). `Overdamped2`, the wall and noise are refused by
-//! `near::check`, typed. A product that does not converge ends the step with
+//! (`Params::solver_kind`). A wall link (one sphere) has no squeeze resistance: its
+//! preconditioner's diagonal is the band's alone. `Overdamped2` and noise are refused
+//! by `near::check`, typed. A product that does not converge ends the step with
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`](crate::Stage::Mobility), the
 //! caller's state unchanged.
 
