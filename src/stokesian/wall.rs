@@ -17,6 +17,7 @@ pub type SphereBlocks<T> = [[<T as Real>::M3; 2]; 2];
 /// Sphere `i`'s wall correction `R_near` and the far field's own 6x6 self block (RPY's
 /// self term with its wall reflections) that it corrects, both at the sphere's gap
 /// clamped to [`NearField::min_gap`]; `None` beyond [`NearField::wall_cutoff`].
+#[allow(clippy::type_complexity)]
 pub fn wall_correction<T: Real>(
     eta: T,
     height: T,
