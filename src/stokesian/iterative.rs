@@ -91,8 +91,9 @@ pub struct Report {
 }
 
 /// Calls `f(i, j)` for every pair `j < i` inside the near field's cutoff, in the
-/// all-pairs loop's order (through the cell list from its size on).
-fn each_pair<T: Real>(
+/// all-pairs loop's order (through the cell list from its size on), then `f(i, i)` for
+/// every sphere inside the wall's cutoff, in order.
+fn each_entry<T: Real>(
     far: Far<'_, T>,
     pos: &[T::V3],
     radius: &[T],
@@ -125,19 +126,6 @@ fn each_pair<T: Real>(
             }
         }
     }
-    Ok(())
-}
-
-/// [`each_pair`], then `f(i, i)` for every sphere inside the wall's cutoff, in order.
-fn each_entry<T: Real>(
-    far: Far<'_, T>,
-    pos: &[T::V3],
-    radius: &[T],
-    near: NearField<T>,
-    cells: &mut [usize],
-    mut f: impl FnMut(usize, usize) -> Result<(), SdError>,
-) -> Result<(), SdError> {
-    each_pair(far, pos, radius, near, cells, &mut f)?;
     let Some(h) = far.wall() else {
         return Ok(());
     };
