@@ -16,7 +16,8 @@
 //! * Spheres whose gap to the wall is below [`NearField::wall_cutoff`] radii: the exact
 //!   sphere-wall resistance ([`crate::near::wall::wall_scalars`]) minus the inverse of the
 //!   sphere's own 6x6 wall mobility block (RPY self term with its wall reflections,
-//!   [`crate::mobility::wall::self_wall`] and [`crate::mobility::wall::self_wall_rot`]).
+//!   [`crate::mobility::wall::self_wall`] and [`crate::mobility::wall::self_wall_rot`]):
+//!   [`wall_correction`], the iterative product's too.
 //! * A pair or a sphere closer than [`NearField::min_gap`] (overlaps included, which RPY
 //!   allows) gets the correction of the minimum gap, along the same line of centres
 //!   (clamped): a surface roughness. Its far part is evaluated at the clamped gap too, so
@@ -38,6 +39,7 @@ mod periodic;
 mod wall;
 
 pub use far::Far;
+pub use wall::{SphereBlocks, wall_correction};
 
 use crate::error::{LinalgError, ParticleError, StepError};
 use crate::linalg::{spd_inverse, tri};
@@ -94,8 +96,8 @@ pub enum SdError {
     /// `M_far` or `R` is not positive definite in this precision.
     NotPositiveDefinite(LinalgError),
     /// A parameter is not finite, a cutoff is negative or `min_gap` is not positive (or,
-    /// for [`iterative`], a tolerance that is not positive, or the wall, which that path
-    /// does not model), or the far field names a geometry the kernel was built without.
+    /// for [`iterative`], a tolerance that is not positive), or the far field names a
+    /// geometry the kernel was built without.
     Params,
     /// The storage is shorter than [`storage`] asks.
     Storage,
@@ -218,7 +220,7 @@ fn close_pairs<T: Real>(far: Far<'_, T>, pos: &[T::V3], radius: &[T], cutoff: T)
 /// How many spheres are inside the wall's cutoff.
 fn close_walls<T: Real>(height: T, pos: &[T::V3], radius: &[T], cutoff: T) -> usize {
     (0..pos.len())
-        .filter(|&i| (T::xyz(pos[i])[2] - height) / radius[i] - T::ONE < cutoff)
+        .filter(|&i| wall::gap(height, pos[i], radius[i]) < cutoff)
         .count()
 }
 

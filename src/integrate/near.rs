@@ -104,12 +104,7 @@ fn check_iterative<T: Real>(
     }
     if rows > 0 && p.method != Method::Overdamped {
         return refuse(
-            "the iterative near field (matrix_free) with constraints (bonds, pins, contacts) in Overdamped2: Overdamped only (or matrix_free = false)",
-        );
-    }
-    if super::wall_height(p).is_some() {
-        return refuse(
-            "the iterative near field (matrix_free) above the wall: the wall's sphere corrections are the dense near field's (matrix_free = false)",
+            "the iterative near field (matrix_free) with constraints (bonds, pins, contacts, the wall's links) in Overdamped2: Overdamped only (or matrix_free = false)",
         );
     }
     if p.pse.is_some() {

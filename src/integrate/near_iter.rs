@@ -13,7 +13,9 @@
 //! (`near_iter/noise.rs`: three products and a Lanczos root of the far field), in free
 //! space or in the periodic box with the Ewald sums; `Overdamped` with bonds, pins and
 //! hard contacts (deterministic) by the Krylov solve along `M_SD`:
-//! `near_iter/constrained.rs`. The
+//! `near_iter/constrained.rs`, and so above the wall, whose links are one-sided
+//! constraints (the far field the wall's grand mobility, each sphere near it one more
+//! entry of the product's near field, `stokesian::iterative`). The
 //! rest is refused by [`super::near::check`]. The conjugate gradients stop at the
 //! relative residual
 //! [`Solver::tolerance`](crate::Solver::tolerance) within its `max_iterations`

@@ -28,8 +28,16 @@
 //! **Storage** ([`Storage`], sized by [`sizes`] from the number of close pairs that
 //! [`count_pairs`] finds) is the caller's; the close pairs are found through the cell
 //! list (`O(N)`), in the order of the all-pairs loop, so the bits are the same on every
-//! run. Not converging within the iterations given is [`SdError::NotConverged`]. The
-//! wall's sphere corrections are not in this path (free space and the box only).
+//! run. Not converging within the iterations given is [`SdError::NotConverged`].
+//!
+//! **The wall.** Above the wall ([`Far::above`], the far field's grand mobility then
+//! the wall's), each sphere inside [`NearField::wall_cutoff`] is one more entry after
+//! the pairs, `[i, i]`: its 6x6 correction ([`super::wall_correction`], the dense
+//! path's) factored as a pair's is, in the translation and rotation slots of a 12x12
+//! entry (the other six rows zero, their unknowns stay zero), and its preconditioner's
+//! block `I + L^T M_ww L` with `M_ww` the sphere's own 6x6 wall mobility: an isolated
+//! sphere near the wall is solved exactly, as an isolated pair is. The entries count
+//! with the pairs ([`count_pairs`], [`Report::pairs`]).
 
 mod noise;
 mod pairs;
@@ -37,7 +45,9 @@ mod pairs;
 use super::{Far, NearField, SdError, pair_correction};
 use crate::cell_list::{self, CellList};
 use crate::real::Real;
-use pairs::{axpy, dot, factor_semidefinite, gather, precond, precondition, scatter};
+use pairs::{
+    axpy, dot, factor_semidefinite, gather, pair_block, precond, precondition, scatter, wall_factor,
+};
 
 /// Entries of one pair's 12x12 matrix.
 pub(crate) const B: usize = 144;
@@ -49,7 +59,8 @@ pub(crate) const K: usize = 12;
 pub type FarProduct<'f, T> =
     dyn FnMut(&[<T as Real>::V3], &mut [<T as Real>::V3]) -> Result<(), SdError> + 'f;
 
-/// What [`Solver::product`] needs for `n` spheres and `pairs` close pairs:
+/// What [`Solver::product`] needs for `n` spheres and `pairs` entries (close pairs and
+/// spheres near the wall, [`count_pairs`]):
 /// `(pairs, pair reals, sphere vectors, cell-list indices)`.
 pub fn sizes(n: usize, pairs: usize) -> (usize, usize, usize, usize) {
     let reals = pairs.saturating_mul(2 * B + 5 * K);
@@ -58,7 +69,7 @@ pub fn sizes(n: usize, pairs: usize) -> (usize, usize, usize, usize) {
 
 /// The caller's storage for the iterative product.
 pub struct Storage<'a, T: Real> {
-    /// The close pairs `(i, j)`, `j < i`.
+    /// The close pairs `(i, j)`, `j < i`, then the spheres near the wall `(i, i)`.
     pub pairs: &'a mut [[usize; 2]],
     /// Per pair: `L_p`, the preconditioner's block, and the five Krylov vectors.
     pub reals: &'a mut [T],
@@ -71,7 +82,7 @@ pub struct Storage<'a, T: Real> {
 /// How the solve went.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Report {
-    /// Close pairs corrected.
+    /// Entries corrected: close pairs and spheres near the wall.
     pub pairs: usize,
     /// Conjugate-gradient iterations (far-field products: this plus two).
     pub iterations: u32,
@@ -80,8 +91,9 @@ pub struct Report {
 }
 
 /// Calls `f(i, j)` for every pair `j < i` inside the near field's cutoff, in the
-/// all-pairs loop's order (through the cell list from its size on).
-fn each_pair<T: Real>(
+/// all-pairs loop's order (through the cell list from its size on), then `f(i, i)` for
+/// every sphere inside the wall's cutoff, in order.
+fn each_entry<T: Real>(
     far: Far<'_, T>,
     pos: &[T::V3],
     radius: &[T],
@@ -114,11 +126,19 @@ fn each_pair<T: Real>(
             }
         }
     }
+    let Some(h) = far.wall() else {
+        return Ok(());
+    };
+    for i in 0..pos.len().min(radius.len()) {
+        if super::wall::gap(h, pos[i], radius[i]) < near.wall_cutoff {
+            f(i, i)?;
+        }
+    }
     Ok(())
 }
 
-/// The number of close pairs (what [`sizes`] takes), with `cells` ([`sizes`]) as the
-/// cell list's scratch.
+/// The number of close pairs and spheres near the wall (what [`sizes`] takes), with
+/// `cells` ([`sizes`]) as the cell list's scratch.
 pub fn count_pairs<T: Real>(
     far: Far<'_, T>,
     pos: &[T::V3],
@@ -128,7 +148,7 @@ pub fn count_pairs<T: Real>(
 ) -> Result<usize, SdError> {
     near.check()?;
     let mut k = 0;
-    each_pair(far, pos, radius, near, cells, |_, _| {
+    each_entry(far, pos, radius, near, cells, |_, _| {
         k += 1;
         Ok(())
     })?;
@@ -152,8 +172,8 @@ pub struct Solver<'a, T: Real> {
 }
 
 impl<'a, T: Real> Solver<'a, T> {
-    /// Finds the close pairs of the spheres, factors their corrections and the
-    /// preconditioner's blocks into `store`.
+    /// Finds the close pairs of the spheres and those near the wall, factors their
+    /// corrections and the preconditioner's blocks into `store`.
     pub fn new(
         eta: T,
         far: Far<'_, T>,
@@ -165,9 +185,6 @@ impl<'a, T: Real> Solver<'a, T> {
         near.check()?;
         let n = pos.len().min(radius.len());
         let (pos, radius) = (&pos[..n], &radius[..n]);
-        if far.wall().is_some() {
-            return Err(SdError::Params);
-        }
         let Storage {
             pairs,
             reals,
@@ -175,7 +192,7 @@ impl<'a, T: Real> Solver<'a, T> {
             cells,
         } = store;
         let mut np = 0;
-        each_pair(far, pos, radius, near, cells, |i, j| {
+        each_entry(far, pos, radius, near, cells, |i, j| {
             *pairs.get_mut(np).ok_or(SdError::Storage)? = [i, j];
             np += 1;
             Ok(())
@@ -187,21 +204,27 @@ impl<'a, T: Real> Solver<'a, T> {
         let (factors, krylov) = reals[..nr].split_at_mut(np * 2 * B);
         for (p, fac) in factors.chunks_exact_mut(2 * B).enumerate() {
             let [i, j] = pairs[p];
+            let (l, b) = fac.split_at_mut(B);
+            if let (true, Some(h)) = (i == j, far.wall()) {
+                let m = wall_factor(eta, h, (pos, radius), near, i, l)?;
+                precondition(&m, l, b)?;
+                continue;
+            }
             // The correction seen from `j` to `i` (`j < i`): rows `(j, i, rot j, rot i)`.
             let c = pair_correction(eta, far, pos, radius, near, (j, i))?;
             pairs[p] = [j, i];
-            let (l, b) = fac.split_at_mut(B);
             match c {
                 Some(c) => {
                     for (k, x) in l.iter_mut().enumerate() {
                         *x = T::m3_get(c[k / 36][(k % K) / 3], (k / K) % 3, k % 3);
                     }
-                    factor_semidefinite(l)?;
+                    factor_semidefinite(l, K)?;
                 }
                 // Coincident centres: no correction (as the dense path).
                 None => l.fill(T::ZERO),
             }
-            precondition(eta, far, pos, radius, near, [j, i], l, b)?;
+            let m = pair_block(eta, far, pos, radius, near, [j, i]);
+            precondition(&m, l, b)?;
         }
         let pairs: &'a [[usize; 2]] = pairs;
         Ok(Self {
@@ -214,7 +237,7 @@ impl<'a, T: Real> Solver<'a, T> {
         })
     }
 
-    /// The close pairs found.
+    /// The entries found: close pairs and spheres near the wall.
     pub fn pairs(&self) -> usize {
         self.npairs
     }

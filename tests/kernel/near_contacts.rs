@@ -1,5 +1,6 @@
 //! Hard contacts on the iterative near field (`Params::near` with `Params::matrix_free`
-//! and `Params::contacts`): spheres settling onto a pinned floor and onto each other,
+//! and `Params::contacts`): spheres settling onto a pinned floor, onto the wall and onto
+//! each other,
 //! each step against the dense near step from the same state with the same solver
 //! (`near_step.rs` checks that one against exact two-sphere hydrodynamics); no pair
 //! overlapping beyond twice the solver's tolerance, measured here from the positions;
@@ -14,7 +15,9 @@ use crate::near_con::{near, run};
 use std::f64::consts::PI;
 
 use common::*;
-use hydrorattle::{Bond, BondSet, Contacts, Layout, NoForce, ParticleSet, Real, SolverKind, step};
+use hydrorattle::{
+    Bond, BondSet, Contacts, Layout, NoForce, ParticleSet, Real, SolverKind, Wall, step,
+};
 use hydrorattle_heap::Buffers;
 
 /// Density of a unit sphere of buoyant weight 4 (`g = 1`, no fluid density).
@@ -52,9 +55,9 @@ fn bed() -> Vec<Sphere> {
     s
 }
 
-/// The floor's pin rows (three a sphere).
+/// The pin rows of the spheres `s` (three a sphere): the floor's.
 fn floor<T: Real>(s: &[Sphere]) -> Vec<Bond<T>> {
-    (0..9)
+    (0..s.len())
         .flat_map(|i| Bond::pins(i, T::from_f64(s[i].radius)))
         .collect()
 }
@@ -96,17 +99,48 @@ fn with_contacts<T: Real>(iterative: bool, kind: SolverKind) -> hydrorattle::Par
 /// pair overlaps beyond twice the tolerance; the floor does not move, bit for bit.
 fn settles_as_dense<T: Real>() {
     for kind in [SolverKind::Krylov, SolverKind::Newton, SolverKind::Sweep] {
-        settles_with::<T>(kind);
+        settles_with::<T>(kind, &bed(), 9, None, 3);
     }
 }
 
-fn settles_with<T: Real>(kind: SolverKind) {
-    let spheres = bed();
-    let rows = floor::<T>(&spheres);
-    let (pd, pi) = (
-        with_contacts::<T>(false, kind),
-        with_contacts::<T>(true, kind),
-    );
+/// Five heavy spheres dropped onto the wall (within 0.002 to 0.01 of it, two of them
+/// on others) settle as the dense near step from the same state settles them, with the
+/// Krylov solve and Newton (the same measures as [`settles_as_dense`]): the wall's
+/// links held, one-sided, beside the pair contacts, the iterative product's far field
+/// the wall's and its near field the wall's sphere corrections.
+fn settles_on_the_wall<T: Real>() {
+    let ground = |x: f64, y: f64, a: f64, h: f64| Sphere {
+        pos: [x, y, a + h],
+        radius: a,
+        density: HEAVY,
+    };
+    let (a, b) = (ground(0.0, 0.0, 1.0, 0.002), ground(2.3, 0.2, 1.2, 0.01));
+    let c = ground(-1.0, 2.0, 0.8, 0.004);
+    let d = above(&a, 0.9, (0.3, -0.2), 0.003);
+    let e = above(&b, 1.1, (0.4, 0.1), 0.02);
+    let spheres = [a, b, c, d, e];
+    for kind in [SolverKind::Krylov, SolverKind::Newton] {
+        settles_with::<T>(kind, &spheres, 0, Some(0.0), 2);
+    }
+}
+
+/// Twelve steps of `spheres` (the first `pinned` of them pinned, the wall at `wall` if
+/// given) with the solver `kind`, each against the dense step from the same state; at
+/// least `contacts` pair contacts held at some step (and two wall links, with the wall).
+fn settles_with<T: Real>(
+    kind: SolverKind,
+    spheres: &[Sphere],
+    pinned: usize,
+    wall: Option<f64>,
+    contacts: u32,
+) {
+    let rows = floor::<T>(&spheres[..pinned]);
+    let setup = |iterative| {
+        let mut p = with_contacts::<T>(iterative, kind);
+        p.wall = wall.map(|h| Wall::new(T::from_f64(h)));
+        p
+    };
+    let (pd, pi) = (setup(false), setup(true));
     let tol = pi.solver.tolerance.to_f64();
     // Within twice the tolerance (the over-relaxed sweep stops just inside its own
     // measure: 1.2e-5 in f32).
@@ -118,7 +152,7 @@ fn settles_with<T: Real>(kind: SolverKind) {
         200.0
     };
     let n = spheres.len();
-    let mut ps: ParticleSet<T, 16> = particles(&spheres);
+    let mut ps: ParticleSet<T, 16> = particles(spheres);
     let mut set: BondSet<T, 32> = BondSet::new();
     for &b in &rows {
         set.push(b, n).unwrap();
@@ -129,7 +163,7 @@ fn settles_with<T: Real>(kind: SolverKind) {
     let at = |ps: &ParticleSet<T, 16>| -> Vec<[f64; 3]> {
         (0..n).map(|i| f64s::<T>(ps.pos[i])).collect()
     };
-    let mut held = 0;
+    let (mut held, mut walls) = (0, 0);
     for k in 0..12 {
         let s = at(&ps);
         let mut dense = ps.clone();
@@ -147,41 +181,54 @@ fn settles_with<T: Real>(kind: SolverKind) {
             .map(|(a, b)| norm(sub(*a, *b)))
             .fold(0.0, f64::max);
         println!(
-            "{kind:?} step {k}: contacts {} (dense {}), rounds {}, krylov {} (dense {}), products {}, pcg {}, moved {moved:.2e}, apart {:.1e}, overlap {:.1e}",
+            "{kind:?} step {k}: contacts {} (dense {}), wall {} (dense {}), rounds {}, krylov {} (dense {}), products {}, pcg {}, moved {moved:.2e}, apart {:.1e}, overlap {:.1e}",
             ri.contacts,
             rd.contacts,
+            ri.wall_contacts,
+            rd.wall_contacts,
             ri.contact_rounds,
             ri.iterations,
             rd.iterations,
             ri.near_products,
             ri.near_iterations,
             apart / moved,
-            overlap(&spheres, &xi),
+            overlap(spheres, &xi),
         );
         assert_eq!(
-            ri.contacts, rd.contacts,
+            (ri.contacts, ri.wall_contacts),
+            (rd.contacts, rd.wall_contacts),
             "{kind:?} step {k}: {ri:?} / {rd:?}"
         );
         assert!(
             apart < allow * tol * moved,
             "step {k}: {apart:e} of {moved:e}"
         );
-        assert!(overlap(&spheres, &xi) <= slack, "step {k}: overlap");
+        assert!(overlap(spheres, &xi) <= slack, "step {k}: overlap");
+        for (s, x) in spheres.iter().zip(&xi) {
+            let below = wall.map_or(0.0, |h| 1.0 - (x[2] - h) / s.radius);
+            assert!(below <= slack, "step {k}: {below:e} below the wall");
+        }
         assert_eq!(ri.near_formations, 0);
-        for i in 0..9 {
+        for i in 0..pinned {
             let pin = f64s::<T>(T::v3_from(spheres[i].pos)).map(f64::to_bits);
             assert_eq!(pin, xi[i].map(f64::to_bits), "step {k}: the floor moved");
         }
         held = held.max(ri.contacts);
+        walls = walls.max(ri.wall_contacts);
     }
-    // The floor, the pile (one on another) and a neighbour: several contacts held.
-    assert!(held >= 3, "{kind:?}: contacts held: {held}");
+    // The floor, the pile (one on another) and a neighbour: several contacts held; on
+    // the wall, the two piles and the spheres resting on it.
+    assert!(held >= contacts, "{kind:?}: contacts held: {held}");
+    assert!(
+        wall.is_none() || walls >= 2,
+        "{kind:?}: wall links held: {walls}"
+    );
 }
 
 /// Two runs of six steps end on the same bits and report the same counts.
 fn same_bits<T: Real>() {
     let spheres = bed();
-    let rows = floor::<T>(&spheres);
+    let rows = floor::<T>(&spheres[..9]);
     let p = with_contacts::<T>(true, SolverKind::Krylov);
     let bits = || {
         let (r, x) = run::<T>(&p, &spheres, &rows, 6).unwrap();
@@ -195,5 +242,6 @@ fn same_bits<T: Real>() {
 
 both_precisions! {
     settles_as_dense => settles_as_dense;
+    settles_on_the_wall => settles_on_the_wall;
     same_bits => same_bits;
 }

@@ -1,15 +1,16 @@
 //! Steps with the iterative near field (`Params::near` with `Params::matrix_free`:
 //! conjugate gradients over the close pairs, `M_SD` never formed), against the dense near
 //! step (`near_step.rs`, `near_box.rs`: there checked against Stimson and Jeffery's exact
-//! series and the box's known correction) on clusters with close pairs, to the
-//! iteration's tolerance; against Stimson and Jeffery's exact series and the published
-//! side-by-side values at `s = 2.1` directly; the same bits run to run; and the
+//! series and the box's known correction) on clusters with close pairs, in free space,
+//! in the box and above the wall, to the iteration's tolerance; against Stimson and
+//! Jeffery's exact series, the published side-by-side values at `s = 2.1` and
+//! Brenner's exact series for a sphere approaching the wall directly; the same bits run to run; and the
 //! refusals, typed, with the state unchanged. Units: `a = 1`, `eta = 1`, buoyant weight
 //! 1 (`U0 = 1 / (6 pi)`).
 #![cfg(all(feature = "near", feature = "periodic"))]
 
 use crate::common;
-use crate::stokesian::stimson_jeffery;
+use crate::stokesian::{brenner, stimson_jeffery};
 
 use std::f64::consts::PI;
 
@@ -227,8 +228,8 @@ fn same_bits<T: Real>() {
     assert_eq!(run(), run());
 }
 
-/// Refused, typed, the state unchanged: what the iterative path does not serve (the
-/// wall's hydrodynamics, PSE), the conjugate gradients
+/// Refused, typed, the state unchanged: what the iterative path does not serve (PSE;
+/// the wall's hydrodynamics, refused before, now stepped), the conjugate gradients
 /// stopped before they converge, and more close pairs than the storage holds (its
 /// Brownian steps: `near_iter_brownian.rs`).
 fn refusals<T: Real>() {
@@ -255,9 +256,11 @@ fn refusals<T: Real>() {
     one_step::<T>(&p, &spheres, &[]).unwrap();
     p.solver.kind = SolverKind::Newton;
     one_step::<T>(&p, &spheres, &[]).unwrap();
+    // Above the wall (its links one-sided constraints): stepped (`wall_matches_dense`).
     let mut p = base;
     p.wall = Some(Wall::new(T::from_f64(-40.0)));
-    unsupported(&p, &[], "wall");
+    let (r, _) = one_step::<T>(&p, &spheres, &[]).unwrap();
+    assert!(r.near_products >= 1, "{r:?}");
     let mut p = base;
     p.pse = Some(1e-3);
     // (The fast free-space product refuses rotation first.)
@@ -305,4 +308,84 @@ macro_rules! both {
     };
 }
 
-both!(matches_dense, pair_falls, same_bits, refusals);
+/// Clusters of 1 to 20 spheres above the wall, the lowest within 0.01 to 0.5 radii of
+/// it: the iterative step's velocities and spins are the dense near step's (the same
+/// wall corrections, the same Blake far field) within the iteration's tolerance, as in
+/// free space ([`matches_dense`]); every sphere inside the wall's cutoff counts as one
+/// entry besides the close pairs.
+fn wall_matches_dense<T: Real>() {
+    let tol = pick::<T>(5e-3, 1e-7);
+    for (n, seed, gap) in [(1, 1, 0.1), (2, 31, 0.01), (7, 32, 0.05), (20, 33, 0.5)] {
+        let spheres = cluster(n, seed, None, [0.0; 3]);
+        let floor = spheres
+            .iter()
+            .map(|s| s.pos[2] - s.radius)
+            .fold(f64::INFINITY, f64::min);
+        let wall = floor - gap;
+        let at_wall = |iterative| {
+            let mut p = near::<T>(Method::Overdamped, iterative, None);
+            p.wall = Some(Wall::new(T::from_f64(wall)));
+            p
+        };
+        let (rd, dense) = one_step::<T>(&at_wall(false), &spheres, &[]).unwrap();
+        let (r, iter) = one_step::<T>(&at_wall(true), &spheres, &[]).unwrap();
+        // Spins over the largest velocity too (radii near 1): a lone sphere does not spin.
+        let big = dense.1.iter().map(|v| norm(*v)).fold(0.0, f64::max);
+        let apart = |a: &[[f64; 3]], b: &[[f64; 3]]| {
+            let d = a.iter().zip(b).map(|(x, y)| norm(sub(*x, *y)));
+            d.fold(0.0, f64::max) / big
+        };
+        let (dv, dw) = (apart(&iter.1, &dense.1), apart(&iter.2, &dense.2));
+        let what = format!("{n} spheres, gap {gap}");
+        println!(
+            "{what}: entries {}, iterations {}, velocities {dv:.1e}, spins {dw:.1e}",
+            r.near_pairs, r.near_iterations
+        );
+        assert!(dv < tol && dw < tol, "{what}: {dv:e} {dw:e}");
+        let walls = spheres
+            .iter()
+            .filter(|s| (s.pos[2] - wall) / s.radius - 1.0 < 4.0)
+            .count();
+        assert!(
+            walls >= 1 && r.near_pairs as usize >= n - 1 + walls,
+            "{what}"
+        );
+        assert_eq!(r.near_formations, 0, "{what}: formed M_SD");
+        assert!(rd.near_formations >= 1, "{what}: dense");
+    }
+}
+
+/// A sphere at `h / a = 1.1` above the wall by the iterative step approaches it at
+/// Brenner's speed (his exact series, `stokesian.rs`), within 0.5 %, as the dense step
+/// does (`near_step.rs`); one entry (the sphere near the wall), solved exactly by the
+/// preconditioner: one iteration a product.
+fn wall_approach<T: Real>() {
+    let sphere = [Sphere {
+        pos: [0.0, 0.0, 1.1],
+        radius: 1.0,
+        density: RHO1,
+    }];
+    let want = brenner(1.1) * U0;
+    let mut p = near::<T>(Method::Overdamped, true, None);
+    p.dt = T::from_f64(0.1);
+    p.wall = Some(Wall::new(T::ZERO));
+    let (r, (_, v, _)) = one_step::<T>(&p, &sphere, &[]).unwrap();
+    let e = (-v[0][2] / want - 1.0).abs();
+    println!(
+        "{} U0 against Brenner's {} U0 ({e:.1e})",
+        -v[0][2] / U0,
+        want / U0
+    );
+    assert!(e < 5e-3, "{} vs {want} ({e:e})", -v[0][2]);
+    assert_eq!(r.near_pairs, 1, "{r:?}");
+    assert_eq!(r.near_iterations, r.near_products, "{r:?}");
+}
+
+both!(
+    matches_dense,
+    pair_falls,
+    same_bits,
+    refusals,
+    wall_matches_dense,
+    wall_approach
+);

@@ -1,5 +1,6 @@
 //! The iterative Stokesian dynamics product against the dense mobility's product, on
-//! random polydisperse clusters with near-contact pairs, in free space and in the box.
+//! random polydisperse clusters with near-contact pairs, in free space, in the box and
+//! above the wall.
 #![cfg(feature = "near")]
 
 use hydrorattle::real::Real;
@@ -180,6 +181,41 @@ fn the_same_bits_on_rerun_and_errors_are_typed() {
         matches!(r, Err(SdError::NotConverged { iterations: 2, .. })),
         "{r:?}"
     );
-    let r = both::<f64>(Far::above(-1000.0), &pos, &rad, 1e-8, 500);
-    assert_eq!(r.err(), Some(SdError::Params));
+}
+
+/// Above the wall (Blake's images in the far field, each sphere inside the wall's
+/// cutoff one more entry of the near field), the lowest sphere at a gap of 1e-3 to 0.1
+/// radii: the product is the dense mobility's (`mobility_in` with the same wall
+/// corrections) within ten times the tolerance, as in free space; and refused before
+/// (`SdError::Params`), so this fails on a product without the wall.
+#[test]
+fn the_iterative_product_is_the_dense_one_above_the_wall() {
+    for (n, gap, seed, tol) in [
+        (1, 0.1, 9, 1e-8),
+        (40, 1e-3, 10, 1e-8),
+        (80, 1e-2, 11, 1e-6),
+    ] {
+        let (pos, rad) = cluster(n, 1e-2, seed);
+        let floor = pos
+            .iter()
+            .zip(&rad)
+            .map(|(p, a)| p[2] - a)
+            .fold(f64::INFINITY, f64::min);
+        let wall = Far::above(floor - gap);
+        let (got, want, it) = both::<f64>(wall, &pos, &rad, tol, 500).unwrap();
+        let e = rel(&got, &want);
+        println!("wall, n = {n}, gap {gap}, tol {tol:e}: {it} iterations, error {e:.2e}");
+        assert!(e < 10.0 * tol, "n = {n}: error {e}");
+    }
+    let (pos, rad) = cluster(30, 1e-2, 12);
+    let floor = pos
+        .iter()
+        .zip(&rad)
+        .map(|(p, a)| p[2] - a)
+        .fold(f64::INFINITY, f64::min);
+    let (got, want, it) =
+        both::<f32>(Far::above(floor as f32 - 0.01), &pos, &rad, 1e-4, 500).unwrap();
+    let e = rel(&got, &want);
+    println!("wall, f32: {it} iterations, error {e:.2e}");
+    assert!(e < 1e-2, "f32: error {e}");
 }

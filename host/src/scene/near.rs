@@ -15,8 +15,9 @@
 //! `"overdamped"` and `"overdamped2"` (level manual), and thermal noise by Cholesky.
 //! Dense: a few hundred spheres at most. With `[integrator] matrix_free = true` the
 //! kernel applies the same mobility by its iterative product instead (no dense matrix;
-//! free space or the Ewald box; bonds, pins and hard contacts with `"overdamped"`, any
-//! solver (`"auto"` is Krylov there); no wall or noise: `docs/NEAR.md`,
+//! free space, the Ewald box or above a `[wall]` with `"overdamped"`; bonds, pins and
+//! hard contacts with `"overdamped"`, any solver (`"auto"` is Krylov there); no noise:
+//! `docs/NEAR.md`,
 //! "Iterative steps"). The kernel's first-step check refuses the rest (the box's PSE
 //! sums, Lanczos noise) at this table.
 

@@ -1,5 +1,5 @@
-//! `Overdamped` with constraints (bonds, pins, hard contacts) on the iterative near
-//! field: the constraint move goes along the Stokesian dynamics mobility, `r' = r* + dt
+//! `Overdamped` with constraints (bonds, pins, hard contacts, the wall's links) on the
+//! iterative near field: the constraint move goes along the Stokesian dynamics mobility, `r' = r* + dt
 //! M_SD,tt G^T lambda`, as the dense near step's does, with `M_SD` known only through
 //! products. The contacts are the dense path's: the same active-set rounds
 //! (`integrate/contacts.rs`, [`project_along`]), each round's solve the Krylov solve
@@ -28,7 +28,8 @@
 //! table of `M_SD`'s columns along the round's rows (one product a row, formed each
 //! round, `Metric::Dense` as the dense path tabulates its stored `M_SD`), cheaper than
 //! the Krylov solve's products where the rows are few; `Auto` resolves to Krylov
-//! (`Params::solver_kind`). `Overdamped2`, the wall and noise are refused by
+//! (`Params::solver_kind`). A wall link's squeeze resistance is its sphere's wall
+//! correction along the normal (a pin has none). `Overdamped2` and noise are refused by
 //! `near::check`, typed. A product that does not converge ends the step with
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`](crate::Stage::Mobility), the
 //! caller's state unchanged.
@@ -154,26 +155,30 @@ const TABLE: StepError =
     StepError::Unsupported("the iterative near field's sweep or Newton without its table");
 
 /// Bond `b`'s squeeze resistance `d^T (R_ii + R_jj - R_ij - R_ji) d / 4` (`d` along the
-/// bond) from its pair's near-field correction, over `c dt |g|^2`.
+/// bond) from its pair's near-field correction, or a wall link's `d^T R_ii d` from its
+/// sphere's wall correction (the sphere against the fixed wall), over `c dt |g|^2`.
 fn squeeze<T: Real>(p: &Params<T>, s: &Start<'_, T>, b: &Bond<T>, g: T::V3, c: T) -> T {
     let (Some(nf), Ok(far)) = (p.near, crate::integrate::near::far(p, s.ewald)) else {
         return T::ZERO;
     };
-    if b.one_sphere() {
-        return T::ZERO;
-    }
-    let Ok(Some(r)) =
-        crate::stokesian::pair_correction(p.viscosity, far, s.pos, s.radius, nf, (b.i, b.j))
-    else {
-        return T::ZERO;
+    let (eta, spheres) = (p.viscosity, (s.pos, s.radius));
+    let (m, share) = match (b.is_wall(), far.wall()) {
+        (true, Some(h)) => match crate::stokesian::wall_correction(eta, h, spheres, nf, b.i) {
+            Ok(Some((r, _))) => (r[0][0], T::ONE),
+            _ => return T::ZERO,
+        },
+        _ if b.one_sphere() => return T::ZERO,
+        _ => match crate::stokesian::pair_correction(eta, far, s.pos, s.radius, nf, (b.i, b.j)) {
+            Ok(Some(r)) => (r[0][0] + r[1][1] - r[0][1] - r[1][0], T::from_f64(0.25)),
+            _ => return T::ZERO,
+        },
     };
     let g2 = T::norm2(g);
     if !(g2 > T::ZERO) {
         return T::ZERO;
     }
     let d = g * (T::ONE / g2.sqrt());
-    let m = r[0][0] + r[1][1] - r[0][1] - r[1][0];
-    let k = T::dot(d, m * d) * T::from_f64(0.25);
+    let k = T::dot(d, m * d) * share;
     (k / (c * p.dt * g2)).max(T::ZERO)
 }
 

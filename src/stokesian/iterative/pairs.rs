@@ -1,7 +1,8 @@
 //! The pairs' blocks of the iterative product: `L` and `L^T` over the sphere vectors,
-//! the block-Jacobi preconditioner, and their set-up.
+//! the block-Jacobi preconditioner, and their set-up (a sphere near the wall is an
+//! entry `[i, i]` beside the pairs, its 6x6 correction in half of a pair's 12x12).
 
-use super::super::{Far, NearField, SdError, pair_far};
+use super::super::{Far, NearField, SdError, pair_far, wall_correction};
 use super::{B, K};
 use crate::linalg::{cholesky_dense, spd_inverse};
 use crate::real::Real;
@@ -92,43 +93,103 @@ pub(super) fn precond<T: Real>((_, _, fac): Ctx<'_, T>, r: &[T], s: &mut [T]) {
     }
 }
 
-/// `l` (a semi-definite 12x12, row-major) into its lower Cholesky factor, strict upper
-/// part zero; a dependent row's column is zero.
-pub(super) fn factor_semidefinite<T: Real>(l: &mut [T]) -> Result<(), SdError> {
+/// `l` (a semi-definite `k x k`, row-major) into its lower Cholesky factor, strict
+/// upper part zero; a dependent row's column is zero.
+pub(super) fn factor_semidefinite<T: Real>(l: &mut [T], k: usize) -> Result<(), SdError> {
     let floor = T::EPSILON * T::from_f64(64.0);
-    cholesky_dense(l, K, floor).map_err(SdError::NotPositiveDefinite)?;
-    for k in 0..K {
-        let d = l[k * K + k];
-        l[k * K + k] = if d == T::ZERO { T::ZERO } else { T::ONE / d };
-        l[k * K + k + 1..(k + 1) * K].fill(T::ZERO);
+    cholesky_dense(l, k, floor).map_err(SdError::NotPositiveDefinite)?;
+    for r in 0..k {
+        let d = l[r * k + r];
+        l[r * k + r] = if d == T::ZERO { T::ZERO } else { T::ONE / d };
+        l[r * k + r + 1..(r + 1) * k].fill(T::ZERO);
     }
     Ok(())
 }
 
-/// The preconditioner's block `(I + L^T M_pp L)^-1` of one pair into `b`.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn precondition<T: Real>(
+/// One entry's 12x12 far-field block, `(1, 2, rotation 1, rotation 2)`.
+pub(super) type Far12<T> = [[<T as Real>::M3; 4]; 4];
+
+/// The pair `(i, j)`'s own free-space RPY 12x12 mobility, the preconditioner's far
+/// block, at the clamped gap as the correction is (apart, so positive definite).
+pub(super) fn pair_block<T: Real>(
     eta: T,
     far: Far<'_, T>,
     pos: &[T::V3],
     radius: &[T],
     near: NearField<T>,
     [i, j]: [usize; 2],
-    l: &[T],
-    b: &mut [T],
-) -> Result<(), SdError> {
+) -> Far12<T> {
     let (a1, a2) = (radius[i], radius[j]);
     let r = far.separation(pos[i], pos[j]);
     let len = T::norm2(r).sqrt();
-    // At the clamped gap, as the correction is (apart, so RPY's pair is positive definite).
     let (mean, floor) = ((a1 + a2) * T::HALF, near.min_gap + T::TWO);
     let d = match len > T::ZERO {
         true => r * ((len.max(mean * floor)) / len),
         false => T::v3(mean * floor, T::ZERO, T::ZERO),
     };
-    let m = pair_far(eta, a1, a2, d);
+    pair_far(eta, a1, a2, d)
+}
+
+/// Sphere `i`'s wall correction ([`wall_correction`]) factored into the 12x12 `l` of
+/// an entry `[i, i]`: its translation rows and columns at the pair's first slot, its
+/// rotation at the third (both [`slot`]s of those are sphere `i`'s), the second and
+/// fourth zero. Returns the far field's 6x6 self block in the same places, the
+/// preconditioner's.
+pub(super) fn wall_factor<T: Real>(
+    eta: T,
+    height: T,
+    spheres: (&[T::V3], &[T]),
+    near: NearField<T>,
+    i: usize,
+    l: &mut [T],
+) -> Result<Far12<T>, SdError> {
+    let z = T::M3_ZERO;
+    let mut m = [[z; 4]; 4];
+    l.fill(T::ZERO);
+    let Some((c, far)) = wall_correction(eta, height, spheres, near, i)? else {
+        return Ok(m);
+    };
+    // The entry's row of local row `q` (translation 0..3, rotation 3..6).
+    let slot_of = |q: usize| if q < 3 { q } else { q + 3 };
+    let entry = |k: usize, c6: usize| T::m3_get(c[k / 3][c6 / 3], k % 3, c6 % 3);
+    // A mode whose correction is zero to rounding (far from the wall, where the far
+    // self block is all but exact) may round below zero in f32: left out, as the
+    // semi-definite factor leaves out a dependent row (its own scale, the far field's
+    // resistance `1 / M_kk`); one further below zero is refused, not hidden.
+    let floor = T::EPSILON * T::from_f64(64.0);
+    let (mut kept, mut nk) = ([0usize; 6], 0);
+    for k in 0..6 {
+        let scale = T::ONE / T::m3_get(far[k / 3][k / 3], k % 3, k % 3);
+        let d = entry(k, k);
+        if d > floor * scale {
+            kept[nk] = k;
+            nk += 1;
+        } else if !(d >= -floor * scale) {
+            let error = crate::error::LinalgError::NotPositiveDefinite { row: slot_of(k) };
+            return Err(SdError::NotPositiveDefinite(error));
+        }
+    }
+    let mut l6 = [T::ZERO; 36];
+    for (q, x) in l6[..nk * nk].iter_mut().enumerate() {
+        *x = entry(kept[q / nk], kept[q % nk]);
+    }
+    factor_semidefinite(&mut l6[..nk * nk], nk)?;
+    for (q, &x) in l6[..nk * nk].iter().enumerate() {
+        l[slot_of(kept[q / nk]) * K + slot_of(kept[q % nk])] = x;
+    }
+    for (r, row) in far.iter().enumerate() {
+        for (c, &b) in row.iter().enumerate() {
+            m[2 * r][2 * c] = b;
+        }
+    }
+    Ok(m)
+}
+
+/// The preconditioner's block `(I + L^T M L)^-1` of one entry into `b`, `m` its far
+/// block ([`pair_block`], [`wall_factor`]).
+pub(super) fn precondition<T: Real>(m: &Far12<T>, l: &[T], b: &mut [T]) -> Result<(), SdError> {
     let mp = |k: usize, c: usize| T::m3_get(m[k / 3][c / 3], k % 3, c % 3);
-    // t = M_pp L, then b = I + L^T t.
+    // t = M L, then b = I + L^T t.
     let mut t = [T::ZERO; B];
     for k in 0..K {
         for c in 0..K {
