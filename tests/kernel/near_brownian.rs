@@ -115,12 +115,11 @@ both_precisions! {
     barometric => barometric_with_the_near_field;
 }
 
-/// `<c^2>` of a freely jointed trimer (unit radii, bonds 3: gaps of one radius, inside
-/// the cutoff) with the near field of minimum gap `min_gap` (the roughness parameter,
-/// which keeps the squeeze resistance of the end beads, which may overlap, finite), and
-/// its standard error; with the share of time the bond angle's cosine spends below
-/// -0.8 (the end beads overlap below -7/9), uniform 0.1, and its standard error.
-fn trimer(min_gap: f64, dt: f64, steps: usize, seed: u64) -> [(f64, f64); 2] {
+/// The cosine `c` of the bond angle of a freely jointed trimer (unit radii, bonds 3:
+/// gaps of one radius, inside the cutoff) after each of `steps` steps, with the near
+/// field of minimum gap `min_gap` (the roughness parameter, which keeps the squeeze
+/// resistance of the end beads, which may overlap, finite; `None`: RPY alone).
+fn trimer_cosines(min_gap: Option<f64>, dt: f64, steps: usize, seed: u64) -> Vec<f64> {
     let d = 3.0;
     let mut ps: ParticleSet<f64, 3> = particles(&[
         Sphere {
@@ -143,20 +142,32 @@ fn trimer(min_gap: f64, dt: f64, steps: usize, seed: u64) -> [(f64, f64); 2] {
     let mut p = thermal::<f64>(dt, 1.0 / (6.0 * PI), Hydro::Rpy, Drift::Midpoint);
     p.allow_overlap = true;
     p.noise_sqrt = NoiseSqrt::Cholesky;
-    p.near = Some(NearField {
+    p.near = min_gap.map(|min_gap| NearField {
         min_gap,
         ..NearField::default()
     });
-    let (mut c2, mut low) = (Vec::with_capacity(steps), Vec::with_capacity(steps));
+    let mut cs = Vec::with_capacity(steps);
     sample(&mut ps, &bonds, &p, seed, steps, |ps| {
         let at = |i: usize| ps.pos[i].to_array();
         let b1 = sub(at(0), at(1));
         let b2 = sub(at(1), at(2));
-        let c = dot(b1, b2) / (norm(b1) * norm(b2));
-        c2.push(c * c);
-        low.push(f64::from(u8::from(c < -0.8)));
+        cs.push(dot(b1, b2) / (norm(b1) * norm(b2)));
     });
-    [block_mean(&c2, 50), block_mean(&low, 50)]
+    cs
+}
+
+/// `<c^2>` of the trimer of [`trimer_cosines`] and its standard error; with the share
+/// of time the bond angle's cosine spends below -0.8 (the end beads overlap below
+/// -7/9), uniform 0.1, and its standard error.
+fn trimer(min_gap: f64, dt: f64, steps: usize, seed: u64) -> [(f64, f64); 2] {
+    let cs = trimer_cosines(Some(min_gap), dt, steps, seed);
+    let c2: Vec<f64> = cs.iter().map(|c| c * c).collect();
+    [block_mean(&c2, 50), block_mean(&below(&cs), 50)]
+}
+
+/// 1 where the cosine `c` is below -0.8, else 0.
+fn below(cs: &[f64]) -> Vec<f64> {
+    cs.iter().map(|&c| f64::from(u8::from(c < -0.8))).collect()
 }
 
 /// 1 200 000 steps (about 75 s in release on one core), minimum gap 0.5: `<c^2>`
@@ -187,16 +198,127 @@ fn trimer_bond_angle_with_the_near_field() {
 
 /// The trimer (minimum gap 0.5) at `dt` = 0.045, 0.015 and 0.005 over the same time
 /// span (18 000 units): `<c^2>` and the share of time below `c = -0.8`, against the
-/// flexible law's 1/3 and 0.1. Long: minutes.
+/// flexible law's 1/3 and 0.1; and the near field's own part of that share: the run
+/// again without the near field (RPY alone) from the same seed, and the difference of
+/// the two, step by step, with its standard error from 50 blocks. The two runs share
+/// their random draws and the angle follows them (their block shares correlate at
+/// 0.97), so the difference is four to five times more precise than either share, and
+/// a deviation of one seed's noise cancels in it (docs/NEAR.md). Long: minutes.
 #[test]
 #[ignore = "minutes: the trimer against the time step"]
 fn trimer_in_dt() {
     for dt in [0.045, 0.015, 0.005] {
-        let [(m, se), (low, se_low)] = trimer(0.5, dt, (18_000.0 / dt) as usize, 21);
+        let steps = (18_000.0 / dt) as usize;
+        let cs = trimer_cosines(Some(0.5), dt, steps, 21);
+        let c2: Vec<f64> = cs.iter().map(|c| c * c).collect();
+        let (near, rpy) = (below(&cs), below(&trimer_cosines(None, dt, steps, 21)));
+        let diff: Vec<f64> = near.iter().zip(&rpy).map(|(a, b)| a - b).collect();
+        let [(m, se), (share, se_share)] = [block_mean(&c2, 50), block_mean(&near, 50)];
+        let ((alone, se_alone), (d, se_d)) = (block_mean(&rpy, 50), block_mean(&diff, 50));
         eprintln!(
-            "dt {dt}: <c^2> = {m:.5} +- {se:.5} ({:+.1} se from 1/3), P(c < -0.8) = {low:.5} +- {se_low:.5} ({:+.1} se from 0.1)",
+            "dt {dt}: <c^2> = {m:.5} +- {se:.5} ({:+.1} se from 1/3), P(c < -0.8) = {share:.5} +- {se_share:.5} ({:+.1} se from 0.1); RPY alone {alone:.5} +- {se_alone:.5}, near field less RPY alone {d:+.5} +- {se_d:.5}",
             (m - 1.0 / 3.0) / se,
-            (low - 0.1) / se_low
+            (share - 0.1) / se_share
         );
+    }
+}
+
+/// A setting of [`trimer_histogram`] from the environment, or `default`.
+fn setting(name: &str, default: &str) -> String {
+    std::env::var(name).unwrap_or_else(|_| default.to_string())
+}
+
+/// The density of the bond angle's cosine over `[-1, 1]` (flat 1 for the flexible
+/// law) in the bins `edges` from `cs`, each with its standard error from 50 blocks.
+fn density(cs: &[f64], edges: &[f64]) -> Vec<(f64, f64)> {
+    edges
+        .windows(2)
+        .map(|w| {
+            let inside: Vec<f64> = cs
+                .iter()
+                .map(|&c| f64::from(u8::from(c >= w[0] && c < w[1])))
+                .collect();
+            let (m, se) = block_mean(&inside, 50);
+            let flat = (w[1] - w[0]) / 2.0;
+            (m / flat, se / flat)
+        })
+        .collect()
+}
+
+/// The trimer's bond-angle histogram, for telling where a deviation from the flexible
+/// law sits. Settings from the environment: `TRIMER_DT` (0.015), `TRIMER_SPAN` (time
+/// units, 18 000), `TRIMER_GAP` (the minimum gap, 0.5; `off`: RPY alone, no near field),
+/// `TRIMER_SEED` (21), `TRIMER_TSV` (a file to write the numbers to as the
+/// tab-separated rows `bench/record.py` takes). Prints `<c^2>` and the share below
+/// -0.8 with standard errors from 10 to 400 blocks (a block is 45 to 1 800 time units
+/// at the default span, against a bond's turning time of a few units, so the errors
+/// should agree), and the density of `c` in ten bins over `[-1, 1]` and four over
+/// `[-1, -0.8]`; `TRIMER_BLOCKS` (a file for the share below -0.8 in each of 1 000
+/// consecutive blocks). Run:
+/// `TRIMER_DT=0.005 cargo test --release --test kernel near_brownian::trimer_histogram -- --ignored --nocapture`.
+#[test]
+#[ignore = "minutes: a diagnostic run, settings from the environment"]
+fn trimer_histogram() {
+    let dt: f64 = setting("TRIMER_DT", "0.015").parse().unwrap();
+    let span: f64 = setting("TRIMER_SPAN", "18000").parse().unwrap();
+    let gap = setting("TRIMER_GAP", "0.5");
+    let min_gap = (gap != "off").then(|| gap.parse::<f64>().unwrap());
+    let seed: u64 = setting("TRIMER_SEED", "21").parse().unwrap();
+    let steps = (span / dt) as usize;
+    let cs = trimer_cosines(min_gap, dt, steps, seed);
+    let c2: Vec<f64> = cs.iter().map(|c| c * c).collect();
+    let low = below(&cs);
+    let field = min_gap.map_or("RPY alone".to_string(), |g| format!("minimum gap {g}"));
+    let measurement = format!(
+        "freely jointed trimer (bonds 3, unit radii, phantom beads), {field}, midpoint, Cholesky noise, standard errors from 50 blocks"
+    );
+    let case = format!("dt {dt}, {steps} steps, seed {seed}");
+    let mut rows = Vec::new();
+    for blocks in [10, 25, 50, 100, 200, 400] {
+        let ((m, se), (l, se_l)) = (block_mean(&c2, blocks), block_mean(&low, blocks));
+        eprintln!(
+            "{case}, {blocks} blocks: <c^2> = {m:.5} +- {se:.5} ({:+.1} se from 1/3), P(c < -0.8) = {l:.5} +- {se_l:.5} ({:+.1} se from 0.1)",
+            (m - 1.0 / 3.0) / se,
+            (l - 0.1) / se_l
+        );
+        if blocks == 50 {
+            rows.push(("<c^2>".to_string(), format!("{m:.5} +- {se:.5}")));
+            rows.push((
+                "share below c = -0.8".to_string(),
+                format!("{l:.5} +- {se_l:.5}"),
+            ));
+        }
+    }
+    let coarse: Vec<f64> = (0..=10).map(|k| -1.0 + 0.2 * k as f64).collect();
+    let fine: Vec<f64> = (0..=4).map(|k| -1.0 + 0.05 * k as f64).collect();
+    for edges in [&coarse[..], &fine[..]] {
+        for (w, (d, se)) in edges.windows(2).zip(density(&cs, edges)) {
+            eprintln!(
+                "  c in {:+.2}..{:+.2}: density {d:.4} +- {se:.4} ({:+.1} se from 1)",
+                w[0],
+                w[1],
+                (d - 1.0) / se
+            );
+            rows.push((
+                format!("density of c in {:+.2}..{:+.2} (flat 1)", w[0], w[1]),
+                format!("{d:.4} +- {se:.4}"),
+            ));
+        }
+    }
+    if let Ok(path) = std::env::var("TRIMER_BLOCKS") {
+        // The share below -0.8 in 1 000 consecutive blocks, to compare two runs.
+        let len = low.len() / 1000;
+        let text: String = low
+            .chunks_exact(len)
+            .map(|b| format!("{}\n", b.iter().sum::<f64>() / len as f64))
+            .collect();
+        std::fs::write(path, text).unwrap();
+    }
+    if let Ok(path) = std::env::var("TRIMER_TSV") {
+        let text: String = rows
+            .iter()
+            .map(|(q, v)| format!("{measurement}\t{case}\t{q}\t{v}\n"))
+            .collect();
+        std::fs::write(path, text).unwrap();
     }
 }
