@@ -23,7 +23,8 @@
 //! paths) or 60 s (the fast one). Times are this thread's CPU seconds a step, best of
 //! two (past 1e4 the first step alone, its kernel transform included); the same
 //! positions and seed every call. With
-//! `HYDRORATTLE_BENCH_MACHINE` set the rows go to `bench/results/free_cost.csv`.
+//! `HYDRORATTLE_BENCH_MACHINE` set the rows go to `bench/results/free_cost.csv`, each
+//! path's as soon as it is measured (a stopped run keeps them).
 
 use hydrorattle::integrate::{fast_storage, step_slices};
 use hydrorattle::linalg::tri;
@@ -124,13 +125,8 @@ fn time_step(k: usize, pos0: &[V], reps: usize) -> Result<Option<(f64, u32)>, St
 
 fn main() -> std::io::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    // `MAX_N` or `MIN_N:MAX_N`.
     let range = args.first().map_or("10000", String::as_str);
-    let (min_n, max_n) = match range.split_once(':') {
-        Some((a, b)) => (a.parse::<f64>().unwrap(), b.parse::<f64>().unwrap()),
-        None => (0.0, range.parse::<f64>().unwrap()),
-    };
-    let (min_n, max_n) = (min_n as usize, max_n as usize);
+    let (min_n, max_n) = free_shapes::count_range(args.first().map(String::as_str), 10_000);
     let only: Vec<&str> = args.iter().skip(1).map(String::as_str).collect();
     let named: String = only.iter().map(|s| format!(" '{s}'")).collect();
     let mut rows = record::Recorder::new(
@@ -177,6 +173,9 @@ fn main() -> std::io::Result<()> {
                         rows.row(TABLE, &case, &cell(""), &format!("refused: {e}"));
                     }
                 }
+                // A step past 1e4 takes minutes: what was measured stays if the run
+                // is stopped.
+                rows.flush()?;
             }
         }
     }

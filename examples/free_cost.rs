@@ -20,12 +20,13 @@
 //!
 //! Shapes: unit spheres uniformly in a ball at volume fractions 0.01, 0.1 and 0.3
 //! (overlaps allowed: equal radii never nest) and the helical chain of
-//! `benches/kernel/shared.rs`. Counts 10 to MAX_N (1e4 by default); the matrix-free and
-//! fast products of the cloud at 0.1 also at 2e4, 5e4 and 1e5 when MAX_N allows (the stored
-//! paths' storage is past any bound there). A path is not timed above the
-//! count where its storage passes 400 MB, or where one call took more than 2 s (the
-//! `N^2` paths; the next count would take 20 s) or 8 s (the fast products); the
-//! Cholesky factor up to N = 300.
+//! `benches/kernel/shared.rs`. Counts MIN_N (10) to MAX_N (1e4 by default); the fast products
+//! of the cloud at 0.1 also at 2e4, 5e4 and 1e5 when MAX_N allows, the matrix-free one
+//! at 2e4 (a call takes some 4 s there and grows as `N^2`; the stored paths' storage is
+//! past any bound). A path is not timed above the count where its storage passes
+//! BYTES (`--max-bytes`, 400 MB by default; the fast product at 1e-4 needs some 600 MB
+//! at 1e5), or where one call took more than 2 s (the `N^2` paths; the next count would
+//! take 20 s) or 8 s (the fast products); the Cholesky factor up to N = 300.
 //!
 //! Fits, minimising relative residuals with non-negative constants (`shared/fit.rs`):
 //! each dense, compact, spin and matrix-free time against `c0 + c1 tri(N)`
@@ -35,11 +36,12 @@
 //! `c0 + cG M log2 M + cN (N + 2 pairs) + cS N P^3`.
 //!
 //! ```text
-//! HYDRORATTLE_BENCH_MACHINE=<id> cargo run --release --example free_cost [-- MAX_N [SHAPE...]]
+//! HYDRORATTLE_BENCH_MACHINE=<id> cargo run --release --example free_cost [-- [MIN_N:]MAX_N [--max-bytes BYTES] [SHAPE...]]
 //! ```
 //!
 //! `SHAPE`s (`"cloud 0.01"`, `"cloud 0.1"`, `"cloud 0.3"`, `chain`) limit the run to
-//! those; all four by default.
+//! those; all four by default. A path's constants are fitted where the run timed it
+//! at least as often as they number.
 //!
 //! Times are this thread's CPU seconds, best of two (`shared/best.rs`). With
 //! `HYDRORATTLE_BENCH_MACHINE` set the rows go to `bench/results/free_cost.csv`
@@ -76,8 +78,10 @@ use splitmix::Rng;
 mod free_shapes;
 use free_shapes::{COUNTS, SHAPES, chain, cloud, extent, near_pairs};
 
-/// Storage past which a path is not timed (bytes).
+/// Storage past which a path is not timed (bytes), unless `--max-bytes` says otherwise.
 const MAX_BYTES: f64 = 4e8;
+/// The largest count the matrix-free product is timed at.
+const MAX_FREE: usize = 20_000;
 /// The paths timed, in the order of their rows.
 const NAMES: [&str; 14] = [
     "dense assembly",
@@ -120,13 +124,21 @@ impl Fit {
 /// One timing of path `k`, kept unless it is past the bounds (its storage, or an
 /// earlier call that took too long).
 fn time(k: usize, bytes: f64, stopped: &mut [bool], f: &mut dyn FnMut()) -> Option<f64> {
-    if stopped[k] || bytes > MAX_BYTES {
+    if stopped[k] || bytes > max_bytes() {
         stopped[k] = true;
         return None;
     }
     let t = best(2, &mut *f);
     stopped[k] = t > max_call(k);
     Some(t)
+}
+
+/// The storage bound of this run: `--max-bytes`, else [`MAX_BYTES`].
+fn max_bytes() -> f64 {
+    let args: Vec<String> = std::env::args().collect();
+    let at = args.iter().position(|a| a == "--max-bytes");
+    at.and_then(|i| args.get(i + 1)?.parse().ok())
+        .unwrap_or(MAX_BYTES)
 }
 
 /// The rows of one shape at one count: every path's time into `fits`, the cells to
@@ -158,15 +170,16 @@ fn measure(
         }
     };
     cell("packed blocks tri(N)", format!("{}", tri(n)));
-    // The matrix-free product stores nothing: it runs past 1e4 too.
-    let t = time(5, 0.0, stopped, &mut || {
+    // The matrix-free product stores nothing: it runs past 1e4 too, to `MAX_FREE`.
+    let bytes = if n <= MAX_FREE { 0.0 } else { f64::INFINITY };
+    let t = time(5, bytes, stopped, &mut || {
         tt_product(Hydro::Rpy, 1.0, pos, &rad, &f, &mut y).unwrap();
     });
     put(5, t, vec![1.0, blocks], fits, cell);
     if all {
         let par = Serial;
         let stored = blocks * 72.0;
-        let mut mu = vec![M::ZERO; if stored <= MAX_BYTES { tri(n) } else { 0 }];
+        let mut mu = vec![M::ZERO; if stored <= max_bytes() { tri(n) } else { 0 }];
         let mut z = vec![V::ZERO; band_scratch(n).max(1)];
         let t = time(0, stored, stopped, &mut || {
             assemble::<f64>(&par, Hydro::Rpy, 1.0, pos, &rad, &mut mu).unwrap();
@@ -205,7 +218,7 @@ fn measure(
         let grand = tri(2 * n) as f64;
         let mut g = vec![
             M::ZERO;
-            if grand * 72.0 <= MAX_BYTES {
+            if grand * 72.0 <= max_bytes() {
                 tri(2 * n)
             } else {
                 0
@@ -239,7 +252,7 @@ fn measure(
             true => ff.storage_grand(n),
         };
         let bytes = FreeBuffers::<f64>::bytes_of(size) as f64;
-        if stopped[k] || bytes > MAX_BYTES {
+        if stopped[k] || bytes > max_bytes() {
             stopped[k] = true;
             continue;
         }
@@ -288,16 +301,23 @@ fn measure(
 }
 
 fn main() -> std::io::Result<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let max_n: usize = args
-        .first()
-        .map_or(10_000, |s| s.parse::<f64>().unwrap() as usize);
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    // `--max-bytes BYTES` anywhere (read by `max_bytes`), named in the command.
+    let bound = match args.iter().position(|a| a == "--max-bytes") {
+        Some(i) => {
+            let b = args.drain(i..(i + 2).min(args.len())).collect::<Vec<_>>();
+            format!(" {}", b.join(" "))
+        }
+        None => String::new(),
+    };
+    let range = args.first().map_or("10000", String::as_str);
+    let (min_n, max_n) = free_shapes::count_range(args.first().map(String::as_str), 10_000);
     let only: Vec<&str> = args.iter().skip(1).map(String::as_str).collect();
     let named: String = only.iter().map(|s| format!(" '{s}'")).collect();
     let mut rows = record::Recorder::new(
         env!("CARGO_MANIFEST_DIR"),
         "free_cost",
-        format!("cargo run --release --example free_cost -- {max_n}{named}"),
+        format!("cargo run --release --example free_cost -- {range}{bound}{named}"),
     );
     let table = "free-space product paths, unit spheres, f64, one thread, CPU seconds a call \
                  (best of two; fast products with the kernel's transform kept)";
@@ -308,7 +328,7 @@ fn main() -> std::io::Result<()> {
             continue;
         }
         let mut stopped = [false; NAMES.len()];
-        for &n in counts.iter().filter(|&&n| n <= max_n) {
+        for &n in counts.iter().filter(|&&n| (min_n..=max_n).contains(&n)) {
             // Past 1e4 only the paths that store no mobility, on the cloud at 0.1.
             let all = n <= 10_000;
             if !all && shape != "cloud 0.1" {
@@ -388,7 +408,8 @@ fn main() -> std::io::Result<()> {
     let model =
         "free-space cost model constants (seconds a call per term), fitted to this run's rows";
     for (path, data, consts) in fitted {
-        if data.t.is_empty() {
+        // Fewer rows than constants (a run over a few counts) fix no fit.
+        if data.t.len() < consts.len() {
             continue;
         }
         let c = fit(&data.x, &data.t);

@@ -22,6 +22,17 @@ pub const COUNTS: [usize; 10] = [
     10, 30, 100, 300, 1000, 3000, 10_000, 20_000, 50_000, 100_000,
 ];
 
+/// The counts an argument `MAX_N` or `MIN_N:MAX_N` names (`default` without one; a
+/// count may be written `1e5`).
+pub fn count_range(arg: Option<&str>, default: usize) -> (usize, usize) {
+    let num = |s: &str| s.parse::<f64>().unwrap() as usize;
+    match arg.map(|a| a.split_once(':')) {
+        Some(Some((a, b))) => (num(a), num(b)),
+        Some(None) => (0, num(arg.unwrap_or_default())),
+        None => (0, default),
+    }
+}
+
 /// `n` unit spheres uniformly in a ball at volume fraction `phi`.
 pub fn cloud(n: usize, phi: f64, seed: u64) -> Vec<V> {
     let radius = (n as f64 / phi).cbrt();

@@ -23,6 +23,7 @@ pub struct Recorder {
     machine: Option<String>,
     load_at_start: Option<f64>,
     rows: Vec<[String; 4]>,
+    written: usize,
 }
 
 impl Recorder {
@@ -43,6 +44,7 @@ impl Recorder {
             machine: std::env::var(MACHINE).ok().filter(|m| !m.is_empty()),
             load_at_start: load(),
             rows: Vec::new(),
+            written: 0,
         }
     }
 
@@ -53,20 +55,23 @@ impl Recorder {
             .push([measurement, case, quantity, value].map(str::to_string));
     }
 
-    /// Appends the rows (the load is the one-minute load average at the start and the
-    /// end of the run); says where, or why nothing was recorded.
-    pub fn finish(self) -> std::io::Result<()> {
-        let Some(machine) = self.machine else {
-            eprintln!(
-                "not recorded: set {MACHINE} to this machine's id in docs/BENCHMARKS.md to append these rows to {}",
-                self.file.display()
-            );
+    /// Appends the rows so far and starts a new batch, so that a long run keeps what it
+    /// measured if it is stopped (each batch's load is the one-minute load average at
+    /// its start and its end). Without a machine it keeps the rows for
+    /// [`Recorder::finish`] to report.
+    #[allow(dead_code)] // Most examples record once, at their end.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        let Some(machine) = self.machine.as_deref() else {
             return Ok(());
         };
+        if self.rows.is_empty() {
+            return Ok(());
+        }
         let dir = self.file.parent().unwrap_or(Path::new("."));
         let commit =
             git(&dir.to_string_lossy(), &["rev-parse", "--short=7", "HEAD"]).unwrap_or_default();
-        let load = match (self.load_at_start, load()) {
+        let end = load();
+        let load = match (self.load_at_start, end) {
             (Some(a), Some(b)) if format!("{a:.1}") != format!("{b:.1}") => {
                 format!("{:.1}-{:.1}", a.min(b), a.max(b))
             }
@@ -82,7 +87,7 @@ impl Recorder {
             let fields = [
                 today(),
                 commit.clone(),
-                machine.clone(),
+                machine.to_string(),
                 load.clone(),
                 self.command.clone(),
             ]
@@ -99,11 +104,25 @@ impl Recorder {
             .append(true)
             .open(&self.file)?
             .write_all(text.as_bytes())?;
-        eprintln!(
-            "recorded {} rows in {}",
-            self.rows.len(),
-            self.file.display()
-        );
+        self.written += self.rows.len();
+        self.rows.clear();
+        self.load_at_start = end;
+        Ok(())
+    }
+
+    /// Appends the rows not yet appended (the load is the one-minute load average at
+    /// the start and the end of the run, or of the batch since the last
+    /// [`Recorder::flush`]); says where, or why nothing was recorded.
+    pub fn finish(mut self) -> std::io::Result<()> {
+        if self.machine.is_none() {
+            eprintln!(
+                "not recorded: set {MACHINE} to this machine's id in docs/BENCHMARKS.md to append these rows to {}",
+                self.file.display()
+            );
+            return Ok(());
+        }
+        self.flush()?;
+        eprintln!("recorded {} rows in {}", self.written, self.file.display());
         Ok(())
     }
 }

@@ -3,9 +3,12 @@
 //! `cargo run --release --example free_cost`) for one shape, without and with rotation,
 //! and the crossovers where the cost model (`hydrorattle_host::scene::free_cost`) that
 //! `auto` chooses by turns from the stored mobility to the fast product, for a step of
-//! one product and for a step with a constraint solve. It prints the measured
-//! crossovers too: the N (interpolated between the measured counts) from which a step
-//! on the fast product costs less than on each other path.
+//! one product and for a step with a constraint solve. Below them, in a second panel,
+//! the thermal case: the measured seconds of one whole Brownian step by each path (the
+//! table of `cargo run --release --example free_brownian`, in the same file) and where
+//! `auto` takes the fast product for it. It prints the measured crossovers too: the N
+//! (interpolated between the measured counts) from which a step on the fast product
+//! costs less than on each other path.
 //!
 //! ```text
 //! cargo run --release -p hydrorattle-study --example free_crossover [-- SHAPE [OUT.png]]
@@ -22,18 +25,27 @@ use hydrorattle_host::output::csv_fields;
 use hydrorattle_host::scene::box_cost::PRODUCTS_SOLVE;
 use hydrorattle_host::scene::free_cost::{FreeChoice, Spheres, choose};
 use hydrorattle_host::scene::sizing::Plan;
-use hydrorattle_host::scene::{Method, Solver};
-use hydrorattle_study::render::{LineChart, Series, line_chart};
+use hydrorattle_host::scene::{DEFAULT_SEED, Drift, Method, Solver, Sqrt, Thermal};
+use hydrorattle_study::render::{LineChart, Series, line_charts};
 
 /// The measured table's name in the record (the fast products in the steady state).
 const TABLE: &str = "free-space product paths, unit spheres, f64, one thread, CPU seconds a call (best of two; fast products with the kernel's transform kept)";
+/// The Brownian steps' table (`examples/free_brownian.rs`).
+const BROWNIAN: &str = "free-space Brownian steps, unit spheres, f64, one thread, CPU seconds a step (best of two; past 1e4 the first step)";
 
-/// The smallest N (on a grid of 40 a decade) at which `auto` leaves the stored
-/// mobility for a cloud at volume fraction `phi`, with `bonds` bonds (a Krylov solve),
-/// with or without `rotation`.
-fn crossover(phi: f64, bonds: usize, rotation: bool) -> Option<f64> {
+/// The smallest N (on a grid of 40 a decade) at which `auto` takes the fast product
+/// for a cloud at volume fraction `phi`, with `bonds` bonds (a Krylov solve), with or
+/// without `rotation`, deterministic or `thermal` (`[brownian]`'s defaults: the
+/// midpoint drift, the kernel's choice of square root).
+fn crossover(phi: f64, bonds: usize, rotation: bool, thermal: bool) -> Option<f64> {
     let mut plan = Plan::free(Method::Overdamped, Solver::Krylov);
     plan.rotation = rotation;
+    plan.brownian = thermal.then_some(Thermal {
+        temperature: 1.0,
+        seed: DEFAULT_SEED,
+        drift: Drift::Midpoint,
+        sqrt: Sqrt::Auto,
+    });
     (40..=200).map(|k| 10f64.powf(k as f64 / 40.0)).find(|&n| {
         let n = n as usize;
         let r = (n as f64 / phi).cbrt();
@@ -97,13 +109,14 @@ fn main() -> Result<()> {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
     let csv = std::fs::read_to_string(Path::new(root).join("bench/results/free_cost.csv"))
         .context("reading bench/results/free_cost.csv (run the free_cost example)")?;
-    // The last recorded value of each (path, N) of the shape.
+    // The last recorded value of each (path, N) of the shape, the Brownian steps' by
+    // their own names ("... Brownian step").
     let mut cells: BTreeMap<String, BTreeMap<u64, f64>> = BTreeMap::new();
     for row in csv.lines().skip(1).map(csv_fields) {
         let Some(n) = row[6].strip_prefix(&format!("{shape}, N = ")) else {
             continue;
         };
-        if row[5] != TABLE {
+        if row[5] != TABLE && row[5] != BROWNIAN {
             continue;
         }
         if let (Ok(n), Ok(t)) = (n.parse::<u64>(), row[8].parse::<f64>()) {
@@ -151,6 +164,32 @@ fn main() -> Result<()> {
         name: "rotation, fast 1e-4: a product and the spins (grand)".into(),
         points: points(&combine(&[&fast_g, &grand], |v| v[0] + v[1])),
     });
+    // The thermal case: whole Brownian steps as measured, no composing.
+    let thermal = [
+        ("dense", "stored mobility"),
+        ("matrix-free", "matrix-free"),
+        ("fast 1e-4", "fast 1e-4"),
+    ]
+    .map(|(q, name)| (name, get(&format!("{q} Brownian step"))));
+    let mut steps: Vec<Series> = thermal
+        .iter()
+        .map(|(name, t)| Series {
+            name: format!("{name}: a whole Brownian step"),
+            points: points(t),
+        })
+        .collect();
+    // A product beside the steps: a step of the fast path is some twenty of them.
+    steps.push(Series {
+        name: "fast, tolerance 1e-4: one product (the panel above)".into(),
+        points: points(&fast),
+    });
+    for (name, other) in &thermal[..2] {
+        let at = measured_crossover(&thermal[2].1, other)
+            .map_or("not within the measured counts".into(), |n| {
+                format!("N = {n:.0}")
+            });
+        println!("{shape}, a Brownian step: fast beats {name} from {at} (measured)");
+    }
     // The measured crossovers of a step of `k` products, fast against each other path.
     for (rotation, k, what) in [
         (false, 1.0, "one product a step"),
@@ -192,35 +231,54 @@ fn main() -> Result<()> {
             println!("{shape}, {what}: fast beats {name} from {at} (measured)");
         }
     }
-    let all = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
-    let (lo, hi) = all.fold((f64::INFINITY, 0.0f64), |(l, h), t| (l.min(t), h.max(t)));
+    // Each panel's range of seconds, for its crossovers' vertical lines.
+    let range = |series: &[Series]| {
+        let all = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
+        all.fold((f64::INFINITY, 0.0f64), |(l, h), t| (l.min(t), h.max(t)))
+    };
+    let (products, thermal_range) = (range(&series), range(&steps));
     let phi = shape
         .strip_prefix("cloud ")
         .and_then(|p| p.parse().ok())
         .unwrap_or(0.1);
-    for (bonds, rotation, what) in [
-        (0, false, "one product a step"),
-        (1, false, "a constraint solve"),
-        (0, true, "one product a step, rotation"),
-        (1, true, "a constraint solve, rotation"),
+    for (bonds, rotation, thermal, what) in [
+        (0, false, false, "one product a step"),
+        (1, false, false, "a constraint solve"),
+        (0, true, false, "one product a step, rotation"),
+        (1, true, false, "a constraint solve, rotation"),
+        (0, false, true, "a Brownian step"),
     ] {
-        if let Some(n) = crossover(phi, bonds, rotation) {
+        if let Some(n) = crossover(phi, bonds, rotation, thermal) {
             println!("auto takes the fast product from N = {n:.0} ({what})");
-            series.push(Series {
+            let ((lo, hi), panel) = match thermal {
+                false => (products, &mut series),
+                true => (thermal_range, &mut steps),
+            };
+            panel.push(Series {
                 name: format!("auto's crossover, {what}: N = {n:.0}"),
                 points: vec![(n, lo), (n, hi)],
             });
         }
     }
-    let chart = LineChart {
-        title: format!("Free-space mobility products, {shape} of unit spheres"),
-        x_label: "spheres N".into(),
-        y_label: "CPU seconds a call, one thread".into(),
-        log_x: true,
-        log_y: true,
-        series,
-    };
-    line_chart(Path::new(root).join(out).as_path(), &chart, (1100, 750))?;
+    let charts = [
+        LineChart {
+            title: format!("Free-space mobility products, {shape} of unit spheres"),
+            x_label: "spheres N".into(),
+            y_label: "CPU seconds a call, one thread".into(),
+            log_x: true,
+            log_y: true,
+            series,
+        },
+        LineChart {
+            title: format!("Thermal: one whole Brownian step, {shape} of unit spheres"),
+            x_label: "spheres N".into(),
+            y_label: "CPU seconds a step, one thread".into(),
+            log_x: true,
+            log_y: true,
+            series: steps,
+        },
+    ];
+    line_charts(Path::new(root).join(out).as_path(), &charts, (1100, 1500))?;
     println!("wrote {out}");
     Ok(())
 }

@@ -32,13 +32,13 @@ pub const MIDPOINT_FILL: f64 = 4.1480e1;
 /// The fit's worst factor between modelled and measured iterations, inverse root.
 pub const MIDPOINT_MISFIT: f64 = 1.36;
 /// Lanczos iterations of the root alone (the uncorrected draw), fixed part.
-pub const ROOT_FIXED: f64 = 1.6357e0;
+pub const ROOT_FIXED: f64 = 2.3443e0;
 /// Lanczos iterations of the root alone per `sqrt(S)`.
-pub const ROOT_SPREAD: f64 = 2.1602e0;
+pub const ROOT_SPREAD: f64 = 1.7118e0;
 /// Lanczos iterations of the root alone per `sqrt(f)`.
-pub const ROOT_FILL: f64 = 4.5737e1;
+pub const ROOT_FILL: f64 = 5.0863e1;
 /// The fit's worst factor between modelled and measured iterations, root alone.
-pub const ROOT_MISFIT: f64 = 1.21;
+pub const ROOT_MISFIT: f64 = 1.28;
 
 /// The iteration model's terms for `s`: `[1, sqrt(S), sqrt(f)]`.
 pub fn terms(s: &Spheres) -> [f64; 3] {

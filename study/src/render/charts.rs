@@ -61,10 +61,28 @@ pub fn line_chart_with_errors(
     errors: &[Vec<f64>],
     size: (u32, u32),
 ) -> Result<()> {
+    save_png(path, size, |root, k| draw_chart(root, chart, errors, k))
+}
+
+/// Line charts stacked in one PNG of `size` pixels, each in an equal band, top first
+/// (related cases, each with its own axes).
+pub fn line_charts(path: &Path, charts: &[LineChart], size: (u32, u32)) -> Result<()> {
+    save_png(path, size, |root, k| {
+        let bands = root.split_evenly((charts.len().max(1), 1));
+        for (band, chart) in bands.iter().zip(charts) {
+            draw_chart(band, chart, &[], k)?;
+        }
+        Ok(())
+    })
+}
+
+/// The points of `chart` as drawn, with their error bars: those a logarithmic axis
+/// can show, every value finite.
+fn drawn<'a>(chart: &'a LineChart, errors: &[Vec<f64>]) -> Vec<Drawn<'a>> {
     let keep = |&(x, y, _): &(f64, f64, f64)| {
         x.is_finite() && y.is_finite() && (!chart.log_x || x > 0.0) && (!chart.log_y || y > 0.0)
     };
-    let series: Vec<Drawn<'_>> = chart
+    chart
         .series
         .iter()
         .enumerate()
@@ -75,7 +93,17 @@ pub fn line_chart_with_errors(
                 points.map(|(k, &(x, y))| (x, y, err(k).filter(|e| e.is_finite()).unwrap_or(0.0)));
             (s.name.as_str(), with_err.filter(keep).collect())
         })
-        .collect();
+        .collect()
+}
+
+/// One chart on `root`, its axes fitted to its points and error bars.
+fn draw_chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &LineChart,
+    errors: &[Vec<f64>],
+    k: f64,
+) -> Result<()> {
+    let series = drawn(chart, errors);
     let all = series.iter().flat_map(|(_, p)| p.iter());
     let (mut x0, mut x1, mut y0, mut y1) =
         (f64::INFINITY, -f64::INFINITY, f64::INFINITY, -f64::INFINITY);
@@ -95,7 +123,7 @@ pub fn line_chart_with_errors(
     }
     let (x0, x1) = padded_range(x0, x1, chart.log_x);
     let (y0, y1) = padded_range(y0, y1, chart.log_y);
-    save_png(path, size, |root, k| match (chart.log_x, chart.log_y) {
+    match (chart.log_x, chart.log_y) {
         (false, false) => plot_lines(root, chart, &series, x0..x1, y0..y1, k),
         (true, false) => plot_lines(root, chart, &series, (x0..x1).log_scale(), y0..y1, k),
         (false, true) => plot_lines(root, chart, &series, x0..x1, (y0..y1).log_scale(), k),
@@ -107,7 +135,7 @@ pub fn line_chart_with_errors(
             (y0..y1).log_scale(),
             k,
         ),
-    })
+    }
 }
 
 fn plot_lines<DB, X, Y>(

@@ -4,7 +4,7 @@
 use hydrorattle_host::scene::{Helix, Scene};
 use hydrorattle_study::render::{
     CategoryMap, Figure1Case, LineChart, Mark, Series, Snapshot, category_map, chain_colors,
-    draw_configuration, draw_figure1, line_chart,
+    draw_configuration, draw_figure1, line_chart, line_charts,
 };
 use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
@@ -134,6 +134,21 @@ fn line_charts_linear_and_log() {
         ..LineChart::default()
     };
     assert!(line_chart(&out_dir().join("empty.png"), &empty, (100, 100)).is_err());
+    // Stacked: one picture of the given size, and no picture where a panel has no point.
+    let panel = |name: &str| LineChart {
+        title: name.into(),
+        log_x: true,
+        log_y: true,
+        series: vec![series("first order", 1.0)],
+        ..LineChart::default()
+    };
+    let path = out_dir().join("stacked.png");
+    line_charts(&path, &[panel("top"), panel("bottom")], (600, 800)).unwrap();
+    assert_eq!(png_size(&path), (600, 800));
+    let path = out_dir().join("stacked_empty.png");
+    let _ = std::fs::remove_file(&path);
+    assert!(line_charts(&path, &[panel("top"), empty], (600, 800)).is_err());
+    assert!(!path.exists());
 }
 
 #[test]
