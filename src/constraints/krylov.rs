@@ -26,7 +26,7 @@
 //!   rows, a diagonal row of the preconditioner, rebuilt when the set changes).
 
 use super::products::{Exact, Products};
-use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, graph, onesided};
 use crate::bonds::Bond;
 use crate::error::{LinalgError, StepError};
 use crate::linalg::band;
@@ -101,13 +101,29 @@ pub fn krylov_with<T: Real, P: Products<T>>(
     // always was).
     let from = problem.one_sided(nb);
     let one_sided = from < nb;
-    let state = &mut scratch.piv[..if one_sided { nb } else { 0 }];
+    let (state, rest) = scratch.piv.split_at_mut(if one_sided { nb } else { 0 });
+    // With one-sided rows (a pile) the preconditioner is built on the constraint graph
+    // (`graph.rs`), its pattern found once: the list does not change within a solve.
+    let on_graph = cfg!(feature = "contacts") && one_sided;
+    let (cols, links) = rest.split_at_mut(if on_graph { graph::WIDTH * nb } else { 0 });
+    if on_graph {
+        graph::pattern(bonds, n, cols, links);
+    }
+    let cols = &*cols;
+    let build = |pre: &mut [T], mask: (usize, &[usize])| match on_graph {
+        true => graph::factor(metric, bonds, c, (pre, cols), mask),
+        false => precondition(metric, bonds, c, pre, mask),
+    };
+    let apply = |pre: &[T], z: &mut [T]| match on_graph {
+        true => graph::solve(pre, cols, z),
+        false => band::solve(pre, nb, BAND, z),
+    };
     // The band's largest diagonal entry: a bound on the curvature test below.
     let mut top = T::ZERO;
     if one_sided {
         onesided::reset(state);
     } else {
-        top = precondition(metric, bonds, c, pre, (nb, state));
+        top = build(pre, (nb, state));
     }
     let mut products = 0u32;
     let mut outer = 0u32;
@@ -126,7 +142,7 @@ pub fn krylov_with<T: Real, P: Products<T>>(
         if one_sided {
             changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
             if changed || outer == 0 {
-                top = precondition(metric, bonds, c, pre, (from, state));
+                top = build(pre, (from, state));
             }
         }
         // Nonlinear residual of the chord iteration.
@@ -211,7 +227,7 @@ pub fn krylov_with<T: Real, P: Products<T>>(
             }
         }
         z.copy_from_slice(r);
-        band::solve(pre, nb, BAND, z);
+        apply(pre, z);
         op.precondition(r, z);
         p.copy_from_slice(z);
         let mut rz = dot(r, z);
@@ -272,7 +288,7 @@ pub fn krylov_with<T: Real, P: Products<T>>(
                 break;
             }
             z.copy_from_slice(r);
-            band::solve(pre, nb, BAND, z);
+            apply(pre, z);
             op.precondition(r, z);
             let rz_new = dot(r, z);
             let beta = rz_new / rz;
