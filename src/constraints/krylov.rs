@@ -16,6 +16,9 @@
 //!   near-field coupling of neighbouring bonds (the hydrodynamic coupling between bonds
 //!   decays as `1/s^3`), so the iteration count barely grows with the chain length.
 //!   If the band is not positive definite, its diagonal (Jacobi) is used instead.
+//!   With one-sided rows (contacts, wall links: a pile, whose rows of one sphere sit
+//!   anywhere in the list) the preconditioner is instead the incomplete Cholesky of
+//!   `A` on the constraint graph, rows coupled where they share a sphere (`graph.rs`).
 //! * Reported iterations are PCG iterations, i.e. operator products: the cost count.
 //! * With a compact metric (`Metric::Mobility::compact`) the products read an `f32`
 //!   copy of the mobility; the residual is still evaluated on the positions in `f64`, so the
@@ -104,7 +107,11 @@ pub fn krylov_with<T: Real, P: Products<T>>(
     let (state, rest) = scratch.piv.split_at_mut(if one_sided { nb } else { 0 });
     // With one-sided rows (a pile) the preconditioner is built on the constraint graph
     // (`graph.rs`), its pattern found once: the list does not change within a solve.
-    let on_graph = cfg!(feature = "contacts") && one_sided;
+    // (A scratch sized for fewer rows or spheres, which `Layout` never gives, keeps the
+    // band.)
+    let on_graph = cfg!(feature = "contacts")
+        && one_sided
+        && rest.len() >= graph::indices(n, nb);
     let (cols, links) = rest.split_at_mut(if on_graph { graph::WIDTH * nb } else { 0 });
     if on_graph {
         graph::pattern(bonds, n, cols, links);
