@@ -110,7 +110,11 @@ fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> 
             time: &mut time,
             noise: None,
         };
-        let (params, ws) = if k < steps { (&p, &mut ws) } else { (&krylov, &mut kws) };
+        let (params, ws) = if k < steps {
+            (&p, &mut ws)
+        } else {
+            (&krylov, &mut kws)
+        };
         let result = step_slices(state, &bonds, params, ws, &mut NoForce);
         let elapsed = match (c, cpu()) {
             (Some(a), Some(b)) => b - a,

@@ -5,8 +5,10 @@
 //! In a pile a sphere's rows (its wall link, its contacts, its bonds) sit anywhere in
 //! the list, so the band `|k - l| <= BAND` of the bond-ordered solve holds little of
 //! `A`'s coupling there. The rows that share a sphere are coupled through that
-//! sphere's self mobility, `A`'s largest off-diagonal entries; every other entry is
-//! a pair mobility, smaller by the spheres' separation over their radius.
+//! sphere's self mobility; every other entry is a pair mobility, which between
+//! touching spheres is still about half the self mobility and decays only as `1 / r`
+//! (so a pattern of near rows holds part of `A`, not most of it: the measured gain,
+//! `docs/CONTACTS.md`, is a fifth of the products).
 //!
 //! * Pattern: row `k` keeps the rows `l < k` that share a sphere with it, at most
 //!   [`WIDTH`] of them, the nearest in list order (a row with more neighbours below it
@@ -32,7 +34,6 @@ use crate::real::Real;
 /// neighbours below it in all but a few rows (`examples/pile_cost.rs`).
 pub(super) const WIDTH: usize = super::krylov::BAND;
 
-
 /// No column: an unused slot of a row's pattern.
 const NONE: usize = usize::MAX;
 
@@ -54,7 +55,12 @@ fn ends<T: Real>(b: &Bond<T>) -> [Option<usize>; 2] {
 
 /// Builds the pattern in `cols` (`WIDTH` per row, ascending, [`NONE`] after the last)
 /// for `bonds` on `n` spheres; `links` is scratch of `2 B + n`.
-pub(super) fn pattern<T: Real>(bonds: &[Bond<T>], n: usize, cols: &mut [usize], links: &mut [usize]) {
+pub(super) fn pattern<T: Real>(
+    bonds: &[Bond<T>],
+    n: usize,
+    cols: &mut [usize],
+    links: &mut [usize],
+) {
     let nb = bonds.len();
     let (next, head) = links.split_at_mut(2 * nb);
     head[..n].fill(NONE);
@@ -136,7 +142,10 @@ pub(super) fn factor<T: Real>(
     let floor = super::dependent::rank_floor::<T>();
     if incomplete(pre, cols, nb, floor).is_err() {
         log::debug!("krylov: graph preconditioner not positive definite, using Jacobi");
-        for (k, row) in pre[..nb * (WIDTH + 1)].chunks_exact_mut(WIDTH + 1).enumerate() {
+        for (k, row) in pre[..nb * (WIDTH + 1)]
+            .chunks_exact_mut(WIDTH + 1)
+            .enumerate()
+        {
             row[..WIDTH].fill(T::ZERO);
             // A's diagonal is positive (a row's own metric); a degenerate row gives 1.
             let mut d = [T::ZERO];

@@ -109,9 +109,7 @@ pub fn krylov_with<T: Real, P: Products<T>>(
     // (`graph.rs`), its pattern found once: the list does not change within a solve.
     // (A scratch sized for fewer rows or spheres, which `Layout` never gives, keeps the
     // band.)
-    let on_graph = cfg!(feature = "contacts")
-        && one_sided
-        && rest.len() >= graph::indices(n, nb);
+    let on_graph = cfg!(feature = "contacts") && one_sided && rest.len() >= graph::indices(n, nb);
     let (cols, links) = rest.split_at_mut(if on_graph { graph::WIDTH * nb } else { 0 });
     if on_graph {
         graph::pattern(bonds, n, cols, links);

@@ -2,8 +2,9 @@
 //! the 100-sphere pile of `examples/pile_cost.rs` after 150 Newton steps (landed:
 //! contacts and wall links forming and releasing), one step with Krylov gives Newton's
 //! positions to the tolerance's order, f32 and f64, and its last constraint solve takes
-//! fewer operator products than the band preconditioner in list order did (400 in f64,
-//! the preconditioner on the constraint graph 314).
+//! fewer operator products than the band preconditioner in list order did (f64: 400
+//! with the band, 314 with the preconditioner on the constraint graph; f32: 257 and
+//! 199).
 
 use crate::common::{f64s, norm, pick, sub};
 use crate::pile_factor::pile;
@@ -42,7 +43,10 @@ fn from_the_pile<T: Real>() -> (f64, u32) {
             length: T::from_f64(b.length),
         })
         .collect();
-    let (newton, krylov) = (params::<T>(SolverKind::Newton, n), params(SolverKind::Krylov, n));
+    let (newton, krylov) = (
+        params::<T>(SolverKind::Newton, n),
+        params(SolverKind::Krylov, n),
+    );
     let mut buf = Buffers::<T>::new(Layout::for_params(&newton, n, bonds.len()));
     let mut kbuf = Buffers::<T>::new(Layout::for_params(&krylov, n, bonds.len()));
     let (mut vel, mut omega, mut time) = (vec![T::V3_ZERO; n], vec![T::V3_ZERO; n], T::ZERO);
@@ -75,11 +79,14 @@ fn agrees_in_few_products<T: Real>() {
     let (d, products) = from_the_pile::<T>();
     eprintln!("Krylov against Newton: {d:.2e}, {products} products");
     // Both solves stop at the tolerance (relative lengths): positions agree to its
-    // order times the pile's conditioning.
-    let tol = pick::<T>(1e-3, 1e-7);
+    // order times the pile's conditioning (f64: 8.5e-8 of a radius, 8.1e-9 with the
+    // band; f32: 1.3e-5, 3.5e-5).
+    let tol = pick::<T>(1e-3, 1e-6);
     assert!(d <= tol, "Krylov and Newton differ by {d:e} of a radius");
-    // The band in list order took 400 products here (f64), the graph's IC(0) 314.
-    assert!(products <= 360, "{products} products");
+    // The band in list order took 400 products here (f32: 257), the graph's IC(0)
+    // 314 (199).
+    let most = pick::<T>(230.0, 360.0);
+    assert!(f64::from(products) <= most, "{products} products");
 }
 
 #[test]
