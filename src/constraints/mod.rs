@@ -56,8 +56,9 @@ pub enum SolverKind {
     /// Newton iterations on the dense `bonds x bonds` Jacobian (LU, reused while it
     /// keeps converging fast): `O(B^2)` storage, `O(B^3)` per factorisation.
     Newton,
-    /// Chord Newton with banded-preconditioned conjugate gradients: `O(B)` storage,
-    /// one mobility product per iteration.
+    /// Chord Newton with banded-preconditioned conjugate gradients (with contacts or
+    /// wall links: preconditioned by the incomplete Cholesky of the rows that share a
+    /// sphere): `O(B)` storage, one mobility product per iteration.
     Krylov,
     /// [`SolverKind::Newton`] up to [`DENSE_BONDS_MAX`] constraint rows,
     /// [`SolverKind::Krylov`] above (the default). A step resolves it once, from every
