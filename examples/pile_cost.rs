@@ -5,11 +5,11 @@
 //! steps (the pile landed, contacts and wall links forming and releasing) is timed.
 //! Prints, per size, the CPU time a step, the Jacobian factorisations a step
 //! (`StepReport::factorizations`), the Newton iterations and active-set rounds a step
-//! and the constraint rows held. Then one Krylov step from each pile's state at the end
-//! (the same parameters, `max_iterations` 500: at most 5 000 products) gives the
-//! products the Krylov constraint solve takes there, or where it gave up. Records them
-//! in `bench/results/pile_cost.csv` where `HYDRORATTLE_BENCH_MACHINE` names the
-//! machine.
+//! and the constraint rows held. Then `KRYLOV_STEPS` Krylov steps from each pile's state
+//! at the end (the same parameters, `max_iterations` 500: at most 5 000 products a
+//! solve) give the products the Krylov constraint solve takes there (the first step's,
+//! and the mean a step), or where it gave up, and their CPU time a step. Records them in
+//! `bench/results/pile_cost.csv` where `HYDRORATTLE_BENCH_MACHINE` names the machine.
 //!
 //! ```text
 //! cargo run --release --example pile_cost [STEPS WINDOW]
@@ -65,6 +65,9 @@ fn pile(fence: usize, side: usize, count: usize) -> (Vec<V>, Vec<f64>, Vec<f64>,
     (pos, radius, density, bonds)
 }
 
+/// Krylov steps taken from the end of the Newton run.
+const KRYLOV_STEPS: usize = 5;
+
 /// The piles' parameters with `kind`'s constraint solve.
 fn params(kind: SolverKind, n: usize) -> Params<f64> {
     let mut p = Params::<f64>::new(0.2);
@@ -78,20 +81,24 @@ fn params(kind: SolverKind, n: usize) -> Params<f64> {
 }
 
 /// Per step over the window: CPU seconds, factorisations, Newton iterations, rounds,
-/// rows held (contacts, wall links and bonds) at the end; then one Krylov step from
-/// the state at the end: its products, and whether it converged.
-fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> [f64; 7] {
+/// rows held (contacts, wall links and bonds) at the end; then [`KRYLOV_STEPS`] Krylov
+/// steps from the state at the end: the first one's products, whether all converged,
+/// and per step their products and CPU seconds.
+fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> [f64; 9] {
     let (mut pos, radius, density, bonds) = pile(fence, side, count);
     let n = pos.len();
     let p = params(SolverKind::Newton, n);
     let krylov = params(SolverKind::Krylov, n);
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, n, bonds.len()));
+    let mut kbuf = Buffers::<f64>::new(Layout::for_params(&krylov, n, bonds.len()));
     let mut ws = buf.workspace();
+    let mut kws = kbuf.workspace();
     let (mut vel, mut omega, mut time) = (vec![V::ZERO; n], vec![V::ZERO; n], 0.0);
     let mut sums = [0.0; 5];
-    let (mut products, mut converged) = (0.0, 0.0);
-    // Steps `0..steps` with Newton, step `steps` with Krylov.
-    for k in 0..=steps {
+    let (mut first, mut converged, mut products, mut cpu_k) = (0.0, 1.0, 0.0, 0.0);
+    let mut taken = 0;
+    // Steps `0..steps` with Newton, then `KRYLOV_STEPS` with Krylov.
+    for k in 0..steps + KRYLOV_STEPS {
         let timed = k + window >= steps;
         let (t, c) = (Instant::now(), cpu());
         let state = State {
@@ -103,43 +110,55 @@ fn run(fence: usize, side: usize, count: usize, steps: usize, window: usize) -> 
             time: &mut time,
             noise: None,
         };
-        let params = if k < steps { &p } else { &krylov };
-        let r = match (
-            step_slices(state, &bonds, params, &mut ws, &mut NoForce),
-            k < steps,
-        ) {
+        let (params, ws) = if k < steps {
+            (&p, &mut ws)
+        } else {
+            (&krylov, &mut kws)
+        };
+        let result = step_slices(state, &bonds, params, ws, &mut NoForce);
+        let elapsed = match (c, cpu()) {
+            (Some(a), Some(b)) => b - a,
+            _ => t.elapsed().as_secs_f64(),
+        };
+        let r = match (result, k < steps) {
             (Ok(r), true) => r,
             (Err(e), true) => panic!("step {k}: {e}"),
             (Ok(r), false) => {
-                (products, converged) = (f64::from(r.iterations), 1.0);
-                break;
+                let it = f64::from(r.iterations);
+                if k == steps {
+                    first = it;
+                }
+                (products, cpu_k, taken) = (products + it, cpu_k + elapsed, taken + 1);
+                continue;
             }
             (Err(StepError::NoConvergence { iterations, .. }), false) => {
-                products = f64::from(iterations);
+                if k == steps {
+                    first = f64::from(iterations);
+                }
+                converged = 0.0;
                 break;
             }
             (Err(e), false) => panic!("krylov: {e}"),
         };
         if timed {
-            sums[0] += match (c, cpu()) {
-                (Some(a), Some(b)) => b - a,
-                _ => t.elapsed().as_secs_f64(),
-            };
+            sums[0] += elapsed;
             sums[1] += f64::from(r.factorizations);
             sums[2] += f64::from(r.iterations);
             sums[3] += f64::from(r.contact_rounds);
             sums[4] = f64::from(r.contacts + r.wall_contacts) + bonds.len() as f64;
         }
     }
-    let w = window as f64;
+    let (w, kt) = (window as f64, f64::from(taken).max(1.0));
     [
         sums[0] / w,
         sums[1] / w,
         sums[2] / w,
         sums[3] / w,
         sums[4],
-        products,
+        first,
         converged,
+        products / kt,
+        cpu_k / kt,
     ]
 }
 
@@ -154,13 +173,15 @@ fn main() {
     };
     let command = format!("cargo run --release --example pile_cost {steps} {window}");
     let mut rows = record::Recorder::new(env!("CARGO_MANIFEST_DIR"), "pile_cost", command);
-    let mut cost = Vec::new();
+    let (mut cost, mut cost_k) = (Vec::new(), Vec::new());
     for (fence, side, count) in [(15, 3, 100), (25, 5, 300)] {
-        let [s, f, it, rounds, held, products, converged] = run(fence, side, count, steps, window);
+        let [s, f, it, rounds, held, products, converged, per_step, cpu_k] =
+            run(fence, side, count, steps, window);
         println!(
             "{count} spheres: {:.4} s a step, {f:.1} factorisations, {it:.1} Newton \
              iterations (last round), {rounds:.1} rounds a step, {held} rows held at the end; \
-             Krylov from there: {products} products ({})",
+             Krylov from there: {products} products ({}), {per_step:.1} products and \
+             {cpu_k:.4} s a step over {KRYLOV_STEPS} steps",
             s,
             match converged == 1.0 {
                 true => "converged",
@@ -176,10 +197,16 @@ fn main() {
         ] {
             rows.row("pile newton", &case, q, &format!("{v}"));
         }
-        for (q, v) in [("products_one_step", products), ("converged", converged)] {
+        for (q, v) in [
+            ("products_one_step", products),
+            ("converged", converged),
+            ("products_per_step", per_step),
+            ("cpu_s_per_step", cpu_k),
+        ] {
             rows.row("pile krylov", &case, q, &format!("{v}"));
         }
         cost.push(s);
+        cost_k.push(cpu_k);
     }
     println!("cost ratio 300 / 100: {:.1}", cost[1] / cost[0]);
     rows.row(
@@ -187,6 +214,18 @@ fn main() {
         "300 / 100",
         "cost_ratio",
         &format!("{}", cost[1] / cost[0]),
+    );
+    println!(
+        "Krylov cost ratio 300 / 100: {:.1}; Krylov / Newton a step: {:.2} (100), {:.2} (300)",
+        cost_k[1] / cost_k[0],
+        cost_k[0] / cost[0],
+        cost_k[1] / cost[1]
+    );
+    rows.row(
+        "pile krylov",
+        "300 / 100",
+        "cost_ratio",
+        &format!("{}", cost_k[1] / cost_k[0]),
     );
     rows.finish().expect("bench/results/pile_cost.csv");
 }

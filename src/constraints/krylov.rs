@@ -16,6 +16,9 @@
 //!   near-field coupling of neighbouring bonds (the hydrodynamic coupling between bonds
 //!   decays as `1/s^3`), so the iteration count barely grows with the chain length.
 //!   If the band is not positive definite, its diagonal (Jacobi) is used instead.
+//!   With one-sided rows (contacts, wall links: a pile, whose rows of one sphere sit
+//!   anywhere in the list) the preconditioner is instead the incomplete Cholesky of
+//!   `A` on the constraint graph, rows coupled where they share a sphere (`graph.rs`).
 //! * Reported iterations are PCG iterations, i.e. operator products: the cost count.
 //! * With a compact metric (`Metric::Mobility::compact`) the products read an `f32`
 //!   copy of the mobility; the residual is still evaluated on the positions in `f64`, so the
@@ -26,7 +29,7 @@
 //!   rows, a diagonal row of the preconditioner, rebuilt when the set changes).
 
 use super::products::{Exact, Products};
-use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, onesided};
+use super::{Metric, Problem, Scratch, SolveStats, Solver, dependent, graph, onesided};
 use crate::bonds::Bond;
 use crate::error::{LinalgError, StepError};
 use crate::linalg::band;
@@ -101,13 +104,31 @@ pub fn krylov_with<T: Real, P: Products<T>>(
     // always was).
     let from = problem.one_sided(nb);
     let one_sided = from < nb;
-    let state = &mut scratch.piv[..if one_sided { nb } else { 0 }];
+    let (state, rest) = scratch.piv.split_at_mut(if one_sided { nb } else { 0 });
+    // With one-sided rows (a pile) the preconditioner is built on the constraint graph
+    // (`graph.rs`), its pattern found once: the list does not change within a solve.
+    // (A scratch sized for fewer rows or spheres, which `Layout` never gives, keeps the
+    // band.)
+    let on_graph = cfg!(feature = "contacts") && one_sided && rest.len() >= graph::indices(n, nb);
+    let (cols, links) = rest.split_at_mut(if on_graph { graph::WIDTH * nb } else { 0 });
+    if on_graph {
+        graph::pattern(bonds, n, cols, links);
+    }
+    let cols = &*cols;
+    let build = |pre: &mut [T], mask: (usize, &[usize])| match on_graph {
+        true => graph::factor(metric, bonds, c, (pre, cols), mask),
+        false => precondition(metric, bonds, c, pre, mask),
+    };
+    let apply = |pre: &[T], z: &mut [T]| match on_graph {
+        true => graph::solve(pre, cols, z),
+        false => band::solve(pre, nb, BAND, z),
+    };
     // The band's largest diagonal entry: a bound on the curvature test below.
     let mut top = T::ZERO;
     if one_sided {
         onesided::reset(state);
     } else {
-        top = precondition(metric, bonds, c, pre, (nb, state));
+        top = build(pre, (nb, state));
     }
     let mut products = 0u32;
     let mut outer = 0u32;
@@ -126,7 +147,7 @@ pub fn krylov_with<T: Real, P: Products<T>>(
         if one_sided {
             changed = onesided::update(&problem, metric, bonds, from, x, mult, state);
             if changed || outer == 0 {
-                top = precondition(metric, bonds, c, pre, (from, state));
+                top = build(pre, (from, state));
             }
         }
         // Nonlinear residual of the chord iteration.
@@ -211,7 +232,7 @@ pub fn krylov_with<T: Real, P: Products<T>>(
             }
         }
         z.copy_from_slice(r);
-        band::solve(pre, nb, BAND, z);
+        apply(pre, z);
         op.precondition(r, z);
         p.copy_from_slice(z);
         let mut rz = dot(r, z);
@@ -272,7 +293,7 @@ pub fn krylov_with<T: Real, P: Products<T>>(
                 break;
             }
             z.copy_from_slice(r);
-            band::solve(pre, nb, BAND, z);
+            apply(pre, z);
             op.precondition(r, z);
             let rz_new = dot(r, z);
             let beta = rz_new / rz;

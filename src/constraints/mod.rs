@@ -17,6 +17,7 @@
 
 mod active;
 mod dependent;
+mod graph;
 mod krylov;
 mod metric;
 mod newton;
@@ -55,8 +56,9 @@ pub enum SolverKind {
     /// Newton iterations on the dense `bonds x bonds` Jacobian (LU, reused while it
     /// keeps converging fast): `O(B^2)` storage, `O(B^3)` per factorisation.
     Newton,
-    /// Chord Newton with banded-preconditioned conjugate gradients: `O(B)` storage,
-    /// one mobility product per iteration.
+    /// Chord Newton with banded-preconditioned conjugate gradients (with contacts or
+    /// wall links: preconditioned by the incomplete Cholesky of the rows that share a
+    /// sphere): `O(B)` storage, one mobility product per iteration.
     Krylov,
     /// [`SolverKind::Newton`] up to [`DENSE_BONDS_MAX`] constraint rows,
     /// [`SolverKind::Krylov`] above (the default). A step resolves it once, from every
@@ -293,23 +295,24 @@ pub const fn scratch_size(kind: SolverKind, n: usize, m: usize, bonds: usize) ->
         SolverKind::Newton => [
             bonds * bonds + bonds,
             0,
-            index_scratch(SolverKind::Newton, bonds),
+            index_scratch(SolverKind::Newton, n, bonds),
         ],
         SolverKind::Krylov => [
             krylov::SCALARS_PER_BOND * bonds,
             2 * n + 2 * m + crate::parallel::band_scratch(m),
-            index_scratch(SolverKind::Krylov, bonds),
+            index_scratch(SolverKind::Krylov, n, bonds),
         ],
         _ => [0, 0, 0],
     }
 }
 
-/// Index scratch of `kind` (resolved) for `bonds` rows: Newton's LU pivots, and with
-/// contacts compiled in the one-sided rows' states (Newton, Krylov).
-pub(crate) const fn index_scratch(kind: SolverKind, bonds: usize) -> usize {
+/// Index scratch of `kind` (resolved) for `bonds` rows on `n` spheres: Newton's LU
+/// pivots, and with contacts compiled in the one-sided rows' states (Newton, Krylov)
+/// and the pattern of Krylov's preconditioner on the constraint graph (`graph.rs`).
+pub(crate) const fn index_scratch(kind: SolverKind, n: usize, bonds: usize) -> usize {
     match kind {
         SolverKind::Newton => bonds + onesided::STATE_PER_ROW * bonds,
-        SolverKind::Krylov => onesided::STATE_PER_ROW * bonds,
+        SolverKind::Krylov => onesided::STATE_PER_ROW * bonds + graph::indices(n, bonds),
         _ => 0,
     }
 }

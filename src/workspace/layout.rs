@@ -132,7 +132,9 @@ impl Layout {
     ///   Krylov.
     ///
     /// The dense Newton solve adds `B^2 + B` scalars and `B` indices; Krylov adds
-    /// `9 B` scalars and `2n + 2m` vectors; the sweep adds nothing. From
+    /// `16 B` scalars (its band and vectors) and `2n + 2m` vectors, and with contacts
+    /// compiled in `13 B + n` indices (the rows' states and the pattern of its
+    /// preconditioner on the constraint graph); the sweep adds nothing. From
     /// [`CELLS_MIN`](crate::cell_list::CELLS_MIN) spheres on (with the `cells` feature)
     /// the pair searches' cell list adds `3n + 1` indices
     /// ([`cell_list::indices`](crate::cell_list::indices)).

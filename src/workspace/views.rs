@@ -198,7 +198,7 @@ impl<T: Real> Workspace<'_, T> {
             jac: sc.take(if newton { nb * nb } else { 0 }),
             rhs: sc.take(if newton { nb } else { 0 }),
             piv: ix.take(match (constrained, kind) {
-                (true, SolverKind::Newton | SolverKind::Krylov) => index_scratch(kind, nb),
+                (true, SolverKind::Newton | SolverKind::Krylov) => index_scratch(kind, n, nb),
                 _ => 0,
             }),
             krylov: sc.take(if constrained && krylov {

@@ -75,6 +75,8 @@ mod periodic_digest;
 mod periodic_step;
 #[cfg(all(feature = "contacts", feature = "wall"))]
 mod pile_factor;
+#[cfg(all(feature = "contacts", feature = "wall"))]
+mod pile_krylov;
 mod pins;
 #[cfg(feature = "pse")]
 mod pse;

@@ -10,10 +10,14 @@ use hydrorattle_heap::Buffers;
 
 type V = <f64 as Real>::V3;
 
-/// 76 spheres: a fence of 12 bonded heavy spheres on the wall around a 4 x 4 x 4 column
-/// of unit spheres, jittered by a fixed pattern .
-fn pile() -> (Vec<V>, Vec<f64>, Vec<f64>, Vec<Bond<f64>>) {
-    let fence = 12;
+/// A fence of `fence` bonded heavy spheres on the wall around a column of `count` unit
+/// spheres, `side x side` a layer, jittered by a fixed pattern (the geometry of
+/// `examples/pile_cost.rs`; also `pile_krylov.rs`).
+pub(crate) fn pile(
+    fence: usize,
+    side: usize,
+    count: usize,
+) -> (Vec<V>, Vec<f64>, Vec<f64>, Vec<Bond<f64>>) {
     let ring = 1.501 / (std::f64::consts::PI / fence as f64).sin();
     let (mut pos, mut radius, mut density) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..fence {
@@ -23,11 +27,12 @@ fn pile() -> (Vec<V>, Vec<f64>, Vec<f64>, Vec<Bond<f64>>) {
         density.push(10.0);
     }
     let jitter = |k: usize, c: usize| 0.1 * (((k * 7919 + c * 104_729) % 1000) as f64 / 1e3 - 0.5);
-    for k in 0..64 {
-        let (l, i, j) = (k / 16, (k / 4) % 4, k % 4);
+    let off = 1.15 * (side as f64 - 1.0);
+    for k in 0..count {
+        let (l, i, j) = (k / (side * side), (k / side) % side, k % side);
         pos.push(V::new(
-            2.3 * i as f64 - 3.45 + jitter(k, 1),
-            2.3 * j as f64 - 3.45 + jitter(k, 2),
+            2.3 * i as f64 - off + jitter(k, 1),
+            2.3 * j as f64 - off + jitter(k, 2),
             2.6 + 2.3 * l as f64 + jitter(k, 3),
         ));
         radius.push(1.0);
@@ -46,7 +51,8 @@ fn pile() -> (Vec<V>, Vec<f64>, Vec<f64>, Vec<Bond<f64>>) {
 /// Steps the pile 60 times with `kind`; returns the factorisations and rounds of
 /// steps 30 to 59.
 fn counts(kind: SolverKind) -> (u32, u32) {
-    let (mut pos, radius, density, bonds) = pile();
+    // 76 spheres: a fence of 12 around a 4 x 4 x 4 column.
+    let (mut pos, radius, density, bonds) = pile(12, 4, 64);
     let n = pos.len();
     let mut p = Params::<f64>::new(0.2);
     p.method = Method::Overdamped;
