@@ -29,6 +29,7 @@
 use hydrorattle::integrate::{fast_storage, step_slices};
 use hydrorattle::linalg::tri;
 use hydrorattle::{Brownian, Layout, Method, NoForce, Noise, Params, Real, State};
+use hydrorattle_heap::FreeBuffers;
 
 type V = <f64 as Real>::V3;
 
@@ -44,7 +45,7 @@ mod free_shapes;
 mod record;
 #[path = "shared/splitmix.rs"]
 mod splitmix;
-use free_shapes::{COUNTS, SHAPES, chain, cloud};
+use free_shapes::{SHAPES, chain, cloud};
 
 /// The paths, as the rows name them.
 const PATHS: [&str; 3] = ["dense", "matrix-free", "fast 1e-4"];
@@ -74,23 +75,16 @@ fn time_step(k: usize, pos0: &[V], reps: usize) -> Result<Option<(f64, u32)>, St
     let density = vec![1.0; n];
     let layout = Layout::for_params(&p, n, 0);
     let size = fast_storage(&p, pos0, &rad).map_err(|e| e.to_string())?;
-    let grid = size.map_or(0, |z| z.complex * 16 + z.reals * 8 + z.index * 8);
+    let grid = size.map_or(0, FreeBuffers::<f64>::bytes_of);
     // The kernel's workspace: the stored mobility (twice with the midpoint) and the
     // Lanczos basis dominate; a generous bound from the layout's blocks.
     let stored = if k == 0 { 2 * 48 * tri(n) } else { 0 };
     if stored + grid + 8 * 3 * 66 * n > MAX_BYTES {
         return Ok(None);
     }
-    let (mut cx, mut re, mut ix) = match size {
-        Some(z) => (
-            vec![[0.0; 2]; z.complex],
-            vec![0.0; z.reals],
-            vec![0; z.index],
-        ),
-        None => (vec![], vec![], vec![]),
-    };
+    let mut arrays = FreeBuffers::<f64>::for_step(size);
     let mut buf = hydrorattle_heap::Buffers::<f64>::new(layout);
-    let mut ws = buf.workspace().with_fast(&mut cx, &mut re, &mut ix);
+    let mut ws = arrays.attach(buf.workspace());
     let (mut pos, mut vel, mut omega) = (pos0.to_vec(), vec![V::ZERO; n], vec![V::ZERO; n]);
     let mut result = Ok(0);
     let mut one = || {
@@ -125,22 +119,19 @@ fn time_step(k: usize, pos0: &[V], reps: usize) -> Result<Option<(f64, u32)>, St
 
 fn main() -> std::io::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let range = args.first().map_or("10000", String::as_str);
-    let (min_n, max_n) = free_shapes::count_range(args.first().map(String::as_str), 10_000);
-    let only: Vec<&str> = args.iter().skip(1).map(String::as_str).collect();
-    let named: String = only.iter().map(|s| format!(" '{s}'")).collect();
+    let pick = free_shapes::Selection::new(&args);
+    let (range, named) = (&pick.range, &pick.named);
     let mut rows = record::Recorder::new(
         env!("CARGO_MANIFEST_DIR"),
         "free_cost",
         format!("cargo run --release --example free_brownian -- {range}{named}"),
     );
-    let (shapes, counts) = (SHAPES, COUNTS);
-    for (shape, phi) in shapes {
-        if !(only.is_empty() || only.contains(&shape)) {
+    for (shape, phi) in SHAPES {
+        if !pick.shape(shape) {
             continue;
         }
         let mut stopped = [false; 3];
-        for &n in counts.iter().filter(|&&n| (min_n..=max_n).contains(&n)) {
+        for n in pick.counts() {
             let past = n > 10_000;
             if past && shape != "cloud 0.1" {
                 continue;

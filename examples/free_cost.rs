@@ -76,7 +76,7 @@ mod splitmix;
 use splitmix::Rng;
 #[path = "shared/free_shapes.rs"]
 mod free_shapes;
-use free_shapes::{COUNTS, SHAPES, chain, cloud, extent, near_pairs};
+use free_shapes::{SHAPES, chain, cloud, extent, near_pairs};
 
 /// Storage past which a path is not timed (bytes), unless `--max-bytes` says otherwise.
 const MAX_BYTES: f64 = 4e8;
@@ -310,10 +310,8 @@ fn main() -> std::io::Result<()> {
         }
         None => String::new(),
     };
-    let range = args.first().map_or("10000", String::as_str);
-    let (min_n, max_n) = free_shapes::count_range(args.first().map(String::as_str), 10_000);
-    let only: Vec<&str> = args.iter().skip(1).map(String::as_str).collect();
-    let named: String = only.iter().map(|s| format!(" '{s}'")).collect();
+    let pick = free_shapes::Selection::new(&args);
+    let (range, named) = (&pick.range, &pick.named);
     let mut rows = record::Recorder::new(
         env!("CARGO_MANIFEST_DIR"),
         "free_cost",
@@ -321,14 +319,13 @@ fn main() -> std::io::Result<()> {
     );
     let table = "free-space product paths, unit spheres, f64, one thread, CPU seconds a call \
                  (best of two; fast products with the kernel's transform kept)";
-    let (shapes, counts) = (SHAPES, COUNTS);
     let mut fits: Vec<Fit> = NAMES.iter().map(|_| Fit::default()).collect();
-    for (shape, phi) in shapes {
-        if !(only.is_empty() || only.contains(&shape)) {
+    for (shape, phi) in SHAPES {
+        if !pick.shape(shape) {
             continue;
         }
         let mut stopped = [false; NAMES.len()];
-        for &n in counts.iter().filter(|&&n| (min_n..=max_n).contains(&n)) {
+        for n in pick.counts() {
             // Past 1e4 only the paths that store no mobility, on the cloud at 0.1.
             let all = n <= 10_000;
             if !all && shape != "cloud 0.1" {

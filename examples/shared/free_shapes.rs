@@ -22,14 +22,49 @@ pub const COUNTS: [usize; 10] = [
     10, 30, 100, 300, 1000, 3000, 10_000, 20_000, 50_000, 100_000,
 ];
 
-/// The counts an argument `MAX_N` or `MIN_N:MAX_N` names (`default` without one; a
-/// count may be written `1e5`).
-pub fn count_range(arg: Option<&str>, default: usize) -> (usize, usize) {
-    let num = |s: &str| s.parse::<f64>().unwrap() as usize;
-    match arg.map(|a| a.split_once(':')) {
-        Some(Some((a, b))) => (num(a), num(b)),
-        Some(None) => (0, num(arg.unwrap_or_default())),
-        None => (0, default),
+/// What a cost example's arguments select: the counts `MAX_N` or `MIN_N:MAX_N` (the
+/// first argument, 1e4 without one; a count may be written `1e5`) and the shapes named
+/// after it (every shape when none), with both as the recorded command writes them.
+pub struct Selection {
+    min_n: usize,
+    max_n: usize,
+    only: Vec<String>,
+    /// The counts' argument as given (`"10000"` without one).
+    pub range: String,
+    /// The shapes' arguments, each quoted after a space.
+    pub named: String,
+}
+
+impl Selection {
+    /// The selection `args` (the example's arguments, its own options removed) make.
+    pub fn new(args: &[String]) -> Self {
+        let num = |s: &str| s.parse::<f64>().unwrap() as usize;
+        let range = args.first().map_or("10000", String::as_str);
+        let (min_n, max_n) = match range.split_once(':') {
+            Some((a, b)) => (num(a), num(b)),
+            None => (0, num(range)),
+        };
+        let only = args.iter().skip(1).cloned().collect::<Vec<_>>();
+        let named = only.iter().map(|s| format!(" '{s}'")).collect();
+        Self {
+            min_n,
+            max_n,
+            only,
+            range: range.to_string(),
+            named,
+        }
+    }
+
+    /// Whether the shape called `name` runs.
+    pub fn shape(&self, name: &str) -> bool {
+        self.only.is_empty() || self.only.iter().any(|o| o == name)
+    }
+
+    /// The counts of [`COUNTS`] that run.
+    pub fn counts(&self) -> impl Iterator<Item = usize> + '_ {
+        COUNTS
+            .into_iter()
+            .filter(|n| (self.min_n..=self.max_n).contains(n))
     }
 }
 
