@@ -1,5 +1,5 @@
-//! The cost of a step of a settling contact pile with the dense Newton solve, at two
-//! sizes: 100 and 300 unit spheres dropped in a column into a fence of bonded heavy
+//! The cost of a step of a settling contact pile with the dense Newton solve, at the
+//! sizes asked (default 100 and 300 unit spheres) dropped in a column into a fence of bonded heavy
 //! spheres on the wall (the geometry of `host/scenes/pile.toml`, dt 0.2, tolerance
 //! 1e-10). Each pile runs `STEPS` steps from the drop; the window of the last `WINDOW`
 //! steps (the pile landed, contacts and wall links forming and releasing) is timed.
@@ -12,8 +12,14 @@
 //! `bench/results/pile_cost.csv` where `HYDRORATTLE_BENCH_MACHINE` names the machine.
 //!
 //! ```text
-//! cargo run --release --example pile_cost [STEPS WINDOW]
+//! cargo run --release --example pile_cost [STEPS WINDOW [COUNT...]]
 //! ```
+//!
+//! A pile of `COUNT` spheres is a column `side` wide (`side^2` a layer, the smallest
+//! `side >= 3` with `12 side^2 >= COUNT`) in a fence of `5 side` spheres: 100 spheres
+//! in 15, 300 in 25, as `host/scenes/pile.toml`. The last line prints, for each size, the
+//! ratio of Krylov's CPU time a step to Newton's: where it falls below 1 is where
+//! `SolverKind::Auto` should stop choosing Newton for contact piles.
 
 use std::time::Instant;
 
@@ -167,14 +173,22 @@ fn main() {
         .skip(1)
         .map(|a| a.parse().expect("a count"))
         .collect();
-    let (steps, window) = match args[..] {
-        [s, w] => (s, w.min(s)),
-        _ => (150, 50),
+    let (steps, window, counts) = match args[..] {
+        [s, w] => (s, w.min(s), vec![100, 300]),
+        [s, w, ref c @ ..] => (s, w.min(s), c.to_vec()),
+        _ => (150, 50, vec![100, 300]),
     };
-    let command = format!("cargo run --release --example pile_cost {steps} {window}");
+    let mut command = format!("cargo run --release --example pile_cost {steps} {window}");
+    if args.len() > 2 {
+        for c in &counts {
+            command += &format!(" {c}");
+        }
+    }
     let mut rows = record::Recorder::new(env!("CARGO_MANIFEST_DIR"), "pile_cost", command);
     let (mut cost, mut cost_k) = (Vec::new(), Vec::new());
-    for (fence, side, count) in [(15, 3, 100), (25, 5, 300)] {
+    for &count in &counts {
+        let side = (3..).find(|s| 12 * s * s >= count).expect("a side");
+        let fence = 5 * side;
         let [s, f, it, rounds, held, products, converged, per_step, cpu_k] =
             run(fence, side, count, steps, window);
         println!(
@@ -205,27 +219,35 @@ fn main() {
         ] {
             rows.row("pile krylov", &case, q, &format!("{v}"));
         }
+        rows.row(
+            "pile krylov / newton",
+            &case,
+            "cpu_ratio",
+            &format!("{}", cpu_k / s),
+        );
+        println!("{count} spheres: Krylov / Newton a step {:.2}", cpu_k / s);
         cost.push(s);
         cost_k.push(cpu_k);
     }
-    println!("cost ratio 300 / 100: {:.1}", cost[1] / cost[0]);
-    rows.row(
-        "pile newton",
-        "300 / 100",
-        "cost_ratio",
-        &format!("{}", cost[1] / cost[0]),
-    );
-    println!(
-        "Krylov cost ratio 300 / 100: {:.1}; Krylov / Newton a step: {:.2} (100), {:.2} (300)",
-        cost_k[1] / cost_k[0],
-        cost_k[0] / cost[0],
-        cost_k[1] / cost[1]
-    );
-    rows.row(
-        "pile krylov",
-        "300 / 100",
-        "cost_ratio",
-        &format!("{}", cost_k[1] / cost_k[0]),
-    );
+    if let ([first, .., last], [first_k, .., last_k]) = (&cost[..], &cost_k[..]) {
+        let ratio = format!("{} / {}", counts[counts.len() - 1], counts[0]);
+        println!(
+            "cost ratio {ratio}: Newton {:.1}, Krylov {:.1}",
+            last / first,
+            last_k / first_k
+        );
+        rows.row(
+            "pile newton",
+            &ratio,
+            "cost_ratio",
+            &format!("{}", last / first),
+        );
+        rows.row(
+            "pile krylov",
+            &ratio,
+            "cost_ratio",
+            &format!("{}", last_k / first_k),
+        );
+    }
     rows.finish().expect("bench/results/pile_cost.csv");
 }

@@ -92,7 +92,7 @@ pub mod workspace;
 
 pub use bonds::{Bond, BondSet};
 pub use cell::{Periodic, PeriodicError};
-pub use constraints::{DENSE_BONDS_MAX, Solver, SolverKind};
+pub use constraints::{DENSE_BONDS_MAX, PILE_NEWTON_MAX, PILE_NEWTON_ROWS_MAX, Solver, SolverKind};
 pub use error::{BondError, INFEASIBLE_SHOWN, LinalgError, ParticleError, Row, Stage, StepError};
 pub use forces::{ExternalForce, NoForce, SoftContact};
 /// The vector crate the kernel is written against (re-exported so callers match versions).

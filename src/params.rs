@@ -447,7 +447,9 @@ impl<T: Real> Params<T> {
     /// The solver that runs for `n` spheres and `bonds` bonds: [`SolverKind::Auto`]
     /// resolved once, from every constraint row the step may solve
     /// ([`Params::constraints`]: bonds, contact capacity, wall links), not from the rows
-    /// held in one round. [`Layout::for_params`](crate::Layout::for_params) sizes the
+    /// held in one round; with contacts by
+    /// [`SolverKind::resolve_contacts`](crate::SolverKind::resolve_contacts) (Newton on
+    /// piles up to a measured size). [`Layout::for_params`](crate::Layout::for_params) sizes the
     /// storage from this same choice, and every stage of the step runs it, so the two
     /// cannot disagree.
     /// With a fast product ([`Params::pse`]: PSE in a box, the fast free-space product
@@ -460,6 +462,9 @@ impl<T: Real> Params<T> {
             (SolverKind::Auto, Some(_), None) if self.wall.is_none() => SolverKind::Krylov,
             // The iterative near field's metric has products only (`integrate/near_iter`).
             (SolverKind::Auto, ..) if self.near_on() && self.matrix_free => SolverKind::Krylov,
+            (kind, ..) if self.contacts.is_some() => {
+                kind.resolve_contacts(self.constraints(n, bonds), n)
+            }
             (kind, ..) => kind.resolve(self.constraints(n, bonds)),
         }
     }

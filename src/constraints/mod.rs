@@ -61,11 +61,28 @@ pub enum SolverKind {
     /// sphere): `O(B)` storage, one mobility product per iteration.
     Krylov,
     /// [`SolverKind::Newton`] up to [`DENSE_BONDS_MAX`] constraint rows,
-    /// [`SolverKind::Krylov`] above (the default). A step resolves it once, from every
-    /// row it may solve ([`Params::solver_kind`](crate::Params::solver_kind)).
+    /// [`SolverKind::Krylov`] above (the default); with contacts, Newton up to
+    /// [`PILE_NEWTON_MAX`] spheres and [`PILE_NEWTON_ROWS_MAX`] rows
+    /// ([`SolverKind::resolve_contacts`]). A step resolves it once, from every row it
+    /// may solve ([`Params::solver_kind`](crate::Params::solver_kind)).
     #[default]
     Auto,
 }
+
+/// With contacts, [`SolverKind::Auto`] picks [`SolverKind::Newton`] up to this many
+/// spheres: the largest settling pile measured (535 spheres), where Newton's one
+/// factorisation a step still costs less than half of Krylov's products. A contact list's rows couple through
+/// the pair mobility, which decays only as `1/r`, so Krylov's preconditioner on the
+/// constraint graph leaves most of the coupling out, and its products a step grow with
+/// the pile (about 370, 570 and 1,330 at 100, 300 and 535 spheres). Measured (`cargo run
+/// --release --example pile_cost 150 50 100 300 500`): see `docs/CONTACTS.md`.
+pub const PILE_NEWTON_MAX: usize = 540;
+
+/// With contacts, [`SolverKind::Auto`] picks [`SolverKind::Newton`] only up to this
+/// many constraint rows: its Jacobian holds `rows^2` scalars (155 MB in `f64` at this
+/// bound; the 535-sphere pile with 7 contact slots a sphere has 4,315 rows), so a larger
+/// contact capacity takes Krylov's `O(rows)` storage instead.
+pub const PILE_NEWTON_ROWS_MAX: usize = 4400;
 
 impl SolverKind {
     /// The algorithm that runs for `rows` constraint rows ([`SolverKind::Auto`]
@@ -75,6 +92,16 @@ impl SolverKind {
             Self::Auto if rows <= DENSE_BONDS_MAX => Self::Newton,
             Self::Auto => Self::Krylov,
             kind => kind,
+        }
+    }
+
+    /// The algorithm that runs for `rows` constraint rows on `n` spheres with contacts
+    /// ([`SolverKind::Auto`] resolved): Newton up to [`PILE_NEWTON_MAX`] spheres and
+    /// [`PILE_NEWTON_ROWS_MAX`] rows, else as [`SolverKind::resolve`].
+    pub const fn resolve_contacts(self, rows: usize, n: usize) -> Self {
+        match self {
+            Self::Auto if n <= PILE_NEWTON_MAX && rows <= PILE_NEWTON_ROWS_MAX => Self::Newton,
+            kind => kind.resolve(rows),
         }
     }
 }
