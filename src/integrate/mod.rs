@@ -267,6 +267,10 @@ fn advance<T: Real, E: ExternalForce<T>>(
                 near_iter::constrained::overdamped(p, &s, bonds, v, ext)
             }
             #[cfg(feature = "near")]
+            (Method::Overdamped2, ..) if iterative && p.constraints(n, bonds.len()) > 0 => {
+                near_iter::constrained2::overdamped2(p, &s, bonds, v, ext)
+            }
+            #[cfg(feature = "near")]
             (Method::Overdamped | Method::Overdamped2, ..) if iterative => {
                 near_iter::overdamped(p, &s, v, ext)
             }

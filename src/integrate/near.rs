@@ -102,11 +102,6 @@ fn check_iterative<T: Real>(
             "the iterative near field (matrix_free) with thermal noise and constraints (bonds, pins, contacts, the wall's links): the dense near field (matrix_free = false)",
         );
     }
-    if rows > 0 && p.method != Method::Overdamped {
-        return refuse(
-            "the iterative near field (matrix_free) with constraints (bonds, pins, contacts, the wall's links) in Overdamped2: Overdamped only (or matrix_free = false)",
-        );
-    }
     if p.pse.is_some() {
         return refuse(
             "the iterative near field with PSE or the fast free-space product: its far field is the assembled grand mobility (pse = None)",

@@ -26,6 +26,7 @@
 //! [`NEAR_PAIRS_PER_SPHERE`](crate::NEAR_PAIRS_PER_SPHERE) close pairs a sphere.
 
 pub(super) mod constrained;
+pub(super) mod constrained2;
 
 use super::{Start, StepReport, Sums, add_flow, check_resolved, step_velocity};
 use crate::error::{Stage, StepError};
