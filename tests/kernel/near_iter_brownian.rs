@@ -489,8 +489,8 @@ fn same_bits<T: Real>() {
 }
 
 /// What the iterative Brownian step still refuses, typed, the state and the generator
-/// unchanged: bonds (constraints), the wall, `Overdamped2` at temperature, and a Lanczos
-/// root given too few iterations (`NoConvergence` at the mobility stage).
+/// unchanged: `Overdamped2` at temperature, and a Lanczos root given too few iterations
+/// (`NoConvergence` at the mobility stage); bonds and the wall step.
 fn refusals<T: Real>() {
     let spheres = cluster([0.0; 3]);
     let n = spheres.len();
@@ -527,10 +527,26 @@ fn refusals<T: Real>() {
         j: 1,
         length: T::from_f64(2.05),
     };
-    unsupported(&base, &[bond], "constraints");
+    // Bonds and the wall (its links one-sided constraints) step (refused before):
+    // `near_con_brownian.rs`.
+    let stepped = |p: &hydrorattle::Params<T>, bonds: &[Bond<T>]| {
+        let mut ps: ParticleSet<T, 8> = particles(&spheres);
+        let mut set: BondSet<T, 2> = BondSet::new();
+        for &b in bonds {
+            set.push(b, n).unwrap();
+        }
+        let mut buf = Buffers::<T>::new(Layout::for_params(p, n, bonds.len()));
+        let mut ws = buf.workspace();
+        let mut noise = Noise::new(5);
+        step_thermal(&mut ps, &set, p, &mut ws, &mut hydrorattle::NoForce, &mut noise)
+            .unwrap_or_else(|e| panic!("{e:?}"))
+    };
+    let r = stepped(&base, &[bond]);
+    assert!(r.near_products > 0 && r.noise_iterations > 0, "{r:?}");
     let mut p = base;
     p.wall = Some(Wall::new(T::from_f64(-40.0)));
-    unsupported(&p, &[], "wall");
+    let r = stepped(&p, &[]);
+    assert!(r.near_products > 0 && r.noise_iterations > 0, "{r:?}");
     let mut p = base;
     p.method = hydrorattle::Method::Overdamped2;
     unsupported(&p, &[], "thermal noise");

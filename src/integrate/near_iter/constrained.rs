@@ -128,7 +128,33 @@ impl<T: Real> Along<T> for Iterative<'_, '_, T> {
     }
 }
 
-impl<T: Real> Iterative<'_, '_, T> {
+impl<'a, 's, T: Real> Iterative<'a, 's, T> {
+    /// The solves along the products of `at` (at `spheres`, with the step's sums
+    /// `ewald`), counted in `counts`; `stiff` the rows' preconditioner diagonal, `table`
+    /// the sweep's and Newton's.
+    pub(super) fn new(
+        at: &'a mut At<'s, T>,
+        p: &'a Params<T>,
+        counts: &'a mut Counts,
+        stiff: &'a mut [T],
+        spheres: (&'a [T::V3], &'a [T]),
+        ewald: Sums<'a, T>,
+        table: &'a mut [T::V3],
+    ) -> Self {
+        Self {
+            packed: at.packed(),
+            sd: Sd {
+                at,
+                p,
+                counts,
+                stiff,
+            },
+            spheres,
+            ewald,
+            table,
+        }
+    }
+
     /// Solves `problem` over `rows` (vectors `grad`) along `scale M_SD,tt G^T` into
     /// `x` and `lambda` (from zero): the Krylov solve, or the sweep and Newton on the
     /// table of `M_SD`'s columns. `chord` is the chord matrix's factor `c scale`.
@@ -200,11 +226,23 @@ impl<T: Real> Iterative<'_, '_, T> {
         if judge {
             check_resolved(pos, u, p.dt)?;
         }
-        bond_vectors(bonds, pos, cell(p), grad);
-        let problem = Problem::Velocities {
-            bond: grad,
-            dt: p.dt,
-        };
+        self.hold_rates(p, bonds, (grad, kappa), scratch, u, p.dt)
+    }
+
+    /// `u` projected at the products' configuration: the bonds' length rates held at
+    /// zero along `M_SD,tt G^T` (`G` the bond vectors there, into `grad`; the
+    /// multipliers into `kappa`), the residual scaled by `dt` (`Problem::Velocities`).
+    pub(super) fn hold_rates(
+        &mut self,
+        p: &Params<T>,
+        bonds: &[Bond<T>],
+        (grad, kappa): (&mut [T::V3], &mut [T]),
+        scratch: &mut Scratch<'_, T>,
+        u: &mut [T::V3],
+        dt: T,
+    ) -> Result<SolveStats<T>, StepError> {
+        bond_vectors(bonds, self.spheres.0, cell(p), grad);
+        let problem = Problem::Velocities { bond: grad, dt };
         // The chord matrix `G M G^T`: `c = 1`, scale 1.
         let unit = (T::ONE, T::ONE);
         self.solve(p, problem, bonds, grad, unit, u, kappa, scratch)

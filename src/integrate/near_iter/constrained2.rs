@@ -18,7 +18,7 @@
 //! A product that does not converge ends the step with [`StepError::NoConvergence`]
 //! at [`Stage::Mobility`](crate::Stage::Mobility), the caller's state unchanged.
 
-use super::constrained::{Iterative, Sd};
+use super::constrained::Iterative;
 use super::{Counts, Store, solve, spins};
 use crate::bonds::Bond;
 use crate::error::StepError;
@@ -71,18 +71,7 @@ pub(in crate::integrate) fn overdamped2<T: Real, E: ExternalForce<T>>(
     // squeeze resistances from its `M_SD`.
     macro_rules! along {
         ($at:expr, $spheres:expr) => {
-            Iterative {
-                packed: $at.packed(),
-                sd: Sd {
-                    at: $at,
-                    p,
-                    counts: &mut counts,
-                    stiff: &mut *stiff,
-                },
-                spheres: $spheres,
-                ewald: s.ewald,
-                table: &mut *disp,
-            }
+            Iterative::new($at, p, &mut counts, &mut *stiff, $spheres, s.ewald, &mut *disp)
         };
     }
     // Predictor: the projected velocity at the start, its constraint forces' spins,
