@@ -46,11 +46,7 @@ pub(super) enum Spins {
 
 /// Refuses the combinations the near field does not serve (a typed
 /// [`StepError::Unsupported`] naming each), and parameters out of range.
-pub(super) fn check<T: Real>(
-    p: &Params<T>,
-    n: usize,
-    thermal: bool,
-) -> Result<(), StepError> {
+pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(), StepError> {
     if !p.near_on() {
         return Ok(());
     }

@@ -54,10 +54,10 @@ mod near;
 mod near_box;
 #[cfg(feature = "near")]
 mod near_brownian;
-#[cfg(all(feature = "near", feature = "wall"))]
-mod near_con_brownian;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod near_con;
+#[cfg(all(feature = "near", feature = "wall"))]
+mod near_con_brownian;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod near_contacts;
 #[cfg(all(feature = "near", feature = "periodic"))]

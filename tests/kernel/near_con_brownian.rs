@@ -55,7 +55,9 @@ fn trimer_bond_angle() {
 #[test]
 fn trimer_bond_angle_short() {
     let [(m, se), (b, se_b)] = trimer(60_000, 22);
-    eprintln!("trimer, iterative near field: <c^2> = {m:.4} +- {se:.4}, below -0.8 {b:.3} +- {se_b:.3}");
+    eprintln!(
+        "trimer, iterative near field: <c^2> = {m:.4} +- {se:.4}, below -0.8 {b:.3} +- {se_b:.3}"
+    );
     assert!((m - 1.0 / 3.0).abs() < 4.0 * se, "{m} +- {se}");
     assert!((b - 0.1).abs() < 4.0 * se_b, "{b} +- {se_b}");
 }
@@ -76,7 +78,9 @@ fn barometric(steps: usize, seed: u64) -> ((f64, f64), f64) {
 #[ignore = "minutes: the barometric law above the wall on the iterative near field"]
 fn barometric_above_the_wall() {
     let ((m, se), biased) = barometric(600_000, 5);
-    eprintln!("wall, iterative near field: E[h - h0 | h > h0] = {m:.4} +- {se:.4} (exact 1, uncorrected {biased:.4})");
+    eprintln!(
+        "wall, iterative near field: E[h - h0 | h > h0] = {m:.4} +- {se:.4} (exact 1, uncorrected {biased:.4})"
+    );
     assert!((1.0 - biased).abs() > 5.0 * se, "too few samples (se {se})");
     assert!((m - 1.0).abs() < 3.0 * se, "{m} +- {se}");
 }
@@ -85,6 +89,8 @@ fn barometric_above_the_wall() {
 #[test]
 fn barometric_above_the_wall_short() {
     let ((m, se), biased) = barometric(60_000, 6);
-    eprintln!("wall, iterative near field: E[h - h0 | h > h0] = {m:.4} +- {se:.4} (exact 1, uncorrected {biased:.4})");
+    eprintln!(
+        "wall, iterative near field: E[h - h0 | h > h0] = {m:.4} +- {se:.4} (exact 1, uncorrected {biased:.4})"
+    );
     assert!((m - 1.0).abs() < 4.0 * se, "{m} +- {se}");
 }

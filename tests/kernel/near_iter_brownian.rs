@@ -538,8 +538,15 @@ fn refusals<T: Real>() {
         let mut buf = Buffers::<T>::new(Layout::for_params(p, n, bonds.len()));
         let mut ws = buf.workspace();
         let mut noise = Noise::new(5);
-        step_thermal(&mut ps, &set, p, &mut ws, &mut hydrorattle::NoForce, &mut noise)
-            .unwrap_or_else(|e| panic!("{e:?}"))
+        step_thermal(
+            &mut ps,
+            &set,
+            p,
+            &mut ws,
+            &mut hydrorattle::NoForce,
+            &mut noise,
+        )
+        .unwrap_or_else(|e| panic!("{e:?}"))
     };
     let r = stepped(&base, &[bond]);
     assert!(r.near_products > 0 && r.noise_iterations > 0, "{r:?}");

@@ -71,7 +71,15 @@ pub(in crate::integrate) fn overdamped2<T: Real, E: ExternalForce<T>>(
     // squeeze resistances from its `M_SD`.
     macro_rules! along {
         ($at:expr, $spheres:expr) => {
-            Iterative::new($at, p, &mut counts, &mut *stiff, $spheres, s.ewald, &mut *disp)
+            Iterative::new(
+                $at,
+                p,
+                &mut counts,
+                &mut *stiff,
+                $spheres,
+                s.ewald,
+                &mut *disp,
+            )
         };
     }
     // Predictor: the projected velocity at the start, its constraint forces' spins,

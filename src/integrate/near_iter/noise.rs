@@ -34,8 +34,7 @@ use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
 use crate::integrate::contacts::project_along;
 use crate::integrate::{
-    Start, StepReport, add_constraint_forces, add_flow, report as constrained_report,
-    step_velocity,
+    Start, StepReport, add_constraint_forces, add_flow, report as constrained_report, step_velocity,
 };
 use crate::noise::{Noise, lanczos};
 use crate::params::{Brownian, Drift, Params};
@@ -102,7 +101,11 @@ pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     noise.fill::<T>(z);
     let start = (s.pos, s.radius);
     let iterations = solve::at(p, s.ewald, start, &mut store, |at| {
-        let w = if rows == 0 { Some(&mut *new_omega) } else { None };
+        let w = if rows == 0 {
+            Some(&mut *new_omega)
+        } else {
+            None
+        };
         at.velocities(p, force, u, w, &mut counts)?;
         let product = |v: &[T::V3], w: &mut [T::V3]| at.far(v, w);
         let root_it = lanczos::sqrt(p.lanczos, product, z, basis, work, root, Some(&mut *f))?;
@@ -134,8 +137,7 @@ pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
             let dx = &mut x[..n];
             dx.iter_mut().for_each(|d| *d *= amplitude);
             let table = &mut *disp;
-            let mut along =
-                Iterative::new(at, p, &mut counts, &mut *stiff, at_mid, s.ewald, table);
+            let mut along = Iterative::new(at, p, &mut counts, &mut *stiff, at_mid, s.ewald, table);
             let views = (&mut *grad, &mut *lambda);
             let stats = along.hold_rates(p, bonds, views, &mut scratch, dx, T::ONE)?;
             Ok(Some(stats.iterations))
@@ -170,7 +172,8 @@ pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         add_constraint_forces(r.held, grad, lambda, force);
         if p.rotation {
             let sd = &mut along.sd;
-            sd.at.velocities(p, force, u, Some(&mut *new_omega), sd.counts)?;
+            sd.at
+                .velocities(p, force, u, Some(&mut *new_omega), sd.counts)?;
         }
         Ok((r.stats, r.contacts, r.wall_contacts, r.rounds))
     })?;
