@@ -132,8 +132,8 @@ impl<T: Real> Workspace<'_, T> {
         let (force, grad) = (ve.take(m), ve.take(nb));
         // (The iterative near field stores no mobility, whatever the method.)
         let iterative = super::layout::near_iterative(p);
-        let stored = !(p.matrix_free && matches!(method, Method::Overdamped | Method::Springs))
-            && !iterative;
+        let unstored = p.matrix_free && matches!(method, Method::Overdamped | Method::Springs);
+        let stored = !(unstored || iterative);
         // The dense solvers' table of displacements (see `Layout::with_solver`).
         // (The iterative near field's sweep and Newton read one too: `near_iter`.)
         let table = if krylov || !(stored || iterative) {

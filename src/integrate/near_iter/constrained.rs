@@ -29,8 +29,9 @@
 //! round, `Metric::Dense` as the dense path tabulates its stored `M_SD`), cheaper than
 //! the Krylov solve's products where the rows are few; `Auto` resolves to Krylov
 //! (`Params::solver_kind`). A wall link's squeeze resistance is its sphere's wall
-//! correction along the normal (a pin has none). `Overdamped2` and noise are refused by
-//! `near::check`, typed. A product that does not converge ends the step with
+//! correction along the normal (a pin has none). `Overdamped2` (`constrained2.rs`)
+//! solves its velocity projections here too ([`Iterative::velocities`]), and the
+//! thermal step its midpoint's (`noise.rs`). A product that does not converge ends the step with
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`](crate::Stage::Mobility), the
 //! caller's state unchanged.
 
@@ -249,6 +250,9 @@ impl<'a, 's, T: Real> Iterative<'a, 's, T> {
     }
 }
 
+/// Sphere centres and radii.
+type Spheres<'a, T> = (&'a [<T as Real>::V3], &'a [T]);
+
 const TABLE: StepError =
     StepError::Unsupported("the iterative near field's sweep or Newton without its table");
 
@@ -258,7 +262,7 @@ const TABLE: StepError =
 /// step's sums `ew`), over `chord |g|^2` (`chord = c scale`, the chord matrix's factor).
 fn squeeze<T: Real>(
     p: &Params<T>,
-    (spheres, ew): ((&[T::V3], &[T]), Sums<'_, T>),
+    (spheres, ew): (Spheres<'_, T>, Sums<'_, T>),
     b: &Bond<T>,
     g: T::V3,
     chord: T,

@@ -23,7 +23,11 @@
 //!
 //! **Cost**: two assemblies of the far field (start, midpoint), three products (the
 //! velocities and the noise's solve share the start's factors), and the far field's
-//! Lanczos iterations ([`StepReport::noise_iterations`]). The Lanczos root stops at
+//! Lanczos iterations ([`StepReport::noise_iterations`]). With constraints (bonds,
+//! pins, the wall's links) the dense near step's constrained step (`brownian.rs`): the
+//! midpoint's noise projected onto the bonds along `M_SD,tt(x~)` (its mean then
+//! `kT dt div (P M_SD,tt)`), and the start's far field assembled a third time for the
+//! move's projection along `M_SD,tt(r)`. The Lanczos root stops at
 //! [`Params::lanczos`]'s tolerance within its iterations; not converging is
 //! [`StepError::NoConvergence`], the caller's state unchanged.
 
