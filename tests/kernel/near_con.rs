@@ -192,6 +192,22 @@ fn matches_dense_by<T: Real>(method: Method) {
     }
 }
 
+/// Two unit spheres 2.1 apart about the origin, their line of centres tilted 60
+/// degrees from the vertical, of buoyant weights `w`.
+fn tilted_dimer(w: [f64; 2]) -> [Sphere; 2] {
+    let th = 60f64.to_radians();
+    let c = scale([th.sin(), 0.0, th.cos()], 1.05);
+    let mut spheres = [scale(c, -1.0), c].map(|pos| Sphere {
+        pos,
+        radius: 1.0,
+        density: RHO1,
+    });
+    for (s, w) in spheres.iter_mut().zip(w) {
+        s.density = w * RHO1;
+    }
+    spheres
+}
+
 /// A bonded pair (bond 2.1 radii) tilted 60 degrees, one sphere three times as heavy
 /// as the other, by the iterative step: it falls and turns as the bond projection with
 /// the two-sphere mobility says (`near_step::projected`), its mean velocity is Stimson
@@ -205,14 +221,7 @@ fn bonded_pair<T: Real>() {
 fn bonded_pair_by<T: Real>(method: Method) {
     let th = 60f64.to_radians();
     let axis = [th.sin(), 0.0, th.cos()];
-    let c = scale(axis, 1.05);
-    let mut spheres = [scale(c, -1.0), c].map(|pos| Sphere {
-        pos,
-        radius: 1.0,
-        density: RHO1,
-    });
-    spheres[0].density = 1.5 * RHO1;
-    spheres[1].density = 0.5 * RHO1;
+    let spheres = tilted_dimer([1.5, 0.5]);
     let want = projected(&spheres, [1.5, 0.5]);
     let (along, across) = (th.cos(), th.sin());
     for kind in [SolverKind::Krylov, SolverKind::Auto] {
@@ -412,15 +421,7 @@ fn refusals<T: Real>() {
 /// radians.
 #[test]
 fn overdamped2_second_order() {
-    let th = 60f64.to_radians();
-    let c = scale([th.sin(), 0.0, th.cos()], 1.05);
-    let mut spheres = [scale(c, -1.0), c].map(|pos| Sphere {
-        pos,
-        radius: 1.0,
-        density: RHO1,
-    });
-    spheres[0].density = 1.9 * RHO1;
-    spheres[1].density = 0.1 * RHO1;
+    let spheres = tilted_dimer([1.9, 0.1]);
     let rows = chain::<f64>(&spheres);
     let end = 32.0;
     let at = |method, dt: f64| {

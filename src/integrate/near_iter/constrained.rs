@@ -250,6 +250,35 @@ impl<'a, 's, T: Real> Iterative<'a, 's, T> {
     }
 }
 
+/// What a constrained step's last projection did: its solve, and the contacts, the
+/// wall's links and the active-set rounds it held.
+pub(super) type Held<T> = (SolveStats<T>, u32, u32, u32);
+
+/// The projection's [`Held`] of `r`.
+pub(super) fn held<T: Real>(r: &crate::integrate::contacts::Projected<'_, T>) -> Held<T> {
+    (r.stats, r.contacts, r.wall_contacts, r.rounds)
+}
+
+/// A constrained step's report: the near field's `counts`, the last projection's
+/// `held`, a midpoint projection's `velocity_iterations`, the multipliers of `bonds`.
+pub(super) fn held_report<T: Real>(
+    counts: &Counts,
+    (stats, contacts, wall_contacts, rounds): Held<T>,
+    velocity_iterations: u32,
+    bonds: &[Bond<T>],
+    lambda: &[T],
+) -> StepReport<T> {
+    StepReport {
+        near_pairs: counts.pairs,
+        near_products: counts.products,
+        near_iterations: counts.iterations,
+        contacts,
+        wall_contacts,
+        contact_rounds: rounds,
+        ..report(stats, velocity_iterations, bonds, lambda)
+    }
+}
+
 /// Sphere centres and radii.
 type Spheres<'a, T> = (&'a [<T as Real>::V3], &'a [T]);
 
@@ -367,14 +396,6 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
                 .velocities(p, force, u, Some(&mut *new_omega), sd.counts)?;
         }
         spins(p, new_omega);
-        Ok(StepReport {
-            near_pairs: sd.counts.pairs,
-            near_products: sd.counts.products,
-            near_iterations: sd.counts.iterations,
-            contacts: r.contacts,
-            wall_contacts: r.wall_contacts,
-            contact_rounds: r.rounds,
-            ..report(r.stats, 0, bonds, lambda)
-        })
+        Ok(held_report(sd.counts, held(&r), 0, bonds, lambda))
     })
 }

@@ -18,15 +18,13 @@
 //! A product that does not converge ends the step with [`StepError::NoConvergence`]
 //! at [`Stage::Mobility`](crate::Stage::Mobility), the caller's state unchanged.
 
-use super::constrained::Iterative;
+use super::constrained::{Iterative, held, held_report};
 use super::{Counts, Store, solve, spins};
 use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
 use crate::integrate::contacts::project_along;
-use crate::integrate::{
-    Start, StepReport, add_constraint_forces, max_tension, report, step_velocity,
-};
+use crate::integrate::{Start, StepReport, add_constraint_forces, max_tension, step_velocity};
 use crate::params::Params;
 use crate::real::Real;
 use crate::workspace::Views;
@@ -126,18 +124,11 @@ pub(in crate::integrate) fn overdamped2<T: Real, E: ExternalForce<T>>(
         };
         let views = (links, &mut *grad, &mut *lambda, &mut scratch);
         let r = project_along(p, bonds, start, views, new_pos, trapezoid, &mut along)?;
-        Ok((r.stats, r.contacts, r.wall_contacts, r.rounds))
+        Ok(held(&r))
     })?;
     step_velocity(s.pos, new_pos, dt, new_vel);
-    let (stats, contacts, wall_contacts, rounds) = r;
     Ok(StepReport {
         max_tension: tension,
-        near_pairs: counts.pairs,
-        near_products: counts.products,
-        near_iterations: counts.iterations,
-        contacts,
-        wall_contacts,
-        contact_rounds: rounds,
-        ..report(stats, 0, bonds, lambda)
+        ..held_report(&counts, r, 0, bonds, lambda)
     })
 }

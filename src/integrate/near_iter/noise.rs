@@ -31,15 +31,13 @@
 //! [`Params::lanczos`]'s tolerance within its iterations; not converging is
 //! [`StepError::NoConvergence`], the caller's state unchanged.
 
-use super::constrained::Iterative;
+use super::constrained::{self, Iterative};
 use super::{Counts, STORAGE, Store, report, solve, spins};
 use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
 use crate::integrate::contacts::project_along;
-use crate::integrate::{
-    Start, StepReport, add_constraint_forces, add_flow, report as constrained_report, step_velocity,
-};
+use crate::integrate::{Start, StepReport, add_constraint_forces, add_flow, step_velocity};
 use crate::noise::{Noise, lanczos};
 use crate::params::{Brownian, Drift, Params};
 use crate::real::Real;
@@ -179,19 +177,12 @@ pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
             sd.at
                 .velocities(p, force, u, Some(&mut *new_omega), sd.counts)?;
         }
-        Ok((r.stats, r.contacts, r.wall_contacts, r.rounds))
+        Ok(constrained::held(&r))
     })?;
     spins(p, new_omega);
     step_velocity(s.pos, new_pos, dt, new_vel);
-    let (stats, contacts, wall_contacts, rounds) = r;
     Ok(StepReport {
         noise_iterations: iterations,
-        near_pairs: counts.pairs,
-        near_products: counts.products,
-        near_iterations: counts.iterations,
-        contacts,
-        wall_contacts,
-        contact_rounds: rounds,
-        ..constrained_report(stats, held.unwrap_or(0), bonds, lambda)
+        ..constrained::held_report(&counts, r, held.unwrap_or(0), bonds, lambda)
     })
 }
