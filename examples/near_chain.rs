@@ -6,12 +6,14 @@
 //! 7, density 4.5, settling; first-order `Overdamped`, the Krylov solver, tolerance
 //! 1e-10, `dt = 0.1`, rotation, free space, f64, one core.
 //!
-//! `cargo run --release --example near_chain -- [N[:steps][:iter] ...]` (default
+//! `cargo run --release --example near_chain -- [N[:steps][:iter][:o2] ...]` (default
 //! `25:20 200:3 1000:2:iter`): the seconds a step (mean over the steps), the
 //! constraint solve's products a step, the `M_SD` products and their conjugate-gradient
 //! iterations a step, the close pairs, and the largest distance between the two paths'
 //! positions after the steps. `:iter` runs the iterative path alone (the dense one
-//! would take minutes a step).
+//! would take minutes a step); `:o2` steps by `Overdamped2` instead (its two
+//! velocity projections and two position projections, along `M_SD` at the start and
+//! at the predicted point).
 //!
 //! With `HYDRORATTLE_BENCH_MACHINE` set, appends its rows to
 //! `bench/results/near_chain.csv`.
@@ -43,9 +45,9 @@ fn chain(n: usize) -> Vec<Particle<f64>> {
         .collect()
 }
 
-fn params(iterative: bool) -> Params<f64> {
+fn params(iterative: bool, method: Method) -> Params<f64> {
     let mut p = Params::new(0.1);
-    p.method = Method::Overdamped;
+    p.method = method;
     p.solver.kind = SolverKind::Krylov;
     p.solver.tolerance = 1e-10;
     p.rotation = true;
@@ -66,7 +68,7 @@ struct Cost {
     pos: Vec<DVec3>,
 }
 
-fn run(n: usize, steps: usize, iterative: bool) -> Cost {
+fn run(n: usize, steps: usize, iterative: bool, method: Method) -> Cost {
     let list = chain(n);
     let mut pos: Vec<DVec3> = list.iter().map(|q| q.position).collect();
     let mut vel = vec![DVec3::ZERO; n];
@@ -80,7 +82,7 @@ fn run(n: usize, steps: usize, iterative: bool) -> Cost {
             length: (pos[i] - pos[i - 1]).length(),
         })
         .collect();
-    let p = params(iterative);
+    let p = params(iterative, method);
     let mut buf = Buffers::<f64>::new(Layout::for_params(&p, n, n - 1));
     let mut ws = buf.workspace();
     let mut time = 0.0;
@@ -136,7 +138,6 @@ fn main() {
             asked.join(" ")
         ),
     );
-    let table = "constrained Overdamped step with the near field, Figure 1 (c) helical chain, Krylov, tol 1e-10, dt 0.1, f64, one core";
     println!(
         "N,path,steps,s a step,krylov products,M_SD products,pcg iterations,close pairs,M_SD formed,max position gap"
     );
@@ -144,9 +145,18 @@ fn main() {
         let mut parts = a.split(':');
         let n: usize = parts.next().and_then(|x| x.parse().ok()).expect("N");
         let steps: usize = parts.next().and_then(|x| x.parse().ok()).unwrap_or(5);
-        let only_iter = parts.next() == Some("iter");
-        let iter = run(n, steps, true);
-        let dense = (!only_iter).then(|| run(n, steps, false));
+        let flags: Vec<&str> = parts.collect();
+        let only_iter = flags.contains(&"iter");
+        let method = match flags.contains(&"o2") {
+            true => Method::Overdamped2,
+            false => Method::Overdamped,
+        };
+        let table = format!(
+            "constrained {method:?} step with the near field, Figure 1 (c) helical chain, Krylov, tol 1e-10, dt 0.1, f64, one core"
+        );
+        let table = table.as_str();
+        let iter = run(n, steps, true, method);
+        let dense = (!only_iter).then(|| run(n, steps, false, method));
         let gap = dense.as_ref().map(|d| {
             d.pos
                 .iter()

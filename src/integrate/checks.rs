@@ -93,7 +93,7 @@ pub(super) fn check_all<T: Real>(
     // The box first: a box with a wall is refused as such, not by the wall's check.
     let sums = check_periodic(p, state, bonds)?;
     check_wall(p, state)?;
-    super::near::check(p, state.len(), bonds.len(), thermal.is_some())?;
+    super::near::check(p, state.len(), thermal.is_some())?;
     Ok((thermal, sums))
 }
 

@@ -260,11 +260,15 @@ fn advance<T: Real, E: ExternalForce<T>>(
         match (p.method, thermal, drawn.as_mut()) {
             #[cfg(feature = "near")]
             (Method::Overdamped, Some(b), Some(g)) if iterative => {
-                near_iter::overdamped_thermal(p, b, &s, v, ext, g)
+                near_iter::overdamped_thermal(p, b, &s, bonds, v, ext, g)
             }
             #[cfg(feature = "near")]
             (Method::Overdamped, ..) if iterative && p.constraints(n, bonds.len()) > 0 => {
                 near_iter::constrained::overdamped(p, &s, bonds, v, ext)
+            }
+            #[cfg(feature = "near")]
+            (Method::Overdamped2, ..) if iterative && p.constraints(n, bonds.len()) > 0 => {
+                near_iter::constrained2::overdamped2(p, &s, bonds, v, ext)
             }
             #[cfg(feature = "near")]
             (Method::Overdamped | Method::Overdamped2, ..) if iterative => {

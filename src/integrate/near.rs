@@ -46,12 +46,7 @@ pub(super) enum Spins {
 
 /// Refuses the combinations the near field does not serve (a typed
 /// [`StepError::Unsupported`] naming each), and parameters out of range.
-pub(super) fn check<T: Real>(
-    p: &Params<T>,
-    n: usize,
-    bonds: usize,
-    thermal: bool,
-) -> Result<(), StepError> {
+pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(), StepError> {
     if !p.near_on() {
         return Ok(());
     }
@@ -72,7 +67,7 @@ pub(super) fn check<T: Real>(
         return refuse("the near field with a method other than Overdamped or Overdamped2");
     }
     if p.matrix_free {
-        return check_iterative(p, n, bonds, thermal);
+        return check_iterative(p);
     }
     if p.place().cell().is_some() && p.pse.is_some() {
         return refuse(
@@ -89,24 +84,8 @@ pub(super) fn check<T: Real>(
 
 /// The iterative near field's refusals ([`Params::matrix_free`], `near_iter.rs`): what
 /// needs `M_SD`'s blocks or a product the iterative path does not have.
-fn check_iterative<T: Real>(
-    p: &Params<T>,
-    n: usize,
-    bonds: usize,
-    thermal: bool,
-) -> Result<(), StepError> {
+fn check_iterative<T: Real>(p: &Params<T>) -> Result<(), StepError> {
     let refuse = |what| Err(StepError::Unsupported(what));
-    let rows = p.constraints(n, bonds);
-    if thermal && rows > 0 {
-        return refuse(
-            "the iterative near field (matrix_free) with thermal noise and constraints (bonds, pins, contacts, the wall's links): the dense near field (matrix_free = false)",
-        );
-    }
-    if rows > 0 && p.method != Method::Overdamped {
-        return refuse(
-            "the iterative near field (matrix_free) with constraints (bonds, pins, contacts, the wall's links) in Overdamped2: Overdamped only (or matrix_free = false)",
-        );
-    }
     if p.pse.is_some() {
         return refuse(
             "the iterative near field with PSE or the fast free-space product: its far field is the assembled grand mobility (pse = None)",

@@ -12,11 +12,12 @@
 //! start and at the predicted point), and `Overdamped` with thermal noise
 //! (`near_iter/noise.rs`: three products and a Lanczos root of the far field), in free
 //! space or in the periodic box with the Ewald sums; `Overdamped` with bonds, pins and
-//! hard contacts (deterministic) by the Krylov solve along `M_SD`:
-//! `near_iter/constrained.rs`, and so above the wall, whose links are one-sided
-//! constraints (the far field the wall's grand mobility, each sphere near it one more
-//! entry of the product's near field, `stokesian::iterative`). The
-//! rest is refused by [`super::near::check`]. The conjugate gradients stop at the
+//! hard contacts by the Krylov solve along `M_SD`: `near_iter/constrained.rs`, and so
+//! above the wall, whose links are one-sided constraints (the far field the wall's
+//! grand mobility, each sphere near it one more entry of the product's near field,
+//! `stokesian::iterative`); `Overdamped2` with them (`near_iter/constrained2.rs`), and
+//! thermal `Overdamped` with them (`near_iter/noise.rs`). The rest is refused by
+//! [`super::near::check`]. The conjugate gradients stop at the
 //! relative residual
 //! [`Solver::tolerance`](crate::Solver::tolerance) within its `max_iterations`
 //! (`Params::solver`, the step's one tolerance for its iterations); not converging is
@@ -26,6 +27,7 @@
 //! [`NEAR_PAIRS_PER_SPHERE`](crate::NEAR_PAIRS_PER_SPHERE) close pairs a sphere.
 
 pub(super) mod constrained;
+pub(super) mod constrained2;
 
 use super::{Start, StepReport, Sums, add_flow, check_resolved, step_velocity};
 use crate::error::{Stage, StepError};

@@ -235,6 +235,11 @@ impl Layout {
         let l = if near_iterative(p) {
             let [blocks, vectors, scalars, indices] = near_iterative_sizes(n, c);
             let [noise_vectors, noise_scalars] = near_noise_sizes(p, n);
+            // `Overdamped2` stores no mobility here either: its two are products.
+            let unstored = match p.method {
+                Method::Overdamped2 => 2 * SYM * tri(n),
+                _ => 0,
+            };
             // The sweep's and Newton's table of `M_SD`'s columns (`integrate::near_iter`),
             // which the matrix-free layout leaves out.
             let table = match (p.method, p.solver_kind(n, bonds)) {
@@ -244,7 +249,7 @@ impl Layout {
             Self {
                 blocks: l.blocks + blocks,
                 vectors: l.vectors + vectors + noise_vectors + table,
-                scalars: l.scalars + scalars + noise_scalars,
+                scalars: l.scalars - unstored + scalars + noise_scalars,
                 indices: l.indices + indices,
                 ..l
             }
@@ -263,6 +268,7 @@ impl Layout {
         // Above a wall: the stored mobilities in blocks of nine.
         let stored = match p.method {
             Method::Overdamped | Method::Springs if p.matrix_free => 0,
+            _ if near_iterative(p) => 0,
             method => symmetric_mobilities(method),
         };
         l.general(stored, n)

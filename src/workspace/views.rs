@@ -130,10 +130,12 @@ impl<T: Real> Workspace<'_, T> {
         let lambda = sc.take(nb);
         let (new_pos, new_vel, new_omega) = (ve.take(n), ve.take(n), ve.take(n));
         let (force, grad) = (ve.take(m), ve.take(nb));
-        let stored = !(p.matrix_free && matches!(method, Method::Overdamped | Method::Springs));
+        // (The iterative near field stores no mobility, whatever the method.)
+        let iterative = super::layout::near_iterative(p);
+        let unstored = p.matrix_free && matches!(method, Method::Overdamped | Method::Springs);
+        let stored = !(unstored || iterative);
         // The dense solvers' table of displacements (see `Layout::with_solver`).
         // (The iterative near field's sweep and Newton read one too: `near_iter`.)
-        let iterative = super::layout::near_iterative(p);
         let table = if krylov || !(stored || iterative) {
             0
         } else {
@@ -162,7 +164,11 @@ impl<T: Real> Workspace<'_, T> {
         let midpoint = lanczos && stored && !uncorrected;
         let (one, two) = (
             if stored { tri(m) } else { 0 },
-            if second || midpoint { tri(m) } else { 0 },
+            if (second && stored) || midpoint {
+                tri(m)
+            } else {
+                0
+            },
         );
         // (`as_chunks_mut`, Rust 1.88: the kernel's minimum since this storage.)
         use super::layout::SYM;

@@ -243,3 +243,46 @@ fn every_step_method_allocates_nothing_f64() {
 fn every_step_method_allocates_nothing_f32() {
     alloc_free_steps::<f32>();
 }
+
+/// The iterative near field (`Params::near` with `Params::matrix_free`) with bonds: in
+/// `Overdamped2` (Krylov, with contacts, Newton) and at temperature, no heap.
+#[cfg(feature = "near")]
+#[test]
+fn iterative_near_field_with_bonds_allocates_nothing() {
+    const N: usize = 25;
+    const B: usize = N - 1;
+    let init = chain::<f64, N>();
+    let bonds = BondSet::<f64, B>::chain(&init.pos[..N]).unwrap();
+    let cases = [
+        (Method::Overdamped2, SolverKind::Krylov, false, false),
+        (Method::Overdamped2, SolverKind::Krylov, true, false),
+        (Method::Overdamped2, SolverKind::Newton, false, false),
+        (Method::Overdamped, SolverKind::Krylov, false, true),
+    ];
+    for (method, kind, contacts, thermal) in cases {
+        let mut p = Params::new(0.01);
+        p.method = method;
+        p.solver.kind = kind;
+        p.rotation = true;
+        p.matrix_free = true;
+        p.near = Some(hydrorattle::stokesian::NearField::default());
+        p.contacts = contacts.then(|| hydrorattle::Contacts::new(16));
+        p.brownian = thermal.then(|| hydrorattle::Brownian::new(1e-3));
+        let layout = hydrorattle::Layout::for_params(&p, N, B);
+        let mut store = hydrorattle_heap::Buffers::<f64>::new(layout);
+        let mut ws = store.workspace();
+        let mut ps = init.clone();
+        // The generator a thermal step draws from (the others ignore it).
+        ps.noise = thermal.then(|| hydrorattle::Noise::new(3));
+        let (res, n) = count(|| {
+            for _ in 0..2 {
+                step(&mut ps, &bonds, &p, &mut ws, &mut NoForce)?;
+            }
+            Ok::<_, StepError>(())
+        });
+        let tag = format!("{method:?}, {kind:?}, contacts {contacts}, thermal {thermal}");
+        res.unwrap_or_else(|e| panic!("{tag}: {e}"));
+        assert_eq!(n, 0, "{tag}: {n} allocator calls in 2 steps");
+        assert!(ps.time > init.time, "{tag}");
+    }
+}

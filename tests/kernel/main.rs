@@ -56,6 +56,8 @@ mod near_box;
 mod near_brownian;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod near_con;
+#[cfg(all(feature = "near", feature = "wall"))]
+mod near_con_brownian;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod near_contacts;
 #[cfg(all(feature = "near", feature = "periodic"))]

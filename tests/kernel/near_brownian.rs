@@ -32,11 +32,25 @@ use hydrorattle::{
 use hydrorattle_heap::Buffers;
 
 /// The threshold above contact: `h0 = a + 0.5`.
-const ABOVE: f64 = 0.5;
+pub(crate) const ABOVE: f64 = 0.5;
 
 /// Heights above the wall (at 0) of a lone Brownian sphere with the near field, one
 /// sample every `every` steps.
 fn heights<T: Real>(drift: Drift, dt: f64, steps: usize, every: usize, seed: u64) -> Vec<f64> {
+    heights_by::<T>(false, drift, dt, steps, every, seed)
+}
+
+/// [`heights`] by the dense near field or, `iterative`, by its iterative products
+/// (`Params::matrix_free`, the noise's Lanczos root of the far field), the wall's link
+/// then a constraint of the step.
+pub(crate) fn heights_by<T: Real>(
+    iterative: bool,
+    drift: Drift,
+    dt: f64,
+    steps: usize,
+    every: usize,
+    seed: u64,
+) -> Vec<f64> {
     let mut p = params::<T>(dt, Method::Overdamped, SolverKind::Auto);
     p.wall = Some(Wall::new(T::ZERO));
     p.brownian = Some(Brownian {
@@ -45,6 +59,10 @@ fn heights<T: Real>(drift: Drift, dt: f64, steps: usize, every: usize, seed: u64
     });
     p.noise_sqrt = NoiseSqrt::Cholesky;
     p.near = Some(NearField::default());
+    if iterative {
+        p.matrix_free = true;
+        p.noise_sqrt = NoiseSqrt::Lanczos;
+    }
     let mut ps: ParticleSet<T, 1> = particles(&[Sphere {
         pos: [0.0, 0.0, 2.0],
         radius: 1.0,
@@ -66,7 +84,7 @@ fn heights<T: Real>(drift: Drift, dt: f64, steps: usize, every: usize, seed: u64
 }
 
 /// `E[h - h0 | h > h0]` and its standard error from `blocks` consecutive blocks.
-fn excess(h: &[f64], h0: f64, blocks: usize) -> (f64, f64) {
+pub(crate) fn excess(h: &[f64], h0: f64, blocks: usize) -> (f64, f64) {
     let len = h.len() / blocks;
     let means: Vec<f64> = h
         .chunks_exact(len)
@@ -120,6 +138,18 @@ both_precisions! {
 /// field of minimum gap `min_gap` (the roughness parameter, which keeps the squeeze
 /// resistance of the end beads, which may overlap, finite; `None`: RPY alone).
 fn trimer_cosines(min_gap: Option<f64>, dt: f64, steps: usize, seed: u64) -> Vec<f64> {
+    trimer_cosines_by(false, min_gap, dt, steps, seed)
+}
+
+/// [`trimer_cosines`] by the dense near field or, `iterative`, by its iterative
+/// products (`Params::matrix_free`, the noise's Lanczos root of the far field).
+pub(crate) fn trimer_cosines_by(
+    iterative: bool,
+    min_gap: Option<f64>,
+    dt: f64,
+    steps: usize,
+    seed: u64,
+) -> Vec<f64> {
     let d = 3.0;
     let mut ps: ParticleSet<f64, 3> = particles(&[
         Sphere {
@@ -146,6 +176,10 @@ fn trimer_cosines(min_gap: Option<f64>, dt: f64, steps: usize, seed: u64) -> Vec
         min_gap,
         ..NearField::default()
     });
+    if iterative {
+        p.matrix_free = true;
+        p.noise_sqrt = NoiseSqrt::Lanczos;
+    }
     let mut cs = Vec::with_capacity(steps);
     sample(&mut ps, &bonds, &p, seed, steps, |ps| {
         let at = |i: usize| ps.pos[i].to_array();
@@ -166,7 +200,7 @@ fn trimer(min_gap: f64, dt: f64, steps: usize, seed: u64) -> [(f64, f64); 2] {
 }
 
 /// 1 where the cosine `c` is below -0.8, else 0.
-fn below(cs: &[f64]) -> Vec<f64> {
+pub(crate) fn below(cs: &[f64]) -> Vec<f64> {
     cs.iter().map(|&c| f64::from(u8::from(c < -0.8))).collect()
 }
 

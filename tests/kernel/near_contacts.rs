@@ -16,7 +16,7 @@ use std::f64::consts::PI;
 
 use common::*;
 use hydrorattle::{
-    Bond, BondSet, Contacts, Layout, NoForce, ParticleSet, Real, SolverKind, Wall, step,
+    Bond, BondSet, Contacts, Layout, Method, NoForce, ParticleSet, Real, SolverKind, Wall, step,
 };
 use hydrorattle_heap::Buffers;
 
@@ -99,7 +99,17 @@ fn with_contacts<T: Real>(iterative: bool, kind: SolverKind) -> hydrorattle::Par
 /// pair overlaps beyond twice the tolerance; the floor does not move, bit for bit.
 fn settles_as_dense<T: Real>() {
     for kind in [SolverKind::Krylov, SolverKind::Newton, SolverKind::Sweep] {
-        settles_with::<T>(kind, &bed(), 9, None, 3);
+        settles_with::<T>(Method::Overdamped, kind, &bed(), 9, None, 3);
+    }
+}
+
+/// [`settles_as_dense`] and [`settles_on_the_wall`] by `Overdamped2` (its predictor's
+/// and its trapezoid's projections hold the contacts, along `M_SD` at the start), with
+/// the Krylov solve and Newton.
+fn settles_as_dense2<T: Real>() {
+    for kind in [SolverKind::Krylov, SolverKind::Newton] {
+        settles_with::<T>(Method::Overdamped2, kind, &bed(), 9, None, 3);
+        settles_with::<T>(Method::Overdamped2, kind, &on_the_wall(), 0, Some(0.0), 2);
     }
 }
 
@@ -109,6 +119,14 @@ fn settles_as_dense<T: Real>() {
 /// links held, one-sided, beside the pair contacts, the iterative product's far field
 /// the wall's and its near field the wall's sphere corrections.
 fn settles_on_the_wall<T: Real>() {
+    for kind in [SolverKind::Krylov, SolverKind::Newton] {
+        settles_with::<T>(Method::Overdamped, kind, &on_the_wall(), 0, Some(0.0), 2);
+    }
+}
+
+/// Five heavy spheres within 0.002 to 0.01 of the wall at height 0, two of them on
+/// others ([`settles_on_the_wall`]).
+fn on_the_wall() -> [Sphere; 5] {
     let ground = |x: f64, y: f64, a: f64, h: f64| Sphere {
         pos: [x, y, a + h],
         radius: a,
@@ -118,16 +136,15 @@ fn settles_on_the_wall<T: Real>() {
     let c = ground(-1.0, 2.0, 0.8, 0.004);
     let d = above(&a, 0.9, (0.3, -0.2), 0.003);
     let e = above(&b, 1.1, (0.4, 0.1), 0.02);
-    let spheres = [a, b, c, d, e];
-    for kind in [SolverKind::Krylov, SolverKind::Newton] {
-        settles_with::<T>(kind, &spheres, 0, Some(0.0), 2);
-    }
+    [a, b, c, d, e]
 }
 
 /// Twelve steps of `spheres` (the first `pinned` of them pinned, the wall at `wall` if
-/// given) with the solver `kind`, each against the dense step from the same state; at
+/// given) by `method` with the solver `kind`, each against the dense step from the
+/// same state; at
 /// least `contacts` pair contacts held at some step (and two wall links, with the wall).
 fn settles_with<T: Real>(
+    method: Method,
     kind: SolverKind,
     spheres: &[Sphere],
     pinned: usize,
@@ -137,6 +154,7 @@ fn settles_with<T: Real>(
     let rows = floor::<T>(&spheres[..pinned]);
     let setup = |iterative| {
         let mut p = with_contacts::<T>(iterative, kind);
+        p.method = method;
         p.wall = wall.map(|h| Wall::new(T::from_f64(h)));
         p
     };
@@ -181,7 +199,7 @@ fn settles_with<T: Real>(
             .map(|(a, b)| norm(sub(*a, *b)))
             .fold(0.0, f64::max);
         println!(
-            "{kind:?} step {k}: contacts {} (dense {}), wall {} (dense {}), rounds {}, krylov {} (dense {}), products {}, pcg {}, moved {moved:.2e}, apart {:.1e}, overlap {:.1e}",
+            "{method:?} {kind:?} step {k}: contacts {} (dense {}), wall {} (dense {}), rounds {}, krylov {} (dense {}), products {}, pcg {}, moved {moved:.2e}, apart {:.1e}, overlap {:.1e}",
             ri.contacts,
             rd.contacts,
             ri.wall_contacts,
@@ -241,6 +259,7 @@ fn same_bits<T: Real>() {
 }
 
 both_precisions! {
+    settles_as_dense2 => settles_as_dense2;
     settles_as_dense => settles_as_dense;
     settles_on_the_wall => settles_on_the_wall;
     same_bits => same_bits;

@@ -489,12 +489,13 @@ fn same_bits<T: Real>() {
 }
 
 /// What the iterative Brownian step still refuses, typed, the state and the generator
-/// unchanged: bonds (constraints), the wall, `Overdamped2` at temperature, and a Lanczos
-/// root given too few iterations (`NoConvergence` at the mobility stage).
+/// unchanged: `Overdamped2` at temperature, and a Lanczos root given too few iterations
+/// (`NoConvergence` at the mobility stage); bonds and the wall step.
 fn refusals<T: Real>() {
     let spheres = cluster([0.0; 3]);
     let n = spheres.len();
     let base = iterative::<T>(1e-3, 1.0, Drift::Midpoint, None);
+    // One step from the cluster: its result, the state and generator before and after.
     let attempt = |p: &hydrorattle::Params<T>, bonds: &[Bond<T>]| {
         let mut ps: ParticleSet<T, 8> = particles(&spheres);
         let mut set: BondSet<T, 2> = BondSet::new();
@@ -505,20 +506,18 @@ fn refusals<T: Real>() {
         let mut ws = buf.workspace();
         let mut noise = Noise::new(5);
         let before = (snapshot(&ps), noise.save());
-        let e = step_thermal(
-            &mut ps,
-            &set,
-            p,
-            &mut ws,
-            &mut hydrorattle::NoForce,
-            &mut noise,
-        )
-        .expect_err("refused");
-        assert_eq!((snapshot(&ps), noise.save()), before, "{e:?}: state moved");
+        let mut force = hydrorattle::NoForce;
+        let r = step_thermal(&mut ps, &set, p, &mut ws, &mut force, &mut noise);
+        (r, before, (snapshot(&ps), noise.save()))
+    };
+    let refused = |p: &hydrorattle::Params<T>, bonds: &[Bond<T>]| {
+        let (r, before, after) = attempt(p, bonds);
+        let e = r.expect_err("refused");
+        assert_eq!(after, before, "{e:?}: state moved");
         e
     };
     let unsupported =
-        |p: &hydrorattle::Params<T>, bonds: &[Bond<T>], what: &str| match attempt(p, bonds) {
+        |p: &hydrorattle::Params<T>, bonds: &[Bond<T>], what: &str| match refused(p, bonds) {
             StepError::Unsupported(m) => assert!(m.contains(what), "{m}"),
             other => panic!("{what}: {other:?}"),
         };
@@ -527,16 +526,23 @@ fn refusals<T: Real>() {
         j: 1,
         length: T::from_f64(2.05),
     };
-    unsupported(&base, &[bond], "constraints");
+    // Bonds and the wall (its links one-sided constraints) step (refused before):
+    // `near_con_brownian.rs`.
+    let stepped = |p: &hydrorattle::Params<T>, bonds: &[Bond<T>]| {
+        attempt(p, bonds).0.unwrap_or_else(|e| panic!("{e:?}"))
+    };
+    let r = stepped(&base, &[bond]);
+    assert!(r.near_products > 0 && r.noise_iterations > 0, "{r:?}");
     let mut p = base;
     p.wall = Some(Wall::new(T::from_f64(-40.0)));
-    unsupported(&p, &[], "wall");
+    let r = stepped(&p, &[]);
+    assert!(r.near_products > 0 && r.noise_iterations > 0, "{r:?}");
     let mut p = base;
     p.method = hydrorattle::Method::Overdamped2;
     unsupported(&p, &[], "thermal noise");
     let mut p = base;
     p.lanczos.max_iterations = 2;
-    match attempt(&p, &[]) {
+    match refused(&p, &[]) {
         StepError::NoConvergence {
             stage: Stage::Mobility,
             iterations: 2,

@@ -29,20 +29,24 @@
 //! round, `Metric::Dense` as the dense path tabulates its stored `M_SD`), cheaper than
 //! the Krylov solve's products where the rows are few; `Auto` resolves to Krylov
 //! (`Params::solver_kind`). A wall link's squeeze resistance is its sphere's wall
-//! correction along the normal (a pin has none). `Overdamped2` and noise are refused by
-//! `near::check`, typed. A product that does not converge ends the step with
+//! correction along the normal (a pin has none). `Overdamped2` (`constrained2.rs`)
+//! solves its velocity projections here too ([`Iterative::velocities`]), and the
+//! thermal step its midpoint's (`noise.rs`). A product that does not converge ends the step with
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`](crate::Stage::Mobility), the
 //! caller's state unchanged.
 
 use super::solve::{self, At};
 use super::{Counts, Store, spins};
 use crate::bonds::Bond;
-use crate::constraints::{self, Metric, Problem, Products, SolveStats, SolverKind, krylov_with};
+use crate::constraints::{
+    self, Metric, Problem, Products, Scratch, SolveStats, SolverKind, krylov_with,
+};
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
 use crate::integrate::contacts::{Along, Round, project_along};
 use crate::integrate::{
-    Start, StepReport, add_constraint_forces, add_flow, cell, check_resolved, report, step_velocity,
+    Start, StepReport, Sums, add_constraint_forces, add_flow, bond_vectors, cell, check_resolved,
+    report, step_velocity,
 };
 use crate::linalg::{Mob, tri};
 use crate::params::Params;
@@ -50,13 +54,13 @@ use crate::real::Real;
 use crate::workspace::Views;
 
 /// The constraint solve's products: `M_SD` at the start ([`solve::at`]), counted.
-struct Sd<'a, 's, T: Real> {
-    at: &'a mut At<'s, T>,
-    p: &'a Params<T>,
-    counts: Counts,
+pub(super) struct Sd<'a, 's, T: Real> {
+    pub(super) at: &'a mut At<'s, T>,
+    pub(super) p: &'a Params<T>,
+    pub(super) counts: &'a mut Counts,
     /// Each row's squeeze resistance over `c dt |g|^2`: the preconditioner's diagonal
     /// (the rows of the round being solved).
-    stiff: &'a mut [T],
+    pub(super) stiff: &'a mut [T],
 }
 
 impl<T: Real> Products<T> for Sd<'_, '_, T> {
@@ -75,8 +79,7 @@ impl<T: Real> Products<T> for Sd<'_, '_, T> {
                 "the iterative near field's constraint products along a metric without forces",
             )),
         };
-        self.at
-            .velocities_of(self.p, fill, out, None, &mut self.counts)
+        self.at.velocities_of(self.p, fill, out, None, self.counts)
     }
 
     fn precondition(&self, r: &[T], z: &mut [T]) {
@@ -88,14 +91,18 @@ impl<T: Real> Products<T> for Sd<'_, '_, T> {
 
 /// Each round of the projection ([`project_along`]: the bonds, and the contacts the
 /// rounds hold) by the Krylov solve, its products [`Sd`]'s, its entries the far
-/// field's `mu_tt` (the grand mobility's first `n` block rows).
-struct Iterative<'a, 's, T: Real> {
-    sd: Sd<'a, 's, T>,
-    packed: &'s [T::M3],
-    s: &'a Start<'a, T>,
+/// field's `mu_tt` (the grand mobility's first `n` block rows); and the velocity
+/// projection of `Overdamped2` ([`Iterative::velocities`]) the same way.
+pub(super) struct Iterative<'a, 's, T: Real> {
+    pub(super) sd: Sd<'a, 's, T>,
+    pub(super) packed: &'s [T::M3],
+    /// Where the products are: the squeeze resistances' configuration, and the
+    /// step's sums.
+    pub(super) spheres: (&'a [T::V3], &'a [T]),
+    pub(super) ewald: Sums<'a, T>,
     /// The sweep's and Newton's table of `M_SD`'s columns (`n x rows`; empty for
     /// Krylov).
-    table: &'a mut [T::V3],
+    pub(super) table: &'a mut [T::V3],
 }
 
 impl<T: Real> Along<T> for Iterative<'_, '_, T> {
@@ -109,14 +116,6 @@ impl<T: Real> Along<T> for Iterative<'_, '_, T> {
             nb,
             start,
         } = r;
-        let n = x.len();
-        let far = Metric::Mobility {
-            mu: Mob::Full(&self.packed[..tri(n)]),
-            grad,
-            scale: p.dt,
-            par: scratch.par,
-            compact: None,
-        };
         let problem = Problem::Positions {
             cell: cell(p),
             one_sided: nb,
@@ -124,10 +123,66 @@ impl<T: Real> Along<T> for Iterative<'_, '_, T> {
             anchor: start,
         };
         let _ = start; // Read only with the `pins` feature.
+        // The chord matrix `2 G dt M G^T`: `c = 2`, scale `dt`.
+        let scaled = (p.dt, T::TWO * p.dt);
+        self.solve(p, problem, rows, grad, scaled, x, lambda, scratch)
+    }
+}
+
+impl<'a, 's, T: Real> Iterative<'a, 's, T> {
+    /// The solves along the products of `at` (at `spheres`, with the step's sums
+    /// `ewald`), counted in `counts`; `stiff` the rows' preconditioner diagonal, `table`
+    /// the sweep's and Newton's.
+    pub(super) fn new(
+        at: &'a mut At<'s, T>,
+        p: &'a Params<T>,
+        counts: &'a mut Counts,
+        stiff: &'a mut [T],
+        spheres: (&'a [T::V3], &'a [T]),
+        ewald: Sums<'a, T>,
+        table: &'a mut [T::V3],
+    ) -> Self {
+        Self {
+            packed: at.packed(),
+            sd: Sd {
+                at,
+                p,
+                counts,
+                stiff,
+            },
+            spheres,
+            ewald,
+            table,
+        }
+    }
+
+    /// Solves `problem` over `rows` (vectors `grad`) along `scale M_SD,tt G^T` into
+    /// `x` and `lambda` (from zero): the Krylov solve, or the sweep and Newton on the
+    /// table of `M_SD`'s columns. `chord` is the chord matrix's factor `c scale`.
+    #[allow(clippy::too_many_arguments)]
+    fn solve(
+        &mut self,
+        p: &Params<T>,
+        problem: Problem<'_, T>,
+        rows: &[Bond<T>],
+        grad: &[T::V3],
+        (scale, chord): (T, T),
+        x: &mut [T::V3],
+        lambda: &mut [T],
+        scratch: &mut Scratch<'_, T>,
+    ) -> Result<SolveStats<T>, StepError> {
+        let n = x.len();
+        let far = Metric::Mobility {
+            mu: Mob::Full(&self.packed[..tri(n)]),
+            grad,
+            scale,
+            par: scratch.par,
+            compact: None,
+        };
         lambda.fill(T::ZERO);
         if p.solver.kind == SolverKind::Krylov {
             for ((k, b), &g) in self.sd.stiff.iter_mut().zip(rows).zip(grad) {
-                *k = squeeze(p, self.s, b, g, T::TWO);
+                *k = squeeze(p, (self.spheres, self.ewald), b, g, chord);
             }
             let ops = (&far, &mut self.sd);
             return krylov_with(problem, ops, rows, &p.solver, x, lambda, scratch);
@@ -149,26 +204,109 @@ impl<T: Real> Along<T> for Iterative<'_, '_, T> {
         };
         constraints::solve(problem, &metric, rows, &p.solver, x, lambda, scratch)
     }
+
+    /// `Overdamped2`'s projected velocity at the products' configuration (the dense
+    /// step's `projected_velocity`): `u = U_inf + M_SD,tt F` (checked to resolve a
+    /// step where `judge`), then the bonds' length rates held at zero along
+    /// `M_SD,tt G^T` (`G` the bond vectors there, into `grad`), the multipliers into
+    /// `kappa`: the constraint forces `G^T kappa`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn velocities(
+        &mut self,
+        p: &Params<T>,
+        bonds: &[Bond<T>],
+        force: &[T::V3],
+        (grad, kappa): (&mut [T::V3], &mut [T]),
+        scratch: &mut Scratch<'_, T>,
+        u: &mut [T::V3],
+        judge: bool,
+    ) -> Result<SolveStats<T>, StepError> {
+        let pos = self.spheres.0;
+        self.sd.at.velocities(p, force, u, None, self.sd.counts)?;
+        add_flow(p, pos, u);
+        if judge {
+            check_resolved(pos, u, p.dt)?;
+        }
+        self.hold_rates(p, bonds, (grad, kappa), scratch, u, p.dt)
+    }
+
+    /// `u` projected at the products' configuration: the bonds' length rates held at
+    /// zero along `M_SD,tt G^T` (`G` the bond vectors there, into `grad`; the
+    /// multipliers into `kappa`), the residual scaled by `dt` (`Problem::Velocities`).
+    pub(super) fn hold_rates(
+        &mut self,
+        p: &Params<T>,
+        bonds: &[Bond<T>],
+        (grad, kappa): (&mut [T::V3], &mut [T]),
+        scratch: &mut Scratch<'_, T>,
+        u: &mut [T::V3],
+        dt: T,
+    ) -> Result<SolveStats<T>, StepError> {
+        bond_vectors(bonds, self.spheres.0, cell(p), grad);
+        let problem = Problem::Velocities { bond: grad, dt };
+        // The chord matrix `G M G^T`: `c = 1`, scale 1.
+        let unit = (T::ONE, T::ONE);
+        self.solve(p, problem, bonds, grad, unit, u, kappa, scratch)
+    }
 }
+
+/// What a constrained step's last projection did: its solve, and the contacts, the
+/// wall's links and the active-set rounds it held.
+pub(super) type Held<T> = (SolveStats<T>, u32, u32, u32);
+
+/// The projection's [`Held`] of `r`.
+pub(super) fn held<T: Real>(r: &crate::integrate::contacts::Projected<'_, T>) -> Held<T> {
+    (r.stats, r.contacts, r.wall_contacts, r.rounds)
+}
+
+/// A constrained step's report: the near field's `counts`, the last projection's
+/// `held`, a midpoint projection's `velocity_iterations`, the multipliers of `bonds`.
+pub(super) fn held_report<T: Real>(
+    counts: &Counts,
+    (stats, contacts, wall_contacts, rounds): Held<T>,
+    velocity_iterations: u32,
+    bonds: &[Bond<T>],
+    lambda: &[T],
+) -> StepReport<T> {
+    StepReport {
+        near_pairs: counts.pairs,
+        near_products: counts.products,
+        near_iterations: counts.iterations,
+        contacts,
+        wall_contacts,
+        contact_rounds: rounds,
+        ..report(stats, velocity_iterations, bonds, lambda)
+    }
+}
+
+/// Sphere centres and radii.
+type Spheres<'a, T> = (&'a [<T as Real>::V3], &'a [T]);
 
 const TABLE: StepError =
     StepError::Unsupported("the iterative near field's sweep or Newton without its table");
 
 /// Bond `b`'s squeeze resistance `d^T (R_ii + R_jj - R_ij - R_ji) d / 4` (`d` along the
 /// bond) from its pair's near-field correction, or a wall link's `d^T R_ii d` from its
-/// sphere's wall correction (the sphere against the fixed wall), over `c dt |g|^2`.
-fn squeeze<T: Real>(p: &Params<T>, s: &Start<'_, T>, b: &Bond<T>, g: T::V3, c: T) -> T {
-    let (Some(nf), Ok(far)) = (p.near, crate::integrate::near::far(p, s.ewald)) else {
+/// sphere's wall correction (the sphere against the fixed wall), at `spheres` (the
+/// step's sums `ew`), over `chord |g|^2` (`chord = c scale`, the chord matrix's factor).
+fn squeeze<T: Real>(
+    p: &Params<T>,
+    (spheres, ew): (Spheres<'_, T>, Sums<'_, T>),
+    b: &Bond<T>,
+    g: T::V3,
+    chord: T,
+) -> T {
+    let (Some(nf), Ok(far)) = (p.near, crate::integrate::near::far(p, ew)) else {
         return T::ZERO;
     };
-    let (eta, spheres) = (p.viscosity, (s.pos, s.radius));
+    let (eta, (pos, radius)) = (p.viscosity, spheres);
     let (m, share) = match (b.is_wall(), far.wall()) {
         (true, Some(h)) => match crate::stokesian::wall_correction(eta, h, spheres, nf, b.i) {
             Ok(Some((r, _))) => (r[0][0], T::ONE),
             _ => return T::ZERO,
         },
         _ if b.one_sphere() => return T::ZERO,
-        _ => match crate::stokesian::pair_correction(eta, far, s.pos, s.radius, nf, (b.i, b.j)) {
+        _ => match crate::stokesian::pair_correction(eta, far, pos, radius, nf, (b.i, b.j)) {
             Ok(Some(r)) => (r[0][0] + r[1][1] - r[0][1] - r[1][0], T::from_f64(0.25)),
             _ => return T::ZERO,
         },
@@ -179,7 +317,7 @@ fn squeeze<T: Real>(p: &Params<T>, s: &Start<'_, T>, b: &Bond<T>, g: T::V3, c: T
     }
     let d = g * (T::ONE / g2.sqrt());
     let k = T::dot(d, m * d) * share;
-    (k / (c * p.dt * g2)).max(T::ZERO)
+    (k / (chord * g2)).max(T::ZERO)
 }
 
 /// `Overdamped` with bonds, pins and contacts on the iterative near field: `r* = r +
@@ -217,13 +355,14 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
     // The far field at the start, and the close pairs factored once.
     solve::at(p, s.ewald, (s.pos, s.radius), &mut store, |at| {
         let packed = at.packed();
-        let mut sd = Sd {
+        let mut counts = Counts::default();
+        let sd = Sd {
             at,
             p,
-            counts: Counts::default(),
+            counts: &mut counts,
             stiff,
         };
-        sd.at.velocities(p, force, u, None, &mut sd.counts)?;
+        sd.at.velocities(p, force, u, None, sd.counts)?;
         add_flow(p, s.pos, u);
         check_resolved(s.pos, u, dt)?;
         let free = |x: &mut [T::V3]| {
@@ -235,7 +374,8 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
         let mut along = Iterative {
             sd,
             packed,
-            s,
+            spheres: (s.pos, s.radius),
+            ewald: s.ewald,
             table: disp,
         };
         let views = (links, &mut *grad, &mut *lambda, &mut scratch);
@@ -253,17 +393,9 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
         add_constraint_forces(r.held, grad, lambda, force);
         if p.rotation {
             sd.at
-                .velocities(p, force, u, Some(&mut *new_omega), &mut sd.counts)?;
+                .velocities(p, force, u, Some(&mut *new_omega), sd.counts)?;
         }
         spins(p, new_omega);
-        Ok(StepReport {
-            near_pairs: sd.counts.pairs,
-            near_products: sd.counts.products,
-            near_iterations: sd.counts.iterations,
-            contacts: r.contacts,
-            wall_contacts: r.wall_contacts,
-            contact_rounds: r.rounds,
-            ..report(r.stats, 0, bonds, lambda)
-        })
+        Ok(held_report(sd.counts, held(&r), 0, bonds, lambda))
     })
 }

@@ -23,14 +23,21 @@
 //!
 //! **Cost**: two assemblies of the far field (start, midpoint), three products (the
 //! velocities and the noise's solve share the start's factors), and the far field's
-//! Lanczos iterations ([`StepReport::noise_iterations`]). The Lanczos root stops at
+//! Lanczos iterations ([`StepReport::noise_iterations`]). With constraints (bonds,
+//! pins, the wall's links) the dense near step's constrained step (`brownian.rs`): the
+//! midpoint's noise projected onto the bonds along `M_SD,tt(x~)` (its mean then
+//! `kT dt div (P M_SD,tt)`), and the start's far field assembled a third time for the
+//! move's projection along `M_SD,tt(r)`. The Lanczos root stops at
 //! [`Params::lanczos`]'s tolerance within its iterations; not converging is
 //! [`StepError::NoConvergence`], the caller's state unchanged.
 
+use super::constrained::{self, Iterative};
 use super::{Counts, STORAGE, Store, report, solve, spins};
+use crate::bonds::Bond;
 use crate::error::StepError;
 use crate::forces::{self, ExternalForce};
-use crate::integrate::{Start, StepReport, add_flow, step_velocity};
+use crate::integrate::contacts::project_along;
+use crate::integrate::{Start, StepReport, add_constraint_forces, add_flow, step_velocity};
 use crate::noise::{Noise, lanczos};
 use crate::params::{Brownian, Drift, Params};
 use crate::real::Real;
@@ -44,11 +51,18 @@ fn tail<X>(s: &mut [X], k: usize) -> Result<(&mut [X], &mut [X]), StepError> {
 
 /// One `Overdamped` step at `b.temperature > 0` with the iterative near field (see the
 /// module): `r' = r + dt (U_inf + M_SD,tt F) + dx`, the spins `Omega_inf + M_SD,rt F`
-/// at the start, as the deterministic step.
+/// at the start, as the deterministic step. With constraints (bonds, pins, contacts,
+/// the wall's links) the dense near step's constrained Brownian step
+/// (`integrate::brownian`): the midpoint's noise projected onto the bonds along
+/// `M_SD,tt(x~)` (its mean then `kT dt div (P M_SD,tt)`), the move projected along
+/// `dt M_SD,tt(r) G^T` as the deterministic step's (`constrained.rs`, the start's
+/// products factored again), the spins of `F + G^T lambda`.
+#[allow(clippy::too_many_arguments)]
 pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     p: &Params<T>,
     b: Brownian<T>,
     s: &Start<'_, T>,
+    bonds: &[Bond<T>],
     v: Views<'_, T>,
     ext: &mut E,
     noise: &mut Noise,
@@ -60,12 +74,20 @@ pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         new_pos,
         new_vel,
         new_omega,
+        grad,
+        lambda,
+        mut scratch,
+        links,
+        disp,
         near,
         near_iter,
         ..
     } = v;
+    // Room for every row the step may solve (none without constraints).
+    let rows = p.constraints(n, bonds.len());
     let [noise_v, noise_s] = near_noise_sizes(p, n);
     let (reals, work) = tail(near.1, noise_s)?;
+    let (reals, stiff) = tail(reals, rows)?;
     let (vectors, rest) = tail(near_iter.0, noise_v)?;
     let mut store = Store::new((near.0, reals), (vectors, near_iter.1));
     let cap = p.lanczos.max_iterations as usize;
@@ -77,10 +99,16 @@ pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
     let mut counts = Counts::default();
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     // At the start: the velocities, then b = M_far^(-1/2) z' + L z and x = M_SD b.
+    // (With constraints the spins wait for the constraint forces.)
     noise.fill::<T>(z);
     let start = (s.pos, s.radius);
     let iterations = solve::at(p, s.ewald, start, &mut store, |at| {
-        at.velocities(p, force, u, Some(&mut *new_omega), &mut counts)?;
+        let w = if rows == 0 {
+            Some(&mut *new_omega)
+        } else {
+            None
+        };
+        at.velocities(p, force, u, w, &mut counts)?;
         let product = |v: &[T::V3], w: &mut [T::V3]| at.far(v, w);
         let root_it = lanczos::sqrt(p.lanczos, product, z, basis, work, root, Some(&mut *f))?;
         at.add_near_noise(&mut |v| noise.fill::<T>(v), f)?;
@@ -88,8 +116,11 @@ pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
         Ok(root_it)
     })?;
     add_flow(p, s.pos, u);
-    spins(p, new_omega);
     let amplitude = (T::TWO * kt * dt).sqrt();
+    let x = &mut x[..2 * n];
+    // The midpoint projection's iterations, where it has projected (and scaled) the
+    // noise.
+    let mut held = None;
     if b.drift == Drift::Midpoint {
         // x~ = r + sqrt(kT dt / 2) x_t; then x = M_SD(x~) b.
         let half = (kt * dt * T::HALF).sqrt();
@@ -98,16 +129,60 @@ pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
             *m = r + d * half;
         }
         let at_mid = (&*mid, s.radius);
-        solve::at(p, s.ewald, at_mid, &mut store, |at| {
-            at.apply(p, f, x, &mut counts)
+        held = solve::at(p, s.ewald, at_mid, &mut store, |at| {
+            at.apply(p, f, x, &mut counts)?;
+            if rows == 0 || bonds.is_empty() {
+                return Ok(None);
+            }
+            // The noise `dx = sqrt(2 kT dt) x_t` projected onto the bonds at x~ along
+            // `M_SD,tt(x~)`, as the dense step projects it.
+            let dx = &mut x[..n];
+            dx.iter_mut().for_each(|d| *d *= amplitude);
+            let table = &mut *disp;
+            let mut along = Iterative::new(at, p, &mut counts, &mut *stiff, at_mid, s.ewald, table);
+            let views = (&mut *grad, &mut *lambda);
+            let stats = along.hold_rates(p, bonds, views, &mut scratch, dx, T::ONE)?;
+            Ok(Some(stats.iterations))
         })?;
     }
-    for i in 0..n {
-        new_pos[i] = s.pos[i] + u[i] * dt + x[i] * amplitude;
+    if rows == 0 {
+        spins(p, new_omega);
+        for i in 0..n {
+            new_pos[i] = s.pos[i] + u[i] * dt + x[i] * amplitude;
+        }
+        step_velocity(s.pos, new_pos, dt, new_vel);
+        return Ok(StepReport {
+            noise_iterations: iterations,
+            ..report(counts)
+        });
     }
+    // The noise, unless the midpoint's projection has scaled it.
+    if held.is_none() {
+        x[..n].iter_mut().for_each(|d| *d *= amplitude);
+    }
+    // r* = r + dt (U_inf + M_SD,tt F) + dx, projected along `M_SD` at the start
+    // (factored again: the midpoint's products have taken the storage).
+    let r = solve::at(p, s.ewald, start, &mut store, |at| {
+        let mut along = Iterative::new(at, p, &mut counts, stiff, start, s.ewald, disp);
+        let free = |y: &mut [T::V3]| {
+            for i in 0..n {
+                y[i] = s.pos[i] + u[i] * dt + x[i];
+            }
+        };
+        let views = (links, &mut *grad, &mut *lambda, &mut scratch);
+        let r = project_along(p, bonds, start, views, new_pos, free, &mut along)?;
+        add_constraint_forces(r.held, grad, lambda, force);
+        if p.rotation {
+            let sd = &mut along.sd;
+            sd.at
+                .velocities(p, force, u, Some(&mut *new_omega), sd.counts)?;
+        }
+        Ok(constrained::held(&r))
+    })?;
+    spins(p, new_omega);
     step_velocity(s.pos, new_pos, dt, new_vel);
     Ok(StepReport {
         noise_iterations: iterations,
-        ..report(counts)
+        ..constrained::held_report(&counts, r, held.unwrap_or(0), bonds, lambda)
     })
 }
