@@ -294,7 +294,7 @@ fn dense_cholesky_ok(mut m: Vec<Vec<f64>>) -> bool {
                 m[i][j] -= m[i][k] * m[j][k];
             }
         }
-        if !(m[j][j] > 0.0) {
+        if m[j][j] <= 0.0 || m[j][j].is_nan() {
             return false;
         }
         let d = m[j][j].sqrt();
