@@ -45,6 +45,7 @@
 pub mod fast;
 pub mod free;
 pub mod periodic;
+pub mod slit;
 #[cfg(feature = "periodic")]
 pub mod sums;
 pub mod wall;
@@ -288,6 +289,9 @@ macro_rules! geometries {
 
 // The registration: every geometry once, in the order the choice tries them.
 geometries! {$
+    /// Between two walls (`mobility/slit.rs`; feature `slit`).
+    #[cfg(feature = "slit")]
+    Slit(slit::step::Slit<T>, slit::Between<T>),
     /// In a periodic box; its step where its images interact, with the step's sums
     /// (Ewald, `mobility/periodic.rs`, or PSE, `mobility/pse.rs`; feature `periodic`).
     #[cfg(feature = "periodic")]

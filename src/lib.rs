@@ -105,7 +105,7 @@ pub use noise::lanczos::{Lanczos, LanczosError};
 pub use parallel::{Parallel, Serial};
 pub use params::{
     Brownian, Contacts, Drift, LANCZOS_CROSSOVER, Method, NEAR_PAIRS_PER_SPHERE, NoiseSqrt, Params,
-    Wall,
+    Slit, Wall,
 };
 pub use particles::{Particle, ParticleSet, State};
 pub use real::Real;

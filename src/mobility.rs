@@ -25,6 +25,8 @@ mod grand;
 pub mod periodic;
 #[cfg(feature = "pse")]
 pub mod pse;
+#[cfg(feature = "slit")]
+pub mod slit;
 pub mod wall;
 
 // The pair formulas sit below the band machinery (`parallel`), which evaluates them.

@@ -181,6 +181,19 @@ impl<T> Wall<T> {
     }
 }
 
+/// A slit between two no-slip plane walls, the floor `z = floor` below the spheres and
+/// the ceiling `z = ceiling` above them (the kernel's `slit` feature;
+/// `docs/GEOMETRY.md`, "The slit"): the mobility is the superposition of both walls'
+/// image systems, and each wall is a one-sided constraint as [`Wall`] is. Refused with
+/// a [`Wall`] or a box beside it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slit<T> {
+    /// The floor's `z` coordinate (finite).
+    pub floor: T,
+    /// The ceiling's `z` coordinate (finite, above the floor).
+    pub ceiling: T,
+}
+
 /// Everything a step needs besides the state. Build with [`Params::new`] and adjust.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params<T: Real> {
@@ -268,6 +281,8 @@ pub struct Params<T: Real> {
     pub contacts: Option<Contacts>,
     /// A no-slip plane wall below the spheres ([`Wall`]). Default `None`: unbounded fluid.
     pub wall: Option<Wall<T>>,
+    /// A slit between two walls ([`Slit`]). Default `None`.
+    pub slit: Option<Slit<T>>,
     /// A rectangular periodic box ([`Periodic`]; the kernel's `periodic` feature): the
     /// mobility is the Ewald-summed RPY tensor of the box (`docs/PERIODIC.md`), and
     /// every pair geometry (bonds, contacts, springs, overlap checks) takes the
@@ -385,6 +400,7 @@ impl<T: Real> Params<T> {
             lanczos: Lanczos::default(),
             contacts: None,
             wall: None,
+            slit: None,
             periodic: None,
             compact_products: false,
             resolve_tensions: T::EPSILON.to_f64() > 1e-10,
@@ -415,8 +431,13 @@ impl<T: Real> Params<T> {
             Some(w) => Some(w.height),
             None => None,
         };
+        let slit = match self.slit {
+            Some(s) => Some((s.floor, s.ceiling)),
+            None => None,
+        };
         crate::geometry::Place::new(crate::geometry::Named {
             wall,
+            slit,
             cell: self.periodic,
             pse: self.pse.is_some(),
         })
@@ -431,17 +452,15 @@ impl<T: Real> Params<T> {
     }
 
     /// Constraint slots a step of `n` spheres with `bonds` bonds holds: the bonds, the
-    /// contact capacity when contacts are on, and one wall link per sphere with a wall.
+    /// contact capacity when contacts are on, and one wall link per sphere for each hard
+    /// surface (a wall's plane; a slit's two).
     pub const fn constraints(&self, n: usize, bonds: usize) -> usize {
         let contacts = match self.contacts {
             Some(c) => c.capacity,
             None => 0,
         };
-        let wall = match self.wall {
-            Some(_) => n,
-            None => 0,
-        };
-        bonds + contacts + wall
+        // One link a sphere for each hard surface of the place.
+        bonds + contacts + n * self.place().surfaces().len()
     }
 
     /// The solver that runs for `n` spheres and `bonds` bonds: [`SolverKind::Auto`]

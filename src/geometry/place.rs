@@ -19,6 +19,8 @@ use crate::real::Real;
 pub struct Named<T: Real> {
     /// The wall's height ([`Params::wall`](crate::Params::wall)).
     pub wall: Option<T>,
+    /// A slit's floor and ceiling ([`Params::slit`](crate::Params::slit)).
+    pub slit: Option<(T, T)>,
     /// The periodic box ([`Params::periodic`](crate::Params::periodic)).
     pub cell: Option<Periodic<T>>,
     /// A box summed by PSE ([`Params::pse`](crate::Params::pse)).
@@ -29,6 +31,7 @@ impl<T: Real> Named<T> {
     /// Nothing named: free space.
     pub const FREE: Self = Self {
         wall: None,
+        slit: None,
         cell: None,
         pse: false,
     };
@@ -123,6 +126,7 @@ mod tests {
                 for pse in [false, true] {
                     let place = Place::<f64>::new(Named {
                         wall,
+                        slit: None,
                         cell: periodic,
                         pse,
                     });

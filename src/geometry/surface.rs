@@ -118,14 +118,15 @@ impl<T: Real> Surfaces<T> {
         self.planes.into_iter().flatten()
     }
 
-    /// The height of the one floor, where the surfaces are that alone: what the
+    /// The height of the first floor (a plane the spheres stay above): what the
     /// contacts' wall links hold (they run in its frame, [`Bond::wall`](crate::Bond::wall)).
-    /// A ceiling's links (a slit's) are not modelled: `None` then, and the geometry's
-    /// checks must refuse contacts there.
+    /// A ceiling has no links (a slit's): the acceptance refuses a step that would
+    /// carry a sphere past it.
     #[inline(always)]
     pub const fn floor(self) -> Option<T> {
         match self.planes {
-            [Some(s), None] if s.above => Some(s.height),
+            [Some(s), _] if s.above => Some(s.height),
+            [_, Some(s)] if s.above => Some(s.height),
             _ => None,
         }
     }
@@ -159,7 +160,7 @@ mod tests {
         }
     }
 
-    /// A place's surfaces: counted in order, and a floor alone is what the contacts hold.
+    /// A place's surfaces: counted in order, and the floor is what the contacts hold.
     #[test]
     fn surfaces_count_and_the_floor() {
         let (f, c) = (Surface::floor(0.5), Surface::ceiling(9.0));
@@ -167,7 +168,7 @@ mod tests {
             (Surfaces::NONE, 0, None),
             (Surfaces::one(f), 1, Some(0.5)),
             (Surfaces::one(c), 1, None),
-            (Surfaces::two(f, c), 2, None),
+            (Surfaces::two(f, c), 2, Some(0.5)),
         ];
         for (s, n, floor) in cases {
             assert_eq!((s.len(), s.is_empty(), s.floor()), (n, n == 0, floor));

@@ -394,7 +394,8 @@ fn midpoint<T: Real>(
     // mobility without a wall does not depend on the positions: mu(x~) is mu, and is
     // not assembled again.
     let mid = &*mid;
-    let same = p.hydro == Hydro::FreeDraining && p.place().wall().is_none() && !p.matrix_free;
+    let walls = !p.place().surfaces().is_empty();
+    let same = p.hydro == Hydro::FreeDraining && !walls && !p.matrix_free;
     let mu_mid: Mob<'_, T> = if same {
         with_blocks!(mu, a => parallel::product::<T>(par, a, n, xi, dx, bands));
         mu

@@ -4,18 +4,21 @@
 //!
 //! This file holds the input checks that read the parameters and the spheres one by
 //! one; the periodic box's checks, which also derive the step's Ewald or PSE sums, are
-//! in `checks/periodic_box.rs`, the wall's in `checks/wall.rs`, and the acceptance of a candidate (a pair search, in
+//! in `checks/periodic_box.rs`, the wall's in `checks/wall.rs`, the slit's in `checks/slit.rs`, and the acceptance of a candidate (a pair search, in
 //! bands through the host's threads) in `checks/acceptance.rs`. The seam is what each
 //! costs and what it hands on: `O(N + B)` checks that return nothing, the box's sums
 //! that every product of the step reads, and the `O(N^2)` (or cell-list) pair search.
 
 mod acceptance;
 mod periodic_box;
+mod slit;
 mod wall;
 
 pub(super) use acceptance::accept;
 pub(super) use periodic_box::check_box;
 use periodic_box::check_periodic;
+use slit::check_slit;
+pub(super) use slit::check_slit_place;
 use wall::check_wall;
 
 use crate::bonds::Bond;
@@ -93,6 +96,7 @@ pub(super) fn check_all<T: Real>(
     // The box first: a box with a wall is refused as such, not by the wall's check.
     let sums = check_periodic(p, state, bonds)?;
     check_wall(p, state)?;
+    check_slit(p, state)?;
     super::near::check(p, state.len(), thermal.is_some())?;
     Ok((thermal, sums))
 }

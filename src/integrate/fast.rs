@@ -54,6 +54,6 @@ pub(super) fn takes_fast<T: Real>(p: &Params<T>) -> bool {
     let place = p.place();
     p.pse.is_some()
         && place.cell().is_none()
-        && place.wall().is_none()
+        && place.surfaces().is_empty()
         && p.hydro != crate::mobility::Hydro::FreeDraining
 }

@@ -6,7 +6,7 @@
 //! radius not below half the box's smallest edge), so a front end cannot get a matrix
 //! no step would use.
 
-use super::checks::check_box;
+use super::checks::{check_box, check_slit_place};
 use super::stages::{HeldSums, Sums, assemble_tt, free_product, held_ewald, hydro};
 use crate::error::StepError;
 use crate::linalg::tri;
@@ -24,6 +24,7 @@ fn check<T: Real>(p: &Params<T>, radius: &[T]) -> Result<HeldSums<T>, StepError>
     if p.place().wall().is_some_and(|h| !h.is_finite()) {
         return Err(StepError::BadParameter("wall.height (finite)"));
     }
+    check_slit_place(p)?;
     check_box(p, radius)
 }
 

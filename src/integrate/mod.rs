@@ -314,7 +314,7 @@ fn advance<T: Real, E: ExternalForce<T>>(
     let solved = p.method == Method::Overdamped
         && thermal.is_none()
         && p.contacts.is_none()
-        && p.place().wall().is_none();
+        && p.place().surfaces().is_empty();
     if !solved {
         report.residual = max_residual_in(bonds, new_pos, cell(p).as_ref()).1;
     }

@@ -90,6 +90,8 @@ mod pse_step;
 mod reference;
 mod resolution;
 mod robustness;
+#[cfg(feature = "slit")]
+mod slit;
 mod springs_thermal;
 mod stability;
 mod states;

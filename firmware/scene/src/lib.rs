@@ -210,6 +210,7 @@ const fn deterministic_f32(method: Method, rotation: bool) -> Params<f32> {
         },
         contacts: None,
         wall: None,
+        slit: None,
         periodic: None,
         compact_products: false,
         // The kernel's f32 default: the inertial methods' tensions from the displacements.

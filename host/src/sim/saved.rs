@@ -58,6 +58,10 @@ pub struct SavedParams {
     /// product without one). Absent in systems saved before the key, and without it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pse: Option<u64>,
+    /// A slit's floor and ceiling. Absent in systems saved before the key, and without
+    /// a slit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    slit: Option<[u64; 2]>,
 }
 
 /// A system as plain data ([`Engine::save`], [`Engine::restore`]); unknown keys are
@@ -143,6 +147,7 @@ impl SavedParams {
                 .near
                 .map(|n| [b(n.cutoff), b(n.wall_cutoff), b(n.min_gap)]),
             pse: p.pse.map(f64::to_bits),
+            slit: p.slit.map(|s| [b(s.floor), b(s.ceiling)]),
         }
     }
 
@@ -184,6 +189,10 @@ impl SavedParams {
             max_rounds,
         });
         p.wall = self.wall.map(|h| Wall::new(f(h)));
+        p.slit = self.slit.map(|[l, h]| hydrorattle::Slit {
+            floor: f(l),
+            ceiling: f(h),
+        });
         p.periodic = match self.periodic {
             Some(s) => Some(Periodic::new(s.map(f)).map_err(|e| format!("saved system: {e}"))?),
             None => None,

@@ -1,5 +1,6 @@
 //! A system's checks where a front end builds or loads it: pairs through the box's
-//! faces, contact capacities past counting, saved records damaged or carrying pins.
+//! faces, contact capacities past counting, saved records damaged, carrying pins or a
+//! slit.
 
 use hydrorattle::{Bond, Contacts, Noise, ParticleError, Periodic, StepError};
 
@@ -154,4 +155,22 @@ fn a_huge_until_is_printed_short() {
         (run, most.max(run))
     });
     assert!(message.contains("1e300") && digits.1 < 30, "{message}");
+}
+
+/// A system in a slit keeps its slit through a save and restore, and moves as before.
+#[test]
+fn a_slit_survives_a_save_and_restore() {
+    let pos = [[0.0, 0.0, 2.0], [3.0, 0.0, 3.0]];
+    let mut a = engine(&pos, |p| {
+        p.slit = Some(hydrorattle::Slit {
+            floor: -1.0,
+            ceiling: 30.0,
+        });
+    });
+    a.step().unwrap();
+    let mut b = reloaded(&a, |_| {}).unwrap();
+    assert_eq!(b.params, a.params);
+    a.step().unwrap();
+    b.step().unwrap();
+    assert_eq!(a.beads.pos, b.beads.pos);
 }

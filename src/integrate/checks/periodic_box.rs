@@ -179,7 +179,7 @@ fn fast_sums<T: Real>(
     let Some(tol) = p.pse else {
         return Ok(None);
     };
-    if p.place().wall().is_some() {
+    if !p.place().surfaces().is_empty() {
         return Err(StepError::Unsupported(
             "the fast free-space product (Params::pse without a box) above a wall",
         ));
