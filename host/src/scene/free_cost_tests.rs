@@ -242,18 +242,18 @@ const MEASURED_BYTES: usize = 400_000_000;
 /// The helical chain of `examples/shared/free_shapes.rs` (0.6 rad a bead, rising 0.8,
 /// bonds 3): its centres.
 fn helix_centres(n: usize) -> Vec<[f64; 3]> {
-    let mut at = [0.0f64; 3];
-    (0..n)
-        .map(|k| {
-            let t = 0.6 * k as f64;
-            let d = [t.cos(), t.sin(), 0.8];
-            let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            if k > 0 {
-                (0..3).for_each(|c| at[c] += 3.0 * d[c] / l);
-            }
-            at
-        })
-        .collect()
+    // Bead `k` is a bond of 3 along (cos 0.6 k, sin 0.6 k, 0.8) past bead `k - 1`.
+    let bond = |k: usize| {
+        let d = [(0.6 * k as f64).cos(), (0.6 * k as f64).sin(), 0.8];
+        let l = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+        d.map(|x| 3.0 * x / l)
+    };
+    let beads = (1..n).scan([0.0f64; 3], |at, k| {
+        let b = bond(k);
+        *at = [at[0] + b[0], at[1] + b[1], at[2] + b[2]];
+        Some(*at)
+    });
+    std::iter::once([0.0; 3]).chain(beads).take(n).collect()
 }
 
 /// The helical chain of `examples/shared/free_shapes.rs`: its bounding box.
