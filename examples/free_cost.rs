@@ -16,7 +16,9 @@
 //!   padded grid points `M`, window points `P^3` and near pairs (within the cutoff,
 //!   counted) recorded; with rotation the same product under the grand parameters
 //!   (`FreeFast::new_grand`) and the grand product `FreeFast::apply_grand` (a step's
-//!   spins).
+//!   spins). Where the rule's grid passes its bounds (the chain from 3000 beads) the
+//!   parameters a step takes instead (`integrate::fast_parameters`: the spreading
+//!   widened until a grid fits).
 //!
 //! Shapes: unit spheres uniformly in a ball at volume fractions 0.01, 0.1 and 0.3
 //! (overlaps allowed: equal radii never nest) and the helical chain of
@@ -51,8 +53,9 @@
 use hydrorattle::Real;
 use hydrorattle::geometry::Geometry;
 use hydrorattle::geometry::free::Free;
+use hydrorattle::integrate::fast_parameters;
 use hydrorattle::linalg::{cholesky, tri};
-use hydrorattle::mobility::free_fast::{FreeFast, transform_counts};
+use hydrorattle::mobility::free_fast::{FreeError, FreeFast, transform_counts};
 use hydrorattle::mobility::{Hydro, assemble_grand, tt_product};
 use hydrorattle::noise::reduced;
 use hydrorattle::parallel::{Serial, assemble, band_scratch, product};
@@ -242,6 +245,12 @@ fn measure(
         let made = match grand {
             false => FreeFast::<f64>::new(1.0, tol, ext, n),
             true => FreeFast::<f64>::new_grand(1.0, tol, ext, n),
+        };
+        // Where the rule's grid passes its bounds (a long chain) a step widens the
+        // spreading until one fits: time those parameters, as a run takes them.
+        let made = match made {
+            Err(FreeError::GridTooLarge) => fast_parameters(tol, grand, 1.0, ext, n),
+            made => made,
         };
         let Ok(ff) = made else {
             cell(NAMES[k], "refused (grid past its bound)".into());

@@ -4,8 +4,8 @@
 
 use crate::error::StepError;
 pub use crate::geometry::free::fast::FAST_MARGIN;
-use crate::geometry::free::fast::params;
-use crate::mobility::free_fast::FreeSize;
+use crate::geometry::free::fast::{fitted, params};
+use crate::mobility::free_fast::{FreeError, FreeFast, FreeSize};
 use crate::params::Params;
 use crate::real::Real;
 
@@ -35,6 +35,24 @@ pub fn fast_storage<T: Real>(
         }
         _ => Ok(None),
     }
+}
+
+/// The fast free-space parameters a step derives for `n` spheres of radius up to
+/// `a_max` whose centres' bounding box has edges `box_edges`, with storage sized from
+/// them (as [`fast_storage`] sizes it): [`FreeFast::new`]'s rule at tolerance `tol`
+/// (with `rotation`, [`FreeFast::new_grand`]'s) over the box widened by
+/// [`FAST_MARGIN`] radii and rounded, and where that grid passes its bounds (a long
+/// chain along one axis) the spreading widened until one fits, as the step does.
+/// For a host that weighs the product before it has positions (a cost model);
+/// refused only where the step would refuse.
+pub fn fast_parameters<T: Real>(
+    tol: f64,
+    rotation: bool,
+    a_max: T,
+    box_edges: [f64; 3],
+    n: usize,
+) -> Result<FreeFast<T>, FreeError> {
+    fitted((tol, rotation), a_max, box_edges, n, [usize::MAX; 2])
 }
 
 /// The vectors a fast free-space step of `n` spheres with `p` needs besides

@@ -13,7 +13,7 @@
 //! contacts of the position projection.
 
 #[cfg(feature = "fast-free")]
-pub use fast::{FAST_MARGIN, fast_storage, fast_vectors};
+pub use fast::{FAST_MARGIN, fast_parameters, fast_storage, fast_vectors};
 
 mod brownian;
 mod checks;

@@ -13,8 +13,10 @@
 //! * matrix-free: every product evaluates every pair again, `FREE_BLOCK` a block;
 //! * fast (`mobility::free_fast`): `FAST_FIXED + FAST_GRID M log2 M + FAST_NEAR (N + 2
 //!   pairs) + FAST_SPREAD N P^3`, with `M` the padded grid's points, `P^3` the window's
-//!   and `pairs` the pairs within the cutoff, all from the kernel's own parameters
-//!   (`FreeFast::new`); the pairs estimated from the spheres' bounding box.
+//!   and `pairs` the pairs within the cutoff, all from the parameters a step derives
+//!   (`integrate::fast_parameters`: `FreeFast::new`'s rule over the padded box, the
+//!   spreading widened where its grid passes the bounds, as along a long chain); the
+//!   pairs estimated from the spheres' bounding box.
 //!
 //! * rotation: the pair paths' spins, one pass of the pairs' rotation blocks a step
 //!   (`SPIN_BLOCK` a packed block); the inertial method's grand assembly
@@ -217,6 +219,14 @@ pub fn near_pairs(n: usize, extent: [f64; 3], a_max: f64, r_cut: f64) -> f64 {
     0.5 * n * (n - 1.0).max(0.0) * share
 }
 
+/// The fast product's parameters for `s` at `tolerance` (with `grand`, the grand
+/// product's), as a step derives them from the spheres' bounding box: where the rule's
+/// grid passes its bounds (a long chain), the spreading widened until one fits
+/// (`integrate::fast_parameters`); `None` where the kernel refuses them.
+fn fast_params(s: &Spheres, tolerance: f64, grand: bool) -> Option<FreeFast<f64>> {
+    hydrorattle::integrate::fast_parameters(tolerance, grand, s.a_max, s.extent, s.n).ok()
+}
+
 /// The fast product's work terms for `s` under `ff`: `[1, M log2 M, N + 2 pairs, N P^3]`.
 fn fast_terms(s: &Spheres, ff: &FreeFast<f64>) -> [f64; 4] {
     let g = ff.grid();
@@ -241,15 +251,11 @@ impl FreeCost {
     /// The spheres `s` with the fast product at `tolerance`.
     pub fn of(s: &Spheres, tolerance: f64) -> FreeCost {
         let (b, n) = (blocks(s.n), s.n as f64);
-        let fast = FreeFast::<f64>::new(s.a_max, tolerance, s.extent, s.n)
-            .ok()
-            .map(|ff| dot(FAST, fast_terms(s, &ff)));
-        let fast_grand = FreeFast::<f64>::new_grand(s.a_max, tolerance, s.extent, s.n)
-            .ok()
-            .map(|ff| {
-                let x = fast_terms(s, &ff);
-                (dot(FAST, x), dot(GRAND, x))
-            });
+        let fast = fast_params(s, tolerance, false).map(|ff| dot(FAST, fast_terms(s, &ff)));
+        let fast_grand = fast_params(s, tolerance, true).map(|ff| {
+            let x = fast_terms(s, &ff);
+            (dot(FAST, x), dot(GRAND, x))
+        });
         FreeCost {
             assembly: DENSE_ASSEMBLY_FIXED + DENSE_ASSEMBLY_BLOCK * b,
             dense: DENSE_PRODUCT_FIXED + DENSE_PRODUCT_BLOCK * b,
@@ -407,12 +413,11 @@ pub fn storage(plan: &Plan, s: &Spheres, tolerance: f64, choice: FreeChoice) -> 
     if choice != FreeChoice::Fast {
         return Some(step);
     }
+    let ff = fast_params(s, tolerance, plan.rotation)?;
     let (z, vectors) = if plan.rotation {
-        let ff = FreeFast::<f64>::new_grand(s.a_max, tolerance, s.extent, s.n).ok()?;
         // The grand product's zero torques and discarded velocities.
         (ff.storage_grand(s.n), 2 * s.n)
     } else {
-        let ff = FreeFast::<f64>::new(s.a_max, tolerance, s.extent, s.n).ok()?;
         (ff.storage(s.n), 0)
     };
     let grid = z.complex.checked_mul(16)? + z.reals.checked_mul(8)? + z.index.checked_mul(8)?;

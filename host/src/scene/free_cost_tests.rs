@@ -240,17 +240,29 @@ const MEASURED: &str = "free-space product paths, unit spheres, f64, one thread,
 const MEASURED_BYTES: usize = 400_000_000;
 
 /// The helical chain of `examples/shared/free_shapes.rs` (0.6 rad a bead, rising 0.8,
-/// bonds 3): its bounding box.
+/// bonds 3): its centres.
+fn helix_centres(n: usize) -> Vec<[f64; 3]> {
+    // Bead `k` is a bond of 3 along (cos 0.6 k, sin 0.6 k, 0.8) past bead `k - 1`.
+    let bond = |k: usize| {
+        let d = [(0.6 * k as f64).cos(), (0.6 * k as f64).sin(), 0.8];
+        let l = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+        d.map(|x| 3.0 * x / l)
+    };
+    let beads = (1..n).scan([0.0f64; 3], |at, k| {
+        let b = bond(k);
+        *at = [at[0] + b[0], at[1] + b[1], at[2] + b[2]];
+        Some(*at)
+    });
+    std::iter::once([0.0; 3]).chain(beads).take(n).collect()
+}
+
+/// The helical chain of `examples/shared/free_shapes.rs`: its bounding box.
 pub(super) fn helix(n: usize) -> Spheres {
-    let (mut at, mut lo, mut hi) = ([0.0f64; 3], [0.0f64; 3], [0.0f64; 3]);
-    for k in 1..n {
-        let t = 0.6 * k as f64;
-        let d = [t.cos(), t.sin(), 0.8];
-        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let (mut lo, mut hi) = ([0.0f64; 3], [0.0f64; 3]);
+    for p in helix_centres(n) {
         for c in 0..3 {
-            at[c] += 3.0 * d[c] / l;
-            lo[c] = lo[c].min(at[c]);
-            hi[c] = hi[c].max(at[c]);
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
         }
     }
     Spheres {
@@ -259,6 +271,40 @@ pub(super) fn helix(n: usize) -> Spheres {
         extent: [0, 1, 2].map(|c| hi[c] - lo[c]),
         a_max: 1.0,
         rpy: true,
+    }
+}
+
+/// The model weighs the fast path wherever the kernel runs it, with the kernel's own
+/// storage, and nowhere else: on the helical chain from 3,000 beads (measured: a
+/// Brownian step of 2.3 s at 3,000 and 3.4 s at 10^4) the rule's grid along the chain
+/// passes its bound, and a step widens the spreading until a grid fits
+/// (`integrate::fast_parameters`); so does the model, and its storage fits the run's
+/// limit. At 10^5 beads (a chain 190,000 radii long) no widening fits, and both refuse.
+#[test]
+fn the_fast_path_is_weighed_where_the_kernel_runs_it() {
+    use hydrorattle::Real;
+    for (n, runs) in [(3000, true), (10_000, true), (100_000, false)] {
+        let pos: Vec<_> = helix_centres(n).into_iter().map(f64::v3_from).collect();
+        let mut kp = hydrorattle::Params::<f64>::new(1e-3);
+        kp.method = Method::Overdamped;
+        kp.matrix_free = true;
+        kp.pse = Some(1e-4);
+        let kernel = hydrorattle::integrate::fast_storage(&kp, &pos, &vec![1.0; n]);
+        assert_eq!(kernel.is_ok(), runs, "chain of {n}: {kernel:?}");
+        let s = helix(n);
+        assert_eq!(FreeCost::of(&s, 1e-4).fast.is_some(), runs, "chain of {n}");
+        let p = overdamped();
+        let fast = storage(&p, &s, 1e-4, FreeChoice::Fast);
+        let pairs = storage(&p, &s, 1e-4, FreeChoice::MatrixFree).unwrap();
+        let grid = kernel
+            .ok()
+            .flatten()
+            .map(|z| 16 * z.complex + 8 * z.reals + 8 * z.index);
+        assert_eq!(fast, grid.map(|g| pairs + g), "chain of {n}");
+        assert!(
+            fast.is_none_or(|b| b <= sizing::DEFAULT_LIMIT),
+            "chain of {n}"
+        );
     }
 }
 

@@ -52,9 +52,32 @@ const WIDEN: f64 = 1.25;
 /// with rotation) the grand product's ([`FreeFast::new_grand`], sized by
 /// [`FreeFast::storage_grand`]).
 pub(crate) fn params<T: Real>(
-    (tol, grand): (f64, bool),
+    rule: (f64, bool),
     pos: &[T::V3],
     radius: &[T],
+    have: [usize; 2],
+) -> Result<FreeFast<T>, FreeError> {
+    let a_max = radius.iter().fold(T::ZERO, |m, &a| m.max(a));
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &p in pos {
+        let p = T::v3_to_f64(p);
+        for d in 0..3 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    let box_edges = core::array::from_fn(|d| (hi[d] - lo[d]).max(0.0));
+    fitted(rule, a_max, box_edges, pos.len(), have)
+}
+
+/// [`params`] for `n` spheres of radius up to `a_max` whose centres' bounding box has
+/// edges `box_edges`: the same parameters a step of such spheres derives, from the box
+/// alone (a host's cost model weighs them before any step).
+pub(crate) fn fitted<T: Real>(
+    (tol, grand): (f64, bool),
+    a_max: T,
+    box_edges: [f64; 3],
+    n: usize,
     have: [usize; 2],
 ) -> Result<FreeFast<T>, FreeError> {
     let fits = |s: FreeSize| s.complex <= have[0] && s.reals <= have[1];
@@ -65,20 +88,10 @@ pub(crate) fn params<T: Real>(
             f.storage(n)
         }
     };
-    let n = pos.len();
-    let a_max = radius.iter().fold(T::ZERO, |m, &a| m.max(a));
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for &p in pos {
-        let p = T::v3_to_f64(p);
-        for d in 0..3 {
-            lo[d] = lo[d].min(p[d]);
-            hi[d] = hi[d].max(p[d]);
-        }
-    }
     let pad = FAST_MARGIN * a_max.to_f64();
     // Edges rounded up to a coarse step: a cloud that travels, or deforms within the
     // step, keeps its parameters and so the kernel's transform in the caller's reals.
-    let edge = |d: usize| round_extent((hi[d] - lo[d]).max(0.0) + pad, a_max.to_f64());
+    let edge = |d: usize| round_extent(box_edges[d] + pad, a_max.to_f64());
     let extent: [T; 3] = core::array::from_fn(|d| T::from_f64(edge(d)));
     let rule = match grand {
         true => FreeFast::new_grand(a_max, tol, extent, n),
