@@ -30,7 +30,6 @@
 //! on or past either plane is refused ([`ParticleError::BelowWall`]), and so is a slit
 //! narrower than the sphere.
 
-use crate::error::StepError;
 use crate::fault::ParticleError;
 use crate::linalg::tri;
 use crate::mobility::wall::{image_rot, image_tt, self_wall, self_wall_rot};
@@ -54,18 +53,6 @@ pub enum SlitError {
         /// Index of the particle.
         particle: usize,
     },
-}
-
-impl From<SlitError> for StepError {
-    fn from(e: SlitError) -> Self {
-        match e {
-            SlitError::Particle(e) => e.into(),
-            SlitError::NotPositive { .. } => StepError::Unsupported(
-                "a sphere so near both walls of a slit that the superposition's self \
-                 mobility is not positive definite (docs/GEOMETRY.md, \"The slit\")",
-            ),
-        }
-    }
 }
 
 /// The mirror `P = diag(1, 1, -1)` of `m`: `P m P`.

@@ -4,7 +4,8 @@
 use crate::error::StepError;
 use crate::geometry::{Geometry, Place, Sums};
 use crate::linalg::MobMut;
-use crate::mobility::{Hydro, slit};
+use crate::mobility::Hydro;
+use crate::mobility::slit::{self, SlitError};
 use crate::parallel::{self, Parallel};
 use crate::real::Real;
 
@@ -118,5 +119,19 @@ impl<T: Real> Geometry<T> for Slit<T> {
     #[inline(always)]
     fn symmetric(self) -> bool {
         false
+    }
+}
+
+// The slit's errors as the step's own, here in the geometry layer: the mobility layer
+// below does not know the step's error.
+impl From<SlitError> for StepError {
+    fn from(e: SlitError) -> Self {
+        match e {
+            SlitError::Particle(e) => e.into(),
+            SlitError::NotPositive { .. } => StepError::Unsupported(
+                "a sphere so near both walls of a slit that the superposition's self \
+                 mobility is not positive definite (docs/GEOMETRY.md, \"The slit\")",
+            ),
+        }
     }
 }
