@@ -1,7 +1,7 @@
 //! The active-set loop of the position projection ([`project_along`]): project, add the
-//! pairs and wall (or ceiling) links that overlap or crossed, release the one that pulls hardest,
-//! until nothing changes; and the error reports of a round that fails (a step too long
-//! for the linearisation, the deepest overlap when the rounds run out).
+//! pairs and wall (or ceiling) links that overlap or crossed, release the one that pulls
+//! hardest, until nothing changes; and the error reports of a round that fails (a step
+//! too long for the linearisation, the deepest overlap when the rounds run out).
 
 use super::search::{Active, add_pairs, add_wall};
 use super::{Along, Projected, Round};
@@ -40,13 +40,14 @@ pub(in crate::integrate) fn project_along<'l, T: Real, A: Along<T>>(
         .surfaces()
         .floor()
         .filter(|_| cfg!(feature = "contacts"));
-    // The ceiling the ceiling links hold, in the floor's frame (a slit's upper plane).
-    let ceiling = p
+    // The ceiling the ceiling links hold (a slit's upper plane), and its height in the
+    // floor's frame.
+    let roof = p
         .place()
         .surfaces()
         .ceiling()
-        .filter(|_| cfg!(feature = "slit") && cfg!(feature = "contacts"))
-        .map(|c| c - wall.unwrap_or(T::ZERO));
+        .filter(|_| cfg!(feature = "slit") && cfg!(feature = "contacts"));
+    let ceiling = roof.map(|c| c - wall.unwrap_or(T::ZERO));
     let nb = bonds.len();
     let cell = integrate::cell(p);
     // The pool of one-sided constraints: the contacts' capacity, one wall link per
@@ -72,9 +73,9 @@ pub(in crate::integrate) fn project_along<'l, T: Real, A: Along<T>>(
             let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
             add_wall(start, (h, false), radius, reach, &mut set)?;
         }
-        if let (Some(c), Some(h)) = (ceiling, wall) {
+        if let Some(c) = roof {
             let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
-            add_wall(start, (c + h, true), radius, reach, &mut set)?;
+            add_wall(start, (c, true), radius, reach, &mut set)?;
         }
     }
     let mut round = 0;
