@@ -51,6 +51,29 @@ impl<T: Real> Bond<T> {
         }
     }
 
+    /// The ceiling link of sphere `i` of radius `radius`: [`Bond::wall`] upside down,
+    /// the centre held a radius below the ceiling (a slit's upper plane). Its length is
+    /// `-radius`, the sign naming the surface: the normal `-z`, so that the gradient
+    /// `(0, 0, 2 d)` and the constraint `2 d (z_i - c - d) = 0` (`c` the ceiling's
+    /// height in the floor's frame, where the projection runs) are the wall link's.
+    pub fn ceiling(i: usize, radius: T) -> Self {
+        Self {
+            i,
+            j: i,
+            length: -radius,
+        }
+    }
+
+    /// `true` for a ceiling link ([`Bond::ceiling`]); always `false` without the
+    /// `slit` and `contacts` features (firmware: the branch compiles away).
+    #[inline(always)]
+    pub fn is_ceiling(&self) -> bool {
+        cfg!(feature = "slit")
+            && cfg!(feature = "contacts")
+            && self.is_wall()
+            && self.length < T::ZERO
+    }
+
     /// Pin row of sphere `i` along `axis` (0, 1, 2: x, y, z; see the module), `scale`
     /// its length (> 0; the sphere's radius). An axis past 2 makes a row that
     /// [`validate`] refuses ([`BondError::OutOfRange`]).

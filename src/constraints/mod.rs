@@ -146,6 +146,10 @@ pub enum Problem<'a, T: Real> {
         /// the step, indexed by sphere (empty where no row is a pin).
         #[cfg(feature = "pins")]
         anchor: &'a [T::V3],
+        /// The ceiling's height in the frame of the positions (a slit's upper plane,
+        /// which the ceiling links hold: [`Bond::ceiling`]); zero without one.
+        #[cfg(feature = "slit")]
+        ceiling: T,
     },
     /// `b_k . (x_i - x_j) = 0` with `b_k` the new bond vectors (RATTLE); `dt` scales the
     /// residual to a relative length change per step.
@@ -187,6 +191,17 @@ impl<T: Real> Problem<'_, T> {
                     two_s * off,
                     crate::bonds::along::<T>(e, two_s),
                     lazy::<T, NORM>(|| (off / b.length).abs()),
+                )
+            }
+            // A ceiling link's: the wall link's measured from the ceiling (`d < 0`).
+            #[cfg(feature = "slit")]
+            Problem::Positions { ceiling, .. } if b.is_ceiling() => {
+                let z = T::xyz(x[b.i])[2] - ceiling;
+                let two_d = T::TWO * b.length;
+                (
+                    two_d * (z - b.length),
+                    T::v3(T::ZERO, T::ZERO, two_d),
+                    lazy::<T, NORM>(|| ((z - b.length) / b.length).abs()),
                 )
             }
             // A wall link's linear constraint `2 d (z - d)` (see [`Bond::wall`]); its
@@ -434,6 +449,8 @@ mod tests {
             one_sided: usize::MAX,
             #[cfg(feature = "pins")]
             anchor: &anchor,
+            #[cfg(feature = "slit")]
+            ceiling: 0.0,
         };
         let _ = anchor;
         let grad: [DVec3; 9] = core::array::from_fn(|k| DVec3::new(0.3, -0.2 * k as f64, 1.1));

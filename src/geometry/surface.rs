@@ -120,13 +120,25 @@ impl<T: Real> Surfaces<T> {
 
     /// The height of the first floor (a plane the spheres stay above): what the
     /// contacts' wall links hold (they run in its frame, [`Bond::wall`](crate::Bond::wall)).
-    /// A ceiling has no links (a slit's): the acceptance refuses a step that would
-    /// carry a sphere past it.
     #[inline(always)]
     pub const fn floor(self) -> Option<T> {
+        self.first(true)
+    }
+
+    /// The height of the first ceiling (a plane the spheres stay below: a slit's
+    /// upper one), which the contacts' ceiling links hold
+    /// ([`Bond::ceiling`](crate::Bond::ceiling)).
+    #[inline(always)]
+    pub const fn ceiling(self) -> Option<T> {
+        self.first(false)
+    }
+
+    /// The height of the first plane with the spheres `above` it (or below).
+    #[inline(always)]
+    const fn first(self, above: bool) -> Option<T> {
         match self.planes {
-            [Some(s), _] if s.above => Some(s.height),
-            [_, Some(s)] if s.above => Some(s.height),
+            [Some(s), _] if s.above == above => Some(s.height),
+            [_, Some(s)] if s.above == above => Some(s.height),
             _ => None,
         }
     }

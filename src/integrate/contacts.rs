@@ -39,6 +39,12 @@
 //! constraints holds one wall link per sphere beside the contacts' capacity
 //! ([`Params::constraints`]).
 //!
+//! **The ceiling** of a slit ([`Params::slit`]) holds the spheres below it the same
+//! way: a sphere whose centre would end above `ceiling - a_i` gets a ceiling link
+//! ([`Bond::ceiling`]: the wall link with the normal `-z`, measured from the ceiling's
+//! height in the floor's frame), so a buoyant sphere comes to rest on it, pushed along
+//! `-z`. The pool holds one such link per sphere per surface.
+//!
 //! This file holds the projection's entry ([`project_overdamped`]) and who solves a
 //! round ([`Along`], [`Round`]); `rounds.rs` the active-set loop ([`project_along`]) and
 //! its error reports; `search.rs` the search for pairs and wall links to add and the
@@ -46,6 +52,18 @@
 
 mod rounds;
 mod search;
+
+/// The height of the ceiling the ceiling links hold ([`Bond::ceiling`]) in the frame the
+/// projection runs in (the floor's: the ceiling's height less the floor's); zero
+/// without a ceiling, or without the `contacts` feature (no link then).
+#[cfg(feature = "slit")]
+pub(in crate::integrate) fn ceiling<T: Real>(p: &Params<T>) -> T {
+    let s = p.place().surfaces();
+    match (s.ceiling(), cfg!(feature = "contacts")) {
+        (Some(c), true) => c - s.floor().unwrap_or(T::ZERO),
+        _ => T::ZERO,
+    }
+}
 
 pub(super) use rounds::project_along;
 

@@ -97,6 +97,8 @@ pub(super) fn rattle_explicit<T: Real, E: ExternalForce<T>>(
             // Pins are refused with this method (`integrate::checks`).
             #[cfg(feature = "pins")]
             anchor: &[],
+            #[cfg(feature = "slit")]
+            ceiling: T::ZERO,
         },
         &metric,
         bonds,

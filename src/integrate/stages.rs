@@ -241,6 +241,8 @@ pub(super) fn project_positions<T: Real>(
             one_sided,
             #[cfg(feature = "pins")]
             anchor,
+            #[cfg(feature = "slit")]
+            ceiling: super::contacts::ceiling(p),
         },
         metric,
         bonds,

@@ -1,7 +1,7 @@
 //! The active-set loop of the position projection ([`project_along`]): project, add the
-//! pairs and wall links that overlap or crossed, release the one that pulls hardest,
-//! until nothing changes; and the error reports of a round that fails (a step too long
-//! for the linearisation, the deepest overlap when the rounds run out).
+//! pairs and wall (or ceiling) links that overlap or crossed, release the one that pulls
+//! hardest, until nothing changes; and the error reports of a round that fails (a step
+//! too long for the linearisation, the deepest overlap when the rounds run out).
 
 use super::search::{Active, add_pairs, add_wall};
 use super::{Along, Projected, Round};
@@ -40,6 +40,14 @@ pub(in crate::integrate) fn project_along<'l, T: Real, A: Along<T>>(
         .surfaces()
         .floor()
         .filter(|_| cfg!(feature = "contacts"));
+    // The ceiling the ceiling links hold (a slit's upper plane), and its height in the
+    // floor's frame.
+    let roof = p
+        .place()
+        .surfaces()
+        .ceiling()
+        .filter(|_| cfg!(feature = "slit") && cfg!(feature = "contacts"));
+    let ceiling = roof.map(|c| c - wall.unwrap_or(T::ZERO));
     let nb = bonds.len();
     let cell = integrate::cell(p);
     // The pool of one-sided constraints: the contacts' capacity, one wall link per
@@ -63,7 +71,11 @@ pub(in crate::integrate) fn project_along<'l, T: Real, A: Along<T>>(
         }
         if let Some(h) = wall {
             let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
-            add_wall(start, h, radius, reach, &mut set)?;
+            add_wall(start, (h, false), radius, reach, &mut set)?;
+        }
+        if let Some(c) = roof {
+            let mut set = Active::new(nb, pool, links, &mut nc, &mut released);
+            add_wall(start, (c, true), radius, reach, &mut set)?;
         }
     }
     let mut round = 0;
@@ -115,7 +127,10 @@ pub(in crate::integrate) fn project_along<'l, T: Real, A: Along<T>>(
             added += add_pairs(bonds, (start, x), radius, cell, reach, &mut set, cells)?;
         }
         if wall.is_some() {
-            added += add_wall(x, T::ZERO, radius, reach, &mut set)?;
+            added += add_wall(x, (T::ZERO, false), radius, reach, &mut set)?;
+        }
+        if let Some(c) = ceiling {
+            added += add_wall(x, (c, true), radius, reach, &mut set)?;
         }
         let let_go = match added {
             0 => set.release_pulling(lambda),
@@ -125,9 +140,14 @@ pub(in crate::integrate) fn project_along<'l, T: Real, A: Along<T>>(
         scratch.carry.released = let_go;
         if added == 0 && let_go.is_none() {
             // Every contact must end on the side it started from (a sphere above the
-            // wall: `grad = (0, 0, a)`, its relative vector `(0, 0, z)`).
+            // wall: `grad = (0, 0, a)`, its relative vector `(0, 0, z)`; below the
+            // ceiling: `(0, 0, -a)` and `(0, 0, z - c)`).
             for (k, l) in links[nb..nb + nc].iter().enumerate() {
-                if !(T::dot(l.separation(x, cell.as_ref()), grad[nb + k]) > T::ZERO) {
+                let r = match (l.is_ceiling(), ceiling) {
+                    (true, Some(c)) => l.relative(x) - crate::bonds::along::<T>(2, c),
+                    _ => l.separation(x, cell.as_ref()),
+                };
+                if !(T::dot(r, grad[nb + k]) > T::ZERO) {
                     return Err(StepError::Degenerate {
                         bond: nb + k,
                         row: Row::of(links, nb + k, nb),
@@ -196,6 +216,11 @@ fn too_long<T: Real>(
             return true;
         }
         let (gap, d) = match b.is_wall() {
+            // Below the ceiling `c`: `c - z - a` (the link's length is `-a`).
+            true if b.is_ceiling() => {
+                let c = p.place().surfaces().ceiling().unwrap_or(T::ZERO);
+                (c - T::xyz(start[b.i])[2] + b.length, -b.length)
+            }
             true => {
                 let h = wall.unwrap_or(T::ZERO);
                 (T::xyz(start[b.i])[2] - h - b.length, b.length)

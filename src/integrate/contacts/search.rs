@@ -11,23 +11,33 @@ use crate::real::Real;
 
 /// Appends a wall link for every sphere whose centre is closer than `reach` times its
 /// radius to the plane `z = height` (or below it) and has none yet; returns how many
-/// were added.
+/// were added. With `ceiling`, ceiling links for the spheres that near the plane from
+/// below ([`Bond::ceiling`]).
 pub(super) fn add_wall<T: Real>(
     pos: &[T::V3],
-    height: T,
+    (height, ceiling): (T, bool),
     radius: &[T],
     reach: T,
     set: &mut Active<'_, T>,
 ) -> Result<usize, StepError> {
     let mut added = 0;
     for (i, (&r, &a)) in pos.iter().zip(radius).enumerate() {
-        if !(T::xyz(r)[2] - height < a * reach) {
+        let z = T::xyz(r)[2];
+        let gap = match ceiling {
+            true => height - z,
+            false => z - height,
+        };
+        if !(gap < a * reach) {
             continue;
         }
-        if set.held().iter().any(|l| l.is_wall() && l.i == i) {
+        let held = |l: &Bond<T>| l.is_wall() && l.i == i && l.is_ceiling() == ceiling;
+        if set.held().iter().any(held) {
             continue;
         }
-        set.push(Bond::wall(i, a))?;
+        set.push(match ceiling {
+            true => Bond::ceiling(i, a),
+            false => Bond::wall(i, a),
+        })?;
         added += 1;
     }
     Ok(added)
@@ -123,6 +133,7 @@ impl<'s, T: Real> Active<'s, T> {
 /// wall link).
 fn same<T: Real>(a: &Bond<T>, b: &Bond<T>) -> bool {
     a.is_wall() == b.is_wall()
+        && a.is_ceiling() == b.is_ceiling()
         && ((a.i == b.i && a.j == b.j) || (!a.is_wall() && a.i == b.j && a.j == b.i))
 }
 

@@ -121,6 +121,8 @@ impl<T: Real> Along<T> for Iterative<'_, '_, T> {
             one_sided: nb,
             #[cfg(feature = "pins")]
             anchor: start,
+            #[cfg(feature = "slit")]
+            ceiling: crate::integrate::contacts::ceiling(p),
         };
         let _ = start; // Read only with the `pins` feature.
         // The chord matrix `2 G dt M G^T`: `c = 2`, scale `dt`.
