@@ -97,7 +97,7 @@ pub(super) fn check_particles(
 /// The first sphere below the wall or crossing it (to the rounding of the numbers
 /// written: a gap of `-1e-12` radii, or of 4 epsilons of `|z| + |height| + a` far from
 /// the origin, as the kernel allows, is touching), and what is wrong with it.
-fn below(wall: Wall, particles: &[Particle]) -> Option<(usize, String)> {
+pub(super) fn below(wall: Wall, particles: &[Particle]) -> Option<(usize, String)> {
     let k = particles.iter().position(|p| {
         let (z, a) = (p.position[2], p.radius);
         let rounding = 4.0 * f64::EPSILON * (z.abs() + wall.height.abs() + a);
