@@ -81,11 +81,11 @@ mod precision;
 mod raw;
 mod resolve;
 pub mod sizing;
+mod slit;
 mod suspension;
 #[cfg(test)]
 mod tests;
 mod thermal;
-mod slit;
 mod wall;
 mod write;
 
@@ -104,9 +104,9 @@ pub use model::{
 pub use near::NearField;
 pub use periodic::{BoxMethod, DEFAULT_BOX_TOLERANCE, PeriodicBox, PseUnsupported, pse_fits};
 pub use resolve::MAX_TURN_PER_STEP;
+pub use slit::Slit;
 pub use suspension::{GAP, MAX_FRACTION, Suspension, TRIALS_PER_SPHERE};
 pub use thermal::{DEFAULT_SEED, Drift, Sqrt, Thermal};
-pub use slit::Slit;
 pub use wall::Wall;
 
 use serde::{Deserialize, Serialize};

@@ -125,7 +125,10 @@ impl RawScene {
                 let s = super::slit::resolve(raw)?;
                 let others = [
                     (self.wall.is_some(), "[wall]"),
-                    (self.periodic.is_some() || self.suspension.is_some(), "[box]"),
+                    (
+                        self.periodic.is_some() || self.suspension.is_some(),
+                        "[box]",
+                    ),
                 ];
                 super::slit::check(raw, &model, &integrator, others)?;
                 Some(s)
@@ -184,7 +187,12 @@ impl RawScene {
             &flow,
             contact,
             brownian,
-            ((wall.is_some(), slit.is_some()), pse, near_field.is_some(), fast),
+            (
+                (wall.is_some(), slit.is_some()),
+                pse,
+                near_field.is_some(),
+                fast,
+            ),
         );
         let every_span = self
             .output

@@ -74,7 +74,9 @@ pub(super) fn check(
     if let Some((_, name)) = others.iter().find(|(named, _)| *named) {
         return Err(issue(
             at,
-            format!("a [slit] with a {name} is not supported (the slit is the only geometry of its scene)"),
+            format!(
+                "a [slit] with a {name} is not supported (the slit is the only geometry of its scene)"
+            ),
         ));
     }
     if model.level == Level::Auto {
@@ -104,7 +106,10 @@ pub(super) fn check_particles(
 ) -> Result<(), Issue> {
     let floor = Wall { height: slit.floor };
     if let Some((k, message)) = super::wall::below(floor, particles) {
-        return Err(issue(spans.position(k), message.replace("wall", "slit floor")));
+        return Err(issue(
+            spans.position(k),
+            message.replace("wall", "slit floor"),
+        ));
     }
     // The ceiling is the floor in the mirror z -> -z.
     let mirrored: Vec<Particle> = particles

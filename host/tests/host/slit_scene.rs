@@ -28,7 +28,10 @@ fn the_slit_reads_and_writes_back() {
     };
     assert_eq!(s.slit, Some(want));
     let text = s.to_toml();
-    assert!(text.contains("[slit]\nceiling = 20.0\nfloor = 0.0"), "{text}");
+    assert!(
+        text.contains("[slit]\nceiling = 20.0\nfloor = 0.0"),
+        "{text}"
+    );
     assert_eq!(Scene::parse(&text, "scene.toml").unwrap(), s);
     let plain = Scene::parse(&lone(10.0, 10.0, 0.01), "lone").unwrap();
     let plain = Scene {
