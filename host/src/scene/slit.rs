@@ -20,7 +20,7 @@ use toml::Spanned;
 use super::error::{Issue, issue};
 use super::raw::{Bound, S};
 use super::resolve::BodySpans;
-use super::{Integrator, Level, Method, Model, Particle, Wall};
+use super::{Integrator, Model, Particle, Wall};
 
 /// The planes `z = floor` below the spheres and `z = ceiling` above them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -79,22 +79,7 @@ pub(super) fn check(
             ),
         ));
     }
-    if model.level == Level::Auto {
-        return Err(issue(
-            at,
-            "a slit needs level = \"manual\" (the automatic level may pick an inertial method, which has no slit)",
-        ));
-    }
-    if !matches!(integrator.method, Method::Overdamped | Method::Overdamped2) {
-        return Err(issue(
-            at,
-            format!(
-                "a slit needs method \"overdamped\" or \"overdamped2\" (the scene's is {:?})",
-                integrator.method
-            ),
-        ));
-    }
-    Ok(())
+    super::wall::overdamped_only(at, "slit", model, integrator)
 }
 
 /// Refuses a sphere that starts below the floor or above the ceiling, or crossing

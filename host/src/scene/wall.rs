@@ -64,17 +64,30 @@ pub(super) fn check_method(
         .height
         .as_ref()
         .map_or(raw.span(), |h| h.span());
+    overdamped_only(at, "wall", model, integrator)
+}
+
+/// The overdamped methods, chosen by hand, hold a wall (`what`: "wall" or "slit");
+/// refused at `at` otherwise.
+pub(super) fn overdamped_only(
+    at: std::ops::Range<usize>,
+    what: &str,
+    model: &Model,
+    integrator: &Integrator,
+) -> Result<(), Issue> {
     if model.level == Level::Auto {
         return Err(issue(
             at,
-            "a wall needs level = \"manual\" (the automatic level may pick an inertial method, which has no wall)",
+            format!(
+                "a {what} needs level = \"manual\" (the automatic level may pick an inertial method, which has no {what})"
+            ),
         ));
     }
     if !matches!(integrator.method, Method::Overdamped | Method::Overdamped2) {
         return Err(issue(
             at,
             format!(
-                "a wall needs method \"overdamped\" or \"overdamped2\" (the scene's is {:?})",
+                "a {what} needs method \"overdamped\" or \"overdamped2\" (the scene's is {:?})",
                 integrator.method
             ),
         ));
