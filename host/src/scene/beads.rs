@@ -167,6 +167,10 @@ pub fn params<T: Real>(scene: &Scene) -> Params<T> {
     p.wall = scene
         .wall
         .map(|w| hydrorattle::Wall::new(T::from_f64(w.height)));
+    p.slit = scene.slit.map(|s| hydrorattle::Slit {
+        floor: T::from_f64(s.floor),
+        ceiling: T::from_f64(s.ceiling),
+    });
     // The scene checked the edges (finite, > 0) in f64; one that overflows `T` is
     // left out here and refused by the scene's check against the first step.
     p.periodic = scene

@@ -359,6 +359,7 @@ pub fn step_cost(plan: &Plan, s: &Spheres, cost: &FreeCost, choice: FreeChoice) 
     };
     let free_ok = matches!(plan.method, Method::Overdamped | Method::Springs)
         && !plan.wall
+        && !plan.slit
         && !plan.near
         && (!thermal || plan.brownian.is_none_or(|t| t.sqrt != Sqrt::Cholesky))
         && (rows == 0 || krylov);

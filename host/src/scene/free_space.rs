@@ -147,7 +147,7 @@ fn unsupported(cx: &Context<'_>) -> Option<&'static str> {
         .is_some_and(|b| b.temperature > 0.0 && b.sqrt == Sqrt::Cholesky);
     Some(match () {
         _ if cx.wall.is_some() => {
-            "is the free-space product: above a [wall] the mobility is the wall's (use \"dense\")"
+            "is the free-space product: above a [wall] or in a [slit] the mobility is the walls' (use \"dense\")"
         }
         _ if cx.near.is_some() => "gives the far field alone: leave out [near_field]",
         _ if m.hydrodynamics != Hydrodynamics::Rpy => {

@@ -66,6 +66,8 @@ impl KeySpans {
             ),
             span(raw.wall.as_ref().map(|w| w.span()), "a wall"),
             span(raw.wall.as_ref().map(|w| w.span()), "wall"),
+            span(raw.slit.as_ref().map(|s| s.span()), "a slit"),
+            span(raw.slit.as_ref().map(|s| s.span()), "slit"),
             span(raw.contact.as_ref().map(|c| c.span()), "contacts"),
             span(box_span(raw), "a periodic box"),
             span(box_span(raw), "periodic"),

@@ -22,6 +22,7 @@
 //! | `[output]` | `every` (steps between trajectory frames, >= 1) | about [`TARGET_FRAMES`] frames |
 //! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"`, `"springs"` or `"rattle-stable"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
 //! | `[wall]` | `height` (required, finite): a no-slip plane `z = height` below every sphere (`method = "overdamped"` or `"overdamped2"`, level manual; see [`Wall`]) | no wall |
+//! | `[slit]` | `floor`, `ceiling` (required, finite, the ceiling above the floor): two no-slip planes around every sphere, their mobility by superposition (`method = "overdamped"` or `"overdamped2"`, level manual, no `[wall]`, `[box]` or `[near_field]`; see [`Slit`], `docs/GEOMETRY.md`) | no slit |
 //! | `[free_space]` | `method = "dense"\|"fast"\|"auto"`, `tolerance` (`1e-10` to `0.1`): how the mobility in open fluid is applied; `"fast"` is the `O(N log N)` product; `"auto"` the path a measured cost model picks when the run starts (`free_cost`) (overdamped or springs, level manual, RPY, no wall, box or near field; its run is matrix-free; see [`FreeSpace`]) | dense, 1e-4 |
 //! | `[box]` | `size = [Lx, Ly, Lz]` (required unless `[suspension]` sets it; finite, > 0), `method = "ewald"\|"pse"\|"auto"`, `tolerance` (`1e-12` to `0.1`): a periodic box (see [`PeriodicBox`]) | no box; auto, 1e-6 |
 //! | `[suspension]` | `count` (required, >= 1), `fraction` (required, `0 < phi <=` [`MAX_FRACTION`]), `radius`, `polydispersity` (`0 <= p < 1`), `density`, `seed`: spheres placed at random in a cubic box (see [`Suspension`]) | 1, 0, 4.5, 1 |
@@ -80,6 +81,7 @@ mod precision;
 mod raw;
 mod resolve;
 pub mod sizing;
+mod slit;
 mod suspension;
 #[cfg(test)]
 mod tests;
@@ -102,6 +104,7 @@ pub use model::{
 pub use near::NearField;
 pub use periodic::{BoxMethod, DEFAULT_BOX_TOLERANCE, PeriodicBox, PseUnsupported, pse_fits};
 pub use resolve::MAX_TURN_PER_STEP;
+pub use slit::Slit;
 pub use suspension::{GAP, MAX_FRACTION, Suspension, TRIALS_PER_SPHERE};
 pub use thermal::{DEFAULT_SEED, Drift, Sqrt, Thermal};
 pub use wall::Wall;
@@ -195,6 +198,10 @@ pub struct Scene {
     pub brownian: Option<Thermal>,
     /// A no-slip plane wall below the spheres (`[wall]`); `None`: unbounded fluid.
     pub wall: Option<Wall>,
+    /// A slit between two no-slip plane walls (`[slit]`); `None`: no slit. Left out of
+    /// the JSON when `None`, so that a run without one records what it did before.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slit: Option<Slit>,
     /// A periodic box (`[box]`); `None`: unbounded fluid. Left out of the JSON when
     /// `None`, so that a run without a box records what it did before boxes existed.
     #[serde(rename = "box", skip_serializing_if = "Option::is_none")]

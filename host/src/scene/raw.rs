@@ -27,6 +27,7 @@ pub(super) struct RawScene {
     pub(super) contact: S<super::contact::RawContact>,
     pub(super) brownian: Option<super::thermal::RawBrownian>,
     pub(super) wall: S<super::wall::RawWall>,
+    pub(super) slit: S<super::slit::RawSlit>,
     #[serde(rename = "box")]
     pub(super) periodic: S<super::periodic::RawBox>,
     pub(super) suspension: S<super::suspension::RawSuspension>,

@@ -119,6 +119,21 @@ impl RawScene {
         if let (Some(b), Some(_)) = (&self.periodic, &self.wall) {
             return Err(super::periodic::refuse_wall(b));
         }
+        let slit = match &self.slit {
+            None => None,
+            Some(raw) => {
+                let s = super::slit::resolve(raw)?;
+                let others = [
+                    (self.wall.is_some(), "[wall]"),
+                    (
+                        self.periodic.is_some() || self.suspension.is_some(),
+                        "[box]",
+                    ),
+                ];
+                super::slit::check(raw, &model, &integrator, others)?;
+                Some(s)
+            }
+        };
         let near_field = match &self.near_field {
             None => None,
             Some(raw) => Some(super::near::resolve(raw, &model)?),
@@ -131,7 +146,9 @@ impl RawScene {
                     model: &model,
                     integrator: &integrator,
                     brownian,
-                    wall: self.wall.as_ref().map(|w| w.span()),
+                    // A slit's mobility is its walls' too.
+                    wall: (self.wall.as_ref().map(|w| w.span()))
+                        .or(self.slit.as_ref().map(|s| s.span())),
                     periodic: self.periodic.as_ref().map(|b| b.span()),
                     near: self.near_field.as_ref().map(|n| n.span()),
                 },
@@ -170,7 +187,12 @@ impl RawScene {
             &flow,
             contact,
             brownian,
-            (wall.is_some(), pse, near_field.is_some(), fast),
+            (
+                (wall.is_some(), slit.is_some()),
+                pse,
+                near_field.is_some(),
+                fast,
+            ),
         );
         let every_span = self
             .output
@@ -205,6 +227,9 @@ impl RawScene {
         )?;
         if let Some(w) = wall {
             super::wall::check_particles(w, &body.particles, &body.spans)?;
+        }
+        if let Some(s) = slit {
+            super::slit::check_particles(s, &body.particles, &body.spans)?;
         }
         super::precision::check(
             &body.particles,
@@ -245,6 +270,7 @@ impl RawScene {
             brownian,
             species: body.species,
             wall,
+            slit,
             periodic,
             suspension: body.suspension.map(|(s, _)| s),
             cloud: body.cloud,

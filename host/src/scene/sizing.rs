@@ -123,6 +123,8 @@ pub struct Plan {
     pub brownian: Option<Thermal>,
     /// A wall (one more constraint slot per particle).
     pub wall: bool,
+    /// A slit (two more constraint slots per particle, one a wall).
+    pub slit: bool,
     /// No stored mobility (`[integrator] matrix_free`).
     pub matrix_free: bool,
     /// The compact `f32` copy for the constraint products
@@ -152,6 +154,7 @@ impl Plan {
             contact: None,
             brownian: None,
             wall: false,
+            slit: false,
             matrix_free: false,
             compact_products: false,
             pse: false,
@@ -170,6 +173,7 @@ impl Plan {
             contact: scene.contact,
             brownian: scene.brownian,
             wall: scene.wall.is_some(),
+            slit: scene.slit.is_some(),
             matrix_free: scene.integrator.matrix_free,
             compact_products: scene.integrator.compact_products,
             pse: scene
@@ -185,7 +189,8 @@ impl Plan {
     /// constraints beside the bonds.
     pub fn layout(&self, n: usize, b: usize) -> Option<Layout> {
         let contacts = self.contact.and_then(|c| c.hard_capacity(n));
-        let walls = if self.wall { n } else { 0 };
+        let surfaces = usize::from(self.wall) + 2 * usize::from(self.slit);
+        let walls = n.saturating_mul(surfaces);
         let c = b
             .saturating_add(contacts.unwrap_or(0))
             .saturating_add(walls);
@@ -204,6 +209,11 @@ impl Plan {
             .and_then(|c| c.hard_capacity(n))
             .map(Contacts::new);
         p.wall = self.wall.then_some(hydrorattle::Wall::new(0.0));
+        // Any slit: only its two surfaces size the storage.
+        p.slit = self.slit.then_some(hydrorattle::Slit {
+            floor: 0.0,
+            ceiling: 1.0,
+        });
         p.matrix_free = self.matrix_free || self.pse || self.fast;
         p.compact_products = self.compact_products;
         if self.pse {
@@ -211,7 +221,7 @@ impl Plan {
             p.periodic = hydrorattle::Periodic::new([1.0; 3]).ok();
             p.pse = Some(1e-3);
         }
-        if self.fast && !self.pse && !self.wall {
+        if self.fast && !self.pse && !self.wall && !self.slit {
             // Free space's fast product (no box): only its presence sizes the storage.
             p.pse = Some(1e-3);
         }

@@ -64,17 +64,30 @@ pub(super) fn check_method(
         .height
         .as_ref()
         .map_or(raw.span(), |h| h.span());
+    overdamped_only(at, "wall", model, integrator)
+}
+
+/// The overdamped methods, chosen by hand, hold a wall (`what`: "wall" or "slit");
+/// refused at `at` otherwise.
+pub(super) fn overdamped_only(
+    at: std::ops::Range<usize>,
+    what: &str,
+    model: &Model,
+    integrator: &Integrator,
+) -> Result<(), Issue> {
     if model.level == Level::Auto {
         return Err(issue(
             at,
-            "a wall needs level = \"manual\" (the automatic level may pick an inertial method, which has no wall)",
+            format!(
+                "a {what} needs level = \"manual\" (the automatic level may pick an inertial method, which has no {what})"
+            ),
         ));
     }
     if !matches!(integrator.method, Method::Overdamped | Method::Overdamped2) {
         return Err(issue(
             at,
             format!(
-                "a wall needs method \"overdamped\" or \"overdamped2\" (the scene's is {:?})",
+                "a {what} needs method \"overdamped\" or \"overdamped2\" (the scene's is {:?})",
                 integrator.method
             ),
         ));
@@ -97,7 +110,7 @@ pub(super) fn check_particles(
 /// The first sphere below the wall or crossing it (to the rounding of the numbers
 /// written: a gap of `-1e-12` radii, or of 4 epsilons of `|z| + |height| + a` far from
 /// the origin, as the kernel allows, is touching), and what is wrong with it.
-fn below(wall: Wall, particles: &[Particle]) -> Option<(usize, String)> {
+pub(super) fn below(wall: Wall, particles: &[Particle]) -> Option<(usize, String)> {
     let k = particles.iter().position(|p| {
         let (z, a) = (p.position[2], p.radius);
         let rounding = 4.0 * f64::EPSILON * (z.abs() + wall.height.abs() + a);

@@ -104,6 +104,10 @@ impl Scene {
         if let Some(w) = self.wall {
             t.insert("wall".into(), table([("height", value(w.height))]));
         }
+        if let Some(s) = self.slit {
+            let st = table([("floor", value(s.floor)), ("ceiling", value(s.ceiling))]);
+            t.insert("slit".into(), st);
+        }
         if let Some(n) = self.near_field {
             let nt = table([
                 ("cutoff", value(n.cutoff)),

@@ -19,5 +19,6 @@ mod layers;
 mod near_field_scene;
 mod packing;
 mod recovery;
+mod slit_scene;
 mod wall_scene;
 mod xyz_roundtrip;

@@ -37,7 +37,7 @@ pub(super) fn plans(
     flow: &Flow,
     contact: Option<Contact>,
     brownian: Option<Thermal>,
-    (wall, pse, near, fast): (bool, bool, bool, bool),
+    ((wall, slit), pse, near, fast): ((bool, bool), bool, bool, bool),
 ) -> Vec<Plan> {
     let plan = |(method, rotation)| Plan {
         method,
@@ -47,6 +47,7 @@ pub(super) fn plans(
         contact,
         brownian,
         wall,
+        slit,
         matrix_free: integrator.matrix_free,
         compact_products: integrator.compact_products,
         pse,
