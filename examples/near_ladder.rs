@@ -10,8 +10,8 @@
 //!   0.137 `U0 / a`), and a sphere at `h / a = 1.1` approaching the wall (Brenner:
 //!   0.087266 `U0`); and the cost of a step of the Figure 1 (c) chain (a head of radius 2
 //!   and 24 tails, settling from its helix, `dt = 0.1`; the mean over `steps` steps)
-//!   twice: as the paper steps it (`Overdamped2`, Newton, hard contacts), which the
-//!   iterative rung refuses, and as every rung steps it (`Overdamped`, Krylov, rotation,
+//!   twice: as the paper steps it (`Overdamped2`, Newton, hard contacts), and as
+//!   every rung steps it (`Overdamped`, Krylov, rotation,
 //!   no contacts), with the iterative rung's distance from the dense one's positions;
 //!   with their counts: mobilities formed, pairs inside the near field's cutoff, dense
 //!   flops.
