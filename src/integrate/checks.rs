@@ -92,7 +92,7 @@ pub(super) fn check_all<T: Real>(
     check_inputs(state, bonds, p)?;
     let thermal = check_thermal(p, has_generator)?;
     super::pins::check(p, bonds, state.pos, state.radius, thermal.is_some())?;
-    check_contacts(p, thermal.is_some())?;
+    check_contacts(p)?;
     // The box first: a box with a wall is refused as such, not by the wall's check.
     let sums = check_periodic(p, state, bonds)?;
     check_wall(p, state)?;
@@ -102,7 +102,7 @@ pub(super) fn check_all<T: Real>(
 }
 
 /// Refuses contacts where they are not implemented.
-pub(super) fn check_contacts<T: Real>(p: &Params<T>, thermal: bool) -> Result<(), StepError> {
+pub(super) fn check_contacts<T: Real>(p: &Params<T>) -> Result<(), StepError> {
     let Some(c) = p.contacts else {
         return Ok(());
     };
@@ -115,9 +115,6 @@ pub(super) fn check_contacts<T: Real>(p: &Params<T>, thermal: bool) -> Result<()
         return Err(StepError::Unsupported(
             "contacts with a method other than Overdamped or Overdamped2",
         ));
-    }
-    if thermal {
-        return Err(StepError::Unsupported("contacts with thermal noise"));
     }
     if c.max_rounds == 0 {
         return Err(StepError::BadParameter("contacts.max_rounds (> 0)"));

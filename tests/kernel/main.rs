@@ -21,6 +21,8 @@ mod brownian;
 mod budget;
 #[cfg(feature = "contacts")]
 mod contacts;
+#[cfg(all(feature = "periodic", feature = "contacts"))]
+mod contacts_brownian;
 mod determinism;
 mod docs;
 mod dynamics;

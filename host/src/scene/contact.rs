@@ -77,13 +77,13 @@ impl Contact {
     }
 }
 
-/// Hard contacts run in the overdamped methods only, without thermal noise (the
-/// kernel's `Params::contacts`): anything else is refused at the `[contact]` table.
+/// Hard contacts run in the overdamped methods only (the kernel's `Params::contacts`;
+/// with thermal noise `"overdamped"`, which the `[brownian]` table's own check asks):
+/// any other method is refused at the `[contact]` table.
 pub(super) fn check_method(
     c: Contact,
     raw: &Spanned<RawContact>,
     integrator: &super::Integrator,
-    brownian: Option<&super::Thermal>,
 ) -> Result<(), Issue> {
     if !matches!(c, Contact::Hard { .. }) {
         return Ok(());
@@ -105,18 +105,11 @@ pub(super) fn check_method(
             ),
         ));
     }
-    if brownian.is_some_and(|b| b.temperature > 0.0) {
-        return Err(issue(
-            span,
-            "hard contacts with thermal noise are not supported; use model = \"soft\"",
-        ));
-    }
     Ok(())
 }
 
 /// Stiffness of the soft contact the project used before hard contacts (overlaps below
-/// ~0.05 a) and still uses where hard contacts do not run (inertial methods, noise,
-/// the charts that compare every method under one model).
+/// ~0.05 a) and still uses where hard contacts do not run (inertial methods, the charts that compare every method under one model).
 pub const SOFT_STIFFNESS: f64 = 1000.0;
 /// The largest step that soft contact allows: `dt k / (3 pi eta a) = 0.53`.
 pub const SOFT_DT: f64 = 0.005;

@@ -16,8 +16,8 @@
 //! Dense: a few hundred spheres at most. With `[integrator] matrix_free = true` the
 //! kernel applies the same mobility by its iterative product instead (no dense matrix;
 //! free space, the Ewald box or above a `[wall]` with `"overdamped"`; bonds, pins and
-//! hard contacts with `"overdamped"`, any solver (`"auto"` is Krylov there); no noise:
-//! `docs/NEAR.md`,
+//! hard contacts with `"overdamped"` and `"overdamped2"`, any solver (`"auto"` is Krylov
+//! there); thermal noise by Lanczos with `"overdamped"`: `docs/NEAR.md`,
 //! "Iterative steps"). The kernel's first-step check refuses the rest (the box's PSE
 //! sums, Lanczos noise) at this table.
 

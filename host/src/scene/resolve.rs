@@ -106,7 +106,7 @@ impl RawScene {
             ));
         }
         if let (Some(c), Some(raw)) = (contact, &self.contact) {
-            super::contact::check_method(c, raw, &integrator, brownian.as_ref())?;
+            super::contact::check_method(c, raw, &integrator)?;
         }
         let wall = match &self.wall {
             None => None,
