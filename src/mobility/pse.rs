@@ -17,6 +17,7 @@
 //! `unsafe`: the caller owns the grid, the cell list and the rows ([`Pse::storage`],
 //! [`PseStorage`]).
 
+mod grand;
 mod jobs;
 mod near;
 mod noise;
@@ -145,10 +146,13 @@ struct Spheres<'a, T: Real> {
     order: &'a [usize],
 }
 
-/// What the wave stage transforms: the spread forces (the product), or the white noise
-/// already drawn on the grid (the Brownian displacement, [`Pse::noise_in`]).
+/// What the wave stage transforms: the spread forces (the product), the spread forces
+/// and torques (the grand product, [`Pse::apply_grand`]), or the white noise already
+/// drawn on the grid (the Brownian displacement, [`Pse::noise_in`]).
+#[derive(Clone, Copy)]
 enum Source<'a, T: Real> {
     Force(&'a [T::V3]),
+    Grand(&'a [T::V3], &'a [T::V3]),
     Noise,
 }
 
@@ -257,7 +261,14 @@ impl<T: Real> Pse<T> {
         out: &mut [T::V3],
         store: &mut PseStorage<'_, T>,
     ) -> Result<(), PseError> {
-        self.check(eta, pos, radius, force, out, store)?;
+        self.check(
+            eta,
+            (pos, radius),
+            (force, None),
+            out,
+            self.storage(pos.len()),
+            store,
+        )?;
         let n = pos.len();
         let par = store.parallel;
         // The cell list orders the near field's rows and neighbours and the spreading.
@@ -279,26 +290,35 @@ impl<T: Real> Pse<T> {
         if part != Part::Near {
             let spheres = Spheres { pos, radius, order };
             let source = Source::Force(force);
-            self.wave(eta, spheres, source, (store.complex, rows, par), out);
+            self.wave(
+                eta,
+                spheres,
+                source,
+                (store.complex, rows, par),
+                (out, None),
+            );
         }
         Ok(())
     }
 
-    /// Lengths, storage, viscosity, positions, forces and radii.
+    /// Lengths, storage (at least `size`), viscosity, positions, forces, torques and
+    /// radii.
     fn check(
         &self,
         eta: T,
-        pos: &[T::V3],
-        radius: &[T],
-        force: &[T::V3],
+        (pos, radius): (&[T::V3], &[T]),
+        (force, torque): (&[T::V3], Option<&[T::V3]>),
         out: &[T::V3],
+        size: PseSize,
         store: &PseStorage<'_, T>,
     ) -> Result<(), PseError> {
         let n = pos.len();
         if radius.len() != n || force.len() != n || out.len() != n {
             return Err(PseError::Length);
         }
-        let size = self.storage(n);
+        if torque.is_some_and(|t| t.len() != n) {
+            return Err(PseError::Length);
+        }
         let need = [size.complex, size.index, size.vectors];
         let have = [store.complex.len(), store.index.len(), store.vectors.len()];
         if need.iter().zip(&have).any(|(n, h)| h < n) {
@@ -308,7 +328,8 @@ impl<T: Real> Pse<T> {
             return Err(PeriodicError::BadParameter("viscosity").into());
         }
         for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
-            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) {
+            let t = torque.map_or(T::V3_ZERO, |t| t[i]);
+            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) || !T::v3_is_finite(t) {
                 return Err(
                     PeriodicError::Particle(ParticleError::NonFinite { particle: i }).into(),
                 );
@@ -320,22 +341,51 @@ impl<T: Real> Pse<T> {
         Ok(())
     }
 
-    /// `out += M^wave F` ([`Source::Force`]) or `out += (M^wave)^{1/2}`-distributed
-    /// noise ([`Source::Noise`]), after the checks and the cell list (whose order the
-    /// spreading follows).
+    /// `out += M^wave F` ([`Source::Force`]), `(out, spin) += M^wave (F, T)`
+    /// ([`Source::Grand`]) or `out += (M^wave)^{1/2}`-distributed noise
+    /// ([`Source::Noise`]), after the checks and the cell list (whose order the
+    /// spreading follows). `rows` holds one vector per sphere, two for the grand product.
     fn wave(
         &self,
         eta: T,
         s: Spheres<'_, T>,
         source: Source<'_, T>,
         (cx, rows, par): (&mut [Cx<T>], &mut [T::V3], &dyn Parallel),
-        out: &mut [T::V3],
+        (out, spin): (&mut [T::V3], Option<&mut [T::V3]>),
+    ) {
+        match source {
+            Source::Grand(..) => self.wave_of::<6>(eta, s, source, (cx, rows, par)),
+            _ => self.wave_of::<3>(eta, s, source, (cx, rows, par)),
+        }
+        let w = if spin.is_some() { 2 } else { 1 };
+        for (&i, r) in s.order.iter().zip(rows.chunks_exact(w)) {
+            out[i] += r[0];
+        }
+        if let Some(spin) = spin {
+            for (&i, r) in s.order.iter().zip(rows.chunks_exact(2)) {
+                spin[i] += r[1];
+            }
+        }
+    }
+
+    /// [`Pse::wave`]'s grid work with `W` components per point (3, or 6 for the
+    /// grand product's torques): the interpolated rows into `rows`, `W / 3` per sphere.
+    fn wave_of<const W: usize>(
+        &self,
+        eta: T,
+        s: Spheres<'_, T>,
+        source: Source<'_, T>,
+        (cx, rows, par): (&mut [Cx<T>], &mut [T::V3], &dyn Parallel),
     ) {
         let Spheres { pos, radius, order } = s;
         let [mx, my, mz] = self.grid.m;
         let points = mx * my * mz;
-        let each = self.grid.scratch_len();
-        let (grid, rest) = cx.split_at_mut(3 * points);
+        let shape = fft::Grid3 {
+            comps: W,
+            ..self.grid
+        };
+        let each = shape.scratch_len();
+        let (grid, rest) = cx.split_at_mut(W * points);
         let (scratch, rest) = rest.split_at_mut(jobs::JOBS * each);
         let (tw, table) = rest.split_at_mut(mx + my + mz);
         let (twx, rest) = tw.split_at_mut(mx);
@@ -345,30 +395,31 @@ impl<T: Real> Pse<T> {
         fft::twiddles(mz, twz);
         wave::tables(self, table);
         let tws = [&*twx, &*twy, &*twz];
-        let slab = 3 * mx * my;
+        let slab = W * mx * my;
         // Spreading and the x, y transforms by slabs of planes (in parallel), the z
         // transforms and the kernel whole (their lines cross every slab).
-        let noise = matches!(source, Source::Noise);
-        match source {
-            Source::Force(force) => {
-                let _ = jobs::pieces(par, (&mut *grid, mz, slab), jobs::none(), |z0, g, _| {
-                    g.fill([T::ZERO; 2]);
-                    let nz = g.len() / slab;
-                    let slab = spread::Slab { z0, nz };
-                    spread::spread(self, (pos, radius, order), force, slab, g);
-                    Ok::<(), Infallible>(())
-                });
-            }
+        let sources = match source {
+            Source::Force(force) => Some((force, None)),
+            Source::Grand(force, torque) => Some((force, Some(torque))),
             // White noise of unit variance at every point, drawn by `noise_in`.
-            Source::Noise => {}
+            Source::Noise => None,
+        };
+        if let Some(sources) = sources {
+            let _ = jobs::pieces(par, (&mut *grid, mz, slab), jobs::none(), |z0, g, _| {
+                g.fill([T::ZERO; 2]);
+                let nz = g.len() / slab;
+                let slab = spread::Slab { z0, nz };
+                spread::spread::<T, W>(self, (pos, radius, order), sources, slab, g);
+                Ok::<(), Infallible>(())
+            });
         }
         let planes = |inverse: bool| {
             move |_: usize, g: &mut [Cx<T>], sc: &mut [Cx<T>]| {
-                let shape = fft::Grid3 {
+                let part = fft::Grid3 {
                     m: [mx, my, g.len() / slab],
-                    ..self.grid
+                    ..shape
                 };
-                fft::fft3(&shape, g, sc, tws, inverse, 0..2);
+                fft::fft3(&part, g, sc, tws, inverse, 0..2);
                 Ok::<(), Infallible>(())
             }
         };
@@ -378,12 +429,13 @@ impl<T: Real> Pse<T> {
             (&mut *scratch, each),
             planes(false),
         );
-        fft::fft3(&self.grid, grid, &mut scratch[..each], tws, false, 2..3);
-        match noise {
-            false => wave::apply_kernel(self, eta, table, grid),
-            true => wave::apply_sqrt_kernel(self, eta, table, grid),
+        fft::fft3(&shape, grid, &mut scratch[..each], tws, false, 2..3);
+        match source {
+            Source::Force(_) => wave::apply_kernel(self, eta, table, grid),
+            Source::Grand(..) => wave::apply_kernel_grand(self, eta, table, grid),
+            Source::Noise => wave::apply_sqrt_kernel(self, eta, table, grid),
         }
-        fft::fft3(&self.grid, grid, &mut scratch[..each], tws, true, 2..3);
+        fft::fft3(&shape, grid, &mut scratch[..each], tws, true, 2..3);
         let _ = jobs::pieces(
             par,
             (&mut *grid, mz, slab),
@@ -392,13 +444,10 @@ impl<T: Real> Pse<T> {
         );
         let grid = &*grid;
         let n = pos.len();
-        let _ = jobs::pieces(par, (&mut *rows, n, 1), jobs::none(), |a, r, _| {
-            let k = a..a + r.len();
-            spread::interpolate(self, (pos, radius, &order[k]), grid, r);
+        let _ = jobs::pieces(par, (&mut *rows, n, W / 3), jobs::none(), |a, r, _| {
+            let k = a..a + r.len() / (W / 3);
+            spread::interpolate::<T, W>(self, (pos, radius, &order[k]), grid, r);
             Ok::<(), Infallible>(())
         });
-        for (&i, &r) in order.iter().zip(rows.iter()) {
-            out[i] += r;
-        }
     }
 }
