@@ -5,6 +5,7 @@
 //! cubic box against its closed form; the translation part against `Pse::apply`.
 
 use crate::common;
+use crate::pse::rel_err;
 
 use common::boxes::{config_radii, to_t};
 use common::fuzz::Rng;
@@ -59,18 +60,6 @@ fn pse_grand<T: Real>(
     let (u, w) = y.split_at_mut(n);
     pse.apply_grand(T::ONE, (pos, rad), f, t, u, w, &mut store)?;
     Ok(y)
-}
-
-/// `|a - b| / |b|` over all components.
-fn rel_err(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    let (mut num, mut den) = (0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        for d in 0..3 {
-            num += (x[d] - y[d]).powi(2);
-            den += y[d] * y[d];
-        }
-    }
-    (num / den).sqrt()
 }
 
 /// The worst of (velocity, rotation) error over tolerance on random polydisperse
