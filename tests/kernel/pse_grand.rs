@@ -11,7 +11,7 @@ use common::boxes::{config_radii, to_t};
 use common::fuzz::Rng;
 use hydrorattle::Real;
 use hydrorattle::linalg::tri;
-use hydrorattle::mobility::periodic::{Ewald, Periodic, assemble_grand};
+use hydrorattle::mobility::periodic::{Ewald, Periodic, PeriodicError, assemble_grand};
 use hydrorattle::mobility::pse::{Part, Pse, PseError, PseStorage};
 use hydrorattle_heap::PseBuffers;
 
@@ -188,7 +188,7 @@ fn lone_sphere_rotation() {
 }
 
 /// Typed errors: short storage (the translation product's is too small), mismatched
-/// lengths, non-finite torques, a sphere nested in another's image.
+/// lengths, a bad viscosity, non-finite torques, a sphere nested in another's image.
 #[test]
 fn grand_errors() {
     let pse = Pse::new(Periodic::new([10.0; 3]).unwrap(), 1.0, 1e-4).unwrap();
@@ -210,6 +210,11 @@ fn grand_errors() {
     assert_eq!(e, Err(PseError::Length));
     let e = pse.apply_grand(1.0, (&pos, &rad), &f, &f, &mut u, &mut w[..1], &mut store);
     assert_eq!(e, Err(PseError::Length));
+    let e = pse.apply_grand(-1.0, (&pos, &rad), &f, &f, &mut u, &mut w, &mut store);
+    assert_eq!(
+        e,
+        Err(PseError::Periodic(PeriodicError::BadParameter("viscosity")))
+    );
     let bad = [f, [f64::v3(f64::NAN, 0.0, 0.0), f[1]]];
     let e = pse.apply_grand(
         1.0,
