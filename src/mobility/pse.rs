@@ -174,20 +174,22 @@ pub enum Part {
     Wave,
 }
 
-/// Storage sizes of [`Pse::apply`] for a given number of spheres.
+/// Storage sizes of [`Pse::apply`] ([`Pse::storage`]) or [`Pse::apply_grand`]
+/// ([`Pse::storage_grand`]) for a given number of spheres.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PseSize {
-    /// Complex values: the grid (3 per point), FFT scratch (one per parallel piece),
+    /// Complex values: the grid (3 per point, 6 for the grand product), FFT scratch (one per parallel piece),
     /// twiddles and kernel tables.
     pub complex: usize,
     /// Indices: the cell list (one per sphere and one per cell, plus one).
     pub index: usize,
-    /// Vectors: one per sphere (the rows of the near field and of the interpolation,
-    /// in the cell list's order).
+    /// Vectors: one per sphere, two for the grand product (the rows of the near field
+    /// and of the interpolation, in the cell list's order).
     pub vectors: usize,
 }
 
-/// Caller-owned storage of [`Pse::apply`], at least [`Pse::storage`], and the
+/// Caller-owned storage of [`Pse::apply`], at least [`Pse::storage`] (of
+/// [`Pse::apply_grand`], at least [`Pse::storage_grand`]), and the
 /// [`Parallel`] that runs its pieces ([`Serial`] unless
 /// [`PseStorage::with_parallel`]).
 pub struct PseStorage<'a, T: Real> {
