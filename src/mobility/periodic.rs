@@ -34,6 +34,8 @@ mod rot;
 mod wave;
 
 pub use rot::{RotBlocks, add_spin, assemble_grand, pair_rot, self_rr};
+#[cfg(feature = "pse")]
+pub(crate) use rot::{real_grand, real_self_rr};
 
 pub use crate::cell::{Periodic, PeriodicError};
 use crate::fault::ParticleError;

@@ -10,6 +10,10 @@
 //! * real space as a sparse near-field sum with a cell list (`near.rs`), each block the
 //!   Ewald path's real-space block, so the halves add to the same periodic RPY.
 //!
+//! The grand product `(U, W) = M (F, T)`, rotations too, is [`Pse::apply_grand`]
+//! (`grand.rs`): the torques spread with the forces, the Ewald path's rotation blocks
+//! in both halves.
+//!
 //! One tolerance sets every parameter ([`Pse::with_xi`], `docs/PERIODIC.md`, section
 //! PSE). Brownian displacements of covariance `M` come from [`Pse::noise`] (`noise.rs`);
 //! a host's thread pool runs the pieces ([`PseStorage::with_parallel`], `jobs.rs`) with
@@ -17,14 +21,15 @@
 //! `unsafe`: the caller owns the grid, the cell list and the rows ([`Pse::storage`],
 //! [`PseStorage`]).
 
+mod grand;
 mod jobs;
 mod near;
 mod noise;
 mod params;
 mod spread;
+mod stage;
 mod wave;
 
-use core::convert::Infallible;
 use core::fmt;
 
 pub use super::fft::{Cx, good_size};
@@ -145,10 +150,13 @@ struct Spheres<'a, T: Real> {
     order: &'a [usize],
 }
 
-/// What the wave stage transforms: the spread forces (the product), or the white noise
-/// already drawn on the grid (the Brownian displacement, [`Pse::noise_in`]).
+/// What the wave stage transforms: the spread forces (the product), the spread forces
+/// and torques (the grand product, [`Pse::apply_grand`]), or the white noise already
+/// drawn on the grid (the Brownian displacement, [`Pse::noise_in`]).
+#[derive(Clone, Copy)]
 enum Source<'a, T: Real> {
     Force(&'a [T::V3]),
+    Grand(&'a [T::V3], &'a [T::V3]),
     Noise,
 }
 
@@ -166,20 +174,22 @@ pub enum Part {
     Wave,
 }
 
-/// Storage sizes of [`Pse::apply`] for a given number of spheres.
+/// Storage sizes of [`Pse::apply`] ([`Pse::storage`]) or [`Pse::apply_grand`]
+/// ([`Pse::storage_grand`]) for a given number of spheres.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PseSize {
-    /// Complex values: the grid (3 per point), FFT scratch (one per parallel piece),
+    /// Complex values: the grid (3 per point, 6 for the grand product), FFT scratch (one per parallel piece),
     /// twiddles and kernel tables.
     pub complex: usize,
     /// Indices: the cell list (one per sphere and one per cell, plus one).
     pub index: usize,
-    /// Vectors: one per sphere (the rows of the near field and of the interpolation,
-    /// in the cell list's order).
+    /// Vectors: one per sphere, two for the grand product (the rows of the near field
+    /// and of the interpolation, in the cell list's order).
     pub vectors: usize,
 }
 
-/// Caller-owned storage of [`Pse::apply`], at least [`Pse::storage`], and the
+/// Caller-owned storage of [`Pse::apply`], at least [`Pse::storage`] (of
+/// [`Pse::apply_grand`], at least [`Pse::storage_grand`]), and the
 /// [`Parallel`] that runs its pieces ([`Serial`] unless
 /// [`PseStorage::with_parallel`]).
 pub struct PseStorage<'a, T: Real> {
@@ -257,7 +267,14 @@ impl<T: Real> Pse<T> {
         out: &mut [T::V3],
         store: &mut PseStorage<'_, T>,
     ) -> Result<(), PseError> {
-        self.check(eta, pos, radius, force, out, store)?;
+        self.check(
+            eta,
+            (pos, radius),
+            (force, None),
+            out,
+            self.storage(pos.len()),
+            store,
+        )?;
         let n = pos.len();
         let par = store.parallel;
         // The cell list orders the near field's rows and neighbours and the spreading.
@@ -279,26 +296,35 @@ impl<T: Real> Pse<T> {
         if part != Part::Near {
             let spheres = Spheres { pos, radius, order };
             let source = Source::Force(force);
-            self.wave(eta, spheres, source, (store.complex, rows, par), out);
+            self.wave(
+                eta,
+                spheres,
+                source,
+                (store.complex, rows, par),
+                (out, None),
+            );
         }
         Ok(())
     }
 
-    /// Lengths, storage, viscosity, positions, forces and radii.
+    /// Lengths, storage (at least `size`), viscosity, positions, forces, torques and
+    /// radii.
     fn check(
         &self,
         eta: T,
-        pos: &[T::V3],
-        radius: &[T],
-        force: &[T::V3],
+        (pos, radius): (&[T::V3], &[T]),
+        (force, torque): (&[T::V3], Option<&[T::V3]>),
         out: &[T::V3],
+        size: PseSize,
         store: &PseStorage<'_, T>,
     ) -> Result<(), PseError> {
         let n = pos.len();
         if radius.len() != n || force.len() != n || out.len() != n {
             return Err(PseError::Length);
         }
-        let size = self.storage(n);
+        if torque.is_some_and(|t| t.len() != n) {
+            return Err(PseError::Length);
+        }
         let need = [size.complex, size.index, size.vectors];
         let have = [store.complex.len(), store.index.len(), store.vectors.len()];
         if need.iter().zip(&have).any(|(n, h)| h < n) {
@@ -308,7 +334,8 @@ impl<T: Real> Pse<T> {
             return Err(PeriodicError::BadParameter("viscosity").into());
         }
         for (i, (&p, &a)) in pos.iter().zip(radius).enumerate() {
-            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) {
+            let t = torque.map_or(T::V3_ZERO, |t| t[i]);
+            if !T::v3_is_finite(p) || !T::v3_is_finite(force[i]) || !T::v3_is_finite(t) {
                 return Err(
                     PeriodicError::Particle(ParticleError::NonFinite { particle: i }).into(),
                 );
@@ -318,87 +345,5 @@ impl<T: Real> Pse<T> {
             }
         }
         Ok(())
-    }
-
-    /// `out += M^wave F` ([`Source::Force`]) or `out += (M^wave)^{1/2}`-distributed
-    /// noise ([`Source::Noise`]), after the checks and the cell list (whose order the
-    /// spreading follows).
-    fn wave(
-        &self,
-        eta: T,
-        s: Spheres<'_, T>,
-        source: Source<'_, T>,
-        (cx, rows, par): (&mut [Cx<T>], &mut [T::V3], &dyn Parallel),
-        out: &mut [T::V3],
-    ) {
-        let Spheres { pos, radius, order } = s;
-        let [mx, my, mz] = self.grid.m;
-        let points = mx * my * mz;
-        let each = self.grid.scratch_len();
-        let (grid, rest) = cx.split_at_mut(3 * points);
-        let (scratch, rest) = rest.split_at_mut(jobs::JOBS * each);
-        let (tw, table) = rest.split_at_mut(mx + my + mz);
-        let (twx, rest) = tw.split_at_mut(mx);
-        let (twy, twz) = rest.split_at_mut(my);
-        fft::twiddles(mx, twx);
-        fft::twiddles(my, twy);
-        fft::twiddles(mz, twz);
-        wave::tables(self, table);
-        let tws = [&*twx, &*twy, &*twz];
-        let slab = 3 * mx * my;
-        // Spreading and the x, y transforms by slabs of planes (in parallel), the z
-        // transforms and the kernel whole (their lines cross every slab).
-        let noise = matches!(source, Source::Noise);
-        match source {
-            Source::Force(force) => {
-                let _ = jobs::pieces(par, (&mut *grid, mz, slab), jobs::none(), |z0, g, _| {
-                    g.fill([T::ZERO; 2]);
-                    let nz = g.len() / slab;
-                    let slab = spread::Slab { z0, nz };
-                    spread::spread(self, (pos, radius, order), force, slab, g);
-                    Ok::<(), Infallible>(())
-                });
-            }
-            // White noise of unit variance at every point, drawn by `noise_in`.
-            Source::Noise => {}
-        }
-        let planes = |inverse: bool| {
-            move |_: usize, g: &mut [Cx<T>], sc: &mut [Cx<T>]| {
-                let shape = fft::Grid3 {
-                    m: [mx, my, g.len() / slab],
-                    ..self.grid
-                };
-                fft::fft3(&shape, g, sc, tws, inverse, 0..2);
-                Ok::<(), Infallible>(())
-            }
-        };
-        let _ = jobs::pieces(
-            par,
-            (&mut *grid, mz, slab),
-            (&mut *scratch, each),
-            planes(false),
-        );
-        fft::fft3(&self.grid, grid, &mut scratch[..each], tws, false, 2..3);
-        match noise {
-            false => wave::apply_kernel(self, eta, table, grid),
-            true => wave::apply_sqrt_kernel(self, eta, table, grid),
-        }
-        fft::fft3(&self.grid, grid, &mut scratch[..each], tws, true, 2..3);
-        let _ = jobs::pieces(
-            par,
-            (&mut *grid, mz, slab),
-            (&mut *scratch, each),
-            planes(true),
-        );
-        let grid = &*grid;
-        let n = pos.len();
-        let _ = jobs::pieces(par, (&mut *rows, n, 1), jobs::none(), |a, r, _| {
-            let k = a..a + r.len();
-            spread::interpolate(self, (pos, radius, &order[k]), grid, r);
-            Ok::<(), Infallible>(())
-        });
-        for (&i, &r) in order.iter().zip(rows.iter()) {
-            out[i] += r;
-        }
     }
 }

@@ -87,6 +87,8 @@ mod pse;
 #[cfg(feature = "pse")]
 mod pse_brownian;
 #[cfg(feature = "pse")]
+mod pse_grand;
+#[cfg(feature = "pse")]
 mod pse_limits;
 mod pse_step;
 mod reference;

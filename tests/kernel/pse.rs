@@ -57,7 +57,7 @@ fn forces(n: usize, seed: u64) -> Vec<[f64; 3]> {
 }
 
 /// `|a - b| / |b|` over all components.
-fn rel_err(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+pub(crate) fn rel_err(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     let (mut num, mut den) = (0.0, 0.0);
     for (x, y) in a.iter().zip(b) {
         for d in 0..3 {

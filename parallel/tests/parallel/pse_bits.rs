@@ -1,4 +1,5 @@
-//! The PSE product (`mobility::pse`) on a thread pool gives the bits of one thread: its
+//! The PSE product (`mobility::pse`) and its grand product on a thread pool give the
+//! bits of one thread: their
 //! pieces (near-field rows, slabs of grid planes, interpolation rows) depend on the
 //! sizes alone, and each value's arithmetic is the same in whichever piece it falls.
 
@@ -12,10 +13,11 @@ use hydrorattle_parallel::Threads;
 
 use crate::fuzz::Rng;
 
-/// `M F` for every part, as bits, with `par`.
+/// `M F` for every part and the grand product `M (F, T)` (torques `F` reversed), as
+/// bits, with `par`.
 fn product(pse: &Pse<f64>, pos: &[DVec3], f: &[DVec3], par: &dyn Parallel) -> Vec<u64> {
     let n = pos.len();
-    let size = pse.storage(n);
+    let size = pse.storage_grand(n);
     let mut arrays = PseBuffers::new(size);
     let mut store = arrays.storage().with_parallel(par);
     let rad = vec![1.0; n];
@@ -26,6 +28,15 @@ fn product(pse: &Pse<f64>, pos: &[DVec3], f: &[DVec3], par: &dyn Parallel) -> Ve
             .unwrap();
         bits.extend(out.iter().flat_map(|u| u.to_array().map(f64::to_bits)));
     }
+    let t: Vec<DVec3> = f.iter().rev().copied().collect();
+    let (mut u, mut w) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+    pse.apply_grand(1.0, (pos, &rad), f, &t, &mut u, &mut w, &mut store)
+        .unwrap();
+    bits.extend(
+        u.iter()
+            .chain(&w)
+            .flat_map(|u| u.to_array().map(f64::to_bits)),
+    );
     bits
 }
 

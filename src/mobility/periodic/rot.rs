@@ -13,7 +13,7 @@
 //! `eta W_rt(r) F = (h'(r) / (2 r)) r x F` and
 //! `eta W_rr(r) = ((h'' - h'/r) e e^T - (h'' + h'/r) I) / 4`.
 
-use super::real::{for_each_image, gauss_erf, smooth_with};
+use super::real::{Split, for_each_image, gauss_erf, smooth_with};
 use super::wave::{add_kk, for_each_mode, for_each_phase, projected, radius_factor};
 use super::{Ewald, PeriodicError, Sums, check};
 use crate::fault::ParticleError;
@@ -103,7 +103,7 @@ pub type RotBlocks<T> = (<T as Real>::M3, <T as Real>::M3, <T as Real>::M3);
 /// a sphere with its own images: `rr` of `n = 0` is `1/(8 pi eta a^3) - W_rr(0)`, and
 /// `rt` is zero by inversion symmetry, so it is not summed).
 fn real_rot<T: Real>(
-    ew: &Ewald<T>,
+    split: &Split<T>,
     eta: T,
     ai: T,
     aj: T,
@@ -112,16 +112,16 @@ fn real_rot<T: Real>(
 ) -> Option<RotBlocks<T>> {
     let inv_eta = T::ONE / eta;
     let (mut rt_ij, mut rt_ji, mut rr) = (T::M3_ZERO, T::M3_ZERO, T::M3_ZERO);
-    for_each_image(&ew.split, r0, |origin, rn, s2| {
+    for_each_image(split, r0, |origin, rn, s2| {
         if same && origin {
-            let (_, a0, _) = smooth_rot(ew.xi, T::ZERO);
+            let (_, a0, _) = smooth_rot(split.xi, T::ZERO);
             rr += T::m3_diag(free_self_rr(eta, ai) - a0 * inv_eta);
             return Some(());
         }
         let b = pair_blocks(Hydro::Rpy, eta, ai, aj, rn)?;
         let (s, inv_s) = s2.root_and_inverse();
         let e = rn * inv_s;
-        let (h1r, a, bb) = smooth_rot(ew.xi, s);
+        let (h1r, a, bb) = smooth_rot(split.xi, s);
         let w_rt = T::m3_cross(rn) * (h1r * T::HALF * inv_eta);
         rr += b.rr - T::m3_add_diag(T::outer(e, e) * (bb * inv_eta), a * inv_eta);
         if !same {
@@ -154,7 +154,7 @@ fn wave_rot<T: Real>(ew: &Ewald<T>, eta: T, r0: T::V3) -> (T::M3, T::M3) {
 /// the other. `rr` is exactly symmetric.
 pub fn pair_rot<T: Real>(ew: &Ewald<T>, eta: T, ai: T, aj: T, r: T::V3) -> Option<RotBlocks<T>> {
     let r0 = ew.cell.minimum_image(r);
-    let (rt_ij, rt_ji, rr) = real_rot(ew, eta, ai, aj, r0, false)?;
+    let (rt_ij, rt_ji, rr) = real_rot(&ew.split, eta, ai, aj, r0, false)?;
     let (rt, rr_w) = wave_rot(ew, eta, r0);
     Some((rt_ij + rt, rt_ji - rt, rr + rr_w))
 }
@@ -174,26 +174,7 @@ pub(super) fn pair_grand<T: Real>(
     r: T::V3,
 ) -> Option<PairBlocks<T>> {
     let r0 = ew.cell.minimum_image(r);
-    // Real space: the arithmetic of `real::real_sum` and `real_rot`, image by image.
-    let six = T::from_f64(6.0);
-    let alpha = (ai * ai + aj * aj) / six;
-    let beta = ai * ai * aj * aj / (six * six);
-    let inv_eta = T::ONE / eta;
-    let (mut tt, mut rt_ij, mut rt_ji, mut rr) = (T::M3_ZERO, T::M3_ZERO, T::M3_ZERO, T::M3_ZERO);
-    for_each_image(&ew.split, r0, |_, rn, s2| {
-        let b = pair_blocks(Hydro::Rpy, eta, ai, aj, rn)?;
-        let (s, inv_s) = s2.root_and_inverse();
-        let e = rn * inv_s;
-        let ee = T::outer(e, e);
-        let rot = |shared| smooth_rot_from(ew.xi, s, shared);
-        let ((a, bt), (h1r, ar, bb)) = smooth_with(ew.xi, alpha, beta, s, rot);
-        tt += b.tt - T::m3_add_diag(ee * (bt * inv_eta), a * inv_eta);
-        let w_rt = T::m3_cross(rn) * (h1r * T::HALF * inv_eta);
-        rr += b.rr - T::m3_add_diag(ee * (bb * inv_eta), ar * inv_eta);
-        rt_ij += b.rt_ij - w_rt;
-        rt_ji += b.rt_ji + w_rt;
-        Some(())
-    })?;
+    let real = real_grand(&ew.split, eta, ai, aj, r0)?;
     // Wave space: the sums of `wave::wave_sum` and `wave_rot`, mode by mode.
     let (mut d_tt, mut kk_tt) = (T::ZERO, [T::ZERO; 6]);
     let (mut d_rr, mut kk_rr, mut ks) = (T::ZERO, [T::ZERO; 6], T::V3_ZERO);
@@ -209,20 +190,64 @@ pub(super) fn pair_grand<T: Real>(
     let w = T::TWO / (eta * ew.volume);
     let rt = T::m3_cross(ks) * (-(w * T::HALF));
     Some(PairBlocks {
-        tt: tt + projected(d_tt, kk_tt, w),
-        rt_ij: rt_ij + rt,
-        rt_ji: rt_ji - rt,
-        rr: rr + projected(d_rr, kk_rr, w * T::from_f64(0.25)),
+        tt: real.tt + projected(d_tt, kk_tt, w),
+        rt_ij: real.rt_ij + rt,
+        rt_ji: real.rt_ji - rt,
+        rr: real.rr + projected(d_rr, kk_rr, w * T::from_f64(0.25)),
     })
+}
+
+/// The real-space half of every block of the pair `(i, j)`, `i != j`, at
+/// minimum-image separation `r0`: the arithmetic of `real::real_sum` and `real_rot`,
+/// image by image, sharing each image's free-space blocks and transcendental parts.
+/// Shared by [`pair_grand`] and the PSE near field (`mobility::pse`). `None` when a
+/// sphere lies inside an image of the other.
+#[inline(always)]
+pub(crate) fn real_grand<T: Real>(
+    split: &Split<T>,
+    eta: T,
+    ai: T,
+    aj: T,
+    r0: T::V3,
+) -> Option<PairBlocks<T>> {
+    let six = T::from_f64(6.0);
+    let alpha = (ai * ai + aj * aj) / six;
+    let beta = ai * ai * aj * aj / (six * six);
+    let inv_eta = T::ONE / eta;
+    let (mut tt, mut rt_ij, mut rt_ji, mut rr) = (T::M3_ZERO, T::M3_ZERO, T::M3_ZERO, T::M3_ZERO);
+    for_each_image(split, r0, |_, rn, s2| {
+        let b = pair_blocks(Hydro::Rpy, eta, ai, aj, rn)?;
+        let (s, inv_s) = s2.root_and_inverse();
+        let e = rn * inv_s;
+        let ee = T::outer(e, e);
+        let rot = |shared| smooth_rot_from(split.xi, s, shared);
+        let ((a, bt), (h1r, ar, bb)) = smooth_with(split.xi, alpha, beta, s, rot);
+        tt += b.tt - T::m3_add_diag(ee * (bt * inv_eta), a * inv_eta);
+        let w_rt = T::m3_cross(rn) * (h1r * T::HALF * inv_eta);
+        rr += b.rr - T::m3_add_diag(ee * (bb * inv_eta), ar * inv_eta);
+        rt_ij += b.rt_ij - w_rt;
+        rt_ji += b.rt_ji + w_rt;
+        Some(())
+    })?;
+    Some(PairBlocks {
+        tt,
+        rt_ij,
+        rt_ji,
+        rr,
+    })
+}
+
+/// The real-space half of a sphere's `rr` self block (its `rt` self block is zero):
+/// `1/(8 pi eta a^3) - W_rr(0)` plus its images within the cutoff.
+pub(crate) fn real_self_rr<T: Real>(split: &Split<T>, eta: T, a: T) -> T::M3 {
+    // No image of a sphere lies inside it (a < L/2), so the real sum is never `None`.
+    real_rot(split, eta, a, a, T::V3_ZERO, true).map_or(T::M3_ZERO, |(_, _, rr)| rr)
 }
 
 /// The `rr` self block of a sphere of radius `a` in the box (for a cubic box of edge
 /// `L`, `(1 - (4 pi / 3)(a/L)^3) / (8 pi eta a^3)`); its `rt` self block is zero.
 pub fn self_rr<T: Real>(ew: &Ewald<T>, eta: T, a: T) -> T::M3 {
-    // No image of a sphere lies inside it (a < L/2), so the real sum is never `None`.
-    let (_, _, rr) =
-        real_rot(ew, eta, a, a, T::V3_ZERO, true).unwrap_or((T::M3_ZERO, T::M3_ZERO, T::M3_ZERO));
-    rr + wave_rot(ew, eta, T::V3_ZERO).1
+    real_self_rr(&ew.split, eta, a) + wave_rot(ew, eta, T::V3_ZERO).1
 }
 
 /// Assembles the `2n x 2n` grand mobility `[[tt, tr], [rt, rr]]` of the box, packed
@@ -298,7 +323,7 @@ impl<T: Real> Grand<T> for Sums<'_, T> {
         let (rt_ij, rt_ji, _) = match self.whole {
             true => pair_rot(ew, eta, radius[i], radius[j], r),
             false => real_rot(
-                ew,
+                &ew.split,
                 eta,
                 radius[i],
                 radius[j],

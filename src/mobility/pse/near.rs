@@ -14,6 +14,7 @@ use super::{Pse, PseError};
 use crate::fault::ParticleError;
 use crate::mobility::periodic::PeriodicError;
 use crate::mobility::periodic::real::real_sum;
+use crate::mobility::periodic::{real_grand, real_self_rr};
 use crate::real::Real;
 
 /// The cell of a position (wrapped into the box), per axis.
@@ -75,6 +76,51 @@ fn axis_neighbours(c: usize, n: usize) -> ([usize; 3], usize) {
     }
 }
 
+/// Calls `f(j, r0)` for every neighbour `j != i` of sphere `i` within the cutoff, in
+/// the cell list's fixed order, `r0` the minimum-image separation `r_hi - r_lo` of the
+/// pair's higher and lower index (the pair is always evaluated from the higher one, so
+/// the operator is exactly symmetric); stops at the first error.
+#[inline(always)]
+fn for_each_neighbour<T: Real>(
+    pse: &Pse<T>,
+    pos: &[T::V3],
+    (order, start): (&[usize], &[usize]),
+    i: usize,
+    mut f: impl FnMut(usize, T::V3) -> Result<(), PseError>,
+) -> Result<(), PseError> {
+    let rc2 = pse.split.r_cut * pse.split.r_cut;
+    let nc = pse.cells;
+    let c = cell_of(pse, pos[i]);
+    let (nz, cz) = axis_neighbours(c[2], nc[2]);
+    let (ny, cy) = axis_neighbours(c[1], nc[1]);
+    let (nx, cx) = axis_neighbours(c[0], nc[0]);
+    for &z in &nz[..cz] {
+        for &y in &ny[..cy] {
+            for &x in &nx[..cx] {
+                let cell = linear([x, y, z], nc);
+                for &j in &order[start[cell]..start[cell + 1]] {
+                    if j == i {
+                        continue;
+                    }
+                    let (hi, lo) = (i.max(j), i.min(j));
+                    let r0 = pse.cell.minimum_image(pos[hi] - pos[lo]);
+                    if !(T::norm2(r0) <= rc2) {
+                        continue;
+                    }
+                    f(j, r0)?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A sphere inside another's image: `ParticleError::Nested { i: lower, j: higher }`.
+fn nested(i: usize, j: usize) -> PseError {
+    let (i, j) = (i.min(j), i.max(j));
+    PseError::Periodic(PeriodicError::Particle(ParticleError::Nested { i, j }))
+}
+
 /// `rows[k] = sum_j M^real_ij F_j` for `i = order[first + k]`, over the pairs within the
 /// cutoff and the self block. A sphere inside another's image is
 /// `ParticleError::Nested { i: lower, j: higher }`.
@@ -84,54 +130,73 @@ pub(super) fn product<T: Real>(
     eta: T,
     (pos, radius): (&[T::V3], &[T]),
     force: &[T::V3],
-    (order, start): (&[usize], &[usize]),
+    cells: (&[usize], &[usize]),
     first: usize,
     rows: &mut [T::V3],
 ) -> Result<(), PseError> {
     let split = &pse.split;
-    let rc2 = split.r_cut * split.r_cut;
-    let nc = pse.cells;
     // Rows in the cell list's order: neighbouring rows share their neighbours, so the
     // positions they read stay in cache. Each row's sum is its own: the order of rows
     // changes no bits.
-    for (row, &i) in rows.iter_mut().zip(&order[first..]) {
+    for (row, &i) in rows.iter_mut().zip(&cells.0[first..]) {
         let a = radius[i];
         // A sphere is never inside its own image (a < L/2): never `None`.
         let own = real_sum(split, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
         let mut acc = own * force[i];
-        let c = cell_of(pse, pos[i]);
-        let (nz, cz) = axis_neighbours(c[2], nc[2]);
-        let (ny, cy) = axis_neighbours(c[1], nc[1]);
-        let (nx, cx) = axis_neighbours(c[0], nc[0]);
-        for &z in &nz[..cz] {
-            for &y in &ny[..cy] {
-                for &x in &nx[..cx] {
-                    let cell = linear([x, y, z], nc);
-                    for &j in &order[start[cell]..start[cell + 1]] {
-                        if j == i {
-                            continue;
-                        }
-                        let (hi, lo) = (i.max(j), i.min(j));
-                        let r0 = pse.cell.minimum_image(pos[hi] - pos[lo]);
-                        if !(T::norm2(r0) <= rc2) {
-                            continue;
-                        }
-                        let b = real_sum(split, eta, radius[hi], radius[lo], r0, false).ok_or(
-                            PseError::Periodic(PeriodicError::Particle(ParticleError::Nested {
-                                i: lo,
-                                j: hi,
-                            })),
-                        )?;
-                        acc += if i == hi {
-                            b * force[j]
-                        } else {
-                            T::m3_tmul(b, force[j])
-                        };
-                    }
-                }
-            }
-        }
+        for_each_neighbour(pse, pos, cells, i, |j, r0| {
+            let (hi, lo) = (i.max(j), i.min(j));
+            let b = real_sum(split, eta, radius[hi], radius[lo], r0, false)
+                .ok_or_else(|| nested(i, j))?;
+            acc += if i == hi {
+                b * force[j]
+            } else {
+                T::m3_tmul(b, force[j])
+            };
+            Ok(())
+        })?;
         *row = acc;
+    }
+    Ok(())
+}
+
+/// The grand product's near field: `rows[2k] = sum_j (tt_ij F_j + tr_ij T_j)` and
+/// `rows[2k + 1] = sum_j (rt_ij F_j + rr_ij T_j)` of the real-space blocks (the Ewald
+/// path's, [`real_grand`]) for `i = order[first + k]`, as [`product`] otherwise. The
+/// self blocks: `tt` and `rr` (the `rt` self block vanishes); `tr_ij` is `rt_ji^T`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn product_grand<T: Real>(
+    pse: &Pse<T>,
+    eta: T,
+    (pos, radius): (&[T::V3], &[T]),
+    (force, torque): (&[T::V3], &[T::V3]),
+    cells: (&[usize], &[usize]),
+    first: usize,
+    rows: &mut [T::V3],
+) -> Result<(), PseError> {
+    let split = &pse.split;
+    for (row, &i) in rows.chunks_exact_mut(2).zip(&cells.0[first..]) {
+        let a = radius[i];
+        let own = real_sum(split, eta, a, a, T::V3_ZERO, true).unwrap_or(T::M3_ZERO);
+        let (mut u, mut w) = (own * force[i], real_self_rr(split, eta, a) * torque[i]);
+        for_each_neighbour(pse, pos, cells, i, |j, r0| {
+            let (hi, lo) = (i.max(j), i.min(j));
+            let b =
+                real_grand(split, eta, radius[hi], radius[lo], r0).ok_or_else(|| nested(i, j))?;
+            if i == hi {
+                u += b.tt * force[j];
+                u += T::m3_tmul(b.rt_ji, torque[j]);
+                w += b.rt_ij * force[j];
+                w += b.rr * torque[j];
+            } else {
+                u += T::m3_tmul(b.tt, force[j]);
+                u += T::m3_tmul(b.rt_ij, torque[j]);
+                w += b.rt_ji * force[j];
+                w += T::m3_tmul(b.rr, torque[j]);
+            }
+            Ok(())
+        })?;
+        row[0] = u;
+        row[1] = w;
     }
     Ok(())
 }

@@ -66,7 +66,8 @@ impl<T: Real> Pse<T> {
     ) -> Result<u32, PseError> {
         let n = pos.len();
         out.fill(T::V3_ZERO);
-        self.check(eta, pos, radius, out, out, store)?;
+        let size = self.storage(n);
+        self.check(eta, (pos, radius), (out, None), out, size, store)?;
         if n == 0 {
             return Ok(0);
         }
@@ -104,7 +105,7 @@ impl<T: Real> Pse<T> {
         };
         let rows = &mut store.vectors[..n];
         let work = (&mut *store.complex, rows, store.parallel);
-        self.wave(eta, spheres, Source::Noise, work, out);
+        self.wave(eta, spheres, Source::Noise, work, (out, None));
         Ok(iterations)
     }
 }

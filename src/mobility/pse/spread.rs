@@ -7,7 +7,8 @@
 //! radius (`wave.rs`), so polydispersity costs no extra transform: three complex FFTs
 //! carry the six real fields. Interpolation reads the real part `U` and the imaginary
 //! part `V = IFFT(k^2 u)` and forms `U - a_i^2 V / 6`, the same factor on the receiving
-//! sphere.
+//! sphere. The grand product adds the torque `T_j` as three more components (real
+//! parts; six complex values per point), whose real parts come back as the spin field.
 //!
 //! The Gaussian is `g(r) = (2 pi sigma^2)^{-3/2} exp(-r^2 / (2 sigma^2))`, truncated to
 //! `P_d` points per axis around the sphere (every point left out is at least `P_d h_d
@@ -116,14 +117,16 @@ fn run<T: Real>(pse: &Pse<T>, w: &Window<T>) -> Option<usize> {
     (i0 + px <= pse.grid.m[0]).then_some(i0)
 }
 
-/// The planes `slab` of the grid (3 components per point, zeroed by the caller) `+=`
-/// each sphere's Gaussian times `(F_j, a_j^2 F_j)`, spheres in the order `order` (the
-/// cell list's, for cache locality). Every point receives its terms in that order
-/// whatever the slab, so slabs in parallel give the bits of the whole grid at once.
-pub(super) fn spread<T: Real>(
+/// The planes `slab` of the grid (`W` components per point, zeroed by the caller) `+=`
+/// each sphere's Gaussian times `(F_j, a_j^2 F_j)` packed in the first three components
+/// and, for the grand product (`W = 6`), its torque `T_j` in the real parts of the last
+/// three; spheres in the order `order` (the cell list's, for cache locality). Every
+/// point receives its terms in that order whatever the slab, so slabs in parallel give
+/// the bits of the whole grid at once.
+pub(super) fn spread<T: Real, const W: usize>(
     pse: &Pse<T>,
     (pos, radius, order): (&[T::V3], &[T], &[usize]),
-    force: &[T::V3],
+    (force, torque): (&[T::V3], Option<&[T::V3]>),
     slab: Slab,
     grid: &mut [Cx<T>],
 ) {
@@ -135,23 +138,27 @@ pub(super) fn spread<T: Real>(
         let w = Window::new(pse, pos[j]);
         let a2 = radius[j] * radius[j];
         let v = T::xyz(force[j]).map(|c| [c, a2 * c]);
+        let t = torque.map_or([T::ZERO; 3], |t| T::xyz(t[j]));
         let add = |pt: &mut [Cx<T>], s: T| {
             for c in 0..3 {
                 pt[c][0] += s * v[c][0];
                 pt[c][1] += s * v[c][1];
             }
+            for c in 3..W {
+                pt[c][0] += s * t[c - 3];
+            }
         };
         let wx = &w.weight[0][..px];
         match run(pse, &w) {
             Some(i0) => rows(pse, &w, slab, |base, wyz| {
-                let seg = &mut grid[3 * (base + i0)..3 * (base + i0 + px)];
-                for (pt, &x) in seg.chunks_exact_mut(3).zip(wx) {
+                let seg = &mut grid[W * (base + i0)..W * (base + i0 + px)];
+                for (pt, &x) in seg.chunks_exact_mut(W).zip(wx) {
                     add(pt, x * wyz);
                 }
             }),
             None => rows(pse, &w, slab, |base, wyz| {
                 for (&i, &x) in w.index[0][..px].iter().zip(wx) {
-                    add(&mut grid[3 * (base + i)..3 * (base + i) + 3], x * wyz);
+                    add(&mut grid[W * (base + i)..W * (base + i) + W], x * wyz);
                 }
             }),
         }
@@ -159,9 +166,12 @@ pub(super) fn spread<T: Real>(
 }
 
 /// `rows[k] = sum_g g(x_g - r_i) (U(x_g) - a_i^2 V(x_g) / 6)` for `i = order[k]`, with
-/// `U + i V` the grid after the inverse transform (the quadrature weight `h^3` is in the
-/// wave-space kernel). Each sphere's sum is its own.
-pub(super) fn interpolate<T: Real>(
+/// `U + i V` the first three components of the grid after the inverse transform (the
+/// quadrature weight `h^3` is in the wave-space kernel); for the grand product
+/// (`W = 6`) each sphere has two rows, that one and its spin `sum_g g(x_g - r_i)
+/// Omega(x_g)`, `Omega` the real parts of the last three components (the rotation
+/// blocks carry no sphere factor). Each sphere's sum is its own.
+pub(super) fn interpolate<T: Real, const W: usize>(
     pse: &Pse<T>,
     (pos, radius, order): (&[T::V3], &[T], &[usize]),
     grid: &[Cx<T>],
@@ -173,34 +183,41 @@ pub(super) fn interpolate<T: Real>(
         z0: 0,
         nz: pse.grid.m[2],
     };
-    for (row, &i) in rows_out.iter_mut().zip(order) {
+    for (row, &i) in rows_out.chunks_exact_mut(W / 3).zip(order) {
         let w = Window::new(pse, pos[i]);
         let mut acc = [[T::ZERO; 2]; 3];
+        let mut spin = [T::ZERO; 3];
         let mut take = |pt: &[Cx<T>], s: T| {
             for c in 0..3 {
                 acc[c][0] += s * pt[c][0];
                 acc[c][1] += s * pt[c][1];
             }
+            for c in 3..W {
+                spin[c - 3] += s * pt[c][0];
+            }
         };
         let wx = &w.weight[0][..px];
         match run(pse, &w) {
             Some(i0) => rows(pse, &w, all, |base, wyz| {
-                let seg = &grid[3 * (base + i0)..3 * (base + i0 + px)];
-                for (pt, &x) in seg.chunks_exact(3).zip(wx) {
+                let seg = &grid[W * (base + i0)..W * (base + i0 + px)];
+                for (pt, &x) in seg.chunks_exact(W).zip(wx) {
                     take(pt, x * wyz);
                 }
             }),
             None => rows(pse, &w, all, |base, wyz| {
                 for (&j, &x) in w.index[0][..px].iter().zip(wx) {
-                    take(&grid[3 * (base + j)..3 * (base + j) + 3], x * wyz);
+                    take(&grid[W * (base + j)..W * (base + j) + W], x * wyz);
                 }
             }),
         }
         let k = radius[i] * radius[i] * sixth;
-        *row = T::v3(
+        row[0] = T::v3(
             acc[0][0] - k * acc[0][1],
             acc[1][0] - k * acc[1][1],
             acc[2][0] - k * acc[2][1],
         );
+        if let Some(r) = row.get_mut(1) {
+            *r = T::v3(spin[0], spin[1], spin[2]);
+        }
     }
 }
