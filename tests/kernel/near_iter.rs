@@ -23,9 +23,9 @@ use hydrorattle::{
 use hydrorattle_heap::Buffers;
 
 /// Stokes' speed of the unit sphere of unit buoyant weight in the unit fluid.
-const U0: f64 = 1.0 / (6.0 * PI);
+pub(crate) const U0: f64 = 1.0 / (6.0 * PI);
 /// Density of unit buoyant weight for a unit sphere (`g = 1`).
-const RHO1: f64 = 3.0 / (4.0 * PI);
+pub(crate) const RHO1: f64 = 3.0 / (4.0 * PI);
 
 /// Positions, velocities and spins after a step.
 type Out = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>);
@@ -77,7 +77,7 @@ fn one_step<T: Real>(
 /// A branched cluster of `n` spheres (radii 0.8 to 1.5, densities 0.5 to 2 times
 /// `RHO1`), each new sphere at a gap of 0.005 to 0.6 mean radii from a random earlier
 /// one and clear of all (by the minimum image in the box of edge `l`), about `c`.
-fn cluster(n: usize, seed: u64, l: Option<f64>, c: [f64; 3]) -> Vec<Sphere> {
+pub(crate) fn cluster(n: usize, seed: u64, l: Option<f64>, c: [f64; 3]) -> Vec<Sphere> {
     let mut state = seed
         .wrapping_mul(6364136223846793005)
         .wrapping_add(1442695040888963407);
@@ -124,7 +124,7 @@ fn cluster(n: usize, seed: u64, l: Option<f64>, c: [f64; 3]) -> Vec<Sphere> {
 }
 
 /// Largest difference of `a` from `b` over the largest of `b`.
-fn relative_gap(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+pub(crate) fn relative_gap(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     let big = b.iter().map(|v| norm(*v)).fold(0.0, f64::max);
     let diff = a
         .iter()
@@ -228,7 +228,8 @@ fn same_bits<T: Real>() {
     assert_eq!(run(), run());
 }
 
-/// Refused, typed, the state unchanged: what the iterative path does not serve (PSE;
+/// Refused, typed, the state unchanged: what the iterative path does not serve (PSE in
+/// a box;
 /// the wall's hydrodynamics, refused before, now stepped), the conjugate gradients
 /// stopped before they converge, and more close pairs than the storage holds (its
 /// Brownian steps: `near_iter_brownian.rs`).
@@ -261,9 +262,10 @@ fn refusals<T: Real>() {
     p.wall = Some(Wall::new(T::from_f64(-40.0)));
     let (r, _) = one_step::<T>(&p, &spheres, &[]).unwrap();
     assert!(r.near_products >= 1, "{r:?}");
+    // PSE in a box (free space's fast product is served: `near_fast.rs`).
     let mut p = base;
     p.pse = Some(1e-3);
-    // (The fast free-space product refuses rotation first.)
+    p.periodic = Some(Periodic::new([T::from_f64(60.0); 3]).unwrap());
     p.rotation = false;
     unsupported(&p, &[], "PSE");
     // One iteration cannot solve twenty coupled spheres.
