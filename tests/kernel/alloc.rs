@@ -286,3 +286,50 @@ fn iterative_near_field_with_bonds_allocates_nothing() {
         assert!(ps.time > init.time, "{tag}");
     }
 }
+
+/// The iterative near field on the fast free-space product's grand product
+/// (`Params::pse` in free space): `Overdamped` and `Overdamped2` with bonds by Krylov,
+/// and at temperature, no heap (the fast arrays the caller's, `FreeBuffers`).
+#[cfg(all(feature = "near", feature = "fast-free"))]
+#[test]
+fn iterative_near_field_on_the_fast_product_allocates_nothing() {
+    use hydrorattle::integrate::{fast_storage, fast_vectors};
+    const N: usize = 25;
+    const B: usize = N - 1;
+    let init = chain::<f64, N>();
+    let bonds = BondSet::<f64, B>::chain(&init.pos[..N]).unwrap();
+    for (method, thermal) in [
+        (Method::Overdamped, false),
+        (Method::Overdamped2, false),
+        (Method::Overdamped, true),
+    ] {
+        let mut p = Params::new(0.01);
+        p.method = method;
+        p.solver.kind = SolverKind::Krylov;
+        p.rotation = true;
+        p.matrix_free = true;
+        p.pse = Some(1e-6);
+        p.near = Some(hydrorattle::stokesian::NearField::default());
+        p.brownian = thermal.then(|| hydrorattle::Brownian::new(1e-3));
+        let layout = hydrorattle::Layout::for_params(&p, N, B);
+        let mut store = hydrorattle_heap::Buffers::<f64>::new(layout);
+        let size = fast_storage(&p, &init.pos[..N], &init.radius[..N]).unwrap();
+        let mut arrays = hydrorattle_heap::FreeBuffers::<f64>::for_step(size);
+        let mut spare = vec![<f64 as Real>::V3_ZERO; fast_vectors(&p, N)];
+        let mut ws = arrays
+            .attach(store.workspace())
+            .with_fast_vectors(&mut spare);
+        let mut ps = init.clone();
+        ps.noise = thermal.then(|| hydrorattle::Noise::new(3));
+        let (res, n) = count(|| {
+            for _ in 0..2 {
+                step(&mut ps, &bonds, &p, &mut ws, &mut NoForce)?;
+            }
+            Ok::<_, StepError>(())
+        });
+        let tag = format!("{method:?}, thermal {thermal}");
+        res.unwrap_or_else(|e| panic!("{tag}: {e}"));
+        assert_eq!(n, 0, "{tag}: {n} allocator calls in 2 steps");
+        assert!(ps.time > init.time, "{tag}");
+    }
+}
