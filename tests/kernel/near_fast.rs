@@ -16,8 +16,7 @@
 #![cfg(all(feature = "near", feature = "fast-free"))]
 
 use crate::common;
-use crate::near_iter::{RHO1, U0, cluster, relative_gap};
-use crate::stokesian::stimson_jeffery;
+use crate::near_iter::{Out, cluster, falls_as_exact, relative_gap};
 
 use common::*;
 use hydrorattle::integrate::{fast_storage, fast_vectors};
@@ -27,9 +26,6 @@ use hydrorattle::{
     SolverKind, StepError, StepReport, step,
 };
 use hydrorattle_heap::{Buffers, FreeBuffers};
-
-/// Positions, velocities and spins after a step.
-type Out = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>);
 
 /// The iterative near field with rotation; its far field the fast free-space product
 /// at tolerance `fast`, else the assembled grand mobility.
@@ -184,19 +180,10 @@ fn serves_every_method<T: Real>() {
 }
 
 /// Two equal spheres at `s = 2.1` on the fast far field (`1e-4` and `1e-8`; f32 at
-/// `1e-4`, the finest its precision reaches): along
-/// their line of centres at Stimson and Jeffery's exact speed, side by side at 1.3917
-/// `U0` (within 0.5 %), spinning at 0.137 `U0 / a` (within 2 %), as `near_iter.rs`
-/// checks the assembled far field.
+/// `1e-4`, the finest its precision reaches): along their line of centres at Stimson
+/// and Jeffery's exact speed, side by side at 1.3917 `U0` (within 0.5 %), spinning at
+/// 0.137 `U0 / a` (within 2 %), as `near_iter.rs` checks the assembled far field.
 fn pair_falls<T: Real>() {
-    let pair = |axis: [f64; 3]| {
-        let d = scale(axis, 1.05);
-        [-1.0, 1.0].map(|s| Sphere {
-            pos: scale(d, s),
-            radius: 1.0,
-            density: RHO1,
-        })
-    };
     let tols: &[f64] = match is_single::<T>() {
         true => &[1e-4],
         false => &[1e-4, 1e-8],
@@ -204,20 +191,8 @@ fn pair_falls<T: Real>() {
     for &tol in tols {
         for method in [Method::Overdamped, Method::Overdamped2] {
             let p = near::<T>(method, Some(tol));
-            let (r, (_, v, _)) = one_step::<T>(&p, &pair([0.0, 0.0, 1.0]), &[], None).unwrap();
-            assert_eq!(r.near_pairs, 1);
-            let want = stimson_jeffery(2.1) * U0;
-            for vi in &v {
-                let e = (-vi[2] / want - 1.0).abs();
-                assert!(e < 5e-3, "{tol:e} {method:?} along: {} U0", -vi[2] / U0);
-            }
-            let (_, (_, v, w)) = one_step::<T>(&p, &pair([1.0, 0.0, 0.0]), &[], None).unwrap();
-            for (vi, wi) in v.iter().zip(&w) {
-                let e = (-vi[2] / (1.3917 * U0) - 1.0).abs();
-                assert!(e < 5e-3, "{tol:e} {method:?} across: {} U0", -vi[2] / U0);
-                let e = (norm(*wi) / (0.137 * U0) - 1.0).abs();
-                assert!(e < 0.02, "{tol:e} {method:?} spin: {} U0", norm(*wi) / U0);
-            }
+            let one = |p: &_, s: &[Sphere]| one_step::<T>(p, s, &[], None).unwrap();
+            falls_as_exact(&p, &format!("{tol:e} {method:?}"), one);
         }
     }
 }
@@ -280,21 +255,10 @@ fn refusals<T: Real>() {
     }
 }
 
-macro_rules! both {
-    ($($name:ident),*) => {
-        $(mod $name {
-            #[test]
-            fn f32() { super::$name::<f32>() }
-            #[test]
-            fn f64() { super::$name::<f64>() }
-        })*
-    };
+crate::both_precisions! {
+    matches_assembled => matches_assembled;
+    serves_every_method => serves_every_method;
+    pair_falls => pair_falls;
+    storage_is_linear => storage_is_linear;
+    refusals => refusals;
 }
-
-both!(
-    matches_assembled,
-    serves_every_method,
-    pair_falls,
-    storage_is_linear,
-    refusals
-);

@@ -28,7 +28,7 @@ pub(crate) const U0: f64 = 1.0 / (6.0 * PI);
 pub(crate) const RHO1: f64 = 3.0 / (4.0 * PI);
 
 /// Positions, velocities and spins after a step.
-type Out = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>);
+pub(crate) type Out = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>);
 
 /// Near-field parameters with the defaults and rotation; iterative when `iterative`; in
 /// the cubic box of edge `l` if given.
@@ -181,6 +181,20 @@ fn matches_dense<T: Real>() {
 /// of centres at Stimson and Jeffery's speed, side by side at 1.3917 `U0` (within
 /// 0.5 %), spinning at 0.137 `U0 / a` (within 2 %), with both overdamped methods.
 fn pair_falls<T: Real>() {
+    for method in [Method::Overdamped, Method::Overdamped2] {
+        let p = near::<T>(method, true, None);
+        let one = |p: &_, s: &[Sphere]| one_step::<T>(p, s, &[]).unwrap();
+        falls_as_exact(&p, &format!("{method:?}"), one);
+    }
+}
+
+/// [`pair_falls`]'s checks of the step `one` of two equal spheres at `s = 2.1` under
+/// `p` (`what` names it): along their line of centres, then side by side.
+pub(crate) fn falls_as_exact<T: Real, P>(
+    p: &P,
+    what: &str,
+    one: impl Fn(&P, &[Sphere]) -> (StepReport<T>, Out),
+) {
     let pair = |axis: [f64; 3]| {
         let d = scale(axis, 1.05);
         [-1.0, 1.0].map(|s| Sphere {
@@ -189,22 +203,19 @@ fn pair_falls<T: Real>() {
             density: RHO1,
         })
     };
-    for method in [Method::Overdamped, Method::Overdamped2] {
-        let p = near::<T>(method, true, None);
-        let (r, (_, v, _)) = one_step::<T>(&p, &pair([0.0, 0.0, 1.0]), &[]).unwrap();
-        assert_eq!(r.near_pairs, 1);
-        let want = stimson_jeffery(2.1) * U0;
-        for vi in &v {
-            let e = (-vi[2] / want - 1.0).abs();
-            assert!(e < 5e-3, "{method:?} along: {} U0", -vi[2] / U0);
-        }
-        let (_, (_, v, w)) = one_step::<T>(&p, &pair([1.0, 0.0, 0.0]), &[]).unwrap();
-        for (vi, wi) in v.iter().zip(&w) {
-            let e = (-vi[2] / (1.3917 * U0) - 1.0).abs();
-            assert!(e < 5e-3, "{method:?} across: {} U0", -vi[2] / U0);
-            let e = (norm(*wi) / (0.137 * U0) - 1.0).abs();
-            assert!(e < 0.02, "{method:?} spin: {} U0", norm(*wi) / U0);
-        }
+    let (r, (_, v, _)) = one(p, &pair([0.0, 0.0, 1.0]));
+    assert_eq!(r.near_pairs, 1, "{what}");
+    let want = stimson_jeffery(2.1) * U0;
+    for vi in &v {
+        let e = (-vi[2] / want - 1.0).abs();
+        assert!(e < 5e-3, "{what} along: {} U0", -vi[2] / U0);
+    }
+    let (_, (_, v, w)) = one(p, &pair([1.0, 0.0, 0.0]));
+    for (vi, wi) in v.iter().zip(&w) {
+        let e = (-vi[2] / (1.3917 * U0) - 1.0).abs();
+        assert!(e < 5e-3, "{what} across: {} U0", -vi[2] / U0);
+        let e = (norm(*wi) / (0.137 * U0) - 1.0).abs();
+        assert!(e < 0.02, "{what} spin: {} U0", norm(*wi) / U0);
     }
 }
 
