@@ -216,10 +216,9 @@ pub(super) fn far_metric<'a, T: Real>(
     (grad, scale): (&'a [T::V3], T),
     par: &'a dyn Parallel,
 ) -> Metric<'a, T> {
-    let (pos, radius) = spheres;
     match far {
         FarField::Packed(packed) => Metric::Mobility {
-            mu: Mob::Full(&packed[..tri(pos.len())]),
+            mu: Mob::Full(&packed[..tri(spheres.0.len())]),
             grad,
             scale,
             par,
@@ -231,8 +230,8 @@ pub(super) fn far_metric<'a, T: Real>(
                 crate::mobility::Hydro::Rpy,
                 eta,
             )),
-            pos,
-            radius,
+            pos: spheres.0,
+            radius: spheres.1,
             grad,
             scale,
             par,
