@@ -51,11 +51,7 @@ type Stepped = (StepReport<f64>, Vec<V>);
 
 /// One step of `p` from `pos0`: CPU seconds, the report and the velocities (or the
 /// step's error), the storage in bytes.
-fn one(
-    p: &Params<f64>,
-    pos0: &[V],
-    rad: &[f64],
-) -> (f64, Result<Stepped, String>, usize) {
+fn one(p: &Params<f64>, pos0: &[V], rad: &[f64]) -> (f64, Result<Stepped, String>, usize) {
     let n = pos0.len();
     let density = vec![RHO1; n];
     let layout = Layout::for_params(p, n, 0);
