@@ -48,6 +48,24 @@ pub trait FastProduct<T: Real> {
         ))
     }
 
+    /// `out = M_grand ft`: the grand mobility (translations and rotations) applied to
+    /// the `2n` forces then torques `ft`, velocities then spins into `out`: the far
+    /// field of the iterative near field (`integrate/near_iter/solve.rs`). Only
+    /// products that carry rotation give it (the fast free-space product's parameters
+    /// for the grand product); the rest refuse.
+    fn grand(
+        &self,
+        eta: T,
+        spheres: (&[T::V3], &[T]),
+        ft: &[T::V3],
+        out: &mut [T::V3],
+    ) -> Result<(), StepError> {
+        let _ = (eta, spheres, ft, out);
+        Err(StepError::Unsupported(
+            "the grand product of a fast product without rotation (its rt and rr products are not built)",
+        ))
+    }
+
     /// `out` = a Brownian displacement of covariance `M` by the sums' own noise
     /// (PSE's [`Pse::noise_in`](crate::mobility::pse::Pse::noise_in): the real part by Lanczos to `s` from the deviates `z`,
     /// the wave part from white noise on the grid), drawn from `rng`; `basis` and

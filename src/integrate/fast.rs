@@ -15,7 +15,9 @@ use crate::real::Real;
 /// at the RPY level), from the parameters the step derives for this cloud; `None` where
 /// it needs none. A host sizes its arrays with it before the first step; as the cloud
 /// moves, the step keeps within them (the module's documentation), so sizing from the
-/// first configuration is enough. With [`Params::rotation`] it is the grand product's
+/// first configuration is enough. With [`Params::rotation`], or the iterative near field
+/// ([`Params::near`] with [`Params::matrix_free`], whose far field is the grand product),
+/// it is the grand product's
 /// ([`FreeFast::storage_grand`](crate::mobility::free_fast::FreeFast::storage_grand)), and the step needs [`fast_vectors`] vectors too.
 pub fn fast_storage<T: Real>(
     p: &Params<T>,
@@ -27,8 +29,8 @@ pub fn fast_storage<T: Real>(
             if pos.len() != radius.len() {
                 return Err(StepError::StateLength);
             }
-            let fast = params((tol, p.rotation), pos, radius, [usize::MAX; 2])?;
-            Ok(Some(match p.rotation {
+            let fast = params((tol, grand(p)), pos, radius, [usize::MAX; 2])?;
+            Ok(Some(match grand(p) {
                 true => fast.storage_grand(pos.len()),
                 false => fast.storage(pos.len()),
             }))
@@ -57,10 +59,11 @@ pub fn fast_parameters<T: Real>(
 
 /// The vectors a fast free-space step of `n` spheres with `p` needs besides
 /// [`fast_storage`] ([`Workspace::with_fast_vectors`](crate::Workspace::with_fast_vectors)):
-/// `2 n` with [`Params::rotation`] (the grand product's zero torques and its discarded
-/// velocities, for the spins `W = M_rt F`), else none.
+/// `2 n` with the grand product ([`Params::rotation`], or the iterative near field: the
+/// grand product's zero torques and its discarded velocities, for the spins
+/// `W = M_rt F`), else none.
 pub fn fast_vectors<T: Real>(p: &Params<T>, n: usize) -> usize {
-    match takes_fast(p) && p.rotation {
+    match takes_fast(p) && grand(p) {
         true => 2 * n,
         false => 0,
     }
@@ -74,4 +77,11 @@ pub(super) fn takes_fast<T: Real>(p: &Params<T>) -> bool {
         && place.cell().is_none()
         && place.surfaces().is_empty()
         && p.hydro != crate::mobility::Hydro::FreeDraining
+}
+
+/// Whether a fast free-space step takes the grand product: for the spins
+/// ([`Params::rotation`]), or as the iterative near field's far field ([`Params::near`]
+/// with [`Params::matrix_free`], `near_iter/solve.rs`).
+pub(super) const fn grand<T: Real>(p: &Params<T>) -> bool {
+    p.rotation || (p.near_on() && p.matrix_free)
 }

@@ -83,12 +83,15 @@ pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(
 }
 
 /// The iterative near field's refusals ([`Params::matrix_free`], `near_iter.rs`): what
-/// needs `M_SD`'s blocks or a product the iterative path does not have.
+/// needs `M_SD`'s blocks or a product the iterative path does not have. Its far field
+/// is the assembled grand mobility, or in free space with [`Params::pse`] the fast
+/// free-space product's grand product (`near_iter/solve.rs`); PSE in a box has no
+/// grand product.
 fn check_iterative<T: Real>(p: &Params<T>) -> Result<(), StepError> {
     let refuse = |what| Err(StepError::Unsupported(what));
-    if p.pse.is_some() {
+    if p.pse.is_some() && p.place().cell().is_some() {
         return refuse(
-            "the iterative near field with PSE or the fast free-space product: its far field is the assembled grand mobility (pse = None)",
+            "the iterative near field with PSE in a box: its far field needs the grand mobility's rotation products (pse = None)",
         );
     }
     Ok(())

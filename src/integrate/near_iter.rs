@@ -6,7 +6,10 @@
 //! applied about twenty times: the box has no matrix-free product of the rotation
 //! blocks the near field couples to, and one assembly (each pair's four blocks in one
 //! pass of the Ewald sums, 1.6 to 1.9 times the RPY step's `mu_tt` assembly) with cheap
-//! products costs less than twenty matrix-free products (`docs/NEAR.md`).
+//! products costs less than twenty matrix-free products (`docs/NEAR.md`). In free space
+//! with [`Params::pse`] the far field is instead the fast free-space product's grand
+//! product, matrix-free, and no `tri(2n)` blocks are stored (`near_iter/solve.rs`, where
+//! the far field is chosen).
 //!
 //! Served: `Overdamped` (one product, at the start) and `Overdamped2` (two, at the
 //! start and at the predicted point), and `Overdamped` with thermal noise
@@ -44,7 +47,7 @@ pub(super) use noise::overdamped_thermal;
 
 /// The iterative near field's storage ([`Views::near`] and `Views::near_iter`).
 struct Store<'a, T: Real> {
-    /// The far field's packed grand mobility.
+    /// The far field's packed grand mobility (empty where the far field is a product).
     packed: &'a mut [T::M3],
     /// The close pairs' factors, preconditioner blocks and Krylov vectors.
     reals: &'a mut [T],

@@ -47,6 +47,19 @@ pub(crate) const fn near_iterative<T: Real>(p: &Params<T>) -> bool {
     p.near_on() && p.matrix_free
 }
 
+/// Whether the iterative near field's far field is a matrix-free grand product (the
+/// fast free-space product's: [`Params::pse`] in free space, kernel feature
+/// `fast-free`), so that no packed grand mobility is stored
+/// (`integrate::near_iter::solve`).
+pub(crate) const fn near_far_product<T: Real>(p: &Params<T>) -> bool {
+    let place = p.place();
+    cfg!(feature = "fast-free")
+        && near_iterative(p)
+        && p.pse.is_some()
+        && place.cell().is_none()
+        && place.surfaces().is_empty()
+}
+
 /// Scalars one close pair of the iterative near field takes: its factor, its
 /// preconditioner's block and five Krylov vectors (`stokesian::iterative::sizes`).
 const NEAR_PAIR_SCALARS: usize = 2 * 144 + 5 * 12;
@@ -54,14 +67,15 @@ const NEAR_PAIR_SCALARS: usize = 2 * 144 + 5 * 12;
 /// The iterative near field's storage for `n` spheres, room for
 /// [`NEAR_PAIRS_PER_SPHERE`](crate::params::NEAR_PAIRS_PER_SPHERE) close pairs a sphere:
 /// `[blocks, vectors, scalars, indices]`. The far field's packed grand mobility
-/// (`tri(2n)` blocks, assembled once a mobility), the product's force-torque and
+/// (`tri(2n)` blocks, assembled once a mobility; none where `packed` is false, the far
+/// field a matrix-free product: [`near_far_product`]), the product's force-torque and
 /// velocity-spin vectors and its own `6n` vectors, the pairs' scalars, and the pairs'
 /// indices with the pair search's cell list (`3n + 1`); with `constraints` a scalar
 /// each, their squeeze resistances (`integrate::near_iter::constrained`).
-pub(crate) const fn near_iterative_sizes(n: usize, constraints: usize) -> [usize; 4] {
+pub(crate) const fn near_iterative_sizes(n: usize, constraints: usize, packed: bool) -> [usize; 4] {
     let pairs = crate::params::NEAR_PAIRS_PER_SPHERE * n;
     [
-        tri(2 * n),
+        if packed { tri(2 * n) } else { 0 },
         10 * n,
         NEAR_PAIR_SCALARS * pairs + constraints,
         2 * pairs + 3 * n + 1,
@@ -233,7 +247,8 @@ impl Layout {
         // or the far-field grand mobility's packed blocks and the dense `6n x 6n`
         // mobility formed from them (`stokesian::storage`).
         let l = if near_iterative(p) {
-            let [blocks, vectors, scalars, indices] = near_iterative_sizes(n, c);
+            let [blocks, vectors, scalars, indices] =
+                near_iterative_sizes(n, c, !near_far_product(p));
             let [noise_vectors, noise_scalars] = near_noise_sizes(p, n);
             // `Overdamped2` stores no mobility here either: its two are products.
             let unstored = match p.method {

@@ -228,7 +228,8 @@ impl<T: Real> Workspace<'_, T> {
         let [noise_v, noise_s] = super::layout::near_noise_sizes(p, n);
         let near = match p.near_on() {
             true if iterative => {
-                let [b, _, s, _] = super::layout::near_iterative_sizes(n, nb);
+                let [b, _, s, _] =
+                    super::layout::near_iterative_sizes(n, nb, !super::layout::near_far_product(p));
                 (bl.take(b), sc.take(s + noise_s))
             }
             true => (
@@ -239,7 +240,8 @@ impl<T: Real> Workspace<'_, T> {
         };
         let near_iter = match iterative {
             true => {
-                let [_, v, _, i] = super::layout::near_iterative_sizes(n, nb);
+                let [_, v, _, i] =
+                    super::layout::near_iterative_sizes(n, nb, !super::layout::near_far_product(p));
                 (ve.take(v + noise_v), ix.take(i))
             }
             false => (ve.take(0), ix.take(0)),

@@ -245,7 +245,9 @@ fn every_step_method_allocates_nothing_f32() {
 }
 
 /// The iterative near field (`Params::near` with `Params::matrix_free`) with bonds: in
-/// `Overdamped2` (Krylov, with contacts, Newton) and at temperature, no heap.
+/// `Overdamped2` (Krylov, with contacts, Newton) and at temperature, no heap; and on
+/// the fast free-space product's grand product (`Params::pse` in free space, the fast
+/// arrays the caller's) in `Overdamped`, `Overdamped2` and at temperature.
 #[cfg(feature = "near")]
 #[test]
 fn iterative_near_field_with_bonds_allocates_nothing() {
@@ -253,23 +255,45 @@ fn iterative_near_field_with_bonds_allocates_nothing() {
     const B: usize = N - 1;
     let init = chain::<f64, N>();
     let bonds = BondSet::<f64, B>::chain(&init.pos[..N]).unwrap();
-    let cases = [
-        (Method::Overdamped2, SolverKind::Krylov, false, false),
-        (Method::Overdamped2, SolverKind::Krylov, true, false),
-        (Method::Overdamped2, SolverKind::Newton, false, false),
-        (Method::Overdamped, SolverKind::Krylov, false, true),
+    let mut cases = vec![
+        (Method::Overdamped2, SolverKind::Krylov, false, false, None),
+        (Method::Overdamped2, SolverKind::Krylov, true, false, None),
+        (Method::Overdamped2, SolverKind::Newton, false, false, None),
+        (Method::Overdamped, SolverKind::Krylov, false, true, None),
     ];
-    for (method, kind, contacts, thermal) in cases {
+    if cfg!(feature = "fast-free") {
+        let fast = Some(1e-6);
+        cases.extend([
+            (Method::Overdamped, SolverKind::Krylov, false, false, fast),
+            (Method::Overdamped2, SolverKind::Krylov, false, false, fast),
+            (Method::Overdamped, SolverKind::Krylov, false, true, fast),
+        ]);
+    }
+    for (method, kind, contacts, thermal, fast) in cases {
         let mut p = Params::new(0.01);
         p.method = method;
         p.solver.kind = kind;
         p.rotation = true;
         p.matrix_free = true;
+        p.pse = fast;
         p.near = Some(hydrorattle::stokesian::NearField::default());
         p.contacts = contacts.then(|| hydrorattle::Contacts::new(16));
         p.brownian = thermal.then(|| hydrorattle::Brownian::new(1e-3));
         let layout = hydrorattle::Layout::for_params(&p, N, B);
         let mut store = hydrorattle_heap::Buffers::<f64>::new(layout);
+        // The fast product's arrays, where the step takes it (empty otherwise).
+        #[cfg(feature = "fast-free")]
+        let (mut arrays, mut spare) = {
+            use hydrorattle::integrate::{fast_storage, fast_vectors};
+            let size = fast_storage(&p, &init.pos[..N], &init.radius[..N]).unwrap();
+            let spare = vec![<f64 as Real>::V3_ZERO; fast_vectors(&p, N)];
+            (hydrorattle_heap::FreeBuffers::<f64>::for_step(size), spare)
+        };
+        #[cfg(feature = "fast-free")]
+        let mut ws = arrays
+            .attach(store.workspace())
+            .with_fast_vectors(&mut spare);
+        #[cfg(not(feature = "fast-free"))]
         let mut ws = store.workspace();
         let mut ps = init.clone();
         // The generator a thermal step draws from (the others ignore it).
@@ -280,7 +304,8 @@ fn iterative_near_field_with_bonds_allocates_nothing() {
             }
             Ok::<_, StepError>(())
         });
-        let tag = format!("{method:?}, {kind:?}, contacts {contacts}, thermal {thermal}");
+        let tag =
+            format!("{method:?}, {kind:?}, contacts {contacts}, thermal {thermal}, fast {fast:?}");
         res.unwrap_or_else(|e| panic!("{tag}: {e}"));
         assert_eq!(n, 0, "{tag}: {n} allocator calls in 2 steps");
         assert!(ps.time > init.time, "{tag}");

@@ -62,6 +62,8 @@ mod near_con;
 mod near_con_brownian;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod near_contacts;
+#[cfg(all(feature = "near", feature = "fast-free"))]
+mod near_fast;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod near_iter;
 mod near_iter_brownian;

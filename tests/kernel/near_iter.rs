@@ -23,12 +23,12 @@ use hydrorattle::{
 use hydrorattle_heap::Buffers;
 
 /// Stokes' speed of the unit sphere of unit buoyant weight in the unit fluid.
-const U0: f64 = 1.0 / (6.0 * PI);
+pub(crate) const U0: f64 = 1.0 / (6.0 * PI);
 /// Density of unit buoyant weight for a unit sphere (`g = 1`).
-const RHO1: f64 = 3.0 / (4.0 * PI);
+pub(crate) const RHO1: f64 = 3.0 / (4.0 * PI);
 
 /// Positions, velocities and spins after a step.
-type Out = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>);
+pub(crate) type Out = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>);
 
 /// Near-field parameters with the defaults and rotation; iterative when `iterative`; in
 /// the cubic box of edge `l` if given.
@@ -77,7 +77,7 @@ fn one_step<T: Real>(
 /// A branched cluster of `n` spheres (radii 0.8 to 1.5, densities 0.5 to 2 times
 /// `RHO1`), each new sphere at a gap of 0.005 to 0.6 mean radii from a random earlier
 /// one and clear of all (by the minimum image in the box of edge `l`), about `c`.
-fn cluster(n: usize, seed: u64, l: Option<f64>, c: [f64; 3]) -> Vec<Sphere> {
+pub(crate) fn cluster(n: usize, seed: u64, l: Option<f64>, c: [f64; 3]) -> Vec<Sphere> {
     let mut state = seed
         .wrapping_mul(6364136223846793005)
         .wrapping_add(1442695040888963407);
@@ -124,7 +124,7 @@ fn cluster(n: usize, seed: u64, l: Option<f64>, c: [f64; 3]) -> Vec<Sphere> {
 }
 
 /// Largest difference of `a` from `b` over the largest of `b`.
-fn relative_gap(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+pub(crate) fn relative_gap(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     let big = b.iter().map(|v| norm(*v)).fold(0.0, f64::max);
     let diff = a
         .iter()
@@ -181,6 +181,20 @@ fn matches_dense<T: Real>() {
 /// of centres at Stimson and Jeffery's speed, side by side at 1.3917 `U0` (within
 /// 0.5 %), spinning at 0.137 `U0 / a` (within 2 %), with both overdamped methods.
 fn pair_falls<T: Real>() {
+    for method in [Method::Overdamped, Method::Overdamped2] {
+        let p = near::<T>(method, true, None);
+        let one = |p: &_, s: &[Sphere]| one_step::<T>(p, s, &[]).unwrap();
+        falls_as_exact(&p, &format!("{method:?}"), one);
+    }
+}
+
+/// [`pair_falls`]'s checks of the step `one` of two equal spheres at `s = 2.1` under
+/// `p` (`what` names it): along their line of centres, then side by side.
+pub(crate) fn falls_as_exact<T: Real, P>(
+    p: &P,
+    what: &str,
+    one: impl Fn(&P, &[Sphere]) -> (StepReport<T>, Out),
+) {
     let pair = |axis: [f64; 3]| {
         let d = scale(axis, 1.05);
         [-1.0, 1.0].map(|s| Sphere {
@@ -189,22 +203,19 @@ fn pair_falls<T: Real>() {
             density: RHO1,
         })
     };
-    for method in [Method::Overdamped, Method::Overdamped2] {
-        let p = near::<T>(method, true, None);
-        let (r, (_, v, _)) = one_step::<T>(&p, &pair([0.0, 0.0, 1.0]), &[]).unwrap();
-        assert_eq!(r.near_pairs, 1);
-        let want = stimson_jeffery(2.1) * U0;
-        for vi in &v {
-            let e = (-vi[2] / want - 1.0).abs();
-            assert!(e < 5e-3, "{method:?} along: {} U0", -vi[2] / U0);
-        }
-        let (_, (_, v, w)) = one_step::<T>(&p, &pair([1.0, 0.0, 0.0]), &[]).unwrap();
-        for (vi, wi) in v.iter().zip(&w) {
-            let e = (-vi[2] / (1.3917 * U0) - 1.0).abs();
-            assert!(e < 5e-3, "{method:?} across: {} U0", -vi[2] / U0);
-            let e = (norm(*wi) / (0.137 * U0) - 1.0).abs();
-            assert!(e < 0.02, "{method:?} spin: {} U0", norm(*wi) / U0);
-        }
+    let (r, (_, v, _)) = one(p, &pair([0.0, 0.0, 1.0]));
+    assert_eq!(r.near_pairs, 1, "{what}");
+    let want = stimson_jeffery(2.1) * U0;
+    for vi in &v {
+        let e = (-vi[2] / want - 1.0).abs();
+        assert!(e < 5e-3, "{what} along: {} U0", -vi[2] / U0);
+    }
+    let (_, (_, v, w)) = one(p, &pair([1.0, 0.0, 0.0]));
+    for (vi, wi) in v.iter().zip(&w) {
+        let e = (-vi[2] / (1.3917 * U0) - 1.0).abs();
+        assert!(e < 5e-3, "{what} across: {} U0", -vi[2] / U0);
+        let e = (norm(*wi) / (0.137 * U0) - 1.0).abs();
+        assert!(e < 0.02, "{what} spin: {} U0", norm(*wi) / U0);
     }
 }
 
@@ -228,7 +239,8 @@ fn same_bits<T: Real>() {
     assert_eq!(run(), run());
 }
 
-/// Refused, typed, the state unchanged: what the iterative path does not serve (PSE;
+/// Refused, typed, the state unchanged: what the iterative path does not serve (PSE in
+/// a box;
 /// the wall's hydrodynamics, refused before, now stepped), the conjugate gradients
 /// stopped before they converge, and more close pairs than the storage holds (its
 /// Brownian steps: `near_iter_brownian.rs`).
@@ -261,9 +273,10 @@ fn refusals<T: Real>() {
     p.wall = Some(Wall::new(T::from_f64(-40.0)));
     let (r, _) = one_step::<T>(&p, &spheres, &[]).unwrap();
     assert!(r.near_products >= 1, "{r:?}");
+    // PSE in a box (free space's fast product is served: `near_fast.rs`).
     let mut p = base;
     p.pse = Some(1e-3);
-    // (The fast free-space product refuses rotation first.)
+    p.periodic = Some(Periodic::new([T::from_f64(60.0); 3]).unwrap());
     p.rotation = false;
     unsupported(&p, &[], "PSE");
     // One iteration cannot solve twenty coupled spheres.

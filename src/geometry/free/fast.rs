@@ -222,6 +222,30 @@ impl<T: Real> FastProduct<T> for FastStep<'_, T> {
             .apply_grand(eta, spheres, f, torque, vel, out, &mut store)?)
     }
 
+    /// `(U, W) = M (F, T)` over the `2n` vectors: the grand product itself (no spare
+    /// vectors: the caller's `ft` and `out` hold both halves).
+    fn grand(
+        &self,
+        eta: T,
+        spheres: (&[T::V3], &[T]),
+        ft: &[T::V3],
+        out: &mut [T::V3],
+    ) -> Result<(), StepError> {
+        let mut store = self.store.try_borrow_mut().map_err(|_| {
+            StepError::Unsupported("a fast free-space product inside another (storage in use)")
+        })?;
+        let n = spheres.0.len();
+        let (Some((f, t)), Some((u, w))) = (
+            ft.get(..2 * n).map(|v| v.split_at(n)),
+            out.get_mut(..2 * n).map(|v| v.split_at_mut(n)),
+        ) else {
+            return Err(StepError::StateLength);
+        };
+        Ok(self
+            .fast
+            .apply_grand(eta, spheres, f, t, u, w, &mut store)?)
+    }
+
     /// Lanczos on the fast product, as the matrix-free path draws in free space: the
     /// deviates `z` from `rng`, then `out = M^(1/2) z`. Free space's RPY mobility is
     /// divergence-free, so nothing else is drawn.

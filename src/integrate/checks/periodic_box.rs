@@ -197,7 +197,8 @@ fn fast_sums<T: Real>(
             "the fast free-space product with Hydro::Oseen (it is RPY's)",
         ));
     }
-    // Rotation is served: the spins come from the grand product (`geometry/free/fast.rs`).
+    // Rotation is served: the spins come from the grand product (`geometry/free/fast.rs`),
+    // as does the iterative near field's far field (`integrate/near_iter/solve.rs`).
     let unrotated = Params {
         rotation: false,
         ..*p
@@ -206,7 +207,7 @@ fn fast_sums<T: Real>(
     #[cfg(feature = "fast-free")]
     return Ok(Some(crate::geometry::Held::Fast(
         crate::geometry::free::fast::params(
-            (tol, p.rotation),
+            (tol, super::super::fast::grand(p)),
             state.pos,
             state.radius,
             [usize::MAX; 2],

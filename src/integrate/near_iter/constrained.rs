@@ -11,7 +11,8 @@
 //! [`crate::constraints::Products`]), and with [`Params::rotation`] the spins of the
 //! total force at the end. The solve's entries (its band preconditioner, its curvature
 //! bound) are read from the far field's translational blocks, the first `n` block rows
-//! of the packed grand mobility assembled for the products: an approximation that
+//! of the packed grand mobility assembled for the products (with a matrix-free far field,
+//! free space's RPY blocks evaluated where they are read: `solve::far_metric`): an approximation that
 //! changes how fast the solve converges, never where it ends, since every move it makes
 //! is a product of `M_SD`. The band lacks the lubrication between bonded beads (their
 //! relative mobility along the bond is several times smaller in `M_SD` than in the far
@@ -35,7 +36,7 @@
 //! [`StepError::NoConvergence`] at [`Stage::Mobility`](crate::Stage::Mobility), the
 //! caller's state unchanged.
 
-use super::solve::{self, At};
+use super::solve::{self, At, FarField, far_metric};
 use super::{Counts, Store, spins};
 use crate::bonds::Bond;
 use crate::constraints::{
@@ -48,7 +49,6 @@ use crate::integrate::{
     Start, StepReport, Sums, add_constraint_forces, add_flow, bond_vectors, cell, check_resolved,
     report, step_velocity,
 };
-use crate::linalg::{Mob, tri};
 use crate::params::Params;
 use crate::real::Real;
 use crate::workspace::Views;
@@ -95,7 +95,8 @@ impl<T: Real> Products<T> for Sd<'_, '_, T> {
 /// projection of `Overdamped2` ([`Iterative::velocities`]) the same way.
 pub(super) struct Iterative<'a, 's, T: Real> {
     pub(super) sd: Sd<'a, 's, T>,
-    pub(super) packed: &'s [T::M3],
+    /// The far field at the products' configuration: the solve's entries.
+    pub(super) far: FarField<'s, T>,
     /// Where the products are: the squeeze resistances' configuration, and the
     /// step's sums.
     pub(super) spheres: (&'a [T::V3], &'a [T]),
@@ -145,7 +146,7 @@ impl<'a, 's, T: Real> Iterative<'a, 's, T> {
         table: &'a mut [T::V3],
     ) -> Self {
         Self {
-            packed: at.packed(),
+            far: at.far_field(),
             sd: Sd {
                 at,
                 p,
@@ -174,13 +175,7 @@ impl<'a, 's, T: Real> Iterative<'a, 's, T> {
         scratch: &mut Scratch<'_, T>,
     ) -> Result<SolveStats<T>, StepError> {
         let n = x.len();
-        let far = Metric::Mobility {
-            mu: Mob::Full(&self.packed[..tri(n)]),
-            grad,
-            scale,
-            par: scratch.par,
-            compact: None,
-        };
+        let far = far_metric(self.far, self.spheres, (grad, scale), scratch.par);
         lambda.fill(T::ZERO);
         if p.solver.kind == SolverKind::Krylov {
             for ((k, b), &g) in self.sd.stiff.iter_mut().zip(rows).zip(grad) {
@@ -356,7 +351,7 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
     // The far field at the start, and the close pairs factored once.
     solve::at(p, s.ewald, (s.pos, s.radius), &mut store, |at| {
-        let packed = at.packed();
+        let far = at.far_field();
         let mut counts = Counts::default();
         let sd = Sd {
             at,
@@ -375,7 +370,7 @@ pub(in crate::integrate) fn overdamped<T: Real, E: ExternalForce<T>>(
         // The projection: entries from the far field's `mu_tt`, moves from `M_SD`.
         let mut along = Iterative {
             sd,
-            packed,
+            far,
             spheres: (s.pos, s.radius),
             ewald: s.ewald,
             table: disp,

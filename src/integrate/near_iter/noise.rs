@@ -109,8 +109,21 @@ pub(in crate::integrate) fn overdamped_thermal<T: Real, E: ExternalForce<T>>(
             None
         };
         at.velocities(p, force, u, w, &mut counts)?;
-        let product = |v: &[T::V3], w: &mut [T::V3]| at.far(v, w);
-        let root_it = lanczos::sqrt(p.lanczos, product, z, basis, work, root, Some(&mut *f))?;
+        // The far field's products, the first failure kept (Lanczos's product is
+        // infallible; the assembled far field's never fails).
+        let mut failed = None;
+        let product = |v: &[T::V3], w: &mut [T::V3]| {
+            if failed.is_none()
+                && let Err(e) = at.far(v, w)
+            {
+                failed = Some(e);
+            }
+        };
+        let root_it = lanczos::sqrt(p.lanczos, product, z, basis, work, root, Some(&mut *f));
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        let root_it = root_it?;
         at.add_near_noise(&mut |v| noise.fill::<T>(v), f)?;
         at.apply(p, f, x, &mut counts)?;
         Ok(root_it)

@@ -1,27 +1,98 @@
-//! One configuration of the iterative near field: the far field's grand mobility
-//! assembled and the close pairs found and factored once, then every product the step
-//! needs there (the velocities, and in a Brownian step the noise's solve and the far
-//! field's products its Lanczos root takes).
+//! One configuration of the iterative near field: the far field made ready and the close
+//! pairs found and factored once, then every product the step needs there (the
+//! velocities, and in a Brownian step the noise's solve and the far field's products its
+//! Lanczos root takes).
+//!
+//! **The far field** ([`FarField`], chosen in [`far_field`], the one place a far field is
+//! picked): the grand mobility assembled into the store's packed blocks (`tri(2n)`,
+//! Ewald's sums in a box, the wall's images above it, free space's RPY), or, with the
+//! fast free-space product ([`Params::pse`] in free space), its matrix-free grand
+//! product (`FastProduct::grand`, `O(n log n)` a product, no `tri(2n)` storage). A box
+//! with a grand product of its own (PSE's) would be a third case in [`far_field`], its
+//! products the same variant.
 
 use super::{Counts, STORAGE, Store, error, tri2};
+use crate::constraints::Metric;
 use crate::error::StepError;
+#[cfg(feature = "fast-free")]
+use crate::geometry::fast::FastProduct;
+use crate::linalg::{Mob, tri};
+use crate::parallel::Parallel;
 use crate::params::{NEAR_PAIRS_PER_SPHERE, Params};
 use crate::real::Real;
+use crate::stokesian::SdError;
 use crate::stokesian::iterative::{Solver, Storage, packed_product};
 
 use super::super::Sums;
 
+/// The far field the near field's products read at one configuration.
+#[derive(Clone, Copy)]
+pub(super) enum FarField<'s, T: Real> {
+    /// The packed grand mobility assembled at the configuration (`tri(2n)` blocks).
+    Packed(&'s [T::M3]),
+    /// A matrix-free grand product at the configuration's spheres (viscosity `eta`).
+    #[cfg(feature = "fast-free")]
+    Product {
+        /// The step's fast product.
+        fast: &'s dyn FastProduct<T>,
+        /// Where it is taken: centres and radii.
+        spheres: (&'s [T::V3], &'s [T]),
+        /// The viscosity.
+        eta: T,
+    },
+}
+
+impl<T: Real> FarField<'_, T> {
+    /// `y = M_far x` over the `2n` forces and torques (velocities and spins out).
+    fn apply(self, n: usize, x: &[T::V3], y: &mut [T::V3]) -> Result<(), SdError> {
+        match self {
+            Self::Packed(packed) => {
+                packed_product::<T>(packed, n, x, y);
+                Ok(())
+            }
+            #[cfg(feature = "fast-free")]
+            Self::Product { fast, spheres, eta } => {
+                fast.grand(eta, spheres, x, y).map_err(SdError::Far)
+            }
+        }
+    }
+}
+
 /// The near field's products at one configuration ([`at`]).
 pub(super) struct At<'s, T: Real> {
     n: usize,
-    packed: &'s [T::M3],
+    far: FarField<'s, T>,
     solver: Solver<'s, T>,
     /// The store's `2n` forces and torques, then `2n` velocities and spins.
     io: &'s mut [T::V3],
 }
 
-/// Runs `body` with the products at `(pos, radius)`: the grand mobility assembled into
-/// the store's packed blocks, the close pairs factored into its reals.
+/// The far field at `(pos, radius)` ([`FarField`]): the step's fast product's grand
+/// product where the step has one in free space, else the grand mobility assembled into
+/// the store's packed blocks.
+fn far_field<'s, T: Real>(
+    p: &Params<T>,
+    ew: Sums<'s, T>,
+    (pos, radius): (&'s [T::V3], &'s [T]),
+    packed: &'s mut [T::M3],
+) -> Result<FarField<'s, T>, StepError> {
+    #[cfg(feature = "fast-free")]
+    if let Some(fast) = ew.and_then(|s| s.pse())
+        && p.place().cell().is_none()
+    {
+        let spheres = (pos, radius);
+        let eta = p.viscosity;
+        return Ok(FarField::Product { fast, spheres, eta });
+    }
+    let far = super::super::near::far(p, ew)?;
+    let packed = packed.get_mut(..tri2(pos.len())).ok_or(STORAGE)?;
+    far.assemble_grand(p.viscosity, pos, radius, packed)
+        .map_err(error)?;
+    Ok(FarField::Packed(packed))
+}
+
+/// Runs `body` with the products at `(pos, radius)`: the far field made ready
+/// ([`far_field`]), the close pairs factored into the store's reals.
 pub(super) fn at<T: Real, R>(
     p: &Params<T>,
     ew: Sums<'_, T>,
@@ -35,10 +106,7 @@ pub(super) fn at<T: Real, R>(
             "the near field's mobility without Params::near",
         ));
     };
-    let far = super::super::near::far(p, ew)?;
-    let packed = store.packed.get_mut(..tri2(n)).ok_or(STORAGE)?;
-    far.assemble_grand(p.viscosity, pos, radius, packed)
-        .map_err(error)?;
+    let far = far_field(p, ew, (pos, radius), &mut *store.packed)?;
     let (io, field) = store.vectors.split_at_mut_checked(4 * n).ok_or(STORAGE)?;
     let cap = NEAR_PAIRS_PER_SPHERE * n;
     let (pairs, cells) = store.indices.split_at_mut_checked(2 * cap).ok_or(STORAGE)?;
@@ -48,19 +116,15 @@ pub(super) fn at<T: Real, R>(
         field,
         cells,
     };
-    let solver = Solver::new(p.viscosity, far, pos, radius, nf, storage).map_err(error)?;
-    body(&mut At {
-        n,
-        packed: &*packed,
-        solver,
-        io,
-    })
+    let geometry = super::super::near::far(p, ew)?;
+    let solver = Solver::new(p.viscosity, geometry, pos, radius, nf, storage).map_err(error)?;
+    body(&mut At { n, far, solver, io })
 }
 
 impl<'s, T: Real> At<'s, T> {
-    /// The far field's packed grand mobility at this configuration.
-    pub(super) fn packed(&self) -> &'s [T::M3] {
-        self.packed
+    /// The far field at this configuration.
+    pub(super) fn far_field(&self) -> FarField<'s, T> {
+        self.far
     }
 
     /// `out = M_SD f` over the `2n` forces and torques (velocities and spins out), to the
@@ -72,11 +136,8 @@ impl<'s, T: Real> At<'s, T> {
         out: &mut [T::V3],
         counts: &mut Counts,
     ) -> Result<(), StepError> {
-        let (n, packed) = (self.n, self.packed);
-        let mut far = |x: &[T::V3], y: &mut [T::V3]| {
-            packed_product::<T>(packed, n, x, y);
-            Ok(())
-        };
+        let (n, field) = (self.n, self.far);
+        let mut far = |x: &[T::V3], y: &mut [T::V3]| field.apply(n, x, y);
         let (tol, cap) = (p.solver.tolerance, p.solver.max_iterations);
         let r = self
             .solver
@@ -130,9 +191,9 @@ impl<'s, T: Real> At<'s, T> {
         done
     }
 
-    /// `y = M_far x` over the `2n` vectors (the packed grand mobility).
-    pub(super) fn far(&self, x: &[T::V3], y: &mut [T::V3]) {
-        packed_product::<T>(self.packed, self.n, x, y);
+    /// `y = M_far x` over the `2n` vectors ([`FarField`]).
+    pub(super) fn far(&self, x: &[T::V3], y: &mut [T::V3]) -> Result<(), StepError> {
+        self.far.apply(self.n, x, y).map_err(error)
     }
 
     /// `b += L z`, the near field's share of the noise ([`Solver::add_near_noise`]).
@@ -142,5 +203,38 @@ impl<'s, T: Real> At<'s, T> {
         b: &mut [T::V3],
     ) -> Result<(), StepError> {
         self.solver.add_near_noise(draw, b).map_err(error)
+    }
+}
+
+/// The constraint solve's entries (its band preconditioner, its curvature bound) from
+/// the far field's `mu_tt` at `spheres`: the packed grand mobility's first `n` block rows,
+/// or, where the far field is a product, each pair block evaluated where it is read (free
+/// space's RPY blocks, which the fast product approximates).
+pub(super) fn far_metric<'a, T: Real>(
+    far: FarField<'a, T>,
+    spheres: (&'a [T::V3], &'a [T]),
+    (grad, scale): (&'a [T::V3], T),
+    par: &'a dyn Parallel,
+) -> Metric<'a, T> {
+    match far {
+        FarField::Packed(packed) => Metric::Mobility {
+            mu: Mob::Full(&packed[..tri(spheres.0.len())]),
+            grad,
+            scale,
+            par,
+            compact: None,
+        },
+        #[cfg(feature = "fast-free")]
+        FarField::Product { eta, .. } => Metric::Free {
+            hydro: crate::geometry::Hydrodynamics::Free(crate::geometry::free::Free::new(
+                crate::mobility::Hydro::Rpy,
+                eta,
+            )),
+            pos: spheres.0,
+            radius: spheres.1,
+            grad,
+            scale,
+            par,
+        },
     }
 }
