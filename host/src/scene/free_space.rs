@@ -14,9 +14,10 @@
 //! and no wall): it gives products only, so the run is matrix-free (written back as
 //! `matrix_free = true`) and the constraints are solved by Krylov. A scene that needs
 //! what it does not give is refused at `method`: a `[wall]` or a `[box]` (their
-//! products are their own), another level than RPY, a `[near_field]`, a
+//! products are their own), another level than RPY, a
 //! method or level that stores the mobility (`matrix_free`'s rule), the Cholesky
-//! factor of the noise. The storage is sized without the mobility (`O(N)`, no `N^2`
+//! factor of the noise. With a `[near_field]` the fast product is the far field of the
+//! near field's iterative product (`docs/NEAR.md`, "On the fast free-space product"). The storage is sized without the mobility (`O(N)`, no `N^2`
 //! term), so a cloud of 10^5 spheres is not refused as dense. `"auto"` picks, when the
 //! run starts, the path a measured cost model says is fastest among those that fit the
 //! storage limit (`scene::free_cost`: the stored mobility, its compact copy,
@@ -149,7 +150,6 @@ fn unsupported(cx: &Context<'_>) -> Option<&'static str> {
         _ if cx.wall.is_some() => {
             "is the free-space product: above a [wall] or in a [slit] the mobility is the walls' (use \"dense\")"
         }
-        _ if cx.near.is_some() => "gives the far field alone: leave out [near_field]",
         _ if m.hydrodynamics != Hydrodynamics::Rpy => {
             "gives the RPY product only: hydrodynamics = \"rpy\""
         }

@@ -66,7 +66,6 @@ fn what_fast_cannot_run_is_refused_at_its_line() {
         ("[wall]\nheight = -30.0", "wall"),
         ("[model]\nhydrodynamics = \"oseen\"", "rpy"),
         ("[model]\nlevel = \"auto\"", "manual"),
-        ("[near_field]", "near_field"),
         (
             "[brownian]\ntemperature = 1.0\nsqrt = \"cholesky\"",
             "cholesky",
@@ -108,6 +107,40 @@ fn fast_runs_rotation_with_the_dense_spins() {
         .fold(0.0, f64::max)
         / big;
     assert!(big > 0.0 && err < 1e-6 && err > 0.0, "{err}");
+}
+
+/// `[near_field]` runs on the fast product (the far field of its iterative product): a
+/// step's velocities within the tolerance of the same scene's on the dense path.
+#[test]
+fn fast_runs_the_near_field_with_the_dense_velocities() {
+    let near = "[near_field]";
+    let run = |free: &str| {
+        let text = format!(
+            "[cloud]\ncount = 60\ncloud_radius = 6.0\n[integrator]\nmethod = \"overdamped\"\n\
+             dt = 0.01\nduration = 0.02\n[free_space]\n{free}\n{near}"
+        );
+        let s = Scene::parse(&text, "c.toml").unwrap();
+        let mut e = Engine::<f64>::new(&s, DEFAULT_LIMIT).unwrap();
+        let before = s.positions();
+        e.step().unwrap();
+        let v: Vec<[f64; 3]> = (0..before.len())
+            .map(|k| std::array::from_fn(|c| e.beads.pos[k][c] - before[k][c]))
+            .collect();
+        (params::<f64>(&s), v)
+    };
+    let (pf, fast) = run("method = \"fast\"\ntolerance = 1e-6");
+    assert!(pf.near.is_some() && pf.pse == Some(1e-6) && pf.matrix_free);
+    let (pd, dense) = run("method = \"dense\"");
+    assert!(pd.near.is_some() && pd.pse.is_none());
+    let len = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let big = dense.iter().map(len).fold(0.0, f64::max);
+    let err = fast
+        .iter()
+        .zip(&dense)
+        .map(|(a, b)| len(&std::array::from_fn(|c| a[c] - b[c])))
+        .fold(0.0, f64::max)
+        / big;
+    assert!(big > 0.0 && err < 1e-5 && err > 0.0, "{err}");
 }
 
 #[test]
