@@ -82,6 +82,8 @@ fn params(method: Method, dt: f64, tol: f64) -> Params<f64> {
     p.method = method;
     p.matrix_free = true;
     p.pse = Some(tol);
+    // Point-like spheres under RPY pass through each other, as the cloud scenes' do.
+    p.allow_overlap = true;
     p
 }
 

@@ -27,6 +27,9 @@ use hydrorattle::{
 };
 use hydrorattle_heap::{Buffers, FreeBuffers, PseBuffers};
 
+/// One vector a sphere.
+type Points = Vec<[f64; 3]>;
+
 /// `steps` steps of `p` from the spheres `s` (the fast products' arrays sized where `p`
 /// takes them); the positions and spins at the end.
 fn run<const M: usize, const B: usize>(
@@ -35,7 +38,7 @@ fn run<const M: usize, const B: usize>(
     p: &Params<f64>,
     ext: &mut impl ExternalForce<f64>,
     steps: usize,
-) -> Result<(Vec<[f64; 3]>, Vec<[f64; 3]>), StepError> {
+) -> Result<(Points, Points), StepError> {
     let mut ps = set::<M>(s);
     let n = s.len();
     let mut buf = Buffers::<f64>::new(Layout::for_params(p, n, bonds.len()));
