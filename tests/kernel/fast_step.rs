@@ -86,7 +86,7 @@ pub(super) fn on(mut p: Params<f64>, tol: Option<f64>) -> Params<f64> {
 }
 
 /// Largest displacement difference over the largest displacement.
-fn relative(start: &[Sphere], a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+pub(super) fn relative(start: &[Sphere], a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     let big = start
         .iter()
         .zip(a)
