@@ -4,7 +4,8 @@
 //! not from the matrix-free code:
 //!
 //! * the same steps on the stored mobility (the dense `Overdamped2`) within rounding
-//!   on the pair products, free and boxed, with and without bonds (every solver), and
+//!   on the pair products (free space, the box and above a wall: the same bits in free
+//!   space and above the wall), with and without bonds (every solver), and
 //!   within the fast products' tolerance on the fast free-space product and PSE;
 //! * the order of the scheme: a small cluster falling through a rotating flow, against
 //!   a fine-step reference, on the fast product: the error falls by about 4 as the step
@@ -24,7 +25,7 @@ use common::*;
 use hydrorattle::integrate::{fast_vectors, pse_storage};
 use hydrorattle::{
     BondSet, Brownian, ExternalForce, Layout, Method, NoForce, Params, ParticleSet, Periodic, Real,
-    SolverKind, StepError, step,
+    SolverKind, StepError, Wall, step,
 };
 use hydrorattle_heap::{Buffers, FreeBuffers, PseBuffers};
 
@@ -86,16 +87,17 @@ fn o2(dt: f64, kind: SolverKind, matrix_free: bool) -> Params<f64> {
 }
 
 /// The pair products in free space (rotation on: spins from the matrix-free `rt`
-/// products) and in the Ewald box: five steps matrix-free within rounding of the
-/// stored `Overdamped2`'s, and no block stored.
+/// products), in the Ewald box and above a wall (`z = -2`): five steps matrix-free
+/// within rounding of the stored `Overdamped2`'s, and no block stored.
 #[test]
 fn pair_products_match_stored() {
     let none = BondSet::<f64, 0>::new();
-    for boxed in [false, true] {
+    for (boxed, wall) in [(false, false), (true, false), (false, true)] {
         let s = spheres(12.0);
         let place = |mut p: Params<f64>| {
             p.rotation = !boxed;
             p.periodic = boxed.then(|| Periodic::new([12.0; 3]).unwrap());
+            p.wall = wall.then(|| Wall::new(-2.0));
             p
         };
         let stored = place(o2(0.05, SolverKind::Auto, false));
@@ -109,8 +111,11 @@ fn pair_products_match_stored() {
             false => spin_error(&a.1, &b.1),
         };
         let err = relative(&s, &a.0, &b.0);
-        println!("box {boxed}: matrix-free vs stored {err:.2e}, spins {spin:.2e}");
-        assert!(err < 1e-13 && spin < 1e-13, "box {boxed}: {err:e} {spin:e}");
+        println!("box {boxed} wall {wall}: matrix-free vs stored {err:.2e}, spins {spin:.2e}");
+        assert!(
+            err < 1e-13 && spin < 1e-13,
+            "box {boxed} wall {wall}: {err:e} {spin:e}"
+        );
     }
 }
 
