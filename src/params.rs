@@ -224,11 +224,12 @@ pub struct Params<T: Real> {
     /// scales with the cores: [`crate::parallel::free_product`]). In free space the
     /// same bits as the stored path at every size and on any number of threads (the
     /// same bands); above a wall or in a periodic box the same bits as the stored path
-    /// below [`BANDED_MIN`](crate::parallel::BANDED_MIN) beads, on one thread. Honoured by [`Method::Overdamped`] and
-    /// [`Method::Springs`]; the other methods factorise or keep a second mobility and
-    /// refuse it ([`StepError::BadParameter`](crate::StepError::BadParameter)). With
+    /// below [`BANDED_MIN`](crate::parallel::BANDED_MIN) beads, on one thread. Honoured by [`Method::Overdamped`],
+    /// [`Method::Overdamped2`] (its predictor's and corrector's mobilities products, no
+    /// second one stored) and [`Method::Springs`]; the inertial methods factorise the
+    /// mobility and refuse it ([`StepError::BadParameter`](crate::StepError::BadParameter)). With
     /// [`Params::near`] it means the near field's iterative products (`M_SD` never
-    /// formed; [`Method::Overdamped2`] too): see there. Default false.
+    /// formed): see there. Default false.
     pub matrix_free: bool,
     /// Constraint solver. Default [`SolverKind::Auto`], tolerance 1e-10 (f64) / 1e-5 (f32), cap 100.
     pub solver: Solver<T>,
@@ -327,8 +328,8 @@ pub struct Params<T: Real> {
     /// `fast-free`; `docs/FREE.md`, "Steps on the fast product") instead of the pair
     /// blocks, with [`Hydro::Rpy`] (Oseen is refused; free draining, which has no pair
     /// blocks, ignores it). Either gives products only, so it needs
-    /// [`Params::matrix_free`] ([`Method::Overdamped`], [`Method::Springs`]; the noise
-    /// by Lanczos from the fast products) and, with constraints, the Krylov solver
+    /// [`Params::matrix_free`] ([`Method::Overdamped`], [`Method::Overdamped2`],
+    /// [`Method::Springs`]; the noise by Lanczos from the fast products) and, with constraints, the Krylov solver
     /// ([`SolverKind::Auto`] resolves to it); the rest (rotation included) is refused
     /// with [`StepError::Unsupported`](crate::StepError::Unsupported), and so is a
     /// wall. Its storage is the caller's: in a box

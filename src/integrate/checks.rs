@@ -170,9 +170,11 @@ pub(super) fn check_inputs<T: Real>(
     bad(p.solver.max_iterations > 0, "max_iterations")?;
     bad(
         !p.matrix_free
-            || matches!(p.method, Method::Overdamped | Method::Springs)
-            || (p.near_on() && p.method == Method::Overdamped2),
-        "matrix_free (Overdamped and Springs only; Overdamped2 too with the near field)",
+            || matches!(
+                p.method,
+                Method::Overdamped | Method::Overdamped2 | Method::Springs
+            ),
+        "matrix_free (Overdamped, Overdamped2 and Springs only)",
     )?;
     if p.method == Method::Springs {
         bad(

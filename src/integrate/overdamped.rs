@@ -7,8 +7,8 @@ use core::cell::Cell;
 use super::near;
 use super::{
     Projection, Start, StepReport, Sums, add_constraint_forces, add_flow, assemble_tt,
-    bond_vectors, check_resolved, hydro, max_tension, mobility_metric, mobility_product,
-    project_overdamped, report, spin, step_velocity,
+    bond_vectors, check_resolved, free_product, hydro, max_tension, mobility_metric,
+    mobility_product, project_overdamped, report, spin, step_velocity,
 };
 use crate::bonds::Bond;
 use crate::constraints::{self, Problem, Scratch, SolveStats};
@@ -128,7 +128,8 @@ fn compact_product<T: Real>(
 
 /// Projected overdamped velocity at `pos`: `U = U_inf + mu (F + G^T kappa)` with `kappa`
 /// such that every bond's length rate vanishes. `mu` and `force` must hold the mobility
-/// and external forces at `pos`; the result is left in `u`. Inlined at both calls, so
+/// and external forces at `pos` (matrix-free `mu` is empty: the product is taken at
+/// `pos`, summed in `bands`); the result is left in `u`. Inlined at both calls, so
 /// that the solver choice folds where the parameters are constant ([`constraints::solve`]).
 /// With `judge`, the unconstrained velocity `U_inf + mu F` is first checked to resolve
 /// a step ([`check_resolved`]), as the first-order scheme checks it.
@@ -137,8 +138,7 @@ fn compact_product<T: Real>(
 fn projected_velocity<T: Real>(
     p: &Params<T>,
     ew: Sums<'_, T>,
-    pos: &[T::V3],
-    radius: &[T],
+    (pos, radius): (&[T::V3], &[T]),
     mu: Mob<'_, T>,
     force: &[T::V3],
     bonds: &[Bond<T>],
@@ -146,11 +146,15 @@ fn projected_velocity<T: Real>(
     disp: &mut [T::V3],
     kappa: &mut [T],
     scratch: &mut Scratch<'_, T>,
-    u: &mut [T::V3],
+    (u, bands): (&mut [T::V3], &mut [T::V3]),
     judge: bool,
 ) -> Result<SolveStats<T>, StepError> {
     let n = pos.len();
-    with_blocks!(mu, a => linalg::sym_matvec::<T>(a, n, force, u));
+    if p.matrix_free {
+        free_product(p, ew, pos, radius, force, u, (scratch.par, bands))?;
+    } else {
+        with_blocks!(mu, a => linalg::sym_matvec::<T>(a, n, force, u));
+    }
     add_flow(p, pos, u);
     if judge {
         check_resolved(pos, u, p.dt)?;
@@ -178,7 +182,9 @@ fn projected_velocity<T: Real>(
 }
 
 /// Overdamped second order: Heun predictor-corrector on the projected velocity, then
-/// the same position projection as the first-order scheme.
+/// the same position projection as the first-order scheme. Matrix-free
+/// ([`Params::matrix_free`]) each mobility is a product where it is used (the pair
+/// products, the fast free-space product, PSE or Ewald in a box), nothing stored.
 pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     p: &Params<T>,
     s: &Start<'_, T>,
@@ -205,6 +211,7 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
         scratch: mut sc,
         mut links,
         near,
+        bands,
         ..
     } = v;
     let formed = Cell::new(0);
@@ -212,13 +219,14 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     // Predictor: projected velocity at r, one projected Euler step.
     if p.near_on() {
         near::assemble_tt(p, s.ewald, s.pos, s.radius, mu0.reborrow(), &mut near)?;
-    } else {
+    } else if !p.matrix_free {
         assemble_tt(p, s.ewald, s.pos, s.radius, mu0.reborrow())?;
     }
     let mu0 = mu0.into_ref();
     forces::external(p, s.pos, s.radius, s.density, ext, force)?;
+    let (spheres, out) = ((s.pos, s.radius), (&mut *f0, &mut *bands));
     projected_velocity(
-        p, s.ewald, s.pos, s.radius, mu0, force, bonds, grad, disp, kappa, &mut sc, f0, true,
+        p, s.ewald, spheres, mu0, force, bonds, grad, disp, kappa, &mut sc, out, true,
     )?;
     // Tension and spin at the start of the step: the velocity projection's multipliers
     // are the constraint forces (metric `mu G^T`, so `G^T kappa` is a force).
@@ -248,13 +256,14 @@ pub(super) fn overdamped2<T: Real, E: ExternalForce<T>>(
     // Corrector: projected velocity at the predicted point, trapezoidal average.
     if p.near_on() {
         near::assemble_tt(p, s.ewald, x_p, s.radius, mu1.reborrow(), &mut near)?;
-    } else {
+    } else if !p.matrix_free {
         assemble_tt(p, s.ewald, x_p, s.radius, mu1.reborrow())?;
     }
     let mu1 = mu1.into_ref();
     forces::external(p, x_p, s.radius, s.density, ext, force)?;
+    let (spheres, out) = ((&*x_p, s.radius), (&mut *f1, &mut *bands));
     projected_velocity(
-        p, s.ewald, x_p, s.radius, mu1, force, bonds, grad_new, disp, kappa, &mut sc, f1, false,
+        p, s.ewald, spheres, mu1, force, bonds, grad_new, disp, kappa, &mut sc, out, false,
     )?;
     // Projection as in the first-order scheme: r' = r* + dt mu(r) G(r)^T lambda.
     let trapezoid = |x: &mut [T::V3]| {

@@ -342,6 +342,10 @@ impl<T: Real> FreeFast<T> {
     pub fn tolerance(&self) -> f64 {
         self.tol
     }
+    /// The largest bounding-box edges the parameters serve, per axis.
+    pub fn extent(&self) -> [f64; 3] {
+        self.extent
+    }
     /// The relative error the chosen parameters give (the sum of the aliasing, window
     /// and cutoff terms, after rounding): at most about the tolerance.
     pub fn estimate(&self) -> f64 {

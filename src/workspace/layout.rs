@@ -250,21 +250,25 @@ impl Layout {
             let [blocks, vectors, scalars, indices] =
                 near_iterative_sizes(n, c, !near_far_product(p));
             let [noise_vectors, noise_scalars] = near_noise_sizes(p, n);
-            // `Overdamped2` stores no mobility here either: its two are products.
-            let unstored = match p.method {
-                Method::Overdamped2 => 2 * SYM * tri(n),
+            // The plain matrix-free `Overdamped2`'s band scratch, which its products here
+            // (`integrate::near_iter`) do not read.
+            let plain_bands = match p.method {
+                Method::Overdamped2 => band_scratch(n),
                 _ => 0,
             };
             // The sweep's and Newton's table of `M_SD`'s columns (`integrate::near_iter`),
             // which the matrix-free layout leaves out.
             let table = match (p.method, p.solver_kind(n, bonds)) {
-                (Method::Overdamped, SolverKind::Sweep | SolverKind::Newton) => n * c,
+                (
+                    Method::Overdamped | Method::Overdamped2,
+                    SolverKind::Sweep | SolverKind::Newton,
+                ) => n * c,
                 _ => 0,
             };
             Self {
                 blocks: l.blocks + blocks,
-                vectors: l.vectors + vectors + noise_vectors + table,
-                scalars: l.scalars - unstored + scalars + noise_scalars,
+                vectors: l.vectors - plain_bands + vectors + noise_vectors + table,
+                scalars: l.scalars + scalars + noise_scalars,
                 indices: l.indices + indices,
                 ..l
             }
@@ -282,7 +286,7 @@ impl Layout {
         }
         // Above a wall: the stored mobilities in blocks of nine.
         let stored = match p.method {
-            Method::Overdamped | Method::Springs if p.matrix_free => 0,
+            Method::Overdamped | Method::Overdamped2 | Method::Springs if p.matrix_free => 0,
             _ if near_iterative(p) => 0,
             method => symmetric_mobilities(method),
         };
@@ -370,7 +374,8 @@ impl Layout {
 
     /// This layout without the stored (symmetric) mobility (and without the displacement table of
     /// the dense solvers), for the methods that run matrix-free
-    /// ([`Params::matrix_free`]: `Overdamped`, `Springs`); unchanged for the others.
+    /// ([`Params::matrix_free`]: `Overdamped`, `Springs`; `Overdamped2` without its two,
+    /// with the products' band scratch instead); unchanged for the others.
     pub const fn matrix_free(
         self,
         method: Method,
@@ -381,13 +386,20 @@ impl Layout {
         // The matrix-free products sum in the stored product's bands too
         // (`parallel::free_product`): their scratch stays.
         let table = match (method, kind.resolve(bonds)) {
-            (Method::Overdamped, SolverKind::Sweep | SolverKind::Newton) => n * bonds,
+            (Method::Overdamped | Method::Overdamped2, SolverKind::Sweep | SolverKind::Newton) => {
+                n * bonds
+            }
             _ => 0,
         };
         match method {
             Method::Overdamped | Method::Springs => Self {
                 scalars: self.scalars - SYM * tri(n),
                 vectors: self.vectors - table,
+                ..self
+            },
+            Method::Overdamped2 => Self {
+                scalars: self.scalars - 2 * SYM * tri(n),
+                vectors: self.vectors - table + band_scratch(n),
                 ..self
             },
             _ => self,

@@ -132,7 +132,11 @@ impl<T: Real> Workspace<'_, T> {
         let (force, grad) = (ve.take(m), ve.take(nb));
         // (The iterative near field stores no mobility, whatever the method.)
         let iterative = super::layout::near_iterative(p);
-        let unstored = p.matrix_free && matches!(method, Method::Overdamped | Method::Springs);
+        let unstored = p.matrix_free
+            && matches!(
+                method,
+                Method::Overdamped | Method::Overdamped2 | Method::Springs
+            );
         let stored = !(unstored || iterative);
         // The dense solvers' table of displacements (see `Layout::with_solver`).
         // (The iterative near field's sweep and Newton read one too: `near_iter`.)
@@ -196,7 +200,9 @@ impl<T: Real> Workspace<'_, T> {
         let sqrt_m = sc.take(sqrt_m);
         let disp = ve.take(disp);
         // Stored or matrix-free, the products sum in bands (`parallel::free_product`).
-        let banded = matches!(method, Method::Overdamped | Method::Springs);
+        // (`Overdamped2` only matrix-free: its stored products are serial.)
+        let banded = matches!(method, Method::Overdamped | Method::Springs)
+            || (method == Method::Overdamped2 && unstored && !iterative);
         let bands = ve.take(if banded { band_scratch(n) } else { 0 });
         let constrained = !matches!(method, Method::Springs);
         let newton = constrained && matches!(kind, SolverKind::Newton);

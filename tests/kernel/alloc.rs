@@ -208,7 +208,7 @@ fn alloc_free_steps<T: Real>() {
     }
     assert_eq!(runs, 30);
     // Matrix-free: no stored mobility, still no heap.
-    for method in [Method::Overdamped, Method::Springs] {
+    for method in [Method::Overdamped, Method::Overdamped2, Method::Springs] {
         let mut p = Params::new(T::from_f64(0.01));
         p.method = method;
         p.matrix_free = true;
@@ -242,6 +242,48 @@ fn every_step_method_allocates_nothing_f64() {
 #[test]
 fn every_step_method_allocates_nothing_f32() {
     alloc_free_steps::<f32>();
+}
+
+/// `Overdamped2` on the fast free-space product (bonds by Krylov, spins from its grand
+/// product) and on PSE in a box: the predictor's and the corrector's products, no heap.
+#[cfg(feature = "fast-free")]
+#[test]
+fn fast_products_overdamped2_allocate_nothing() {
+    use hydrorattle::integrate::{fast_storage, fast_vectors, pse_storage};
+    const N: usize = 25;
+    const B: usize = N - 1;
+    let init = chain::<f64, N>();
+    let bonds = BondSet::<f64, B>::chain(&init.pos[..N]).unwrap();
+    for boxed in [false, true] {
+        let mut p = Params::new(0.01);
+        p.method = Method::Overdamped2;
+        p.solver.kind = SolverKind::Krylov;
+        p.matrix_free = true;
+        p.pse = Some(1e-5);
+        p.rotation = !boxed;
+        p.periodic = boxed.then(|| hydrorattle::Periodic::new([60.0; 3]).unwrap());
+        let layout = hydrorattle::Layout::for_params(&p, N, B);
+        let mut store = hydrorattle_heap::Buffers::<f64>::new(layout);
+        let (pos, rad) = (&init.pos[..N], &init.radius[..N]);
+        let mut fast = hydrorattle_heap::FreeBuffers::for_step(fast_storage(&p, pos, rad).unwrap());
+        let mut pse = hydrorattle_heap::PseBuffers::for_step(pse_storage(&p, rad).unwrap());
+        let mut spare = vec![<f64 as Real>::V3_ZERO; fast_vectors(&p, N)];
+        let ws = store.workspace();
+        let mut ws = match boxed {
+            true => pse.attach(ws),
+            false => fast.attach(ws).with_fast_vectors(&mut spare),
+        };
+        let mut ps = init.clone();
+        let (res, n) = count(|| {
+            for _ in 0..2 {
+                step(&mut ps, &bonds, &p, &mut ws, &mut NoForce)?;
+            }
+            Ok::<_, StepError>(())
+        });
+        res.unwrap_or_else(|e| panic!("box {boxed}: {e}"));
+        assert_eq!(n, 0, "box {boxed}: {n} allocator calls in 2 steps");
+        assert!(ps.time > init.time);
+    }
 }
 
 /// The iterative near field (`Params::near` with `Params::matrix_free`) with bonds: in

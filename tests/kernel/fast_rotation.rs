@@ -62,7 +62,7 @@ fn run<const M: usize, const B: usize, E: ExternalForce<f64>>(
 }
 
 /// Largest spin difference over the largest spin.
-fn spin_error(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+pub(super) fn spin_error(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     let big = a.iter().map(|w| norm(*w)).fold(0.0, f64::max);
     let diff = a
         .iter()

@@ -86,7 +86,7 @@ pub(super) fn on(mut p: Params<f64>, tol: Option<f64>) -> Params<f64> {
 }
 
 /// Largest displacement difference over the largest displacement.
-fn relative(start: &[Sphere], a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+pub(super) fn relative(start: &[Sphere], a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     let big = start
         .iter()
         .zip(a)
@@ -234,9 +234,16 @@ fn chain_krylov_matches_dense() {
 }
 
 /// Four spheres in a row pushed together with hard contacts by Krylov: no overlap, a
-/// contact held, the positions within the tolerance of the dense path's after 4 steps.
+/// contact held, the positions within the tolerance of the dense path's after 4 steps
+/// (`Overdamped`, and `Overdamped2` against the stored `Overdamped2`).
 #[test]
 fn contacts_match_dense() {
+    for method in [Method::Overdamped, Method::Overdamped2] {
+        contacts_match_dense_with(method);
+    }
+}
+
+fn contacts_match_dense_with(method: Method) {
     let s: Vec<Sphere> = (0..4)
         .map(|k| Sphere {
             pos: [[-1.6, -0.3, 1.2, 2.5][k], 0.0, 0.1 * k as f64],
@@ -246,10 +253,7 @@ fn contacts_match_dense() {
         .collect();
     let none = BondSet::<f64, 0>::new();
     let with = |tol| {
-        let mut p = on(
-            params::<f64>(0.05, Method::Overdamped, SolverKind::Krylov),
-            tol,
-        );
+        let mut p = on(params::<f64>(0.05, method, SolverKind::Krylov), tol);
         p.allow_overlap = false;
         p.contacts = Some(Contacts::new(8));
         p
@@ -268,8 +272,8 @@ fn contacts_match_dense() {
     }
     assert!(closest(&fast[3]) < 1.0 + 1e-8, "no contact held");
     let err = relative(&s, &dense[3], &fast[3]);
-    println!("contacts tol 1e-5: fast vs dense after 4 steps {err:.2e}");
-    assert!(err < 1e-5, "{err}");
+    println!("{method:?} contacts tol 1e-5: fast vs dense after 4 steps {err:.2e}");
+    assert!(err < 1e-5, "{method:?}: {err}");
 }
 
 /// The spheres of the covariance test: 4, polydisperse (radii 0.6 to 1.4), an

@@ -37,6 +37,8 @@ mod free_draining;
 mod free_fast;
 #[cfg(feature = "fast-free")]
 mod free_fast_grand;
+#[cfg(feature = "fast-free")]
+mod free_o2;
 mod fuzz_step;
 #[cfg(feature = "periodic")]
 mod grand_cost;

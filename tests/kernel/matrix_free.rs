@@ -53,7 +53,7 @@ fn refused_where_unsupported<T: Real>() {
     let bonds: BondSet<T, 7> = BondSet::chain(&ps.pos[..8]).unwrap();
     let mut store = Buffers::<T>::new(Layout::all(8, 7));
     let mut ws = store.workspace();
-    for method in [Method::Overdamped2, Method::Rattle, Method::RattleStable] {
+    for method in [Method::Rattle, Method::RattleStable] {
         let mut p = params::<T>(0.02, method, SolverKind::Auto);
         p.matrix_free = true;
         let before = snapshot(&ps);

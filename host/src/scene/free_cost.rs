@@ -285,8 +285,8 @@ fn with_path(plan: &Plan, choice: FreeChoice) -> Plan {
 /// * the stored paths: every method; compact only where the kernel keeps the copy
 ///   (`Params::compact_copy`: first-order overdamped, `f64`, Krylov, from
 ///   `REDUCED_MIN` spheres), and it changes only the constraint products;
-/// * matrix-free and fast: `Overdamped` and `Springs` (the others factorise or keep a
-///   second mobility), no wall, no near field, no Cholesky noise, and with constraints
+/// * matrix-free and fast: `Overdamped`, `Overdamped2` (two evaluations a step) and
+///   `Springs` (the inertial methods factorise the mobility), no wall, no near field, no Cholesky noise, and with constraints
 ///   the Krylov solver (the dense solvers read the metric entry by entry); fast also
 ///   needs RPY and a grid the kernel accepts;
 /// * rotation: the pair paths add a pass of the pairs' rotation blocks a step (the
@@ -328,8 +328,14 @@ pub fn step_cost(plan: &Plan, s: &Spheres, cost: &FreeCost, choice: FreeChoice) 
     // Products beside the noise's: the step's own, the solve's, the midpoint's (its
     // mobility applied once, and the projection or the fast path's solve).
     let at_mid = if midpoint && !fast { 1.0 } else { 0.0 };
-    let products = 1.0 + solve + mid + at_mid;
-    let assemblies = if midpoint { 2.0 } else { 1.0 };
+    // `Overdamped2` (no noise): two evaluations, the predictor's and the corrector's,
+    // each with its velocity solve, and the position projection's solve.
+    let second = plan.method == Method::Overdamped2;
+    let products = match second {
+        true => 2.0 + 3.0 * solve,
+        false => 1.0 + solve + mid + at_mid,
+    };
+    let assemblies = if midpoint || second { 2.0 } else { 1.0 };
     // With rotation the inertial method assembles the grand mobility and reads its
     // spins from it; the others add one pass of the pairs' rotation blocks a step.
     let grand = plan.rotation && plan.method == Method::RattleStable;
@@ -357,8 +363,10 @@ pub fn step_cost(plan: &Plan, s: &Spheres, cost: &FreeCost, choice: FreeChoice) 
         (true, true, true) => cost.copy + (iterations - 1.0) * cost.compact,
         (true, true, false) => iterations * cost.dense,
     };
-    let free_ok = matches!(plan.method, Method::Overdamped | Method::Springs)
-        && !plan.wall
+    let free_ok = matches!(
+        plan.method,
+        Method::Overdamped | Method::Overdamped2 | Method::Springs
+    ) && !plan.wall
         && !plan.slit
         && !plan.near
         && (!thermal || plan.brownian.is_none_or(|t| t.sqrt != Sqrt::Cholesky))

@@ -74,19 +74,23 @@ fn the_choice_at_known_points() {
     }
 }
 
-/// Methods that factorise or keep a second mobility run dense at any size, and are
-/// refused (naming their need) when the dense storage does not fit; Cholesky noise,
+/// Methods that factorise the mobility run dense at any size, and are refused (naming
+/// their need) when the dense storage does not fit (`Overdamped2` runs on the fast
+/// product, its two mobilities products); Cholesky noise,
 /// a wall keep what they need; with rotation the fast path runs (its grand product
 /// gives the spins).
 #[test]
 fn what_each_path_can_run() {
     let s = cloud(20_000, 0.1);
-    for method in [Method::Rattle, Method::RattleStable, Method::Overdamped2] {
+    for method in [Method::Rattle, Method::RattleStable] {
         let p = plan(method, Solver::Krylov);
         assert_eq!(pick(&p, &s, 64 * GIB), FreeChoice::Dense, "{method:?}");
         let e = choose(&p, &s, 1e-4, GIB).unwrap_err();
         assert!(e.bytes.is_some_and(|b| b > GIB), "{method:?}: {e:?}");
     }
+    let second = plan(Method::Overdamped2, Solver::Krylov);
+    assert_eq!(pick(&second, &s, 64 * GIB), FreeChoice::Fast);
+    assert_eq!(choose(&second, &s, 1e-4, GIB).unwrap().0, FreeChoice::Fast);
     let mut thermal = overdamped();
     thermal.brownian = Some(Thermal {
         temperature: 1.0,

@@ -153,10 +153,12 @@ fn unsupported(cx: &Context<'_>) -> Option<&'static str> {
         _ if m.hydrodynamics != Hydrodynamics::Rpy => {
             "gives the RPY product only: hydrodynamics = \"rpy\""
         }
-        _ if !matches!(i.method, Method::Overdamped | Method::Springs)
-            || m.level != Level::Manual =>
+        _ if !matches!(
+            i.method,
+            Method::Overdamped | Method::Overdamped2 | Method::Springs
+        ) || m.level != Level::Manual =>
         {
-            "gives products only: it needs method = \"overdamped\" or \"springs\" and level = \"manual\" \
+            "gives products only: it needs method = \"overdamped\", \"overdamped2\" or \"springs\" and level = \"manual\" \
              (the other methods store or factorise the mobility)"
         }
         _ if cholesky => {

@@ -300,8 +300,11 @@ pub fn needs_matrix(
     if near {
         return Some("[near_field]");
     }
-    if !matches!(i.method, Method::Overdamped | Method::Springs) {
-        return Some("a method other than overdamped or springs");
+    if !matches!(
+        i.method,
+        Method::Overdamped | Method::Overdamped2 | Method::Springs
+    ) {
+        return Some("a method other than overdamped, overdamped2 or springs");
     }
     if model.level != Level::Manual {
         return Some("level = \"auto\" (it may pick another method)");

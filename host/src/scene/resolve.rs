@@ -81,11 +81,14 @@ impl RawScene {
             .as_ref()
             .filter(|m| *m.get_ref())
         {
-            let runs = matches!(integrator.method, Method::Overdamped | Method::Springs);
+            let runs = matches!(
+                integrator.method,
+                Method::Overdamped | Method::Overdamped2 | Method::Springs
+            );
             if !runs || model.level != Level::Manual {
                 return Err(issue(
                     m.span(),
-                    "matrix_free needs method = \"overdamped\" or \"springs\" and level = \"manual\" \
+                    "matrix_free needs method = \"overdamped\", \"overdamped2\" or \"springs\" and level = \"manual\" \
                      (the other methods store or factorise the mobility)",
                 ));
             }

@@ -168,3 +168,35 @@ fn the_shipped_clouds_read_and_the_small_one_falls_at_the_continuum_speed() {
         "{mean} against {expected} +- {sigma}"
     );
 }
+
+/// `method = "overdamped2"` runs on the fast product (the predictor's and the
+/// corrector's products): matrix-free, and two steps within the tolerance of the same
+/// scene's on the dense path.
+#[test]
+fn fast_runs_overdamped2_as_the_dense_path() {
+    let second = |free: &str| {
+        let text = scene("", free).replace("\"overdamped\"", "\"overdamped2\"");
+        let s = Scene::parse(&text, "c.toml").unwrap();
+        let mut e = Engine::<f64>::new(&s, DEFAULT_LIMIT).unwrap();
+        e.step().unwrap();
+        e.step().unwrap();
+        (s, e.beads.pos.clone())
+    };
+    let (sf, fast) = second("method = \"fast\"\ntolerance = 1e-6");
+    assert!(sf.integrator.matrix_free && params::<f64>(&sf).pse == Some(1e-6));
+    assert_eq!(params::<f64>(&sf).method, hydrorattle::Method::Overdamped2);
+    let (sd, dense) = second("method = \"dense\"");
+    let start = sd.positions();
+    let moved = dense
+        .iter()
+        .zip(&start)
+        .map(|(a, b)| (*a - <f64 as hydrorattle::Real>::v3_from(*b)).length())
+        .fold(0.0, f64::max);
+    let err = fast
+        .iter()
+        .zip(&dense)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f64::max)
+        / moved;
+    assert!(moved > 0.0 && err < 3e-6 && err > 0.0, "{err}");
+}

@@ -7,6 +7,9 @@
 //! parameters afresh from the cloud's bounding box at its start, each edge widened by
 //! [`FAST_MARGIN`] largest radii (a midpoint's or a contact round's positions stay
 //! within it), so a cloud may grow, shrink and travel without a limit set in advance.
+//! A product whose spheres pass that box (the predictor-corrector's predicted point
+//! after a step that stretches the cloud further) derives parameters over the larger
+//! box, which the rest of the step keeps.
 //! The grid follows the cloud: with the rule's `sigma ~ (V / n)^{1/3}` its points stay
 //! near `n` times a constant whatever the cloud's volume, so storage sized once by
 //! `integrate::fast_storage` usually keeps fitting. Where it does not (a cloud that has grown
@@ -21,7 +24,7 @@
 //! stays in the caller's reals between steps and is used again where they match bit for
 //! bit ([`FreeStorage`]). Whether it is kept never changes a step's bits.
 
-use core::cell::RefCell;
+use core::cell::{Cell, RefCell};
 
 use crate::error::StepError;
 use crate::geometry::fast::{FastProduct, Slices};
@@ -58,6 +61,11 @@ pub(crate) fn params<T: Real>(
     have: [usize; 2],
 ) -> Result<FreeFast<T>, FreeError> {
     let a_max = radius.iter().fold(T::ZERO, |m, &a| m.max(a));
+    fitted(rule, a_max, edges::<T>(pos), pos.len(), have)
+}
+
+/// The edges of the centres' bounding box (zero for no spheres).
+fn edges<T: Real>(pos: &[T::V3]) -> [f64; 3] {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for &p in pos {
         let p = T::v3_to_f64(p);
@@ -66,8 +74,7 @@ pub(crate) fn params<T: Real>(
             hi[d] = hi[d].max(p[d]);
         }
     }
-    let box_edges = core::array::from_fn(|d| (hi[d] - lo[d]).max(0.0));
-    fitted(rule, a_max, box_edges, pos.len(), have)
+    core::array::from_fn(|d| (hi[d] - lo[d]).max(0.0))
 }
 
 /// [`params`] for `n` spheres of radius up to `a_max` whose centres' bounding box has
@@ -133,7 +140,11 @@ pub(crate) fn fitted<T: Real>(
 /// borrowed in turn by each product (they never nest) as PSE's storage is
 /// ([`PseStep`](crate::geometry::sums::PseStep)).
 pub(crate) struct FastStep<'s, T: Real> {
-    fast: FreeFast<T>,
+    /// The parameters, re-derived where a product's spheres pass their extent
+    /// ([`FastStep::covering`]).
+    fast: Cell<FreeFast<T>>,
+    /// The caller's complex values and reals, which any parameters must fit.
+    have: [usize; 2],
     store: RefCell<FreeStorage<'s, T>>,
     /// The spins' zero torques and discarded velocities (`integrate::fast_vectors`; empty
     /// without rotation).
@@ -175,10 +186,33 @@ impl<'s, T: Real> FastStep<'s, T> {
             false => &mut [],
         };
         Ok(Self {
-            fast,
+            fast: Cell::new(fast),
+            have,
             store: RefCell::new(FreeStorage::new(complex, reals, index).with_parallel(par)),
             spare: RefCell::new(spare),
         })
+    }
+}
+
+impl<T: Real> FastStep<'_, T> {
+    /// The step's parameters where they cover the spheres at `pos` (radii `radius`),
+    /// else parameters over the larger of their extent and these spheres' box, kept
+    /// for the rest of the step (fitted to the caller's storage as [`params`] fits
+    /// them). A product away from the start can pass the margin: the predictor-corrector's
+    /// predicted point, or a Krylov product there, after a step that stretches the cloud
+    /// by more than [`FAST_MARGIN`] radii.
+    fn covering(&self, pos: &[T::V3], radius: &[T]) -> Result<FreeFast<T>, StepError> {
+        let held = self.fast.get();
+        let (edge, extent) = (edges::<T>(pos), held.extent());
+        if (0..3).all(|d| edge[d] <= extent[d]) {
+            return Ok(held);
+        }
+        let wide = core::array::from_fn(|d| edge[d].max(extent[d]));
+        let a_max = radius.iter().fold(T::ZERO, |m, &a| m.max(a));
+        let rule = (held.tolerance(), held.is_grand());
+        let fast = fitted(rule, a_max, wide, pos.len(), self.have)?;
+        self.fast.set(fast);
+        Ok(fast)
     }
 }
 
@@ -194,7 +228,8 @@ impl<T: Real> FastProduct<T> for FastStep<'_, T> {
         let mut store = self.store.try_borrow_mut().map_err(|_| {
             StepError::Unsupported("a fast free-space product inside another (storage in use)")
         })?;
-        Ok(self.fast.apply(eta, pos, radius, f, u, &mut store)?)
+        let fast = self.covering(pos, radius)?;
+        Ok(fast.apply(eta, pos, radius, f, u, &mut store)?)
     }
 
     /// `out = M_rt F`: the grand product with zero torques, its velocities discarded.
@@ -217,9 +252,8 @@ impl<T: Real> FastProduct<T> for FastStep<'_, T> {
         let vel = vel.get_mut(..n).ok_or(StepError::BadParameter(SPARE))?;
         torque.fill(T::V3_ZERO);
         let spheres = (pos, radius);
-        Ok(self
-            .fast
-            .apply_grand(eta, spheres, f, torque, vel, out, &mut store)?)
+        let fast = self.covering(pos, radius)?;
+        Ok(fast.apply_grand(eta, spheres, f, torque, vel, out, &mut store)?)
     }
 
     /// `(U, W) = M (F, T)` over the `2n` vectors: the grand product itself (no spare
