@@ -275,9 +275,8 @@ impl<T: Real> FastProduct<T> for FastStep<'_, T> {
         ) else {
             return Err(StepError::StateLength);
         };
-        Ok(self
-            .fast
-            .apply_grand(eta, spheres, f, t, u, w, &mut store)?)
+        let fast = self.covering(spheres.0, spheres.1)?;
+        Ok(fast.apply_grand(eta, spheres, f, t, u, w, &mut store)?)
     }
 
     /// Lanczos on the fast product, as the matrix-free path draws in free space: the
