@@ -86,10 +86,9 @@ pub(super) struct Context<'a> {
     pub(super) model: &'a Model,
     pub(super) integrator: &'a Integrator,
     pub(super) brownian: Option<Thermal>,
-    /// Spans of the `[wall]`, `[box]` and `[near_field]` tables, when given.
+    /// Spans of the `[wall]` and `[box]` tables, when given.
     pub(super) wall: Option<std::ops::Range<usize>>,
     pub(super) periodic: Option<std::ops::Range<usize>>,
-    pub(super) near: Option<std::ops::Range<usize>>,
 }
 
 /// Resolves `[free_space]`, refusing at `method` what `"fast"` cannot run.

@@ -153,7 +153,6 @@ impl RawScene {
                     wall: (self.wall.as_ref().map(|w| w.span()))
                         .or(self.slit.as_ref().map(|s| s.span())),
                     periodic: self.periodic.as_ref().map(|b| b.span()),
-                    near: self.near_field.as_ref().map(|n| n.span()),
                 },
             )?),
         };
