@@ -182,7 +182,7 @@ pub(in crate::integrate) fn project_along<'l, T: Real, A: Along<T>>(
             return Err(StepError::NoConvergence {
                 stage: Stage::Contacts,
                 iterations: round,
-                residual: deepest_overlap(x, radius, cell, wall.is_some()).to_f64(),
+                residual: deepest_overlap(x, radius, cell, (wall.is_some(), ceiling)).to_f64(),
             });
         }
     }
@@ -256,18 +256,23 @@ fn shift<T: Real>(x: &mut [T::V3], wall: Option<T>, sign: T) {
     }
 }
 
-/// Largest relative overlap `1 - |r_ij| / (a_i + a_j)` (the minimum image in a box), and
-/// with a wall `1 - z_i / a_i` (positions in the wall's frame), for the error report.
+/// Largest relative overlap `1 - |r_ij| / (a_i + a_j)` (the minimum image in a box),
+/// with a wall `1 - z_i / a_i` and with a ceiling at `c` `1 - (c - z_i) / a_i`
+/// (positions in the wall's frame), for the error report.
 fn deepest_overlap<T: Real>(
     pos: &[T::V3],
     radius: &[T],
     cell: Option<Periodic<T>>,
-    wall: bool,
+    (wall, ceiling): (bool, Option<T>),
 ) -> T {
     let mut worst = T::ZERO;
     for i in 0..pos.len() {
+        let z = T::xyz(pos[i])[2];
         if wall {
-            worst = worst.max(T::ONE - T::xyz(pos[i])[2] / radius[i]);
+            worst = worst.max(T::ONE - z / radius[i]);
+        }
+        if let Some(c) = ceiling {
+            worst = worst.max(T::ONE - (c - z) / radius[i]);
         }
         for j in 0..i {
             let sigma = radius[i] + radius[j];
