@@ -76,6 +76,31 @@ impl<T: Real> FastProduct<T> for PseStep<'_, T> {
             .apply(Part::Both, eta, pos, radius, f, u, &mut store)?)
     }
 
+    /// `(U, W) = M (F, T)` over the `2n` vectors: PSE's grand product
+    /// ([`Pse::apply_grand`]), the iterative near field's far field in the box (its
+    /// storage at least [`Pse::storage_grand`], which `integrate::pse_storage` sizes when
+    /// the near field is on).
+    fn grand(
+        &self,
+        eta: T,
+        spheres: (&[T::V3], &[T]),
+        ft: &[T::V3],
+        out: &mut [T::V3],
+    ) -> Result<(), StepError> {
+        let mut store = self
+            .store
+            .try_borrow_mut()
+            .map_err(|_| StepError::Unsupported("a PSE product inside another (storage in use)"))?;
+        let n = spheres.0.len();
+        let (Some((f, t)), Some((u, w))) = (
+            ft.get(..2 * n).map(|v| v.split_at(n)),
+            out.get_mut(..2 * n).map(|v| v.split_at_mut(n)),
+        ) else {
+            return Err(StepError::StateLength);
+        };
+        Ok(self.pse.apply_grand(eta, spheres, f, t, u, w, &mut store)?)
+    }
+
     fn noise(
         &self,
         eta: T,
