@@ -247,7 +247,8 @@ fn every_step_method_allocates_nothing_f32() {
 /// The iterative near field (`Params::near` with `Params::matrix_free`) with bonds: in
 /// `Overdamped2` (Krylov, with contacts, Newton) and at temperature, no heap; and on
 /// the fast free-space product's grand product (`Params::pse` in free space, the fast
-/// arrays the caller's) in `Overdamped`, `Overdamped2` and at temperature.
+/// arrays the caller's) and on PSE's in a box, in `Overdamped`, `Overdamped2` and at
+/// temperature.
 #[cfg(feature = "near")]
 #[test]
 fn iterative_near_field_with_bonds_allocates_nothing() {
@@ -306,6 +307,41 @@ fn iterative_near_field_with_bonds_allocates_nothing() {
         });
         let tag =
             format!("{method:?}, {kind:?}, contacts {contacts}, thermal {thermal}, fast {fast:?}");
+        res.unwrap_or_else(|e| panic!("{tag}: {e}"));
+        assert_eq!(n, 0, "{tag}: {n} allocator calls in 2 steps");
+        assert!(ps.time > init.time, "{tag}");
+    }
+    // On PSE's grand product in a box (PSE's arrays the caller's, sized by
+    // `pse_storage` for the grand product).
+    #[cfg(feature = "pse")]
+    for (method, thermal) in [
+        (Method::Overdamped, false),
+        (Method::Overdamped2, false),
+        (Method::Overdamped, true),
+    ] {
+        let mut p = Params::new(0.01);
+        p.method = method;
+        p.solver.kind = SolverKind::Krylov;
+        p.rotation = true;
+        p.matrix_free = true;
+        p.pse = Some(1e-4);
+        p.periodic = Some(hydrorattle::Periodic::new([64.0; 3]).unwrap());
+        p.near = Some(hydrorattle::stokesian::NearField::default());
+        p.brownian = thermal.then(|| hydrorattle::Brownian::new(1e-3));
+        let layout = hydrorattle::Layout::for_params(&p, N, B);
+        let mut store = hydrorattle_heap::Buffers::<f64>::new(layout);
+        let size = hydrorattle::integrate::pse_storage(&p, &init.radius[..N]).unwrap();
+        let mut arrays = hydrorattle_heap::PseBuffers::<f64>::for_step(size);
+        let mut ws = arrays.attach(store.workspace());
+        let mut ps = init.clone();
+        ps.noise = thermal.then(|| hydrorattle::Noise::new(3));
+        let (res, n) = count(|| {
+            for _ in 0..2 {
+                step(&mut ps, &bonds, &p, &mut ws, &mut NoForce)?;
+            }
+            Ok::<_, StepError>(())
+        });
+        let tag = format!("PSE in a box, {method:?}, thermal {thermal}");
         res.unwrap_or_else(|e| panic!("{tag}: {e}"));
         assert_eq!(n, 0, "{tag}: {n} allocator calls in 2 steps");
         assert!(ps.time > init.time, "{tag}");
