@@ -6,7 +6,7 @@
 //! * the same step on the Ewald sums' assembled grand mobility (`near_iter.rs`, there
 //!   checked against the dense near step) at the PSE tolerances `1e-4` and `1e-8`: a
 //!   random suspension at volume fraction 0.2, both overdamped methods, bonds by Krylov,
-//!   thermal `Overdamped`;
+//!   hard contacts, thermal `Overdamped`;
 //! * two equal spheres at `s = 2.1` in a box of edge 30: Stimson and Jeffery's exact
 //!   speed along their line of centres and the published side-by-side speed, each less
 //!   the box's known correction (Hasimoto's constant, as `near_box.rs` checks the Ewald
@@ -25,7 +25,7 @@ use common::*;
 use hydrorattle::integrate::pse_storage;
 use hydrorattle::stokesian::NearField;
 use hydrorattle::{
-    Bond, BondSet, Brownian, Layout, Method, NoForce, Noise, ParticleSet, Periodic, Real,
+    Bond, BondSet, Brownian, Contacts, Layout, Method, NoForce, Noise, ParticleSet, Periodic, Real,
     SolverKind, StepError, StepReport, step,
 };
 use hydrorattle_heap::{Buffers, PseBuffers};
@@ -169,7 +169,7 @@ fn nearest_bonds(spheres: &[Sphere], l: f64) -> Vec<Bond<f64>> {
         .collect()
 }
 
-/// Bonds by Krylov in `Overdamped` and `Overdamped2`, and thermal `Overdamped` (the far
+/// Bonds by Krylov in `Overdamped` and `Overdamped2`, hard contacts, and thermal `Overdamped` (the far
 /// field's Lanczos root on PSE's grand product, the same deviates) with and without
 /// bonds, against the Ewald sums' step.
 #[test]
@@ -184,6 +184,10 @@ fn constrained_and_thermal() {
         let what = format!("bonds, {method:?}");
         compare(p, tol, (&spheres, &bonds), None, 1e-6, &what);
     }
+    let mut p = near(Method::Overdamped, l, None);
+    p.contacts = Some(Contacts::new(64));
+    p.dt = 0.5;
+    compare(p, tol, (&spheres, &[]), None, 1e-6, "contacts");
     let mut p = near(Method::Overdamped, l, None);
     p.brownian = Some(Brownian::new(1e-2));
     p.allow_overlap = true;

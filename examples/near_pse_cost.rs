@@ -1,0 +1,170 @@
+//! Cost of one `Overdamped` step with the iterative near field in the periodic box on its
+//! two far fields, against the plain RPY steps of both sums: a random suspension of `N`
+//! spheres (radii 0.8 to 1.2, volume fraction 0.25, the box's cube), f64, one thread,
+//! this thread's CPU time (a loaded machine's waits do not count). Paths:
+//!
+//! * `PSE RPY`: PSE's product alone (`Params::pse`, `Params::matrix_free`, no near field);
+//! * `near, PSE far field`: the iterative near field (`Params::near` with
+//!   `Params::matrix_free`) on PSE's grand product, no `tri(2N)` storage;
+//! * `near, Ewald far field`: the same on the Ewald sums' grand mobility assembled once
+//!   (`tri(2N)` blocks of 72 bytes: 2.3 GB at 4000; skipped with `fast`);
+//! * `Ewald RPY`: the plain step on the Ewald sums' assembled `mu_tt` (as
+//!   `near_box_cost` times it; skipped with `fast`).
+//!
+//! ```text
+//! cargo run --release --example near_pse_cost                   # N = 1000, tolerance 1e-4
+//! cargo run --release --example near_pse_cost -- 1e-4 4000 fast # without the Ewald paths
+//! ```
+//!
+//! Prints one row per `N` and path: the step's CPU seconds and its ratio to the Ewald
+//! RPY step's, the close pairs, the near field's products and conjugate-gradient
+//! iterations, the far field's products (iterations plus two a product), the storage
+//! (the workspace's layout and PSE's arrays), and the largest velocity difference from
+//! the Ewald near path's over its largest velocity. Where `HYDRORATTLE_BENCH_MACHINE`
+//! names the machine, appends records to `bench/results/near_pse_cost.csv`.
+
+#[path = "shared/cpu.rs"]
+mod cpu;
+#[path = "shared/record.rs"]
+mod record;
+#[path = "shared/suspension.rs"]
+mod suspension;
+
+use hydrorattle::integrate::{pse_storage, step_slices};
+use hydrorattle::stokesian::NearField;
+use hydrorattle::{Layout, Method, NoForce, Params, Periodic, Real, State, StepReport};
+use hydrorattle_heap::{Buffers, PseBuffers};
+
+type V = <f64 as Real>::V3;
+
+/// Density of unit buoyant weight for a unit sphere (`g = 1`).
+const RHO1: f64 = 3.0 / (4.0 * std::f64::consts::PI);
+
+/// The paths: name, near field, PSE.
+const PATHS: [(&str, bool, bool); 4] = [
+    ("PSE RPY", false, true),
+    ("near, PSE far field", true, true),
+    ("near, Ewald far field", true, false),
+    ("Ewald RPY", false, false),
+];
+
+/// A step's report and the velocities after it.
+type Stepped = (StepReport<f64>, Vec<V>);
+
+/// One step of `p` from `pos0`: CPU seconds, the report and the velocities (or the
+/// step's error), the storage in bytes.
+fn one(p: &Params<f64>, pos0: &[V], rad: &[f64]) -> (f64, Result<Stepped, String>, usize) {
+    let n = pos0.len();
+    let density = vec![RHO1; n];
+    let layout = Layout::for_params(p, n, 0);
+    let size = pse_storage(p, rad).unwrap();
+    let mut arrays = PseBuffers::<f64>::for_step(size);
+    let cx = std::mem::size_of::<[f64; 2]>();
+    let bytes = layout.bytes::<f64>()
+        + arrays.complex.len() * cx
+        + arrays.index.len() * std::mem::size_of::<usize>()
+        + arrays.vectors.len() * std::mem::size_of::<V>();
+    let mut buf = Buffers::<f64>::new(layout);
+    let mut ws = arrays.attach(buf.workspace());
+    let (mut pos, mut vel, mut omega) = (pos0.to_vec(), vec![V::ZERO; n], vec![V::ZERO; n]);
+    let mut time = 0.0;
+    let state = State {
+        pos: &mut pos,
+        vel: &mut vel,
+        omega: &mut omega,
+        radius: rad,
+        density: &density,
+        time: &mut time,
+        noise: None,
+    };
+    let c0 = cpu::cpu().expect("CPU time (Linux)");
+    let r = step_slices(state, &[], p, &mut ws, &mut NoForce);
+    let t = cpu::cpu().expect("CPU time") - c0;
+    (t, r.map(|r| (r, vel)).map_err(|e| e.to_string()), bytes)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let tol: f64 = args.first().map_or(1e-4, |s| s.parse().expect("tolerance"));
+    let mut ns: Vec<usize> = args.iter().skip(1).filter_map(|a| a.parse().ok()).collect();
+    let skip_ewald = args.iter().any(|a| a == "fast");
+    if ns.is_empty() {
+        ns = vec![1000];
+    }
+    let mut rec = record::Recorder::new(
+        env!("CARGO_MANIFEST_DIR"),
+        "near_pse_cost",
+        format!(
+            "cargo run --release --example near_pse_cost -- {}",
+            args.join(" ")
+        ),
+    );
+    let table = format!(
+        "one Overdamped step with the iterative near field on PSE's far field in the periodic box, suspension at volume fraction 0.25, f64, one thread, CPU time, tolerance {tol:e}"
+    );
+    println!(
+        "N,path,step CPU s,to Ewald RPY,close pairs,near products,CG iterations,far products,storage MB,velocity vs Ewald near"
+    );
+    for &n in &ns {
+        let (pos, rad, l) = suspension::suspension(n, 0.25);
+        let pos: Vec<V> = pos.iter().map(|p| f64::v3_from(p.to_array())).collect();
+        let mut rows = vec![];
+        for (path, near, pse) in PATHS {
+            if skip_ewald && !pse {
+                continue;
+            }
+            let mut p = Params::<f64>::new(1e-4);
+            p.method = Method::Overdamped;
+            p.periodic = Some(Periodic::new([l; 3]).expect("box"));
+            // PSE gives products only; the Ewald RPY step assembles `mu_tt`.
+            p.matrix_free = near || pse;
+            p.near = near.then(NearField::default);
+            p.pse = pse.then_some(tol);
+            let (t, r, bytes) = one(&p, &pos, &rad);
+            match r {
+                Ok((r, vel)) => rows.push((path, t, r, vel, bytes)),
+                Err(e) => println!("{n},{path},{t:.3},refused: {e}"),
+            }
+        }
+        let find = |name: &str| rows.iter().find(|r| r.0 == name);
+        let ewald_near = find(PATHS[2].0).map(|r| r.3.clone());
+        let ewald_rpy = find(PATHS[3].0).map(|r| r.1);
+        for (path, t, r, vel, bytes) in &rows {
+            let far = r.near_iterations + 2 * r.near_products;
+            let diff = match (&ewald_near, r.near_products > 0) {
+                (Some(a), true) => {
+                    let big = a.iter().map(|v| f64::norm2(*v).sqrt()).fold(0.0, f64::max);
+                    let d = vel.iter().zip(a).map(|(x, y)| f64::norm2(*x - *y).sqrt());
+                    format!("{:.2e}", d.fold(0.0, f64::max) / big)
+                }
+                _ => "-".into(),
+            };
+            let ratio = ewald_rpy.map_or("-".into(), |e| format!("{:.2}", t / e));
+            let mb = *bytes as f64 / 1e6;
+            println!(
+                "{n},{path},{t:.3},{ratio},{},{},{},{far},{mb:.1},{diff}",
+                r.near_pairs, r.near_products, r.near_iterations
+            );
+            let case = format!("N = {n}, {path}");
+            let cells = [
+                ("step, CPU s", format!("{t:.3e}")),
+                ("step over the Ewald RPY step", ratio),
+                ("close pairs", r.near_pairs.to_string()),
+                ("near-field products", r.near_products.to_string()),
+                (
+                    "conjugate-gradient iterations",
+                    r.near_iterations.to_string(),
+                ),
+                ("far-field products", far.to_string()),
+                ("storage, MB", format!("{mb:.1}")),
+                ("velocity vs Ewald near field", diff),
+            ];
+            for (quantity, value) in cells {
+                rec.row(&table, &case, quantity, &value);
+            }
+        }
+    }
+    if let Err(e) = rec.finish() {
+        eprintln!("recording failed: {e}");
+    }
+}
