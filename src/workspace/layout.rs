@@ -53,10 +53,8 @@ pub(crate) const fn near_iterative<T: Real>(p: &Params<T>) -> bool {
 /// stored (`integrate::near_iter::solve`).
 pub(crate) const fn near_far_product<T: Real>(p: &Params<T>) -> bool {
     let place = p.place();
-    let fast = match place.cell() {
-        Some(_) => cfg!(feature = "pse"),
-        None => cfg!(feature = "fast-free"),
-    };
+    let boxed = place.cell().is_some();
+    let fast = (boxed && cfg!(feature = "pse")) || (!boxed && cfg!(feature = "fast-free"));
     fast && near_iterative(p) && p.pse.is_some() && place.surfaces().is_empty()
 }
 
