@@ -91,13 +91,7 @@ impl<T: Real> FastProduct<T> for PseStep<'_, T> {
             .store
             .try_borrow_mut()
             .map_err(|_| StepError::Unsupported("a PSE product inside another (storage in use)"))?;
-        let n = spheres.0.len();
-        let (Some((f, t)), Some((u, w))) = (
-            ft.get(..2 * n).map(|v| v.split_at(n)),
-            out.get_mut(..2 * n).map(|v| v.split_at_mut(n)),
-        ) else {
-            return Err(StepError::StateLength);
-        };
+        let ((f, t), (u, w)) = super::fast::grand_halves::<T>(spheres.0.len(), ft, out)?;
         Ok(self.pse.apply_grand(eta, spheres, f, t, u, w, &mut store)?)
     }
 

@@ -234,13 +234,7 @@ impl<T: Real> FastProduct<T> for FastStep<'_, T> {
         let mut store = self.store.try_borrow_mut().map_err(|_| {
             StepError::Unsupported("a fast free-space product inside another (storage in use)")
         })?;
-        let n = spheres.0.len();
-        let (Some((f, t)), Some((u, w))) = (
-            ft.get(..2 * n).map(|v| v.split_at(n)),
-            out.get_mut(..2 * n).map(|v| v.split_at_mut(n)),
-        ) else {
-            return Err(StepError::StateLength);
-        };
+        let ((f, t), (u, w)) = crate::geometry::fast::grand_halves::<T>(spheres.0.len(), ft, out)?;
         Ok(self
             .fast
             .apply_grand(eta, spheres, f, t, u, w, &mut store)?)
