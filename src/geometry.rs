@@ -272,6 +272,13 @@ macro_rules! geometries {
                 let _ = (place, sums); // Read above only with the geometries' features.
                 Self::$F(<$fty>::new(level, eta))
             }
+
+            /// Free space's blocks whatever the place: what a metric takes as its
+            /// preconditioner's blocks where the far field itself is a fast product.
+            #[inline(always)]
+            pub fn free_space(level: Hydro, eta: T) -> Self {
+                Self::$F(<$fty>::new(level, eta))
+            }
         }
 
         /// `$e` with `$g` bound to the geometry of the step `$s`, whichever it is.

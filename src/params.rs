@@ -329,10 +329,12 @@ pub struct Params<T: Real> {
     /// blocks, with [`Hydro::Rpy`] (Oseen is refused; free draining, which has no pair
     /// blocks, ignores it). Either gives products only, so it needs
     /// [`Params::matrix_free`] ([`Method::Overdamped`], [`Method::Overdamped2`],
-    /// [`Method::Springs`]; the noise by Lanczos from the fast products) and, with constraints, the Krylov solver
-    /// ([`SolverKind::Auto`] resolves to it); the rest (rotation included) is refused
-    /// with [`StepError::Unsupported`](crate::StepError::Unsupported), and so is a
-    /// wall. Its storage is the caller's: in a box
+    /// [`Method::Springs`]; the noise by Lanczos from the fast products) and, with
+    /// constraints, the Krylov solver ([`SolverKind::Auto`] resolves to it); the rest
+    /// (rotation included, except with the iterative near field, whose far field is then
+    /// the fast product's grand product) is refused with
+    /// [`StepError::Unsupported`](crate::StepError::Unsupported), and so is a wall. Its
+    /// storage is the caller's: in a box
     /// [`Workspace::with_pse`](crate::Workspace::with_pse), sized by
     /// [`pse_storage`](crate::integrate::pse_storage); in free space
     /// [`Workspace::with_fast`](crate::Workspace::with_fast), sized by

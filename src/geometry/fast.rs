@@ -18,6 +18,29 @@ pub(crate) type Slices<'a, T> = (
     &'a mut [T],
 );
 
+/// The grand product's `2n` forces then torques `ft` and velocities then spins `out`
+/// as their halves (`FastProduct::grand`'s implementors), or the length error.
+#[allow(clippy::type_complexity)]
+pub(crate) fn grand_halves<'a, 'b, T: Real>(
+    n: usize,
+    ft: &'a [T::V3],
+    out: &'b mut [T::V3],
+) -> Result<
+    (
+        (&'a [T::V3], &'a [T::V3]),
+        (&'b mut [T::V3], &'b mut [T::V3]),
+    ),
+    StepError,
+> {
+    match (
+        ft.get(..2 * n).map(|v| v.split_at(n)),
+        out.get_mut(..2 * n).map(|v| v.split_at_mut(n)),
+    ) {
+        (Some(ft), Some(out)) => Ok((ft, out)),
+        _ => Err(StepError::StateLength),
+    }
+}
+
 /// A product `u = M f` of a geometry's mobility over storage the implementor holds:
 /// PSE's in a box ([`PseStep`](super::sums::PseStep)), the fast free-space product's
 /// (`geometry/free/fast.rs`).

@@ -76,6 +76,25 @@ impl<T: Real> FastProduct<T> for PseStep<'_, T> {
             .apply(Part::Both, eta, pos, radius, f, u, &mut store)?)
     }
 
+    /// `(U, W) = M (F, T)` over the `2n` vectors: PSE's grand product
+    /// ([`Pse::apply_grand`]), the iterative near field's far field in the box (its
+    /// storage at least [`Pse::storage_grand`], which `integrate::pse_storage` sizes when
+    /// the near field is on).
+    fn grand(
+        &self,
+        eta: T,
+        spheres: (&[T::V3], &[T]),
+        ft: &[T::V3],
+        out: &mut [T::V3],
+    ) -> Result<(), StepError> {
+        let mut store = self
+            .store
+            .try_borrow_mut()
+            .map_err(|_| StepError::Unsupported("a PSE product inside another (storage in use)"))?;
+        let ((f, t), (u, w)) = super::fast::grand_halves::<T>(spheres.0.len(), ft, out)?;
+        Ok(self.pse.apply_grand(eta, spheres, f, t, u, w, &mut store)?)
+    }
+
     fn noise(
         &self,
         eta: T,

@@ -58,14 +58,17 @@ use crate::workspace::Workspace;
 /// ([`Workspace::with_pse`](crate::Workspace::with_pse)): `Some` where the step sums
 /// its box by PSE ([`Params::pse`], a box whose images interact), from the same
 /// parameters the step derives; `None` where it needs none. A host sizes its arrays
-/// with it before the first step (the radii do not change during a run).
+/// with it before the first step (the radii do not change during a run). With the
+/// iterative near field ([`Params::near`] with [`Params::matrix_free`]), whose far field
+/// is PSE's grand product, it is [`Pse::storage_grand`](crate::mobility::pse::Pse::storage_grand)'s.
 #[cfg(feature = "pse")]
 pub fn pse_storage<T: Real>(
     p: &Params<T>,
     radius: &[T],
 ) -> Result<Option<crate::geometry::PseSize>, StepError> {
+    let grand = p.near_on() && p.matrix_free;
     match (stages::ewald_cell(p), p.pse) {
-        (Some(c), Some(tol)) => Ok(Some(crate::geometry::pse_size(c, radius, tol)?)),
+        (Some(c), Some(tol)) => Ok(Some(crate::geometry::pse_size(c, radius, (tol, grand))?)),
         _ => Ok(None),
     }
 }

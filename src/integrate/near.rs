@@ -66,8 +66,12 @@ pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(
     if !matches!(p.method, Method::Overdamped | Method::Overdamped2) {
         return refuse("the near field with a method other than Overdamped or Overdamped2");
     }
+    // The iterative near field (`near_iter.rs`) reads no block of `M_SD`: its far field
+    // is the assembled grand mobility, or with `Params::pse` the fast product's grand
+    // product (free space's, or PSE's in a box: `near_iter/solve.rs`). PSE's own
+    // refusals (rotation, the solvers that read blocks) are the box's checks'.
     if p.matrix_free {
-        return check_iterative(p);
+        return Ok(());
     }
     if p.place().cell().is_some() && p.pse.is_some() {
         return refuse(
@@ -77,21 +81,6 @@ pub(super) fn check<T: Real>(p: &Params<T>, n: usize, thermal: bool) -> Result<(
     if thermal && p.lanczos_noise(n) {
         return refuse(
             "the near field with Lanczos noise (noise_sqrt = Cholesky, or Auto up to LANCZOS_CROSSOVER beads)",
-        );
-    }
-    Ok(())
-}
-
-/// The iterative near field's refusals ([`Params::matrix_free`], `near_iter.rs`): what
-/// needs `M_SD`'s blocks or a product the iterative path does not have. Its far field
-/// is the assembled grand mobility, or in free space with [`Params::pse`] the fast
-/// free-space product's grand product (`near_iter/solve.rs`); PSE in a box has no
-/// grand product.
-fn check_iterative<T: Real>(p: &Params<T>) -> Result<(), StepError> {
-    let refuse = |what| Err(StepError::Unsupported(what));
-    if p.pse.is_some() && p.place().cell().is_some() {
-        return refuse(
-            "the iterative near field with PSE in a box: its far field needs the grand mobility's rotation products (pse = None)",
         );
     }
     Ok(())
@@ -211,7 +200,7 @@ pub(super) fn keep_spin<T: Real>(n: usize, store: &mut Store<'_, T>) {
 /// (`ew`: the box's Ewald sums).
 #[cfg(feature = "near")]
 pub(super) fn far<'a, T: Real>(p: &Params<T>, ew: Sums<'a, T>) -> Result<Far<'a, T>, StepError> {
-    // `check` has refused PSE, so a box summed for RPY holds Ewald's parameters.
+    // A box summed by PSE (the iterative near field's) is a far field without blocks.
     Far::at(p.place(), ew).ok_or(StepError::Unsupported(
         "the near field in a box without the Ewald sums",
     ))

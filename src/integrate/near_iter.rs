@@ -3,13 +3,12 @@
 //! needs is one product `(U, W) = M_SD (F, 0)` of [`crate::stokesian::iterative`]
 //! (Woodbury's identity, conjugate gradients over the close pairs), whose far field is
 //! the grand mobility (`tri(2n)` blocks) assembled once at that configuration and
-//! applied about twenty times: the box has no matrix-free product of the rotation
-//! blocks the near field couples to, and one assembly (each pair's four blocks in one
+//! applied about twenty times: one assembly (each pair's four blocks in one
 //! pass of the Ewald sums, 1.6 to 1.9 times the RPY step's `mu_tt` assembly) with cheap
-//! products costs less than twenty matrix-free products (`docs/NEAR.md`). In free space
-//! with [`Params::pse`] the far field is instead the fast free-space product's grand
-//! product, matrix-free, and no `tri(2n)` blocks are stored (`near_iter/solve.rs`, where
-//! the far field is chosen).
+//! products costs less than twenty matrix-free Ewald products (`docs/NEAR.md`). With
+//! [`Params::pse`] the far field is instead a fast product's grand product, matrix-free
+//! (free space's fast product, or PSE's in a box), and no `tri(2n)` blocks are stored
+//! (`near_iter/solve.rs`, where the far field is chosen).
 //!
 //! Served: `Overdamped` (one product, at the start) and `Overdamped2` (two, at the
 //! start and at the predicted point), and `Overdamped` with thermal noise

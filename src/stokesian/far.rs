@@ -51,11 +51,18 @@ impl<'a, T: Real> Far<'a, T> {
 
     /// The far field of a step at `place` ([`Params::place`](crate::Params::place))
     /// with its sums: `None` where the place's box has none (sums the step never
-    /// derived) or they have no blocks to assemble (PSE's, products only).
+    /// derived). A box summed by PSE (products only, no blocks) is a far field without
+    /// sums: the near field's pair corrections read only the box's cell, the minimum
+    /// image and RPY's pair blocks, and its grand mobility is PSE's product
+    /// (`integrate/near_iter/solve.rs`); [`Far::assemble_grand`] refuses it.
     pub fn at(place: Place<T>, sums: Sums<'a, T>) -> Option<Self> {
+        let given = sums.is_some();
         let sums: BlockSums<'a, T> = sums.and_then(|s| s.try_into().ok());
-        let summed = place.summed_cell(Hydro::Rpy).is_some() == sums.is_some();
-        summed.then_some(Self { place, sums })
+        let ok = match place.summed_cell(Hydro::Rpy) {
+            Some(_) => given,
+            None => sums.is_none(),
+        };
+        ok.then_some(Self { place, sums })
     }
 
     /// The wall's height, where there is one.
@@ -92,8 +99,9 @@ impl<'a, T: Real> Far<'a, T> {
     }
 
     /// The RPY grand mobility of the spheres, packed as `assemble_grand` stores it: the
-    /// geometry's own. A geometry the kernel was built without is refused
-    /// ([`SdError::Params`]), not taken for free space.
+    /// geometry's own. A geometry the kernel was built without, or a box without the
+    /// Ewald sums' blocks (PSE's, [`Far::at`]), is refused ([`SdError::Params`]), not
+    /// taken for free space.
     pub fn assemble_grand(
         self,
         eta: T,
@@ -102,7 +110,8 @@ impl<'a, T: Real> Far<'a, T> {
         packed: &mut [T::M3],
     ) -> Result<(), SdError> {
         let p = self.place;
-        if p.wall() != p.step_wall() || p.cell() != p.step_cell() {
+        let unsummed = p.summed_cell(Hydro::Rpy).is_some() && self.sums.is_none();
+        if p.wall() != p.step_wall() || p.cell() != p.step_cell() || unsummed {
             return Err(SdError::Params);
         }
         let geometry = Hydrodynamics::at(p, Hydro::Rpy, eta, self.sums.map(Into::into));

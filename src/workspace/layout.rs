@@ -49,15 +49,13 @@ pub(crate) const fn near_iterative<T: Real>(p: &Params<T>) -> bool {
 
 /// Whether the iterative near field's far field is a matrix-free grand product (the
 /// fast free-space product's: [`Params::pse`] in free space, kernel feature
-/// `fast-free`), so that no packed grand mobility is stored
-/// (`integrate::near_iter::solve`).
+/// `fast-free`; PSE's in a box, feature `pse`), so that no packed grand mobility is
+/// stored (`integrate::near_iter::solve`).
 pub(crate) const fn near_far_product<T: Real>(p: &Params<T>) -> bool {
     let place = p.place();
-    cfg!(feature = "fast-free")
-        && near_iterative(p)
-        && p.pse.is_some()
-        && place.cell().is_none()
-        && place.surfaces().is_empty()
+    let boxed = place.cell().is_some();
+    let fast = (boxed && cfg!(feature = "pse")) || (!boxed && cfg!(feature = "fast-free"));
+    fast && near_iterative(p) && p.pse.is_some() && place.surfaces().is_empty()
 }
 
 /// Scalars one close pair of the iterative near field takes: its factor, its

@@ -289,7 +289,8 @@ fn fast_products_overdamped2_allocate_nothing() {
 /// The iterative near field (`Params::near` with `Params::matrix_free`) with bonds: in
 /// `Overdamped2` (Krylov, with contacts, Newton) and at temperature, no heap; and on
 /// the fast free-space product's grand product (`Params::pse` in free space, the fast
-/// arrays the caller's) in `Overdamped`, `Overdamped2` and at temperature.
+/// arrays the caller's) and on PSE's in a box, in `Overdamped`, `Overdamped2` and at
+/// temperature.
 #[cfg(feature = "near")]
 #[test]
 fn iterative_near_field_with_bonds_allocates_nothing() {
@@ -340,16 +341,56 @@ fn iterative_near_field_with_bonds_allocates_nothing() {
         let mut ps = init.clone();
         // The generator a thermal step draws from (the others ignore it).
         ps.noise = thermal.then(|| hydrorattle::Noise::new(3));
-        let (res, n) = count(|| {
-            for _ in 0..2 {
-                step(&mut ps, &bonds, &p, &mut ws, &mut NoForce)?;
-            }
-            Ok::<_, StepError>(())
-        });
         let tag =
             format!("{method:?}, {kind:?}, contacts {contacts}, thermal {thermal}, fast {fast:?}");
-        res.unwrap_or_else(|e| panic!("{tag}: {e}"));
-        assert_eq!(n, 0, "{tag}: {n} allocator calls in 2 steps");
+        two_steps_allocate_nothing(&mut ps, &bonds, &p, &mut ws, &tag);
         assert!(ps.time > init.time, "{tag}");
     }
+    // On PSE's grand product in a box (PSE's arrays the caller's, sized by
+    // `pse_storage` for the grand product).
+    #[cfg(feature = "pse")]
+    for (method, thermal) in [
+        (Method::Overdamped, false),
+        (Method::Overdamped2, false),
+        (Method::Overdamped, true),
+    ] {
+        let mut p = Params::new(0.01);
+        p.method = method;
+        p.solver.kind = SolverKind::Krylov;
+        p.rotation = true;
+        p.matrix_free = true;
+        p.pse = Some(1e-4);
+        p.periodic = Some(hydrorattle::Periodic::new([64.0; 3]).unwrap());
+        p.near = Some(hydrorattle::stokesian::NearField::default());
+        p.brownian = thermal.then(|| hydrorattle::Brownian::new(1e-3));
+        let layout = hydrorattle::Layout::for_params(&p, N, B);
+        let mut store = hydrorattle_heap::Buffers::<f64>::new(layout);
+        let size = hydrorattle::integrate::pse_storage(&p, &init.radius[..N]).unwrap();
+        let mut arrays = hydrorattle_heap::PseBuffers::<f64>::for_step(size);
+        let mut ws = arrays.attach(store.workspace());
+        let mut ps = init.clone();
+        ps.noise = thermal.then(|| hydrorattle::Noise::new(3));
+        let tag = format!("PSE in a box, {method:?}, thermal {thermal}");
+        two_steps_allocate_nothing(&mut ps, &bonds, &p, &mut ws, &tag);
+        assert!(ps.time > init.time, "{tag}");
+    }
+}
+
+/// Two steps of `ps` under `p` succeed without an allocator call (`tag` names them).
+#[cfg(feature = "near")]
+fn two_steps_allocate_nothing<const N: usize, const B: usize>(
+    ps: &mut ParticleSet<f64, N>,
+    bonds: &BondSet<f64, B>,
+    p: &Params<f64>,
+    ws: &mut hydrorattle::Workspace<'_, f64>,
+    tag: &str,
+) {
+    let (res, n) = count(|| {
+        for _ in 0..2 {
+            step(ps, bonds, p, ws, &mut NoForce)?;
+        }
+        Ok::<_, StepError>(())
+    });
+    res.unwrap_or_else(|e| panic!("{tag}: {e}"));
+    assert_eq!(n, 0, "{tag}: {n} allocator calls in 2 steps");
 }

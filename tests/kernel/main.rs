@@ -69,6 +69,8 @@ mod near_fast;
 #[cfg(all(feature = "near", feature = "periodic"))]
 mod near_iter;
 mod near_iter_brownian;
+#[cfg(all(feature = "near", feature = "pse"))]
+mod near_pse;
 #[cfg(feature = "near")]
 mod near_step;
 mod observables;

@@ -22,7 +22,7 @@ use common::*;
 use hydrorattle::integrate::{fast_storage, fast_vectors};
 use hydrorattle::stokesian::NearField;
 use hydrorattle::{
-    Bond, BondSet, Brownian, Contacts, Layout, Method, NoForce, Noise, ParticleSet, Periodic, Real,
+    Bond, BondSet, Brownian, Contacts, Layout, Method, NoForce, Noise, ParticleSet, Real,
     SolverKind, StepError, StepReport, step,
 };
 use hydrorattle_heap::{Buffers, FreeBuffers};
@@ -232,7 +232,7 @@ fn storage_is_linear<T: Real>() {
 
 /// What stays refused on the fast far field, typed, the state unchanged: the sweep
 /// with bonds (it tabulates along products the fast product's checks do not admit:
-/// Krylov serves them), and PSE in a box (no grand product there).
+/// Krylov serves them). PSE's grand product in a box is served (`near_pse.rs`).
 fn refusals<T: Real>() {
     let spheres = cluster(12, 21, None, [0.0; 3]);
     let bond = Bond {
@@ -245,13 +245,6 @@ fn refusals<T: Real>() {
     match one_step::<T>(&p, &spheres, &[bond], None) {
         Err(StepError::Unsupported(m)) => assert!(m.contains("Sweep"), "{m}"),
         other => panic!("sweep: {other:?}"),
-    }
-    let mut p = near::<T>(Method::Overdamped, Some(1e-4));
-    p.rotation = false;
-    p.periodic = Some(Periodic::new([T::from_f64(60.0); 3]).unwrap());
-    match one_step::<T>(&p, &spheres, &[], None) {
-        Err(StepError::Unsupported(m)) => assert!(m.contains("PSE"), "{m}"),
-        other => panic!("PSE in a box: {other:?}"),
     }
 }
 

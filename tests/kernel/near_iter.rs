@@ -239,20 +239,14 @@ fn same_bits<T: Real>() {
     assert_eq!(run(), run());
 }
 
-/// Refused, typed, the state unchanged: what the iterative path does not serve (PSE in
-/// a box;
-/// the wall's hydrodynamics, refused before, now stepped), the conjugate gradients
+/// Refused, typed, the state unchanged: what the iterative path does not serve (the
+/// wall's hydrodynamics, refused before, now stepped; PSE's far field, free space's and
+/// the box's: `near_fast.rs`, `near_pse.rs`), the conjugate gradients
 /// stopped before they converge, and more close pairs than the storage holds (its
 /// Brownian steps: `near_iter_brownian.rs`).
 fn refusals<T: Real>() {
     let spheres = cluster(20, 21, None, [0.0; 3]);
     let base = near::<T>(Method::Overdamped, true, None);
-    let unsupported = |p: &hydrorattle::Params<T>, bonds: &[Bond<T>], what: &str| match one_step::<T>(
-        p, &spheres, bonds,
-    ) {
-        Err(StepError::Unsupported(m)) => assert!(m.contains(what), "{m}"),
-        other => panic!("{what}: {other:?}"),
-    };
     let bond = Bond {
         i: 0,
         j: 1,
@@ -273,12 +267,6 @@ fn refusals<T: Real>() {
     p.wall = Some(Wall::new(T::from_f64(-40.0)));
     let (r, _) = one_step::<T>(&p, &spheres, &[]).unwrap();
     assert!(r.near_products >= 1, "{r:?}");
-    // PSE in a box (free space's fast product is served: `near_fast.rs`).
-    let mut p = base;
-    p.pse = Some(1e-3);
-    p.periodic = Some(Periodic::new([T::from_f64(60.0); 3]).unwrap());
-    p.rotation = false;
-    unsupported(&p, &[], "PSE");
     // One iteration cannot solve twenty coupled spheres.
     let mut p = base;
     p.solver.max_iterations = 1;

@@ -268,13 +268,7 @@ impl<T: Real> FastProduct<T> for FastStep<'_, T> {
         let mut store = self.store.try_borrow_mut().map_err(|_| {
             StepError::Unsupported("a fast free-space product inside another (storage in use)")
         })?;
-        let n = spheres.0.len();
-        let (Some((f, t)), Some((u, w))) = (
-            ft.get(..2 * n).map(|v| v.split_at(n)),
-            out.get_mut(..2 * n).map(|v| v.split_at_mut(n)),
-        ) else {
-            return Err(StepError::StateLength);
-        };
+        let ((f, t), (u, w)) = crate::geometry::fast::grand_halves::<T>(spheres.0.len(), ft, out)?;
         let fast = self.covering(spheres.0, spheres.1)?;
         Ok(fast.apply_grand(eta, spheres, f, t, u, w, &mut store)?)
     }

@@ -116,13 +116,18 @@ mod fast {
     }
 
     /// The PSE storage a step of these spheres in `cell` with the tolerance `tol` needs,
-    /// from the same parameters the step derives (`integrate::pse_storage`).
+    /// from the same parameters the step derives (`integrate::pse_storage`): the grand
+    /// product's where `grand` (the iterative near field's far field).
     pub(crate) fn pse_size<T: Real>(
         cell: Periodic<T>,
         radius: &[T],
-        tol: f64,
+        (tol, grand): (f64, bool),
     ) -> Result<PseSize, StepError> {
-        Ok(pse(cell, radius, tol)?.storage(radius.len()))
+        let pse = pse(cell, radius, tol)?;
+        Ok(match grand {
+            true => pse.storage_grand(radius.len()),
+            false => pse.storage(radius.len()),
+        })
     }
 
     /// The caller's fast arrays as the step's storage, after checking them against the

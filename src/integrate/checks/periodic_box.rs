@@ -131,6 +131,12 @@ fn pse_sums<T: Real>(
         ));
     }
     let rotation = "PSE with rotation (its rt and rr products are not built: Ewald sums them)";
+    // With the iterative near field the spins are its own, from PSE's grand product
+    // (`integrate/near_iter/solve.rs`): rotation is served there.
+    let p = &Params {
+        rotation: p.rotation && !(p.near_on() && p.matrix_free),
+        ..*p
+    };
     products_only(p, state.len(), bonds, (PSE_ASSEMBLED, rotation))?;
     #[cfg(feature = "pse")]
     return Ok(Some(crate::geometry::Held::pse(c, state.radius, tol)?));

@@ -6,15 +6,14 @@
 //! **The far field** ([`FarField`], chosen in [`far_field`], the one place a far field is
 //! picked): the grand mobility assembled into the store's packed blocks (`tri(2n)`,
 //! Ewald's sums in a box, the wall's images above it, free space's RPY), or, with the
-//! fast free-space product ([`Params::pse`] in free space), its matrix-free grand
-//! product (`FastProduct::grand`, `O(n log n)` a product, no `tri(2n)` storage). A box
-//! with a grand product of its own (PSE's) would be a third case in [`far_field`], its
-//! products the same variant.
+//! fast product ([`Params::pse`]: free space's fast product, or PSE's in a box), its
+//! matrix-free grand product (`FastProduct::grand`, `O(n log n)` a product, no `tri(2n)`
+//! storage).
 
 use super::{Counts, STORAGE, Store, error, tri2};
 use crate::constraints::Metric;
 use crate::error::StepError;
-#[cfg(feature = "fast-free")]
+#[cfg(feature = "pse")]
 use crate::geometry::fast::FastProduct;
 use crate::linalg::{Mob, tri};
 use crate::parallel::Parallel;
@@ -31,7 +30,7 @@ pub(super) enum FarField<'s, T: Real> {
     /// The packed grand mobility assembled at the configuration (`tri(2n)` blocks).
     Packed(&'s [T::M3]),
     /// A matrix-free grand product at the configuration's spheres (viscosity `eta`).
-    #[cfg(feature = "fast-free")]
+    #[cfg(feature = "pse")]
     Product {
         /// The step's fast product.
         fast: &'s dyn FastProduct<T>,
@@ -50,7 +49,7 @@ impl<T: Real> FarField<'_, T> {
                 packed_product::<T>(packed, n, x, y);
                 Ok(())
             }
-            #[cfg(feature = "fast-free")]
+            #[cfg(feature = "pse")]
             Self::Product { fast, spheres, eta } => {
                 fast.grand(eta, spheres, x, y).map_err(SdError::Far)
             }
@@ -68,18 +67,16 @@ pub(super) struct At<'s, T: Real> {
 }
 
 /// The far field at `(pos, radius)` ([`FarField`]): the step's fast product's grand
-/// product where the step has one in free space, else the grand mobility assembled into
-/// the store's packed blocks.
+/// product where the step has one (free space's, or PSE's in a box), else the grand
+/// mobility assembled into the store's packed blocks.
 fn far_field<'s, T: Real>(
     p: &Params<T>,
     ew: Sums<'s, T>,
     (pos, radius): (&'s [T::V3], &'s [T]),
     packed: &'s mut [T::M3],
 ) -> Result<FarField<'s, T>, StepError> {
-    #[cfg(feature = "fast-free")]
-    if let Some(fast) = ew.and_then(|s| s.pse())
-        && p.place().cell().is_none()
-    {
+    #[cfg(feature = "pse")]
+    if let Some(fast) = ew.and_then(|s| s.pse()) {
         let spheres = (pos, radius);
         let eta = p.viscosity;
         return Ok(FarField::Product { fast, spheres, eta });
@@ -209,7 +206,8 @@ impl<'s, T: Real> At<'s, T> {
 /// The constraint solve's entries (its band preconditioner, its curvature bound) from
 /// the far field's `mu_tt` at `spheres`: the packed grand mobility's first `n` block rows,
 /// or, where the far field is a product, each pair block evaluated where it is read (free
-/// space's RPY blocks, which the fast product approximates).
+/// space's RPY blocks, which the fast product approximates; in PSE's box they miss the
+/// images, which slows the solve and leaves where it ends: its moves are `M_SD`'s).
 pub(super) fn far_metric<'a, T: Real>(
     far: FarField<'a, T>,
     spheres: (&'a [T::V3], &'a [T]),
@@ -224,12 +222,9 @@ pub(super) fn far_metric<'a, T: Real>(
             par,
             compact: None,
         },
-        #[cfg(feature = "fast-free")]
+        #[cfg(feature = "pse")]
         FarField::Product { eta, .. } => Metric::Free {
-            hydro: crate::geometry::Hydrodynamics::Free(crate::geometry::free::Free::new(
-                crate::mobility::Hydro::Rpy,
-                eta,
-            )),
+            hydro: crate::geometry::Hydrodynamics::free_space(crate::mobility::Hydro::Rpy, eta),
             pos: spheres.0,
             radius: spheres.1,
             grad,
