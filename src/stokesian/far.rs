@@ -57,6 +57,8 @@ impl<'a, T: Real> Far<'a, T> {
     /// (`integrate/near_iter/solve.rs`); [`Far::assemble_grand`] refuses it.
     pub fn at(place: Place<T>, sums: Sums<'a, T>) -> Option<Self> {
         let given = sums.is_some();
+        // Without the `periodic` feature both sums are the same empty type.
+        #[allow(clippy::useless_conversion)]
         let sums: BlockSums<'a, T> = sums.and_then(|s| s.try_into().ok());
         let ok = match place.summed_cell(Hydro::Rpy) {
             Some(_) => given,
@@ -114,6 +116,8 @@ impl<'a, T: Real> Far<'a, T> {
         if p.wall() != p.step_wall() || p.cell() != p.step_cell() || unsummed {
             return Err(SdError::Params);
         }
+        // Without the `periodic` feature both sums are the same empty type.
+        #[allow(clippy::useless_conversion)]
         let geometry = Hydrodynamics::at(p, Hydro::Rpy, eta, self.sums.map(Into::into));
         geometry
             .assemble_grand(pos, radius, packed)

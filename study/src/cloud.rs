@@ -200,6 +200,19 @@ pub fn axis_ratio(
     thickness: f64,
     r_max: f64,
 ) -> Option<f64> {
+    ring_ratio(&axis_rings(positions, core, width, thickness, r_max))
+}
+
+/// The spheres in each ring of [`axis_ratio`]'s slab (the first about the axis):
+/// rings from several frames add up, and [`ring_ratio`] of their sum is the criterion
+/// with the counting noise of one frame divided by their number.
+pub fn axis_rings(
+    positions: &[[f64; 3]],
+    core: &Core,
+    width: f64,
+    thickness: f64,
+    r_max: f64,
+) -> Vec<usize> {
     let nr = (r_max / width).ceil().max(1.0) as usize;
     let map = axis_map(
         positions,
@@ -208,8 +221,31 @@ pub fn axis_ratio(
         (nr as f64 * width, 0.5 * thickness),
         (nr, 1),
     );
-    let peak = map.peak();
-    (peak > 0.0).then(|| map.density[0] / peak)
+    map.count
+}
+
+/// [`axis_ratio`] from ring counts ([`axis_rings`], maybe summed over frames): ring
+/// `k`'s area grows as `2 k + 1`; `None` when every ring is empty.
+pub fn ring_ratio(rings: &[usize]) -> Option<f64> {
+    let density = |k: usize| rings[k] as f64 / (2 * k + 1) as f64;
+    let peak = (0..rings.len()).map(density).fold(0.0, f64::max);
+    (peak > 0.0).then(|| density(0) / peak)
+}
+
+/// How flat the core is: `sqrt(2) z_rms / r_rms` over its spheres, `z` measured from
+/// its centre's height and `r` from its vertical axis. 1 for a uniform ball and `C / A`
+/// for a uniform spheroid of vertical semi-axis `C` and horizontal `A`; a thin torus of
+/// tube radius `b` and major radius `R_t` about `b / (sqrt(2) R_t)`. `None` for an
+/// empty core.
+pub fn flatness(positions: &[[f64; 3]], core: &Core, reach: f64) -> Option<f64> {
+    let c = core.centre;
+    let (mut zz, mut rr, mut n) = (0.0, 0.0, 0usize);
+    for p in positions.iter().filter(|p| (p[2] - c[2]).abs() <= reach) {
+        zz += (p[2] - c[2]).powi(2);
+        rr += (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
+        n += 1;
+    }
+    (n > 0 && rr > 0.0).then(|| (2.0 * zz / rr).sqrt())
 }
 
 /// The positions within `half_width` of the vertical plane through the core's centre

@@ -1,9 +1,12 @@
 //! The falling cloud's analysis (`hydrorattle_study::cloud`) on synthetic clouds whose
 //! answer is known in closed form: a uniform ball (flat density `N / (4/3 pi R^3)`, no
 //! hole on the axis), a solid torus (no sphere within `R_t - a_t` of the axis), a ball
-//! with a tail of known size above it, and a rigid motion plus a known radial flow.
+//! with a tail of known size above it, a rigid motion plus a known radial flow, and the
+//! flatness of a ball, a spheroid and a torus (their second moments in closed form).
 
-use hydrorattle_study::cloud::{axis_map, axis_ratio, axis_slice, ball_radius, core};
+use hydrorattle_study::cloud::{
+    axis_map, axis_ratio, axis_rings, axis_slice, ball_radius, core, flatness, ring_ratio,
+};
 
 /// A small deterministic generator (xorshift64*), uniform in `[0, 1)`.
 struct Rng(u64);
@@ -150,4 +153,55 @@ fn velocities_are_taken_in_the_cores_frame() {
             );
         }
     }
+}
+
+/// `sqrt(2) z_rms / r_rms` in closed form: 1 for a ball, `C / A` for a spheroid (a ball
+/// squashed along `z`), `sqrt(2 (b^2 / 4) / (R_t^2 + 3 b^2 / 4))` for a solid torus
+/// (its moments by Pappus: `<z^2> = b^2 / 4`, `<r^2> = R_t^2 + 3 b^2 / 4`).
+#[test]
+fn flatness_is_one_for_a_ball_and_the_axes_ratio_for_a_spheroid() {
+    let r = 10.0;
+    let pts = ball(&mut Rng(5), 100_000, r, [0.0, 0.0, 0.0]);
+    let c = core(&pts, &[], r);
+    let ball_f = flatness(&pts, &c, 1.5 * r).unwrap();
+    // Second moments of 10^5 points scatter by about 0.3 %.
+    assert!((ball_f - 1.0).abs() < 0.01, "ball {ball_f}");
+    let squashed: Vec<[f64; 3]> = pts.iter().map(|p| [p[0], p[1], 0.4 * p[2]]).collect();
+    let c = core(&squashed, &[], r);
+    let f = flatness(&squashed, &c, 1.5 * r).unwrap();
+    assert!((f / ball_f - 0.4).abs() < 1e-12, "spheroid {f}");
+    let (big, tube) = (6.0, 2.5);
+    let pts = torus(&mut Rng(13), 100_000, big, tube, [1.0, 2.0, 3.0]);
+    let c = core(&pts, &[], big + tube);
+    let want = (2.0 * tube * tube / 4.0 / (big * big + 0.75 * tube * tube)).sqrt();
+    let got = flatness(&pts, &c, big + tube).unwrap();
+    assert!(
+        (got / want - 1.0).abs() < 0.01,
+        "torus {got} against {want}"
+    );
+    assert_eq!(flatness(&[], &c, 1.0), None);
+}
+
+/// Ring counts add over frames, and their ratio weighs each ring by its area.
+#[test]
+fn ring_counts_pool_over_frames() {
+    assert_eq!(ring_ratio(&[3, 9, 5]), Some(1.0));
+    assert_eq!(ring_ratio(&[0, 3, 10]), Some(0.0));
+    assert_eq!(ring_ratio(&[0, 0]), None);
+    let r = 10.0;
+    let a = ball(&mut Rng(21), 20_000, r, [0.0; 3]);
+    let b = ball(&mut Rng(22), 20_000, r, [0.0; 3]);
+    let (ca, cb) = (core(&a, &[], r), core(&b, &[], r));
+    let (ra, rb) = (
+        axis_rings(&a, &ca, 2.0, 4.0, 8.0),
+        axis_rings(&b, &cb, 2.0, 4.0, 8.0),
+    );
+    assert_eq!(ring_ratio(&ra), axis_ratio(&a, &ca, 2.0, 4.0, 8.0));
+    let both: Vec<usize> = ra.iter().zip(&rb).map(|(x, y)| x + y).collect();
+    assert_eq!(
+        both.iter().sum::<usize>(),
+        ra.iter().sum::<usize>() + rb.iter().sum::<usize>()
+    );
+    // The pooled ball still has no hole.
+    assert!(ring_ratio(&both).unwrap() > 0.85);
 }
