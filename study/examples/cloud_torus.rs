@@ -1,10 +1,10 @@
 //! A falling cloud's run turned into its measures and pictures: for each frame of the
-//! run's `trajectory.xyz` (or of the `trajectory.xyz.tmp` of a run still going or
-//! stopped, its last whole frame), the core's fall speed, the fraction of spheres leaked
-//! into the tail, the torus criterion (the density on the axis in the core's mid-plane
-//! over the densest ring's: about 1 for a ball, 0 for a torus), that criterion with the
-//! rings of the nine frames about it pooled, and the core's flatness (1 for a ball,
-//! about 0.3 for a thin torus); and, for the
+//! run's `trajectory.xyz` (or of the `trajectory.xyz.tmp` of a run still going, resumed
+//! or stopped, where it is the newer: its last whole frame), the core's fall speed, the
+//! fraction of spheres leaked into the tail, the torus criterion (the density on the
+//! axis in the core's mid-plane over the densest ring's: about 1 for a ball, 0 for a
+//! torus), that criterion with the rings of the nine frames about it pooled, and the
+//! core's flatness (1 for a ball, about 0.3 for a thin torus); and, for the
 //! times asked, a picture with one row per time: a thin slice through the axis and the
 //! density averaged about the axis in `(r, z)` with the mean velocity in the cloud's
 //! frame (`hydrorattle_study::cloud`, `render::cloud`).
@@ -35,6 +35,8 @@ const POOL: usize = 4;
 /// The pooled criterion below which a cloud counts as a torus (a ball's is about 0.9,
 /// a torus's with a hole wider than the axis ring 0).
 const ONSET: f64 = 0.5;
+/// Frames a run recorded at most (evenly spaced; the onset is recorded besides).
+const RECORDED: usize = 50;
 /// The pooled criterion's name in the records.
 const POOLED: &str = "on-axis density over peak, 9 frames pooled";
 
@@ -52,10 +54,14 @@ fn whole_frames(text: &str) -> Result<Vec<Frame>> {
 }
 
 fn read_frames(dir: &Path) -> Result<Vec<Frame>> {
-    let done = dir.join("trajectory.xyz");
-    let path = match done.exists() {
-        true => done,
-        false => dir.join("trajectory.xyz.tmp"),
+    // A run resumed past its end writes `.tmp` again beside the finished file: the
+    // newer of the two is the run as it stands.
+    let (done, going) = (dir.join("trajectory.xyz"), dir.join("trajectory.xyz.tmp"));
+    let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let path = match (modified(&done), modified(&going)) {
+        (Some(d), Some(g)) if g > d => going,
+        (Some(_), _) => done,
+        _ => going,
     };
     let text =
         std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
@@ -133,6 +139,10 @@ fn main() -> Result<()> {
             "{time},{:.2},{speed:.3},{fallen:.2},{tail:.4},{ratio},{pooled},{flat}",
             c.centre[2]
         );
+        // The records keep about RECORDED frames a run (every frame is printed).
+        if k % frames.len().div_ceil(RECORDED) != 0 {
+            continue;
+        }
         let at = format!("{case}, t = {time}");
         if f.time > 0.0 {
             rec.row(&what, &at, "core fall speed, U0", &format!("{speed:.3}"));
