@@ -113,7 +113,7 @@ fn main() -> Result<()> {
         .collect();
     let show = |r: Option<f64>| r.map_or("".into(), |r| format!("{r:.3}"));
     // The last frame whose pooled criterion is still a ball's (at least ONSET).
-    let (mut ball_until, mut fallen_at) = (None, Vec::with_capacity(frames.len()));
+    let mut ball_until = None;
     for (k, (f, c)) in frames.iter().zip(&cores).enumerate() {
         let tail = c.tail as f64 / n as f64;
         let ratio = show(ring_ratio(&rings[k]));
@@ -131,7 +131,6 @@ fn main() -> Result<()> {
         let pooled = show(pooled);
         let flat = show(flatness(&f.positions, c, CORE_REACH * radius));
         let fallen = (z0 - c.centre[2]) / radius;
-        fallen_at.push(fallen);
         let speed = -c.velocity[2];
         let time = format!("{:.3}", f.time);
         let time = time.trim_end_matches('0').trim_end_matches('.');
@@ -156,7 +155,8 @@ fn main() -> Result<()> {
     let onset = ball_until.map_or(Some(0), |k| (k + 1 < frames.len()).then_some(k + 1));
     match onset {
         Some(k) => {
-            let (t, fallen) = (format!("{:.1}", frames[k].time), fallen_at[k]);
+            let t = format!("{:.1}", frames[k].time);
+            let fallen = (z0 - cores[k].centre[2]) / radius;
             println!(
                 "torus from t = {t} ({fallen:.1} radii fallen): pooled criterion below {ONSET} to the last frame"
             );
@@ -176,11 +176,14 @@ fn main() -> Result<()> {
     let rows: Vec<CloudRow> = times
         .iter()
         .map(|&t| {
-            let f = frames
-                .iter()
-                .min_by(|a, b| (a.time - t).abs().total_cmp(&(b.time - t).abs()))
+            let k = (0..frames.len())
+                .min_by(|&a, &b| {
+                    (frames[a].time - t)
+                        .abs()
+                        .total_cmp(&(frames[b].time - t).abs())
+                })
                 .expect("frames");
-            let c = core(&f.positions, &f.velocities, radius);
+            let (f, c) = (&frames[k], cores[k]);
             let half_width = 0.1 * radius;
             CloudRow {
                 time: f.time,

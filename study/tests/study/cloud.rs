@@ -182,26 +182,45 @@ fn flatness_is_one_for_a_ball_and_the_axes_ratio_for_a_spheroid() {
     assert_eq!(flatness(&[], &c, 1.0), None);
 }
 
-/// Ring counts add over frames, and their ratio weighs each ring by its area.
+/// Ring counts add over frames, and their ratio weighs each ring by its area: each
+/// ring of a uniform ball holds its closed-form share, and a torus's pooled frames keep
+/// their hole.
 #[test]
 fn ring_counts_pool_over_frames() {
     assert_eq!(ring_ratio(&[3, 9, 5]), Some(1.0));
     assert_eq!(ring_ratio(&[0, 3, 10]), Some(0.0));
     assert_eq!(ring_ratio(&[0, 0]), None);
-    let r = 10.0;
-    let a = ball(&mut Rng(21), 20_000, r, [0.0; 3]);
-    let b = ball(&mut Rng(22), 20_000, r, [0.0; 3]);
+    let (n, r, width, slab) = (20_000, 10.0, 2.0, 4.0);
+    let a = ball(&mut Rng(21), n, r, [0.0; 3]);
+    let b = ball(&mut Rng(22), n, r, [0.0; 3]);
     let (ca, cb) = (core(&a, &[], r), core(&b, &[], r));
     let (ra, rb) = (
-        axis_rings(&a, &ca, 2.0, 4.0, 8.0),
-        axis_rings(&b, &cb, 2.0, 4.0, 8.0),
+        axis_rings(&a, &ca, width, slab, 8.0),
+        axis_rings(&b, &cb, width, slab, 8.0),
     );
-    assert_eq!(ring_ratio(&ra), axis_ratio(&a, &ca, 2.0, 4.0, 8.0));
+    // Ring k (inside the ball: sqrt(8^2 + 2^2) < 10) holds rho pi w^2 (2k + 1) slab
+    // spheres on average, rho = n / (4/3 pi r^3); 4 Poisson sigmas of the pooled count.
+    let rho = n as f64 / (4.0 / 3.0 * std::f64::consts::PI * r.powi(3));
+    for (k, (x, y)) in ra.iter().zip(&rb).enumerate() {
+        let mean = rho * std::f64::consts::PI * width * width * (2 * k + 1) as f64 * slab;
+        let pooled = (x + y) as f64;
+        assert!(
+            (pooled - 2.0 * mean).abs() < 4.0 * (2.0 * mean).sqrt(),
+            "ring {k}: {pooled} against {}",
+            2.0 * mean
+        );
+    }
     let both: Vec<usize> = ra.iter().zip(&rb).map(|(x, y)| x + y).collect();
-    assert_eq!(
-        both.iter().sum::<usize>(),
-        ra.iter().sum::<usize>() + rb.iter().sum::<usize>()
-    );
     // The pooled ball still has no hole.
     assert!(ring_ratio(&both).unwrap() > 0.85);
+    // Two frames of a torus (hole of radius 3.5 > 2 rings) pool to an empty axis ring.
+    let t1 = torus(&mut Rng(23), 20_000, 6.0, 2.5, [0.0; 3]);
+    let t2 = torus(&mut Rng(24), 20_000, 6.0, 2.5, [5.0, 0.0, 0.0]);
+    let (c1, c2) = (core(&t1, &[], 8.5), core(&t2, &[], 8.5));
+    let pooled: Vec<usize> = axis_rings(&t1, &c1, 1.5, 2.0, 9.0)
+        .iter()
+        .zip(&axis_rings(&t2, &c2, 1.5, 2.0, 9.0))
+        .map(|(x, y)| x + y)
+        .collect();
+    assert_eq!(ring_ratio(&pooled), Some(0.0));
 }
