@@ -223,16 +223,16 @@ pub fn near_pairs(n: usize, extent: [f64; 3], a_max: f64, r_cut: f64) -> f64 {
 /// product's), as a step derives them from the spheres' bounding box: where the rule's
 /// grid passes its bounds (a long chain), the spreading widened until one fits
 /// (`integrate::fast_parameters`); `None` where the kernel refuses them.
-fn fast_params(s: &Spheres, tolerance: f64, grand: bool) -> Option<FreeFast<f64>> {
+pub(super) fn fast_params(s: &Spheres, tolerance: f64, grand: bool) -> Option<FreeFast<f64>> {
     hydrorattle::integrate::fast_parameters(tolerance, grand, s.a_max, s.extent, s.n).ok()
 }
 
-/// The fast product's work terms for `s` under `ff`: `[1, M log2 M, N + 2 pairs, N P^3]`.
-fn fast_terms(s: &Spheres, ff: &FreeFast<f64>) -> [f64; 4] {
+/// The fast product's work terms for `s` under `ff` with `pairs` pairs within its cutoff:
+/// `[1, M log2 M, N + 2 pairs, N P^3]`.
+fn fast_terms(s: &Spheres, ff: &FreeFast<f64>, pairs: f64) -> [f64; 4] {
     let g = ff.grid();
     let m = (g[0] * g[1] * g[2]) as f64;
     let p3 = (ff.support() as f64).powi(3);
-    let pairs = near_pairs(s.n, s.extent, s.a_max, ff.r_cut());
     let n = s.n as f64;
     [1.0, m * m.log2(), n + 2.0 * pairs, n * p3]
 }
@@ -248,12 +248,22 @@ const FAST: [f64; 4] = [FAST_FIXED, FAST_GRID, FAST_NEAR, FAST_SPREAD];
 const GRAND: [f64; 4] = [GRAND_FIXED, GRAND_GRID, GRAND_NEAR, GRAND_SPREAD];
 
 impl FreeCost {
-    /// The spheres `s` with the fast product at `tolerance`.
+    /// The spheres `s` with the fast product at `tolerance`, its near pairs estimated
+    /// as if spread evenly over their bounding box ([`near_pairs`]).
     pub fn of(s: &Spheres, tolerance: f64) -> FreeCost {
+        FreeCost::counted(s, tolerance, &|r_cut| {
+            near_pairs(s.n, s.extent, s.a_max, r_cut)
+        })
+    }
+
+    /// [`FreeCost::of`] with the fast product's near pairs `pairs(r_cut)` given (a
+    /// count of the spheres as they are, where a run's cloud has left its box's mean).
+    pub fn counted(s: &Spheres, tolerance: f64, pairs: &dyn Fn(f64) -> f64) -> FreeCost {
         let (b, n) = (blocks(s.n), s.n as f64);
-        let fast = fast_params(s, tolerance, false).map(|ff| dot(FAST, fast_terms(s, &ff)));
+        let terms = |ff: &FreeFast<f64>| fast_terms(s, ff, pairs(ff.r_cut()));
+        let fast = fast_params(s, tolerance, false).map(|ff| dot(FAST, terms(&ff)));
         let fast_grand = fast_params(s, tolerance, true).map(|ff| {
-            let x = fast_terms(s, &ff);
+            let x = terms(&ff);
             (dot(FAST, x), dot(GRAND, x))
         });
         FreeCost {
@@ -446,12 +456,22 @@ pub fn choose(
     tolerance: f64,
     limit: usize,
 ) -> Result<(FreeChoice, f64), TooLarge> {
-    let cost = FreeCost::of(s, tolerance);
+    choose_priced(plan, s, &FreeCost::of(s, tolerance), tolerance, limit)
+}
+
+/// [`choose`] with the paths' costs given (the fast product's near pairs counted).
+fn choose_priced(
+    plan: &Plan,
+    s: &Spheres,
+    cost: &FreeCost,
+    tolerance: f64,
+    limit: usize,
+) -> Result<(FreeChoice, f64), TooLarge> {
     // The best under the cap, and the best of all.
     let mut best: [Option<(FreeChoice, f64)>; 2] = [None, None];
     let mut need: Option<usize> = None;
     for choice in CHOICES {
-        let Some(t) = step_cost(plan, s, &cost, choice) else {
+        let Some(t) = step_cost(plan, s, cost, choice) else {
             continue;
         };
         let bytes = storage(plan, s, tolerance, choice);
@@ -478,13 +498,19 @@ pub fn choose(
 
 /// [`choose`] for a free-space `scene` as it will run (its level applied): its plan
 /// ([`Plan::of`]), its spheres ([`Spheres::of`]), the fast product at `tolerance` and
-/// the step storage limit `limit`.
+/// the step storage limit `limit`. The fast product's near pairs are counted from the
+/// spheres' centres ([`count_pairs`](super::free_reweigh::count_pairs)), as the
+/// model's constant was fitted (the even estimate undercounts a ball's).
 pub fn choose_for(
     scene: &super::Scene,
     tolerance: f64,
     limit: usize,
 ) -> Result<(FreeChoice, f64), TooLarge> {
-    choose(&Plan::of(scene), &Spheres::of(scene), tolerance, limit)
+    let s = Spheres::of(scene);
+    let pos: Vec<[f64; 3]> = scene.particles.iter().map(|p| p.position).collect();
+    let count = |r_cut| super::free_reweigh::count_pairs(&pos, r_cut, u64::MAX) as f64;
+    let cost = FreeCost::counted(&s, tolerance, &count);
+    choose_priced(&Plan::of(scene), &s, &cost, tolerance, limit)
 }
 
 impl super::Scene {
@@ -518,6 +544,8 @@ impl super::Scene {
         };
         if let Some(fs) = self.free_space.as_mut() {
             fs.method = method;
+            // Only a run on the fast product weighs it again.
+            fs.reweigh &= method == FreeMethod::Fast;
         }
         self
     }

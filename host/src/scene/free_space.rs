@@ -4,6 +4,7 @@
 //! [free_space]
 //! method = "fast"     # "dense" (default) | "fast" | "auto"
 //! tolerance = 1e-4    # the fast product's relative error (1e-10 to 0.1)
+//! reweigh = true      # weigh the fast product against the pair sums before each step
 //! ```
 //!
 //! The table names how the mobility of spheres in open fluid is applied, as `[box]`
@@ -24,6 +25,14 @@
 //! matrix-free or fast); where `"fast"` cannot run the scene it is `"dense"` at once.
 //! An `"auto"` scene is sized at read time as the fast path would be (the choice then
 //! checks each path's storage before taking it).
+//!
+//! `reweigh` (default `true` under `"auto"`, `false` under `"fast"`): a run on the fast
+//! product weighs it again before every step against the pair sums, on the pairs
+//! counted within its cutoff (`scene::free_reweigh`), and takes the cheaper. A cloud
+//! that leaves a tail stretches the box the fast product is sized from and makes its
+//! near part dearer as the run goes on, while the pair sums cost the same whatever the
+//! shape. The written scene keeps the key, so that a resumed run weighs as the
+//! uninterrupted one did.
 
 use serde::{Deserialize, Serialize};
 use toml::Spanned;
@@ -58,6 +67,9 @@ pub struct FreeSpace {
     pub method: FreeMethod,
     /// The fast product's relative error (`"dense"` ignores it).
     pub tolerance: f64,
+    /// Whether a run on the fast product weighs it against the pair sums before each
+    /// step (`scene::free_reweigh`); only with `"fast"` or `"auto"`.
+    pub reweigh: bool,
 }
 
 impl FreeSpace {
@@ -65,6 +77,12 @@ impl FreeSpace {
     /// resolved): the scene is then sized without the `N^2` mobility.
     pub fn may_be_fast(&self) -> bool {
         matches!(self.method, FreeMethod::Fast | FreeMethod::Auto)
+    }
+
+    /// Whether the run weighs the fast product against the pair sums before each step:
+    /// `reweigh` on `"fast"` (`"auto"` resolved to it).
+    pub fn reweighs(&self) -> bool {
+        self.reweigh && self.method == FreeMethod::Fast
     }
 
     /// The kernel's `Params::pse` for this table: the tolerance when `"fast"`.
@@ -79,6 +97,7 @@ impl FreeSpace {
 pub(super) struct RawFreeSpace {
     method: Option<Spanned<FreeMethod>>,
     tolerance: S<f64>,
+    reweigh: S<bool>,
 }
 
 /// What the rest of the scene says that `"fast"` must agree with.
@@ -130,12 +149,26 @@ pub(super) fn resolve(raw: &Spanned<RawFreeSpace>, cx: &Context<'_>) -> Result<F
     {
         return Err(issue(at, format!("method = \"fast\" {why}")));
     }
+    let reweigh = match (&r.reweigh, method) {
+        (Some(w), FreeMethod::Dense) if *w.get_ref() => {
+            return Err(issue(
+                w.span(),
+                "reweigh weighs the fast product against the pair sums before each step: it needs method = \"fast\" or \"auto\"",
+            ));
+        }
+        (Some(w), _) => *w.get_ref(),
+        (None, m) => m == FreeMethod::Auto,
+    };
     // "auto" where the fast product cannot run: the dense paths, resolved at once.
     let method = match method {
         FreeMethod::Auto if unsupported(cx).is_some() => FreeMethod::Dense,
         m => m,
     };
-    Ok(FreeSpace { method, tolerance })
+    Ok(FreeSpace {
+        method,
+        tolerance,
+        reweigh: reweigh && method != FreeMethod::Dense,
+    })
 }
 
 /// Why `"fast"` cannot run this scene, if it cannot.

@@ -23,7 +23,7 @@
 //! | `[brownian]` | `temperature` (kT, >= 0; > 0 needs `method = "overdamped"`, `"springs"` or `"rattle-stable"`, level manual), `seed` (>= 0), `drift = "midpoint"\|"uncorrected"` | 0, 1, midpoint |
 //! | `[wall]` | `height` (required, finite): a no-slip plane `z = height` below every sphere (`method = "overdamped"` or `"overdamped2"`, level manual; see [`Wall`]) | no wall |
 //! | `[slit]` | `floor`, `ceiling` (required, finite, the ceiling above the floor): two no-slip planes around every sphere, their mobility by superposition (`method = "overdamped"` or `"overdamped2"`, level manual, no `[wall]`, `[box]` or `[near_field]`; see [`Slit`], `docs/GEOMETRY.md`) | no slit |
-//! | `[free_space]` | `method = "dense"\|"fast"\|"auto"`, `tolerance` (`1e-10` to `0.1`): how the mobility in open fluid is applied; `"fast"` is the `O(N log N)` product; `"auto"` the path a measured cost model picks when the run starts (`free_cost`) (overdamped, overdamped2 or springs, level manual, RPY, no wall, box or near field; its run is matrix-free; see [`FreeSpace`]) | dense, 1e-4 |
+//! | `[free_space]` | `method = "dense"\|"fast"\|"auto"`, `tolerance` (`1e-10` to `0.1`): how the mobility in open fluid is applied; `"fast"` is the `O(N log N)` product; `"auto"` the path a measured cost model picks when the run starts (`free_cost`); `reweigh`: on the fast product, weigh it against the pair sums before every step (`free_reweigh`; default on under `"auto"`) (overdamped, overdamped2 or springs, level manual, RPY, no wall, box or near field; its run is matrix-free; see [`FreeSpace`]) | dense, 1e-4 |
 //! | `[box]` | `size = [Lx, Ly, Lz]` (required unless `[suspension]` sets it; finite, > 0), `method = "ewald"\|"pse"\|"auto"`, `tolerance` (`1e-12` to `0.1`): a periodic box (see [`PeriodicBox`]) | no box; auto, 1e-6 |
 //! | `[suspension]` | `count` (required, >= 1), `fraction` (required, `0 < phi <=` [`MAX_FRACTION`]), `radius`, `polydispersity` (`0 <= p < 1`), `density`, `seed`: spheres placed at random in a cubic box (see [`Suspension`]) | 1, 0, 4.5, 1 |
 //! | `[cloud]` | `count` (required, >= 1), `cloud_radius` (required, > 0), `radius`, `polydispersity` (`0 <= p < 1`), `density`, `centre = [x, y, z]`, `seed`: spheres placed at random, without overlap, in a ball in open fluid (see [`Cloud`]) | 1, 0, 4.5, origin, 1 |
@@ -70,6 +70,9 @@ pub mod free_noise;
 mod free_noise_tests;
 #[cfg(test)]
 mod free_pick_tests;
+pub mod free_reweigh;
+#[cfg(test)]
+mod free_reweigh_tests;
 mod free_space;
 mod helix;
 mod kernel;

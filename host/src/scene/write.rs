@@ -117,10 +117,14 @@ impl Scene {
             t.insert("near_field".into(), nt);
         }
         if let Some(f) = self.free_space {
-            let ft = table([
+            let mut ft = table([
                 ("method", value(f.method)),
                 ("tolerance", value(f.tolerance)),
             ]);
+            // Written where it is on: the scenes before the key read the same.
+            if let (Value::Table(m), true) = (&mut ft, f.reweigh) {
+                m.insert("reweigh".into(), value(true));
+            }
             t.insert("free_space".into(), ft);
         }
         if let Some(b) = self.periodic {

@@ -63,6 +63,9 @@ pub struct Checkpoint {
     /// Steps retried split so far (Brownian runs).
     #[serde(default)]
     pub retries: super::retry::Retries,
+    /// With `[free_space] reweigh`: the steps taken on the pair sums so far.
+    #[serde(default)]
+    pub pair_steps: u64,
     /// With a wall: the landing time so far (`f64` bits; absent: not landed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub landing: Option<u64>,
@@ -137,6 +140,7 @@ impl Checkpoint {
             last,
             noise: None,
             retries: super::retry::Retries::default(),
+            pair_steps: 0,
             landing: None,
             lanczos: None,
             last_step: None,

@@ -15,6 +15,8 @@ use hydrorattle_parallel::Threads;
 use super::lanczos::LanczosTally;
 use super::retry::{self, Retries};
 use super::{Beads, BuildError, bonds, params};
+use crate::scene::free_cost::FreeChoice;
+use crate::scene::free_reweigh::Reweigh;
 use crate::scene::{DEFAULT_SEED, Overlap, Scene};
 use crate::sizing::{Plan, TooLarge};
 
@@ -60,6 +62,13 @@ pub struct Engine<T: Real> {
     /// complex values and indices, with rotation the spins' vectors in its vectors);
     /// empty otherwise.
     fast: Vec<T>,
+    /// With `[free_space] reweigh` on the fast product: the weighing made before each
+    /// step, and the pair sums' parameters it takes where they are cheaper.
+    reweigh: Option<(Reweigh, Params<T>)>,
+    /// Steps taken on the pair sums in place of the fast product ([`Reweigh`]).
+    pub pair_steps: u64,
+    /// Whether the last step weighed took the pair sums (for the log of each change).
+    on_pairs: bool,
 }
 
 impl<T: Real> Engine<T> {
@@ -82,7 +91,34 @@ impl<T: Real> Engine<T> {
         let mut e = Self::with_layout(beads, bonds, p, noise, contact, layout, limit)?;
         hydrorattle::bonds::validate(&pins, n)?;
         e.pins = pins;
+        if scene.free_space.is_some_and(|f| f.reweighs()) {
+            e.reweighing();
+        }
         Ok(e)
+    }
+
+    /// Weighs the fast product against the pair sums before each step
+    /// ([`Reweigh`]). Nothing where the step does not take the fast product, or where
+    /// the storage does not hold the pair sums' step.
+    pub(super) fn reweighing(&mut self) {
+        let (n, b) = (self.beads.len(), self.bonds.len() + self.pins.len());
+        let Some(w) = Reweigh::new(&self.params, b) else {
+            return;
+        };
+        // The pair sums: no fast product, the constraints by the solver it resolved.
+        let mut pairs = self.params;
+        pairs.pse = None;
+        pairs.solver.kind = self.params.solver_kind(n, b);
+        let need = Layout::for_params(&pairs, n, b);
+        if self.store.workspace().capacity().holds(&need) {
+            self.reweigh = Some((w, pairs));
+        }
+    }
+
+    /// Whether the system weighs the fast product against the pair sums before each
+    /// step ([`Reweigh`]).
+    pub fn reweighs(&self) -> bool {
+        self.reweigh.is_some()
     }
 
     /// A system from its parts (checked by the caller), with storage sized by the
@@ -200,6 +236,9 @@ impl<T: Real> Engine<T> {
                 vec![T::V3_ZERO; pse.vectors],
             ),
             fast: vec![T::ZERO; fast],
+            reweigh: None,
+            pair_steps: 0,
+            on_pairs: false,
         })
     }
 
@@ -250,6 +289,17 @@ impl<T: Real> Engine<T> {
     /// A failed step leaves the state and the noise generator as they were.
     pub fn step_with(&mut self, extra: Extra<'_, T>) -> Result<StepReport<T>, StepError> {
         let contact = self.contact;
+        // The path of this step, weighed on the spheres as they start it.
+        let pairs = self.reweigh.as_ref().and_then(|(w, pairs)| {
+            let choice = w.choose(&self.beads.pos, &self.beads.radius);
+            (choice == FreeChoice::MatrixFree).then_some(*pairs)
+        });
+        if self.reweigh.is_some() && pairs.is_some() != self.on_pairs {
+            self.on_pairs = pairs.is_some();
+            let path = ["the fast product", "the pair sums"][usize::from(self.on_pairs)];
+            log::info!("t = {:?}: stepping on {path}", self.beads.time.to_f64());
+        }
+        let params = pairs.unwrap_or(self.params);
         let mut ext = |pos: &[T::V3], radius: &[T], force: &mut [T::V3]| {
             if let Some(mut c) = contact {
                 c.add(pos, radius, force);
@@ -277,7 +327,7 @@ impl<T: Real> Engine<T> {
         let report = retry::step(
             &mut self.beads,
             rows,
-            &self.params,
+            &params,
             &mut ws,
             &mut ext,
             &mut self.noise,
@@ -291,6 +341,7 @@ impl<T: Real> Engine<T> {
         self.multipliers.clear();
         self.multipliers
             .extend_from_slice(ws.multipliers(rows.len()));
+        self.pair_steps += u64::from(pairs.is_some());
         Ok(report)
     }
 

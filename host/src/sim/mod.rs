@@ -124,6 +124,10 @@ pub struct Summary {
     /// step (absent for a run without noise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise_iterations: Option<NoiseIterations>,
+    /// With `[free_space] reweigh`: the steps taken on the pair sums in place of the
+    /// fast product (`scene::free_reweigh`); absent for a run that does not weigh.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pair_sum_steps: Option<u64>,
     /// With a wall: the landing time, the end of the first step after which a sphere
     /// is held on the wall (`StepReport::wall_contacts > 0`: the first contact);
     /// `None` without a wall or before any sphere touches it.
@@ -170,6 +174,7 @@ impl Summary {
             failure: None,
             retries: retry::Retries::default(),
             noise_iterations: None,
+            pair_sum_steps: None,
             landing_time: None,
             level_choice: None,
             resolved_scene: scene.clone(),

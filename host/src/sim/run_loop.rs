@@ -63,6 +63,7 @@ pub(super) fn run_t<T: Real>(
             None => {}
         }
         engine.retries = c.retries;
+        engine.pair_steps = c.pair_steps;
         engine.lanczos = c.lanczos.unwrap_or_default();
     }
     let mut lock = None;

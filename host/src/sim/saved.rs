@@ -90,6 +90,19 @@ pub struct Saved {
     lanczos: LanczosTally,
     multipliers: Vec<u64>,
     threads: usize,
+    /// Whether the system weighs the fast product against the pair sums before each
+    /// step ([`Engine::reweighs`]); absent where it does not (and in systems saved
+    /// before the key).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    reweigh: bool,
+    /// Steps taken on the pair sums by a system that weighs (absent: none).
+    #[serde(default, skip_serializing_if = "none")]
+    pair_steps: u64,
+}
+
+/// Whether a count is zero (left out of the record).
+fn none(k: &u64) -> bool {
+    *k == 0
 }
 
 fn b<T: Real>(x: T) -> u64 {
@@ -235,6 +248,8 @@ impl<T: Real> Engine<T> {
             lanczos: self.lanczos,
             multipliers: s(&self.multipliers),
             threads: self.threads.as_ref().map_or(1, |t| t.threads()),
+            reweigh: self.reweighs(),
+            pair_steps: self.pair_steps,
         }
     }
 
@@ -308,6 +323,10 @@ impl<T: Real> Engine<T> {
         e.retries = s.retries;
         e.lanczos = s.lanczos;
         e.multipliers = s.multipliers.iter().map(|&x| f(x)).collect();
+        if s.reweigh {
+            e.reweighing();
+        }
+        e.pair_steps = s.pair_steps;
         e.with_threads(s.threads).map_err(|e| e.to_string())
     }
 }

@@ -11,6 +11,7 @@ mod box_sweep;
 mod cloud;
 mod falling_cloud;
 mod free_auto;
+mod free_reweigh;
 mod free_space_scene;
 mod fuzz_scene;
 mod geometries;

@@ -36,6 +36,7 @@ impl<T: Real> Tracks<'_, '_, T> {
             c.retries = engine.retries;
             c.lanczos = Some(engine.lanczos);
         }
+        c.pair_steps = engine.pair_steps;
         c.landing = self.landing.map(|t| t.to_f64().to_bits());
         c.last_step = Some(StepSolve {
             iterations: self.solve.0,
@@ -130,6 +131,7 @@ impl<T: Real> Tracks<'_, '_, T> {
             front,
             failure,
             retries: engine.retries,
+            pair_sum_steps: engine.reweighs().then_some(engine.pair_steps),
             noise_iterations: self
                 .thermal()
                 .then(|| engine.lanczos.record(&engine.params, beads.len())),

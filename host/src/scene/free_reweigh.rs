@@ -1,0 +1,232 @@
+//! Free space's `auto` over a whole run: the fast product weighed against the pair sums
+//! before every step, on the cloud as it is (`[free_space] reweigh`).
+//!
+//! The cost model ([`free_cost`](super::free_cost)) prices the fast product from the
+//! spheres' bounding box, as if they filled it evenly. That holds for the cloud a run
+//! starts from, and fails for one that leaves a tail: the tail stretches the box, the
+//! fast product's spreading width grows with the box's mean spacing, and the pairs
+//! within its cutoff in the dense core grow with the box's volume (a falling cloud of
+//! 10^4 spheres, 100 times as tall after 180 time units, runs its fast product 11 times
+//! slower than the pair sums). The pair sums' cost depends on the number of spheres
+//! alone. So before each step a run that reweighs **counts** the pairs within the
+//! fast product's cutoff ([`count_pairs`], on a cell list, stopping at the count where the
+//! two paths tie) and takes the pair sums where the fast product's modelled time, with
+//! that count, passes theirs.
+//!
+//! The model's near-pair constant was fitted against counted pairs
+//! (`examples/free_cost.rs` counts them), so the count enters it as it is, as it does
+//! in `auto`'s first choice ([`choose_for`](super::free_cost::choose_for)); the even
+//! estimate undercounts a ball's pairs (a ball fills `pi / 6` of its box: 0.64 of the
+//! count on the shipped 10^4-sphere cloud). Measured frame by frame on a falling cloud
+//! (`study/examples/reweigh_frames.rs`), a step's time grows by the fitted constant per
+//! counted pair.
+//!
+//! The choice is a function of the positions alone: the same bits on any number of
+//! threads, and a run resumed from a checkpoint chooses as the uninterrupted run did.
+
+use std::collections::HashMap;
+
+use hydrorattle::{Params, Real};
+
+use super::free_cost::{FreeChoice, FreeCost, Spheres, fast_params, step_cost, within_cap};
+use super::sizing::Plan;
+use super::{Contact, Precision, Thermal};
+
+/// Pairs of `pos` closer than `r_cut`, counted up to `cap` (a count at `cap` means at
+/// least `cap`), on a cell list of cells `r_cut` wide. The count does not depend on the
+/// order of the cells visited.
+pub fn count_pairs(pos: &[[f64; 3]], r_cut: f64, cap: u64) -> u64 {
+    if !(r_cut > 0.0 && r_cut.is_finite()) || pos.len() < 2 || cap == 0 {
+        return 0;
+    }
+    let cell = |p: &[f64; 3]| p.map(|x| (x / r_cut).floor() as i64);
+    let mut cells: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (i, p) in pos.iter().enumerate() {
+        cells.entry(cell(p)).or_default().push(i);
+    }
+    let r2 = r_cut * r_cut;
+    let mut count = 0u64;
+    for (i, p) in pos.iter().enumerate() {
+        let c = cell(p);
+        for d in 0..27 {
+            let k = [c[0] + d / 9 - 1, c[1] + (d / 3) % 3 - 1, c[2] + d % 3 - 1];
+            let Some(js) = cells.get(&k) else { continue };
+            for &j in js.iter().filter(|&&j| j > i) {
+                let q = pos[j];
+                let r = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum::<f64>();
+                if r < r2 {
+                    count += 1;
+                    if count >= cap {
+                        return cap;
+                    }
+                }
+            }
+        }
+    }
+    count
+}
+
+/// The spheres at `pos` (largest radius `a_max`) with `bonds` constraint rows.
+fn spheres(pos: &[[f64; 3]], a_max: f64, bonds: usize) -> Spheres {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in pos {
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    Spheres {
+        n: pos.len(),
+        bonds,
+        extent: [0, 1, 2].map(|c| (hi[c] - lo[c]).max(0.0)),
+        a_max,
+        rpy: true,
+    }
+}
+
+/// The cost model's plan of a fast free-space step with parameters `p`.
+fn plan_of<T: Real>(p: &Params<T>) -> Plan {
+    let mut plan = Plan::free(p.method, p.solver.kind);
+    plan.rotation = p.rotation;
+    plan.precision = match core::mem::size_of::<T>() {
+        4 => Precision::F32,
+        _ => Precision::F64,
+    };
+    plan.contact = p.contacts.map(|c| Contact::Hard {
+        capacity: Some(c.capacity),
+    });
+    plan.brownian = p.brownian.map(|b| Thermal {
+        temperature: b.temperature.to_f64(),
+        seed: 0,
+        drift: b.drift,
+        sqrt: p.noise_sqrt,
+    });
+    plan.matrix_free = true;
+    plan.fast = true;
+    plan
+}
+
+/// The positions as `f64` and their largest radius.
+fn widened<T: Real>(pos: &[T::V3], radius: &[T]) -> (Vec<[f64; 3]>, f64) {
+    let a_max = radius.iter().fold(0.0f64, |m, a| m.max(a.to_f64()));
+    (pos.iter().map(|&p| T::v3_to_f64(p)).collect(), a_max)
+}
+
+/// The weighing a run makes before each step (module documentation).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reweigh {
+    plan: Plan,
+    bonds: usize,
+    tolerance: f64,
+}
+
+impl Reweigh {
+    /// The weighing for steps with parameters `p` (the fast product's: [`Params::pse`]
+    /// in free space) with `bonds` constraint rows; `None` where the step does not take
+    /// the fast product, or takes it as the near field's far field (weighed by neither
+    /// path).
+    pub fn new<T: Real>(p: &Params<T>, bonds: usize) -> Option<Self> {
+        let place = p.place();
+        let free = place.cell().is_none() && place.surfaces().is_empty();
+        let takes = free && p.near.is_none() && p.hydro == hydrorattle::Hydro::Rpy;
+        let tolerance = p.pse.filter(|_| takes)?;
+        Some(Reweigh {
+            plan: plan_of(p),
+            bonds,
+            tolerance,
+        })
+    }
+
+    /// The path for a step from the spheres at `pos` with radii `radius`: the pair sums
+    /// ([`FreeChoice::MatrixFree`]) where the fast product's modelled time with the
+    /// pairs counted now passes theirs (and their noise stays within the Lanczos cap),
+    /// else [`FreeChoice::Fast`].
+    pub fn choose<T: Real>(&self, pos: &[T::V3], radius: &[T]) -> FreeChoice {
+        let (pos, a_max) = widened::<T>(pos, radius);
+        let w = match self.weights(&pos, a_max) {
+            Weights::Sums => return FreeChoice::MatrixFree,
+            Weights::Fast => return FreeChoice::Fast,
+            Weights::Linear(w) => w,
+        };
+        if w.t0 >= w.sums {
+            return FreeChoice::MatrixFree;
+        }
+        // The pairs at the tie: a count that reaches them needs go no further.
+        let tie = (w.sums - w.t0) / w.slope;
+        let cap = tie.max(0.0).ceil();
+        let cap = if cap >= u64::MAX as f64 {
+            u64::MAX
+        } else {
+            cap as u64
+        };
+        match count_pairs(&pos, w.r_cut, cap) >= cap {
+            true => FreeChoice::MatrixFree,
+            false => FreeChoice::Fast,
+        }
+    }
+
+    /// The modelled seconds of a step from the spheres at `pos` (radii `radius`) on
+    /// the fast product, with every pair within its cutoff counted, and on the pair
+    /// sums: what [`Reweigh::choose`] compares (it stops counting at the tie). `None`
+    /// where one of the two is not weighed (the kernel refuses the fast parameters, or
+    /// the pair sums cannot run the step).
+    pub fn modelled<T: Real>(&self, pos: &[T::V3], radius: &[T]) -> Option<[f64; 2]> {
+        let (pos, a_max) = widened::<T>(pos, radius);
+        let Weights::Linear(w) = self.weights(&pos, a_max) else {
+            return None;
+        };
+        let pairs = count_pairs(&pos, w.r_cut, u64::MAX) as f64;
+        Some([w.t0 + w.slope * pairs, w.sums])
+    }
+
+    /// The step's modelled times as functions of the fast product's near pairs.
+    fn weights(&self, pos: &[[f64; 3]], a_max: f64) -> Weights {
+        let s = spheres(pos, a_max, self.bonds);
+        let plan = &self.plan;
+        let even = FreeCost::of(&s, self.tolerance);
+        let Some(sums) = step_cost(plan, &s, &even, FreeChoice::MatrixFree)
+            .filter(|_| within_cap(plan, &s, FreeChoice::MatrixFree))
+        else {
+            return Weights::Fast;
+        };
+        // The fast step's time is linear in the modelled pairs: its value at none and
+        // its slope give the tie.
+        let fast = |x: f64| {
+            let c = FreeCost::counted(&s, self.tolerance, &|_| x);
+            step_cost(plan, &s, &c, FreeChoice::Fast)
+        };
+        match (
+            fast(0.0),
+            fast(1e6),
+            fast_params(&s, self.tolerance, plan.rotation),
+        ) {
+            (Some(t0), Some(t1), Some(ff)) if t1 > t0 => Weights::Linear(Linear {
+                sums,
+                t0,
+                slope: (t1 - t0) / 1e6,
+                r_cut: ff.r_cut(),
+            }),
+            // The kernel refuses the fast parameters here: the pair sums run.
+            _ => Weights::Sums,
+        }
+    }
+}
+
+/// What a step weighs ([`Reweigh::choose`]).
+enum Weights {
+    /// The pair sums, whatever the count (the fast product cannot run).
+    Sums,
+    /// The fast product, whatever the count (the pair sums cannot run).
+    Fast,
+    /// The fast product's time linear in its near pairs against the pair sums'.
+    Linear(Linear),
+}
+
+/// A step's modelled seconds: the pair sums', and the fast product's `t0 + slope
+/// pairs` with its cutoff `r_cut`.
+struct Linear {
+    sums: f64,
+    t0: f64,
+    slope: f64,
+    r_cut: f64,
+}
