@@ -16,7 +16,9 @@
 //!   and `pairs` the pairs within the cutoff, all from the parameters a step derives
 //!   (`integrate::fast_parameters`: `FreeFast::new`'s rule over the padded box, the
 //!   spreading widened where its grid passes the bounds, as along a long chain); the
-//!   pairs estimated from the spheres' bounding box.
+//!   pairs counted, as the constants were fitted (a run's choice, [`choose_for`], and
+//!   its weighing before each step, `free_reweigh`), or estimated from the spheres'
+//!   bounding box where there are no positions ([`choose`], [`near_pairs`]).
 //!
 //! * rotation: the pair paths' spins, one pass of the pairs' rotation blocks a step
 //!   (`SPIN_BLOCK` a packed block); the inertial method's grand assembly

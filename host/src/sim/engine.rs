@@ -64,7 +64,7 @@ pub struct Engine<T: Real> {
     fast: Vec<T>,
     /// With `[free_space] reweigh` on the fast product: the weighing made before each
     /// step, and the pair sums' parameters it takes where they are cheaper.
-    reweigh: Option<(Reweigh, Params<T>)>,
+    reweigh: Option<Box<(Reweigh, Params<T>)>>,
     /// Steps taken on the pair sums in place of the fast product ([`Reweigh`]).
     pub pair_steps: u64,
     /// Whether the last step weighed took the pair sums (for the log of each change).
@@ -111,7 +111,7 @@ impl<T: Real> Engine<T> {
         pairs.solver.kind = self.params.solver_kind(n, b);
         let need = Layout::for_params(&pairs, n, b);
         if self.store.workspace().capacity().holds(&need) {
-            self.reweigh = Some((w, pairs));
+            self.reweigh = Some(Box::new((w, pairs)));
         }
     }
 
@@ -290,7 +290,7 @@ impl<T: Real> Engine<T> {
     pub fn step_with(&mut self, extra: Extra<'_, T>) -> Result<StepReport<T>, StepError> {
         let contact = self.contact;
         // The path of this step, weighed on the spheres as they start it.
-        let pairs = self.reweigh.as_ref().and_then(|(w, pairs)| {
+        let pairs = self.reweigh.as_deref().and_then(|(w, pairs)| {
             let choice = w.choose(&self.beads.pos, &self.beads.radius);
             (choice == FreeChoice::MatrixFree).then_some(*pairs)
         });
