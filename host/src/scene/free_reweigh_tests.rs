@@ -7,26 +7,13 @@ use hydrorattle::{Method, Params, Real};
 use super::free_cost::FreeChoice;
 use super::free_reweigh::{Reweigh, count_pairs};
 
-/// A generator of uniform numbers in `[0, 1)` (the same draws on every machine).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// `n` points uniform in a ball of radius `r` about the origin (unit spheres, their
 /// overlaps not removed: the weighing reads the centres only).
 fn ball(n: usize, r: f64, seed: u64) -> Vec<[f64; 3]> {
-    let mut g = Lcg(seed);
+    let mut g = hydrorattle::Noise::new(seed);
     let mut out = Vec::with_capacity(n);
     while out.len() < n {
-        let p = [0; 3].map(|_| r * (2.0 * g.next() - 1.0));
+        let p = [0; 3].map(|_| r * (2.0 * g.uniform() - 1.0));
         if p.iter().map(|x| x * x).sum::<f64>() <= r * r {
             out.push(p);
         }

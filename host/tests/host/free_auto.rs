@@ -120,6 +120,21 @@ fn compact_kept(text: &str, name: &str) -> bool {
     params::<f64>(&run).compact_copy(s.n, s.bonds)
 }
 
+/// The rows of `bench/results/NAME.csv` whose case names a scene and a path
+/// (`"scene, path"`), with them.
+fn scene_rows(name: &str) -> Vec<(String, String, Vec<String>)> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let csv = std::fs::read_to_string(root.join(format!("bench/results/{name}.csv"))).unwrap();
+    csv.lines()
+        .skip(1)
+        .map(hydrorattle_host::output::csv_fields)
+        .filter_map(|row| {
+            let (scene, path) = row[6].split_once(", ")?;
+            Some((scene.to_string(), path.to_string(), row.clone()))
+        })
+        .collect()
+}
+
 /// Every shipped scene that can run more than one way runs under `auto` within a fifth
 /// of its fastest explicit path, as measured (`bench/results/free_scenes.csv`, written
 /// by `bench/free_scenes.py`: CPU seconds a step of short `host-demo run`s under each
@@ -130,21 +145,13 @@ fn compact_kept(text: &str, name: &str) -> bool {
 #[test]
 fn auto_is_within_a_fifth_of_the_best() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let csv = std::fs::read_to_string(root.join("bench/results/free_scenes.csv")).unwrap();
     // The last recorded seconds a step of each (scene, path).
     let mut times = BTreeMap::<String, BTreeMap<String, f64>>::new();
-    for row in csv
-        .lines()
-        .skip(1)
-        .map(hydrorattle_host::output::csv_fields)
-    {
-        let Some((scene, path)) = row[6].split_once(", ") else {
-            continue;
-        };
+    for (scene, path, row) in scene_rows("free_scenes") {
         if row[7] != "seconds a step" || path == "auto" {
             continue;
         }
-        let paths = times.entry(scene.to_string()).or_default();
+        let paths = times.entry(scene).or_default();
         // A run stopped at the script's limit is slower than every one that finished.
         let t = match row[8].parse::<f64>() {
             Ok(t) => Some(t),
@@ -152,8 +159,8 @@ fn auto_is_within_a_fifth_of_the_best() {
             Err(_) => None,
         };
         match t {
-            Some(t) => paths.insert(path.to_string(), t),
-            None => paths.remove(path),
+            Some(t) => paths.insert(path.clone(), t),
+            None => paths.remove(&path),
         };
     }
     let mut checked = Vec::new();
@@ -220,27 +227,18 @@ fn auto_is_within_a_fifth_of_the_best() {
 /// a fifth of the fastest explicit path's.
 #[test]
 fn auto_is_within_a_fifth_of_the_best_over_whole_runs() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let csv = std::fs::read_to_string(root.join("bench/results/whole_runs.csv")).unwrap();
     // Per scene: the last commit's CPU seconds by path.
     let mut runs = BTreeMap::<String, (String, BTreeMap<String, f64>)>::new();
-    for row in csv
-        .lines()
-        .skip(1)
-        .map(hydrorattle_host::output::csv_fields)
-    {
-        let Some((scene, path)) = row[6].split_once(", ") else {
-            continue;
-        };
+    for (scene, path, row) in scene_rows("whole_runs") {
         if !row[7].starts_with("CPU seconds") {
             continue;
         }
-        let (commit, times) = runs.entry(scene.to_string()).or_default();
+        let (commit, times) = runs.entry(scene).or_default();
         if *commit != row[1] {
             *commit = row[1].clone();
             times.clear();
         }
-        times.insert(path.to_string(), row[8].parse().unwrap());
+        times.insert(path, row[8].parse().unwrap());
     }
     assert!(runs.contains_key("cloud"), "{runs:?}");
     for (scene, (commit, times)) in &runs {
