@@ -3,7 +3,8 @@
 //! the fast product (its near pairs counted) and on the pair sums, the path the
 //! weighing takes, and the measured seconds of one step on each path from that frame
 //! (the second of two steps: the first may compute the fast product's kernel
-//! transform again, which a run pays only when its rounded box changes).
+//! transform again, which a run pays only when its rounded box changes), and the
+//! seconds of the weighing itself.
 //!
 //! ```text
 //! cargo run --release -p hydrorattle-study --example reweigh_frames -- RUN_DIR SCENE.toml [EVERY]
@@ -82,7 +83,9 @@ fn main() -> Result<()> {
     let n = fast.beads.len();
     let what =
         format!("frames of a falling cloud of {n} spheres ({scene}), seconds a step, one thread");
-    println!("time,box_height,modelled_fast,modelled_sums,choice,measured_fast,measured_sums");
+    println!(
+        "time,box_height,modelled_fast,modelled_sums,choice,weighing,measured_fast,measured_sums"
+    );
     for f in frames.iter().step_by(every.max(1)) {
         let pos = &f.positions;
         let radius = vec![1.0; pos.len()];
@@ -90,18 +93,24 @@ fn main() -> Result<()> {
         let [mf, ms] = weigh
             .modelled::<f64>(&v, &radius)
             .ok_or_else(|| anyhow!("not weighed"))?;
+        let clock = Instant::now();
         let choice = format!("{:?}", weigh.choose::<f64>(&v, &radius));
+        let weighing = clock.elapsed().as_secs_f64();
         let height = pos.iter().map(|p| p[2]).fold(f64::MIN, f64::max)
             - pos.iter().map(|p| p[2]).fold(f64::MAX, f64::min);
         let (tf, ts) = (timed(&mut fast, pos)?, timed(&mut sums, pos)?);
-        println!(
-            "{},{height:.0},{mf:.3},{ms:.3},{choice},{tf:.3},{ts:.3}",
-            f.time
-        );
-        let case = format!("t = {}, box height {height:.0}", f.time);
+        let t = f.time;
+        println!("{t:.1},{height:.0},{mf:.3},{ms:.3},{choice},{weighing:.4},{tf:.3},{ts:.3}");
+        let case = format!("t = {t:.1}, box height {height:.0}");
         rec.row(&what, &case, "modelled fast", &format!("{mf:.3}"));
         rec.row(&what, &case, "modelled pair sums", &format!("{ms:.3}"));
         rec.row(&what, &case, "weighing takes", &choice);
+        rec.row(
+            &what,
+            &case,
+            "seconds of the weighing",
+            &format!("{weighing:.4}"),
+        );
         rec.row(&what, &case, "measured fast", &format!("{tf:.3}"));
         rec.row(&what, &case, "measured pair sums", &format!("{ts:.3}"));
     }

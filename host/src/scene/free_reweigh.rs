@@ -32,38 +32,59 @@ use super::free_cost::{FreeChoice, FreeCost, Spheres, fast_params, step_cost, wi
 use super::sizing::Plan;
 use super::{Contact, Precision, Thermal};
 
-/// Pairs of `pos` closer than `r_cut`, counted up to `cap` (a count at `cap` means at
-/// least `cap`), on a cell list of cells `r_cut` wide. The count does not depend on the
-/// order of the cells visited.
+/// Spheres whose neighbours [`count_pairs`] counts one by one at most; past them it
+/// counts those of every `ceil(N / SAMPLED)`-th sphere (by index) and scales the sum:
+/// a few per cent off the whole count on a cloud, for a few milliseconds a step at
+/// 10^5 spheres (a cost model needs no more).
+pub const SAMPLED: usize = 2048;
+
+/// Pairs of `pos` closer than `r_cut`, on a cell list of cells `r_cut` wide: exactly up
+/// to [`SAMPLED`] spheres, else estimated from the neighbours of every
+/// `ceil(N / SAMPLED)`-th sphere; counted up to `cap` (a count at `cap` means at least
+/// `cap`). Neither depends on the order of the cells visited.
 pub fn count_pairs(pos: &[[f64; 3]], r_cut: f64, cap: u64) -> u64 {
-    if !(r_cut > 0.0 && r_cut.is_finite()) || pos.len() < 2 || cap == 0 {
+    let n = pos.len();
+    if !(r_cut > 0.0 && r_cut.is_finite()) || n < 2 || cap == 0 {
         return 0;
     }
+    // Far cells saturate and wrap: that only adds candidates, checked by distance.
     let cell = |p: &[f64; 3]| p.map(|x| (x / r_cut).floor() as i64);
     let mut cells: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
     for (i, p) in pos.iter().enumerate() {
         cells.entry(cell(p)).or_default().push(i);
     }
+    let stride = n.div_ceil(SAMPLED);
+    let samples = n.div_ceil(stride);
+    // Each pair is met from both ends; sampled, each sphere stands for `stride`.
+    let per_neighbour = n as f64 / (2.0 * samples as f64);
     let r2 = r_cut * r_cut;
-    let mut count = 0u64;
-    for (i, p) in pos.iter().enumerate() {
+    let mut met = 0u64;
+    for (i, p) in pos.iter().enumerate().step_by(stride) {
         let c = cell(p);
         for d in 0..27 {
-            let k = [c[0] + d / 9 - 1, c[1] + (d / 3) % 3 - 1, c[2] + d % 3 - 1];
+            let k = [-1, 0, 1];
+            let k = [
+                c[0].wrapping_add(k[d / 9]),
+                c[1].wrapping_add(k[(d / 3) % 3]),
+                c[2].wrapping_add(k[d % 3]),
+            ];
             let Some(js) = cells.get(&k) else { continue };
-            for &j in js.iter().filter(|&&j| j > i) {
+            for &j in js.iter().filter(|&&j| j != i) {
                 let q = pos[j];
                 let r = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum::<f64>();
-                if r < r2 {
-                    count += 1;
-                    if count >= cap {
-                        return cap;
-                    }
-                }
+                met += u64::from(r < r2);
             }
         }
+        if met as f64 * per_neighbour >= cap as f64 {
+            return cap;
+        }
     }
-    count
+    // Exact where every sphere was visited (`met` is then even).
+    match stride {
+        1 => met / 2,
+        _ => (met as f64 * per_neighbour).round() as u64,
+    }
+    .min(cap)
 }
 
 /// The spheres at `pos` (largest radius `a_max`) with `bonds` constraint rows.

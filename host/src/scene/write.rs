@@ -121,9 +121,11 @@ impl Scene {
                 ("method", value(f.method)),
                 ("tolerance", value(f.tolerance)),
             ]);
-            // Written where it is on: the scenes before the key read the same.
-            if let (Value::Table(m), true) = (&mut ft, f.reweigh) {
-                m.insert("reweigh".into(), value(true));
+            // Written where it is on, and under "auto" (whose default is on): the
+            // other scenes read as they did before the key.
+            let auto = f.method == super::FreeMethod::Auto;
+            if let (Value::Table(m), true) = (&mut ft, f.reweigh || auto) {
+                m.insert("reweigh".into(), value(f.reweigh));
             }
             t.insert("free_space".into(), ft);
         }

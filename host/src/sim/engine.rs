@@ -63,8 +63,8 @@ pub struct Engine<T: Real> {
     /// empty otherwise.
     fast: Vec<T>,
     /// With `[free_space] reweigh` on the fast product: the weighing made before each
-    /// step, and the pair sums' parameters it takes where they are cheaper.
-    reweigh: Option<Box<(Reweigh, Params<T>)>>,
+    /// step ([`Engine::pair_params`] where the pair sums are cheaper).
+    reweigh: Option<Box<Reweigh>>,
     /// Steps taken on the pair sums in place of the fast product ([`Reweigh`]).
     pub pair_steps: u64,
     /// Whether the last step weighed took the pair sums (for the log of each change).
@@ -98,21 +98,22 @@ impl<T: Real> Engine<T> {
     }
 
     /// Weighs the fast product against the pair sums before each step
-    /// ([`Reweigh`]). Nothing where the step does not take the fast product, or where
-    /// the storage does not hold the pair sums' step.
+    /// ([`Reweigh`]). Nothing where the step does not take the fast product.
     pub(super) fn reweighing(&mut self) {
+        let b = self.bonds.len() + self.pins.len();
+        self.reweigh = Reweigh::new(&self.params, b).map(Box::new);
+    }
+
+    /// The pair sums' parameters for a step of this system on the fast product: no
+    /// fast product, the constraints by the solver it resolved. The kernel sizes their
+    /// storage as the fast product's (`Layout::for_params` reads neither the product
+    /// nor a solver it does not resolve to), so the system's storage holds them.
+    fn pair_params(&self) -> Params<T> {
         let (n, b) = (self.beads.len(), self.bonds.len() + self.pins.len());
-        let Some(w) = Reweigh::new(&self.params, b) else {
-            return;
-        };
-        // The pair sums: no fast product, the constraints by the solver it resolved.
         let mut pairs = self.params;
         pairs.pse = None;
         pairs.solver.kind = self.params.solver_kind(n, b);
-        let need = Layout::for_params(&pairs, n, b);
-        if self.store.workspace().capacity().holds(&need) {
-            self.reweigh = Some(Box::new((w, pairs)));
-        }
+        pairs
     }
 
     /// Whether the system weighs the fast product against the pair sums before each
@@ -289,17 +290,22 @@ impl<T: Real> Engine<T> {
     /// A failed step leaves the state and the noise generator as they were.
     pub fn step_with(&mut self, extra: Extra<'_, T>) -> Result<StepReport<T>, StepError> {
         let contact = self.contact;
-        // The path of this step, weighed on the spheres as they start it.
-        let pairs = self.reweigh.as_deref().and_then(|(w, pairs)| {
+        // The path of this step, weighed on the spheres as they start it: the pair
+        // sums first where they are cheaper, the fast product after them should the
+        // kernel refuse them (their noise's Lanczos run past its cap, which the model
+        // misjudges on a stretched cloud); a refused step leaves the state as it was.
+        let sums = self.reweigh.as_deref().and_then(|w| {
             let choice = w.choose(&self.beads.pos, &self.beads.radius);
-            (choice == FreeChoice::MatrixFree).then_some(*pairs)
+            (choice == FreeChoice::MatrixFree).then(|| self.pair_params())
         });
-        if self.reweigh.is_some() && pairs.is_some() != self.on_pairs {
-            self.on_pairs = pairs.is_some();
+        if self.reweigh.is_some() && sums.is_some() != self.on_pairs {
+            self.on_pairs = sums.is_some();
             let path = ["the fast product", "the pair sums"][usize::from(self.on_pairs)];
-            log::info!("t = {:?}: stepping on {path}", self.beads.time.to_f64());
+            log::debug!("t = {:?}: stepping on {path}", self.beads.time.to_f64());
         }
-        let params = pairs.unwrap_or(self.params);
+        let tries = [sums, Some(self.params)];
+        let tries = tries.iter().flatten().enumerate();
+        let n_tries = 1 + usize::from(sums.is_some());
         let mut ext = |pos: &[T::V3], radius: &[T], force: &mut [T::V3]| {
             if let Some(mut c) = contact {
                 c.add(pos, radius, force);
@@ -324,24 +330,33 @@ impl<T: Real> Engine<T> {
             true => &self.bonds[..],
             false => &self.rows[..],
         };
-        let report = retry::step(
-            &mut self.beads,
-            rows,
-            &params,
-            &mut ws,
-            &mut ext,
-            &mut self.noise,
-            retry::Counters {
-                retries: &mut self.retries,
-                lanczos: &mut self.lanczos,
-            },
-        )?;
+        let mut done = Err(StepError::BadParameter("no step tried"));
+        let mut on_sums = false;
+        for (k, params) in tries {
+            done = retry::step(
+                &mut self.beads,
+                rows,
+                params,
+                &mut ws,
+                &mut ext,
+                &mut self.noise,
+                retry::Counters {
+                    retries: &mut self.retries,
+                    lanczos: &mut self.lanczos,
+                },
+            );
+            on_sums = k + 1 < n_tries;
+            if done.is_ok() {
+                break;
+            }
+        }
+        let report = done?;
         // The multipliers are the workspace's until the next step, which may fail and
         // leave them partial: keep the accepted step's.
         self.multipliers.clear();
         self.multipliers
             .extend_from_slice(ws.multipliers(rows.len()));
-        self.pair_steps += u64::from(pairs.is_some());
+        self.pair_steps += u64::from(on_sums);
         Ok(report)
     }
 

@@ -79,6 +79,12 @@ fn the_key_is_read_written_and_refused_on_dense() {
     assert!(f.reweigh && f.method == FreeMethod::Fast && f.reweighs());
     let again = Scene::parse(&on.to_toml(), "again.toml").unwrap();
     assert_eq!(again.free_space, on.free_space);
+    // "auto" without the weighing keeps it off when written and read back (a sweep's
+    // frozen point is checked by its written scene).
+    let off = fs("method = \"auto\"\nreweigh = false").unwrap();
+    let again = Scene::parse(&off.to_toml(), "again.toml").unwrap();
+    assert_eq!(again.free_space, off.free_space);
+    assert!(!again.free_space.unwrap().reweigh);
     let err = fs("method = \"dense\"\nreweigh = true")
         .unwrap_err()
         .to_string();
@@ -87,4 +93,45 @@ fn the_key_is_read_written_and_refused_on_dense() {
     let two = fs("method = \"auto\"").unwrap();
     let run = resolve_level(&two, "s").0;
     assert!(!run.free_space.unwrap().reweigh);
+}
+
+/// A Brownian step the pair sums cannot take (their Lanczos run, with the midpoint's
+/// inverse root, past the cap) is taken on the fast product instead, bit for bit as a
+/// system on the fast product alone takes it; where both run, the pair sums.
+#[test]
+fn a_step_the_pair_sums_cannot_take_falls_back_to_the_fast_product() {
+    let text = |reweigh: bool| {
+        format!(
+            "[cloud]\ncount = 500\ncloud_radius = 23.2\nseed = 2\n\n\
+             [free_space]\nmethod = \"fast\"\nreweigh = {reweigh}\n\n\
+             [brownian]\ntemperature = 1.0\nseed = 5\n\n\
+             [integrator]\nmethod = \"overdamped\"\ndt = 0.05\nduration = 0.05\n"
+        )
+    };
+    let build = |reweigh: bool| {
+        let scene = Scene::parse(&text(reweigh), "b.toml").unwrap();
+        let scene = resolve_level(&scene, "b").0;
+        Engine::<f64>::new(&scene, DEFAULT_LIMIT).unwrap()
+    };
+    let (mut weighed, mut fast) = (build(true), build(false));
+    assert!(weighed.reweighs());
+    // 500 spheres: the pair sums are the cheaper, and run.
+    let mut first = weighed.clone();
+    first.step().unwrap();
+    let mut alone = fast.clone();
+    alone.step().unwrap();
+    let (sums, root) = (first.lanczos.max, alone.lanczos.max);
+    assert_eq!((first.pair_steps, first.lanczos.capped), (1, 0));
+    assert_ne!(first.beads.pos, alone.beads.pos);
+    // A cap the fast product's root passes and the midpoint's inverse root does not.
+    assert!(sums > root, "{sums} against {root}");
+    for e in [&mut weighed, &mut fast] {
+        e.params.lanczos.max_iterations = root;
+    }
+    weighed.step().unwrap();
+    fast.step().unwrap();
+    assert_eq!(weighed.pair_steps, 0);
+    assert!(weighed.lanczos.capped > 0);
+    assert_eq!(weighed.beads.pos, fast.beads.pos);
+    assert_eq!(weighed.noise.save(), fast.noise.save());
 }
