@@ -16,10 +16,17 @@
 //! The model's near-pair constant was fitted against counted pairs
 //! (`examples/free_cost.rs` counts them), so the count enters it as it is, as it does
 //! in `auto`'s first choice ([`choose_for`](super::free_cost::choose_for)); the even
-//! estimate undercounts a ball's pairs (a ball fills `pi / 6` of its box: 0.64 of the
-//! count on the shipped 10^4-sphere cloud). Measured frame by frame on a falling cloud
-//! (`study/examples/reweigh_frames.rs`), a step's time grows by the fitted constant per
-//! counted pair.
+//! estimate undercounts a ball's pairs (a ball fills `pi / 6` of its box). Measured
+//! frame by frame on a falling cloud (`study/examples/reweigh_frames.rs`), a step's
+//! time grows by the fitted constant per counted pair. Past [`SAMPLED`] spheres the
+//! count is estimated from a fixed sample of them (a few per cent off, a few
+//! milliseconds a step).
+//!
+//! Where the kernel refuses the pair sums' step (a Brownian step whose Lanczos run
+//! passes its cap: the model's iterations read the box, which a tail stretches while
+//! the dense core needs as many as before), the step is taken on the fast product, from
+//! the same state and the same generator: the bits of a system on the fast product
+//! alone.
 //!
 //! The choice is a function of the positions alone: the same bits on any number of
 //! threads, and a run resumed from a checkpoint chooses as the uninterrupted run did.

@@ -242,7 +242,9 @@ fn auto_is_within_a_fifth_of_the_best_over_whole_runs() {
     }
     assert!(runs.contains_key("cloud"), "{runs:?}");
     for (scene, (commit, times)) in &runs {
-        let auto = times[&"auto".to_string()];
+        let auto = *times
+            .get("auto")
+            .unwrap_or_else(|| panic!("{scene} at {commit}: no auto row: {times:?}"));
         let (best, t_best) = times
             .iter()
             .filter(|(p, _)| *p != "auto")
