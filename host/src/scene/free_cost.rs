@@ -152,20 +152,29 @@ impl Spheres {
     /// the bounding box of the centres.
     pub fn of(scene: &super::Scene) -> Spheres {
         let ps = &scene.particles;
+        let pos: Vec<[f64; 3]> = ps.iter().map(|p| p.position).collect();
+        let a_max = ps.iter().fold(0.0, |m: f64, p| m.max(p.radius));
+        let rpy = scene.model.hydrodynamics == super::Hydrodynamics::Rpy;
+        Spheres::at(&pos, a_max, scene.bonds.len() + scene.pinned.len(), rpy)
+    }
+
+    /// The spheres centred at `pos`, of radius up to `a_max`, with `bonds` constraint
+    /// rows (`rpy`: RPY hydrodynamics): the bounding box of the centres.
+    pub fn at(pos: &[[f64; 3]], a_max: f64, bonds: usize, rpy: bool) -> Spheres {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        for p in ps {
+        for p in pos {
             for c in 0..3 {
-                lo[c] = lo[c].min(p.position[c]);
-                hi[c] = hi[c].max(p.position[c]);
+                lo[c] = lo[c].min(p[c]);
+                hi[c] = hi[c].max(p[c]);
             }
         }
         Spheres {
-            n: ps.len(),
-            bonds: scene.bonds.len() + scene.pinned.len(),
+            n: pos.len(),
+            bonds,
             extent: [0, 1, 2].map(|c| (hi[c] - lo[c]).max(0.0)),
-            a_max: ps.iter().fold(0.0, |m: f64, p| m.max(p.radius)),
-            rpy: scene.model.hydrodynamics == super::Hydrodynamics::Rpy,
+            a_max,
+            rpy,
         }
     }
 }

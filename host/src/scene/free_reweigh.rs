@@ -94,24 +94,6 @@ pub fn count_pairs(pos: &[[f64; 3]], r_cut: f64, cap: u64) -> u64 {
     .min(cap)
 }
 
-/// The spheres at `pos` (largest radius `a_max`) with `bonds` constraint rows.
-fn spheres(pos: &[[f64; 3]], a_max: f64, bonds: usize) -> Spheres {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in pos {
-        for c in 0..3 {
-            lo[c] = lo[c].min(p[c]);
-            hi[c] = hi[c].max(p[c]);
-        }
-    }
-    Spheres {
-        n: pos.len(),
-        bonds,
-        extent: [0, 1, 2].map(|c| (hi[c] - lo[c]).max(0.0)),
-        a_max,
-        rpy: true,
-    }
-}
-
 /// The cost model's plan of a fast free-space step with parameters `p`.
 fn plan_of<T: Real>(p: &Params<T>) -> Plan {
     let mut plan = Plan::free(p.method, p.solver.kind);
@@ -209,7 +191,7 @@ impl Reweigh {
 
     /// The step's modelled times as functions of the fast product's near pairs.
     fn weights(&self, pos: &[[f64; 3]], a_max: f64) -> Weights {
-        let s = spheres(pos, a_max, self.bonds);
+        let s = Spheres::at(pos, a_max, self.bonds, true);
         let plan = &self.plan;
         let even = FreeCost::of(&s, self.tolerance);
         let Some(sums) = step_cost(plan, &s, &even, FreeChoice::MatrixFree)

@@ -303,9 +303,6 @@ impl<T: Real> Engine<T> {
             let path = ["the fast product", "the pair sums"][usize::from(self.on_pairs)];
             log::debug!("t = {:?}: stepping on {path}", self.beads.time.to_f64());
         }
-        let tries = [sums, Some(self.params)];
-        let tries = tries.iter().flatten().enumerate();
-        let n_tries = 1 + usize::from(sums.is_some());
         let mut ext = |pos: &[T::V3], radius: &[T], force: &mut [T::V3]| {
             if let Some(mut c) = contact {
                 c.add(pos, radius, force);
@@ -330,10 +327,8 @@ impl<T: Real> Engine<T> {
             true => &self.bonds[..],
             false => &self.rows[..],
         };
-        let mut done = Err(StepError::BadParameter("no step tried"));
-        let mut on_sums = false;
-        for (k, params) in tries {
-            done = retry::step(
+        let mut attempt = |params: &Params<T>| {
+            retry::step(
                 &mut self.beads,
                 rows,
                 params,
@@ -344,13 +339,12 @@ impl<T: Real> Engine<T> {
                     retries: &mut self.retries,
                     lanczos: &mut self.lanczos,
                 },
-            );
-            on_sums = k + 1 < n_tries;
-            if done.is_ok() {
-                break;
-            }
-        }
-        let report = done?;
+            )
+        };
+        let (report, on_sums) = match sums.map(|p| attempt(&p)) {
+            Some(Ok(r)) => (r, true),
+            _ => (attempt(&self.params)?, false),
+        };
         // The multipliers are the workspace's until the next step, which may fail and
         // leave them partial: keep the accepted step's.
         self.multipliers.clear();
